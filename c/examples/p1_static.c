@@ -1,0 +1,118 @@
+/* P1 (mass on a rigid plane, static) through the C API, checked against the closed form of
+ * PROBLEMS.md P1, coded here independently. Also the error exits: one bad argument at a
+ * time, each must return its documented code (as LAPACK's error-exit tests do).
+ * Returns non-zero on any failure, so ctest reports it. */
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+#include "martello.h"
+
+static int failures = 0, checks = 0;
+
+static void expect_close(const char *what, double got, double want, double rtol) {
+  double err = fabs(got - want);
+  checks++;
+  if (!(err <= rtol * fabs(want))) {
+    failures++;
+    printf("FAIL %s: got %.17g want %.17g (rel err %.3g > %.1g)\n", what, got, want,
+           err / fabs(want), rtol);
+  }
+}
+
+static void expect_status(const char *what, int got, int want) {
+  checks++;
+  if (got != want) {
+    failures++;
+    printf("FAIL %s: status %s, expected %s\n", what, martello_status_name(got),
+           martello_status_name(want));
+  }
+}
+
+/* Build P1: m = 1, k = 100, h = 0.05, g = 9.81, with the given scheme and ε. */
+static martello_model *p1(int scheme, double eps) {
+  martello_model *m = NULL;
+  double lp[MARTELLO_NPAR_LINK] = {0}, cp[MARTELLO_NPAR_CONTACT] = {0};
+  lp[MARTELLO_L_STIFF] = 100.0;
+  cp[MARTELLO_P_STIFF] = eps;
+  cp[MARTELLO_P_EXPONENT] = 1.0;
+  cp[MARTELLO_P_RESTITUTION] = -1.0;
+  if (martello_model_create(1, 1, 1, 0, 0, &m) != MARTELLO_OK) return NULL;
+  martello_model_set_node(m, 0, 1.0, 0.0, 0.0, 0);
+  martello_model_add_link(m, MARTELLO_LINK_SPRING, 0, MARTELLO_GROUND, lp);
+  martello_model_add_contact(m, 0, MARTELLO_GROUND, 0.05, scheme, MARTELLO_LAW_LINEAR, cp);
+  martello_model_set_gravity(m, 9.81);
+  return m;
+}
+
+int main(void) {
+  const double mass = 1.0, k = 100.0, h = 0.05, g = 9.81;
+  double u, force, pen, cond[4];
+  int active, counters[3], st;
+  char msg[512];
+
+  /* The header's enums must equal the kernels' constants. */
+  const char *names[] = {"MARTELLO_ERR_ARGUMENT", "MARTELLO_ERR_UNSUPPORTED", "LAW_JANKOWSKI",
+                         "LINK_BAR", "SCHEME_RESTITUTION", "P_MSTAR", "L_VREG", "TF_HALF_SINE",
+                         "NPAR_CONTACT", "NPAR_LINK", "NPAR_TF", "MARTELLO_ILL_CONDITIONED"};
+  const int values[] = {MARTELLO_ERR_ARGUMENT, MARTELLO_ERR_UNSUPPORTED, MARTELLO_LAW_JANKOWSKI,
+                        MARTELLO_LINK_BAR, MARTELLO_SCHEME_RESTITUTION, MARTELLO_P_MSTAR,
+                        MARTELLO_L_VREG, MARTELLO_TF_HALF_SINE, MARTELLO_NPAR_CONTACT,
+                        MARTELLO_NPAR_LINK, MARTELLO_NPAR_TF, MARTELLO_ILL_CONDITIONED};
+  for (size_t i = 0; i < sizeof values / sizeof values[0]; i++) {
+    int v = 0;
+    checks++;
+    if (martello_constant(names[i], &v) != MARTELLO_OK || v != values[i]) {
+      failures++;
+      printf("FAIL constant %s: library %d, header %d\n", names[i], v, values[i]);
+    }
+  }
+
+  /* Lagrange: u = h, P = m g − k h (PROBLEMS.md P1). A 2×2 KKT solve: a few ulps, 1e-14. */
+  martello_model *m = p1(MARTELLO_SCHEME_LAGRANGE, 0.0);
+  st = martello_static_solve(m, 1e-14, 100, &u, &force, &pen, &active, counters, cond);
+  expect_status("lagrange solve", st, MARTELLO_OK);
+  expect_close("lagrange u", u, h, 1e-14);
+  expect_close("lagrange P", force, mass * g - k * h, 1e-14);
+  martello_model_free(&m);
+  checks++;
+  if (m != NULL) { failures++; printf("FAIL model_free must null the handle\n"); }
+
+  /* Penalty ε = 1e4: u = (m g + ε h)/(k + ε); P = ε(u − h) loses log10(h/δ) ≈ 2 digits. */
+  const double eps = 1e4;
+  m = p1(MARTELLO_SCHEME_PENALTY, eps);
+  st = martello_static_solve(m, 1e-14, 100, &u, &force, &pen, &active, counters, cond);
+  expect_status("penalty solve", st, MARTELLO_OK);
+  expect_close("penalty u", u, (mass * g + eps * h) / (k + eps), 1e-14);
+  expect_close("penalty P", force, eps * (mass * g - k * h) / (k + eps), 1e-11);
+  martello_model_free(&m);
+
+  /* ε/k = 1e16: finishes, returns the ill-conditioning outcome and says why. */
+  m = p1(MARTELLO_SCHEME_PENALTY, 1e18);
+  st = martello_static_solve(m, 1e-14, 100, &u, &force, &pen, &active, counters, cond);
+  expect_status("penalty 1e16 solve", st, MARTELLO_ILL_CONDITIONED);
+  martello_model_message(m, msg, sizeof msg);
+  checks++;
+  if (strstr(msg, "digits") == NULL || !isfinite(u) || !isfinite(force) || cond[1] < 8.0) {
+    failures++;
+    printf("FAIL penalty 1e16: message '%s', u %g, P %g, digits lost %g\n", msg, u, force, cond[1]);
+  }
+  martello_model_free(&m);
+
+  /* Error exits, one bad argument at a time. */
+  double lp[MARTELLO_NPAR_LINK] = {0}, cp[MARTELLO_NPAR_CONTACT] = {0};
+  expect_status("create n=0", martello_model_create(0, 0, 0, 0, 0, &m), MARTELLO_ERR_ARGUMENT);
+  martello_model_create(2, 1, 1, 0, 0, &m);
+  expect_status("negative mass", martello_model_set_node(m, 0, -1.0, 0, 0, 0), MARTELLO_ERR_ARGUMENT);
+  expect_status("node out of range", martello_model_set_node(m, 5, 1.0, 0, 0, 0), MARTELLO_ERR_ARGUMENT);
+  expect_status("NaN u0", martello_model_set_node(m, 0, 1.0, NAN, 0, 0), MARTELLO_ERR_ARGUMENT);
+  expect_status("unknown link", martello_model_add_link(m, 99, 0, 1, lp), MARTELLO_ERR_ARGUMENT);
+  expect_status("self link", martello_model_add_link(m, MARTELLO_LINK_SPRING, 1, 1, lp), MARTELLO_ERR_ARGUMENT);
+  expect_status("unknown scheme", martello_model_add_contact(m, 0, 1, 0.0, 9, 1, cp), MARTELLO_ERR_ARGUMENT);
+  expect_status("unknown law", martello_model_add_contact(m, 0, 1, 0.0, MARTELLO_SCHEME_PENALTY, 99, cp), MARTELLO_ERR_ARGUMENT);
+  expect_status("solve before nodes set", martello_static_solve(m, 1e-14, 10, &u, &force, &pen, &active, counters, cond), MARTELLO_ERR_STATE);
+  expect_status("null model", martello_model_set_gravity(NULL, 1.0), MARTELLO_ERR_ARGUMENT);
+  martello_model_free(&m);
+
+  printf("p1_static: %d passed, %d failed\n", checks - failures, failures);
+  return failures != 0;
+}

@@ -1,0 +1,104 @@
+/* martello — verification and benchmark suite for contact and impact in structural dynamics.
+ * The library's C API. SPDX-License-Identifier: GPL-3.0-or-later
+ *
+ * Lifecycle (as SUNDIALS' IDACreate ... IDAFree):
+ *   martello_model_create -> martello_model_set_node (every node) -> martello_model_add_*
+ *   -> martello_static_solve (or a dynamic run) -> martello_model_free.
+ * Nodes are numbered from 0; MARTELLO_GROUND (-1) stands for the ground / a rigid wall.
+ * Contact sign convention: penetration delta = (u_a - u_b) - gap, contact when delta > 0,
+ * the compressive force P >= 0 pushes a back and b forward.
+ * Return codes: 0 success, > 0 a non-error outcome, < 0 failure; martello_status_name()
+ * names them and martello_model_message() explains the last one of a model.
+ * Arrays are plain C arrays of double; parameter slots are given by the MARTELLO_P_* and
+ * MARTELLO_L_* indices (0-based). */
+#ifndef MARTELLO_H
+#define MARTELLO_H
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+#define MARTELLO_GROUND (-1)
+
+/* Status codes (values fixed; fortran/status.f90 mirrors them). */
+enum martello_status {
+  MARTELLO_OK = 0,
+  MARTELLO_ILL_CONDITIONED = 1,     /* solved, but digits were lost: read the message   */
+  MARTELLO_ROOT_FOUND = 2,          /* an event stopped the integration                  */
+  MARTELLO_ERR_ARGUMENT = -1,       /* a bad argument: the message names it              */
+  MARTELLO_ERR_MEMORY = -2,
+  MARTELLO_ERR_SINGULAR = -3,       /* singular system (a node held by nothing)          */
+  MARTELLO_ERR_NOT_CONVERGED = -4,  /* Newton, active set or Uzawa did not converge      */
+  MARTELLO_ERR_DIVERGED = -5,       /* NaN or energy growth beyond the input             */
+  MARTELLO_ERR_UNSUPPORTED = -6,    /* scheme/integrator/link not possible here          */
+  MARTELLO_ERR_UNSTABLE = -7,       /* explicit step beyond its stability limit          */
+  MARTELLO_ERR_LAPACK = -8,
+  MARTELLO_ERR_STEP_UNDERFLOW = -9,
+  MARTELLO_ERR_EXTERNAL = -10,      /* GSL or SUNDIALS reported a failure                */
+  MARTELLO_ERR_STATE = -11          /* call out of order                                 */
+};
+
+/* Contact schemes, laws, link kinds and time functions (values are the kernels';
+ * martello_constant() returns them by name). */
+enum { MARTELLO_SCHEME_PENALTY = 1, MARTELLO_SCHEME_LAGRANGE = 2,
+       MARTELLO_SCHEME_AUGMENTED = 3, MARTELLO_SCHEME_RESTITUTION = 4 };
+enum { MARTELLO_LAW_LINEAR = 1, MARTELLO_LAW_HERTZ = 2, MARTELLO_LAW_KELVIN = 3,
+       MARTELLO_LAW_HUNT_CROSSLEY = 4, MARTELLO_LAW_LANKARANI_NIKRAVESH = 5,
+       MARTELLO_LAW_FLORES = 6, MARTELLO_LAW_GONTHIER = 7, MARTELLO_LAW_HERTZDAMP = 8,
+       MARTELLO_LAW_JANKOWSKI = 9 };
+enum { MARTELLO_NPAR_CONTACT = 8, MARTELLO_P_STIFF = 0, MARTELLO_P_EXPONENT = 1,
+       MARTELLO_P_DAMPING = 2, MARTELLO_P_RESTITUTION = 3, MARTELLO_P_CLIP = 4,
+       MARTELLO_P_MSTAR = 5 };
+enum { MARTELLO_LINK_SPRING = 1, MARTELLO_LINK_DASHPOT = 2, MARTELLO_LINK_BILINEAR = 3,
+       MARTELLO_LINK_FLUID_DAMPER = 4, MARTELLO_LINK_BAR = 5 };
+enum { MARTELLO_NPAR_LINK = 6, MARTELLO_L_STIFF = 0, MARTELLO_L_DAMP = 1, MARTELLO_L_YIELD = 2,
+       MARTELLO_L_HARDENING = 3, MARTELLO_L_ALPHA = 4, MARTELLO_L_VREG = 5 };
+enum { MARTELLO_TF_CONSTANT = 1, MARTELLO_TF_TABLE = 2, MARTELLO_TF_SINE = 3,
+       MARTELLO_TF_RECTANGULAR = 4, MARTELLO_TF_HALF_SINE = 5, MARTELLO_NPAR_TF = 5 };
+
+/* ---- library ----------------------------------------------------------------------- */
+const char *martello_version(void);
+/* Versions of the numerical libraries linked in (GSL, SUNDIALS, FFTW, LAPACK), as text. */
+int martello_library_versions(char *buf, int buflen);
+const char *martello_status_name(int status);
+int martello_constant(const char *name, int *value);
+
+/* ---- model ------------------------------------------------------------------------- */
+typedef struct martello_model martello_model;
+
+int martello_model_create(int n_nodes, int max_links, int max_contacts, int max_forces,
+                          int max_mass_couplings, martello_model **model);
+void martello_model_free(martello_model **model);
+int martello_model_set_node(martello_model *model, int node, double mass, double u0,
+                            double v0, int fixed);
+int martello_model_add_link(martello_model *model, int kind, int a, int b,
+                            const double par[MARTELLO_NPAR_LINK]);
+int martello_model_add_contact(martello_model *model, int a, int b, double gap, int scheme,
+                               int law, const double par[MARTELLO_NPAR_CONTACT]);
+int martello_model_add_mass_coupling(martello_model *model, int a, int b, double value);
+int martello_model_set_gravity(martello_model *model, double g);
+/* A time function: kind MARTELLO_TF_*, par[MARTELLO_NPAR_TF], and for a table n_table
+ * samples (t[i], y[i]) with t strictly increasing (y scaled by par[0]). */
+int martello_model_add_nodal_force(martello_model *model, int node, int kind,
+                                   const double *par, int n_table, const double *t,
+                                   const double *y);
+int martello_model_set_ground_acceleration(martello_model *model, int kind,
+                                           const double *par, int n_table, const double *t,
+                                           const double *y);
+int martello_model_message(const martello_model *model, char *buf, int buflen);
+
+/* ---- static analysis ---------------------------------------------------------------- */
+/* Outputs: u[n_nodes]; per contact force[] (P >= 0), penetration[], active[] (0/1);
+ * counters[3] = {active-set iterations, Uzawa iterations, linear solves};
+ * conditioning[4] = {LAPACK reciprocal condition estimate of the system solved, significant
+ * digits lost, max penalty ratio eps/k, reciprocal condition estimate of the penalised
+ * stiffness K + eps B B^T (what a primal penalty solve faces)}.
+ * Returns MARTELLO_ILL_CONDITIONED (> 0) when more than 8 digits were lost. */
+int martello_static_solve(martello_model *model, double tol, int max_iter, double *u,
+                          double *force, double *penetration, int *active, int *counters,
+                          double *conditioning);
+
+#ifdef __cplusplus
+}
+#endif
+#endif /* MARTELLO_H */

@@ -1,0 +1,260 @@
+!> The scene as native code sees it: a 1D network of lumped masses (nodes), two-node links,
+!> unilateral contacts and loads. Node numbers are 1-based here; 0 means ground. The C door
+!> (api.f90) converts from the 0-based numbering of the C API.
+module martello_model
+   use martello_kinds, only: dp
+   use martello_status, only: MARTELLO_OK, MARTELLO_ERR_ARGUMENT
+   use martello_time_functions, only: time_function_t, tf_is_known, TF_TABLE, NPAR_TF
+   use martello_contact_laws, only: NPAR_CONTACT, law_is_known
+   use martello_links, only: NPAR_LINK, link_is_known
+   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
+   implicit none
+   private
+   public :: model_t, model_init, model_set_node, model_add_link, model_add_contact, &
+      model_add_mass_coupling, model_add_nodal_force, model_set_ground_acceleration, &
+      model_bandwidth, SCHEME_PENALTY, SCHEME_LAGRANGE, SCHEME_AUGMENTED, &
+      SCHEME_RESTITUTION, scheme_name
+
+   integer, parameter :: SCHEME_PENALTY = 1      !< force law on the penetration
+   integer, parameter :: SCHEME_LAGRANGE = 2     !< non-penetration constraint, multiplier = force
+   integer, parameter :: SCHEME_AUGMENTED = 3    !< augmented Lagrangian (Uzawa), static only
+   integer, parameter :: SCHEME_RESTITUTION = 4  !< instantaneous impacts, Newton's e
+
+   type :: model_t
+      integer :: n = 0
+      real(dp), allocatable :: mass(:), u0(:), v0(:)
+      logical, allocatable :: fixed(:)
+      ! links
+      integer :: nlink = 0
+      integer, allocatable :: link_kind(:), link_a(:), link_b(:)
+      real(dp), allocatable :: link_par(:, :)           !< (NPAR_LINK, nlink)
+      ! contacts: penetration δ = (u_a − u_b) − gap, compressive force pushes a back, b forward
+      integer :: ncontact = 0
+      integer, allocatable :: con_a(:), con_b(:), con_scheme(:), con_law(:)
+      real(dp), allocatable :: con_gap(:), con_par(:, :) !< (NPAR_CONTACT, ncontact)
+      ! off-diagonal mass (consistent bar mass): M(a,b) = M(b,a) += value
+      integer :: ncoupling = 0
+      integer, allocatable :: mc_a(:), mc_b(:)
+      real(dp), allocatable :: mc_value(:)
+      ! loads: gravity is an acceleration along +u acting on M; ground acceleration loads −M·1·ü_g
+      real(dp) :: gravity = 0.0_dp
+      integer :: nforce = 0
+      integer, allocatable :: force_node(:)
+      type(time_function_t), allocatable :: force_fn(:)
+      type(time_function_t) :: ground_accel
+      character(len=512) :: errmsg = ''
+   end type model_t
+
+contains
+
+   pure function scheme_name(scheme) result(name)
+      integer, intent(in) :: scheme
+      character(len=:), allocatable :: name
+      select case (scheme)
+      case (SCHEME_PENALTY); name = 'penalty'
+      case (SCHEME_LAGRANGE); name = 'lagrange'
+      case (SCHEME_AUGMENTED); name = 'augmented-lagrange'
+      case (SCHEME_RESTITUTION); name = 'restitution'
+      case default; name = 'unknown'
+      end select
+   end function scheme_name
+
+   subroutine fail(m, stat, msg)
+      type(model_t), intent(inout) :: m
+      integer, intent(out) :: stat
+      character(len=*), intent(in) :: msg
+      stat = MARTELLO_ERR_ARGUMENT
+      m%errmsg = msg
+   end subroutine fail
+
+   !> Allocate for n nodes and the given capacities (the front end knows them up front).
+   subroutine model_init(m, n, max_links, max_contacts, max_forces, max_couplings, stat)
+      type(model_t), intent(inout) :: m
+      integer, intent(in) :: n, max_links, max_contacts, max_forces, max_couplings
+      integer, intent(out) :: stat
+      stat = MARTELLO_OK
+      if (n < 1 .or. min(max_links, max_contacts, max_forces, max_couplings) < 0) then
+         call fail(m, stat, 'model_create: need n_nodes >= 1 and non-negative capacities')
+         return
+      end if
+      m%n = n
+      allocate (m%mass(n), m%u0(n), m%v0(n), m%fixed(n))
+      m%mass = -1.0_dp; m%u0 = 0.0_dp; m%v0 = 0.0_dp; m%fixed = .false.
+      allocate (m%link_kind(max_links), m%link_a(max_links), m%link_b(max_links), &
+                m%link_par(NPAR_LINK, max_links))
+      allocate (m%con_a(max_contacts), m%con_b(max_contacts), m%con_scheme(max_contacts), &
+                m%con_law(max_contacts), m%con_gap(max_contacts), &
+                m%con_par(NPAR_CONTACT, max_contacts))
+      allocate (m%force_node(max_forces), m%force_fn(max_forces))
+      allocate (m%mc_a(max_couplings), m%mc_b(max_couplings), m%mc_value(max_couplings))
+   end subroutine model_init
+
+   logical function node_ok(m, i, ground_allowed)
+      type(model_t), intent(in) :: m
+      integer, intent(in) :: i
+      logical, intent(in) :: ground_allowed
+      node_ok = (i >= 1 .and. i <= m%n) .or. (ground_allowed .and. i == 0)
+   end function node_ok
+
+   subroutine model_set_node(m, i, mass, u0, v0, fixed, stat)
+      type(model_t), intent(inout) :: m
+      integer, intent(in) :: i
+      real(dp), intent(in) :: mass, u0, v0
+      logical, intent(in) :: fixed
+      integer, intent(out) :: stat
+      stat = MARTELLO_OK
+      if (.not. node_ok(m, i, .false.)) then
+         call fail(m, stat, 'set_node: node index out of range'); return
+      end if
+      if (.not. (ieee_is_finite(mass) .and. ieee_is_finite(u0) .and. ieee_is_finite(v0))) then
+         call fail(m, stat, 'set_node: mass, u0 and v0 must be finite'); return
+      end if
+      ! A fixed node may be massless (a support); a free one needs mass > 0.
+      if (mass < 0.0_dp .or. (.not. fixed .and. mass <= 0.0_dp)) then
+         call fail(m, stat, 'set_node: mass must be > 0 for a free node (>= 0 for a fixed one)')
+         return
+      end if
+      m%mass(i) = mass; m%u0(i) = u0; m%v0(i) = v0; m%fixed(i) = fixed
+   end subroutine model_set_node
+
+   subroutine model_add_link(m, kind, a, b, par, stat)
+      type(model_t), intent(inout) :: m
+      integer, intent(in) :: kind, a, b
+      real(dp), intent(in) :: par(NPAR_LINK)
+      integer, intent(out) :: stat
+      stat = MARTELLO_OK
+      if (m%nlink >= size(m%link_kind)) then
+         call fail(m, stat, 'add_link: more links than declared at model_create'); return
+      end if
+      if (.not. link_is_known(kind)) then
+         call fail(m, stat, 'add_link: unknown link kind'); return
+      end if
+      if (.not. (node_ok(m, a, .true.) .and. node_ok(m, b, .true.)) .or. a == b) then
+         call fail(m, stat, 'add_link: nodes out of range, or both ends on the same node'); return
+      end if
+      if (.not. all(ieee_is_finite(par))) then
+         call fail(m, stat, 'add_link: parameters must be finite'); return
+      end if
+      m%nlink = m%nlink + 1
+      m%link_kind(m%nlink) = kind; m%link_a(m%nlink) = a; m%link_b(m%nlink) = b
+      m%link_par(:, m%nlink) = par
+   end subroutine model_add_link
+
+   subroutine model_add_contact(m, a, b, gap, scheme, law, par, stat)
+      type(model_t), intent(inout) :: m
+      integer, intent(in) :: a, b, scheme, law
+      real(dp), intent(in) :: gap, par(NPAR_CONTACT)
+      integer, intent(out) :: stat
+      stat = MARTELLO_OK
+      if (m%ncontact >= size(m%con_a)) then
+         call fail(m, stat, 'add_contact: more contacts than declared at model_create'); return
+      end if
+      if (.not. (node_ok(m, a, .true.) .and. node_ok(m, b, .true.)) .or. a == b) then
+         call fail(m, stat, 'add_contact: nodes out of range, or both sides on the same node')
+         return
+      end if
+      if (scheme < SCHEME_PENALTY .or. scheme > SCHEME_RESTITUTION) then
+         call fail(m, stat, 'add_contact: unknown scheme'); return
+      end if
+      if (scheme == SCHEME_PENALTY .and. .not. law_is_known(law)) then
+         call fail(m, stat, 'add_contact: unknown contact law'); return
+      end if
+      if (.not. (ieee_is_finite(gap) .and. all(ieee_is_finite(par)))) then
+         call fail(m, stat, 'add_contact: gap and parameters must be finite'); return
+      end if
+      m%ncontact = m%ncontact + 1
+      m%con_a(m%ncontact) = a; m%con_b(m%ncontact) = b; m%con_gap(m%ncontact) = gap
+      m%con_scheme(m%ncontact) = scheme; m%con_law(m%ncontact) = law
+      m%con_par(:, m%ncontact) = par
+   end subroutine model_add_contact
+
+   subroutine model_add_mass_coupling(m, a, b, value, stat)
+      type(model_t), intent(inout) :: m
+      integer, intent(in) :: a, b
+      real(dp), intent(in) :: value
+      integer, intent(out) :: stat
+      stat = MARTELLO_OK
+      if (m%ncoupling >= size(m%mc_a)) then
+         call fail(m, stat, 'add_mass_coupling: more couplings than declared'); return
+      end if
+      if (.not. (node_ok(m, a, .false.) .and. node_ok(m, b, .false.)) .or. a == b &
+          .or. .not. ieee_is_finite(value)) then
+         call fail(m, stat, 'add_mass_coupling: two distinct nodes and a finite value needed')
+         return
+      end if
+      m%ncoupling = m%ncoupling + 1
+      m%mc_a(m%ncoupling) = a; m%mc_b(m%ncoupling) = b; m%mc_value(m%ncoupling) = value
+   end subroutine model_add_mass_coupling
+
+   subroutine set_function(m, fn, kind, par, t, y, stat)
+      type(model_t), intent(inout) :: m
+      type(time_function_t), intent(out) :: fn
+      integer, intent(in) :: kind
+      real(dp), intent(in) :: par(NPAR_TF), t(:), y(:)
+      integer, intent(out) :: stat
+      integer :: i
+      stat = MARTELLO_OK
+      if (.not. tf_is_known(kind)) then
+         call fail(m, stat, 'time function: unknown kind'); return
+      end if
+      if (.not. (all(ieee_is_finite(par)) .and. all(ieee_is_finite(t)) .and. &
+                 all(ieee_is_finite(y)))) then
+         call fail(m, stat, 'time function: values must be finite'); return
+      end if
+      if (kind == TF_TABLE) then
+         if (size(t) < 2 .or. size(t) /= size(y)) then
+            call fail(m, stat, 'time function: a table needs >= 2 (t, y) pairs'); return
+         end if
+         do i = 2, size(t)
+            if (t(i) <= t(i - 1)) then
+               call fail(m, stat, 'time function: table times must increase strictly'); return
+            end if
+         end do
+         fn%t = t; fn%y = y
+      end if
+      fn%kind = kind; fn%par = par
+   end subroutine set_function
+
+   subroutine model_add_nodal_force(m, node, kind, par, t, y, stat)
+      type(model_t), intent(inout) :: m
+      integer, intent(in) :: node, kind
+      real(dp), intent(in) :: par(NPAR_TF), t(:), y(:)
+      integer, intent(out) :: stat
+      stat = MARTELLO_OK
+      if (m%nforce >= size(m%force_node)) then
+         call fail(m, stat, 'add_nodal_force: more forces than declared'); return
+      end if
+      if (.not. node_ok(m, node, .false.)) then
+         call fail(m, stat, 'add_nodal_force: node out of range'); return
+      end if
+      call set_function(m, m%force_fn(m%nforce + 1), kind, par, t, y, stat)
+      if (stat /= MARTELLO_OK) return
+      m%nforce = m%nforce + 1
+      m%force_node(m%nforce) = node
+   end subroutine model_add_nodal_force
+
+   subroutine model_set_ground_acceleration(m, kind, par, t, y, stat)
+      type(model_t), intent(inout) :: m
+      integer, intent(in) :: kind
+      real(dp), intent(in) :: par(NPAR_TF), t(:), y(:)
+      integer, intent(out) :: stat
+      call set_function(m, m%ground_accel, kind, par, t, y, stat)
+   end subroutine model_set_ground_acceleration
+
+   !> Half-bandwidth of the mass, stiffness and contact matrices: max |a − b| over every
+   !> two-node element (ground ends do not count). 1 for chains numbered in order.
+   pure integer function model_bandwidth(m) result(kd)
+      type(model_t), intent(in) :: m
+      integer :: j
+      kd = 0
+      do j = 1, m%nlink
+         if (m%link_a(j) > 0 .and. m%link_b(j) > 0) kd = max(kd, abs(m%link_a(j) - m%link_b(j)))
+      end do
+      do j = 1, m%ncontact
+         if (m%con_a(j) > 0 .and. m%con_b(j) > 0) kd = max(kd, abs(m%con_a(j) - m%con_b(j)))
+      end do
+      do j = 1, m%ncoupling
+         kd = max(kd, abs(m%mc_a(j) - m%mc_b(j)))
+      end do
+   end function model_bandwidth
+end module martello_model

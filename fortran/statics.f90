@@ -1,0 +1,355 @@
+!> Static equilibrium of any scene with unilateral contacts (PROBLEMS.md P1, P3; seed §3).
+!> Elastic links only (springs, bars). Contacts are solved by a primal–dual active set:
+!>  - lagrange: KKT system [K B; Bᵀ 0][u; P] = [f; d] (symmetric indefinite, dsytrf);
+!>  - penalty (linear law, stiffness ε): the SPD penalised stiffness K + ε B Bᵀ is formed for
+!>    its condition estimate (dpocon), and solved in the equivalent perturbed-Lagrangian form;
+!>  - augmented-lagrange: Uzawa, P_{k+1} = max(0, P_k + ε δ(u_k)), each u_k a penalty solve
+!>    shifted by P_k; converges to the Lagrange values for any finite ε.
+!> A restitution contact is a rigid unilateral constraint in statics and is solved as lagrange.
+!> Matrices are dense: static scenes are small (for n in the thousands use a dynamic run).
+module martello_statics
+   use martello_kinds, only: dp
+   use martello_status
+   use martello_model, only: model_t, SCHEME_PENALTY, SCHEME_LAGRANGE, SCHEME_AUGMENTED, &
+      SCHEME_RESTITUTION
+   use martello_contact_laws, only: LAW_LINEAR, P_STIFF
+   use martello_links, only: LINK_SPRING, LINK_BAR, LINK_DASHPOT, LINK_FLUID_DAMPER, L_STIFF
+   use martello_linalg, only: solve_spd, solve_symmetric_indefinite
+   use martello_time_functions, only: tf_value
+   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
+   implicit none
+   private
+   public :: static_result_t, static_solve
+
+   type :: static_result_t
+      real(dp), allocatable :: u(:)            !< displacement of every node
+      real(dp), allocatable :: force(:)        !< contact force P >= 0 (compression)
+      real(dp), allocatable :: penetration(:)  !< δ = u_a − u_b − gap
+      logical, allocatable :: active(:)
+      integer :: active_set_iterations = 0, uzawa_iterations = 0, solves = 0
+      real(dp) :: rcond = 1.0_dp               !< LAPACK reciprocal condition estimate (1-norm)
+      real(dp) :: digits_lost = 0.0_dp         !< see assess_digits
+      real(dp) :: penalty_ratio = 0.0_dp       !< max ε/k over active penalty contacts
+      real(dp) :: penalised_rcond = 1.0_dp     !< dpocon of K + εBBᵀ (what a primal solve faces)
+   end type static_result_t
+
+   !> Round-off allowance in the activation/release tests (in units of ε_mach × scale):
+   !> without it, a grazing contact (m g = k h exactly) can flip forever on the last bit.
+   real(dp), parameter :: ROUNDOFF = 64.0_dp*epsilon(1.0_dp)
+
+contains
+
+   subroutine static_solve(m, tol, max_iter, r, stat)
+      type(model_t), intent(inout) :: m
+      real(dp), intent(in) :: tol        !< Uzawa: stop when max|ΔP| <= tol·force scale
+      integer, intent(in) :: max_iter    !< bound on Uzawa and on active-set iterations
+      type(static_result_t), intent(out) :: r
+      integer, intent(out) :: stat
+
+      integer :: n, nc, nf, i, j, outer, inner, nlag
+      integer, allocatable :: dof(:), lag_row(:)
+      real(dp), allocatable :: kfree(:, :), fext(:), p_shift(:), p_new(:), sys(:, :), rhs(:)
+      logical, allocatable :: act(:), act_new(:)
+      real(dp) :: kk, fscale, kscale, change, rc
+      logical :: any_aug, changed
+
+      n = m%n; nc = m%ncontact
+      allocate (r%u(n), r%force(nc), r%penetration(nc), r%active(nc))
+      r%force = 0.0_dp; r%penetration = 0.0_dp; r%active = .false.
+      stat = MARTELLO_OK
+
+      call check_supported(m, stat)
+      if (stat /= MARTELLO_OK) return
+
+      ! Free-DOF numbering: fixed nodes keep u = u0 and leave the system.
+      allocate (dof(0:n)); dof = 0; nf = 0
+      do i = 1, n
+         if (.not. m%fixed(i)) then
+            nf = nf + 1; dof(i) = nf
+         end if
+      end do
+      r%u = merge(m%u0, 0.0_dp, m%fixed)
+
+      ! Elastic stiffness and loads on the free DOFs (fixed displacements moved to the rhs).
+      allocate (kfree(nf, nf), fext(nf)); kfree = 0.0_dp; fext = 0.0_dp
+      do i = 1, n
+         if (dof(i) > 0) fext(dof(i)) = m%gravity*m%mass(i)
+      end do
+      do j = 1, m%ncoupling
+         if (dof(m%mc_a(j)) > 0) fext(dof(m%mc_a(j))) = fext(dof(m%mc_a(j))) + m%gravity*m%mc_value(j)
+         if (dof(m%mc_b(j)) > 0) fext(dof(m%mc_b(j))) = fext(dof(m%mc_b(j))) + m%gravity*m%mc_value(j)
+      end do
+      do j = 1, m%nforce
+         i = dof(m%force_node(j))
+         if (i > 0) fext(i) = fext(i) + tf_value(m%force_fn(j), 0.0_dp)
+      end do
+      do j = 1, m%nlink
+         if (m%link_kind(j) /= LINK_SPRING .and. m%link_kind(j) /= LINK_BAR) cycle
+         kk = m%link_par(L_STIFF, j)
+         call add_pair(kfree, fext, dof, r%u, m%link_a(j), m%link_b(j), kk)
+      end do
+      fscale = 1.0_dp; kscale = 1.0_dp
+      if (nf > 0) then
+         fscale = max(maxval(abs(fext)), tiny(1.0_dp))
+         kscale = 0.0_dp
+         do i = 1, nf
+            kscale = max(kscale, abs(kfree(i, i)))
+         end do
+         if (kscale == 0.0_dp) kscale = 1.0_dp
+      end if
+
+      any_aug = any(m%con_scheme(1:nc) == SCHEME_AUGMENTED)
+      allocate (act(nc), act_new(nc), p_shift(nc), p_new(nc), lag_row(nc))
+      act = .false.; p_shift = 0.0_dp
+
+      do outer = 1, max_iter
+         ! Primal–dual active set for the current Uzawa shift.
+         do inner = 1, max_iter
+            call assemble_and_solve(stat)
+            if (stat == MARTELLO_ERR_SINGULAR .and. inner == 1 .and. .not. all(act)) then
+               ! Without contacts the structure is a mechanism (a node held only by its
+               ! contact): start again from the all-active set.
+               act = .true.; stat = MARTELLO_OK; m%errmsg = ''
+               call assemble_and_solve(stat)
+            end if
+            if (stat < 0) return
+            call update_active_set(changed)
+            r%active_set_iterations = r%active_set_iterations + 1
+            if (.not. changed) exit
+         end do
+         if (changed) then
+            stat = MARTELLO_ERR_NOT_CONVERGED
+            m%errmsg = 'static active set did not settle within max_iter iterations'
+            return
+         end if
+         if (.not. any_aug) exit
+         ! Uzawa update of the augmented contacts' multipliers.
+         r%uzawa_iterations = outer
+         change = 0.0_dp
+         do j = 1, nc
+            if (m%con_scheme(j) /= SCHEME_AUGMENTED) cycle
+            p_new(j) = max(0.0_dp, p_shift(j) + m%con_par(P_STIFF, j)*r%penetration(j))
+            change = max(change, abs(p_new(j) - p_shift(j)))
+            p_shift(j) = p_new(j)
+            r%force(j) = p_new(j)
+         end do
+         if (change <= tol*max(fscale, maxval(abs(p_shift)))) exit
+         if (outer == max_iter) then
+            stat = MARTELLO_ERR_NOT_CONVERGED
+            write (m%errmsg, '(a,i0,a,es9.2)') 'augmented-lagrange (Uzawa) did not reach tol in ', &
+               max_iter, ' iterations; last multiplier change ', change
+            return
+         end if
+      end do
+
+      call assess_digits()
+
+   contains
+
+      !> K(a,a) += s, K(b,b) += s, K(a,b) −= s for free ends; known displacements to the rhs.
+      subroutine add_pair(kmat, f, dof, u, a, b, s)
+         real(dp), intent(inout) :: kmat(:, :), f(:)
+         integer, intent(in) :: dof(0:), a, b
+         real(dp), intent(in) :: u(:), s
+         integer :: ia, ib
+         ia = dof(a); ib = dof(b)
+         if (ia > 0) kmat(ia, ia) = kmat(ia, ia) + s
+         if (ib > 0) kmat(ib, ib) = kmat(ib, ib) + s
+         if (ia > 0 .and. ib > 0) then
+            kmat(ia, ib) = kmat(ia, ib) - s; kmat(ib, ia) = kmat(ib, ia) - s
+         end if
+         if (ia > 0 .and. b > 0 .and. ib == 0) f(ia) = f(ia) + s*u(b)
+         if (ib > 0 .and. a > 0 .and. ia == 0) f(ib) = f(ib) + s*u(a)
+      end subroutine add_pair
+
+      !> Every active contact adds a row: Bᵀu − c_j P_j = rhs_j, with B = +1 at a, −1 at b and
+      !>  lagrange: c = 0, rhs = d;  penalty: c = 1/ε, rhs = d  (the perturbed-Lagrangian form
+      !>  of the penalty method: eliminating P gives K + εBBᵀ, but the condition stays bounded
+      !>  as ε → ∞, so P and δ = P/ε keep their digits);  augmented: c = 1/ε, rhs = d − P_k/ε.
+      !> Rows and P are scaled by kscale (unknown P/kscale) so the matrix is equilibrated.
+      subroutine assemble_and_solve(st)
+         integer, intent(out) :: st
+         integer :: dim, row, ia, ib, i, j, a, b
+         real(dp) :: dknown
+         nlag = 0; lag_row = 0
+         do j = 1, nc
+            if (act(j) .and. (dof(m%con_a(j)) > 0 .or. dof(m%con_b(j)) > 0)) then
+               nlag = nlag + 1; lag_row(j) = nf + nlag
+            end if
+         end do
+         dim = nf + nlag
+         if (allocated(sys)) deallocate (sys, rhs)
+         allocate (sys(dim, dim), rhs(dim))
+         sys = 0.0_dp; rhs = 0.0_dp
+         sys(1:nf, 1:nf) = kfree; rhs(1:nf) = fext
+         do j = 1, nc
+            row = lag_row(j)
+            if (row == 0) cycle
+            a = m%con_a(j); b = m%con_b(j)
+            ia = dof(a); ib = dof(b)
+            ! gap minus the part of u_a − u_b that is known (fixed or ground ends)
+            dknown = m%con_gap(j)
+            if (a > 0 .and. ia == 0) dknown = dknown - r%u(a)
+            if (b > 0 .and. ib == 0) dknown = dknown + r%u(b)
+            if (ia > 0) then
+               sys(ia, row) = kscale; sys(row, ia) = kscale
+            end if
+            if (ib > 0) then
+               sys(ib, row) = -kscale; sys(row, ib) = -kscale
+            end if
+            rhs(row) = kscale*dknown
+            if (.not. is_lagrange(j)) then
+               sys(row, row) = -kscale**2/m%con_par(P_STIFF, j)
+               rhs(row) = rhs(row) - kscale*p_shift(j)/m%con_par(P_STIFF, j)
+            end if
+         end do
+         if (nlag > 0) then
+            call solve_symmetric_indefinite(sys, rhs, rc, st, m%errmsg)
+         else
+            call solve_spd(sys, rhs, rc, st, m%errmsg)
+         end if
+         r%solves = r%solves + 1
+         if (st /= MARTELLO_OK) return
+         if (.not. all(ieee_is_finite(rhs))) then
+            st = MARTELLO_ERR_SINGULAR
+            m%errmsg = 'static solve produced non-finite values (singular or overflowing system)'
+            return
+         end if
+         r%rcond = rc
+         do i = 1, n
+            if (dof(i) > 0) r%u(i) = rhs(dof(i))
+         end do
+         do j = 1, nc
+            r%penetration(j) = penetration(j)
+            r%force(j) = 0.0_dp
+            if (lag_row(j) > 0) r%force(j) = kscale*rhs(lag_row(j))
+            ! a penalty contact's δ = P/ε exactly; from u it would cancel to noise at large ε
+            if (lag_row(j) > 0 .and. m%con_scheme(j) == SCHEME_PENALTY) &
+               r%penetration(j) = r%force(j)/m%con_par(P_STIFF, j)
+         end do
+      end subroutine assemble_and_solve
+
+      real(dp) function penetration(j)
+         integer, intent(in) :: j
+         real(dp) :: ua, ub
+         ua = 0.0_dp; ub = 0.0_dp
+         if (m%con_a(j) > 0) ua = r%u(m%con_a(j))
+         if (m%con_b(j) > 0) ub = r%u(m%con_b(j))
+         penetration = (ua - ub) - m%con_gap(j)
+      end function penetration
+
+      logical function is_lagrange(j)
+         integer, intent(in) :: j
+         is_lagrange = m%con_scheme(j) == SCHEME_LAGRANGE .or. m%con_scheme(j) == SCHEME_RESTITUTION
+      end function is_lagrange
+
+      real(dp) function length_scale(j)
+         integer, intent(in) :: j
+         length_scale = abs(m%con_gap(j))
+         if (m%con_a(j) > 0) length_scale = length_scale + abs(r%u(m%con_a(j)))
+         if (m%con_b(j) > 0) length_scale = length_scale + abs(r%u(m%con_b(j)))
+      end function length_scale
+
+      subroutine update_active_set(chg)
+         logical, intent(out) :: chg
+         integer :: j
+         real(dp) :: trial
+         do j = 1, nc
+            if (act(j)) then
+               ! release on tension (round-off allowance: see ROUNDOFF)
+               act_new(j) = r%force(j) >= -ROUNDOFF*fscale
+            else if (is_lagrange(j)) then
+               act_new(j) = r%penetration(j) > ROUNDOFF*length_scale(j)
+            else
+               ! εδ is resolved only to ε·ulp(u): within that band a huge ε would flip the
+               ! contact on the last bit, so activation needs a force beyond it
+               trial = p_shift(j) + m%con_par(P_STIFF, j)*r%penetration(j)
+               act_new(j) = trial > ROUNDOFF*(fscale + m%con_par(P_STIFF, j)*length_scale(j))
+            end if
+         end do
+         chg = any(act_new .neqv. act)
+         act = act_new
+         r%active = act
+      end subroutine update_active_set
+
+      !> Digits lost. The system solved is well conditioned (LAPACK estimate in rcond), but a
+      !> penalty stiffness ε far above the structure's stiffness k at its nodes swamps k in
+      !> K + εBBᵀ: that matrix's condition (dpocon, reported too) grows like ε/k and a primal
+      !> penalty code loses log10(1 + ε/k) digits — and so does u, which cannot resolve δ.
+      subroutine assess_digits()
+         real(dp) :: lost, ratio, kd, pen_rc, dummy(max(nf, 1)), kpen(nf, nf)
+         integer :: k, st, ia, ib
+         lost = 16.0_dp
+         if (r%rcond > 0.0_dp) lost = log10(1.0_dp/r%rcond)
+         r%penalty_ratio = 0.0_dp
+         kpen = kfree
+         do k = 1, nc
+            if (.not. act(k) .or. m%con_scheme(k) /= SCHEME_PENALTY) cycle
+            ia = dof(m%con_a(k)); ib = dof(m%con_b(k))
+            kd = 0.0_dp
+            if (ia > 0) kd = max(kd, kfree(ia, ia))
+            if (ib > 0) kd = max(kd, kfree(ib, ib))
+            ratio = m%con_par(P_STIFF, k)/max(kd, tiny(1.0_dp))
+            r%penalty_ratio = max(r%penalty_ratio, ratio)
+            if (ia > 0) kpen(ia, ia) = kpen(ia, ia) + m%con_par(P_STIFF, k)
+            if (ib > 0) kpen(ib, ib) = kpen(ib, ib) + m%con_par(P_STIFF, k)
+            if (ia > 0 .and. ib > 0) then
+               kpen(ia, ib) = kpen(ia, ib) - m%con_par(P_STIFF, k)
+               kpen(ib, ia) = kpen(ib, ia) - m%con_par(P_STIFF, k)
+            end if
+         end do
+         r%penalised_rcond = 1.0_dp
+         if (r%penalty_ratio > 0.0_dp .and. nf > 0) then
+            dummy = 0.0_dp
+            call solve_spd(kpen, dummy(1:nf), pen_rc, st, m%errmsg)
+            r%penalised_rcond = merge(pen_rc, 0.0_dp, st == MARTELLO_OK)
+            m%errmsg = ''
+            lost = max(lost, log10(1.0_dp + r%penalty_ratio))
+            if (r%penalised_rcond > 0.0_dp) lost = max(lost, log10(1.0_dp/r%penalised_rcond))
+         end if
+         r%digits_lost = min(lost, -log10(epsilon(1.0_dp)))
+         if (r%digits_lost > 8.0_dp) then
+            stat = MARTELLO_ILL_CONDITIONED
+            write (m%errmsg, '(a,es8.1,a,f4.1,a)') 'ill-conditioned: penalty stiffness eps/k = ', &
+               r%penalty_ratio, ' swamps the structure: K + eps*B*B'' loses about ', &
+               r%digits_lost, ' of 16 significant digits (u cannot resolve the penetration);'// &
+               ' lower eps or use scheme lagrange / augmented-lagrange'
+         end if
+      end subroutine assess_digits
+
+   end subroutine static_solve
+
+   subroutine check_supported(m, stat)
+      type(model_t), intent(inout) :: m
+      integer, intent(out) :: stat
+      integer :: j
+      character(len=16) :: num
+      stat = MARTELLO_OK
+      do j = 1, m%nlink
+         select case (m%link_kind(j))
+         case (LINK_SPRING, LINK_BAR, LINK_DASHPOT, LINK_FLUID_DAMPER)
+         case default
+            write (num, '(i0)') j - 1
+            stat = MARTELLO_ERR_UNSUPPORTED
+            m%errmsg = 'link '//trim(num)//': static analysis handles elastic links (spring, bar)'// &
+               ' and ignores dampers; an elasto-plastic spring needs a dynamic analysis'
+            return
+         end select
+      end do
+      do j = 1, m%ncontact
+         write (num, '(i0)') j - 1
+         if (m%con_scheme(j) == SCHEME_PENALTY .and. m%con_law(j) /= LAW_LINEAR) then
+            stat = MARTELLO_ERR_UNSUPPORTED
+            m%errmsg = 'contact '//trim(num)//': static penalty supports law linear only'// &
+               ' (nonlinear laws need a dynamic analysis)'
+            return
+         end if
+         if ((m%con_scheme(j) == SCHEME_PENALTY .or. m%con_scheme(j) == SCHEME_AUGMENTED) .and. &
+             .not. m%con_par(P_STIFF, j) > 0.0_dp) then
+            stat = MARTELLO_ERR_ARGUMENT
+            m%errmsg = 'contact '//trim(num)//': penalty stiffness eps must be > 0'
+            return
+         end if
+      end do
+   end subroutine check_supported
+end module martello_statics

@@ -1,0 +1,27 @@
+!> Status codes returned through the C door. The values must match the enum in c/martello.h
+!> (the C example `status_codes` checks that they do): 0 success, > 0 a result with a
+!> non-error outcome, < 0 failure.
+module martello_status
+   implicit none
+   private
+   public :: MARTELLO_OK, MARTELLO_ILL_CONDITIONED, MARTELLO_ROOT_FOUND, &
+      MARTELLO_ERR_ARGUMENT, MARTELLO_ERR_MEMORY, MARTELLO_ERR_SINGULAR, &
+      MARTELLO_ERR_NOT_CONVERGED, MARTELLO_ERR_DIVERGED, MARTELLO_ERR_UNSUPPORTED, &
+      MARTELLO_ERR_UNSTABLE, MARTELLO_ERR_LAPACK, MARTELLO_ERR_STEP_UNDERFLOW, &
+      MARTELLO_ERR_EXTERNAL, MARTELLO_ERR_STATE
+
+   integer, parameter :: MARTELLO_OK = 0
+   integer, parameter :: MARTELLO_ILL_CONDITIONED = 1  !< solved, but digits were lost
+   integer, parameter :: MARTELLO_ROOT_FOUND = 2       !< an event stopped the integration
+   integer, parameter :: MARTELLO_ERR_ARGUMENT = -1
+   integer, parameter :: MARTELLO_ERR_MEMORY = -2
+   integer, parameter :: MARTELLO_ERR_SINGULAR = -3
+   integer, parameter :: MARTELLO_ERR_NOT_CONVERGED = -4
+   integer, parameter :: MARTELLO_ERR_DIVERGED = -5
+   integer, parameter :: MARTELLO_ERR_UNSUPPORTED = -6
+   integer, parameter :: MARTELLO_ERR_UNSTABLE = -7
+   integer, parameter :: MARTELLO_ERR_LAPACK = -8
+   integer, parameter :: MARTELLO_ERR_STEP_UNDERFLOW = -9
+   integer, parameter :: MARTELLO_ERR_EXTERNAL = -10   !< GSL or SUNDIALS reported a failure
+   integer, parameter :: MARTELLO_ERR_STATE = -11      !< call out of order (e.g. run before build)
+end module martello_status

@@ -1,0 +1,71 @@
+!> Scalar functions of time for nodal forces and ground acceleration. Analytic kinds are
+!> evaluated exactly (no sampling), so order-of-accuracy tests are not polluted by
+!> interpolation of the load; records are tables, linear between samples.
+module martello_time_functions
+   use martello_kinds, only: dp
+   implicit none
+   private
+   public :: time_function_t, tf_value, tf_is_known, NPAR_TF, &
+      TF_NONE, TF_CONSTANT, TF_TABLE, TF_SINE, TF_RECTANGULAR, TF_HALF_SINE
+
+   integer, parameter :: TF_NONE = 0
+   integer, parameter :: TF_CONSTANT = 1     !< par(1)
+   integer, parameter :: TF_TABLE = 2        !< linear between (t_i, y_i), 0 outside [t_1, t_n], times par(1)
+   integer, parameter :: TF_SINE = 3         !< par(1)·sin(par(2)·(t − par(4)) + par(3)) on [par(4), par(5)]
+   integer, parameter :: TF_RECTANGULAR = 4  !< par(1) on [par(4), par(5)), 0 elsewhere
+   integer, parameter :: TF_HALF_SINE = 5    !< par(1)·sin(π (t − par(4))/(par(5) − par(4))) on [par(4), par(5)]
+   integer, parameter :: NPAR_TF = 5
+
+   type :: time_function_t
+      integer :: kind = TF_NONE
+      real(dp) :: par(NPAR_TF) = 0.0_dp
+      real(dp), allocatable :: t(:), y(:)
+   end type time_function_t
+
+contains
+
+   pure logical function tf_is_known(kind)
+      integer, intent(in) :: kind
+      tf_is_known = kind >= TF_CONSTANT .and. kind <= TF_HALF_SINE
+   end function tf_is_known
+
+   !> Value at time t. The table search is a bisection: O(log n) per call, no saved cursor,
+   !> so the function stays pure and thread-safe.
+   pure function tf_value(tf, t) result(y)
+      type(time_function_t), intent(in) :: tf
+      real(dp), intent(in) :: t
+      real(dp) :: y
+      real(dp), parameter :: pi = acos(-1.0_dp)
+      integer :: lo, hi, mid, n
+      real(dp) :: w
+
+      y = 0.0_dp
+      select case (tf%kind)
+      case (TF_CONSTANT)
+         y = tf%par(1)
+      case (TF_SINE)
+         if (t >= tf%par(4) .and. t <= tf%par(5)) &
+            y = tf%par(1)*sin(tf%par(2)*(t - tf%par(4)) + tf%par(3))
+      case (TF_RECTANGULAR)
+         if (t >= tf%par(4) .and. t < tf%par(5)) y = tf%par(1)
+      case (TF_HALF_SINE)
+         if (t >= tf%par(4) .and. t <= tf%par(5)) &
+            y = tf%par(1)*sin(pi*(t - tf%par(4))/(tf%par(5) - tf%par(4)))
+      case (TF_TABLE)
+         n = size(tf%t)
+         if (n < 2) return
+         if (t < tf%t(1) .or. t > tf%t(n)) return
+         lo = 1; hi = n
+         do while (hi - lo > 1)
+            mid = (lo + hi)/2
+            if (tf%t(mid) <= t) then
+               lo = mid
+            else
+               hi = mid
+            end if
+         end do
+         w = (t - tf%t(lo))/(tf%t(hi) - tf%t(lo))
+         y = tf%par(1)*((1.0_dp - w)*tf%y(lo) + w*tf%y(hi))
+      end select
+   end function tf_value
+end module martello_time_functions

@@ -1,0 +1,68 @@
+"""Verification of a run against its scene's closed form (the `[check]` table).
+
+The oracle is evaluated from the parameters written in the check table itself, by
+martello.closed_forms, which never calls the solvers: a scene and its reference are two
+independent statements of the same problem."""
+
+import math
+
+from . import closed_forms
+from .errors import SceneError
+
+DIGITS_CAP = 16.0   # a double carries ~15.95 digits; an exact match is reported as 16
+
+
+def lookup(summary, path):
+    node = summary
+    for part in path.split("."):
+        if not isinstance(node, dict) or part not in node:
+            raise KeyError(path)
+        node = node[part]
+    return node
+
+
+def oracle_values(check, source="<scene>"):
+    fn = getattr(closed_forms, check["closed_form"], None)
+    if fn is None or not callable(fn):
+        raise SceneError(source, "check.closed_form", f"unknown closed form {check['closed_form']!r}",
+                         "name a function of martello.closed_forms")
+    try:
+        result = fn(**check["params"])
+    except TypeError as exc:
+        raise SceneError(source, "check.params", str(exc), "match the closed form's parameters") from None
+    return result if isinstance(result, dict) else vars(result)
+
+
+def digits(value, reference):
+    """Significant correct digits −log10 |rel. error| (absolute error when the reference is 0)."""
+    err = abs(value - reference)
+    scale = abs(reference) if reference != 0 else 1.0
+    if err == 0:
+        return DIGITS_CAP
+    return max(0.0, min(DIGITS_CAP, -math.log10(err / scale)))
+
+
+def verify(scene, summary):
+    """Rows (dicts) of the verification table for one run."""
+    check = scene.check
+    ref = oracle_values(check, scene.source)
+    rows = []
+    for item in check["compare"]:
+        if item["oracle"] not in ref:
+            raise SceneError(scene.source, "check.compare.oracle", f"{item['oracle']!r} is not an output of "
+                             f"{check['closed_form']}", "valid: " + ", ".join(ref))
+        try:
+            value = float(lookup(summary, item["result"]))
+        except KeyError:
+            raise SceneError(scene.source, "check.compare.result", f"{item['result']!r} is not in the summary",
+                             "use a dotted path such as nodes.<name>.u or contacts.<name>.force") from None
+        reference = float(ref[item["oracle"]])
+        rtol, atol = item.get("rtol") or 0.0, item.get("atol") or 0.0
+        err = abs(value - reference)
+        rows.append({
+            "scene": scene.title, "file": scene.source, "quantity": item["result"],
+            "value": value, "reference": reference, "abs_error": err,
+            "rel_error": err / abs(reference) if reference != 0 else float("nan"),
+            "digits": digits(value, reference), "rtol": rtol, "atol": atol,
+            "passed": bool(err <= atol + rtol * abs(reference)), "why": item["why"]})
+    return rows

@@ -1,0 +1,108 @@
+"""The `martello` command line (git-like subcommands; exit code non-zero on any failure)."""
+
+import argparse
+import csv
+import json
+import sys
+from pathlib import Path
+
+from . import catalogue, native
+from . import scene as scene_mod
+from .errors import MartelloError
+
+DESCRIPTION = """\
+martello: verification and benchmark suite for contact and impact in structural dynamics.
+
+A scene (TOML, see docs/scene-format.md) describes a small 1D mechanical network: nodes
+(lumped masses), links (springs, dampers, bars), contacts (lagrange, penalty,
+augmented-lagrange, restitution), loads, and the analysis to run. The catalogue in
+benchmarks/ holds the canonical problems with their closed-form references.
+
+examples:
+  martello list                               the catalogue, one line per scene
+  martello run benchmarks/p1/p1_static_lagrange.toml -o out/p1
+                                              run one scene, write summary.json
+  martello check                              run the catalogue against its closed forms
+"""
+
+
+def cmd_list(args):
+    files = catalogue.scene_files()
+    if not files:
+        print("the catalogue is empty")
+        return 0
+    width = max(len(str(f.relative_to(catalogue.ROOT.parent))) for f in files)
+    for f in files:
+        s = scene_mod.load(f)
+        schemes = ",".join(sorted({c["scheme"] for c in s.contacts})) or "-"
+        print(f"{str(f.relative_to(catalogue.ROOT.parent)):<{width}}  {s.problem or '-':<4} "
+              f"{s.analysis['type']:<8} {schemes:<22} {s.title}")
+    return 0
+
+
+def cmd_run(args):
+    from .run import run, write_results
+    s = scene_mod.load(args.scene)
+    summary = run(s)
+    out = Path(args.output) if args.output else Path("out") / Path(args.scene).stem
+    path = write_results(summary, out)
+    for w in summary.get("warnings", []):
+        print(f"warning: {w}", file=sys.stderr)
+    print(f"{s.title}: {summary['status']} -> {path}")
+    if args.print:
+        print(json.dumps(summary, indent=2, default=float))
+    return 0
+
+
+def cmd_check(args):
+    from .report import check_catalogue
+    files = [Path(p) for p in args.scenes] if args.scenes else catalogue.scene_files()
+    ok = check_catalogue(files, Path(args.output), plots=not args.no_plots)
+    return 0 if ok else 1
+
+
+def main(argv=None):
+    parser = argparse.ArgumentParser(prog="martello", description=DESCRIPTION,
+                                     formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("--version", action="version",
+                        version=f"martello (Python front end); library: see `martello version`")
+    sub = parser.add_subparsers(dest="command", metavar="COMMAND")
+
+    p = sub.add_parser("list", help="list the benchmark catalogue, one line per scene")
+    p.set_defaults(func=cmd_list)
+
+    p = sub.add_parser("run", help="run one scene and write summary.json (and history.csv)",
+                       description="Run the analysis a scene asks for and write its results: "
+                       "summary.json (displacements, contact forces, penetrations, cost, "
+                       "conditioning, provenance) and, for dynamic runs, history.csv.")
+    p.add_argument("scene", help="scene file (TOML)")
+    p.add_argument("-o", "--output", help="output folder (default: out/<scene name>)")
+    p.add_argument("--print", action="store_true", help="also print the summary")
+    p.set_defaults(func=cmd_run)
+
+    p = sub.add_parser("check", help="verify scenes against their closed forms",
+                       description="Run scenes (default: the whole catalogue), compare each "
+                       "with the closed form named in its [check] table, print the "
+                       "verification table and write report.md, verification.csv and plots. "
+                       "Exit code 1 if any check fails.")
+    p.add_argument("scenes", nargs="*", help="scene files (default: the catalogue)")
+    p.add_argument("-o", "--output", default="out/check", help="report folder (default: out/check)")
+    p.add_argument("--no-plots", action="store_true", help="skip the PNG plots")
+    p.set_defaults(func=cmd_check)
+
+    p = sub.add_parser("version", help="versions of martello and the libraries it links")
+    p.set_defaults(func=lambda a: print(f"martello {native.version()} ({native.library_versions()})") or 0)
+
+    args = parser.parse_args(argv)
+    if not args.command:
+        parser.print_help()
+        return 2
+    try:
+        return args.func(args)
+    except MartelloError as exc:
+        print(f"martello: error: {exc}", file=sys.stderr)
+        return 1
+
+
+if __name__ == "__main__":
+    sys.exit(main())

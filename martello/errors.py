@@ -1,0 +1,42 @@
+"""Exceptions the command line reports as one clear message, without a traceback."""
+
+
+class MartelloError(Exception):
+    """Base class: anything the user can fix (bad input, impossible request, failed run)."""
+
+
+class SceneError(MartelloError):
+    """A scene file is invalid. The message names the file, the field and what would be valid."""
+
+    def __init__(self, file, field, problem, fix=None):
+        self.file, self.field, self.problem, self.fix = str(file), field, problem, fix
+        msg = f"{self.file}: {field}: {problem}"
+        if fix:
+            msg += f" ({fix})"
+        super().__init__(msg)
+
+
+class RecordError(MartelloError):
+    """A ground-motion record (CSV or PEER AT2) is unreadable or inconsistent."""
+
+    def __init__(self, file, problem, line=None, fix=None):
+        self.file, self.problem, self.line, self.fix = str(file), problem, line, fix
+        where = f"{self.file}:{line}" if line is not None else self.file
+        msg = f"{where}: {problem}"
+        if fix:
+            msg += f" ({fix})"
+        super().__init__(msg)
+
+
+class SolverError(MartelloError):
+    """The native library returned a failure status."""
+
+    def __init__(self, status, name, message):
+        self.status, self.name = status, name
+        super().__init__(f"{name} ({status}): {message}")
+
+
+class DivergenceError(SolverError):
+    """A run diverged (NaN, energy growth beyond the input, step past the stability limit).
+
+    Its partial results are never written out as if they were a result."""

@@ -1,0 +1,185 @@
+"""The ctypes binding to libmartello: the only place Python touches the C API.
+
+Status codes become exceptions here (as dftd4 raises RuntimeError from its error handle):
+negative codes raise, positive ones are returned to the caller as outcomes."""
+
+import ctypes
+import os
+from functools import lru_cache
+from pathlib import Path
+
+import numpy as np
+
+from .errors import MartelloError, SolverError, DivergenceError
+
+_REPO = Path(__file__).resolve().parent.parent
+_DOUBLE_P = np.ctypeslib.ndpointer(dtype=np.float64, flags="C_CONTIGUOUS")
+_INT_P = np.ctypeslib.ndpointer(dtype=np.int32, flags="C_CONTIGUOUS")
+_VOID_P = ctypes.c_void_p
+
+
+def library_path():
+    """MARTELLO_LIB if set, else the CMake build tree of this checkout."""
+    env = os.environ.get("MARTELLO_LIB")
+    if env:
+        return Path(env)
+    return _REPO / "build" / "libmartello.so"
+
+
+@lru_cache(maxsize=None)
+def lib():
+    path = library_path()
+    if not path.exists():
+        raise MartelloError(
+            f"native library not found at {path}: build it with ./scripts/build "
+            "(or point MARTELLO_LIB at libmartello.so)")
+    L = ctypes.CDLL(str(path))
+    c_int, c_double, c_char_p = ctypes.c_int, ctypes.c_double, ctypes.c_char_p
+    protos = {
+        "martello_version": (c_char_p, []),
+        "martello_library_versions": (c_int, [c_char_p, c_int]),
+        "martello_status_name": (c_char_p, [c_int]),
+        "martello_constant": (c_int, [c_char_p, ctypes.POINTER(c_int)]),
+        "martello_model_create": (c_int, [c_int] * 5 + [ctypes.POINTER(_VOID_P)]),
+        "martello_model_free": (None, [ctypes.POINTER(_VOID_P)]),
+        "martello_model_set_node": (c_int, [_VOID_P, c_int, c_double, c_double, c_double, c_int]),
+        "martello_model_add_link": (c_int, [_VOID_P, c_int, c_int, c_int, _DOUBLE_P]),
+        "martello_model_add_contact": (c_int, [_VOID_P, c_int, c_int, c_double, c_int, c_int,
+                                               _DOUBLE_P]),
+        "martello_model_add_mass_coupling": (c_int, [_VOID_P, c_int, c_int, c_double]),
+        "martello_model_set_gravity": (c_int, [_VOID_P, c_double]),
+        "martello_model_add_nodal_force": (c_int, [_VOID_P, c_int, c_int, _DOUBLE_P, c_int,
+                                                   _DOUBLE_P, _DOUBLE_P]),
+        "martello_model_set_ground_acceleration": (c_int, [_VOID_P, c_int, _DOUBLE_P, c_int,
+                                                           _DOUBLE_P, _DOUBLE_P]),
+        "martello_model_message": (c_int, [_VOID_P, c_char_p, c_int]),
+        "martello_static_solve": (c_int, [_VOID_P, c_double, c_int, _DOUBLE_P, _DOUBLE_P,
+                                          _DOUBLE_P, _INT_P, _INT_P, _DOUBLE_P]),
+    }
+    for name, (res, args) in protos.items():
+        fn = getattr(L, name)
+        fn.restype, fn.argtypes = res, args
+    return L
+
+
+@lru_cache(maxsize=None)
+def constant(name):
+    """A named integer constant of the kernels (law, link kind, scheme, slot, status)."""
+    value = ctypes.c_int()
+    if lib().martello_constant(name.encode(), ctypes.byref(value)) != 0:
+        raise KeyError(f"the native library has no constant {name!r}")
+    return value.value
+
+
+def version():
+    return lib().martello_version().decode()
+
+
+def library_versions():
+    buf = ctypes.create_string_buffer(256)
+    lib().martello_library_versions(buf, len(buf))
+    return buf.value.decode()
+
+
+def status_name(status):
+    return lib().martello_status_name(status).decode()
+
+
+def _f64(values, n=None):
+    a = np.ascontiguousarray(values, dtype=np.float64)
+    if n is not None and a.size != n:
+        raise ValueError(f"expected {n} values, got {a.size}")
+    return a
+
+
+class Model:
+    """Owns one native model handle; free() (or a with-block) releases it."""
+
+    def __init__(self, n_nodes, max_links, max_contacts, max_forces, max_couplings=0):
+        self._h = _VOID_P()
+        st = lib().martello_model_create(n_nodes, max_links, max_contacts, max_forces,
+                                         max_couplings, ctypes.byref(self._h))
+        if st < 0:
+            raise SolverError(st, status_name(st), "could not create the model")
+        self.n_nodes, self.n_contacts = n_nodes, 0
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        self.free()
+
+    def __del__(self):
+        self.free()
+
+    def free(self):
+        if getattr(self, "_h", None) and self._h.value:
+            lib().martello_model_free(ctypes.byref(self._h))
+
+    @property
+    def handle(self):
+        return self._h
+
+    def message(self):
+        buf = ctypes.create_string_buffer(1024)
+        lib().martello_model_message(self._h, buf, len(buf))
+        return buf.value.decode(errors="replace")
+
+    def check(self, status, what):
+        """Raise on a negative status; return the status (0 or a positive outcome)."""
+        if status < 0:
+            cls = DivergenceError if status in (constant("MARTELLO_ERR_DIVERGED"),
+                                                constant("MARTELLO_ERR_UNSTABLE")) else SolverError
+            raise cls(status, status_name(status), f"{what}: {self.message()}")
+        return status
+
+    def set_node(self, i, mass, u0=0.0, v0=0.0, fixed=False):
+        self.check(lib().martello_model_set_node(self._h, i, mass, u0, v0, int(fixed)),
+                   f"node {i}")
+
+    def add_link(self, kind, a, b, par):
+        self.check(lib().martello_model_add_link(self._h, kind, a, b,
+                                                 _f64(par, constant("NPAR_LINK"))), "link")
+
+    def add_contact(self, a, b, gap, scheme, law, par):
+        self.check(lib().martello_model_add_contact(self._h, a, b, gap, scheme, law,
+                                                    _f64(par, constant("NPAR_CONTACT"))),
+                   "contact")
+        self.n_contacts += 1
+
+    def add_mass_coupling(self, a, b, value):
+        self.check(lib().martello_model_add_mass_coupling(self._h, a, b, value), "mass coupling")
+
+    def set_gravity(self, g):
+        self.check(lib().martello_model_set_gravity(self._h, g), "gravity")
+
+    def add_nodal_force(self, node, kind, par, t=(), y=()):
+        t, y = _f64(t), _f64(y)
+        self.check(lib().martello_model_add_nodal_force(
+            self._h, node, kind, _f64(par, constant("NPAR_TF")), t.size, t, y), "nodal force")
+
+    def set_ground_acceleration(self, kind, par, t=(), y=()):
+        t, y = _f64(t), _f64(y)
+        self.check(lib().martello_model_set_ground_acceleration(
+            self._h, kind, _f64(par, constant("NPAR_TF")), t.size, t, y), "ground acceleration")
+
+    def static_solve(self, tol, max_iter):
+        """Static equilibrium with unilateral contacts; returns a dict of arrays and counters."""
+        nc = self.n_contacts
+        u = np.zeros(self.n_nodes)
+        force, pen = np.zeros(max(nc, 1)), np.zeros(max(nc, 1))
+        active = np.zeros(max(nc, 1), dtype=np.int32)
+        counters = np.zeros(3, dtype=np.int32)
+        cond = np.zeros(4)
+        st = lib().martello_static_solve(self._h, tol, max_iter, u, force, pen, active,
+                                         counters, cond)
+        self.check(st, "static analysis")
+        return {
+            "status": status_name(st),
+            "warning": self.message() if st > 0 else "",
+            "u": u, "force": force[:nc], "penetration": pen[:nc], "active": active[:nc] != 0,
+            "active_set_iterations": int(counters[0]), "uzawa_iterations": int(counters[1]),
+            "linear_solves": int(counters[2]),
+            "rcond": float(cond[0]), "digits_lost": float(cond[1]),
+            "penalty_ratio": float(cond[2]), "penalised_rcond": float(cond[3]),
+        }

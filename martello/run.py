@@ -1,0 +1,176 @@
+"""Run a scene: build the native model from a validated Scene, run its analysis, and shape
+the results as a summary dict (and, for dynamic runs, a history) ready to be written."""
+
+import json
+import time
+from pathlib import Path
+
+import numpy as np
+
+from . import native
+from .native import constant
+from .records import read_record
+
+LAW_CONST = {"linear": "LAW_LINEAR", "hertz": "LAW_HERTZ", "kelvin": "LAW_KELVIN",
+             "hunt-crossley": "LAW_HUNT_CROSSLEY", "lankarani-nikravesh": "LAW_LANKARANI_NIKRAVESH",
+             "flores": "LAW_FLORES", "gonthier": "LAW_GONTHIER", "hertzdamp": "LAW_HERTZDAMP",
+             "jankowski": "LAW_JANKOWSKI"}
+# Default exponent n of each law's elastic part F ~ δ^n.
+LAW_EXPONENT = {"linear": 1.0, "kelvin": 1.0, "hertz": 1.5, "hunt-crossley": 1.5,
+                "lankarani-nikravesh": 1.5, "flores": 1.5, "gonthier": 1.5, "hertzdamp": 1.5,
+                "jankowski": 1.5}
+SCHEME_CONST = {"penalty": "SCHEME_PENALTY", "lagrange": "SCHEME_LAGRANGE",
+                "augmented-lagrange": "SCHEME_AUGMENTED", "restitution": "SCHEME_RESTITUTION"}
+LINK_CONST = {"spring": "LINK_SPRING", "dashpot": "LINK_DASHPOT", "bilinear": "LINK_BILINEAR",
+              "fluid_damper": "LINK_FLUID_DAMPER", "bar": "LINK_BAR"}
+
+
+def effective_mass(scene, a, b):
+    """m* = m_a m_b/(m_a + m_b); a ground (or fixed) side is infinitely heavy."""
+    def m(i):
+        if i < 0 or scene.nodes[i]["fixed"]:
+            return np.inf
+        return scene.nodes[i]["mass"]
+    ma, mb = m(a), m(b)
+    if np.isinf(ma) and np.isinf(mb):
+        return np.inf
+    if np.isinf(ma):
+        return mb
+    if np.isinf(mb):
+        return ma
+    return ma * mb / (ma + mb)
+
+
+def _link_par(lk):
+    par = np.zeros(constant("NPAR_LINK"))
+    if lk["type"] == "spring":
+        par[constant("L_STIFF")] = lk["k"]
+    elif lk["type"] == "dashpot":
+        par[constant("L_DAMP")] = lk["c"]
+    elif lk["type"] == "bilinear":
+        par[constant("L_STIFF")] = lk["k"]
+        par[constant("L_YIELD")] = lk["fy"]
+        par[constant("L_HARDENING")] = lk["hardening"]
+    elif lk["type"] == "fluid_damper":
+        par[constant("L_DAMP")] = lk["c"]
+        par[constant("L_ALPHA")] = lk["alpha"]
+        par[constant("L_VREG")] = lk["v_reg"]
+    elif lk["type"] == "bar":
+        par[constant("L_STIFF")] = lk["EA"] / lk["L"]
+    return par
+
+
+def _contact_par(scene, c):
+    par = np.zeros(constant("NPAR_CONTACT"))
+    par[constant("P_RESTITUTION")] = -1.0
+    mstar = effective_mass(scene, c["a"], c["b"])
+    par[constant("P_MSTAR")] = mstar if np.isfinite(mstar) else 0.0
+    law = 0
+    if c["scheme"] == "penalty":
+        law = constant(LAW_CONST[c["law"]])
+        par[constant("P_STIFF")] = c["stiffness"]
+        par[constant("P_EXPONENT")] = c["exponent"] or LAW_EXPONENT[c["law"]]
+        if c["damping"] is not None:
+            par[constant("P_DAMPING")] = c["damping"]
+        if c["restitution"] is not None:
+            par[constant("P_RESTITUTION")] = c["restitution"]
+        par[constant("P_CLIP")] = 1.0 if c["clipped"] else 0.0
+    elif c["scheme"] == "augmented-lagrange":
+        par[constant("P_STIFF")] = c["stiffness"]
+    elif c.get("restitution") is not None:
+        par[constant("P_RESTITUTION")] = c["restitution"]
+    return law, par
+
+
+def _function_args(fn):
+    """A validated function table -> (kind, par[NPAR_TF], t, y) for the native library."""
+    par = np.zeros(constant("NPAR_TF"))
+    kind = fn["type"]
+    if kind == "constant":
+        par[0] = fn["value"]
+        return constant("TF_CONSTANT"), par, (), ()
+    if kind == "sine":
+        par[:] = [fn["amplitude"], fn["omega"], fn["phase"], fn["t_start"], fn["t_end"]]
+        return constant("TF_SINE"), par, (), ()
+    if kind in ("rectangular", "half_sine"):
+        par[:] = [fn["amplitude"], 0.0, 0.0, fn["t_start"], fn["t_end"]]
+        return constant("TF_RECTANGULAR" if kind == "rectangular" else "TF_HALF_SINE"), par, (), ()
+    if kind == "table":
+        par[0] = fn["scale"]
+        return constant("TF_TABLE"), par, fn["t"], fn["values"]
+    if kind == "record":
+        rec = read_record(fn["file"], fmt=fn["format"], units=fn["units"], scale=fn["scale"])
+        par[0] = 1.0
+        return constant("TF_TABLE"), par, rec.t, rec.accel
+    raise AssertionError(kind)
+
+
+def build_model(scene):
+    """A native Model holding the scene (the caller frees it, or uses a with-block)."""
+    m = native.Model(len(scene.nodes), len(scene.links), len(scene.contacts), len(scene.forces))
+    for i, n in enumerate(scene.nodes):
+        m.set_node(i, n["mass"], n["u0"], n["v0"], n["fixed"])
+    for lk in scene.links:
+        m.add_link(constant(LINK_CONST[lk["type"]]), lk["a"], lk["b"], _link_par(lk))
+    for c in scene.contacts:
+        law, par = _contact_par(scene, c)
+        m.add_contact(c["a"], c["b"], c["gap"], constant(SCHEME_CONST[c["scheme"]]), law, par)
+    m.set_gravity(scene.gravity)
+    for f in scene.forces:
+        m.add_nodal_force(f["node"], *_function_args(f["function"]))
+    if scene.ground is not None:
+        m.set_ground_acceleration(*_function_args(scene.ground))
+    return m
+
+
+def provenance(scene):
+    return {"martello_version": native.version(), "libraries": native.library_versions(),
+            "scene_file": scene.source, "scene_sha256": scene.digest,
+            "date": time.strftime("%Y-%m-%dT%H:%M:%SZ", time.gmtime())}
+
+
+def run(scene):
+    """Run the scene's analysis; return the summary dict (JSON-ready)."""
+    with build_model(scene) as model:
+        if scene.analysis["type"] == "static":
+            return _static(scene, model)
+    raise AssertionError(scene.analysis["type"])
+
+
+def _static(scene, model):
+    t0 = time.perf_counter()
+    r = model.static_solve(scene.analysis["tol"], scene.analysis["max_iter"])
+    wall = time.perf_counter() - t0
+    contacts = {}
+    for j, c in enumerate(scene.contacts):
+        contacts[c["name"]] = {
+            "scheme": c["scheme"], "force": float(r["force"][j]),
+            "lambda": float(-r["force"][j]),  # the seed's sign: λ < 0 in compression
+            "penetration": float(r["penetration"][j]), "active": bool(r["active"][j])}
+    return {
+        "title": scene.title, "problem": scene.problem,
+        "analysis": dict(scene.analysis),
+        "status": r["status"],
+        "warnings": [r["warning"]] if r["warning"] else [],
+        "nodes": {n["name"]: {"u": float(r["u"][i])} for i, n in enumerate(scene.nodes)},
+        "contacts": contacts,
+        "conditioning": {"rcond": r["rcond"],
+                         "condition_estimate": (1.0 / r["rcond"]) if r["rcond"] > 0 else None,
+                         "digits_lost": r["digits_lost"],
+                         "penalty_ratio": r["penalty_ratio"],
+                         "penalised_stiffness_condition": (1.0 / r["penalised_rcond"])
+                         if r["penalised_rcond"] > 0 else None},
+        "cost": {"active_set_iterations": r["active_set_iterations"],
+                 "uzawa_iterations": r["uzawa_iterations"], "linear_solves": r["linear_solves"],
+                 "wall_time_s": wall},
+        "provenance": provenance(scene),
+    }
+
+
+def write_results(summary, outdir):
+    outdir = Path(outdir)
+    outdir.mkdir(parents=True, exist_ok=True)
+    with open(outdir / "summary.json", "w") as fh:
+        json.dump(summary, fh, indent=2, allow_nan=False, default=float)
+        fh.write("\n")
+    return outdir / "summary.json"
