@@ -98,6 +98,47 @@ int martello_static_solve(martello_model *model, double tol, int max_iter, doubl
                           double *force, double *penetration, int *active, int *counters,
                           double *conditioning);
 
+/* ---- dynamic analysis --------------------------------------------------------------- */
+/* Lifecycle: martello_run_create -> martello_run_set_integrator (-> _set_outputs)
+ * -> martello_dynamic_run(model, run) -> martello_run_* getters -> martello_run_free.
+ * A failed run (status < 0: diverged, unstable, Newton not converged ...) keeps what it
+ * computed up to the failure for diagnosis; martello_run_message() says where and why. */
+typedef struct martello_run martello_run;
+
+enum { MARTELLO_INT_NEWMARK = 1, MARTELLO_INT_HHT = 2, MARTELLO_INT_GENERALIZED_ALPHA = 3,
+       MARTELLO_INT_CENTRAL_DIFFERENCE = 4 };
+/* Slots of the integrator parameter array (0-based). */
+enum { MARTELLO_NPAR_INTEGRATOR = 12, MARTELLO_R_DT = 0, MARTELLO_R_T_END = 1,
+       MARTELLO_R_BETA = 2, MARTELLO_R_GAMMA = 3, MARTELLO_R_ALPHA = 4, MARTELLO_R_RHO_INF = 5,
+       MARTELLO_R_TOL_RESIDUAL = 6, MARTELLO_R_TOL_INCREMENT = 7, MARTELLO_R_MAX_NEWTON = 8,
+       MARTELLO_R_CHECK_STABILITY = 9, MARTELLO_R_EVERY = 10, MARTELLO_R_DIVERGENCE_FACTOR = 11 };
+enum { MARTELLO_NCOUNTERS = 8, MARTELLO_NENERGY = 9, MARTELLO_NEVENT = 6 };
+
+int martello_run_create(martello_run **run);
+void martello_run_free(martello_run **run);
+int martello_run_set_integrator(martello_run *run, int kind,
+                                const double par[MARTELLO_NPAR_INTEGRATOR]);
+int martello_run_set_outputs(martello_run *run, int n_nodes, const int *nodes, int n_contacts,
+                             const int *contacts);
+int martello_dynamic_run(martello_model *model, martello_run *run);
+int martello_run_message(const martello_run *run, char *buf, int buflen);
+/* History: rows records of cols values, record after record: t, then u, v, a of each output
+ * node (all u first, then all v, then all a), then penetration and force of each output
+ * contact, then the MARTELLO_NENERGY energy terms. */
+int martello_run_history_shape(const martello_run *run, int *rows, int *cols);
+int martello_run_history(const martello_run *run, double *buf);
+/* Contact phases: n on return; with non-NULL arrays also contact[n] and
+ * values[n][6] = {t_on, t_off (-1: open at the end), v_in, v_out, max penetration, max force}. */
+int martello_run_events(const martello_run *run, int *n, int *contacts, double *values);
+/* counters = {steps, rejected steps, Newton iterations, residual evaluations,
+ * factorizations, events, Jacobian evaluations, root-function evaluations} */
+int martello_run_counters(const martello_run *run, long long counters[MARTELLO_NCOUNTERS]);
+int martello_run_peaks(const martello_run *run, double *u_max, double *u_min, double *v_absmax,
+                       double *a_absmax, double *pen_max, double *force_max, int *impacts);
+/* energy = {kinetic, recoverable, input work, damping, plastic, contact dissipation, balance,
+ * initial, impact}; extra = {max |balance|, omega_max, dt_crit (explicit), time reached} */
+int martello_run_energy(const martello_run *run, double energy[MARTELLO_NENERGY], double extra[4]);
+
 #ifdef __cplusplus
 }
 #endif

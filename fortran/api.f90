@@ -10,9 +10,25 @@ module martello_api
    use martello_time_functions
    use martello_contact_laws
    use martello_links
+   use martello_structural_integrators
+   use martello_results
    implicit none
    private
    public :: c_model_create, c_model_free
+
+   !> Slots of the integrator parameter array of martello_run_set_integrator (0-based in C).
+   integer, parameter :: NPAR_INTEGRATOR = 12
+   integer, parameter :: R_DT = 1, R_T_END = 2, R_BETA = 3, R_GAMMA = 4, R_ALPHA = 5, &
+                         R_RHO_INF = 6, R_TOL_RESIDUAL = 7, R_TOL_INCREMENT = 8, &
+                         R_MAX_NEWTON = 9, R_CHECK_STABILITY = 10, R_EVERY = 11, &
+                         R_DIVERGENCE_FACTOR = 12
+
+   type :: run_t
+      type(integrator_settings_t) :: settings
+      type(results_t) :: results
+      integer, allocatable :: out_nodes(:), out_contacts(:)
+      logical :: configured = .false., done = .false.
+   end type run_t
 
 contains
 
@@ -206,6 +222,235 @@ contains
       c_static_solve = stat
    end function c_static_solve
 
+   function get_run(handle) result(rp)
+      type(c_ptr), value :: handle
+      type(run_t), pointer :: rp
+      rp => null()
+      if (c_associated(handle)) call c_f_pointer(handle, rp)
+   end function get_run
+
+   integer(c_int) function c_run_create(handle) bind(C, name='martello_run_create')
+      type(c_ptr), intent(out) :: handle
+      type(run_t), pointer :: rp
+      integer :: stat
+      handle = c_null_ptr
+      allocate (rp, stat=stat)
+      if (stat /= 0) then
+         c_run_create = MARTELLO_ERR_MEMORY; return
+      end if
+      allocate (rp%out_nodes(0), rp%out_contacts(0))
+      handle = c_loc(rp)
+      c_run_create = MARTELLO_OK
+   end function c_run_create
+
+   subroutine c_run_free(handle) bind(C, name='martello_run_free')
+      type(c_ptr), intent(inout) :: handle
+      type(run_t), pointer :: rp
+      rp => get_run(handle)
+      if (associated(rp)) deallocate (rp)
+      handle = c_null_ptr
+   end subroutine c_run_free
+
+   integer(c_int) function c_run_set_integrator(handle, kind, par) &
+      bind(C, name='martello_run_set_integrator')
+      type(c_ptr), value :: handle
+      integer(c_int), value :: kind
+      real(c_double), intent(in) :: par(NPAR_INTEGRATOR)
+      type(run_t), pointer :: rp
+      rp => get_run(handle)
+      c_run_set_integrator = MARTELLO_ERR_ARGUMENT
+      if (.not. associated(rp)) return
+      if (kind < INT_NEWMARK .or. kind > INT_CENTRAL_DIFFERENCE) then
+         rp%results%message = 'set_integrator: unknown integrator kind'; return
+      end if
+      if (.not. (par(R_DT) > 0.0_dp .and. par(R_T_END) > 0.0_dp .and. par(R_EVERY) >= 1.0_dp &
+                 .and. par(R_MAX_NEWTON) >= 1.0_dp .and. par(R_TOL_RESIDUAL) > 0.0_dp &
+                 .and. par(R_TOL_INCREMENT) > 0.0_dp .and. par(R_DIVERGENCE_FACTOR) > 1.0_dp)) then
+         rp%results%message = 'set_integrator: need dt, t_end, tolerances > 0, every and'// &
+            ' max_newton >= 1, divergence_factor > 1'
+         return
+      end if
+      if (kind == INT_NEWMARK .and. .not. (par(R_GAMMA) >= 0.0_dp .and. par(R_BETA) >= 0.0_dp)) then
+         rp%results%message = 'set_integrator: Newmark needs beta >= 0 and gamma >= 0'; return
+      end if
+      if (kind == INT_NEWMARK .and. par(R_BETA) == 0.0_dp) then
+         rp%results%message = 'set_integrator: Newmark with beta = 0 is explicit: use'// &
+            ' central-difference (lumped mass, lagged damping velocity)'
+         c_run_set_integrator = MARTELLO_ERR_UNSUPPORTED; return
+      end if
+      if (kind == INT_HHT .and. .not. (par(R_ALPHA) >= -1.0_dp/3.0_dp .and. par(R_ALPHA) <= 0.0_dp)) then
+         rp%results%message = 'set_integrator: HHT alpha must lie in [-1/3, 0]'; return
+      end if
+      if (kind == INT_GENERALIZED_ALPHA .and. .not. (par(R_RHO_INF) >= 0.0_dp .and. par(R_RHO_INF) <= 1.0_dp)) then
+         rp%results%message = 'set_integrator: generalized-alpha rho_inf must lie in [0, 1]'; return
+      end if
+      rp%settings%kind = kind
+      rp%settings%dt = par(R_DT); rp%settings%t_end = par(R_T_END)
+      rp%settings%beta = par(R_BETA); rp%settings%gamma = par(R_GAMMA)
+      rp%settings%alpha = par(R_ALPHA); rp%settings%rho_inf = par(R_RHO_INF)
+      rp%settings%tol_residual = par(R_TOL_RESIDUAL); rp%settings%tol_increment = par(R_TOL_INCREMENT)
+      rp%settings%max_newton = nint(par(R_MAX_NEWTON))
+      rp%settings%check_stability = par(R_CHECK_STABILITY) /= 0.0_dp
+      rp%settings%every = nint(par(R_EVERY))
+      rp%settings%divergence_factor = par(R_DIVERGENCE_FACTOR)
+      rp%configured = .true.
+      c_run_set_integrator = MARTELLO_OK
+   end function c_run_set_integrator
+
+   !> Which nodes and contacts the history records (0-based); the peaks cover all of them.
+   integer(c_int) function c_run_set_outputs(handle, nn, nodes, nc, contacts) &
+      bind(C, name='martello_run_set_outputs')
+      type(c_ptr), value :: handle
+      integer(c_int), value :: nn, nc
+      integer(c_int), intent(in) :: nodes(*), contacts(*)
+      type(run_t), pointer :: rp
+      rp => get_run(handle)
+      c_run_set_outputs = MARTELLO_ERR_ARGUMENT
+      if (.not. associated(rp) .or. nn < 0 .or. nc < 0) return
+      rp%out_nodes = nodes(1:nn) + 1
+      rp%out_contacts = contacts(1:nc) + 1
+      c_run_set_outputs = MARTELLO_OK
+   end function c_run_set_outputs
+
+   integer(c_int) function c_dynamic_run(mhandle, rhandle) bind(C, name='martello_dynamic_run')
+      type(c_ptr), value :: mhandle, rhandle
+      type(model_t), pointer :: mp
+      type(run_t), pointer :: rp
+      integer :: stat, cap
+      mp => get_model(mhandle); rp => get_run(rhandle)
+      c_dynamic_run = MARTELLO_ERR_ARGUMENT
+      if (.not. associated(mp) .or. .not. associated(rp)) return
+      if (.not. rp%configured) then
+         rp%results%message = 'dynamic_run: call martello_run_set_integrator first'
+         c_dynamic_run = MARTELLO_ERR_STATE; return
+      end if
+      if (any(rp%out_nodes < 1 .or. rp%out_nodes > mp%n) .or. &
+          any(rp%out_contacts < 1 .or. rp%out_contacts > mp%ncontact)) then
+         rp%results%message = 'dynamic_run: an output node or contact is out of range'; return
+      end if
+      cap = int(min(rp%settings%t_end/rp%settings%dt/rp%settings%every + 3.0_dp, 1.0e7_dp))
+      call results_init(rp%results, mp%n, mp%ncontact, rp%out_nodes, rp%out_contacts, cap)
+      call run_structural(mp, rp%settings, rp%results, stat)
+      rp%done = .true.
+      c_dynamic_run = stat
+   end function c_dynamic_run
+
+   integer(c_int) function c_run_message(handle, buf, buflen) bind(C, name='martello_run_message')
+      type(c_ptr), value :: handle
+      integer(c_int), value :: buflen
+      character(kind=c_char), intent(out) :: buf(*)
+      type(run_t), pointer :: rp
+      integer :: i, n
+      rp => get_run(handle)
+      c_run_message = MARTELLO_ERR_ARGUMENT
+      if (.not. associated(rp) .or. buflen < 1) return
+      n = min(len_trim(rp%results%message), int(buflen) - 1)
+      do i = 1, n
+         buf(i) = rp%results%message(i:i)
+      end do
+      buf(n + 1) = c_null_char
+      c_run_message = MARTELLO_OK
+   end function c_run_message
+
+   integer(c_int) function c_run_history_shape(handle, rows, cols) bind(C, name='martello_run_history_shape')
+      type(c_ptr), value :: handle
+      integer(c_int), intent(out) :: rows, cols
+      type(run_t), pointer :: rp
+      rp => get_run(handle)
+      rows = 0; cols = 0
+      c_run_history_shape = MARTELLO_ERR_ARGUMENT
+      if (.not. associated(rp)) return
+      rows = rp%results%nrec; cols = rp%results%ncol
+      c_run_history_shape = MARTELLO_OK
+   end function c_run_history_shape
+
+   !> The history, one record after the other (C row-major rows × cols).
+   integer(c_int) function c_run_history(handle, buf) bind(C, name='martello_run_history')
+      type(c_ptr), value :: handle
+      real(c_double), intent(out) :: buf(*)
+      type(run_t), pointer :: rp
+      integer :: nr, nc
+      rp => get_run(handle)
+      c_run_history = MARTELLO_ERR_ARGUMENT
+      if (.not. associated(rp)) return
+      nr = rp%results%nrec; nc = rp%results%ncol
+      if (nr > 0) buf(1:nr*nc) = reshape(rp%results%hist(:, 1:nr), [nr*nc])
+      c_run_history = MARTELLO_OK
+   end function c_run_history
+
+   !> Contact phases: n on return; if contacts is not NULL also contact[n] (0-based) and
+   !> values[n][6] = {t_on, t_off (−1: still open at the end), v_in, v_out, max δ, max P}.
+   integer(c_int) function c_run_events(handle, n, contacts, values) bind(C, name='martello_run_events')
+      type(c_ptr), value :: handle
+      integer(c_int), intent(out) :: n
+      type(c_ptr), value :: contacts, values
+      type(run_t), pointer :: rp
+      integer(c_int), pointer :: ic(:)
+      real(c_double), pointer :: vals(:, :)
+      rp => get_run(handle)
+      n = 0
+      c_run_events = MARTELLO_ERR_ARGUMENT
+      if (.not. associated(rp)) return
+      n = rp%results%nevents
+      if (c_associated(contacts) .and. n > 0) then
+         call c_f_pointer(contacts, ic, [n])
+         ic = rp%results%ev_contact(1:n) - 1
+      end if
+      if (c_associated(values) .and. n > 0) then
+         call c_f_pointer(values, vals, [NEVENT, n])
+         vals = rp%results%ev(:, 1:n)
+      end if
+      c_run_events = MARTELLO_OK
+   end function c_run_events
+
+   !> counters[8] = {steps, rejected steps, Newton iterations, residual evaluations,
+   !> factorizations, events, Jacobian evaluations, root-function evaluations}
+   integer(c_int) function c_run_counters(handle, counters) bind(C, name='martello_run_counters')
+      type(c_ptr), value :: handle
+      integer(c_long_long), intent(out) :: counters(NCOUNTERS)
+      type(run_t), pointer :: rp
+      rp => get_run(handle)
+      c_run_counters = MARTELLO_ERR_ARGUMENT
+      if (.not. associated(rp)) return
+      counters = rp%results%counters
+      c_run_counters = MARTELLO_OK
+   end function c_run_counters
+
+   integer(c_int) function c_run_peaks(handle, u_max, u_min, v_absmax, a_absmax, pen_max, &
+                                       force_max, impacts) bind(C, name='martello_run_peaks')
+      type(c_ptr), value :: handle
+      real(c_double), intent(out) :: u_max(*), u_min(*), v_absmax(*), a_absmax(*), pen_max(*), &
+                                     force_max(*)
+      integer(c_int), intent(out) :: impacts(*)
+      type(run_t), pointer :: rp
+      integer :: n, nc
+      rp => get_run(handle)
+      c_run_peaks = MARTELLO_ERR_ARGUMENT
+      if (.not. associated(rp)) return
+      if (.not. allocated(rp%results%u_max)) return
+      n = size(rp%results%u_max); nc = size(rp%results%pen_max)
+      u_max(1:n) = rp%results%u_max; u_min(1:n) = rp%results%u_min
+      v_absmax(1:n) = rp%results%v_absmax; a_absmax(1:n) = rp%results%a_absmax
+      pen_max(1:nc) = rp%results%pen_max; force_max(1:nc) = rp%results%force_max
+      impacts(1:nc) = rp%results%impacts
+      c_run_peaks = MARTELLO_OK
+   end function c_run_peaks
+
+   !> energy[9] = {kinetic, recoverable, input, damping, plastic, contact, balance, initial,
+   !> impact}; extra[4] = {max |balance| over the run, omega_max, dt_crit, t reached}
+   integer(c_int) function c_run_energy(handle, energy, extra) bind(C, name='martello_run_energy')
+      type(c_ptr), value :: handle
+      real(c_double), intent(out) :: energy(NENERGY), extra(4)
+      type(run_t), pointer :: rp
+      rp => get_run(handle)
+      c_run_energy = MARTELLO_ERR_ARGUMENT
+      if (.not. associated(rp)) return
+      energy = rp%results%energy
+      extra = [rp%results%energy_balance_max, rp%results%omega_max, rp%results%dt_critical, &
+               rp%results%t_end_reached]
+      c_run_energy = MARTELLO_OK
+   end function c_run_energy
+
    !> Named integer constants of the kernels (laws, links, schemes, parameter slots, status
    !> codes): one source of truth for C and Python. Returns MARTELLO_ERR_ARGUMENT if unknown.
    integer(c_int) function c_constant(cname, value) bind(C, name='martello_constant')
@@ -258,6 +503,26 @@ contains
       case ('TF_RECTANGULAR'); v = TF_RECTANGULAR
       case ('TF_HALF_SINE'); v = TF_HALF_SINE
       case ('NPAR_TF'); v = NPAR_TF
+      case ('INT_NEWMARK'); v = INT_NEWMARK
+      case ('INT_HHT'); v = INT_HHT
+      case ('INT_GENERALIZED_ALPHA'); v = INT_GENERALIZED_ALPHA
+      case ('INT_CENTRAL_DIFFERENCE'); v = INT_CENTRAL_DIFFERENCE
+      case ('NPAR_INTEGRATOR'); v = NPAR_INTEGRATOR
+      case ('R_DT'); v = R_DT - 1
+      case ('R_T_END'); v = R_T_END - 1
+      case ('R_BETA'); v = R_BETA - 1
+      case ('R_GAMMA'); v = R_GAMMA - 1
+      case ('R_ALPHA'); v = R_ALPHA - 1
+      case ('R_RHO_INF'); v = R_RHO_INF - 1
+      case ('R_TOL_RESIDUAL'); v = R_TOL_RESIDUAL - 1
+      case ('R_TOL_INCREMENT'); v = R_TOL_INCREMENT - 1
+      case ('R_MAX_NEWTON'); v = R_MAX_NEWTON - 1
+      case ('R_CHECK_STABILITY'); v = R_CHECK_STABILITY - 1
+      case ('R_EVERY'); v = R_EVERY - 1
+      case ('R_DIVERGENCE_FACTOR'); v = R_DIVERGENCE_FACTOR - 1
+      case ('NCOUNTERS'); v = NCOUNTERS
+      case ('NENERGY'); v = NENERGY
+      case ('NEVENT'); v = NEVENT
       case ('MARTELLO_OK'); v = MARTELLO_OK
       case ('MARTELLO_ILL_CONDITIONED'); v = MARTELLO_ILL_CONDITIONED
       case ('MARTELLO_ROOT_FOUND'); v = MARTELLO_ROOT_FOUND

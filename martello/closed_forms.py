@@ -23,7 +23,6 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
-from typing import Callable, Optional, Sequence, Union
 
 import numpy as np
 from scipy import integrate, optimize, special
@@ -230,6 +229,19 @@ def _atan_exp_deriv(y, n):
     return float(P(y) / Q(y) ** n)
 
 
+def _neumaier_cumsum(x):
+    """[0, x0, x0+x1, ...]: compensated (Neumaier) running sums, O(n), error ~1 ulp."""
+    out = np.empty(len(x) + 1)
+    out[0] = 0.0
+    s = comp = 0.0
+    for i, xi in enumerate(np.asarray(x, float).tolist()):
+        tt = s + xi
+        comp += (s - tt) + xi if abs(s) >= abs(xi) else (xi - tt) + s
+        s = tt
+        out[i + 1] = s + comp
+    return out
+
+
 def bouncing_oscillator_restitution(m, k, h, g, e, n_impacts, u0=0.0, v0=0.0) -> BounceSequence:
     """P2, restitution law (PROBLEMS.md "P2 - Mass on a rigid plane, dynamic").
 
@@ -245,7 +257,8 @@ def bouncing_oscillator_restitution(m, k, h, g, e, n_impacts, u0=0.0, v0=0.0) ->
             = (2/w) (pi - atan(e v_n/(w (h - u_s))))           if u_s < h  (no Zeno)
 
     zeno_time is t_1 + sum tau_n, summed to convergence. It is t_1 for e = 0 and inf for
-    e = 1 or when u_s <= h. resting_force is k h - m g after the Zeno point (the P1 Lagrange
+    e = 1 or when u_s <= h. For e = 0 with u_s > h, only the first (sticking) impact is
+    returned. resting_force is k h - m g after the Zeno point (the P1 Lagrange
     value), and 0 when there is no resting phase. If the plane is never reached, the arrays
     are empty and zeno_time is inf.
     """
@@ -264,9 +277,11 @@ def bouncing_oscillator_restitution(m, k, h, g, e, n_impacts, u0=0.0, v0=0.0) ->
     dist = us - h
     n = int(n_impacts)
     v = v1 * e ** np.arange(n, dtype=float)
+    if e == 0.0 and dist > 0.0:
+        n = min(n, 1)                 # plastic impact against a pressing load: it sticks at t_1
+        v = v[:n]
     tau = _flight_tau(w, dist, e * v[:-1]) if n > 1 else empty
-    # t_n = t_1 + sum_{i<n} tau_i, every partial sum correctly rounded (fsum)
-    t = np.array([t1 + math.fsum(tau[:i]) for i in range(n)])
+    t = t1 + _neumaier_cumsum(tau) if n >= 1 else empty
     zeno = math.inf
     resting = 0.0
     if dist > 0.0 and e < 1.0:
@@ -323,7 +338,7 @@ class KelvinBounce:
     max_penetration: np.ndarray  #: max(u - h) during each contact phase (m)
     t_max_penetration: np.ndarray  #: time of that maximum (s)
     persistent_contact: bool   #: the last contact phase never ends (mass settles on the plane)
-    end_reason: str            #: "persistent_contact" | "n_impacts" | "no_impact" | "escaped"
+    end_reason: str            #: "persistent_contact" | "n_impacts" | "no_impact" | "escaped" | "max_phases"
     phases: tuple = field(repr=False, default=())  #: (t0, kind, x0, v0, params) per phase
     u_rest: float = math.nan   #: static equilibrium in contact, (m g + eps h)/(k + eps)
 
@@ -627,6 +642,10 @@ def bouncing_oscillator_kelvin(m, k, h, g, eps, c, n_impacts, clipped=False, u0=
             ts.append(t)
             vout.append(v)
             in_contact = False
+    else:
+        reason = "max_phases"
+        if phases:
+            phases[-1][4].setdefault("t_end", t)
     return KelvinBounce(np.array(ti), np.array(ts), np.array(vin), np.array(vout),
                         np.array(dmax), np.array(tdmax), persistent, reason, tuple(phases),
                         float(u_c))
@@ -802,13 +821,26 @@ def kelvin_clipped_restitution(xi):
     positive root is theta* = atan2(2 xi nu, 2 xi^2 - 1), which equals PROBLEMS.md's
     pi - atan(2 xi nu/(1 - 2 xi^2)) for xi < 1/sqrt(2) and holds for all xi < 1. Then
     e_F0 = -delta'(theta*)/v0 = exp(-xi theta*/nu) [(xi/nu) sin theta* - cos theta*].
-    Overdamped contact (xi >= 1) is not handled (ValueError).
+    Overdamped contact (xi > 1) is the analytic continuation nu = i nu~, theta = i theta~:
+    tanh(theta~) = 2 xi nu~/(2 xi^2 - 1), where the ratio is < 1 because
+    (2 xi^2 - 1)^2 - 4 xi^2 (xi^2 - 1) = 1, and
+    e_F0 = exp(-xi theta~/nu~) [(xi/nu~) sinh theta~ - cosh theta~].
+    Critical damping (xi = 1) is the common limit, e^{-2}. (The unclipped law never
+    separates for xi >= 1.)
     """
-    if not (0.0 <= xi < 1.0):
-        raise ValueError("kelvin_clipped_restitution needs 0 <= xi < 1")
-    nu = math.sqrt(1.0 - xi * xi)
-    th = math.atan2(2.0 * xi * nu, 2.0 * xi * xi - 1.0)
-    return math.exp(-xi * th / nu) * ((xi / nu) * math.sin(th) - math.cos(th))
+    if xi < 0.0:
+        raise ValueError("xi must be >= 0")
+    if xi == 1.0:
+        return math.exp(-2.0)
+    if xi < 1.0:
+        nu = math.sqrt(1.0 - xi * xi)
+        th = math.atan2(2.0 * xi * nu, 2.0 * xi * xi - 1.0)
+        return math.exp(-xi * th / nu) * ((xi / nu) * math.sin(th) - math.cos(th))
+    nu = math.sqrt((xi - 1.0) * (xi + 1.0))
+    th = math.atanh(2.0 * xi * nu / (2.0 * xi * xi - 1.0))
+    # exp(-xi th/nu) * cosh th overflows for huge xi; fold the exponentials together
+    return 0.5 * (math.exp(th - xi * th / nu) * (xi / nu - 1.0)
+                  - math.exp(-th - xi * th / nu) * (xi / nu + 1.0))
 
 
 def linear_contact_time(mstar, k):
@@ -835,15 +867,18 @@ def hertz_impact(mstar, kh, v0) -> HertzImpact:
     return HertzImpact(dm, HERTZ_TC_CONSTANT * dm / v0, kh * dm ** 1.5)
 
 
-def _hc_q(a, e):
-    """q(a, e) = [ln((1+a)/(1-e a)) - (1+e) a]/a^2, without cancellation.
-    For small a it uses the series sum_{j>=2} a^{j-2} ((-1)^{j+1} + e^j)/j."""
+def _hc_q(a, e, z):
+    """q = [ln(1+a) - ln(1 - e a) - (1+e) a]/a^2 with z = ln(1 - e a) supplied exactly.
+
+    Solving in z keeps the digits of 1 - e a, which is ~e^{-a} when a >> 1. For small a
+    the series sum_{j>=2} a^{j-2} ((-1)^{j+1} + e^j)/j is used, which removes the O(a)
+    cancellation."""
     if a * max(1.0, e) < 0.1:
         s = 0.0
         for j in range(40, 1, -1):
             s = s * a + ((-1.0) ** (j + 1) + e ** j) / j
         return s
-    return (math.log1p(a) - math.log1p(-e * a) - (1.0 + e) * a) / (a * a)
+    return (math.log1p(a) - z - (1.0 + e) * a) / (a * a)
 
 
 def hunt_crossley_realised_e(a):
@@ -851,31 +886,35 @@ def hunt_crossley_realised_e(a):
     exact realised e, the root of (1+e) a = ln[(1+a)/(1 - e a)] with 0 < e < min(1, 1/a).
     It depends on a only (not on n, K, m*).
     Derivation: m* v dv = -K delta^n (1 + chi v) d delta integrates to
-    (m*/chi^2)[chi v - ln(1 + chi v)] + K delta^{n+1}/(n+1) = const."""
+    (m*/chi^2)[chi v - ln(1 + chi v)] + K delta^{n+1}/(n+1) = const.
+    The unknown is z = ln(1 - e a) in (z_lo, 0), so e = -expm1(z)/a. Brentq on z works
+    for any a: for a >> 1, e = (1 - O(e^{-a}))/a, and the distance to 1/a is kept in z."""
     if a < 0:
         raise ValueError("a = chi v0 must be >= 0")
     if a == 0.0:
         return 1.0
-    hi = min(1.0, (1.0 / a) * (1.0 - 1e-16)) if a > 1 else 1.0
-    f = lambda e: _hc_q(a, e)
-    if f(hi) <= 0.0:       # only when e is so close to 1/a that log1p overflows its range
-        hi = hi * (1 - 1e-15)
-    return optimize.brentq(f, 0.0, hi, xtol=1e-300, rtol=4 * _EPS, maxiter=500)
+    ez = lambda z: -math.expm1(z) / a
+    f = lambda z: _hc_q(a, ez(z), z)           # < 0 at z = 0 (e = 0); > 0 at e = min(1, 1/a)
+    z_lo = math.log1p(-a) if a < 1.0 else -(2.0 * a + 50.0)
+    z = optimize.brentq(f, z_lo, 0.0, xtol=1e-300, rtol=4 * _EPS, maxiter=500)
+    return ez(z)
 
 
 def hunt_crossley_exact_factor(e):
     """Inverse of :func:`hunt_crossley_realised_e`: the a = chi v0 that realises e exactly.
-    Returns inf for e = 0 and 0 for e = 1."""
+    Returns inf for e = 0 and 0 for e = 1. Solved in z = ln(1 - e a) with
+    a = -expm1(z)/e. q < 0 as z -> 0- (q -> (e^2-1)/2), and q > 0 as z -> -inf (a -> 1/e),
+    so z = 0 (the trivial root a = 0) is never returned."""
     if not (0.0 <= e <= 1.0):
         raise ValueError("e must lie in [0, 1]")
     if e == 1.0:
         return 0.0
     if e == 0.0:
         return math.inf
-    f = lambda a: _hc_q(a, e)          # q(0+) = (e^2 - 1)/2 < 0; q -> +inf as a -> 1/e
-    hi = (1.0 / e) * (1.0 - 1e-15)
-    lo = 0.0
-    return optimize.brentq(f, lo, hi, xtol=1e-300, rtol=4 * _EPS, maxiter=500)
+    az = lambda z: -math.expm1(z) / e
+    f = lambda z: _hc_q(az(z), e, z)
+    z = optimize.brentq(f, -(2.0 / e + 50.0), 0.0, xtol=1e-300, rtol=4 * _EPS, maxiter=500)
+    return az(z)
 
 
 def hc_factor_hunt_crossley(e):
@@ -944,7 +983,7 @@ def jankowski_realised_e(xi, rtol=1e-13):
     (p = 1) to p = 1/2. Then s is used as a function of p, ds/dp = p/(-4 s^9 - 8 xi s^4 p),
     which is smooth for s > 0 down to p = 0, where s = s_m = x_m^{1/4}. Both legs use
     DOP853 with rtol 1e-13 and atol 1e-16. The result agrees with a direct time integration
-    to ~1e-11 (see the tests)."""
+    to ~1e-12 (see the tests)."""
     if xi == 0.0:
         return 1.0
     if xi < 0:

@@ -36,10 +36,10 @@ def test_p1_lagrange_example():
 
 def test_p1_penalty_example():
     r = cf.mass_on_plane_static(M, K, H, G, "penalty", eps=1e4)
-    # PROBLEMS.md quotes u = 0.0504762376... (10 significant digits shown) -> 1e-12 abs
-    assert r.u == pytest.approx(0.0504762376, abs=1e-12)
-    # lam = -4.7623762376... (11 significant digits shown) -> 1e-10 abs
-    assert r.lam == pytest.approx(-4.7623762376, abs=1e-10)
+    # PROBLEMS.md quotes u = 0.0504762376... (truncated, "..."): within one unit of the last digit
+    assert 0 <= r.u - 0.0504762376 < 1e-10   # last quoted digit is the 10th decimal
+    # lam = -4.7623762376... (truncated): within one unit of the last quoted digit
+    assert 0 <= -r.lam - 4.7623762376 < 1e-10   # last quoted digit is the 10th decimal
     # exact rational values 509.81/10100 and -48.1/10.1: closed form evaluated in a few flops
     assert r.u == pytest.approx(509.81 / 10100, rel=4e-16)
     assert r.lam == pytest.approx(-48.1 / 10.1, rel=1e-14)
@@ -91,9 +91,11 @@ def test_p2_zeno_limit_of_partial_sums():
     # after 400 impacts the remaining flight time is ~ tau_1 0.8^400/(1-0.8) ~ 1e-39: only
     # summation round-off separates t_400 from t_inf (a few ulps of 1.3)
     assert r.t[-1] == pytest.approx(r.zeno_time, abs=1e-15)
-    assert np.all(np.diff(r.t) > 0)
+    # strictly increasing while tau_n (~0.19*0.8^n) exceeds an ulp of 1.3; never decreasing
+    assert np.all(np.diff(r.t[:100]) > 0) and np.all(np.diff(r.t) >= 0)
     # e = 0: sticks at the first impact; e = 1: no Zeno
-    assert cf.bouncing_oscillator_restitution(M, K, H, G, 0.0, 3).zeno_time == r.t[0]
+    r0 = cf.bouncing_oscillator_restitution(M, K, H, G, 0.0, 3)
+    assert r0.zeno_time == r.t[0] and len(r0.t) == 1      # plastic impact: sticks at t_1
     assert math.isinf(cf.bouncing_oscillator_restitution(M, K, H, G, 1.0, 3).zeno_time)
 
 
@@ -193,6 +195,46 @@ def test_kelvin_free_impact_unclipped_and_clipped_restitution():
         # at clipped separation the force eps*delta + c*delta' vanishes (relative to c v0)
         u, v = kc.evaluate(kc.t_separation[0])
         assert abs(eps * u[0] + c * v[0]) < 1e-12 * c * 1.3   # cancellation of two O(c v0) terms
+
+
+def test_kelvin_clipped_overdamped_and_critical():
+    """xi >= 1: the hyperbolic continuation of e_F0 against the semi-analytic free impact,
+    continuity through xi = 1 (limit e^{-2}), and the unclipped law never separating."""
+    for xi in (1.5, 3.0):
+        eps = 1e5
+        c = cf.kelvin_damping(eps, 1.0, xi)
+        kc = cf.bouncing_oscillator_kelvin(1.0, 0.0, 0.0, 0.0, eps, c, 3, u0=-0.1, v0=1.3,
+                                           clipped=True)
+        # brentq root on the closed form vs the hyperbolic formula: 1e-11 (e ~ 0.02-0.08)
+        assert -kc.v_out[0] / kc.v_in[0] == pytest.approx(cf.kelvin_clipped_restitution(xi),
+                                                          rel=1e-11)
+        ku = cf.bouncing_oscillator_kelvin(1.0, 0.0, 0.0, 0.0, eps, c, 3, u0=-0.1, v0=1.3)
+        assert ku.persistent_contact           # overdamped Kelvin creeps back, never separates
+    # the xi = 1 limit e^{-2} is approached from both sides at rate O(|xi - 1|) ~ 1e-9
+    for xi in (1 - 1e-9, 1 + 1e-9):
+        assert cf.kelvin_clipped_restitution(xi) == pytest.approx(math.exp(-2), abs=1e-8)
+
+
+def test_kelvin_clipped_reengagement_phase_logic():
+    """Clipped law with gravity (xi = 0.9, eps = 1e4): the mass re-engages while still
+    penetrated. On a fine grid of the exact history, every contact phase must have
+    eps(u-h) + c u' >= 0, and every flight phase must have u <= h or eps(u-h) + c u' <= 0."""
+    eps, xi = 1e4, 0.9
+    c = cf.kelvin_damping(eps, M, xi)
+    kb = cf.bouncing_oscillator_kelvin(M, K, H, G, eps, c, 50, clipped=True)
+    u_on, _ = kb.evaluate(kb.t_impact)
+    assert np.any(u_on > H)                    # at least one re-engagement at u > h
+    scale_F = c * kb.v_in[0]                   # force scale of the first contact
+    for i, (t0, kind, _, _, _) in enumerate(kb.phases):
+        t1 = kb.phases[i + 1][0] if i + 1 < len(kb.phases) else t0 + 1.0
+        tt = np.linspace(t0, t1, 4001)[1:-1]
+        u, v = kb.evaluate(tt)
+        F = eps * (u - H) + c * v
+        # the end roots are exact to ~1e-15 relative; allow 1e-9 of the force scale
+        if kind == "contact":
+            assert np.all(F >= -1e-9 * scale_F)
+        else:
+            assert np.all((u <= H + 1e-15) | (F <= 1e-9 * scale_F))
 
 
 def test_kelvin_undamped_contact_time_and_penetration():
@@ -430,8 +472,8 @@ def test_kelvin_clipped_matches_problems_form_and_brute_force():
     xi = 0.85
     nu = math.sqrt(1 - xi * xi)
     th = np.linspace(0, math.pi, 2_000_001)
-    F = -2 * xi * np.cos(th) + ((2 * xi * xi - 1) / nu) * np.sin(th)   # ~ -delta''
-    i = np.argmax(F < 0)
+    F = 2 * xi * np.cos(th) - ((2 * xi * xi - 1) / nu) * np.sin(th)   # ~ -delta'' = force
+    i = np.argmax(F < 0)                                   # F(0) = 2 xi > 0: first sign change
     vel = np.exp(-xi * th[i] / nu) * (np.cos(th[i]) - (xi / nu) * np.sin(th[i]))
     assert cf.kelvin_clipped_restitution(xi) == pytest.approx(-vel, abs=1e-6)
 
@@ -440,7 +482,7 @@ def test_hertz_constant_by_quadrature():
     # energy integral int_0^1 dx / sqrt(1 - x^{5/2}), with its endpoint singularity taken out:
     # weight (1-x)^{-1/2}; QUADPACK 'alg' weight reaches ~1e-14
     f = lambda x: math.sqrt((1 - x) / (1 - x ** 2.5)) if x < 1 else math.sqrt(0.4)
-    I, err = integrate.quad(f, 0, 1, weight="alg", wvar=(0, -0.5), epsabs=0, epsrel=1e-14)
+    I, err = integrate.quad(f, 0, 1, weight="alg", wvar=(0, -0.5), epsabs=0, epsrel=2e-14)
     assert 2 * I == pytest.approx(cf.HERTZ_TC_CONSTANT, rel=1e-12)   # quadrature accuracy
     # PROBLEMS.md value quoted with 10 decimals: half a unit of the 10th decimal
     assert cf.HERTZ_TC_CONSTANT == pytest.approx(2.9432751843, abs=5e-11)
@@ -479,9 +521,9 @@ def _hc_ivp(a, n, Kc=1.0, ms=1.0, v0=1.0):
 @pytest.mark.parametrize("a,n", [(0.2, 1.5), (0.6, 1.0), (1.2, 1.5)])
 def test_hunt_crossley_exact_relation_vs_time_integration(a, n):
     e_ivp, dmax_ivp = _hc_ivp(a, n)
-    # DOP853 at rtol 1e-12 over one contact: ~1e-9 on the exit speed and the max
-    assert cf.hunt_crossley_realised_e(a) == pytest.approx(e_ivp, rel=1e-9)
-    assert cf.hc_max_penetration(n, 1.0, 1.0, a, 1.0) == pytest.approx(dmax_ivp, rel=1e-9)
+    # DOP853 at rtol 1e-12 over one contact (observed ~2e-12): 1e-10 on exit speed and max
+    assert cf.hunt_crossley_realised_e(a) == pytest.approx(e_ivp, rel=1e-10)
+    assert cf.hc_max_penetration(n, 1.0, 1.0, a, 1.0) == pytest.approx(dmax_ivp, rel=1e-10)
 
 
 def test_hunt_crossley_factor_roundtrip_and_limits():
@@ -511,6 +553,9 @@ def test_hunt_crossley_floors():
     # Flores and Gonthier have unbounded a as e -> 0: no floor
     assert cf.hunt_crossley_realised_e(cf.hc_factor_flores(0.01)) < 0.05
     assert cf.hunt_crossley_realised_e(cf.hc_factor_gonthier(0.01)) < 0.05
+    # a >> 1: e = (1 - (1+a) e^{-(1+e)a})/a, i.e. 1/a to double precision (here e^{-158} ~ 0)
+    a = cf.hc_factor_flores(0.01)
+    assert cf.hunt_crossley_realised_e(a) == pytest.approx(1 / a, rel=1e-15)
 
 
 def _jankowski_ivp(xi):
@@ -538,8 +583,9 @@ def test_jankowski():
     # PROBLEMS.md: "target 0.65 realises ~0.647" (3 digits): half a unit of the third decimal
     assert e == pytest.approx(0.647, abs=5e-4)
     assert e < 0.65                                            # "slightly undershoots"
-    # independent time integration; the x^{1/4} start singularity limits it to ~1e-8
-    assert e == pytest.approx(_jankowski_ivp(xi), rel=1e-8)
+    # independent time integration (DOP853, rtol 1e-13); observed agreement ~3e-13, and the
+    # x^{1/4} start and the law switch cost the IVP a few digits: 1e-10
+    assert e == pytest.approx(_jankowski_ivp(xi), rel=1e-10)
     assert cf.jankowski_realised_e(0.0) == 1.0 and cf.jankowski_xi(1.0) == 0.0
     # the undamped limit: x_m = (5/4)^{2/5} -> e = 1 (the quadrature legs, 1e-12)
     assert cf.jankowski_realised_e(1e-14) == pytest.approx(1.0, abs=1e-12)
@@ -671,8 +717,12 @@ def _galpha_amplification(Om, am, af, beta, gamma):
     for j in range(3):
         d, v, a = np.eye(3)[j]
         # (1-am) a1 + am a + Om^2 [(1-af) d1 + af d] = 0, d1 = d + v + (1/2-beta) a + beta a1
-        rhs = -am * a - Om ** 2 * ((1 - af) * (d + v + (0.5 - beta) * a) + af * d)
-        a1 = rhs / ((1 - am) + Om ** 2 * (1 - af) * beta)
+        if math.isinf(Om):      # the limit Om -> inf: (1-af) d1 + af d = 0
+            d1 = -af * d / (1 - af)
+            a1 = (d1 - d - v - (0.5 - beta) * a) / beta
+        else:
+            rhs = -am * a - Om ** 2 * ((1 - af) * (d + v + (0.5 - beta) * a) + af * d)
+            a1 = rhs / ((1 - am) + Om ** 2 * (1 - af) * beta)
         d1 = d + v + (0.5 - beta) * a + beta * a1
         v1 = v + (1 - gamma) * a + gamma * a1
         Amat[:, j] = [d1, v1, a1]
@@ -682,9 +732,10 @@ def _galpha_amplification(Om, am, af, beta, gamma):
 @pytest.mark.parametrize("rho", [0.0, 0.3, 0.8, 1.0])
 def test_generalized_alpha_rho_inf(rho):
     am, af, beta, gamma = cf.generalized_alpha_params(rho)
-    sr = max(abs(np.linalg.eigvals(_galpha_amplification(1e7, am, af, beta, gamma))))
-    # at Om = 1e7 the radius differs from rho_inf by O(1/Om); eigen-solve round-off ~1e-8
-    assert sr == pytest.approx(rho, abs=1e-6)
+    sr = max(abs(np.linalg.eigvals(_galpha_amplification(math.inf, am, af, beta, gamma))))
+    # exact Om -> inf limit matrix; its principal root is double (defective), so eig
+    # round-off is ~sqrt(eps) ~ 1e-8
+    assert sr == pytest.approx(rho, abs=1e-7)
     if rho == 1.0:
         assert (am, af, beta, gamma) == (0.5, 0.5, 0.25, 0.5)   # trapezoidal, exact arithmetic
 
@@ -692,9 +743,9 @@ def test_generalized_alpha_rho_inf(rho):
 @pytest.mark.parametrize("alpha", [-1 / 3, -0.1, 0.0])
 def test_hht_rho_inf(alpha):
     p = cf.hht_params(alpha)
-    sr = max(abs(np.linalg.eigvals(_galpha_amplification(1e7, p["alpha_m"], p["alpha_f"],
+    sr = max(abs(np.linalg.eigvals(_galpha_amplification(math.inf, p["alpha_m"], p["alpha_f"],
                                                           p["beta"], p["gamma"]))))
-    assert sr == pytest.approx(p["rho_inf"], abs=1e-6)   # same argument as generalized-alpha
+    assert sr == pytest.approx(p["rho_inf"], abs=1e-7)   # same argument as generalized-alpha
 
 
 def test_newmark_params():
@@ -711,7 +762,9 @@ def test_trapezoidal_period_elongation():
     w, h = 10.0, 0.05
     wb, ratio = cf.trapezoidal_period_elongation(w, h)
     A = _galpha_amplification(w * h, 0.5, 0.5, 0.25, 0.5)
-    ang = max(abs(np.angle(np.linalg.eigvals(A))))
+    lam = np.linalg.eigvals(A)
+    lam = lam[np.abs(lam.imag) > 1e-12]        # the principal pair (the third root is spurious)
+    ang = max(abs(np.angle(lam)))
     # the eigen-angle of the trapezoidal amplification matrix is w_bar h (eig round-off ~1e-13)
     assert ang == pytest.approx(wb * h, rel=1e-12)
     assert ratio > 1

@@ -1,0 +1,225 @@
+!> Forces of a scene at a trial state: internal forces of links and penalty contacts with
+!> their tangents (assembled into a band matrix), external forces, recoverable energy and the
+!> element work needed for the energy balance. Node arrays run 0:n with 0 = ground (always
+!> at rest in the relative frame), so ground ends need no branches in the loops.
+module martello_assembly
+   use martello_kinds, only: dp
+   use martello_model, only: model_t, SCHEME_PENALTY
+   use martello_links, only: link_force, bilinear_energy, LINK_SPRING, LINK_BAR, LINK_BILINEAR, &
+      LINK_DASHPOT, LINK_FLUID_DAMPER, L_STIFF, L_YIELD, L_HARDENING
+   use martello_contact_laws, only: contact_force, contact_elastic_energy
+   use martello_band_matrix, only: band_t, band_add_pair, band_add
+   use martello_time_functions, only: tf_value, TF_NONE
+   implicit none
+   private
+   public :: mech_state_t, mech_init, internal_forces, external_forces, mech_commit, &
+      recoverable_energy, element_work, mass_times, assemble_mass, ONSET_SPEED_FLOOR
+
+   !> Hunt–Crossley-type laws scale damping by 1/v_in; a contact first seen while δ̇ ≤ 0
+   !> (grazing, or a step that lands inside) uses this floor [m/s] instead of a division by 0.
+   real(dp), parameter :: ONSET_SPEED_FLOOR = 1.0e-12_dp
+
+   type :: mech_state_t
+      ! committed link state (rate-independent force and elongation), and its trial
+      real(dp), allocatable :: link_fc(:), link_u(:), link_fc_trial(:)
+      ! link and contact forces at the committed step (for trapezoidal work) and at the trial
+      real(dp), allocatable :: link_f(:), link_f_trial(:)
+      real(dp), allocatable :: con_f(:), con_f_trial(:), con_pen(:), con_pen_trial(:)
+      real(dp), allocatable :: con_rate_trial(:)
+      logical, allocatable :: con_on(:)                 !< committed: in contact
+      real(dp), allocatable :: con_vin(:), con_vin_trial(:)
+      logical, allocatable :: is_penalty(:)
+   end type mech_state_t
+
+contains
+
+   subroutine mech_init(m, s, u, v)
+      type(model_t), intent(in) :: m
+      type(mech_state_t), intent(out) :: s
+      real(dp), intent(in) :: u(0:), v(0:)
+      real(dp), allocatable :: f(:)
+      integer :: j
+      allocate (s%link_fc(m%nlink), s%link_u(m%nlink), s%link_fc_trial(m%nlink), &
+                s%link_f(m%nlink), s%link_f_trial(m%nlink))
+      allocate (s%con_f(m%ncontact), s%con_f_trial(m%ncontact), s%con_pen(m%ncontact), &
+                s%con_pen_trial(m%ncontact), s%con_rate_trial(m%ncontact), &
+                s%con_on(m%ncontact), s%con_vin(m%ncontact), s%con_vin_trial(m%ncontact), &
+                s%is_penalty(m%ncontact))
+      s%is_penalty = m%con_scheme(1:m%ncontact) == SCHEME_PENALTY
+      ! The initial state is elastic and unloaded history: the committed force of a bilinear
+      ! spring starts on its elastic line k·u0 (clamped into the band by the first step).
+      do j = 1, m%nlink
+         s%link_u(j) = u(m%link_a(j)) - u(m%link_b(j))
+         s%link_fc(j) = 0.0_dp
+         if (m%link_kind(j) == LINK_SPRING .or. m%link_kind(j) == LINK_BAR .or. &
+             m%link_kind(j) == LINK_BILINEAR) s%link_fc(j) = m%link_par(L_STIFF, j)*s%link_u(j)
+      end do
+      s%con_on = .false.; s%con_vin = 0.0_dp
+      allocate (f(0:m%n))
+      call internal_forces(m, s, u, v, f)
+      call mech_commit(m, s, u)
+   end subroutine mech_init
+
+   !> fint(0:n) of links and penalty contacts at (u, v); with jac present, also
+   !> jac += ck·K_t + cc·C_t (tangent stiffness and damping), ground rows skipped.
+   subroutine internal_forces(m, s, u, v, fint, jac, ck, cc)
+      type(model_t), intent(in) :: m
+      type(mech_state_t), intent(inout) :: s
+      real(dp), intent(in) :: u(0:), v(0:)
+      real(dp), intent(out) :: fint(0:)
+      type(band_t), intent(inout), optional :: jac
+      real(dp), intent(in), optional :: ck, cc
+      integer :: j, a, b
+      real(dp) :: du, dv, f, kt, ct, fnew, pen, rate, vin, dfd, dfv
+
+      fint = 0.0_dp
+      do j = 1, m%nlink
+         a = m%link_a(j); b = m%link_b(j)
+         du = u(a) - u(b); dv = v(a) - v(b)
+         call link_force(m%link_kind(j), m%link_par(:, j), du, dv, s%link_fc(j), s%link_u(j), &
+                         f, kt, ct, fnew)
+         s%link_fc_trial(j) = fnew
+         s%link_f_trial(j) = f
+         fint(a) = fint(a) + f
+         fint(b) = fint(b) - f
+         if (present(jac)) call band_add_pair(jac, a, b, ck*kt + cc*ct)
+      end do
+      do j = 1, m%ncontact
+         if (.not. s%is_penalty(j)) cycle
+         a = m%con_a(j); b = m%con_b(j)
+         pen = u(a) - u(b) - m%con_gap(j)
+         rate = v(a) - v(b)
+         s%con_pen_trial(j) = pen; s%con_rate_trial(j) = rate
+         if (pen > 0.0_dp) then
+            vin = s%con_vin(j)
+            if (.not. s%con_on(j)) vin = max(rate, ONSET_SPEED_FLOOR)
+            s%con_vin_trial(j) = vin
+            call contact_force(m%con_law(j), m%con_par(:, j), pen, rate, vin, f, dfd, dfv)
+         else
+            f = 0.0_dp; dfd = 0.0_dp; dfv = 0.0_dp
+            s%con_vin_trial(j) = 0.0_dp
+         end if
+         s%con_f_trial(j) = f
+         fint(a) = fint(a) + f
+         fint(b) = fint(b) - f
+         if (present(jac) .and. (dfd /= 0.0_dp .or. dfv /= 0.0_dp)) &
+            call band_add_pair(jac, a, b, ck*dfd + cc*dfv)
+      end do
+      fint(0) = 0.0_dp
+   end subroutine internal_forces
+
+   !> Accept the trial state of the last internal_forces call.
+   subroutine mech_commit(m, s, u)
+      type(model_t), intent(in) :: m
+      type(mech_state_t), intent(inout) :: s
+      real(dp), intent(in) :: u(0:)
+      integer :: j
+      do j = 1, m%nlink
+         s%link_fc(j) = s%link_fc_trial(j)
+         s%link_u(j) = u(m%link_a(j)) - u(m%link_b(j))
+      end do
+      s%link_f = s%link_f_trial
+      s%con_f = s%con_f_trial
+      s%con_pen = s%con_pen_trial
+      s%con_on = s%con_pen_trial > 0.0_dp .and. s%is_penalty
+      s%con_vin = s%con_vin_trial
+   end subroutine mech_commit
+
+   !> Gravity on M·1, nodal forces, and −M·1·ü_g (relative coordinates), at time t.
+   subroutine external_forces(m, mass_row_sum, t, fext)
+      type(model_t), intent(in) :: m
+      real(dp), intent(in) :: mass_row_sum(0:), t
+      real(dp), intent(out) :: fext(0:)
+      integer :: j
+      real(dp) :: acc
+      acc = m%gravity
+      if (m%ground_accel%kind /= TF_NONE) acc = acc - tf_value(m%ground_accel, t)
+      fext = acc*mass_row_sum
+      do j = 1, m%nforce
+         fext(m%force_node(j)) = fext(m%force_node(j)) + tf_value(m%force_fn(j), t)
+      end do
+      fext(0) = 0.0_dp
+   end subroutine external_forces
+
+   !> Recoverable (elastic) energy of links and of penalty contacts at the committed state.
+   subroutine recoverable_energy(m, s, u, e_links, e_contacts)
+      type(model_t), intent(in) :: m
+      type(mech_state_t), intent(in) :: s
+      real(dp), intent(in) :: u(0:)
+      real(dp), intent(out) :: e_links, e_contacts
+      integer :: j
+      real(dp) :: du, eb
+      e_links = 0.0_dp; e_contacts = 0.0_dp
+      do j = 1, m%nlink
+         du = u(m%link_a(j)) - u(m%link_b(j))
+         select case (m%link_kind(j))
+         case (LINK_SPRING, LINK_BAR)
+            e_links = e_links + 0.5_dp*m%link_par(L_STIFF, j)*du**2
+         case (LINK_BILINEAR)
+            call bilinear_energy(m%link_par(L_STIFF, j), m%link_par(L_YIELD, j), &
+                                 m%link_par(L_HARDENING, j), s%link_fc(j), du, eb)
+            e_links = e_links + eb
+         end select
+      end do
+      do j = 1, m%ncontact
+         if (s%is_penalty(j)) e_contacts = e_contacts + &
+            contact_elastic_energy(m%con_law(j), m%con_par(:, j), max(s%con_pen(j), 0.0_dp))
+      end do
+   end subroutine recoverable_energy
+
+   !> Trapezoidal work of the elements over the step just committed (forces old/new,
+   !> elongations old/new), split into damping links, other links and contacts.
+   subroutine element_work(m, s_old_link_f, s_old_link_u, s_old_con_f, s_old_con_pen, s, u, &
+                           w_damp, w_links, w_contact)
+      type(model_t), intent(in) :: m
+      real(dp), intent(in) :: s_old_link_f(:), s_old_link_u(:), s_old_con_f(:), s_old_con_pen(:)
+      type(mech_state_t), intent(in) :: s
+      real(dp), intent(in) :: u(0:)
+      real(dp), intent(out) :: w_damp, w_links, w_contact
+      integer :: j
+      real(dp) :: w
+      w_damp = 0.0_dp; w_links = 0.0_dp; w_contact = 0.0_dp
+      do j = 1, m%nlink
+         w = 0.5_dp*(s_old_link_f(j) + s%link_f(j))* &
+             ((u(m%link_a(j)) - u(m%link_b(j))) - s_old_link_u(j))
+         if (m%link_kind(j) == LINK_DASHPOT .or. m%link_kind(j) == LINK_FLUID_DAMPER) then
+            w_damp = w_damp + w
+         else
+            w_links = w_links + w
+         end if
+      end do
+      do j = 1, m%ncontact
+         if (s%is_penalty(j)) w_contact = w_contact + &
+            0.5_dp*(s_old_con_f(j) + s%con_f(j))*(s%con_pen(j) - s_old_con_pen(j))
+      end do
+   end subroutine element_work
+
+   !> y = M x for the lumped diagonal plus the consistent-mass couplings.
+   pure subroutine mass_times(m, x, y)
+      type(model_t), intent(in) :: m
+      real(dp), intent(in) :: x(0:)
+      real(dp), intent(out) :: y(0:)
+      integer :: j
+      y(1:) = m%mass*x(1:)
+      y(0) = 0.0_dp
+      do j = 1, m%ncoupling
+         y(m%mc_a(j)) = y(m%mc_a(j)) + m%mc_value(j)*x(m%mc_b(j))
+         y(m%mc_b(j)) = y(m%mc_b(j)) + m%mc_value(j)*x(m%mc_a(j))
+      end do
+   end subroutine mass_times
+
+   !> jac += c·M (band).
+   pure subroutine assemble_mass(m, c, jac)
+      type(model_t), intent(in) :: m
+      real(dp), intent(in) :: c
+      type(band_t), intent(inout) :: jac
+      integer :: i, j
+      do i = 1, m%n
+         call band_add(jac, i, i, c*m%mass(i))
+      end do
+      do j = 1, m%ncoupling
+         call band_add(jac, m%mc_a(j), m%mc_b(j), c*m%mc_value(j))
+         call band_add(jac, m%mc_b(j), m%mc_a(j), c*m%mc_value(j))
+      end do
+   end subroutine assemble_mass
+end module martello_assembly

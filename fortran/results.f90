@@ -1,0 +1,113 @@
+!> What a dynamic run produces, whatever integrator made it: a decimated history, contact
+!> events (one per contact phase), peaks over every step (not only the recorded ones), the
+!> energy balance and the cost counters. Native integrators (Fortran and C) fill it through
+!> the same procedures, so every method is measured the same way.
+module martello_results
+   use martello_kinds, only: dp, i8
+   implicit none
+   private
+   public :: results_t, results_init, results_record, results_add_event, &
+      NCOUNTERS, C_STEPS, C_REJECTED, C_NEWTON, C_RESIDUALS, C_FACTORIZATIONS, C_EVENTS, &
+      C_JACOBIANS, C_ROOT_EVALS, NENERGY, E_KINETIC, E_RECOVERABLE, E_INPUT, E_DAMPING, &
+      E_PLASTIC, E_CONTACT, E_BALANCE, E_INITIAL, E_IMPACT, NEVENT, EV_T_ON, EV_T_OFF, &
+      EV_V_IN, EV_V_OUT, EV_MAX_PEN, EV_MAX_FORCE
+
+   ! cost counters
+   integer, parameter :: NCOUNTERS = 8
+   integer, parameter :: C_STEPS = 1, C_REJECTED = 2, C_NEWTON = 3, C_RESIDUALS = 4, &
+                         C_FACTORIZATIONS = 5, C_EVENTS = 6, C_JACOBIANS = 7, C_ROOT_EVALS = 8
+   ! energy terms [J]: balance = initial + input − kinetic − recoverable − dissipated (≈ 0)
+   integer, parameter :: NENERGY = 9
+   integer, parameter :: E_KINETIC = 1, E_RECOVERABLE = 2, E_INPUT = 3, E_DAMPING = 4, &
+                         E_PLASTIC = 5, E_CONTACT = 6, E_BALANCE = 7, E_INITIAL = 8, E_IMPACT = 9
+   ! one contact phase
+   integer, parameter :: NEVENT = 6
+   integer, parameter :: EV_T_ON = 1, EV_T_OFF = 2, EV_V_IN = 3, EV_V_OUT = 4, &
+                         EV_MAX_PEN = 5, EV_MAX_FORCE = 6
+
+   type :: results_t
+      ! history: hist(:, k) = [t, (u, v, a of each output node), (δ, P of each output
+      ! contact), energy(1:NENERGY)]
+      integer :: ncol = 0, nrec = 0
+      real(dp), allocatable :: hist(:, :)
+      integer, allocatable :: out_nodes(:), out_contacts(:)
+      ! events
+      integer :: nevents = 0
+      integer, allocatable :: ev_contact(:)
+      real(dp), allocatable :: ev(:, :)
+      ! peaks over every accepted step
+      real(dp), allocatable :: u_max(:), u_min(:), v_absmax(:), a_absmax(:)
+      real(dp), allocatable :: pen_max(:), force_max(:)
+      integer, allocatable :: impacts(:)
+      real(dp) :: energy(NENERGY) = 0.0_dp
+      real(dp) :: energy_balance_max = 0.0_dp   !< max |balance| over the run
+      integer(i8) :: counters(NCOUNTERS) = 0_i8
+      real(dp) :: t_end_reached = 0.0_dp
+      real(dp) :: dt_critical = 0.0_dp          !< explicit stability limit (0: not computed)
+      real(dp) :: omega_max = 0.0_dp
+      character(len=512) :: message = ''
+   end type results_t
+
+contains
+
+   subroutine results_init(r, n_nodes, n_contacts, out_nodes, out_contacts, capacity)
+      type(results_t), intent(inout) :: r
+      integer, intent(in) :: n_nodes, n_contacts, out_nodes(:), out_contacts(:), capacity
+      r%out_nodes = out_nodes; r%out_contacts = out_contacts
+      r%ncol = 1 + 3*size(out_nodes) + 2*size(out_contacts) + NENERGY
+      r%nrec = 0
+      if (allocated(r%hist)) deallocate (r%hist)
+      allocate (r%hist(r%ncol, max(capacity, 2)))
+      r%nevents = 0
+      if (allocated(r%ev)) deallocate (r%ev, r%ev_contact)
+      allocate (r%ev(NEVENT, 16), r%ev_contact(16))
+      if (allocated(r%u_max)) deallocate (r%u_max, r%u_min, r%v_absmax, r%a_absmax, &
+                                          r%pen_max, r%force_max, r%impacts)
+      allocate (r%u_max(n_nodes), r%u_min(n_nodes), r%v_absmax(n_nodes), r%a_absmax(n_nodes), &
+                r%pen_max(n_contacts), r%force_max(n_contacts), r%impacts(n_contacts))
+      r%u_max = -huge(1.0_dp); r%u_min = huge(1.0_dp); r%v_absmax = 0.0_dp
+      r%a_absmax = 0.0_dp; r%pen_max = -huge(1.0_dp); r%force_max = 0.0_dp; r%impacts = 0
+      r%energy = 0.0_dp; r%energy_balance_max = 0.0_dp
+      r%counters = 0_i8
+      r%message = ''
+   end subroutine results_init
+
+   !> Append one history row (grows by doubling when a variable-step integrator needs it).
+   subroutine results_record(r, t, u, v, a, pen, force, energy)
+      type(results_t), intent(inout) :: r
+      real(dp), intent(in) :: t, u(:), v(:), a(:), pen(:), force(:), energy(NENERGY)
+      real(dp), allocatable :: tmp(:, :)
+      integer :: k, c
+      if (r%nrec == size(r%hist, 2)) then
+         allocate (tmp(r%ncol, 2*size(r%hist, 2)))
+         tmp(:, 1:r%nrec) = r%hist(:, 1:r%nrec)
+         call move_alloc(tmp, r%hist)
+      end if
+      r%nrec = r%nrec + 1
+      k = r%nrec; c = 1
+      r%hist(c, k) = t
+      r%hist(c + 1:c + size(r%out_nodes), k) = u(r%out_nodes); c = c + size(r%out_nodes)
+      r%hist(c + 1:c + size(r%out_nodes), k) = v(r%out_nodes); c = c + size(r%out_nodes)
+      r%hist(c + 1:c + size(r%out_nodes), k) = a(r%out_nodes); c = c + size(r%out_nodes)
+      r%hist(c + 1:c + size(r%out_contacts), k) = pen(r%out_contacts); c = c + size(r%out_contacts)
+      r%hist(c + 1:c + size(r%out_contacts), k) = force(r%out_contacts); c = c + size(r%out_contacts)
+      r%hist(c + 1:c + NENERGY, k) = energy
+   end subroutine results_record
+
+   subroutine results_add_event(r, contact, values)
+      type(results_t), intent(inout) :: r
+      integer, intent(in) :: contact
+      real(dp), intent(in) :: values(NEVENT)
+      real(dp), allocatable :: tmp(:, :)
+      integer, allocatable :: itmp(:)
+      if (r%nevents == size(r%ev, 2)) then
+         allocate (tmp(NEVENT, 2*size(r%ev, 2)), itmp(2*size(r%ev, 2)))
+         tmp(:, 1:r%nevents) = r%ev(:, 1:r%nevents)
+         itmp(1:r%nevents) = r%ev_contact(1:r%nevents)
+         call move_alloc(tmp, r%ev); call move_alloc(itmp, r%ev_contact)
+      end if
+      r%nevents = r%nevents + 1
+      r%ev(:, r%nevents) = values
+      r%ev_contact(r%nevents) = contact
+   end subroutine results_add_event
+end module martello_results

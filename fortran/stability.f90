@@ -1,0 +1,94 @@
+!> The highest natural frequency ω_max of the linearised scene (initial link stiffnesses plus
+!> every linear/Kelvin penalty contact as if closed), from the banded generalized symmetric
+!> eigenproblem K φ = ω² M φ on the free DOFs (LAPACK dsbgvx, largest eigenvalue only: O(n)
+!> for a chain). It gives the explicit central-difference limit Δt_crit = 2/ω_max.
+!> Hertz-type laws have zero stiffness at first touch and are left out: their limit depends
+!> on the penetration, so only the run-time divergence detector guards them.
+module martello_stability
+   use martello_kinds, only: dp
+   use martello_model, only: model_t, model_bandwidth, SCHEME_PENALTY
+   use martello_links, only: LINK_SPRING, LINK_BAR, LINK_BILINEAR, L_STIFF
+   use martello_contact_laws, only: LAW_LINEAR, LAW_KELVIN, P_STIFF
+   implicit none
+   private
+   public :: omega_max
+
+   interface
+      subroutine dsbgvx(jobz, range, uplo, n, ka, kb, ab, ldab, bb, ldbb, q, ldq, vl, vu, il, &
+                        iu, abstol, m, w, z, ldz, work, iwork, ifail, info)
+         import :: dp
+         character, intent(in) :: jobz, range, uplo
+         integer, intent(in) :: n, ka, kb, ldab, ldbb, ldq, il, iu, ldz
+         real(dp), intent(inout) :: ab(ldab, *), bb(ldbb, *)
+         real(dp), intent(out) :: q(ldq, *), w(*), z(ldz, *), work(*)
+         real(dp), intent(in) :: vl, vu, abstol
+         integer, intent(out) :: m, iwork(*), ifail(*), info
+      end subroutine dsbgvx
+   end interface
+
+contains
+
+   !> ω_max [rad/s]; info /= 0 if LAPACK failed (M not positive definite on the free DOFs).
+   subroutine omega_max(m, w_max, info)
+      type(model_t), intent(in) :: m
+      real(dp), intent(out) :: w_max
+      integer, intent(out) :: info
+      integer :: kd, nf, i, j, nfound
+      integer, allocatable :: dof(:), iwork(:), ifail(:)
+      real(dp), allocatable :: ka(:, :), mb(:, :), w(:), work(:)
+      real(dp) :: q(1, 1), z(1, 1)
+
+      kd = max(model_bandwidth(m), 0)
+      allocate (dof(0:m%n)); dof = 0; nf = 0
+      do i = 1, m%n
+         if (.not. m%fixed(i)) then
+            nf = nf + 1; dof(i) = nf
+         end if
+      end do
+      w_max = 0.0_dp; info = 0
+      if (nf == 0) return
+      ! upper band storage: A(i,j), i <= j, in ab(kd+1+i−j, j)
+      allocate (ka(kd + 1, nf), mb(kd + 1, nf), w(nf), work(7*nf), iwork(5*nf), ifail(nf))
+      ka = 0.0_dp; mb = 0.0_dp
+      do i = 1, m%n
+         if (dof(i) > 0) mb(kd + 1, dof(i)) = m%mass(i)
+      end do
+      do j = 1, m%ncoupling
+         call put(mb, dof(m%mc_a(j)), dof(m%mc_b(j)), m%mc_value(j), .false.)
+      end do
+      do j = 1, m%nlink
+         select case (m%link_kind(j))
+         case (LINK_SPRING, LINK_BAR, LINK_BILINEAR)
+            call pair(dof(m%link_a(j)), dof(m%link_b(j)), m%link_par(L_STIFF, j))
+         end select
+      end do
+      do j = 1, m%ncontact
+         if (m%con_scheme(j) /= SCHEME_PENALTY) cycle
+         if (m%con_law(j) /= LAW_LINEAR .and. m%con_law(j) /= LAW_KELVIN) cycle
+         call pair(dof(m%con_a(j)), dof(m%con_b(j)), m%con_par(P_STIFF, j))
+      end do
+      call dsbgvx('N', 'I', 'U', nf, kd, kd, ka, kd + 1, mb, kd + 1, q, 1, 0.0_dp, 0.0_dp, &
+                  nf, nf, 0.0_dp, nfound, w, z, 1, work, iwork, ifail, info)
+      if (info == 0 .and. nfound >= 1) w_max = sqrt(max(w(1), 0.0_dp))
+
+   contains
+      subroutine pair(ia, ib, k)
+         integer, intent(in) :: ia, ib
+         real(dp), intent(in) :: k
+         if (ia > 0) ka(kd + 1, ia) = ka(kd + 1, ia) + k
+         if (ib > 0) ka(kd + 1, ib) = ka(kd + 1, ib) + k
+         if (ia > 0 .and. ib > 0) call put(ka, ia, ib, -k, .false.)
+      end subroutine pair
+      subroutine put(band, ia, ib, val, diag)
+         real(dp), intent(inout) :: band(:, :)
+         integer, intent(in) :: ia, ib
+         real(dp), intent(in) :: val
+         logical, intent(in) :: diag
+         integer :: r, c
+         if (ia == 0 .or. ib == 0) return
+         if (diag) return
+         r = min(ia, ib); c = max(ia, ib)
+         band(kd + 1 + r - c, c) = band(kd + 1 + r - c, c) + val
+      end subroutine put
+   end subroutine omega_max
+end module martello_stability

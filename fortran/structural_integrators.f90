@@ -1,0 +1,457 @@
+!> Fixed-step structural integrators for penalty scenes (PROBLEMS.md "Integrators", seed §4):
+!>  - the generalized-α family, one Newton kernel for Newmark (any β, γ; α_m = α_f = 0),
+!>    HHT-α (α_m = 0, α_f = −α) and Chung–Hulbert generalized-α (ρ∞). Residual with the
+!>    forces interpolated between the old and new states (Hilber et al. 1977; Chung & Hulbert
+!>    1993, eqs 3–5), consistent tangent, and a residual-plus-increment convergence test;
+!>  - explicit central difference (velocity Verlet) with a lagged (half-step) damping velocity
+!>    and an a priori stability check against Δt_crit = 2/ω_max.
+!> Every step is O(n·kd²): band assembly and solve, workspaces allocated once per run.
+module martello_structural_integrators
+   use martello_kinds, only: dp, i8
+   use martello_status
+   use martello_model, only: model_t, model_bandwidth, SCHEME_PENALTY, scheme_name
+   use martello_band_matrix
+   use martello_assembly
+   use martello_results
+   use martello_stability, only: omega_max
+   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
+   implicit none
+   private
+   public :: integrator_settings_t, run_structural, generalized_alpha_coefficients, &
+      INT_NEWMARK, INT_HHT, INT_GENERALIZED_ALPHA, INT_CENTRAL_DIFFERENCE, integrator_name
+
+   integer, parameter :: INT_NEWMARK = 1, INT_HHT = 2, INT_GENERALIZED_ALPHA = 3, &
+                         INT_CENTRAL_DIFFERENCE = 4
+
+   type :: integrator_settings_t
+      integer :: kind = INT_NEWMARK
+      real(dp) :: dt = 0.0_dp, t_end = 0.0_dp
+      real(dp) :: beta = 0.25_dp, gamma = 0.5_dp     !< Newmark
+      real(dp) :: alpha = 0.0_dp                     !< HHT, in [−1/3, 0]
+      real(dp) :: rho_inf = 1.0_dp                   !< generalized-α, in [0, 1]
+      real(dp) :: tol_residual = 1.0e-9_dp           !< ‖r‖∞ ≤ tol·force scale
+      real(dp) :: tol_increment = 1.0e-11_dp         !< predicted ‖Δu‖∞ ≤ tol·displacement scale
+      integer :: max_newton = 30
+      logical :: check_stability = .true.           !< central difference: refuse Δt > Δt_crit
+      integer :: every = 1                           !< record every n-th step
+      real(dp) :: divergence_factor = 10.0_dp        !< mechanical energy > factor·(E0 + input)
+   end type integrator_settings_t
+
+contains
+
+   pure function integrator_name(kind) result(name)
+      integer, intent(in) :: kind
+      character(len=:), allocatable :: name
+      select case (kind)
+      case (INT_NEWMARK); name = 'newmark'
+      case (INT_HHT); name = 'hht'
+      case (INT_GENERALIZED_ALPHA); name = 'generalized-alpha'
+      case (INT_CENTRAL_DIFFERENCE); name = 'central-difference'
+      case default; name = 'unknown'
+      end select
+   end function integrator_name
+
+   !> (α_m, α_f, β, γ) of the family member; α's weigh the old state.
+   pure subroutine generalized_alpha_coefficients(s, am, af, beta, gamma)
+      type(integrator_settings_t), intent(in) :: s
+      real(dp), intent(out) :: am, af, beta, gamma
+      select case (s%kind)
+      case (INT_HHT)                 ! Hilber–Hughes–Taylor (1977)
+         am = 0.0_dp; af = -s%alpha
+         gamma = 0.5_dp - s%alpha; beta = 0.25_dp*(1.0_dp - s%alpha)**2
+      case (INT_GENERALIZED_ALPHA)   ! Chung & Hulbert (1993), eq. 25
+         am = (2.0_dp*s%rho_inf - 1.0_dp)/(s%rho_inf + 1.0_dp)
+         af = s%rho_inf/(s%rho_inf + 1.0_dp)
+         gamma = 0.5_dp - am + af; beta = 0.25_dp*(1.0_dp - am + af)**2
+      case default                   ! Newmark (1959)
+         am = 0.0_dp; af = 0.0_dp; beta = s%beta; gamma = s%gamma
+      end select
+   end subroutine generalized_alpha_coefficients
+
+   !> Run a scene from t = 0 to t_end. stat < 0 on failure with r%message saying where/why;
+   !> the results filled so far stay in r for diagnosis but are not a result.
+   subroutine run_structural(m, s, r, stat)
+      type(model_t), intent(inout) :: m
+      type(integrator_settings_t), intent(in) :: s
+      type(results_t), intent(inout) :: r
+      integer, intent(out) :: stat
+
+      integer :: n, kd, j, nsteps, step, it, info
+      real(dp), allocatable :: u(:), v(:), a(:), un(:), vn(:), an(:), fint(:), fint_n(:), &
+                               fext(:), fext_n(:), res(:), du(:), work(:), mrow(:), ma(:)
+      real(dp), allocatable :: old_link_f(:), old_link_u(:), old_con_f(:), old_con_pen(:)
+      ! open contact phases: onset time, speed, running maxima
+      real(dp), allocatable :: ph_t(:), ph_v(:), ph_pen(:), ph_f(:)
+      logical, allocatable :: ph_open(:)
+      type(mech_state_t) :: ms
+      type(band_t) :: jac, mband
+      real(dp) :: h, t, am, af, beta, gamma, cm, cv, fscale, uscale, rnorm, jmin, &
+                  e_kin, e_links, e_cont, e_links0, e_cont0, e0, w_ext, d_damp, d_links, &
+                  d_contact, w_abs, wd, wl, wc, e_mech
+      logical :: ok, converged
+
+      stat = MARTELLO_OK
+      n = m%n
+      call check_scene(stat)
+      if (stat /= MARTELLO_OK) return
+      h = s%dt
+      nsteps = nint(s%t_end/h)
+      if (abs(nsteps*h - s%t_end) > 1.0e-9_dp*s%t_end) nsteps = ceiling(s%t_end/h)
+      kd = model_bandwidth(m)
+
+      allocate (u(0:n), v(0:n), a(0:n), un(0:n), vn(0:n), an(0:n), fint(0:n), fint_n(0:n), &
+                fext(0:n), fext_n(0:n), res(0:n), du(n), work(0:n), mrow(0:n), ma(0:n))
+      allocate (ph_t(m%ncontact), ph_v(m%ncontact), ph_pen(m%ncontact), ph_f(m%ncontact), &
+                ph_open(m%ncontact))
+      ph_open = .false.
+      call band_init(jac, n, kd)
+      call band_init(mband, n, kd)
+
+      ! initial state; M·1 carries gravity and ground-motion loads
+      u(0) = 0.0_dp; v(0) = 0.0_dp
+      u(1:n) = m%u0; v(1:n) = merge(0.0_dp, m%v0, m%fixed)
+      work = 1.0_dp; work(0) = 0.0_dp
+      call mass_times(m, work, mrow)
+      call mech_init(m, ms, u, v)
+      call internal_forces(m, ms, u, v, fint)
+      call external_forces(m, mrow, 0.0_dp, fext)
+      call initial_acceleration(ok)
+      if (.not. ok) then
+         call fail(MARTELLO_ERR_SINGULAR, 'the mass matrix is singular on the free nodes')
+         return
+      end if
+      call mech_commit(m, ms, u)
+
+      ! stability of the explicit scheme, before anything is written
+      if (s%kind == INT_CENTRAL_DIFFERENCE) then
+         call omega_max(m, r%omega_max, info)
+         if (info == 0 .and. r%omega_max > 0.0_dp) r%dt_critical = 2.0_dp/r%omega_max
+         if (s%check_stability .and. r%dt_critical > 0.0_dp .and. h > r%dt_critical) then
+            write (r%message, '(a,es12.5,a,es12.5,a,es11.4,a)') 'central difference is unstable: dt = ', &
+               h, ' s exceeds dt_crit = 2/omega_max = ', r%dt_critical, ' s (omega_max = ', &
+               r%omega_max, ' rad/s, penalty stiffness included); reduce dt or use an implicit integrator'
+            stat = MARTELLO_ERR_UNSTABLE
+            return
+         end if
+      end if
+
+      call generalized_alpha_coefficients(s, am, af, beta, gamma)
+      cm = (1.0_dp - am)/(beta*h*h)
+      cv = gamma/(beta*h)
+      e_kin = kinetic(v)
+      call recoverable_energy(m, ms, u, e_links, e_cont)
+      e_links0 = e_links; e_cont0 = e_cont
+      e0 = e_kin + e_links + e_cont
+      w_ext = 0.0_dp; d_damp = 0.0_dp; d_links = 0.0_dp; d_contact = 0.0_dp; w_abs = 0.0_dp
+      t = 0.0_dp
+      call track_peaks()
+      call record()
+
+      do step = 1, nsteps
+         un = u; vn = v; an = a; fint_n = fint; fext_n = fext
+         old_link_f = ms%link_f; old_link_u = ms%link_u
+         old_con_f = ms%con_f; old_con_pen = ms%con_pen
+         t = min(step*h, s%t_end)
+         if (step == nsteps) t = s%t_end
+         call external_forces(m, mrow, t, fext)
+
+         if (s%kind == INT_CENTRAL_DIFFERENCE) then
+            call central_difference_step(ok)
+            if (.not. ok) then
+               call fail(MARTELLO_ERR_SINGULAR, 'the mass matrix is singular on the free nodes')
+               return
+            end if
+         else
+            call newton_step(converged)
+            if (.not. converged) return
+         end if
+         r%counters(C_STEPS) = r%counters(C_STEPS) + 1_i8
+         call mech_commit(m, ms, u)
+
+         ! energy balance: trapezoidal work of every force over the step
+         work(1:n) = u(1:n) - un(1:n)
+         wd = 0.0_dp
+         do j = 1, n
+            if (.not. m%fixed(j)) wd = wd + 0.5_dp*(fext_n(j) + fext(j))*work(j)
+         end do
+         w_ext = w_ext + wd; w_abs = w_abs + abs(wd)
+         call element_work(m, old_link_f, old_link_u, old_con_f, old_con_pen, ms, u, wd, wl, wc)
+         d_damp = d_damp + wd; d_links = d_links + wl; d_contact = d_contact + wc
+         e_kin = kinetic(v)
+         call recoverable_energy(m, ms, u, e_links, e_cont)
+         call track_events()
+         call track_peaks()
+         if (mod(step, s%every) == 0 .or. step == nsteps) call record()
+
+         ! divergence: NaN, or mechanical energy far beyond what was put in
+         e_mech = e_kin + e_links + e_cont
+         if (.not. (ieee_is_finite(e_mech) .and. all(ieee_is_finite(u)))) then
+            write (r%message, '(a,es12.5,a)') 'diverged at t = ', t, ' s: non-finite state (NaN/inf)'
+            stat = MARTELLO_ERR_DIVERGED; r%t_end_reached = t
+            return
+         end if
+         if (e_mech > s%divergence_factor*(e0 + w_abs) + tiny(1.0_dp) .and. e0 + w_abs > 0.0_dp) then
+            write (r%message, '(a,es12.5,a,es10.3,a,es10.3,a)') 'diverged at t = ', t, &
+               ' s: mechanical energy ', e_mech, ' J exceeds ', s%divergence_factor, &
+               ' x (initial energy + input work); the step is past the stability limit'
+            stat = MARTELLO_ERR_DIVERGED; r%t_end_reached = t
+            return
+         end if
+      end do
+      call close_open_phases()
+      r%t_end_reached = t
+
+   contains
+
+      subroutine check_scene(st)
+         integer, intent(out) :: st
+         integer :: jj
+         character(len=16) :: num
+         st = MARTELLO_OK
+         if (.not. (s%dt > 0.0_dp .and. s%t_end > 0.0_dp .and. s%every >= 1)) then
+            st = MARTELLO_ERR_ARGUMENT
+            r%message = 'dynamic run: need dt > 0, t_end > 0 and every >= 1'
+            return
+         end if
+         do jj = 1, m%ncontact
+            if (m%con_scheme(jj) /= SCHEME_PENALTY) then
+               write (num, '(i0)') jj - 1
+               st = MARTELLO_ERR_UNSUPPORTED
+               r%message = 'contact '//trim(num)//': scheme '//scheme_name(m%con_scheme(jj))// &
+                  ' cannot run on the fixed-step structural integrator '//integrator_name(s%kind)// &
+                  '; it runs on penalty contacts only (see the compatibility table in docs)'
+               return
+            end if
+         end do
+         if (any(m%mass < 0.0_dp)) then
+            st = MARTELLO_ERR_STATE; r%message = 'every node must be set before a run'
+         end if
+      end subroutine check_scene
+
+      subroutine fail(code, msg)
+         integer, intent(in) :: code
+         character(len=*), intent(in) :: msg
+         stat = code
+         write (r%message, '(a,a,es12.5,a)') msg, ' (t = ', t, ' s)'
+         r%t_end_reached = t
+      end subroutine fail
+
+      real(dp) function kinetic(vel)
+         real(dp), intent(in) :: vel(0:)
+         call mass_times(m, vel, ma)
+         kinetic = 0.5_dp*dot_product(vel(1:n), ma(1:n))
+      end function kinetic
+
+      !> M a = fext − fint on the free nodes (fixed nodes: a = 0).
+      subroutine solve_mass(rhs, ok)
+         real(dp), intent(inout) :: rhs(0:)
+         logical, intent(out) :: ok
+         integer :: i
+         call band_zero(mband)
+         call assemble_mass(m, 1.0_dp, mband)
+         do i = 1, n
+            if (m%fixed(i)) then
+               call pin_row(mband, i); rhs(i) = 0.0_dp
+            end if
+         end do
+         call band_solve(mband, rhs(1:n), ok)
+         rhs(0) = 0.0_dp
+         r%counters(C_FACTORIZATIONS) = r%counters(C_FACTORIZATIONS) + 1_i8
+      end subroutine solve_mass
+
+      subroutine initial_acceleration(ok)
+         logical, intent(out) :: ok
+         a = fext - fint
+         call solve_mass(a, ok)
+      end subroutine initial_acceleration
+
+      !> Replace row and column i by the identity (a fixed DOF: Δu_i = 0).
+      subroutine pin_row(b, i)
+         type(band_t), intent(inout) :: b
+         integer, intent(in) :: i
+         integer :: jj, rr
+         rr = 2*b%kd + 1
+         do jj = max(1, i - b%kd), min(n, i + b%kd)
+            b%ab(rr + i - jj, jj) = 0.0_dp      ! row i
+            b%ab(rr + jj - i, i) = 0.0_dp       ! column i
+         end do
+         b%ab(rr, i) = 1.0_dp
+      end subroutine pin_row
+
+      !> Newmark relations for a trial u: a(u), v(u).
+      subroutine kinematics()
+         a(1:n) = (u(1:n) - un(1:n) - h*vn(1:n))/(beta*h*h) - (0.5_dp - beta)/beta*an(1:n)
+         v(1:n) = vn(1:n) + h*((1.0_dp - gamma)*an(1:n) + gamma*a(1:n))
+         where (m%fixed)
+            u(1:n) = un(1:n); v(1:n) = 0.0_dp; a(1:n) = 0.0_dp
+         end where
+      end subroutine kinematics
+
+      subroutine newton_step(converged)
+         logical, intent(out) :: converged
+         integer :: i
+         ! predictor: constant acceleration
+         u(1:n) = un(1:n) + h*vn(1:n) + 0.5_dp*h*h*an(1:n)
+         converged = .false.
+         do it = 0, s%max_newton
+            call kinematics()
+            call band_zero(jac)
+            call internal_forces(m, ms, u, v, fint, jac, 1.0_dp - af, (1.0_dp - af)*cv)
+            call assemble_mass(m, cm, jac)
+            r%counters(C_RESIDUALS) = r%counters(C_RESIDUALS) + 1_i8
+            r%counters(C_JACOBIANS) = r%counters(C_JACOBIANS) + 1_i8
+            call mass_times(m, a, ma)
+            call mass_times(m, an, work)
+            res = (1.0_dp - am)*ma + am*work + (1.0_dp - af)*fint + af*fint_n &
+                  - (1.0_dp - af)*fext - af*fext_n
+            jmin = huge(1.0_dp)
+            do i = 1, n
+               if (m%fixed(i)) then
+                  res(i) = 0.0_dp; call pin_row(jac, i)
+               else
+                  jmin = min(jmin, abs(jac%ab(2*kd + 1, i)))
+               end if
+            end do
+            res(0) = 0.0_dp
+            rnorm = maxval(abs(res(1:n)))
+            fscale = max(maxval(abs(fext)), maxval(abs(fint)), maxval(abs(ma)), tiny(1.0_dp))
+            uscale = max(maxval(abs(u)), maxval(abs(un)), h*maxval(abs(vn)), tiny(1.0_dp))
+            ! residual test, and the increment the next iteration would make (‖r‖/min J_ii,
+            ! a bound for the diagonally dominant J), both small: converged
+            if (it > 0 .and. rnorm <= s%tol_residual*fscale .and. &
+                rnorm <= s%tol_increment*uscale*jmin) then
+               converged = .true.
+               exit
+            end if
+            if (it == s%max_newton) exit
+            du = -res(1:n)
+            call band_solve(jac, du, ok)
+            r%counters(C_FACTORIZATIONS) = r%counters(C_FACTORIZATIONS) + 1_i8
+            r%counters(C_NEWTON) = r%counters(C_NEWTON) + 1_i8
+            if (.not. ok) then
+               call fail(MARTELLO_ERR_SINGULAR, 'singular effective stiffness in the Newton step')
+               return
+            end if
+            u(1:n) = u(1:n) + du
+         end do
+         if (.not. converged) then
+            write (r%message, '(a,es12.5,a,i0,a,es9.2,a,es9.2,a)') 'Newton did not converge at t = ', t, &
+               ' s after ', s%max_newton, ' iterations (residual ', rnorm/fscale, &
+               ' of the force scale, tolerance ', s%tol_residual, '); reduce dt'
+            stat = MARTELLO_ERR_NOT_CONVERGED; r%t_end_reached = t
+         end if
+      end subroutine newton_step
+
+      !> Velocity Verlet with the damping (and contact-rate) velocity lagged to t + h/2.
+      subroutine central_difference_step(ok)
+         logical, intent(out) :: ok
+         work = vn + 0.5_dp*h*an                      ! v(n+1/2)
+         u = un + h*work
+         where ([.false., m%fixed])
+            u = un; work = 0.0_dp
+         end where
+         call internal_forces(m, ms, u, work, fint)
+         r%counters(C_RESIDUALS) = r%counters(C_RESIDUALS) + 1_i8
+         a = fext - fint
+         call solve_mass(a, ok)
+         v = work + 0.5_dp*h*a
+      end subroutine central_difference_step
+
+      subroutine track_peaks()
+         integer :: i
+         do i = 1, n
+            r%u_max(i) = max(r%u_max(i), u(i)); r%u_min(i) = min(r%u_min(i), u(i))
+            r%v_absmax(i) = max(r%v_absmax(i), abs(v(i)))
+            r%a_absmax(i) = max(r%a_absmax(i), abs(a(i)))
+         end do
+         do i = 1, m%ncontact
+            r%pen_max(i) = max(r%pen_max(i), ms%con_pen(i))
+            r%force_max(i) = max(r%force_max(i), ms%con_f(i))
+         end do
+      end subroutine track_peaks
+
+      !> Contact phases: onset and separation times located on the free side of the step by
+      !> the quadratic δ + δ̇τ + ½δ̈τ² = 0 (O(h³) in time), speeds extrapolated likewise.
+      subroutine track_events()
+         integer :: c, ia, ib
+         real(dp) :: d0, r0, q0, tau
+         do c = 1, m%ncontact
+            ia = m%con_a(c); ib = m%con_b(c)
+            if (.not. ph_open(c) .and. ms%con_on(c)) then
+               d0 = un(ia) - un(ib) - m%con_gap(c); r0 = vn(ia) - vn(ib); q0 = an(ia) - an(ib)
+               tau = crossing(d0, r0, q0, 0.0_dp, h)
+               ph_open(c) = .true.
+               ph_t(c) = t - h + tau; ph_v(c) = r0 + q0*tau
+               ph_pen(c) = 0.0_dp; ph_f(c) = 0.0_dp
+               r%impacts(c) = r%impacts(c) + 1
+               r%counters(C_EVENTS) = r%counters(C_EVENTS) + 1_i8
+            end if
+            if (ph_open(c)) then
+               ph_pen(c) = max(ph_pen(c), ms%con_pen(c)); ph_f(c) = max(ph_f(c), ms%con_f(c))
+               if (.not. ms%con_on(c)) then
+                  d0 = u(ia) - u(ib) - m%con_gap(c); r0 = v(ia) - v(ib); q0 = a(ia) - a(ib)
+                  tau = crossing(d0, r0, q0, -h, 0.0_dp)
+                  call results_add_event(r, c, [ph_t(c), t + tau, ph_v(c), r0 + q0*tau, &
+                                                ph_pen(c), ph_f(c)])
+                  ph_open(c) = .false.
+               end if
+            end if
+         end do
+      end subroutine track_events
+
+      subroutine close_open_phases()
+         integer :: c
+         do c = 1, m%ncontact
+            if (ph_open(c)) call results_add_event(r, c, [ph_t(c), -1.0_dp, ph_v(c), 0.0_dp, &
+                                                          ph_pen(c), ph_f(c)])
+         end do
+      end subroutine close_open_phases
+
+      !> Energy terms: W are trapezoidal works since t = 0, E recoverable energies; the
+      !> dissipation of links (plasticity) and contacts is their work minus the change of
+      !> their recoverable energy, so the balance is the work–energy identity
+      !> KE0 + W_ext − KE − W_damp − W_links − W_contact (≈ 0 to the integrator's accuracy).
+      subroutine record()
+         real(dp) :: e(NENERGY)
+         e = 0.0_dp
+         e(E_KINETIC) = e_kin; e(E_RECOVERABLE) = e_links + e_cont; e(E_INPUT) = w_ext
+         e(E_DAMPING) = d_damp
+         e(E_PLASTIC) = d_links - (e_links - e_links0)
+         e(E_CONTACT) = d_contact - (e_cont - e_cont0)
+         e(E_INITIAL) = e0
+         e(E_BALANCE) = e0 + w_ext - e_kin - e(E_RECOVERABLE) - e(E_DAMPING) - e(E_PLASTIC) &
+                        - e(E_CONTACT)
+         r%energy = e
+         r%energy_balance_max = max(r%energy_balance_max, abs(e(E_BALANCE)))
+         call results_record(r, t, u(1:n), v(1:n), a(1:n), ms%con_pen, ms%con_f, e)
+      end subroutine record
+
+      pure real(dp) function crossing(d, rate, acc, lo, hi) result(tau)
+         real(dp), intent(in) :: d, rate, acc, lo, hi
+         real(dp) :: disc, t1, t2, q
+         ! root of d + rate·τ + ½acc·τ² in [lo, hi]; linear fallback, then the bracket end
+         tau = hi
+         if (abs(acc) > 0.0_dp) then
+            disc = rate*rate - 2.0_dp*acc*d
+            if (disc >= 0.0_dp) then
+               q = -0.5_dp*(rate + sign(sqrt(disc), rate))
+               if (q /= 0.0_dp) then
+                  t1 = q/(0.5_dp*acc); t2 = d/q
+               else
+                  t1 = 0.0_dp; t2 = 0.0_dp
+               end if
+               if (t1 >= lo .and. t1 <= hi .and. (t1 <= t2 .or. t2 < lo .or. t2 > hi)) then
+                  tau = t1; return
+               end if
+               if (t2 >= lo .and. t2 <= hi) then
+                  tau = t2; return
+               end if
+            end if
+         end if
+         if (rate /= 0.0_dp) then
+            tau = -d/rate
+            tau = min(max(tau, lo), hi)
+         end if
+      end function crossing
+   end subroutine run_structural
+end module martello_structural_integrators
