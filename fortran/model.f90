@@ -5,7 +5,8 @@ module martello_model
    use martello_kinds, only: dp
    use martello_status, only: MARTELLO_OK, MARTELLO_ERR_ARGUMENT
    use martello_time_functions, only: time_function_t, tf_is_known, TF_TABLE, NPAR_TF
-   use martello_contact_laws, only: NPAR_CONTACT, law_is_known
+   use martello_contact_laws, only: NPAR_CONTACT, law_is_known, damping_from_restitution, &
+      P_RESTITUTION, P_DAMPING
    use martello_links, only: NPAR_LINK, link_is_known
    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
    implicit none
@@ -162,10 +163,18 @@ contains
       if (.not. (ieee_is_finite(gap) .and. all(ieee_is_finite(par)))) then
          call fail(m, stat, 'add_contact: gap and parameters must be finite'); return
       end if
+      if (scheme == SCHEME_PENALTY .and. par(P_RESTITUTION) >= 0.0_dp) then
+         if (par(P_RESTITUTION) > 1.0_dp) then
+            call fail(m, stat, 'add_contact: target restitution must lie in [0, 1]'); return
+         end if
+      end if
       m%ncontact = m%ncontact + 1
       m%con_a(m%ncontact) = a; m%con_b(m%ncontact) = b; m%con_gap(m%ncontact) = gap
       m%con_scheme(m%ncontact) = scheme; m%con_law(m%ncontact) = law
       m%con_par(:, m%ncontact) = par
+      ! Damping from a target restitution, by the law's own published formula (contact_laws).
+      if (scheme == SCHEME_PENALTY .and. par(P_RESTITUTION) >= 0.0_dp) &
+         m%con_par(P_DAMPING, m%ncontact) = damping_from_restitution(law, par(P_RESTITUTION), par)
    end subroutine model_add_contact
 
    subroutine model_add_mass_coupling(m, a, b, value, stat)

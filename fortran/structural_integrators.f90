@@ -87,7 +87,7 @@ contains
       type(band_t) :: jac, mband
       real(dp) :: h, t, am, af, beta, gamma, cm, cv, fscale, uscale, rnorm, jmin, &
                   e_kin, e_links, e_cont, e_links0, e_cont0, e0, w_ext, d_damp, d_links, &
-                  d_contact, w_abs, wd, wl, wc, e_mech
+                  d_contact, w_abs, wd, wl, wc, e_mech, mmax
       logical :: ok, converged
 
       stat = MARTELLO_OK
@@ -137,6 +137,7 @@ contains
 
       call generalized_alpha_coefficients(s, am, af, beta, gamma)
       cm = (1.0_dp - am)/(beta*h*h)
+      mmax = max(maxval(m%mass), tiny(1.0_dp))
       cv = gamma/(beta*h)
       e_kin = kinetic(v)
       call recoverable_energy(m, ms, u, e_links, e_cont)
@@ -314,8 +315,11 @@ contains
             end do
             res(0) = 0.0_dp
             rnorm = maxval(abs(res(1:n)))
-            fscale = max(maxval(abs(fext)), maxval(abs(fint)), maxval(abs(ma)), tiny(1.0_dp))
             uscale = max(maxval(abs(u)), maxval(abs(un)), h*maxval(abs(vn)), tiny(1.0_dp))
+            ! The inertia term cm·M·u is evaluated with rounding error ~ε·cm·m·|u|, which can
+            ! exceed the physical forces by far (small h, free flight): it floors the scale.
+            fscale = max(maxval(abs(fext)), maxval(abs(fint)), maxval(abs(ma)), &
+                         64.0_dp*epsilon(1.0_dp)/s%tol_residual*cm*mmax*uscale, tiny(1.0_dp))
             ! residual test, and the increment the next iteration would make (‖r‖/min J_ii,
             ! a bound for the diagonally dominant J), both small: converged
             if (it > 0 .and. rnorm <= s%tol_residual*fscale .and. &

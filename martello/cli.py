@@ -41,11 +41,11 @@ def cmd_list(args):
 
 
 def cmd_run(args):
-    from .run import run, write_results
+    from .run import run_full, write_results
     s = scene_mod.load(args.scene)
-    summary = run(s)
+    summary, history = run_full(s)
     out = Path(args.output) if args.output else Path("out") / Path(args.scene).stem
-    path = write_results(summary, out)
+    path = write_results(summary, out, history)
     for w in summary.get("warnings", []):
         print(f"warning: {w}", file=sys.stderr)
     print(f"{s.title}: {summary['status']} -> {path}")

@@ -55,6 +55,18 @@ def lib():
         "martello_model_message": (c_int, [_VOID_P, c_char_p, c_int]),
         "martello_static_solve": (c_int, [_VOID_P, c_double, c_int, _DOUBLE_P, _DOUBLE_P,
                                           _DOUBLE_P, _INT_P, _INT_P, _DOUBLE_P]),
+        "martello_run_create": (c_int, [ctypes.POINTER(_VOID_P)]),
+        "martello_run_free": (None, [ctypes.POINTER(_VOID_P)]),
+        "martello_run_set_integrator": (c_int, [_VOID_P, c_int, _DOUBLE_P]),
+        "martello_run_set_outputs": (c_int, [_VOID_P, c_int, _INT_P, c_int, _INT_P]),
+        "martello_dynamic_run": (c_int, [_VOID_P, _VOID_P]),
+        "martello_run_message": (c_int, [_VOID_P, c_char_p, c_int]),
+        "martello_run_history_shape": (c_int, [_VOID_P, ctypes.POINTER(c_int), ctypes.POINTER(c_int)]),
+        "martello_run_history": (c_int, [_VOID_P, _DOUBLE_P]),
+        "martello_run_events": (c_int, [_VOID_P, ctypes.POINTER(c_int), _VOID_P, _VOID_P]),
+        "martello_run_counters": (c_int, [_VOID_P, np.ctypeslib.ndpointer(dtype=np.int64, flags="C_CONTIGUOUS")]),
+        "martello_run_peaks": (c_int, [_VOID_P] + [_DOUBLE_P] * 6 + [_INT_P]),
+        "martello_run_energy": (c_int, [_VOID_P, _DOUBLE_P, _DOUBLE_P]),
     }
     for name, (res, args) in protos.items():
         fn = getattr(L, name)
@@ -183,3 +195,100 @@ class Model:
             "rcond": float(cond[0]), "digits_lost": float(cond[1]),
             "penalty_ratio": float(cond[2]), "penalised_rcond": float(cond[3]),
         }
+
+
+COUNTER_NAMES = ("steps", "rejected_steps", "newton_iterations", "residual_evaluations",
+                 "factorizations", "events", "jacobian_evaluations", "root_evaluations")
+ENERGY_NAMES = ("kinetic", "recoverable", "input", "damping", "plastic", "contact", "balance",
+                "initial", "impact")
+EVENT_NAMES = ("t_on", "t_off", "v_in", "v_out", "max_penetration", "max_force")
+
+
+class Run:
+    """One dynamic run: its integrator settings and, after execute(), its results."""
+
+    def __init__(self):
+        self._h = _VOID_P()
+        st = lib().martello_run_create(ctypes.byref(self._h))
+        if st < 0:
+            raise SolverError(st, status_name(st), "could not create the run")
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        self.free()
+
+    def __del__(self):
+        self.free()
+
+    def free(self):
+        if getattr(self, "_h", None) and self._h.value:
+            lib().martello_run_free(ctypes.byref(self._h))
+
+    def message(self):
+        buf = ctypes.create_string_buffer(1024)
+        lib().martello_run_message(self._h, buf, len(buf))
+        return buf.value.decode(errors="replace")
+
+    def _check(self, st, what):
+        if st < 0:
+            cls = DivergenceError if st in (constant("MARTELLO_ERR_DIVERGED"),
+                                            constant("MARTELLO_ERR_UNSTABLE")) else SolverError
+            raise cls(st, status_name(st), f"{what}: {self.message()}")
+        return st
+
+    def set_integrator(self, kind, par):
+        self._check(lib().martello_run_set_integrator(
+            self._h, kind, _f64(par, constant("NPAR_INTEGRATOR"))), "integrator")
+
+    def set_outputs(self, nodes, contacts):
+        n = np.ascontiguousarray(nodes, dtype=np.int32)
+        c = np.ascontiguousarray(contacts, dtype=np.int32)
+        self._check(lib().martello_run_set_outputs(self._h, n.size, n, c.size, c), "outputs")
+
+    def execute(self, model):
+        """Run; raises on failure (DivergenceError for diverged/unstable runs)."""
+        return self._check(lib().martello_dynamic_run(model.handle, self._h), "dynamic run")
+
+    def status_of(self, model):
+        """Run without raising; returns the status code (for studies that classify failures)."""
+        return lib().martello_dynamic_run(model.handle, self._h)
+
+    def history(self):
+        rows, cols = ctypes.c_int(), ctypes.c_int()
+        lib().martello_run_history_shape(self._h, ctypes.byref(rows), ctypes.byref(cols))
+        buf = np.zeros(max(rows.value * cols.value, 1))
+        lib().martello_run_history(self._h, buf)
+        return buf[: rows.value * cols.value].reshape(rows.value, cols.value)
+
+    def events(self):
+        n = ctypes.c_int()
+        lib().martello_run_events(self._h, ctypes.byref(n), None, None)
+        contacts = np.zeros(max(n.value, 1), dtype=np.int32)
+        values = np.zeros((max(n.value, 1), constant("NEVENT")))
+        lib().martello_run_events(self._h, ctypes.byref(n), contacts.ctypes.data_as(_VOID_P),
+                                  values.ctypes.data_as(_VOID_P))
+        return contacts[: n.value], values[: n.value]
+
+    def counters(self):
+        c = np.zeros(constant("NCOUNTERS"), dtype=np.int64)
+        lib().martello_run_counters(self._h, c)
+        return dict(zip(COUNTER_NAMES, map(int, c)))
+
+    def peaks(self, n_nodes, n_contacts):
+        arrays = [np.zeros(max(n_nodes, 1)) for _ in range(4)] + \
+                 [np.zeros(max(n_contacts, 1)) for _ in range(2)]
+        impacts = np.zeros(max(n_contacts, 1), dtype=np.int32)
+        lib().martello_run_peaks(self._h, *arrays, impacts)
+        names = ("u_max", "u_min", "v_absmax", "a_absmax", "pen_max", "force_max")
+        out = {k: a[: (n_nodes if i < 4 else n_contacts)] for i, (k, a) in enumerate(zip(names, arrays))}
+        out["impacts"] = impacts[:n_contacts]
+        return out
+
+    def energy(self):
+        e, extra = np.zeros(constant("NENERGY")), np.zeros(4)
+        lib().martello_run_energy(self._h, e, extra)
+        d = dict(zip(ENERGY_NAMES, map(float, e)))
+        return d, {"balance_max": float(extra[0]), "omega_max": float(extra[1]),
+                   "dt_critical": float(extra[2]), "t_reached": float(extra[3])}

@@ -11,7 +11,7 @@ from . import native
 from . import scene as scene_mod
 from .check import verify
 from .errors import MartelloError
-from .run import run, write_results
+from .run import run_full, write_results
 
 
 def _fmt(x):
@@ -28,8 +28,8 @@ def check_catalogue(files, outdir, plots=True, stream=sys.stdout):
     for k, path in enumerate(files, 1):
         try:
             s = scene_mod.load(path)
-            summary = run(s)
-            write_results(summary, outdir / "runs" / Path(path).stem)
+            summary, history = run_full(s)
+            write_results(summary, outdir / "runs" / Path(path).stem, history)
             if s.check is None:
                 print(f"{s.title[:44]:<44} (no closed form: ran, not verified)", file=stream)
                 continue

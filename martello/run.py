@@ -131,10 +131,113 @@ def provenance(scene):
 
 def run(scene):
     """Run the scene's analysis; return the summary dict (JSON-ready)."""
+    return run_full(scene)[0]
+
+
+def run_full(scene):
+    """(summary, history) — history is None for static runs, else (columns, 2D array)."""
     with build_model(scene) as model:
         if scene.analysis["type"] == "static":
-            return _static(scene, model)
-    raise AssertionError(scene.analysis["type"])
+            return _static(scene, model), None
+        return _dynamic(scene, model)
+
+
+INTEGRATOR_CONST = {"newmark": "INT_NEWMARK", "hht": "INT_HHT",
+                    "generalized-alpha": "INT_GENERALIZED_ALPHA",
+                    "central-difference": "INT_CENTRAL_DIFFERENCE"}
+
+
+def integrator_par(an):
+    """The analysis table -> the native integrator parameter array."""
+    par = np.zeros(constant("NPAR_INTEGRATOR"))
+    def put(slot, value):
+        par[constant(slot)] = value
+    put("R_DT", an["dt"]); put("R_T_END", an["t_end"])
+    put("R_BETA", an["beta"] or 0.0); put("R_GAMMA", an["gamma"] or 0.0)
+    put("R_ALPHA", an["alpha"] or 0.0)
+    put("R_RHO_INF", an["rho_inf"] if an["rho_inf"] is not None else 1.0)
+    put("R_TOL_RESIDUAL", an["tol_residual"]); put("R_TOL_INCREMENT", an["tol_increment"])
+    put("R_MAX_NEWTON", an["max_newton"]); put("R_CHECK_STABILITY", 1.0 if an["check_stability"] else 0.0)
+    put("R_EVERY", an["output"]["every"]); put("R_DIVERGENCE_FACTOR", an["divergence_factor"])
+    return par
+
+
+def integrator_description(an):
+    d = {"name": an["integrator"], "dt": an["dt"], "t_end": an["t_end"]}
+    if an["integrator"] == "newmark":
+        d.update(beta=an["beta"], gamma=an["gamma"], preset=an["preset"])
+    elif an["integrator"] == "hht":
+        d.update(alpha=an["alpha"])
+    elif an["integrator"] == "generalized-alpha":
+        d.update(rho_inf=an["rho_inf"])
+    if an["integrator"] != "central-difference":
+        d.update(tol_residual=an["tol_residual"], tol_increment=an["tol_increment"],
+                 max_newton=an["max_newton"])
+    return d
+
+
+def _dynamic(scene, model, raise_on_failure=True):
+    an = scene.analysis
+    out_nodes = [scene.index[n] for n in an["output"]["nodes"]]
+    cnames = [c["name"] for c in scene.contacts]
+    out_contacts = [cnames.index(c) for c in an["output"]["contacts"]]
+    with native.Run() as r:
+        r.set_integrator(constant(INTEGRATOR_CONST[an["integrator"]]), integrator_par(an))
+        r.set_outputs(out_nodes, out_contacts)
+        t0 = time.perf_counter()
+        st = r.execute(model) if raise_on_failure else r.status_of(model)
+        wall = time.perf_counter() - t0
+        hist = r.history()
+        ev_contacts, ev = r.events()
+        peaks = r.peaks(len(scene.nodes), len(scene.contacts))
+        energy, extra = r.energy()
+        counters = r.counters()
+        message = r.message()
+
+    nodes = {}
+    for i, n in enumerate(scene.nodes):
+        nodes[n["name"]] = {"u_max": float(peaks["u_max"][i]), "u_min": float(peaks["u_min"][i]),
+                            "v_absmax": float(peaks["v_absmax"][i]),
+                            "a_absmax": float(peaks["a_absmax"][i])}
+    contacts = {}
+    for j, c in enumerate(scene.contacts):
+        mine = ev[ev_contacts == j]
+        closed = mine[mine[:, 1] >= 0]
+        contacts[c["name"]] = {
+            "scheme": c["scheme"], "law": c.get("law"),
+            "max_penetration": float(max(peaks["pen_max"][j], 0.0)),
+            "max_force": float(peaks["force_max"][j]),
+            "impacts": int(peaks["impacts"][j]),
+            "impact_times": [float(x) for x in mine[:, 0]],
+            "separation_times": [float(x) if x >= 0 else None for x in mine[:, 1]],
+            "approach_speeds": [float(x) for x in mine[:, 2]],
+            "separation_speeds": [float(x) for x in closed[:, 3]],
+            # realised restitution of each completed contact phase: −δ̇_out/δ̇_in
+            "restitution": [float(-vo / vi) if vi > 0 else None for vi, vo in closed[:, 2:4]],
+            "phase_max_penetration": [float(x) for x in mine[:, 4]],
+            "phase_max_force": [float(x) for x in mine[:, 5]]}
+    scale = max(abs(energy["initial"]), abs(energy["input"]), 1e-300)
+    energy.update(balance_max=extra["balance_max"], balance_relative=extra["balance_max"] / scale)
+    summary = {
+        "title": scene.title, "problem": scene.problem,
+        "analysis": {k: v for k, v in an.items() if k != "output"} | {"output_every": an["output"]["every"]},
+        "integrator": integrator_description(an),
+        "status": native.status_name(st),
+        "message": message,
+        "warnings": [],
+        "t_reached": extra["t_reached"],
+        "nodes": nodes, "contacts": contacts, "energy": energy,
+        "stability": {"omega_max": extra["omega_max"] or None,
+                      "dt_critical": extra["dt_critical"] or None},
+        "cost": counters | {"wall_time_s": wall},
+        "provenance": provenance(scene),
+    }
+    columns = ["t"] + [f"u:{n}" for n in an["output"]["nodes"]] + \
+              [f"v:{n}" for n in an["output"]["nodes"]] + [f"a:{n}" for n in an["output"]["nodes"]] + \
+              [f"penetration:{c}" for c in an["output"]["contacts"]] + \
+              [f"force:{c}" for c in an["output"]["contacts"]] + \
+              [f"energy:{e}" for e in native.ENERGY_NAMES]
+    return summary, (columns, hist)
 
 
 def _static(scene, model):
@@ -167,9 +270,13 @@ def _static(scene, model):
     }
 
 
-def write_results(summary, outdir):
+def write_results(summary, outdir, history=None):
     outdir = Path(outdir)
     outdir.mkdir(parents=True, exist_ok=True)
+    if history is not None:
+        columns, data = history
+        np.savetxt(outdir / "history.csv", data, delimiter=",", header=",".join(columns),
+                   comments="", fmt="%.17g")
     with open(outdir / "summary.json", "w") as fh:
         json.dump(summary, fh, indent=2, allow_nan=False, default=float)
         fh.write("\n")

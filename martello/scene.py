@@ -43,7 +43,8 @@ LINK_COMMON = {"name": ("str", False, None, None), "type": ("str", True, None, N
                "a": ("str", True, None, None), "b": ("str", True, None, None)}
 LINK_TYPES = {
     "spring": {"k": ("float", True, POSITIVE, None)},
-    "dashpot": {"c": ("float", True, POSITIVE, None)},
+    "dashpot": {"c": ("float", False, POSITIVE, None),
+                "zeta": ("float", False, (lambda x: 0 < x < 10, "a number in (0, 10)"), None)},
     "bilinear": {"k": ("float", True, POSITIVE, None), "fy": ("float", True, POSITIVE, None),
                  "hardening": ("float", False, _unit_interval(hi_open=True), 0.0)},
     "fluid_damper": {"c": ("float", True, POSITIVE, None),
@@ -85,10 +86,31 @@ FUNCTION_TYPES = {
                "units": ("str", False, None, None), "scale": ("float", False, ANY, 1.0)},
 }
 
+INTEGRATORS = ("newmark", "hht", "generalized-alpha", "central-difference")
+NEWMARK_PRESETS = {"average-acceleration": (0.25, 0.5), "linear-acceleration": (1.0 / 6.0, 0.5)}
 ANALYSIS_TYPES = {
     "static": {"tol": ("float", False, POSITIVE, 1e-14),
                "max_iter": ("int", False, POSITIVE, 500)},
+    "dynamic": {"integrator": ("str", True, None, None),
+                "dt": ("float", True, POSITIVE, None),
+                "t_end": ("float", True, POSITIVE, None),
+                "preset": ("str", False, None, None),
+                "beta": ("float", False, (lambda x: x > 0, "a number > 0 (beta = 0 is central-difference)"), None),
+                "gamma": ("float", False, (lambda x: x >= 0.5, "a number >= 0.5"), None),
+                "alpha": ("float", False, (lambda x: -1 / 3 <= x <= 0, "a number in [-1/3, 0]"), None),
+                "rho_inf": ("float", False, (lambda x: 0 <= x <= 1, "a number in [0, 1]"), None),
+                "tol_residual": ("float", False, POSITIVE, 1e-9),
+                "tol_increment": ("float", False, POSITIVE, 1e-11),
+                "max_newton": ("int", False, POSITIVE, 30),
+                "check_stability": ("bool", False, None, True),
+                "divergence_factor": ("float", False, (lambda x: x > 1, "a number > 1"), 10.0),
+                "output": ("table", False, None, None)},
 }
+OUTPUT_KEYS = {"every": ("int", False, POSITIVE, 1), "nodes": ("list", False, None, None),
+               "contacts": ("list", False, None, None)}
+INTEGRATOR_KEYS = {"newmark": {"preset", "beta", "gamma"}, "hht": {"alpha"},
+                   "generalized-alpha": {"rho_inf"}, "central-difference": {"check_stability"}}
+IMPLICIT_KEYS = {"tol_residual", "tol_increment", "max_newton"}
 
 TOP_KEYS = {"title", "problem", "description", "node", "link", "contact", "loads", "analysis",
             "check"}
@@ -271,6 +293,9 @@ def from_dict(data, source="<scene>", base_dir=Path("."), digest=None):
         if lk["a"] == lk["b"]:
             raise SceneError(src, f"{where}.b", "connects a node to itself", "name two different nodes")
         lk["name"] = lk["name"] or f"link{i}"
+        if kind == "dashpot" and (lk["c"] is None) == (lk["zeta"] is None):
+            raise SceneError(src, where, "needs exactly one of c or zeta",
+                             "c = damping [N s/m], or zeta = damping ratio of a node-to-ground oscillator")
         links.append(lk)
 
     # contacts
@@ -326,6 +351,11 @@ def from_dict(data, source="<scene>", base_dir=Path("."), digest=None):
     atype = _choice(src, "analysis.type", an["type"], list(ANALYSIS_TYPES))
     analysis = _fields(src, an, "analysis", ANALYSIS_TYPES[atype], extra_ok=("type",))
     analysis["type"] = atype
+    if atype == "dynamic":
+        _dynamic_analysis(src, an, analysis, index, [c["name"] for c in contacts])
+    for lk in links:
+        if lk["type"] == "dashpot" and lk["zeta"] is not None:
+            lk["c"] = _dashpot_from_zeta(src, lk, links, nodes)
 
     check = data.get("check")
     if check is not None:
@@ -339,6 +369,66 @@ def from_dict(data, source="<scene>", base_dir=Path("."), digest=None):
                  description=meta["description"], nodes=nodes, links=links, contacts=contacts,
                  gravity=lt["gravity"], forces=forces, ground=ground, analysis=analysis,
                  check=check, digest=digest, index=index)
+
+
+def _dynamic_analysis(src, raw, an, index, contact_names):
+    integ = _choice(src, "analysis.integrator", an["integrator"], INTEGRATORS)
+    allowed = INTEGRATOR_KEYS[integ] | ({"check_stability"} if integ == "central-difference" else IMPLICIT_KEYS)
+    for key in (set(INTEGRATOR_KEYS["newmark"]) | {"alpha", "rho_inf", "check_stability"} | IMPLICIT_KEYS):
+        if key in raw and key not in allowed:
+            raise SceneError(src, f"analysis.{key}", f"does not apply to integrator {integ}",
+                             "valid here: " + ", ".join(sorted(allowed)))
+    if integ == "newmark":
+        if an["preset"] is not None:
+            _choice(src, "analysis.preset", an["preset"], list(NEWMARK_PRESETS))
+            if an["beta"] is not None or an["gamma"] is not None:
+                raise SceneError(src, "analysis.preset", "given together with beta/gamma",
+                                 "give a preset or beta and gamma")
+            an["beta"], an["gamma"] = NEWMARK_PRESETS[an["preset"]]
+        else:
+            if an["beta"] is None and an["gamma"] is None:
+                an["preset"] = "average-acceleration"
+                an["beta"], an["gamma"] = NEWMARK_PRESETS["average-acceleration"]
+            elif an["beta"] is None or an["gamma"] is None:
+                raise SceneError(src, "analysis.beta" if an["beta"] is None else "analysis.gamma",
+                                 "missing", "Newmark needs both beta and gamma (or a preset)")
+    if integ == "hht" and an["alpha"] is None:
+        raise SceneError(src, "analysis.alpha", "missing", "HHT needs alpha in [-1/3, 0]")
+    if integ == "generalized-alpha" and an["rho_inf"] is None:
+        raise SceneError(src, "analysis.rho_inf", "missing", "generalized-alpha needs rho_inf in [0, 1]")
+    if an["dt"] > an["t_end"]:
+        raise SceneError(src, "analysis.dt", f"{an['dt']} is longer than t_end = {an['t_end']}",
+                         "choose dt <= t_end")
+    out = _fields(src, an["output"] or {}, "analysis.output", OUTPUT_KEYS)
+    names = list(index)
+    # default: every node and contact of a small scene; none of a large one (peaks are always there)
+    out["nodes"] = out["nodes"] if out["nodes"] is not None else (names if len(names) <= 50 else [])
+    out["contacts"] = (out["contacts"] if out["contacts"] is not None
+                       else (contact_names if len(contact_names) <= 50 else []))
+    for i, nm in enumerate(out["nodes"]):
+        if nm not in index:
+            raise SceneError(src, f"analysis.output.nodes[{i}]", f"names no node {nm!r}",
+                             "use node names of this scene")
+    for i, nm in enumerate(out["contacts"]):
+        if nm not in contact_names:
+            raise SceneError(src, f"analysis.output.contacts[{i}]", f"names no contact {nm!r}",
+                             "use contact names of this scene")
+    an["output"] = out
+
+
+def _dashpot_from_zeta(src, lk, links, nodes):
+    """c = 2ζ√(k m) for a dashpot from a node to ground, k the node's springs to ground."""
+    where = f"link[{links.index(lk)}].zeta"
+    if lk["b"] != -1 and lk["a"] != -1:
+        raise SceneError(src, where, "applies to a dashpot between a node and ground",
+                         "give c for a dashpot between two nodes")
+    node = lk["a"] if lk["b"] == -1 else lk["b"]
+    k = sum(l.get("k") or (l["EA"] / l["L"] if l["type"] == "bar" else 0.0) for l in links
+            if l["type"] in ("spring", "bilinear", "bar") and {l["a"], l["b"]} == {node, -1})
+    if k <= 0:
+        raise SceneError(src, where, "the node has no spring to ground to define a frequency",
+                         "give c directly")
+    return 2.0 * lk["zeta"] * (k * nodes[node]["mass"]) ** 0.5
 
 
 def _check_table(src, check):
