@@ -112,7 +112,7 @@ enum { MARTELLO_NPAR_INTEGRATOR = 12, MARTELLO_R_DT = 0, MARTELLO_R_T_END = 1,
        MARTELLO_R_BETA = 2, MARTELLO_R_GAMMA = 3, MARTELLO_R_ALPHA = 4, MARTELLO_R_RHO_INF = 5,
        MARTELLO_R_TOL_RESIDUAL = 6, MARTELLO_R_TOL_INCREMENT = 7, MARTELLO_R_MAX_NEWTON = 8,
        MARTELLO_R_CHECK_STABILITY = 9, MARTELLO_R_EVERY = 10, MARTELLO_R_DIVERGENCE_FACTOR = 11 };
-enum { MARTELLO_NCOUNTERS = 8, MARTELLO_NENERGY = 9, MARTELLO_NEVENT = 6 };
+enum { MARTELLO_NCOUNTERS = 9, MARTELLO_NENERGY = 9, MARTELLO_NEVENT = 6 };
 
 int martello_run_create(martello_run **run);
 void martello_run_free(martello_run **run);
@@ -131,7 +131,8 @@ int martello_run_history(const martello_run *run, double *buf);
  * values[n][6] = {t_on, t_off (-1: open at the end), v_in, v_out, max penetration, max force}. */
 int martello_run_events(const martello_run *run, int *n, int *contacts, double *values);
 /* counters = {steps, rejected steps, Newton iterations, residual evaluations,
- * factorizations, events, Jacobian evaluations, root-function evaluations} */
+ * factorizations, events, Jacobian evaluations, root-function evaluations, contact
+ * chatter resolutions (steps where a contact was held open, see docs/integrators.md)} */
 int martello_run_counters(const martello_run *run, long long counters[MARTELLO_NCOUNTERS]);
 int martello_run_peaks(const martello_run *run, double *u_max, double *u_min, double *v_absmax,
                        double *a_absmax, double *pen_max, double *force_max, int *impacts);

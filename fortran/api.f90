@@ -403,8 +403,8 @@ contains
       c_run_events = MARTELLO_OK
    end function c_run_events
 
-   !> counters[8] = {steps, rejected steps, Newton iterations, residual evaluations,
-   !> factorizations, events, Jacobian evaluations, root-function evaluations}
+   !> counters[9] = {steps, rejected steps, Newton iterations, residual evaluations,
+   !> factorizations, events, Jacobian evaluations, root-function evaluations, chatter}
    integer(c_int) function c_run_counters(handle, counters) bind(C, name='martello_run_counters')
       type(c_ptr), value :: handle
       integer(c_long_long), intent(out) :: counters(NCOUNTERS)

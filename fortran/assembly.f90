@@ -29,6 +29,8 @@ module martello_assembly
       logical, allocatable :: con_on(:)                 !< committed: in contact
       real(dp), allocatable :: con_vin(:), con_vin_trial(:)
       logical, allocatable :: is_penalty(:)
+      !> contacts held open for the current step (see the chatter rule of the integrators)
+      logical, allocatable :: forced_off(:)
    end type mech_state_t
 
 contains
@@ -46,6 +48,7 @@ contains
                 s%con_on(m%ncontact), s%con_vin(m%ncontact), s%con_vin_trial(m%ncontact), &
                 s%is_penalty(m%ncontact))
       s%is_penalty = m%con_scheme(1:m%ncontact) == SCHEME_PENALTY
+      allocate (s%forced_off(m%ncontact)); s%forced_off = .false.
       ! The initial state is elastic and unloaded history: the committed force of a bilinear
       ! spring starts on its elastic line k·u0 (clamped into the band by the first step).
       do j = 1, m%nlink
@@ -90,7 +93,7 @@ contains
          pen = u(a) - u(b) - m%con_gap(j)
          rate = v(a) - v(b)
          s%con_pen_trial(j) = pen; s%con_rate_trial(j) = rate
-         if (pen > 0.0_dp) then
+         if (pen > 0.0_dp .and. .not. s%forced_off(j)) then
             vin = s%con_vin(j)
             if (.not. s%con_on(j)) vin = max(rate, ONSET_SPEED_FLOOR)
             s%con_vin_trial(j) = vin
@@ -121,7 +124,8 @@ contains
       s%link_f = s%link_f_trial
       s%con_f = s%con_f_trial
       s%con_pen = s%con_pen_trial
-      s%con_on = s%con_pen_trial > 0.0_dp .and. s%is_penalty
+      s%con_on = s%con_pen_trial > 0.0_dp .and. s%is_penalty .and. .not. s%forced_off
+      s%forced_off = .false.
       s%con_vin = s%con_vin_trial
    end subroutine mech_commit
 

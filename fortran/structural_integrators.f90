@@ -3,8 +3,8 @@
 !>    HHT-α (α_m = 0, α_f = −α) and Chung–Hulbert generalized-α (ρ∞). Residual with the
 !>    forces interpolated between the old and new states (Hilber et al. 1977; Chung & Hulbert
 !>    1993, eqs 3–5), consistent tangent, and a residual-plus-increment convergence test;
-!>  - explicit central difference (velocity Verlet) with a lagged (half-step) damping velocity
-!>    and an a priori stability check against Δt_crit = 2/ω_max.
+!>  - explicit central difference (velocity Verlet) with an extrapolated damping velocity
+!>    v_n + h a_n and an a priori stability check against Δt_crit = 2/ω_max.
 !> Every step is O(n·kd²): band assembly and solve, workspaces allocated once per run.
 module martello_structural_integrators
    use martello_kinds, only: dp, i8
@@ -288,11 +288,42 @@ contains
          end where
       end subroutine kinematics
 
+      !> Newton on the step. A law whose force jumps at δ = 0 (Kelvin: cδ̇ at first touch and
+      !> at separation) can leave the step without any root: the iterates then flip the
+      !> contact on and off. Chatter rule: a contact that flips in three iterations of one
+      !> step is held open (F = 0) for this step and Newton restarts; the onset is thus
+      !> delayed, or the separation advanced, by at most one step (O(h), counted in the
+      !> contact_chatter_resolutions counter).
       subroutine newton_step(converged)
          logical, intent(out) :: converged
+         integer :: i, restart
+         integer :: flips(m%ncontact)
+         logical :: was_on(m%ncontact)
+         converged = .false.
+         do restart = 0, 1
+            ! predictor: constant acceleration
+            u(1:n) = un(1:n) + h*vn(1:n) + 0.5_dp*h*h*an(1:n)
+            flips = 0; was_on = ms%con_on
+            call newton_iterations(converged, flips, was_on)
+            if (converged .or. stat /= MARTELLO_OK) return
+            if (.not. any(flips >= 3)) exit
+            ms%forced_off = ms%forced_off .or. flips >= 3
+            r%counters(C_CHATTER) = r%counters(C_CHATTER) + 1_i8
+         end do
+         if (.not. converged) then
+            write (r%message, '(a,es12.5,a,i0,a,es9.2,a,es9.2,a)') 'Newton did not converge at t = ', t, &
+               ' s after ', s%max_newton, ' iterations (residual ', rnorm/fscale, &
+               ' of the force scale, tolerance ', s%tol_residual, '); reduce dt'
+            stat = MARTELLO_ERR_NOT_CONVERGED; r%t_end_reached = t
+         end if
+      end subroutine newton_step
+
+      subroutine newton_iterations(converged, flips, was_on)
+         logical, intent(out) :: converged
+         integer, intent(inout) :: flips(:)
+         logical, intent(inout) :: was_on(:)
          integer :: i
-         ! predictor: constant acceleration
-         u(1:n) = un(1:n) + h*vn(1:n) + 0.5_dp*h*h*an(1:n)
+         logical :: on
          converged = .false.
          do it = 0, s%max_newton
             call kinematics()
@@ -315,6 +346,11 @@ contains
             end do
             res(0) = 0.0_dp
             rnorm = maxval(abs(res(1:n)))
+            do i = 1, m%ncontact
+               on = ms%con_pen_trial(i) > 0.0_dp .and. .not. ms%forced_off(i)
+               if (on .neqv. was_on(i)) flips(i) = flips(i) + 1
+               was_on(i) = on
+            end do
             uscale = max(maxval(abs(u)), maxval(abs(un)), h*maxval(abs(vn)), tiny(1.0_dp))
             ! The inertia term cm·M·u is evaluated with rounding error ~ε·cm·m·|u|, which can
             ! exceed the physical forces by far (small h, free flight): it floors the scale.
@@ -336,21 +372,46 @@ contains
                call fail(MARTELLO_ERR_SINGULAR, 'singular effective stiffness in the Newton step')
                return
             end if
-            u(1:n) = u(1:n) + du
+            if (it >= 2) then
+               call line_search(rnorm)
+            else
+               u(1:n) = u(1:n) + du
+            end if
          end do
-         if (.not. converged) then
-            write (r%message, '(a,es12.5,a,i0,a,es9.2,a,es9.2,a)') 'Newton did not converge at t = ', t, &
-               ' s after ', s%max_newton, ' iterations (residual ', rnorm/fscale, &
-               ' of the force scale, tolerance ', s%tol_residual, '); reduce dt'
-            stat = MARTELLO_ERR_NOT_CONVERGED; r%t_end_reached = t
-         end if
-      end subroutine newton_step
+      end subroutine newton_iterations
 
-      !> Velocity Verlet with the damping (and contact-rate) velocity lagged to t + h/2.
+      !> Backtracking on ‖r‖∞ once plain Newton has taken two steps without converging: laws
+      !> whose tangent is unbounded at first touch (Jankowski: ∂F/∂δ ~ δ^{−3/4}) or that switch
+      !> branch inside a step make full steps overshoot; halving restores a decrease.
+      subroutine line_search(r0)
+         real(dp), intent(in) :: r0
+         real(dp) :: lam, rtrial
+         integer :: k
+         work(1:n) = u(1:n)
+         lam = 1.0_dp
+         do k = 1, 12
+            u(1:n) = work(1:n) + lam*du
+            call kinematics()
+            call internal_forces(m, ms, u, v, fint)
+            call mass_times(m, a, ma)
+            call mass_times(m, an, res)
+            res = (1.0_dp - am)*ma + am*res + (1.0_dp - af)*fint + af*fint_n &
+                  - (1.0_dp - af)*fext - af*fext_n
+            where ([.false., m%fixed]) res = 0.0_dp
+            r%counters(C_RESIDUALS) = r%counters(C_RESIDUALS) + 1_i8
+            rtrial = maxval(abs(res(1:n)))
+            if (rtrial < r0) return
+            lam = 0.5_dp*lam
+         end do
+      end subroutine line_search
+
+      !> Velocity Verlet. Velocity-dependent forces (dampers, contact rates) see the explicit
+      !> estimate v* = v_n + h a_n of v_{n+1}: O(h²) accurate, so the scheme stays second
+      !> order with damping (a lagged v_{n+1/2} would make it first order).
       subroutine central_difference_step(ok)
          logical, intent(out) :: ok
-         work = vn + 0.5_dp*h*an                      ! v(n+1/2)
-         u = un + h*work
+         u = un + h*(vn + 0.5_dp*h*an)
+         work = vn + h*an
          where ([.false., m%fixed])
             u = un; work = 0.0_dp
          end where
@@ -358,7 +419,8 @@ contains
          r%counters(C_RESIDUALS) = r%counters(C_RESIDUALS) + 1_i8
          a = fext - fint
          call solve_mass(a, ok)
-         v = work + 0.5_dp*h*a
+         v = vn + 0.5_dp*h*(an + a)
+         where ([.false., m%fixed]) v = 0.0_dp
       end subroutine central_difference_step
 
       subroutine track_peaks()

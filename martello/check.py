@@ -15,9 +15,14 @@ DIGITS_CAP = 16.0   # a double carries ~15.95 digits; an exact match is reported
 def lookup(summary, path):
     node = summary
     for part in path.split("."):
-        if not isinstance(node, dict) or part not in node:
+        if isinstance(node, list) and part.isdigit() and int(part) < len(node):
+            node = node[int(part)]
+        elif isinstance(node, dict) and part in node:
+            node = node[part]
+        else:
             raise KeyError(path)
-        node = node[part]
+    if node is None:
+        raise KeyError(path)
     return node
 
 

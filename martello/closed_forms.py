@@ -1385,3 +1385,54 @@ def match_events(t, t_ref, window) -> EventMatch:
     extra = np.setdiff1d(np.arange(len(t)), pairs[:, 0])
     return EventMatch(pairs, dt, len(pairs), len(missing), len(extra), missing, extra,
                       float(np.max(np.abs(dt))) if len(dt) else 0.0)
+
+
+# ---------------------------------------------------------------------------------------------
+# Catalogue dispatchers: one call per scene kind, returning a dict of named oracle values, so
+# that a scene's [check] table can name them (martello/check.py). They only combine the
+# closed forms above.
+
+def two_body_impact(law, m1, m2, v0, stiffness, restitution=None, exponent=None, clipped=False):
+    """P5: a free two-body impact (approach speed v0 > 0) under one penalty law.
+
+    Returns restitution (realised e), contact_time where a closed form exists, and
+    max_penetration where one exists. For kelvin the damping is the Anagnostopoulos one
+    derived from the target e; the HC family uses its own published factor a(e)."""
+    mstar = m1 * m2 / (m1 + m2)
+    out = {}
+    if law == "linear":
+        out.update(restitution=1.0, contact_time=linear_contact_time(mstar, stiffness),
+                   max_penetration=v0 * math.sqrt(mstar / stiffness))
+    elif law == "hertz":
+        h = hertz_impact(mstar, stiffness, v0)
+        out.update(restitution=1.0, contact_time=h.t_c, max_penetration=h.delta_max)
+    elif law == "kelvin":
+        xi = kelvin_xi_from_e(restitution)
+        out["restitution"] = kelvin_clipped_restitution(xi) if clipped else restitution
+        if not clipped:
+            # the unclipped phase is exactly half a damped period
+            out["contact_time"] = math.pi / (math.sqrt(stiffness / mstar) * math.sqrt(1 - xi * xi))
+    elif law in ("hunt-crossley", "lankarani-nikravesh", "flores", "gonthier", "hertzdamp"):
+        key = "lankarani_nikravesh" if law == "hertzdamp" else law.replace("-", "_")
+        a = HC_FACTORS[key](restitution)
+        n = 1.5 if (law == "hertzdamp" or exponent is None) else exponent
+        out.update(restitution=hunt_crossley_realised_e(a),
+                   max_penetration=hc_max_penetration(n, stiffness, mstar, a / v0, v0))
+    elif law == "jankowski":
+        out["restitution"] = jankowski_realised_e(jankowski_xi(restitution))
+    else:
+        raise ValueError(f"no closed form for law {law!r}")
+    return out
+
+
+def elastoplastic_peak(m, k, uy, rho, v0):
+    """P6 as a dict (u_max, t_max) for scene checks."""
+    r = elastoplastic_impulse(m, k, uy, rho, v0)
+    return {"u_max": r.u_max, "t_max": r.t_max}
+
+
+def sdof_sine_ground_final(m, k, zeta, ag_amp, omega_g, t_end):
+    """Exact relative displacement and velocity of a damped SDOF under A sin(Ωt) ground
+    acceleration at t_end, from rest."""
+    r = sdof_sine_ground_response(m, k, zeta, ag_amp, omega_g, np.array([t_end]))
+    return {"u": float(r.u[0]), "v": float(r.v[0])}

@@ -198,7 +198,8 @@ class Model:
 
 
 COUNTER_NAMES = ("steps", "rejected_steps", "newton_iterations", "residual_evaluations",
-                 "factorizations", "events", "jacobian_evaluations", "root_evaluations")
+                 "factorizations", "events", "jacobian_evaluations", "root_evaluations",
+                 "contact_chatter_resolutions")
 ENERGY_NAMES = ("kinetic", "recoverable", "input", "damping", "plastic", "contact", "balance",
                 "initial", "impact")
 EVENT_NAMES = ("t_on", "t_off", "v_in", "v_out", "max_penetration", "max_force")

@@ -22,7 +22,7 @@ def check_catalogue(files, outdir, plots=True, stream=sys.stdout):
     outdir.mkdir(parents=True, exist_ok=True)
     rows, failures, t_start = [], [], time.perf_counter()
     print(f"martello {native.version()} ({native.library_versions()})", file=stream)
-    header = f"{'scene':<44} {'scheme':<19} {'quantity':<28} {'digits':>6} {'tol':>8}  result"
+    header = f"{'scene':<44} {'scheme':<19} {'quantity':<36} {'digits':>6} {'tol':>8}  result"
     print(header, file=stream)
     print("-" * len(header), file=stream)
     for k, path in enumerate(files, 1):
@@ -40,7 +40,7 @@ def check_catalogue(files, outdir, plots=True, stream=sys.stdout):
                 rows.append(r)
                 tol = f"{r['rtol']:8.0e}" if r["rtol"] else ("   exact" if r["atol"] < 1e-100
                                                              else f"{r['atol']:8.0e}")
-                print(f"{s.title[:44]:<44} {schemes[:19]:<19} {r['quantity'][:28]:<28} "
+                print(f"{s.title[:44]:<44} {schemes[:19]:<19} {r['quantity'][:36]:<36} "
                       f"{r['digits']:6.1f} {tol}  {'pass' if r['passed'] else 'FAIL'}",
                       file=stream)
                 if not r["passed"]:

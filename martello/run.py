@@ -216,6 +216,8 @@ def _dynamic(scene, model, raise_on_failure=True):
             "restitution": [float(-vo / vi) if vi > 0 else None for vi, vo in closed[:, 2:4]],
             "phase_max_penetration": [float(x) for x in mine[:, 4]],
             "phase_max_force": [float(x) for x in mine[:, 5]]}
+        if len(closed):
+            contacts[c["name"]]["contact_time"] = float(closed[0, 1] - closed[0, 0])  # first phase
     scale = max(abs(energy["initial"]), abs(energy["input"]), 1e-300)
     energy.update(balance_max=extra["balance_max"], balance_relative=extra["balance_max"] / scale)
     summary = {
