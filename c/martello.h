@@ -134,8 +134,12 @@ int martello_run_events(const martello_run *run, int *n, int *contacts, double *
  * factorizations, events, Jacobian evaluations, root-function evaluations, contact
  * chatter resolutions (steps where a contact was held open, see docs/integrators.md)} */
 int martello_run_counters(const martello_run *run, long long counters[MARTELLO_NCOUNTERS]);
+/* Per node: extremes over the steps, and the largest local maximum of u interpolated between
+ * steps (u_peak at t_peak; t_peak = -1 if u never turned back); per contact: max
+ * penetration, max force and the number of contact phases. */
 int martello_run_peaks(const martello_run *run, double *u_max, double *u_min, double *v_absmax,
-                       double *a_absmax, double *pen_max, double *force_max, int *impacts);
+                       double *a_absmax, double *pen_max, double *force_max, int *impacts,
+                       double *u_peak, double *t_peak);
 /* energy = {kinetic, recoverable, input work, damping, plastic, contact dissipation, balance,
  * initial, impact}; extra = {max |balance|, omega_max, dt_crit (explicit), time reached} */
 int martello_run_energy(const martello_run *run, double energy[MARTELLO_NENERGY], double extra[4]);

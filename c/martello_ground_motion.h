@@ -44,10 +44,7 @@ int martello_gm_response_spectrum(const double *ag, int n, double dt, double zet
 int martello_gm_fourier_amplitude(const double *a, int n, double dt, double *freq, double *amp,
                                   int *nfreq);
 
-/* Envelope slots (Jennings, Housner & Tsai 1968 type):
- *   I(t) = (t/t_rise)^2              0 <= t < t_rise
- *        = 1                         t_rise <= t <= t_plateau_end
- *        = exp(-decay (t - t_plateau_end))   t > t_plateau_end                              */
+/* Slots of the envelope array of martello_gm_synthesize. */
 enum { MARTELLO_GM_NENV = 3, MARTELLO_GM_ENV_RISE = 0, MARTELLO_GM_ENV_PLATEAU_END = 1,
        MARTELLO_GM_ENV_DECAY = 2 };
 
@@ -55,37 +52,54 @@ enum { MARTELLO_GM_NENV = 3, MARTELLO_GM_ENV_RISE = 0, MARTELLO_GM_ENV_PLATEAU_E
  * spectrum (target_periods[j], target_psa[j]), j < n_target, periods strictly increasing and
  * >= 0, psa > 0, interpolated linearly in T between the points.
  *
- * Method (the SIMQKE scheme, Gasparini & Vanmarcke 1976):
+ * Method (SIMQKE, Gasparini & Vanmarcke 1976, with the PGA steered inside the loop):
  *  1. phases phi_k uniform on [0, 2 pi) from GSL's gsl_rng_mt19937 seeded with `seed` (GSL
- *     maps seed 0 to its default 4357); initial Fourier amplitudes A_k = Sa(1/f_k)/sqrt(f_k)
- *     (the stationary-response relation between a one-sided PSD and the PSA), tapered to zero
- *     below half the lowest target frequency;
- *  2. stationary signal s = FFTW c2r of A_k exp(i phi_k) on N = 2^a 3^b 5^c >= 2n points
- *     (zero-padding gives a frequency step 1/(N dt) fine enough to shape the spectrum near
- *     the longest periods); a(t_i) = I(t_i) s(t_i) for i < n;
- *  3. baseline correction: a <- a - I(t) (alpha + beta t/t_end) with alpha, beta solved so
- *     that the final velocity (trapezoidal rule) and final displacement (exact integration of
- *     the piecewise-linear a) are zero; the correction lives inside the envelope, so the
- *     record still starts and ends quietly;
- *  4. a <- a * pga / max|a|, so the PGA equals `pga` (normally the target at T = 0);
- *  5. the zeta-damped PSA on a log-spaced period grid (>= 150 points per decade, holding t_min
- *     and t_max, from max(first positive target period, 2 dt) to the last target period);
+ *     maps seed 0 to its default 4357); Fourier amplitudes A_k = Sa(1/f_k)/sqrt(f_k) (the
+ *     stationary-response relation between a one-sided PSD and the PSA), faded to zero below
+ *     half the lowest target frequency 1/T_last;
+ *  2. stationary signal sig = FFTW c2r of A_k exp(i phi_k) on N = 2^a 3^b 5^c >= 4n points,
+ *     first n samples kept; the record is a(t_i) = I(t_i) sig(t_i) (the envelope below);
+ *  3. baseline correction: sig <- sig - (alpha + beta t/t_end), alpha and beta solved so that
+ *     the record I sig has zero final velocity (trapezoidal rule) and zero final displacement
+ *     (exact integration of the piecewise-linear record); being under the envelope, the
+ *     correction leaves the record's quiet start and end alone;
+ *  4. the record judged is g a, g = pga / max|a|: its PGA is `pga` (normally the target at
+ *     T = 0) to rounding, and scaling keeps final velocity and displacement zero;
+ *  5. the zeta-damped PSA on a log-spaced period grid from ta = max(first positive target
+ *     period, 2 dt) to the last target period, holding t_min and t_max, >= 600 points per
+ *     decade in [t_min, t_max] and >= 150 outside (between grid points the PSA, which has
+ *     kinks, can stray a few tenths of a percent further: 0.4 % at most on 10 records);
  *     deviation = max |PSA/target - 1| over the grid points in [t_min, t_max];
- *  6. if deviation <= band, stop; else A_k <- A_k * target/PSA at T = 1/f_k (interpolated in
- *     log T on the grid, held constant beyond its ends), phases kept, back to 2.
- * The record returned is the one with the smallest deviation met, always after steps 3 and 4,
+ *  6. if deviation <= band: done.  Else every bin of the FFTW r2c transform of sig (zero-padded
+ *     to N, so the correction filter does not wrap around) is multiplied by (target/PSA)^1.5
+ *     at T = 1/f (over-relaxed: the envelope smears a correction of sig over neighbouring
+ *     frequencies; interpolated in log T on the grid, held beyond its ends, faded to 1 below
+ *     half the lowest target frequency), c2r back, the envelope re-applied (a = I sig), back
+ *     to 3.
+ *     Below t_min the matching target is not the code's ramp, which a sampled record cannot
+ *     follow (its PSA tends to its own PGA at short periods): it is a ramp from rho*pga at ta
+ *     to the target at t_min, and rho <- rho g after each correction steers the record's own
+ *     PGA to `pga`, so that the scaling of step 4 does not pull the matched spectrum out of
+ *     the band;
+ *  7. an attempt whose deviation has not improved for 10 corrections is abandoned and a new
+ *     attempt starts at 1 with fresh phases drawn further along the same generator stream
+ *     (so a record still depends on the seed alone).
+ * The record returned is the best one met (smallest deviation), always after steps 3 and 4,
  * so its PGA is `pga` to rounding and its final velocity and displacement are zero to
- * rounding.  *iterations = number of amplitude corrections (step 6) made;
- * *worst_deviation = the deviation of the record returned.
- * envelope[MARTELLO_GM_NENV]: t_rise >= 0, t_plateau_end >= t_rise, decay > 0.
- * 0 < t_min < t_max, both inside the target's period range; band > 0; max_iter >= 0.
- * Returns MARTELLO_OK when the band was met, MARTELLO_ERR_NOT_CONVERGED when max_iter
- * corrections did not reach it (outputs still filled with the best record). */
+ * rounding.  Outputs: *iterations = corrections (step 6) made in all, *restarts = attempts
+ * abandoned (may be NULL), *worst_deviation = the deviation of the record returned.
+ * The envelope (Jennings, Housner & Tsai 1968 type):
+ *   I(t) = (t/t_rise)^2 for t < t_rise, 1 up to t_plateau_end, exp(-decay (t - t_plateau_end))
+ *   after; t_rise >= 0, t_plateau_end >= t_rise, decay > 0.
+ * 0 < t_min < t_max, with ta <= t_min and t_max <= the last target period; band > 0;
+ * max_iter >= 0 is the budget of corrections over all attempts.
+ * Returns MARTELLO_OK when the band was met, MARTELLO_ERR_NOT_CONVERGED when the budget ran
+ * out first (the outputs are still filled, with the best record met). */
 int martello_gm_synthesize(const double *target_periods, const double *target_psa,
                            int n_target, double pga, double zeta, double dt, int n,
                            const double envelope[MARTELLO_GM_NENV], double t_min, double t_max,
                            double band, int max_iter, unsigned long seed, double *accel,
-                           int *iterations, double *worst_deviation);
+                           int *iterations, int *restarts, double *worst_deviation);
 
 #ifdef __cplusplus
 }

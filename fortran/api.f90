@@ -417,10 +417,10 @@ contains
    end function c_run_counters
 
    integer(c_int) function c_run_peaks(handle, u_max, u_min, v_absmax, a_absmax, pen_max, &
-                                       force_max, impacts) bind(C, name='martello_run_peaks')
+                                       force_max, impacts, u_peak, t_peak) bind(C, name='martello_run_peaks')
       type(c_ptr), value :: handle
       real(c_double), intent(out) :: u_max(*), u_min(*), v_absmax(*), a_absmax(*), pen_max(*), &
-                                     force_max(*)
+                                     force_max(*), u_peak(*), t_peak(*)
       integer(c_int), intent(out) :: impacts(*)
       type(run_t), pointer :: rp
       integer :: n, nc
@@ -433,6 +433,7 @@ contains
       v_absmax(1:n) = rp%results%v_absmax; a_absmax(1:n) = rp%results%a_absmax
       pen_max(1:nc) = rp%results%pen_max; force_max(1:nc) = rp%results%force_max
       impacts(1:nc) = rp%results%impacts
+      u_peak(1:n) = rp%results%u_peak; t_peak(1:n) = rp%results%t_peak
       c_run_peaks = MARTELLO_OK
    end function c_run_peaks
 

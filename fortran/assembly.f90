@@ -6,14 +6,14 @@ module martello_assembly
    use martello_kinds, only: dp
    use martello_model, only: model_t, SCHEME_PENALTY
    use martello_links, only: link_force, bilinear_energy, LINK_SPRING, LINK_BAR, LINK_BILINEAR, &
-      LINK_DASHPOT, LINK_FLUID_DAMPER, L_STIFF, L_YIELD, L_HARDENING
-   use martello_contact_laws, only: contact_force, contact_elastic_energy
-   use martello_band_matrix, only: band_t, band_add_pair, band_add
+      LINK_DASHPOT, LINK_FLUID_DAMPER, L_STIFF, L_DAMP, L_YIELD, L_HARDENING
+   use martello_contact_laws, only: contact_force, contact_elastic_energy, LAW_LINEAR, P_STIFF
+   use martello_band_matrix, only: band_t, band_add
    use martello_time_functions, only: tf_value, TF_NONE
    implicit none
    private
    public :: mech_state_t, mech_init, internal_forces, external_forces, mech_commit, &
-      recoverable_energy, element_work, mass_times, assemble_mass, ONSET_SPEED_FLOOR
+      recoverable_energy, mass_times, assemble_mass, ONSET_SPEED_FLOOR
 
    !> Hunt–Crossley-type laws scale damping by 1/v_in; a contact first seen while δ̇ ≤ 0
    !> (grazing, or a step that lands inside) uses this floor [m/s] instead of a division by 0.
@@ -65,28 +65,49 @@ contains
 
    !> fint(0:n) of links and penalty contacts at (u, v); with jac present, also
    !> jac += ck·K_t + cc·C_t (tangent stiffness and damping), ground rows skipped.
-   subroutine internal_forces(m, s, u, v, fint, jac, ck, cc)
+   !> This loop is the cost of a chain step: the linear kinds (spring, bar, dashpot, linear
+   !> penalty) are evaluated in line, the others through their constitutive kernels.
+   subroutine internal_forces(m, s, u, v, fint, jac, ck, cc, cmat)
       type(model_t), intent(in) :: m
       type(mech_state_t), intent(inout) :: s
-      real(dp), intent(in) :: u(0:), v(0:)
-      real(dp), intent(out) :: fint(0:)
-      type(band_t), intent(inout), optional :: jac
+      real(dp), intent(in), contiguous :: u(0:), v(0:)
+      real(dp), intent(out), contiguous :: fint(0:)
+      !> band arrays in the layout of martello_band_matrix (A(i,j) in ab(2kd+1+i−j, j))
+      real(dp), intent(inout), contiguous, optional :: jac(:, :)
       real(dp), intent(in), optional :: ck, cc
-      integer :: j, a, b
+      real(dp), intent(inout), contiguous, optional :: cmat(:, :)   !< += C_t alone
+      integer :: j, a, b, r
       real(dp) :: du, dv, f, kt, ct, fnew, pen, rate, vin, dfd, dfv
+      logical :: tangent
 
+      tangent = present(jac)
+      r = 0
+      if (tangent) r = (size(jac, 1) - 1)/3*2 + 1
       fint = 0.0_dp
-      do j = 1, m%nlink
-         a = m%link_a(j); b = m%link_b(j)
-         du = u(a) - u(b); dv = v(a) - v(b)
-         call link_force(m%link_kind(j), m%link_par(:, j), du, dv, s%link_fc(j), s%link_u(j), &
-                         f, kt, ct, fnew)
-         s%link_fc_trial(j) = fnew
-         s%link_f_trial(j) = f
-         fint(a) = fint(a) + f
-         fint(b) = fint(b) - f
-         if (present(jac)) call band_add_pair(jac, a, b, ck*kt + cc*ct)
-      end do
+      ! associate: the descriptors are read once, not at every access inside the loop
+      associate (la => m%link_a, lb => m%link_b, kind => m%link_kind, par => m%link_par, &
+                 fc => s%link_fc, lu => s%link_u, fc_trial => s%link_fc_trial, f_trial => s%link_f_trial)
+         do j = 1, m%nlink
+            a = la(j); b = lb(j)
+            du = u(a) - u(b); dv = v(a) - v(b)
+            select case (kind(j))
+            case (LINK_SPRING, LINK_BAR)
+               kt = par(L_STIFF, j); ct = 0.0_dp
+               f = kt*du; fnew = f
+            case (LINK_DASHPOT)
+               kt = 0.0_dp; ct = par(L_DAMP, j)
+               f = ct*dv; fnew = 0.0_dp
+            case default
+               call link_force(kind(j), par(1, j), du, dv, fc(j), lu(j), f, kt, ct, fnew)
+            end select
+            fc_trial(j) = fnew
+            f_trial(j) = f
+            fint(a) = fint(a) + f
+            fint(b) = fint(b) - f
+            if (tangent) call stencil(jac, a, b, ck*kt + cc*ct)
+            if (present(cmat) .and. ct /= 0.0_dp) call stencil(cmat, a, b, ct)
+         end do
+      end associate
       do j = 1, m%ncontact
          if (.not. s%is_penalty(j)) cycle
          a = m%con_a(j); b = m%con_b(j)
@@ -97,7 +118,11 @@ contains
             vin = s%con_vin(j)
             if (.not. s%con_on(j)) vin = max(rate, ONSET_SPEED_FLOOR)
             s%con_vin_trial(j) = vin
-            call contact_force(m%con_law(j), m%con_par(:, j), pen, rate, vin, f, dfd, dfv)
+            if (m%con_law(j) == LAW_LINEAR) then
+               dfd = m%con_par(P_STIFF, j); dfv = 0.0_dp; f = dfd*pen
+            else
+               call contact_force(m%con_law(j), m%con_par(1, j), pen, rate, vin, f, dfd, dfv)
+            end if
          else
             f = 0.0_dp; dfd = 0.0_dp; dfv = 0.0_dp
             s%con_vin_trial(j) = 0.0_dp
@@ -105,22 +130,57 @@ contains
          s%con_f_trial(j) = f
          fint(a) = fint(a) + f
          fint(b) = fint(b) - f
-         if (present(jac) .and. (dfd /= 0.0_dp .or. dfv /= 0.0_dp)) &
-            call band_add_pair(jac, a, b, ck*dfd + cc*dfv)
+         if (tangent .and. (dfd /= 0.0_dp .or. dfv /= 0.0_dp)) call stencil(jac, a, b, ck*dfd + cc*dfv)
+         if (present(cmat) .and. dfv /= 0.0_dp) call stencil(cmat, a, b, dfv)
       end do
       fint(0) = 0.0_dp
+   contains
+      !> The two-node stencil of band_add_pair, in line (this loop runs n times a step).
+      subroutine stencil(ab, i, k, val)
+         real(dp), intent(inout) :: ab(:, :)
+         integer, intent(in) :: i, k
+         real(dp), intent(in) :: val
+         if (i > 0) ab(r, i) = ab(r, i) + val
+         if (k > 0) ab(r, k) = ab(r, k) + val
+         if (i > 0 .and. k > 0) then
+            ab(r + i - k, k) = ab(r + i - k, k) - val
+            ab(r + k - i, i) = ab(r + k - i, i) - val
+         end if
+      end subroutine stencil
    end subroutine internal_forces
 
-   !> Accept the trial state of the last internal_forces call.
-   subroutine mech_commit(m, s, u)
+   !> Accept the trial state of the last internal_forces call; optionally return the
+   !> trapezoidal work of the elements over the step just ended, split into damping links,
+   !> other links and contacts (the energy balance of the integrators).
+   subroutine mech_commit(m, s, u, w_damp, w_links, w_contact)
       type(model_t), intent(in) :: m
       type(mech_state_t), intent(inout) :: s
       real(dp), intent(in) :: u(0:)
+      real(dp), intent(out), optional :: w_damp, w_links, w_contact
       integer :: j
+      real(dp) :: du, w
+      if (present(w_damp)) then
+         w_damp = 0.0_dp; w_links = 0.0_dp; w_contact = 0.0_dp
+      end if
       do j = 1, m%nlink
+         du = u(m%link_a(j)) - u(m%link_b(j))
+         if (present(w_damp)) then
+            w = 0.5_dp*(s%link_f(j) + s%link_f_trial(j))*(du - s%link_u(j))
+            if (m%link_kind(j) == LINK_DASHPOT .or. m%link_kind(j) == LINK_FLUID_DAMPER) then
+               w_damp = w_damp + w
+            else
+               w_links = w_links + w
+            end if
+         end if
          s%link_fc(j) = s%link_fc_trial(j)
-         s%link_u(j) = u(m%link_a(j)) - u(m%link_b(j))
+         s%link_u(j) = du
       end do
+      if (present(w_damp)) then
+         do j = 1, m%ncontact
+            if (s%is_penalty(j)) w_contact = w_contact + &
+               0.5_dp*(s%con_f(j) + s%con_f_trial(j))*(s%con_pen_trial(j) - s%con_pen(j))
+         end do
+      end if
       s%link_f = s%link_f_trial
       s%con_f = s%con_f_trial
       s%con_pen = s%con_pen_trial
@@ -171,33 +231,6 @@ contains
       end do
    end subroutine recoverable_energy
 
-   !> Trapezoidal work of the elements over the step just committed (forces old/new,
-   !> elongations old/new), split into damping links, other links and contacts.
-   subroutine element_work(m, s_old_link_f, s_old_link_u, s_old_con_f, s_old_con_pen, s, u, &
-                           w_damp, w_links, w_contact)
-      type(model_t), intent(in) :: m
-      real(dp), intent(in) :: s_old_link_f(:), s_old_link_u(:), s_old_con_f(:), s_old_con_pen(:)
-      type(mech_state_t), intent(in) :: s
-      real(dp), intent(in) :: u(0:)
-      real(dp), intent(out) :: w_damp, w_links, w_contact
-      integer :: j
-      real(dp) :: w
-      w_damp = 0.0_dp; w_links = 0.0_dp; w_contact = 0.0_dp
-      do j = 1, m%nlink
-         w = 0.5_dp*(s_old_link_f(j) + s%link_f(j))* &
-             ((u(m%link_a(j)) - u(m%link_b(j))) - s_old_link_u(j))
-         if (m%link_kind(j) == LINK_DASHPOT .or. m%link_kind(j) == LINK_FLUID_DAMPER) then
-            w_damp = w_damp + w
-         else
-            w_links = w_links + w
-         end if
-      end do
-      do j = 1, m%ncontact
-         if (s%is_penalty(j)) w_contact = w_contact + &
-            0.5_dp*(s_old_con_f(j) + s%con_f(j))*(s%con_pen(j) - s_old_con_pen(j))
-      end do
-   end subroutine element_work
-
    !> y = M x for the lumped diagonal plus the consistent-mass couplings.
    pure subroutine mass_times(m, x, y)
       type(model_t), intent(in) :: m
@@ -217,9 +250,10 @@ contains
       type(model_t), intent(in) :: m
       real(dp), intent(in) :: c
       type(band_t), intent(inout) :: jac
-      integer :: i, j
+      integer :: i, j, r
+      r = 2*jac%kd + 1
       do i = 1, m%n
-         call band_add(jac, i, i, c*m%mass(i))
+         jac%ab(r, i) = jac%ab(r, i) + c*m%mass(i)
       end do
       do j = 1, m%ncoupling
          call band_add(jac, m%mc_a(j), m%mc_b(j), c*m%mc_value(j))

@@ -77,8 +77,17 @@ contains
       type(band_t), intent(in) :: b
       real(dp), intent(in) :: x(:)
       real(dp), intent(out) :: y(:)
-      integer :: i, j, r
+      integer :: i, j, r, n
       r = 2*b%kd + 1
+      n = b%n
+      if (b%kd == 1 .and. n > 1) then     ! the chain case, unrolled
+         y(1) = b%ab(r, 1)*x(1) + b%ab(r - 1, 2)*x(2)
+         do i = 2, n - 1
+            y(i) = b%ab(r + 1, i - 1)*x(i - 1) + b%ab(r, i)*x(i) + b%ab(r - 1, i + 1)*x(i + 1)
+         end do
+         y(n) = b%ab(r + 1, n - 1)*x(n - 1) + b%ab(r, n)*x(n)
+         return
+      end if
       do i = 1, b%n
          y(i) = 0.0_dp
          do j = max(1, i - b%kd), min(b%n, i + b%kd)

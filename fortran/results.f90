@@ -38,6 +38,9 @@ module martello_results
       real(dp), allocatable :: ev(:, :)
       ! peaks over every accepted step
       real(dp), allocatable :: u_max(:), u_min(:), v_absmax(:), a_absmax(:)
+      !> the largest local maximum of u, interpolated between steps (u_peak at t_peak); the
+      !> step maxima above are O(h) in time, these are O(h²)
+      real(dp), allocatable :: u_peak(:), t_peak(:)
       real(dp), allocatable :: pen_max(:), force_max(:)
       integer, allocatable :: impacts(:)
       real(dp) :: energy(NENERGY) = 0.0_dp
@@ -63,9 +66,11 @@ contains
       if (allocated(r%ev)) deallocate (r%ev, r%ev_contact)
       allocate (r%ev(NEVENT, 16), r%ev_contact(16))
       if (allocated(r%u_max)) deallocate (r%u_max, r%u_min, r%v_absmax, r%a_absmax, &
-                                          r%pen_max, r%force_max, r%impacts)
+                                          r%pen_max, r%force_max, r%impacts, r%u_peak, r%t_peak)
       allocate (r%u_max(n_nodes), r%u_min(n_nodes), r%v_absmax(n_nodes), r%a_absmax(n_nodes), &
-                r%pen_max(n_contacts), r%force_max(n_contacts), r%impacts(n_contacts))
+                r%pen_max(n_contacts), r%force_max(n_contacts), r%impacts(n_contacts), &
+                r%u_peak(n_nodes), r%t_peak(n_nodes))
+      r%u_peak = -huge(1.0_dp); r%t_peak = -1.0_dp
       r%u_max = -huge(1.0_dp); r%u_min = huge(1.0_dp); r%v_absmax = 0.0_dp
       r%a_absmax = 0.0_dp; r%pen_max = -huge(1.0_dp); r%force_max = 0.0_dp; r%impacts = 0
       r%energy = 0.0_dp; r%energy_balance_max = 0.0_dp

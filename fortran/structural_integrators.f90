@@ -79,16 +79,20 @@ contains
       integer :: n, kd, j, nsteps, step, it, info
       real(dp), allocatable :: u(:), v(:), a(:), un(:), vn(:), an(:), fint(:), fint_n(:), &
                                fext(:), fext_n(:), res(:), du(:), work(:), mrow(:), ma(:)
-      real(dp), allocatable :: old_link_f(:), old_link_u(:), old_con_f(:), old_con_pen(:)
+      real(dp), allocatable :: man(:)
+      integer, allocatable :: fixed_nodes(:)
       ! open contact phases: onset time, speed, running maxima
       real(dp), allocatable :: ph_t(:), ph_v(:), ph_pen(:), ph_f(:)
       logical, allocatable :: ph_open(:)
       type(mech_state_t) :: ms
-      type(band_t) :: jac, mband
+      type(band_t) :: jac, mband, cjac
       real(dp) :: h, t, am, af, beta, gamma, cm, cv, fscale, uscale, rnorm, jmin, &
                   e_kin, e_links, e_cont, e_links0, e_cont0, e0, w_ext, d_damp, d_links, &
-                  d_contact, w_abs, wd, wl, wc, e_mech, mmax
-      logical :: ok, converged
+                  d_contact, w_abs, wd, wl, wc, e_mech, mmax, fmag, fext_mag
+      logical :: ok, converged, recording, tangent_valid
+      !> steps between divergence checks on the mechanical energy (NaN is caught every step
+      !> through the work increments)
+      integer, parameter :: ENERGY_CHECK = 16
 
       stat = MARTELLO_OK
       n = m%n
@@ -100,12 +104,15 @@ contains
       kd = model_bandwidth(m)
 
       allocate (u(0:n), v(0:n), a(0:n), un(0:n), vn(0:n), an(0:n), fint(0:n), fint_n(0:n), &
-                fext(0:n), fext_n(0:n), res(0:n), du(n), work(0:n), mrow(0:n), ma(0:n))
+                fext(0:n), fext_n(0:n), res(0:n), du(n), work(0:n), mrow(0:n), ma(0:n), man(0:n))
       allocate (ph_t(m%ncontact), ph_v(m%ncontact), ph_pen(m%ncontact), ph_f(m%ncontact), &
                 ph_open(m%ncontact))
       ph_open = .false.
+      fixed_nodes = pack([(j, j = 1, n)], m%fixed)
       call band_init(jac, n, kd)
       call band_init(mband, n, kd)
+      call band_init(cjac, n, kd)
+      tangent_valid = .false.
 
       ! initial state; M·1 carries gravity and ground-motion loads
       u(0) = 0.0_dp; v(0) = 0.0_dp
@@ -150,11 +157,11 @@ contains
 
       do step = 1, nsteps
          un = u; vn = v; an = a; fint_n = fint; fext_n = fext
-         old_link_f = ms%link_f; old_link_u = ms%link_u
-         old_con_f = ms%con_f; old_con_pen = ms%con_pen
+         call mass_times(m, an, man)
          t = min(step*h, s%t_end)
          if (step == nsteps) t = s%t_end
          call external_forces(m, mrow, t, fext)
+         fext_mag = maxval(abs(fext))
 
          if (s%kind == INT_CENTRAL_DIFFERENCE) then
             call central_difference_step(ok)
@@ -167,22 +174,24 @@ contains
             if (.not. converged) return
          end if
          r%counters(C_STEPS) = r%counters(C_STEPS) + 1_i8
-         call mech_commit(m, ms, u)
-
-         ! energy balance: trapezoidal work of every force over the step
-         work(1:n) = u(1:n) - un(1:n)
+         ! energy balance: trapezoidal work of every force over the step (elements in commit)
+         call mech_commit(m, ms, u, wd, wl, wc)
+         d_damp = d_damp + wd; d_links = d_links + wl; d_contact = d_contact + wc
          wd = 0.0_dp
          do j = 1, n
-            if (.not. m%fixed(j)) wd = wd + 0.5_dp*(fext_n(j) + fext(j))*work(j)
+            if (.not. m%fixed(j)) wd = wd + 0.5_dp*(fext_n(j) + fext(j))*(u(j) - un(j))
          end do
          w_ext = w_ext + wd; w_abs = w_abs + abs(wd)
-         call element_work(m, old_link_f, old_link_u, old_con_f, old_con_pen, ms, u, wd, wl, wc)
-         d_damp = d_damp + wd; d_links = d_links + wl; d_contact = d_contact + wc
-         e_kin = kinetic(v)
-         call recoverable_energy(m, ms, u, e_links, e_cont)
          call track_events()
          call track_peaks()
-         if (mod(step, s%every) == 0 .or. step == nsteps) call record()
+         recording = mod(step, s%every) == 0 .or. step == nsteps
+         ! kinetic and recoverable energy (two passes over the model) only where needed: at
+         ! recorded steps and every ENERGY_CHECK steps for the divergence test
+         if (.not. (recording .or. mod(step, ENERGY_CHECK) == 0 .or. &
+                    .not. ieee_is_finite(wd + d_links + d_contact + d_damp))) cycle
+         e_kin = kinetic(v)
+         call recoverable_energy(m, ms, u, e_links, e_cont)
+         if (recording) call record()
 
          ! divergence: NaN, or mechanical energy far beyond what was put in
          e_mech = e_kin + e_links + e_cont
@@ -281,11 +290,13 @@ contains
 
       !> Newmark relations for a trial u: a(u), v(u).
       subroutine kinematics()
+         integer :: i, k
          a(1:n) = (u(1:n) - un(1:n) - h*vn(1:n))/(beta*h*h) - (0.5_dp - beta)/beta*an(1:n)
          v(1:n) = vn(1:n) + h*((1.0_dp - gamma)*an(1:n) + gamma*a(1:n))
-         where (m%fixed)
-            u(1:n) = un(1:n); v(1:n) = 0.0_dp; a(1:n) = 0.0_dp
-         end where
+         do k = 1, size(fixed_nodes)
+            i = fixed_nodes(k)
+            u(i) = un(i); v(i) = 0.0_dp; a(i) = 0.0_dp
+         end do
       end subroutine kinematics
 
       !> Newton on the step. A law whose force jumps at δ = 0 (Kelvin: cδ̇ at first touch and
@@ -301,10 +312,23 @@ contains
          logical :: was_on(m%ncontact)
          converged = .false.
          do restart = 0, 1
-            ! predictor: constant acceleration
-            u(1:n) = un(1:n) + h*vn(1:n) + 0.5_dp*h*h*an(1:n)
             flips = 0; was_on = ms%con_on
-            call newton_iterations(converged, flips, was_on)
+            if (restart == 0 .and. tangent_valid) then
+               ! First iterate from the committed state with the tangent assembled there at
+               ! the end of the last step: no element loop is needed for it, so a step whose
+               ! laws stay on one branch costs a single evaluation.
+               call linearised_first_iterate(ok)
+               if (.not. ok) then
+                  call fail(MARTELLO_ERR_SINGULAR, 'singular effective stiffness in the Newton step')
+                  return
+               end if
+               call newton_iterations(converged, flips, was_on, 1)
+            else
+               ! predictor: constant acceleration
+               u(1:n) = un(1:n) + h*vn(1:n) + 0.5_dp*h*h*an(1:n)
+               call newton_iterations(converged, flips, was_on, 0)
+            end if
+            tangent_valid = converged .and. kd <= 1
             if (converged .or. stat /= MARTELLO_OK) return
             if (.not. any(flips >= 3)) exit
             ms%forced_off = ms%forced_off .or. flips >= 3
@@ -318,46 +342,89 @@ contains
          end if
       end subroutine newton_step
 
-      subroutine newton_iterations(converged, flips, was_on)
+      !> u = u_n + Δu with J Δu = −r(u_n), where r(u_n) uses the committed internal force and
+      !> the damping tangent C of the last evaluation for the velocity change (exact for
+      !> linear dampers). J is intact: the kd ≤ 1 solve works on copies.
+      subroutine linearised_first_iterate(ok)
+         logical, intent(out) :: ok
+         u = un
+         call kinematics()
+         work(1:n) = v(1:n) - vn(1:n)
+         call band_matvec(cjac, work(1:n), res(1:n))   ! C_t Δv
+         res(0) = 0.0_dp
+         call mass_times(m, a, ma)
+         res = (1.0_dp - am)*ma + am*man + (1.0_dp - af)*(fint_n + res) + af*fint_n &
+               - (1.0_dp - af)*fext - af*fext_n
+         res(fixed_nodes) = 0.0_dp
+         du = -res(1:n)
+         call band_solve(jac, du, ok)
+         r%counters(C_FACTORIZATIONS) = r%counters(C_FACTORIZATIONS) + 1_i8
+         r%counters(C_NEWTON) = r%counters(C_NEWTON) + 1_i8
+         u(1:n) = un(1:n) + du
+      end subroutine linearised_first_iterate
+
+      !> Residual of the step at the current u, the effective stiffness
+      !> J = c_m M + (1−α_f)(K_t + c_v C_t) with fixed rows pinned, min_i J_ii, and the
+      !> damping tangent C_t (kept for the next step's first iterate).
+      subroutine evaluate(want_jac)
+         logical, intent(in) :: want_jac
+         integer :: i
+         call kinematics()
+         if (want_jac) then
+            jac%ab = 0.0_dp; cjac%ab = 0.0_dp
+            call internal_forces(m, ms, u, v, fint, jac%ab, 1.0_dp - af, (1.0_dp - af)*cv, cjac%ab)
+            call assemble_mass(m, cm, jac)
+            r%counters(C_JACOBIANS) = r%counters(C_JACOBIANS) + 1_i8
+            do i = 1, size(fixed_nodes)
+               call pin_row(jac, fixed_nodes(i))
+            end do
+            jmin = huge(1.0_dp)
+            do i = 1, n
+               if (.not. m%fixed(i)) jmin = min(jmin, abs(jac%ab(2*kd + 1, i)))
+            end do
+         else
+            call internal_forces(m, ms, u, v, fint)
+         end if
+         r%counters(C_RESIDUALS) = r%counters(C_RESIDUALS) + 1_i8
+         call mass_times(m, a, ma)
+         ! residual and the magnitudes for the convergence test, in one pass
+         rnorm = 0.0_dp; fmag = fext_mag
+         do i = 1, n
+            res(i) = (1.0_dp - am)*ma(i) + am*man(i) + (1.0_dp - af)*fint(i) + af*fint_n(i) &
+                     - (1.0_dp - af)*fext(i) - af*fext_n(i)
+            fmag = max(fmag, abs(fint(i)), abs(ma(i)))
+         end do
+         res(0) = 0.0_dp
+         res(fixed_nodes) = 0.0_dp
+         rnorm = maxval(abs(res(1:n)))
+      end subroutine evaluate
+
+      subroutine newton_iterations(converged, flips, was_on, first)
          logical, intent(out) :: converged
          integer, intent(inout) :: flips(:)
          logical, intent(inout) :: was_on(:)
+         integer, intent(in) :: first
          integer :: i
          logical :: on
          converged = .false.
-         do it = 0, s%max_newton
-            call kinematics()
-            call band_zero(jac)
-            call internal_forces(m, ms, u, v, fint, jac, 1.0_dp - af, (1.0_dp - af)*cv)
-            call assemble_mass(m, cm, jac)
-            r%counters(C_RESIDUALS) = r%counters(C_RESIDUALS) + 1_i8
-            r%counters(C_JACOBIANS) = r%counters(C_JACOBIANS) + 1_i8
-            call mass_times(m, a, ma)
-            call mass_times(m, an, work)
-            res = (1.0_dp - am)*ma + am*work + (1.0_dp - af)*fint + af*fint_n &
-                  - (1.0_dp - af)*fext - af*fext_n
-            jmin = huge(1.0_dp)
-            do i = 1, n
-               if (m%fixed(i)) then
-                  res(i) = 0.0_dp; call pin_row(jac, i)
-               else
-                  jmin = min(jmin, abs(jac%ab(2*kd + 1, i)))
-               end if
-            end do
-            res(0) = 0.0_dp
-            rnorm = maxval(abs(res(1:n)))
+         uscale = tiny(1.0_dp)
+         do i = 1, n
+            uscale = max(uscale, abs(un(i)), h*abs(vn(i)), h*h*abs(an(i)))
+         end do
+         do it = first, s%max_newton
+            ! J is assembled at every iterate: the converged one serves the next step
+            call evaluate(.true.)
             do i = 1, m%ncontact
                on = ms%con_pen_trial(i) > 0.0_dp .and. .not. ms%forced_off(i)
                if (on .neqv. was_on(i)) flips(i) = flips(i) + 1
                was_on(i) = on
             end do
-            uscale = max(maxval(abs(u)), maxval(abs(un)), h*maxval(abs(vn)), tiny(1.0_dp))
             ! The inertia term cm·M·u is evaluated with rounding error ~ε·cm·m·|u|, which can
             ! exceed the physical forces by far (small h, free flight): it floors the scale.
-            fscale = max(maxval(abs(fext)), maxval(abs(fint)), maxval(abs(ma)), &
-                         64.0_dp*epsilon(1.0_dp)/s%tol_residual*cm*mmax*uscale, tiny(1.0_dp))
+            fscale = max(fmag, 64.0_dp*epsilon(1.0_dp)/s%tol_residual*cm*mmax*uscale, tiny(1.0_dp))
             ! residual test, and the increment the next iteration would make (‖r‖/min J_ii,
             ! a bound for the diagonally dominant J), both small: converged
+            if (it == 1) uscale = max(uscale, maxval(abs(u)))
             if (it > 0 .and. rnorm <= s%tol_residual*fscale .and. &
                 rnorm <= s%tol_increment*uscale*jmin) then
                converged = .true.
@@ -394,10 +461,9 @@ contains
             call kinematics()
             call internal_forces(m, ms, u, v, fint)
             call mass_times(m, a, ma)
-            call mass_times(m, an, res)
-            res = (1.0_dp - am)*ma + am*res + (1.0_dp - af)*fint + af*fint_n &
+            res = (1.0_dp - am)*ma + am*man + (1.0_dp - af)*fint + af*fint_n &
                   - (1.0_dp - af)*fext - af*fext_n
-            where ([.false., m%fixed]) res = 0.0_dp
+            res(fixed_nodes) = 0.0_dp
             r%counters(C_RESIDUALS) = r%counters(C_RESIDUALS) + 1_i8
             rtrial = maxval(abs(res(1:n)))
             if (rtrial < r0) return
@@ -412,24 +478,35 @@ contains
          logical, intent(out) :: ok
          u = un + h*(vn + 0.5_dp*h*an)
          work = vn + h*an
-         where ([.false., m%fixed])
-            u = un; work = 0.0_dp
-         end where
+         u(fixed_nodes) = un(fixed_nodes); work(fixed_nodes) = 0.0_dp
          call internal_forces(m, ms, u, work, fint)
          r%counters(C_RESIDUALS) = r%counters(C_RESIDUALS) + 1_i8
          a = fext - fint
          call solve_mass(a, ok)
          v = vn + 0.5_dp*h*(an + a)
-         where ([.false., m%fixed]) v = 0.0_dp
+         v(fixed_nodes) = 0.0_dp
       end subroutine central_difference_step
 
       subroutine track_peaks()
          integer :: i
-         do i = 1, n
-            r%u_max(i) = max(r%u_max(i), u(i)); r%u_min(i) = min(r%u_min(i), u(i))
-            r%v_absmax(i) = max(r%v_absmax(i), abs(v(i)))
-            r%a_absmax(i) = max(r%a_absmax(i), abs(a(i)))
-         end do
+         real(dp) :: tau, up
+         associate (umax => r%u_max, umin => r%u_min, vmax => r%v_absmax, amax => r%a_absmax, &
+                    upk => r%u_peak, tpk => r%t_peak)
+            do i = 1, n
+               umax(i) = max(umax(i), u(i)); umin(i) = min(umin(i), u(i))
+               vmax(i) = max(vmax(i), abs(v(i))); amax(i) = max(amax(i), abs(a(i)))
+               ! a local maximum between t − h and t: u_n + v_n τ + ½ a_n τ², τ = −v_n/a_n
+               if (vn(i) > 0.0_dp .and. v(i) <= 0.0_dp) then
+                  if (an(i) < 0.0_dp .and. t > 0.0_dp) then
+                     tau = min(-vn(i)/an(i), h)
+                     up = un(i) + vn(i)*tau + 0.5_dp*an(i)*tau*tau
+                     if (up > upk(i)) then
+                        upk(i) = up; tpk(i) = t - h + tau
+                     end if
+                  end if
+               end if
+            end do
+         end associate
          do i = 1, m%ncontact
             r%pen_max(i) = max(r%pen_max(i), ms%con_pen(i))
             r%force_max(i) = max(r%force_max(i), ms%con_f(i))

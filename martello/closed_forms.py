@@ -1436,3 +1436,31 @@ def sdof_sine_ground_final(m, k, zeta, ag_amp, omega_g, t_end):
     acceleration at t_end, from rest."""
     r = sdof_sine_ground_response(m, k, zeta, ag_amp, omega_g, np.array([t_end]))
     return {"u": float(r.u[0]), "v": float(r.v[0])}
+
+
+def bouncing_kelvin_events(m, k, h, g, eps, n_impacts, restitution=None, damping=0.0,
+                           clipped=False):
+    """P2 with a Kelvin (or, damping = 0, linear) penalty plane, as named values for scene
+    checks: t_impact_i, t_separation_i, max_penetration_i (i from 0). The dashpot c comes from
+    the target e by Anagnostopoulos' formula with m* = m, as the scene's law does."""
+    c = damping
+    if restitution is not None:
+        c = kelvin_damping(eps, m, kelvin_xi_from_e(restitution))
+    r = bouncing_oscillator_kelvin(m, k, h, g, eps, c, n_impacts, clipped=clipped)
+    out = {}
+    for i in range(min(n_impacts, len(r.t_impact))):
+        out[f"t_impact_{i}"] = r.t_impact[i]
+        if i < len(r.t_separation) and r.t_separation[i] is not None:
+            out[f"t_separation_{i}"] = r.t_separation[i]
+        out[f"max_penetration_{i}"] = r.max_penetration[i]
+    return out
+
+
+def bouncing_restitution_events(m, k, h, g, e, n_impacts):
+    """P2 with Newton restitution, as named values: t_impact_i, v_impact_i, zeno_time,
+    resting_force."""
+    r = bouncing_oscillator_restitution(m, k, h, g, e, n_impacts)
+    out = {f"t_impact_{i}": float(t) for i, t in enumerate(r.t)}
+    out.update({f"v_impact_{i}": float(v) for i, v in enumerate(r.v)})
+    out.update(zeno_time=r.zeno_time, resting_force=r.resting_force)
+    return out

@@ -65,7 +65,7 @@ def lib():
         "martello_run_history": (c_int, [_VOID_P, _DOUBLE_P]),
         "martello_run_events": (c_int, [_VOID_P, ctypes.POINTER(c_int), _VOID_P, _VOID_P]),
         "martello_run_counters": (c_int, [_VOID_P, np.ctypeslib.ndpointer(dtype=np.int64, flags="C_CONTIGUOUS")]),
-        "martello_run_peaks": (c_int, [_VOID_P] + [_DOUBLE_P] * 6 + [_INT_P]),
+        "martello_run_peaks": (c_int, [_VOID_P] + [_DOUBLE_P] * 6 + [_INT_P] + [_DOUBLE_P] * 2),
         "martello_run_energy": (c_int, [_VOID_P, _DOUBLE_P, _DOUBLE_P]),
     }
     for name, (res, args) in protos.items():
@@ -281,10 +281,12 @@ class Run:
         arrays = [np.zeros(max(n_nodes, 1)) for _ in range(4)] + \
                  [np.zeros(max(n_contacts, 1)) for _ in range(2)]
         impacts = np.zeros(max(n_contacts, 1), dtype=np.int32)
-        lib().martello_run_peaks(self._h, *arrays, impacts)
+        peak = [np.zeros(max(n_nodes, 1)) for _ in range(2)]
+        lib().martello_run_peaks(self._h, *arrays, impacts, *peak)
         names = ("u_max", "u_min", "v_absmax", "a_absmax", "pen_max", "force_max")
         out = {k: a[: (n_nodes if i < 4 else n_contacts)] for i, (k, a) in enumerate(zip(names, arrays))}
         out["impacts"] = impacts[:n_contacts]
+        out["u_peak"], out["t_peak"] = peak[0][:n_nodes], peak[1][:n_nodes]
         return out
 
     def energy(self):

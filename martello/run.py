@@ -199,6 +199,12 @@ def _dynamic(scene, model, raise_on_failure=True):
         nodes[n["name"]] = {"u_max": float(peaks["u_max"][i]), "u_min": float(peaks["u_min"][i]),
                             "v_absmax": float(peaks["v_absmax"][i]),
                             "a_absmax": float(peaks["a_absmax"][i])}
+        if peaks["t_peak"][i] >= 0:
+            nodes[n["name"]].update(u_peak=float(peaks["u_peak"][i]), t_peak=float(peaks["t_peak"][i]))
+        if an["output"]["nodes"] and n["name"] in an["output"]["nodes"] and len(hist):
+            k = an["output"]["nodes"].index(n["name"])
+            nodes[n["name"]].update(u_final=float(hist[-1, 1 + k]),
+                                    v_final=float(hist[-1, 1 + len(an["output"]["nodes"]) + k]))
     contacts = {}
     for j, c in enumerate(scene.contacts):
         mine = ev[ev_contacts == j]

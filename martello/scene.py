@@ -113,7 +113,18 @@ INTEGRATOR_KEYS = {"newmark": {"preset", "beta", "gamma"}, "hht": {"alpha"},
 IMPLICIT_KEYS = {"tol_residual", "tol_increment", "max_newton"}
 
 TOP_KEYS = {"title", "problem", "description", "node", "link", "contact", "loads", "analysis",
-            "check"}
+            "check", "chain"}
+
+# [[chain]]: n oscillators in a row (PROBLEMS.md P7), each a mass on a spring to ground
+# (bilinear if fy is given) with an optional dashpot (zeta), and contacts between
+# neighbours: δ_i = u_i − u_{i+1} − gap_i. Scalars apply to every oscillator, lists give one
+# value each (n for oscillators, n − 1 for gaps).
+CHAIN_KEYS = {"prefix": ("str", True, None, None), "n": ("int", True, POSITIVE, None),
+              "mass": ("any", True, None, None), "k": ("any", True, None, None),
+              "fy": ("any", False, None, None), "hardening": ("any", False, None, None),
+              "zeta": ("any", False, None, None), "gap": ("any", False, None, 0.0),
+              "u0": ("any", False, None, None), "v0": ("any", False, None, None),
+              "contact": ("table", False, None, None)}
 
 
 @dataclass
@@ -140,6 +151,8 @@ class Scene:
 # --- helpers ---------------------------------------------------------------------------------
 
 def _kind_ok(kind, v):
+    if kind == "any":
+        return True
     if kind == "float":
         return isinstance(v, (int, float)) and not isinstance(v, bool)
     if kind == "int":
@@ -250,6 +263,8 @@ def from_dict(data, source="<scene>", base_dir=Path("."), digest=None):
     for key in data:
         if key not in TOP_KEYS:
             raise SceneError(src, key, "unknown key", "valid top-level keys: " + ", ".join(sorted(TOP_KEYS)))
+    if "chain" in data:
+        data = _expand_chains(src, data)
 
     # nodes
     raw_nodes = data.get("node")
@@ -353,9 +368,10 @@ def from_dict(data, source="<scene>", base_dir=Path("."), digest=None):
     analysis["type"] = atype
     if atype == "dynamic":
         _dynamic_analysis(src, an, analysis, index, [c["name"] for c in contacts])
-    for lk in links:
+    ground_k = _ground_stiffness(links)
+    for i, lk in enumerate(links):
         if lk["type"] == "dashpot" and lk["zeta"] is not None:
-            lk["c"] = _dashpot_from_zeta(src, lk, links, nodes)
+            lk["c"] = _dashpot_from_zeta(src, i, lk, ground_k, nodes)
 
     check = data.get("check")
     if check is not None:
@@ -369,6 +385,60 @@ def from_dict(data, source="<scene>", base_dir=Path("."), digest=None):
                  description=meta["description"], nodes=nodes, links=links, contacts=contacts,
                  gravity=lt["gravity"], forces=forces, ground=ground, analysis=analysis,
                  check=check, digest=digest, index=index)
+
+
+def _per_item(src, where, value, count, check=None):
+    """A scalar for all, or a list of exactly `count` numbers."""
+    values = value if isinstance(value, list) else [value] * count
+    if len(values) != count:
+        raise SceneError(src, where, f"has {len(values)} values", f"give one number or a list of {count}")
+    for i, v in enumerate(values):
+        path = f"{where}[{i}]" if isinstance(value, list) else where
+        if not _kind_ok("float", v):
+            raise SceneError(src, path, f"has the wrong type ({type(v).__name__})", "expected float")
+        if check is not None and not check[0](float(v)):
+            raise SceneError(src, path, f"invalid value {v!r}", f"must be {check[1]}")
+    return [float(v) for v in values]
+
+
+def _expand_chains(src, data):
+    """Replace [[chain]] tables by the nodes, links and contacts they stand for."""
+    data = dict(data)
+    chains = data.pop("chain")
+    if not isinstance(chains, list):
+        raise SceneError(src, "chain", "must be an array of tables", "write [[chain]]")
+    nodes, links, contacts = list(data.get("node", [])), list(data.get("link", [])), list(data.get("contact", []))
+    for ci, tab in enumerate(chains):
+        w = f"chain[{ci}]"
+        ch = _fields(src, tab, w, CHAIN_KEYS)
+        n, p = ch["n"], ch["prefix"]
+        mass = _per_item(src, f"{w}.mass", ch["mass"], n, POSITIVE)
+        k = _per_item(src, f"{w}.k", ch["k"], n, POSITIVE)
+        fy = _per_item(src, f"{w}.fy", ch["fy"], n, POSITIVE) if ch["fy"] is not None else None
+        rho = _per_item(src, f"{w}.hardening", ch["hardening"] or 0.0, n, _unit_interval(hi_open=True))
+        zeta = _per_item(src, f"{w}.zeta", ch["zeta"], n, (lambda x: 0 <= x < 10, "a number in [0, 10)")) \
+            if ch["zeta"] is not None else None
+        gap = _per_item(src, f"{w}.gap", ch["gap"], n - 1) if n > 1 else []
+        u0 = _per_item(src, f"{w}.u0", ch["u0"], n) if ch["u0"] is not None else [0.0] * n
+        v0 = _per_item(src, f"{w}.v0", ch["v0"], n) if ch["v0"] is not None else [0.0] * n
+        for i in range(n):
+            name = f"{p}{i + 1}"
+            nodes.append({"name": name, "mass": mass[i], "u0": u0[i], "v0": v0[i]})
+            if fy is None:
+                links.append({"name": f"{name}.spring", "type": "spring", "a": name, "b": "ground", "k": k[i]})
+            else:
+                links.append({"name": f"{name}.spring", "type": "bilinear", "a": name, "b": "ground",
+                              "k": k[i], "fy": fy[i], "hardening": rho[i]})
+            if zeta is not None and zeta[i] > 0:
+                links.append({"name": f"{name}.damper", "type": "dashpot", "a": name, "b": "ground",
+                              "zeta": zeta[i]})
+        if ch["contact"] is not None and n > 1:
+            for i in range(n - 1):
+                c = {"name": f"{p}{i + 1}-{p}{i + 2}", "a": f"{p}{i + 1}", "b": f"{p}{i + 2}", "gap": gap[i]}
+                c.update(ch["contact"])
+                contacts.append(c)
+    data.update(node=nodes, link=links, contact=contacts)
+    return data
 
 
 def _dynamic_analysis(src, raw, an, index, contact_names):
@@ -416,15 +486,24 @@ def _dynamic_analysis(src, raw, an, index, contact_names):
     an["output"] = out
 
 
-def _dashpot_from_zeta(src, lk, links, nodes):
+def _ground_stiffness(links):
+    """Sum of the stiffnesses of springs, bilinear springs and bars from each node to ground."""
+    k = {}
+    for l in links:
+        if l["type"] in ("spring", "bilinear", "bar") and -1 in (l["a"], l["b"]):
+            node = l["a"] if l["b"] == -1 else l["b"]
+            k[node] = k.get(node, 0.0) + (l["EA"] / l["L"] if l["type"] == "bar" else l["k"])
+    return k
+
+
+def _dashpot_from_zeta(src, i, lk, ground_k, nodes):
     """c = 2ζ√(k m) for a dashpot from a node to ground, k the node's springs to ground."""
-    where = f"link[{links.index(lk)}].zeta"
+    where = f"link[{i}].zeta"
     if lk["b"] != -1 and lk["a"] != -1:
         raise SceneError(src, where, "applies to a dashpot between a node and ground",
                          "give c for a dashpot between two nodes")
     node = lk["a"] if lk["b"] == -1 else lk["b"]
-    k = sum(l.get("k") or (l["EA"] / l["L"] if l["type"] == "bar" else 0.0) for l in links
-            if l["type"] in ("spring", "bilinear", "bar") and {l["a"], l["b"]} == {node, -1})
+    k = ground_k.get(node, 0.0)
     if k <= 0:
         raise SceneError(src, where, "the node has no spring to ground to define a frequency",
                          "give c directly")
