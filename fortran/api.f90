@@ -10,18 +10,35 @@ module martello_api
    use martello_time_functions
    use martello_contact_laws
    use martello_links
+   use martello_integrator_settings
    use martello_structural_integrators
+   use martello_moreau_jean, only: run_moreau_jean
+   use martello_newmark_lagrange, only: run_newmark_lagrange
+   use martello_evaluator
    use martello_results
    implicit none
    private
    public :: c_model_create, c_model_free
 
    !> Slots of the integrator parameter array of martello_run_set_integrator (0-based in C).
-   integer, parameter :: NPAR_INTEGRATOR = 12
+   integer, parameter :: NPAR_INTEGRATOR = 17
    integer, parameter :: R_DT = 1, R_T_END = 2, R_BETA = 3, R_GAMMA = 4, R_ALPHA = 5, &
                          R_RHO_INF = 6, R_TOL_RESIDUAL = 7, R_TOL_INCREMENT = 8, &
                          R_MAX_NEWTON = 9, R_CHECK_STABILITY = 10, R_EVERY = 11, &
-                         R_DIVERGENCE_FACTOR = 12
+                         R_DIVERGENCE_FACTOR = 12, R_RTOL = 13, R_ATOL = 14, R_THETA = 15, &
+                         R_EVENT_TOL = 16, R_H_MAX = 17
+
+   !> Dispatched to the C integrators (c/event_driven.c, c/ida.c).
+   interface
+      integer(c_int) function c_event_driven_run(model, run) bind(C, name='martello_event_driven_run')
+         import :: c_int, c_ptr
+         type(c_ptr), value :: model, run
+      end function c_event_driven_run
+      integer(c_int) function c_ida_run(model, run) bind(C, name='martello_ida_run')
+         import :: c_int, c_ptr
+         type(c_ptr), value :: model, run
+      end function c_ida_run
+   end interface
 
    type :: run_t
       type(integrator_settings_t) :: settings
@@ -260,7 +277,7 @@ contains
       rp => get_run(handle)
       c_run_set_integrator = MARTELLO_ERR_ARGUMENT
       if (.not. associated(rp)) return
-      if (kind < INT_NEWMARK .or. kind > INT_CENTRAL_DIFFERENCE) then
+      if (kind < INT_NEWMARK .or. kind > INT_LAST) then
          rp%results%message = 'set_integrator: unknown integrator kind'; return
       end if
       if (.not. (par(R_DT) > 0.0_dp .and. par(R_T_END) > 0.0_dp .and. par(R_EVERY) >= 1.0_dp &
@@ -293,6 +310,9 @@ contains
       rp%settings%check_stability = par(R_CHECK_STABILITY) /= 0.0_dp
       rp%settings%every = nint(par(R_EVERY))
       rp%settings%divergence_factor = par(R_DIVERGENCE_FACTOR)
+      rp%settings%rtol = par(R_RTOL); rp%settings%atol = par(R_ATOL)
+      rp%settings%theta = par(R_THETA); rp%settings%event_tol = par(R_EVENT_TOL)
+      rp%settings%h_max = par(R_H_MAX)
       rp%configured = .true.
       c_run_set_integrator = MARTELLO_OK
    end function c_run_set_integrator
@@ -330,10 +350,314 @@ contains
       end if
       cap = int(min(rp%settings%t_end/rp%settings%dt/rp%settings%every + 3.0_dp, 1.0e7_dp))
       call results_init(rp%results, mp%n, mp%ncontact, rp%out_nodes, rp%out_contacts, cap)
-      call run_structural(mp, rp%settings, rp%results, stat)
+      call check_compatibility(mp, rp, stat)
+      if (stat == MARTELLO_OK) then
+         select case (rp%settings%kind)
+         case (INT_NEWMARK, INT_HHT, INT_GENERALIZED_ALPHA, INT_CENTRAL_DIFFERENCE)
+            call run_structural(mp, rp%settings, rp%results, stat)
+         case (INT_MOREAU_JEAN)
+            call run_moreau_jean(mp, rp%settings, rp%results, stat)
+         case (INT_NEWMARK_LAGRANGE)
+            call run_newmark_lagrange(mp, rp%settings, rp%results, stat)
+         case (INT_RKF45, INT_RK8PD, INT_MSBDF)
+            stat = c_event_driven_run(mhandle, rhandle)
+         case (INT_IDA)
+            stat = c_ida_run(mhandle, rhandle)
+         end select
+      end if
       rp%done = .true.
       c_dynamic_run = stat
    end function c_dynamic_run
+
+   !> Every contact's scheme must run on the chosen integrator; the error names those that
+   !> would (the compatibility table of martello_integrator_settings).
+   subroutine check_compatibility(mp, rp, stat)
+      type(model_t), intent(in) :: mp
+      type(run_t), intent(inout) :: rp
+      integer, intent(out) :: stat
+      integer :: j, k
+      character(len=16) :: num
+      character(len=256) :: works
+      stat = MARTELLO_OK
+      do j = 1, mp%ncontact
+         if (scheme_supported(rp%settings%kind, mp%con_scheme(j))) cycle
+         works = ''
+         do k = 1, INT_LAST
+            if (scheme_supported(k, mp%con_scheme(j))) works = trim(works)//' '//integrator_name(k)
+         end do
+         write (num, '(i0)') j - 1
+         stat = MARTELLO_ERR_UNSUPPORTED
+         rp%results%message = 'contact '//trim(num)//': scheme '//scheme_name(mp%con_scheme(j))// &
+            ' cannot run on '//integrator_name(rp%settings%kind)//'; integrators that can:'//trim(works)
+         if (len_trim(works) == 0) rp%results%message = 'contact '//trim(num)//': scheme '// &
+            scheme_name(mp%con_scheme(j))//' is static only; use analysis type static'
+         return
+      end do
+   end subroutine check_compatibility
+
+   ! ---- the door for the C integrators (c/martello_internal.h) -----------------------------
+
+   integer(c_int) function c_model_topology(handle, n, nc, mass, fixed, con_a, con_b, scheme, &
+                                            gap, restitution, ncoupling) bind(C, name='martello_model_topology')
+      type(c_ptr), value :: handle
+      integer(c_int), intent(out) :: n, nc, ncoupling
+      type(c_ptr), value :: mass, fixed, con_a, con_b, scheme, gap, restitution
+      type(model_t), pointer :: mp
+      real(c_double), pointer :: pm(:), pg(:), pe(:)
+      integer(c_int), pointer :: pf(:), pa(:), pb(:), ps(:)
+      mp => get_model(handle)
+      c_model_topology = MARTELLO_ERR_ARGUMENT
+      if (.not. associated(mp)) return
+      n = mp%n; nc = mp%ncontact; ncoupling = mp%ncoupling
+      if (c_associated(mass)) then
+         call c_f_pointer(mass, pm, [n]); pm = mp%mass
+      end if
+      if (c_associated(fixed)) then
+         call c_f_pointer(fixed, pf, [n]); pf = merge(1, 0, mp%fixed)
+      end if
+      if (nc > 0) then
+         if (c_associated(con_a)) then
+            call c_f_pointer(con_a, pa, [nc]); pa = mp%con_a(1:nc) - 1
+         end if
+         if (c_associated(con_b)) then
+            call c_f_pointer(con_b, pb, [nc]); pb = mp%con_b(1:nc) - 1
+         end if
+         if (c_associated(scheme)) then
+            call c_f_pointer(scheme, ps, [nc]); ps = mp%con_scheme(1:nc)
+         end if
+         if (c_associated(gap)) then
+            call c_f_pointer(gap, pg, [nc]); pg = mp%con_gap(1:nc)
+         end if
+         if (c_associated(restitution)) then
+            call c_f_pointer(restitution, pe, [nc]); pe = mp%con_par(P_RESTITUTION, 1:nc)
+         end if
+      end if
+      c_model_topology = MARTELLO_OK
+   end function c_model_topology
+
+   function get_eval(handle) result(ep)
+      type(c_ptr), value :: handle
+      type(evaluator_t), pointer :: ep
+      ep => null()
+      if (c_associated(handle)) call c_f_pointer(handle, ep)
+   end function get_eval
+
+   integer(c_int) function c_eval_create(mhandle, handle) bind(C, name='martello_eval_create')
+      type(c_ptr), value :: mhandle
+      type(c_ptr), intent(out) :: handle
+      type(model_t), pointer :: mp
+      type(evaluator_t), pointer :: ep
+      handle = c_null_ptr
+      mp => get_model(mhandle)
+      c_eval_create = MARTELLO_ERR_ARGUMENT
+      if (.not. associated(mp)) return
+      allocate (ep)
+      call evaluator_init(ep, mp)
+      handle = c_loc(ep)
+      c_eval_create = MARTELLO_OK
+   end function c_eval_create
+
+   subroutine c_eval_free(handle) bind(C, name='martello_eval_free')
+      type(c_ptr), intent(inout) :: handle
+      type(evaluator_t), pointer :: ep
+      ep => get_eval(handle)
+      if (associated(ep)) deallocate (ep)
+      handle = c_null_ptr
+   end subroutine c_eval_free
+
+   integer(c_int) function c_eval_acceleration(handle, t, u, v, a) bind(C, name='martello_eval_acceleration')
+      type(c_ptr), value :: handle
+      real(c_double), value :: t
+      real(c_double), intent(in) :: u(*), v(*)
+      real(c_double), intent(out) :: a(*)
+      type(evaluator_t), pointer :: ep
+      logical :: ok
+      ep => get_eval(handle)
+      c_eval_acceleration = MARTELLO_ERR_ARGUMENT
+      if (.not. associated(ep)) return
+      call evaluator_acceleration(ep, t, u(1:ep%m%n), v(1:ep%m%n), a(1:ep%m%n), ok)
+      c_eval_acceleration = merge(MARTELLO_OK, MARTELLO_ERR_SINGULAR, ok)
+   end function c_eval_acceleration
+
+   integer(c_int) function c_eval_forces(handle, t, u, v, fint, fext) bind(C, name='martello_eval_forces')
+      type(c_ptr), value :: handle
+      real(c_double), value :: t
+      real(c_double), intent(in) :: u(*), v(*)
+      real(c_double), intent(out) :: fint(*), fext(*)
+      type(evaluator_t), pointer :: ep
+      ep => get_eval(handle)
+      c_eval_forces = MARTELLO_ERR_ARGUMENT
+      if (.not. associated(ep)) return
+      call evaluator_forces(ep, t, u(1:ep%m%n), v(1:ep%m%n), fint(1:ep%m%n), fext(1:ep%m%n))
+      c_eval_forces = MARTELLO_OK
+   end function c_eval_forces
+
+   integer(c_int) function c_eval_solve_mass(handle, x) bind(C, name='martello_eval_solve_mass')
+      type(c_ptr), value :: handle
+      real(c_double), intent(inout) :: x(*)
+      type(evaluator_t), pointer :: ep
+      logical :: ok
+      ep => get_eval(handle)
+      c_eval_solve_mass = MARTELLO_ERR_ARGUMENT
+      if (.not. associated(ep)) return
+      call evaluator_solve_mass(ep, x(1:ep%m%n), ok)
+      c_eval_solve_mass = merge(MARTELLO_OK, MARTELLO_ERR_SINGULAR, ok)
+   end function c_eval_solve_mass
+
+   integer(c_int) function c_eval_contacts(handle, u, v, pen, rate) bind(C, name='martello_eval_contacts')
+      type(c_ptr), value :: handle
+      real(c_double), intent(in) :: u(*), v(*)
+      real(c_double), intent(out) :: pen(*), rate(*)
+      type(evaluator_t), pointer :: ep
+      ep => get_eval(handle)
+      c_eval_contacts = MARTELLO_ERR_ARGUMENT
+      if (.not. associated(ep)) return
+      call evaluator_contacts(ep, u(1:ep%m%n), v(1:ep%m%n), pen(1:ep%m%ncontact), rate(1:ep%m%ncontact))
+      c_eval_contacts = MARTELLO_OK
+   end function c_eval_contacts
+
+   integer(c_int) function c_eval_commit(handle, u, v) bind(C, name='martello_eval_commit')
+      type(c_ptr), value :: handle
+      real(c_double), intent(in) :: u(*), v(*)
+      type(evaluator_t), pointer :: ep
+      ep => get_eval(handle)
+      c_eval_commit = MARTELLO_ERR_ARGUMENT
+      if (.not. associated(ep)) return
+      call evaluator_commit(ep, u(1:ep%m%n), v(1:ep%m%n))
+      c_eval_commit = MARTELLO_OK
+   end function c_eval_commit
+
+   integer(c_int) function c_eval_energy(handle, u, v, kinetic, recoverable) bind(C, name='martello_eval_energy')
+      type(c_ptr), value :: handle
+      real(c_double), intent(in) :: u(*), v(*)
+      real(c_double), intent(out) :: kinetic, recoverable
+      type(evaluator_t), pointer :: ep
+      ep => get_eval(handle)
+      c_eval_energy = MARTELLO_ERR_ARGUMENT
+      if (.not. associated(ep)) return
+      call evaluator_energy(ep, u(1:ep%m%n), v(1:ep%m%n), kinetic, recoverable)
+      c_eval_energy = MARTELLO_OK
+   end function c_eval_energy
+
+   integer(c_int) function c_run_settings(handle, kind, par) bind(C, name='martello_run_settings')
+      type(c_ptr), value :: handle
+      integer(c_int), intent(out) :: kind
+      real(c_double), intent(out) :: par(NPAR_INTEGRATOR)
+      type(run_t), pointer :: rp
+      rp => get_run(handle)
+      c_run_settings = MARTELLO_ERR_ARGUMENT
+      if (.not. associated(rp)) return
+      associate (st => rp%settings)
+         kind = st%kind
+         par = 0.0_c_double
+         par(R_DT) = st%dt; par(R_T_END) = st%t_end; par(R_BETA) = st%beta
+         par(R_GAMMA) = st%gamma; par(R_ALPHA) = st%alpha; par(R_RHO_INF) = st%rho_inf
+         par(R_TOL_RESIDUAL) = st%tol_residual; par(R_TOL_INCREMENT) = st%tol_increment
+         par(R_MAX_NEWTON) = st%max_newton; par(R_CHECK_STABILITY) = merge(1, 0, st%check_stability)
+         par(R_EVERY) = st%every; par(R_DIVERGENCE_FACTOR) = st%divergence_factor
+         par(R_RTOL) = st%rtol; par(R_ATOL) = st%atol; par(R_THETA) = st%theta
+         par(R_EVENT_TOL) = st%event_tol; par(R_H_MAX) = st%h_max
+      end associate
+      c_run_settings = MARTELLO_OK
+   end function c_run_settings
+
+   !> (Re)initialise the run's results for the model (the dispatcher already did; C
+   !> integrators may call it to start over).
+   integer(c_int) function c_run_begin(handle, mhandle) bind(C, name='martello_run_begin')
+      type(c_ptr), value :: handle, mhandle
+      type(run_t), pointer :: rp
+      type(model_t), pointer :: mp
+      rp => get_run(handle); mp => get_model(mhandle)
+      c_run_begin = MARTELLO_ERR_ARGUMENT
+      if (.not. (associated(rp) .and. associated(mp))) return
+      call results_init(rp%results, mp%n, mp%ncontact, rp%out_nodes, rp%out_contacts, 1024)
+      c_run_begin = MARTELLO_OK
+   end function c_run_begin
+
+   integer(c_int) function c_run_track(handle, t, u, v, a, pen, force) bind(C, name='martello_run_track')
+      type(c_ptr), value :: handle
+      real(c_double), value :: t
+      real(c_double), intent(in) :: u(*), v(*), a(*), pen(*), force(*)
+      type(run_t), pointer :: rp
+      integer :: n, nc
+      rp => get_run(handle)
+      c_run_track = MARTELLO_ERR_ARGUMENT
+      if (.not. associated(rp)) return
+      n = size(rp%results%u_max); nc = size(rp%results%pen_max)
+      call results_track(rp%results, t, u(1:n), v(1:n), a(1:n), pen(1:nc), force(1:nc))
+      c_run_track = MARTELLO_OK
+   end function c_run_track
+
+   integer(c_int) function c_run_record(handle, t, u, v, a, pen, force, energy) bind(C, name='martello_run_record')
+      type(c_ptr), value :: handle
+      real(c_double), value :: t
+      real(c_double), intent(in) :: u(*), v(*), a(*), pen(*), force(*), energy(NENERGY)
+      type(run_t), pointer :: rp
+      integer :: n, nc
+      rp => get_run(handle)
+      c_run_record = MARTELLO_ERR_ARGUMENT
+      if (.not. associated(rp)) return
+      n = size(rp%results%u_max); nc = size(rp%results%pen_max)
+      call results_record(rp%results, t, u(1:n), v(1:n), a(1:n), pen(1:nc), force(1:nc), energy)
+      rp%results%energy = energy
+      rp%results%energy_balance_max = max(rp%results%energy_balance_max, abs(energy(E_BALANCE)))
+      c_run_record = MARTELLO_OK
+   end function c_run_record
+
+   integer(c_int) function c_run_add_event(handle, contact, values) bind(C, name='martello_run_add_event')
+      type(c_ptr), value :: handle
+      integer(c_int), value :: contact
+      real(c_double), intent(in) :: values(NEVENT)
+      type(run_t), pointer :: rp
+      rp => get_run(handle)
+      c_run_add_event = MARTELLO_ERR_ARGUMENT
+      if (.not. associated(rp)) return
+      if (contact < 0 .or. contact >= size(rp%results%impacts)) return
+      call results_add_event(rp%results, int(contact) + 1, values)
+      rp%results%impacts(contact + 1) = rp%results%impacts(contact + 1) + 1
+      c_run_add_event = MARTELLO_OK
+   end function c_run_add_event
+
+   integer(c_int) function c_run_add_counts(handle, inc) bind(C, name='martello_run_add_counts')
+      type(c_ptr), value :: handle
+      integer(c_long_long), intent(in) :: inc(NCOUNTERS)
+      type(run_t), pointer :: rp
+      rp => get_run(handle)
+      c_run_add_counts = MARTELLO_ERR_ARGUMENT
+      if (.not. associated(rp)) return
+      rp%results%counters = rp%results%counters + inc
+      c_run_add_counts = MARTELLO_OK
+   end function c_run_add_counts
+
+   integer(c_int) function c_run_set_message(handle, msg) bind(C, name='martello_run_set_message')
+      type(c_ptr), value :: handle
+      character(kind=c_char), intent(in) :: msg(*)
+      type(run_t), pointer :: rp
+      integer :: i
+      rp => get_run(handle)
+      c_run_set_message = MARTELLO_ERR_ARGUMENT
+      if (.not. associated(rp)) return
+      rp%results%message = ''
+      do i = 1, len(rp%results%message)
+         if (msg(i) == c_null_char) exit
+         rp%results%message(i:i) = msg(i)
+      end do
+      c_run_set_message = MARTELLO_OK
+   end function c_run_set_message
+
+   integer(c_int) function c_run_finish(handle, t_reached, energy, balance_max) bind(C, name='martello_run_finish')
+      type(c_ptr), value :: handle
+      real(c_double), value :: t_reached, balance_max
+      real(c_double), intent(in) :: energy(NENERGY)
+      type(run_t), pointer :: rp
+      rp => get_run(handle)
+      c_run_finish = MARTELLO_ERR_ARGUMENT
+      if (.not. associated(rp)) return
+      rp%results%t_end_reached = t_reached
+      rp%results%energy = energy
+      rp%results%energy_balance_max = max(rp%results%energy_balance_max, balance_max)
+      c_run_finish = MARTELLO_OK
+   end function c_run_finish
 
    integer(c_int) function c_run_message(handle, buf, buflen) bind(C, name='martello_run_message')
       type(c_ptr), value :: handle
@@ -508,6 +832,17 @@ contains
       case ('INT_HHT'); v = INT_HHT
       case ('INT_GENERALIZED_ALPHA'); v = INT_GENERALIZED_ALPHA
       case ('INT_CENTRAL_DIFFERENCE'); v = INT_CENTRAL_DIFFERENCE
+      case ('INT_MOREAU_JEAN'); v = INT_MOREAU_JEAN
+      case ('INT_NEWMARK_LAGRANGE'); v = INT_NEWMARK_LAGRANGE
+      case ('INT_RKF45'); v = INT_RKF45
+      case ('INT_RK8PD'); v = INT_RK8PD
+      case ('INT_MSBDF'); v = INT_MSBDF
+      case ('INT_IDA'); v = INT_IDA
+      case ('R_RTOL'); v = R_RTOL - 1
+      case ('R_ATOL'); v = R_ATOL - 1
+      case ('R_THETA'); v = R_THETA - 1
+      case ('R_EVENT_TOL'); v = R_EVENT_TOL - 1
+      case ('R_H_MAX'); v = R_H_MAX - 1
       case ('NPAR_INTEGRATOR'); v = NPAR_INTEGRATOR
       case ('R_DT'); v = R_DT - 1
       case ('R_T_END'); v = R_T_END - 1

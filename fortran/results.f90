@@ -6,7 +6,7 @@ module martello_results
    use martello_kinds, only: dp, i8
    implicit none
    private
-   public :: results_t, results_init, results_record, results_add_event, &
+   public :: results_t, results_init, results_record, results_add_event, results_track, &
       NCOUNTERS, C_STEPS, C_REJECTED, C_NEWTON, C_RESIDUALS, C_FACTORIZATIONS, C_EVENTS, &
       C_JACOBIANS, C_ROOT_EVALS, C_CHATTER, NENERGY, E_KINETIC, E_RECOVERABLE, E_INPUT, E_DAMPING, &
       E_PLASTIC, E_CONTACT, E_BALANCE, E_INITIAL, E_IMPACT, NEVENT, EV_T_ON, EV_T_OFF, &
@@ -50,6 +50,9 @@ module martello_results
       real(dp) :: dt_critical = 0.0_dp          !< explicit stability limit (0: not computed)
       real(dp) :: omega_max = 0.0_dp
       character(len=512) :: message = ''
+      ! the previous accepted state, for the interpolated peaks of results_track
+      real(dp), allocatable :: prev_u(:), prev_v(:), prev_a(:)
+      real(dp) :: prev_t = -1.0_dp
    end type results_t
 
 contains
@@ -73,6 +76,9 @@ contains
       r%u_peak = -huge(1.0_dp); r%t_peak = -1.0_dp
       r%u_max = -huge(1.0_dp); r%u_min = huge(1.0_dp); r%v_absmax = 0.0_dp
       r%a_absmax = 0.0_dp; r%pen_max = -huge(1.0_dp); r%force_max = 0.0_dp; r%impacts = 0
+      if (allocated(r%prev_u)) deallocate (r%prev_u, r%prev_v, r%prev_a)
+      allocate (r%prev_u(n_nodes), r%prev_v(n_nodes), r%prev_a(n_nodes))
+      r%prev_t = -1.0_dp
       r%energy = 0.0_dp; r%energy_balance_max = 0.0_dp
       r%counters = 0_i8
       r%message = ''
@@ -116,4 +122,37 @@ contains
       r%ev(:, r%nevents) = values
       r%ev_contact(r%nevents) = contact
    end subroutine results_add_event
+   !> Peaks over every accepted state (call once per accepted step, from any integrator):
+   !> extremes of u, |v|, |a|, penetration and force, and the largest local maximum of u
+   !> interpolated between the previous and this state by u + vτ + ½aτ², τ = −v/a (O(h²) in
+   !> time where the step maxima are O(h)).
+   subroutine results_track(r, t, u, v, a, pen, force)
+      type(results_t), intent(inout) :: r
+      real(dp), intent(in) :: t, u(:), v(:), a(:), pen(:), force(:)
+      integer :: i
+      real(dp) :: tau, up, h
+      h = t - r%prev_t
+      associate (umax => r%u_max, umin => r%u_min, vmax => r%v_absmax, amax => r%a_absmax, &
+                 upk => r%u_peak, tpk => r%t_peak, un => r%prev_u, vn => r%prev_v, an => r%prev_a)
+         do i = 1, size(u)
+            umax(i) = max(umax(i), u(i)); umin(i) = min(umin(i), u(i))
+            vmax(i) = max(vmax(i), abs(v(i))); amax(i) = max(amax(i), abs(a(i)))
+            if (r%prev_t >= 0.0_dp .and. vn(i) > 0.0_dp .and. v(i) <= 0.0_dp) then
+               if (an(i) < 0.0_dp) then
+                  tau = min(-vn(i)/an(i), h)
+                  up = un(i) + vn(i)*tau + 0.5_dp*an(i)*tau*tau
+                  if (up > upk(i)) then
+                     upk(i) = up; tpk(i) = r%prev_t + tau
+                  end if
+               end if
+            end if
+         end do
+         un = u; vn = v; an = a
+      end associate
+      r%prev_t = t
+      do i = 1, size(pen)
+         r%pen_max(i) = max(r%pen_max(i), pen(i))
+         r%force_max(i) = max(r%force_max(i), force(i))
+      end do
+   end subroutine results_track
 end module martello_results

@@ -14,42 +14,13 @@ module martello_structural_integrators
    use martello_assembly
    use martello_results
    use martello_stability, only: omega_max
+   use martello_integrator_settings
    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
    implicit none
    private
-   public :: integrator_settings_t, run_structural, generalized_alpha_coefficients, &
-      INT_NEWMARK, INT_HHT, INT_GENERALIZED_ALPHA, INT_CENTRAL_DIFFERENCE, integrator_name
-
-   integer, parameter :: INT_NEWMARK = 1, INT_HHT = 2, INT_GENERALIZED_ALPHA = 3, &
-                         INT_CENTRAL_DIFFERENCE = 4
-
-   type :: integrator_settings_t
-      integer :: kind = INT_NEWMARK
-      real(dp) :: dt = 0.0_dp, t_end = 0.0_dp
-      real(dp) :: beta = 0.25_dp, gamma = 0.5_dp     !< Newmark
-      real(dp) :: alpha = 0.0_dp                     !< HHT, in [−1/3, 0]
-      real(dp) :: rho_inf = 1.0_dp                   !< generalized-α, in [0, 1]
-      real(dp) :: tol_residual = 1.0e-9_dp           !< ‖r‖∞ ≤ tol·force scale
-      real(dp) :: tol_increment = 1.0e-11_dp         !< predicted ‖Δu‖∞ ≤ tol·displacement scale
-      integer :: max_newton = 30
-      logical :: check_stability = .true.           !< central difference: refuse Δt > Δt_crit
-      integer :: every = 1                           !< record every n-th step
-      real(dp) :: divergence_factor = 10.0_dp        !< mechanical energy > factor·(E0 + input)
-   end type integrator_settings_t
+   public :: run_structural, generalized_alpha_coefficients
 
 contains
-
-   pure function integrator_name(kind) result(name)
-      integer, intent(in) :: kind
-      character(len=:), allocatable :: name
-      select case (kind)
-      case (INT_NEWMARK); name = 'newmark'
-      case (INT_HHT); name = 'hht'
-      case (INT_GENERALIZED_ALPHA); name = 'generalized-alpha'
-      case (INT_CENTRAL_DIFFERENCE); name = 'central-difference'
-      case default; name = 'unknown'
-      end select
-   end function integrator_name
 
    !> (α_m, α_f, β, γ) of the family member; α's weigh the old state.
    pure subroutine generalized_alpha_coefficients(s, am, af, beta, gamma)
@@ -152,7 +123,7 @@ contains
       e0 = e_kin + e_links + e_cont
       w_ext = 0.0_dp; d_damp = 0.0_dp; d_links = 0.0_dp; d_contact = 0.0_dp; w_abs = 0.0_dp
       t = 0.0_dp
-      call track_peaks()
+      call results_track(r, t, u(1:n), v(1:n), a(1:n), ms%con_pen, ms%con_f)
       call record()
 
       do step = 1, nsteps
@@ -183,7 +154,7 @@ contains
          end do
          w_ext = w_ext + wd; w_abs = w_abs + abs(wd)
          call track_events()
-         call track_peaks()
+         call results_track(r, t, u(1:n), v(1:n), a(1:n), ms%con_pen, ms%con_f)
          recording = mod(step, s%every) == 0 .or. step == nsteps
          ! kinetic and recoverable energy (two passes over the model) only where needed: at
          ! recorded steps and every ENERGY_CHECK steps for the divergence test
@@ -224,12 +195,11 @@ contains
             return
          end if
          do jj = 1, m%ncontact
-            if (m%con_scheme(jj) /= SCHEME_PENALTY) then
+            if (.not. scheme_supported(s%kind, m%con_scheme(jj))) then
                write (num, '(i0)') jj - 1
                st = MARTELLO_ERR_UNSUPPORTED
                r%message = 'contact '//trim(num)//': scheme '//scheme_name(m%con_scheme(jj))// &
-                  ' cannot run on the fixed-step structural integrator '//integrator_name(s%kind)// &
-                  '; it runs on penalty contacts only (see the compatibility table in docs)'
+                  ' cannot run on '//integrator_name(s%kind)//' (see docs/integrators.md)'
                return
             end if
          end do
@@ -486,32 +456,6 @@ contains
          v = vn + 0.5_dp*h*(an + a)
          v(fixed_nodes) = 0.0_dp
       end subroutine central_difference_step
-
-      subroutine track_peaks()
-         integer :: i
-         real(dp) :: tau, up
-         associate (umax => r%u_max, umin => r%u_min, vmax => r%v_absmax, amax => r%a_absmax, &
-                    upk => r%u_peak, tpk => r%t_peak)
-            do i = 1, n
-               umax(i) = max(umax(i), u(i)); umin(i) = min(umin(i), u(i))
-               vmax(i) = max(vmax(i), abs(v(i))); amax(i) = max(amax(i), abs(a(i)))
-               ! a local maximum between t − h and t: u_n + v_n τ + ½ a_n τ², τ = −v_n/a_n
-               if (vn(i) > 0.0_dp .and. v(i) <= 0.0_dp) then
-                  if (an(i) < 0.0_dp .and. t > 0.0_dp) then
-                     tau = min(-vn(i)/an(i), h)
-                     up = un(i) + vn(i)*tau + 0.5_dp*an(i)*tau*tau
-                     if (up > upk(i)) then
-                        upk(i) = up; tpk(i) = t - h + tau
-                     end if
-                  end if
-               end if
-            end do
-         end associate
-         do i = 1, m%ncontact
-            r%pen_max(i) = max(r%pen_max(i), ms%con_pen(i))
-            r%force_max(i) = max(r%force_max(i), ms%con_f(i))
-         end do
-      end subroutine track_peaks
 
       !> Contact phases: onset and separation times located on the free side of the step by
       !> the quadratic δ + δ̇τ + ½δ̈τ² = 0 (O(h³) in time), speeds extrapolated likewise.

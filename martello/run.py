@@ -144,7 +144,9 @@ def run_full(scene):
 
 INTEGRATOR_CONST = {"newmark": "INT_NEWMARK", "hht": "INT_HHT",
                     "generalized-alpha": "INT_GENERALIZED_ALPHA",
-                    "central-difference": "INT_CENTRAL_DIFFERENCE"}
+                    "central-difference": "INT_CENTRAL_DIFFERENCE", "moreau-jean": "INT_MOREAU_JEAN",
+                    "newmark-lagrange": "INT_NEWMARK_LAGRANGE", "rkf45": "INT_RKF45",
+                    "rk8pd": "INT_RK8PD", "msbdf": "INT_MSBDF", "ida": "INT_IDA"}
 
 
 def integrator_par(an):
@@ -159,6 +161,8 @@ def integrator_par(an):
     put("R_TOL_RESIDUAL", an["tol_residual"]); put("R_TOL_INCREMENT", an["tol_increment"])
     put("R_MAX_NEWTON", an["max_newton"]); put("R_CHECK_STABILITY", 1.0 if an["check_stability"] else 0.0)
     put("R_EVERY", an["output"]["every"]); put("R_DIVERGENCE_FACTOR", an["divergence_factor"])
+    put("R_RTOL", an["rtol"]); put("R_ATOL", an["atol"]); put("R_THETA", an["theta"])
+    put("R_EVENT_TOL", an["event_tol"]); put("R_H_MAX", an["h_max"])
     return par
 
 
@@ -170,7 +174,11 @@ def integrator_description(an):
         d.update(alpha=an["alpha"])
     elif an["integrator"] == "generalized-alpha":
         d.update(rho_inf=an["rho_inf"])
-    if an["integrator"] != "central-difference":
+    elif an["integrator"] == "moreau-jean":
+        d.update(theta=an["theta"])
+    elif an["integrator"] in ("rkf45", "rk8pd", "msbdf", "ida"):
+        d.update(rtol=an["rtol"], atol=an["atol"], event_tol=an["event_tol"], h_max=an["h_max"])
+    if an["integrator"] in ("newmark", "hht", "generalized-alpha", "newmark-lagrange"):
         d.update(tol_residual=an["tol_residual"], tol_increment=an["tol_increment"],
                  max_newton=an["max_newton"])
     return d

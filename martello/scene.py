@@ -86,7 +86,20 @@ FUNCTION_TYPES = {
                "units": ("str", False, None, None), "scale": ("float", False, ANY, 1.0)},
 }
 
-INTEGRATORS = ("newmark", "hht", "generalized-alpha", "central-difference")
+INTEGRATORS = ("newmark", "hht", "generalized-alpha", "central-difference", "moreau-jean",
+               "newmark-lagrange", "rkf45", "rk8pd", "msbdf", "ida")
+STRUCTURAL = ("newmark", "hht", "generalized-alpha", "central-difference")
+ADAPTIVE = ("rkf45", "rk8pd", "msbdf", "ida")
+# Which contact schemes each integrator runs (fortran/integrator_settings.f90 holds the same
+# table for the C API; tests/test_compatibility.py checks they agree). Penalty contacts are
+# smooth forces; lagrange and restitution contacts need event location or impulse-level
+# time stepping; augmented-lagrange is a static scheme.
+COMPATIBLE = {
+    "penalty": tuple(i for i in INTEGRATORS if i != "newmark-lagrange"),
+    "lagrange": ("moreau-jean", "newmark-lagrange", "rkf45", "rk8pd", "msbdf", "ida"),
+    "restitution": ("moreau-jean", "newmark-lagrange", "rkf45", "rk8pd", "msbdf", "ida"),
+    "augmented-lagrange": (),
+}
 NEWMARK_PRESETS = {"average-acceleration": (0.25, 0.5), "linear-acceleration": (1.0 / 6.0, 0.5)}
 ANALYSIS_TYPES = {
     "static": {"tol": ("float", False, POSITIVE, 1e-14),
@@ -104,13 +117,21 @@ ANALYSIS_TYPES = {
                 "max_newton": ("int", False, POSITIVE, 30),
                 "check_stability": ("bool", False, None, True),
                 "divergence_factor": ("float", False, (lambda x: x > 1, "a number > 1"), 10.0),
+                "rtol": ("float", False, POSITIVE, 1e-8),
+                "atol": ("float", False, POSITIVE, 1e-12),
+                "theta": ("float", False, (lambda x: 0.5 <= x <= 1, "a number in [0.5, 1]"), 0.5),
+                "event_tol": ("float", False, POSITIVE, 1e-12),
+                "h_max": ("float", False, NONNEG, 0.0),
                 "output": ("table", False, None, None)},
 }
 OUTPUT_KEYS = {"every": ("int", False, POSITIVE, 1), "nodes": ("list", False, None, None),
                "contacts": ("list", False, None, None)}
 INTEGRATOR_KEYS = {"newmark": {"preset", "beta", "gamma"}, "hht": {"alpha"},
-                   "generalized-alpha": {"rho_inf"}, "central-difference": {"check_stability"}}
+                   "generalized-alpha": {"rho_inf"}, "central-difference": {"check_stability"},
+                   "moreau-jean": {"theta"}, "newmark-lagrange": set(),
+                   **{k: {"rtol", "atol", "event_tol", "h_max"} for k in ADAPTIVE}}
 IMPLICIT_KEYS = {"tol_residual", "tol_increment", "max_newton"}
+ALL_SPECIFIC = set().union(*INTEGRATOR_KEYS.values()) | IMPLICIT_KEYS
 
 TOP_KEYS = {"title", "problem", "description", "node", "link", "contact", "loads", "analysis",
             "check", "chain"}
@@ -367,7 +388,7 @@ def from_dict(data, source="<scene>", base_dir=Path("."), digest=None):
     analysis = _fields(src, an, "analysis", ANALYSIS_TYPES[atype], extra_ok=("type",))
     analysis["type"] = atype
     if atype == "dynamic":
-        _dynamic_analysis(src, an, analysis, index, [c["name"] for c in contacts])
+        _dynamic_analysis(src, an, analysis, index, contacts)
     ground_k = _ground_stiffness(links)
     for i, lk in enumerate(links):
         if lk["type"] == "dashpot" and lk["zeta"] is not None:
@@ -441,10 +462,11 @@ def _expand_chains(src, data):
     return data
 
 
-def _dynamic_analysis(src, raw, an, index, contact_names):
+def _dynamic_analysis(src, raw, an, index, contacts):
     integ = _choice(src, "analysis.integrator", an["integrator"], INTEGRATORS)
-    allowed = INTEGRATOR_KEYS[integ] | ({"check_stability"} if integ == "central-difference" else IMPLICIT_KEYS)
-    for key in (set(INTEGRATOR_KEYS["newmark"]) | {"alpha", "rho_inf", "check_stability"} | IMPLICIT_KEYS):
+    implicit = IMPLICIT_KEYS if integ in ("newmark", "hht", "generalized-alpha", "newmark-lagrange") else set()
+    allowed = INTEGRATOR_KEYS[integ] | implicit
+    for key in ALL_SPECIFIC:
         if key in raw and key not in allowed:
             raise SceneError(src, f"analysis.{key}", f"does not apply to integrator {integ}",
                              "valid here: " + ", ".join(sorted(allowed)))
@@ -466,6 +488,12 @@ def _dynamic_analysis(src, raw, an, index, contact_names):
         raise SceneError(src, "analysis.alpha", "missing", "HHT needs alpha in [-1/3, 0]")
     if integ == "generalized-alpha" and an["rho_inf"] is None:
         raise SceneError(src, "analysis.rho_inf", "missing", "generalized-alpha needs rho_inf in [0, 1]")
+    for i, c in enumerate(contacts):
+        if integ not in COMPATIBLE[c["scheme"]]:
+            works = ", ".join(COMPATIBLE[c["scheme"]]) or "none (a static scheme: use analysis type static)"
+            raise SceneError(src, f"contact[{i}].scheme",
+                             f"scheme {c['scheme']} cannot run on integrator {integ}",
+                             f"integrators that can: {works}")
     if an["dt"] > an["t_end"]:
         raise SceneError(src, "analysis.dt", f"{an['dt']} is longer than t_end = {an['t_end']}",
                          "choose dt <= t_end")
@@ -473,6 +501,7 @@ def _dynamic_analysis(src, raw, an, index, contact_names):
     names = list(index)
     # default: every node and contact of a small scene; none of a large one (peaks are always there)
     out["nodes"] = out["nodes"] if out["nodes"] is not None else (names if len(names) <= 50 else [])
+    contact_names = [c["name"] for c in contacts]
     out["contacts"] = (out["contacts"] if out["contacts"] is not None
                        else (contact_names if len(contact_names) <= 50 else []))
     for i, nm in enumerate(out["nodes"]):

@@ -1,0 +1,132 @@
+!> Force evaluation of a scene for integrators that live outside the Fortran kernels (GSL
+!> and SUNDIALS adapters in c/): the accelerations M⁻¹(f_ext − f_int), contact gaps, mass
+!> solves for impulses, energies, and the commit of path-dependent link states at accepted
+!> steps. It wraps the same assembly code as the structural integrators.
+module martello_evaluator
+   use martello_kinds, only: dp
+   use martello_model, only: model_t, model_bandwidth
+   use martello_assembly
+   use martello_band_matrix
+   implicit none
+   private
+   public :: evaluator_t, evaluator_init, evaluator_acceleration, evaluator_forces, &
+      evaluator_solve_mass, evaluator_contacts, evaluator_commit, evaluator_energy
+
+   type :: evaluator_t
+      type(model_t), pointer :: m => null()
+      type(mech_state_t) :: ms
+      type(band_t) :: mband
+      real(dp), allocatable :: mrow(:), u(:), v(:), f(:), fext(:), work(:)
+      integer, allocatable :: fixed_nodes(:)
+   end type evaluator_t
+
+contains
+
+   subroutine evaluator_init(ev, m)
+      type(evaluator_t), intent(inout) :: ev
+      type(model_t), intent(in), target :: m
+      integer :: n, j
+      ev%m => m
+      n = m%n
+      allocate (ev%mrow(0:n), ev%u(0:n), ev%v(0:n), ev%f(0:n), ev%fext(0:n), ev%work(0:n))
+      ev%work = 1.0_dp; ev%work(0) = 0.0_dp
+      call mass_times(m, ev%work, ev%mrow)
+      ev%u = 0.0_dp; ev%v = 0.0_dp
+      ev%u(1:n) = m%u0; ev%v(1:n) = merge(0.0_dp, m%v0, m%fixed)
+      call mech_init(m, ev%ms, ev%u, ev%v)
+      call band_init(ev%mband, n, model_bandwidth(m))
+      ev%fixed_nodes = pack([(j, j = 1, n)], m%fixed)
+   end subroutine evaluator_init
+
+   subroutine load(ev, u, v)
+      type(evaluator_t), intent(inout) :: ev
+      real(dp), intent(in) :: u(:), v(:)
+      ev%u(1:) = u; ev%v(1:) = v
+      ev%u(ev%fixed_nodes) = ev%m%u0(ev%fixed_nodes); ev%v(ev%fixed_nodes) = 0.0_dp
+   end subroutine load
+
+   !> fint and fext (length n) at (t, u, v); links from the committed state.
+   subroutine evaluator_forces(ev, t, u, v, fint, fext)
+      type(evaluator_t), intent(inout) :: ev
+      real(dp), intent(in) :: t, u(:), v(:)
+      real(dp), intent(out) :: fint(:), fext(:)
+      call load(ev, u, v)
+      call internal_forces(ev%m, ev%ms, ev%u, ev%v, ev%f)
+      call external_forces(ev%m, ev%mrow, t, ev%fext)
+      fint = ev%f(1:); fext = ev%fext(1:)
+   end subroutine evaluator_forces
+
+   !> a = M⁻¹(fext − fint) on the free nodes, 0 on fixed ones; ok = .false. if M is singular.
+   subroutine evaluator_acceleration(ev, t, u, v, a, ok)
+      type(evaluator_t), intent(inout) :: ev
+      real(dp), intent(in) :: t, u(:), v(:)
+      real(dp), intent(out) :: a(:)
+      logical, intent(out) :: ok
+      real(dp) :: fint(size(a)), fext(size(a))
+      call evaluator_forces(ev, t, u, v, fint, fext)
+      a = fext - fint
+      call evaluator_solve_mass(ev, a, ok)
+   end subroutine evaluator_acceleration
+
+   !> x ← M⁻¹x on the free nodes (fixed rows give 0): accelerations, or velocity jumps from
+   !> impulses.
+   subroutine evaluator_solve_mass(ev, x, ok)
+      type(evaluator_t), intent(inout) :: ev
+      real(dp), intent(inout) :: x(:)
+      logical, intent(out) :: ok
+      integer :: k, i, rr, jj
+      if (ev%m%ncoupling == 0) then
+         x = x/merge(1.0_dp, ev%m%mass, ev%m%fixed)
+         x(ev%fixed_nodes) = 0.0_dp
+         ok = .true.
+         return
+      end if
+      call band_zero(ev%mband)
+      call assemble_mass(ev%m, 1.0_dp, ev%mband)
+      rr = 2*ev%mband%kd + 1
+      do k = 1, size(ev%fixed_nodes)
+         i = ev%fixed_nodes(k)
+         do jj = max(1, i - ev%mband%kd), min(ev%m%n, i + ev%mband%kd)
+            ev%mband%ab(rr + i - jj, jj) = 0.0_dp
+            ev%mband%ab(rr + jj - i, i) = 0.0_dp
+         end do
+         ev%mband%ab(rr, i) = 1.0_dp
+         x(i) = 0.0_dp
+      end do
+      call band_solve(ev%mband, x, ok)
+   end subroutine evaluator_solve_mass
+
+   !> Penetration δ = u_a − u_b − gap and its rate, for every contact (any scheme).
+   subroutine evaluator_contacts(ev, u, v, pen, rate)
+      type(evaluator_t), intent(inout) :: ev
+      real(dp), intent(in) :: u(:), v(:)
+      real(dp), intent(out) :: pen(:), rate(:)
+      integer :: j
+      call load(ev, u, v)
+      do j = 1, ev%m%ncontact
+         pen(j) = ev%u(ev%m%con_a(j)) - ev%u(ev%m%con_b(j)) - ev%m%con_gap(j)
+         rate(j) = ev%v(ev%m%con_a(j)) - ev%v(ev%m%con_b(j))
+      end do
+   end subroutine evaluator_contacts
+
+   !> Accept (u, v) as the state at the end of a step: path-dependent links commit.
+   subroutine evaluator_commit(ev, u, v)
+      type(evaluator_t), intent(inout) :: ev
+      real(dp), intent(in) :: u(:), v(:)
+      call load(ev, u, v)
+      call internal_forces(ev%m, ev%ms, ev%u, ev%v, ev%f)
+      call mech_commit(ev%m, ev%ms, ev%u)
+   end subroutine evaluator_commit
+
+   subroutine evaluator_energy(ev, u, v, kinetic, recoverable)
+      type(evaluator_t), intent(inout) :: ev
+      real(dp), intent(in) :: u(:), v(:)
+      real(dp), intent(out) :: kinetic, recoverable
+      real(dp) :: el, ec
+      call load(ev, u, v)
+      call mass_times(ev%m, ev%v, ev%work)
+      kinetic = 0.5_dp*dot_product(ev%v(1:), ev%work(1:))
+      call recoverable_energy(ev%m, ev%ms, ev%u, el, ec)
+      recoverable = el + ec
+   end subroutine evaluator_energy
+end module martello_evaluator
