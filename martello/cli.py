@@ -90,6 +90,26 @@ def main(argv=None):
     p.add_argument("--no-plots", action="store_true", help="skip the PNG plots")
     p.set_defaults(func=cmd_check)
 
+    p = sub.add_parser("study", help="run a sweep (scenes x integrators x steps) and plot it",
+                       description="Run a study file (benchmarks/studies/*.toml): every scene x "
+                       "scheme x integrator x step/tolerance it lists, in parallel, with a progress "
+                       "bar; write a tidy CSV (one row per run) and work-precision and "
+                       "error-vs-step plots with the measured orders.")
+    p.add_argument("study", help="study file (TOML)")
+    p.add_argument("-o", "--output", help="output folder (default: out/studies/<name>)")
+    p.add_argument("-j", "--jobs", type=int, default=0, help="parallel runs (default: all cores)")
+    p.set_defaults(func=lambda a: __import__("martello.study", fromlist=["main"]).main(a))
+
+    p = sub.add_parser("compare", help="score another code's time history against a scene",
+                       description="Score a foreign time history (CSV, columns documented in "
+                       "docs/compare.md) against martello's reference for a scene, with the same "
+                       "metrics as the studies (max error, significant digits, peak and impact "
+                       "errors).")
+    p.add_argument("history", help="the other code's history (CSV)")
+    p.add_argument("--against", required=True, help="scene file (TOML) it claims to solve")
+    p.add_argument("-o", "--output", help="write the scores as JSON here")
+    p.set_defaults(func=lambda a: __import__("martello.compare", fromlist=["main"]).main(a))
+
     p = sub.add_parser("version", help="versions of martello and the libraries it links")
     p.set_defaults(func=lambda a: print(f"martello {native.version()} ({native.library_versions()})") or 0)
 

@@ -107,7 +107,8 @@ def _function_args(fn):
 
 def build_model(scene):
     """A native Model holding the scene (the caller frees it, or uses a with-block)."""
-    m = native.Model(len(scene.nodes), len(scene.links), len(scene.contacts), len(scene.forces))
+    m = native.Model(len(scene.nodes), len(scene.links), len(scene.contacts), len(scene.forces),
+                     len(scene.couplings))
     for i, n in enumerate(scene.nodes):
         m.set_node(i, n["mass"], n["u0"], n["v0"], n["fixed"])
     for lk in scene.links:
@@ -115,6 +116,8 @@ def build_model(scene):
     for c in scene.contacts:
         law, par = _contact_par(scene, c)
         m.add_contact(c["a"], c["b"], c["gap"], constant(SCHEME_CONST[c["scheme"]]), law, par)
+    for mc in scene.couplings:
+        m.add_mass_coupling(mc["a"], mc["b"], mc["value"])
     m.set_gravity(scene.gravity)
     for f in scene.forces:
         m.add_nodal_force(f["node"], *_function_args(f["function"]))
@@ -253,6 +256,8 @@ def _dynamic(scene, model, raise_on_failure=True):
               [f"penetration:{c}" for c in an["output"]["contacts"]] + \
               [f"force:{c}" for c in an["output"]["contacts"]] + \
               [f"energy:{e}" for e in native.ENERGY_NAMES]
+    from .measures import attach     # problem-specific measures (e.g. rod impact, P4)
+    attach(scene, summary, (columns, hist))
     return summary, (columns, hist)
 
 

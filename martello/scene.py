@@ -134,7 +134,7 @@ IMPLICIT_KEYS = {"tol_residual", "tol_increment", "max_newton"}
 ALL_SPECIFIC = set().union(*INTEGRATOR_KEYS.values()) | IMPLICIT_KEYS
 
 TOP_KEYS = {"title", "problem", "description", "node", "link", "contact", "loads", "analysis",
-            "check", "chain"}
+            "check", "chain", "bar", "mass_coupling"}
 
 # [[chain]]: n oscillators in a row (PROBLEMS.md P7), each a mass on a spring to ground
 # (bilinear if fy is given) with an optional dashpot (zeta), and contacts between
@@ -164,6 +164,8 @@ class Scene:
     check: dict | None
     digest: str          # sha256 of the file (or of the canonical JSON of a dict scene)
     index: dict = field(default_factory=dict)   # node name -> index
+    couplings: list = field(default_factory=list)  # dicts: a, b (indices), value
+    extras: dict = field(default_factory=dict)     # what generators ([[bar]]) know of the scene
 
     def node_index(self, name):
         return -1 if name == GROUND else self.index[name]
@@ -284,8 +286,12 @@ def from_dict(data, source="<scene>", base_dir=Path("."), digest=None):
     for key in data:
         if key not in TOP_KEYS:
             raise SceneError(src, key, "unknown key", "valid top-level keys: " + ", ".join(sorted(TOP_KEYS)))
+    extras = {}
     if "chain" in data:
         data = _expand_chains(src, data)
+    if "bar" in data:
+        from .bars import expand_bars     # [[bar]]: axial rods meshed into elements (P4)
+        data, extras["bars"] = expand_bars(src, data)
 
     # nodes
     raw_nodes = data.get("node")
@@ -398,6 +404,18 @@ def from_dict(data, source="<scene>", base_dir=Path("."), digest=None):
     if check is not None:
         check = _check_table(src, check)
 
+    # off-diagonal (consistent) mass terms: M(a,b) = M(b,a) += value
+    couplings = []
+    for i, tab in enumerate(data.get("mass_coupling", [])):
+        where = f"mass_coupling[{i}]"
+        mc = _fields(src, tab, where, {"a": ("str", True, None, None), "b": ("str", True, None, None),
+                                       "value": ("float", True, POSITIVE, None)})
+        mc["a"] = node_ref(f"{where}.a", mc["a"], ground_ok=False)
+        mc["b"] = node_ref(f"{where}.b", mc["b"], ground_ok=False)
+        if mc["a"] == mc["b"]:
+            raise SceneError(src, f"{where}.b", "couples a node with itself", "name two different nodes")
+        couplings.append(mc)
+
     meta = {k: data.get(k, "") for k in ("title", "problem", "description")}
     for k, v in meta.items():
         if not isinstance(v, str):
@@ -405,7 +423,7 @@ def from_dict(data, source="<scene>", base_dir=Path("."), digest=None):
     return Scene(source=src, title=meta["title"] or Path(src).stem, problem=meta["problem"],
                  description=meta["description"], nodes=nodes, links=links, contacts=contacts,
                  gravity=lt["gravity"], forces=forces, ground=ground, analysis=analysis,
-                 check=check, digest=digest, index=index)
+                 check=check, digest=digest, index=index, couplings=couplings, extras=extras)
 
 
 def _per_item(src, where, value, count, check=None):
