@@ -124,11 +124,14 @@ int martello_run_set_integrator(martello_run *run, int kind,
                                 const double par[MARTELLO_NPAR_INTEGRATOR]);
 int martello_run_set_outputs(martello_run *run, int n_nodes, const int *nodes, int n_contacts,
                              const int *contacts);
+/* Links whose force and elongation the history records (0-based; default none). */
+int martello_run_set_link_outputs(martello_run *run, int n_links, const int *links);
 int martello_dynamic_run(martello_model *model, martello_run *run);
 int martello_run_message(const martello_run *run, char *buf, int buflen);
 /* History: rows records of cols values, record after record: t, then u, v, a of each output
  * node (all u first, then all v, then all a), then penetration and force of each output
- * contact, then the MARTELLO_NENERGY energy terms. */
+ * contact, then force and elongation of each output link (NaN where an integrator does not
+ * report links), then the MARTELLO_NENERGY energy terms. */
 int martello_run_history_shape(const martello_run *run, int *rows, int *cols);
 int martello_run_history(const martello_run *run, double *buf);
 /* Contact phases: n on return; with non-NULL arrays also contact[n] and
@@ -147,6 +150,9 @@ int martello_run_peaks(const martello_run *run, double *u_max, double *u_min, do
 /* energy = {kinetic, recoverable, input work, damping, plastic, contact dissipation, balance,
  * initial, impact}; extra = {max |balance|, omega_max, dt_crit (explicit), time reached} */
 int martello_run_energy(const martello_run *run, double energy[MARTELLO_NENERGY], double extra[4]);
+/* Per link: max |force| and max |elongation| over the run (NaN if the integrator does not
+ * report link states). */
+int martello_run_link_peaks(const martello_run *run, double *force_absmax, double *elongation_absmax);
 
 #ifdef __cplusplus
 }

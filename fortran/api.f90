@@ -43,7 +43,7 @@ module martello_api
    type :: run_t
       type(integrator_settings_t) :: settings
       type(results_t) :: results
-      integer, allocatable :: out_nodes(:), out_contacts(:)
+      integer, allocatable :: out_nodes(:), out_contacts(:), out_links(:)
       logical :: configured = .false., done = .false.
    end type run_t
 
@@ -255,7 +255,7 @@ contains
       if (stat /= 0) then
          c_run_create = MARTELLO_ERR_MEMORY; return
       end if
-      allocate (rp%out_nodes(0), rp%out_contacts(0))
+      allocate (rp%out_nodes(0), rp%out_contacts(0), rp%out_links(0))
       handle = c_loc(rp)
       c_run_create = MARTELLO_OK
    end function c_run_create
@@ -317,6 +317,34 @@ contains
       c_run_set_integrator = MARTELLO_OK
    end function c_run_set_integrator
 
+   !> Which links the history records (0-based): their force and elongation.
+   integer(c_int) function c_run_set_link_outputs(handle, nl, links) bind(C, name='martello_run_set_link_outputs')
+      type(c_ptr), value :: handle
+      integer(c_int), value :: nl
+      integer(c_int), intent(in) :: links(*)
+      type(run_t), pointer :: rp
+      rp => get_run(handle)
+      c_run_set_link_outputs = MARTELLO_ERR_ARGUMENT
+      if (.not. associated(rp) .or. nl < 0) return
+      rp%out_links = links(1:nl) + 1
+      c_run_set_link_outputs = MARTELLO_OK
+   end function c_run_set_link_outputs
+
+   !> Per link: max |force| and max |elongation| over the run (NaN if not tracked).
+   integer(c_int) function c_run_link_peaks(handle, fmax, dumax) bind(C, name='martello_run_link_peaks')
+      type(c_ptr), value :: handle
+      real(c_double), intent(out) :: fmax(*), dumax(*)
+      type(run_t), pointer :: rp
+      integer :: nl
+      rp => get_run(handle)
+      c_run_link_peaks = MARTELLO_ERR_ARGUMENT
+      if (.not. associated(rp)) return
+      if (.not. allocated(rp%results%link_force_absmax)) return
+      nl = size(rp%results%link_force_absmax)
+      fmax(1:nl) = rp%results%link_force_absmax; dumax(1:nl) = rp%results%link_du_absmax
+      c_run_link_peaks = MARTELLO_OK
+   end function c_run_link_peaks
+
    !> Which nodes and contacts the history records (0-based); the peaks cover all of them.
    integer(c_int) function c_run_set_outputs(handle, nn, nodes, nc, contacts) &
       bind(C, name='martello_run_set_outputs')
@@ -349,7 +377,11 @@ contains
          rp%results%message = 'dynamic_run: an output node or contact is out of range'; return
       end if
       cap = int(min(rp%settings%t_end/rp%settings%dt/rp%settings%every + 3.0_dp, 1.0e7_dp))
-      call results_init(rp%results, mp%n, mp%ncontact, rp%out_nodes, rp%out_contacts, cap)
+      if (any(rp%out_links < 1 .or. rp%out_links > mp%nlink)) then
+         rp%results%message = 'dynamic_run: an output link is out of range'; return
+      end if
+      call results_init(rp%results, mp%n, mp%ncontact, rp%out_nodes, rp%out_contacts, cap, &
+                        mp%nlink, rp%out_links)
       call check_compatibility(mp, rp, stat)
       if (stat == MARTELLO_OK) then
          select case (rp%settings%kind)
@@ -570,7 +602,8 @@ contains
       rp => get_run(handle); mp => get_model(mhandle)
       c_run_begin = MARTELLO_ERR_ARGUMENT
       if (.not. (associated(rp) .and. associated(mp))) return
-      call results_init(rp%results, mp%n, mp%ncontact, rp%out_nodes, rp%out_contacts, 1024)
+      call results_init(rp%results, mp%n, mp%ncontact, rp%out_nodes, rp%out_contacts, 1024, &
+                        mp%nlink, rp%out_links)
       c_run_begin = MARTELLO_OK
    end function c_run_begin
 

@@ -4,6 +4,7 @@
 !> the same procedures, so every method is measured the same way.
 module martello_results
    use martello_kinds, only: dp, i8
+   use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan
    implicit none
    private
    public :: results_t, results_init, results_record, results_add_event, results_track, &
@@ -31,7 +32,7 @@ module martello_results
       ! contact), energy(1:NENERGY)]
       integer :: ncol = 0, nrec = 0
       real(dp), allocatable :: hist(:, :)
-      integer, allocatable :: out_nodes(:), out_contacts(:)
+      integer, allocatable :: out_nodes(:), out_contacts(:), out_links(:)
       ! events
       integer :: nevents = 0
       integer, allocatable :: ev_contact(:)
@@ -42,6 +43,9 @@ module martello_results
       !> step maxima above are O(h) in time, these are O(h²)
       real(dp), allocatable :: u_peak(:), t_peak(:)
       real(dp), allocatable :: pen_max(:), force_max(:)
+      !> per link: max |force| and max |elongation| (storey shear and drift of a frame);
+      !> NaN when the integrator does not report link states
+      real(dp), allocatable :: link_force_absmax(:), link_du_absmax(:)
       integer, allocatable :: impacts(:)
       real(dp) :: energy(NENERGY) = 0.0_dp
       real(dp) :: energy_balance_max = 0.0_dp   !< max |balance| over the run
@@ -57,11 +61,24 @@ module martello_results
 
 contains
 
-   subroutine results_init(r, n_nodes, n_contacts, out_nodes, out_contacts, capacity)
+   subroutine results_init(r, n_nodes, n_contacts, out_nodes, out_contacts, capacity, n_links, out_links)
       type(results_t), intent(inout) :: r
       integer, intent(in) :: n_nodes, n_contacts, out_nodes(:), out_contacts(:), capacity
+      integer, intent(in), optional :: n_links, out_links(:)
+      integer :: nl
       r%out_nodes = out_nodes; r%out_contacts = out_contacts
-      r%ncol = 1 + 3*size(out_nodes) + 2*size(out_contacts) + NENERGY
+      if (present(out_links)) then
+         r%out_links = out_links
+      else
+         allocate (r%out_links(0))
+      end if
+      nl = 0
+      if (present(n_links)) nl = n_links
+      if (allocated(r%link_force_absmax)) deallocate (r%link_force_absmax, r%link_du_absmax)
+      allocate (r%link_force_absmax(nl), r%link_du_absmax(nl))
+      r%link_force_absmax = ieee_value(1.0_dp, ieee_quiet_nan)
+      r%link_du_absmax = ieee_value(1.0_dp, ieee_quiet_nan)
+      r%ncol = 1 + 3*size(out_nodes) + 2*size(out_contacts) + 2*size(r%out_links) + NENERGY
       r%nrec = 0
       if (allocated(r%hist)) deallocate (r%hist)
       allocate (r%hist(r%ncol, max(capacity, 2)))
@@ -85,9 +102,10 @@ contains
    end subroutine results_init
 
    !> Append one history row (grows by doubling when a variable-step integrator needs it).
-   subroutine results_record(r, t, u, v, a, pen, force, energy)
+   subroutine results_record(r, t, u, v, a, pen, force, energy, link_f, link_du)
       type(results_t), intent(inout) :: r
       real(dp), intent(in) :: t, u(:), v(:), a(:), pen(:), force(:), energy(NENERGY)
+      real(dp), intent(in), optional :: link_f(:), link_du(:)   !< absent: NaN columns
       real(dp), allocatable :: tmp(:, :)
       integer :: k, c
       if (r%nrec == size(r%hist, 2)) then
@@ -103,6 +121,13 @@ contains
       r%hist(c + 1:c + size(r%out_nodes), k) = a(r%out_nodes); c = c + size(r%out_nodes)
       r%hist(c + 1:c + size(r%out_contacts), k) = pen(r%out_contacts); c = c + size(r%out_contacts)
       r%hist(c + 1:c + size(r%out_contacts), k) = force(r%out_contacts); c = c + size(r%out_contacts)
+      if (present(link_f) .and. present(link_du)) then
+         r%hist(c + 1:c + size(r%out_links), k) = link_f(r%out_links); c = c + size(r%out_links)
+         r%hist(c + 1:c + size(r%out_links), k) = link_du(r%out_links); c = c + size(r%out_links)
+      else
+         r%hist(c + 1:c + 2*size(r%out_links), k) = ieee_value(1.0_dp, ieee_quiet_nan)
+         c = c + 2*size(r%out_links)
+      end if
       r%hist(c + 1:c + NENERGY, k) = energy
    end subroutine results_record
 
@@ -126,9 +151,10 @@ contains
    !> extremes of u, |v|, |a|, penetration and force, and the largest local maximum of u
    !> interpolated between the previous and this state by u + vτ + ½aτ², τ = −v/a (O(h²) in
    !> time where the step maxima are O(h)).
-   subroutine results_track(r, t, u, v, a, pen, force)
+   subroutine results_track(r, t, u, v, a, pen, force, link_f, link_du)
       type(results_t), intent(inout) :: r
       real(dp), intent(in) :: t, u(:), v(:), a(:), pen(:), force(:)
+      real(dp), intent(in), optional :: link_f(:), link_du(:)
       integer :: i
       real(dp) :: tau, up, h
       h = t - r%prev_t
@@ -154,5 +180,12 @@ contains
          r%pen_max(i) = max(r%pen_max(i), pen(i))
          r%force_max(i) = max(r%force_max(i), force(i))
       end do
+      if (present(link_f) .and. present(link_du)) then
+         do i = 1, size(link_f)
+            ! written as "not ≥" so that the NaN the maxima start from is replaced
+            if (.not. (r%link_force_absmax(i) >= abs(link_f(i)))) r%link_force_absmax(i) = abs(link_f(i))
+            if (.not. (r%link_du_absmax(i) >= abs(link_du(i)))) r%link_du_absmax(i) = abs(link_du(i))
+         end do
+      end if
    end subroutine results_track
 end module martello_results

@@ -123,7 +123,7 @@ contains
       e0 = e_kin + e_links + e_cont
       w_ext = 0.0_dp; d_damp = 0.0_dp; d_links = 0.0_dp; d_contact = 0.0_dp; w_abs = 0.0_dp
       t = 0.0_dp
-      call results_track(r, t, u(1:n), v(1:n), a(1:n), ms%con_pen, ms%con_f)
+      call results_track(r, t, u(1:n), v(1:n), a(1:n), ms%con_pen, ms%con_f, ms%link_f, ms%link_u)
       call record()
 
       do step = 1, nsteps
@@ -154,7 +154,7 @@ contains
          end do
          w_ext = w_ext + wd; w_abs = w_abs + abs(wd)
          call track_events()
-         call results_track(r, t, u(1:n), v(1:n), a(1:n), ms%con_pen, ms%con_f)
+         call results_track(r, t, u(1:n), v(1:n), a(1:n), ms%con_pen, ms%con_f, ms%link_f, ms%link_u)
          recording = mod(step, s%every) == 0 .or. step == nsteps
          ! kinetic and recoverable energy (two passes over the model) only where needed: at
          ! recorded steps and every ENERGY_CHECK steps for the divergence test
@@ -510,7 +510,7 @@ contains
                         - e(E_CONTACT)
          r%energy = e
          r%energy_balance_max = max(r%energy_balance_max, abs(e(E_BALANCE)))
-         call results_record(r, t, u(1:n), v(1:n), a(1:n), ms%con_pen, ms%con_f, e)
+         call results_record(r, t, u(1:n), v(1:n), a(1:n), ms%con_pen, ms%con_f, e, ms%link_f, ms%link_u)
       end subroutine record
 
       pure real(dp) function crossing(d, rate, acc, lo, hi) result(tau)

@@ -67,6 +67,8 @@ def lib():
         "martello_run_counters": (c_int, [_VOID_P, np.ctypeslib.ndpointer(dtype=np.int64, flags="C_CONTIGUOUS")]),
         "martello_run_peaks": (c_int, [_VOID_P] + [_DOUBLE_P] * 6 + [_INT_P] + [_DOUBLE_P] * 2),
         "martello_run_energy": (c_int, [_VOID_P, _DOUBLE_P, _DOUBLE_P]),
+        "martello_run_set_link_outputs": (c_int, [_VOID_P, c_int, _INT_P]),
+        "martello_run_link_peaks": (c_int, [_VOID_P, _DOUBLE_P, _DOUBLE_P]),
     }
     for name, (res, args) in protos.items():
         fn = getattr(L, name)
@@ -247,6 +249,15 @@ class Run:
         n = np.ascontiguousarray(nodes, dtype=np.int32)
         c = np.ascontiguousarray(contacts, dtype=np.int32)
         self._check(lib().martello_run_set_outputs(self._h, n.size, n, c.size, c), "outputs")
+
+    def set_link_outputs(self, links):
+        l = np.ascontiguousarray(links, dtype=np.int32)
+        self._check(lib().martello_run_set_link_outputs(self._h, l.size, l), "link outputs")
+
+    def link_peaks(self, n_links):
+        f, du = np.zeros(max(n_links, 1)), np.zeros(max(n_links, 1))
+        lib().martello_run_link_peaks(self._h, f, du)
+        return f[:n_links], du[:n_links]
 
     def execute(self, model):
         """Run; raises on failure (DivergenceError for diverged/unstable runs)."""

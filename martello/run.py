@@ -195,6 +195,9 @@ def _dynamic(scene, model, raise_on_failure=True):
     with native.Run() as r:
         r.set_integrator(constant(INTEGRATOR_CONST[an["integrator"]]), integrator_par(an))
         r.set_outputs(out_nodes, out_contacts)
+        lnames = [l["name"] for l in scene.links]
+        out_links = [lnames.index(n) for n in an["output"]["links"]]
+        r.set_link_outputs(out_links)
         t0 = time.perf_counter()
         st = r.execute(model) if raise_on_failure else r.status_of(model)
         wall = time.perf_counter() - t0
@@ -202,6 +205,7 @@ def _dynamic(scene, model, raise_on_failure=True):
         ev_contacts, ev = r.events()
         peaks = r.peaks(len(scene.nodes), len(scene.contacts))
         energy, extra = r.energy()
+        link_f, link_du = r.link_peaks(len(scene.links))
         counters = r.counters()
         message = r.message()
 
@@ -246,6 +250,9 @@ def _dynamic(scene, model, raise_on_failure=True):
         "warnings": [],
         "t_reached": extra["t_reached"],
         "nodes": nodes, "contacts": contacts, "energy": energy,
+        "links": {l["name"]: {"type": l["type"], "max_abs_force": _finite_or_none(link_f[i]),
+                              "max_abs_elongation": _finite_or_none(link_du[i])}
+                  for i, l in enumerate(scene.links)},
         "stability": {"omega_max": extra["omega_max"] or None,
                       "dt_critical": extra["dt_critical"] or None},
         "cost": counters | {"wall_time_s": wall},
@@ -255,6 +262,8 @@ def _dynamic(scene, model, raise_on_failure=True):
               [f"v:{n}" for n in an["output"]["nodes"]] + [f"a:{n}" for n in an["output"]["nodes"]] + \
               [f"penetration:{c}" for c in an["output"]["contacts"]] + \
               [f"force:{c}" for c in an["output"]["contacts"]] + \
+              [f"link_force:{l}" for l in an["output"]["links"]] + \
+              [f"elongation:{l}" for l in an["output"]["links"]] + \
               [f"energy:{e}" for e in native.ENERGY_NAMES]
     from .measures import attach     # problem-specific measures (e.g. rod impact, P4)
     attach(scene, summary, (columns, hist))
@@ -289,6 +298,10 @@ def _static(scene, model):
                  "wall_time_s": wall},
         "provenance": provenance(scene),
     }
+
+
+def _finite_or_none(x):
+    return float(x) if np.isfinite(x) else None
 
 
 def write_results(summary, outdir, history=None):

@@ -125,7 +125,7 @@ ANALYSIS_TYPES = {
                 "output": ("table", False, None, None)},
 }
 OUTPUT_KEYS = {"every": ("int", False, POSITIVE, 1), "nodes": ("list", False, None, None),
-               "contacts": ("list", False, None, None)}
+               "contacts": ("list", False, None, None), "links": ("list", False, None, [])}
 INTEGRATOR_KEYS = {"newmark": {"preset", "beta", "gamma"}, "hht": {"alpha"},
                    "generalized-alpha": {"rho_inf"}, "central-difference": {"check_stability"},
                    "moreau-jean": {"theta"}, "newmark-lagrange": set(),
@@ -394,7 +394,7 @@ def from_dict(data, source="<scene>", base_dir=Path("."), digest=None):
     analysis = _fields(src, an, "analysis", ANALYSIS_TYPES[atype], extra_ok=("type",))
     analysis["type"] = atype
     if atype == "dynamic":
-        _dynamic_analysis(src, an, analysis, index, contacts)
+        _dynamic_analysis(src, an, analysis, index, contacts, links)
     ground_k = _ground_stiffness(links)
     for i, lk in enumerate(links):
         if lk["type"] == "dashpot" and lk["zeta"] is not None:
@@ -480,7 +480,7 @@ def _expand_chains(src, data):
     return data
 
 
-def _dynamic_analysis(src, raw, an, index, contacts):
+def _dynamic_analysis(src, raw, an, index, contacts, links):
     integ = _choice(src, "analysis.integrator", an["integrator"], INTEGRATORS)
     implicit = IMPLICIT_KEYS if integ in ("newmark", "hht", "generalized-alpha", "newmark-lagrange") else set()
     allowed = INTEGRATOR_KEYS[integ] | implicit
@@ -530,6 +530,11 @@ def _dynamic_analysis(src, raw, an, index, contacts):
         if nm not in contact_names:
             raise SceneError(src, f"analysis.output.contacts[{i}]", f"names no contact {nm!r}",
                              "use contact names of this scene")
+    link_names = [l["name"] for l in links]
+    for i, nm in enumerate(out["links"]):
+        if nm not in link_names:
+            raise SceneError(src, f"analysis.output.links[{i}]", f"names no link {nm!r}",
+                             "use link names of this scene (links without a name are link<i>)")
     an["output"] = out
 
 
