@@ -27,15 +27,22 @@ def lookup(summary, path):
 
 
 def oracle_values(check, source="<scene>"):
-    fn = getattr(closed_forms, check["closed_form"], None)
-    if fn is None or not callable(fn):
-        raise SceneError(source, "check.closed_form", f"unknown closed form {check['closed_form']!r}",
-                         "name a function of martello.closed_forms")
+    import inspect
+    name = check["closed_form"]
+    fn = getattr(closed_forms, name, None)
+    if not (inspect.isfunction(fn) and fn.__module__ == closed_forms.__name__ and not name.startswith("_")):
+        raise SceneError(source, "check.closed_form", f"unknown closed form {name!r}",
+                         "name a public function of martello.closed_forms")
     try:
         result = fn(**check["params"])
-    except TypeError as exc:
-        raise SceneError(source, "check.params", str(exc), "match the closed form's parameters") from None
-    return result if isinstance(result, dict) else vars(result)
+    except (TypeError, ValueError) as exc:
+        raise SceneError(source, "check.params", f"{name}: {exc}", "match the closed form's parameters") from None
+    if isinstance(result, dict):
+        return result
+    if hasattr(result, "__dataclass_fields__"):
+        return vars(result)
+    raise SceneError(source, "check.closed_form", f"{name} returns a {type(result).__name__}, not named values",
+                     "use a closed form that returns a dataclass or dict (e.g. two_body_impact)")
 
 
 def digits(value, reference):
@@ -52,14 +59,14 @@ def verify(scene, summary):
     check = scene.check
     ref = oracle_values(check, scene.source)
     rows = []
-    for item in check["compare"]:
+    for i, item in enumerate(check["compare"]):
         if item["oracle"] not in ref:
-            raise SceneError(scene.source, "check.compare.oracle", f"{item['oracle']!r} is not an output of "
+            raise SceneError(scene.source, f"check.compare[{i}].oracle", f"{item['oracle']!r} is not an output of "
                              f"{check['closed_form']}", "valid: " + ", ".join(ref))
         try:
             value = float(lookup(summary, item["result"]))
         except KeyError:
-            raise SceneError(scene.source, "check.compare.result", f"{item['result']!r} is not in the summary",
+            raise SceneError(scene.source, f"check.compare[{i}].result", f"{item['result']!r} is not in the summary",
                              "use a dotted path such as nodes.<name>.u or contacts.<name>.force") from None
         reference = float(ref[item["oracle"]])
         rtol, atol = item.get("rtol") or 0.0, item.get("atol") or 0.0

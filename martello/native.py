@@ -106,16 +106,17 @@ def _f64(values, n=None):
     return a
 
 
-class Model:
-    """Owns one native model handle; free() (or a with-block) releases it."""
+class _Handle:
+    """A native handle with a lifecycle (create ... free) and a last message; the base of
+    Model and Run. free() (or a with-block) releases it."""
 
-    def __init__(self, n_nodes, max_links, max_contacts, max_forces, max_couplings=0):
+    _kind = ""   # "model" or "run": names the C functions martello_<kind>_free/_message
+
+    def _create(self, create, *args):
         self._h = _VOID_P()
-        st = lib().martello_model_create(n_nodes, max_links, max_contacts, max_forces,
-                                         max_couplings, ctypes.byref(self._h))
+        st = create(*args, ctypes.byref(self._h))
         if st < 0:
-            raise SolverError(st, status_name(st), "could not create the model")
-        self.n_nodes, self.n_contacts = n_nodes, 0
+            raise SolverError(st, status_name(st), f"could not create the {self._kind}")
 
     def __enter__(self):
         return self
@@ -128,7 +129,7 @@ class Model:
 
     def free(self):
         if getattr(self, "_h", None) and self._h.value:
-            lib().martello_model_free(ctypes.byref(self._h))
+            getattr(lib(), f"martello_{self._kind}_free")(ctypes.byref(self._h))
 
     @property
     def handle(self):
@@ -136,16 +137,28 @@ class Model:
 
     def message(self):
         buf = ctypes.create_string_buffer(1024)
-        lib().martello_model_message(self._h, buf, len(buf))
+        getattr(lib(), f"martello_{self._kind}_message")(self._h, buf, len(buf))
         return buf.value.decode(errors="replace")
 
     def check(self, status, what):
-        """Raise on a negative status; return the status (0 or a positive outcome)."""
+        """Raise on a negative status (DivergenceError for diverged or unstable runs);
+        return the status (0 or a positive outcome)."""
         if status < 0:
             cls = DivergenceError if status in (constant("MARTELLO_ERR_DIVERGED"),
                                                 constant("MARTELLO_ERR_UNSTABLE")) else SolverError
             raise cls(status, status_name(status), f"{what}: {self.message()}")
         return status
+
+
+class Model(_Handle):
+    """Owns one native model."""
+
+    _kind = "model"
+
+    def __init__(self, n_nodes, max_links, max_contacts, max_forces, max_couplings=0):
+        self._create(lib().martello_model_create, n_nodes, max_links, max_contacts, max_forces,
+                     max_couplings)
+        self.n_nodes, self.n_contacts = n_nodes, 0
 
     def set_node(self, i, mass, u0=0.0, v0=0.0, fixed=False):
         self.check(lib().martello_model_set_node(self._h, i, mass, u0, v0, int(fixed)),
@@ -207,39 +220,15 @@ ENERGY_NAMES = ("kinetic", "recoverable", "input", "damping", "plastic", "contac
 EVENT_NAMES = ("t_on", "t_off", "v_in", "v_out", "max_penetration", "max_force")
 
 
-class Run:
+class Run(_Handle):
     """One dynamic run: its integrator settings and, after execute(), its results."""
 
+    _kind = "run"
+
     def __init__(self):
-        self._h = _VOID_P()
-        st = lib().martello_run_create(ctypes.byref(self._h))
-        if st < 0:
-            raise SolverError(st, status_name(st), "could not create the run")
+        self._create(lib().martello_run_create)
 
-    def __enter__(self):
-        return self
-
-    def __exit__(self, *exc):
-        self.free()
-
-    def __del__(self):
-        self.free()
-
-    def free(self):
-        if getattr(self, "_h", None) and self._h.value:
-            lib().martello_run_free(ctypes.byref(self._h))
-
-    def message(self):
-        buf = ctypes.create_string_buffer(1024)
-        lib().martello_run_message(self._h, buf, len(buf))
-        return buf.value.decode(errors="replace")
-
-    def _check(self, st, what):
-        if st < 0:
-            cls = DivergenceError if st in (constant("MARTELLO_ERR_DIVERGED"),
-                                            constant("MARTELLO_ERR_UNSTABLE")) else SolverError
-            raise cls(st, status_name(st), f"{what}: {self.message()}")
-        return st
+    _check = _Handle.check
 
     def set_integrator(self, kind, par):
         self._check(lib().martello_run_set_integrator(

@@ -278,13 +278,23 @@ def _static(scene, model):
     for j, c in enumerate(scene.contacts):
         contacts[c["name"]] = {
             "scheme": c["scheme"], "force": float(r["force"][j]),
-            "lambda": float(-r["force"][j]),  # the seed's sign: λ < 0 in compression
+            "lambda": 0.0 - float(r["force"][j]),  # the seed's sign: λ < 0 in compression (no −0)
             "penetration": float(r["penetration"][j]), "active": bool(r["active"][j])}
+    warnings = [r["warning"]] if r["warning"] else []
+    ignored = [w for w, present in (
+        ("ground acceleration", scene.ground is not None),
+        ("dashpots and fluid dampers", any(l["type"] in ("dashpot", "fluid_damper") for l in scene.links)),
+        ("initial velocities", any(n["v0"] != 0 for n in scene.nodes)),
+        ("initial displacements of free nodes", any(n["u0"] != 0 and not n["fixed"] for n in scene.nodes)),
+        ("time dependence of nodal forces (evaluated at t = 0)",
+         any(f["function"]["type"] != "constant" for f in scene.forces))) if present]
+    if ignored:
+        warnings.append("static analysis ignores: " + ", ".join(ignored))
     return {
         "title": scene.title, "problem": scene.problem,
         "analysis": dict(scene.analysis),
         "status": r["status"],
-        "warnings": [r["warning"]] if r["warning"] else [],
+        "warnings": warnings,
         "nodes": {n["name"]: {"u": float(r["u"][i])} for i, n in enumerate(scene.nodes)},
         "contacts": contacts,
         "conditioning": {"rcond": r["rcond"],

@@ -56,6 +56,7 @@ LINK_TYPES = {
 SCHEMES = ("penalty", "lagrange", "augmented-lagrange", "restitution")
 LAWS = ("linear", "hertz", "kelvin", "hunt-crossley", "lankarani-nikravesh", "flores",
         "gonthier", "hertzdamp", "jankowski")
+FIXED_EXPONENT = {"linear": 1, "kelvin": 1, "hertzdamp": 1.5, "jankowski": 1.5}
 CONTACT_COMMON = {"name": ("str", True, None, None), "a": ("str", True, None, None),
                   "b": ("str", True, None, None), "gap": ("float", False, ANY, 0.0),
                   "scheme": ("str", True, None, None)}
@@ -258,6 +259,9 @@ def _function(src, tab, where, base_dir, allow_record):
     if kind == "record":
         p = Path(f["file"])
         f["file"] = str(p if p.is_absolute() else (base_dir / p))
+        if not Path(f["file"]).exists():
+            raise SceneError(src, f"{where}.file", f"{f['file']} does not exist",
+                             "paths are relative to the scene file's folder")
     return f
 
 
@@ -322,6 +326,11 @@ def from_dict(data, source="<scene>", base_dir=Path("."), digest=None):
                              f"use one of: {known}" + (", ground" if ground_ok else ""))
         return index[name]
 
+    for key in ("link", "contact", "mass_coupling"):
+        if key in data and not isinstance(data[key], list):
+            raise SceneError(src, key, "must be an array of tables", f"write [[{key}]]")
+    if "force" in data.get("loads", {}) and not isinstance(data["loads"]["force"], list):
+        raise SceneError(src, "loads.force", "must be an array of tables", "write [[loads.force]]")
     # links
     links = []
     for i, tab in enumerate(data.get("link", [])):
@@ -335,6 +344,8 @@ def from_dict(data, source="<scene>", base_dir=Path("."), digest=None):
         if lk["a"] == lk["b"]:
             raise SceneError(src, f"{where}.b", "connects a node to itself", "name two different nodes")
         lk["name"] = lk["name"] or f"link{i}"
+        if any(l["name"] == lk["name"] for l in links):
+            raise SceneError(src, f"{where}.name", f"duplicate name {lk['name']!r}", "names must be unique")
         if kind == "dashpot" and (lk["c"] is None) == (lk["zeta"] is None):
             raise SceneError(src, where, "needs exactly one of c or zeta",
                              "c = damping [N s/m], or zeta = damping ratio of a node-to-ground oscillator")
@@ -358,6 +369,16 @@ def from_dict(data, source="<scene>", base_dir=Path("."), digest=None):
             _choice(src, f"{where}.law", c["law"], LAWS)
             if c["clipped"] and c["law"] != "kelvin":
                 raise SceneError(src, f"{where}.clipped", "applies to law kelvin only", "remove it")
+            if c["exponent"] is not None and c["law"] in FIXED_EXPONENT:
+                raise SceneError(src, f"{where}.exponent", f"does not apply to law {c['law']}",
+                                 f"its exponent is fixed at {FIXED_EXPONENT[c['law']]}; remove it")
+            if c["law"] in ("linear", "hertz") and (c["damping"] is not None or c["restitution"] is not None):
+                key = "damping" if c["damping"] is not None else "restitution"
+                raise SceneError(src, f"{where}.{key}", f"law {c['law']} is elastic (e = 1)",
+                                 "remove it, or choose a damped law (kelvin, hunt-crossley, ...)")
+            if c["law"] in ("flores", "gonthier", "jankowski") and c["restitution"] == 0:
+                raise SceneError(src, f"{where}.restitution", f"law {c['law']} divides by e",
+                                 "give e > 0 (e = 0 is a plastic impact: use scheme restitution)")
             if c["damping"] is not None and c["restitution"] is not None:
                 raise SceneError(src, f"{where}.damping", "given together with restitution",
                                  "give one: damping directly, or restitution to derive it")
@@ -555,6 +576,8 @@ def _dashpot_from_zeta(src, i, lk, ground_k, nodes):
         raise SceneError(src, where, "applies to a dashpot between a node and ground",
                          "give c for a dashpot between two nodes")
     node = lk["a"] if lk["b"] == -1 else lk["b"]
+    if nodes[node]["fixed"]:
+        raise SceneError(src, where, "the node is fixed", "a damping ratio needs a free node")
     k = ground_k.get(node, 0.0)
     if k <= 0:
         raise SceneError(src, where, "the node has no spring to ground to define a frequency",
@@ -569,8 +592,9 @@ def _check_table(src, check):
     for i, item in enumerate(c["compare"]):
         _fields(src, item, f"check.compare[{i}]", {
             "result": ("str", True, None, None), "oracle": ("str", True, None, None),
-            "rtol": ("float", False, POSITIVE, None), "atol": ("float", False, POSITIVE, None),
+            "rtol": ("float", False, NONNEG, None), "atol": ("float", False, NONNEG, None),
             "why": ("str", True, None, None)})
         if "rtol" not in item and "atol" not in item:
-            raise SceneError(src, f"check.compare[{i}]", "needs rtol or atol", "state the tolerance and why")
+            raise SceneError(src, f"check.compare[{i}]", "needs rtol or atol",
+                             "state the tolerance and why (rtol = 0 and atol = 0 ask for exact equality)")
     return c

@@ -70,6 +70,20 @@ CASES = [
     ("sine window reversed", lambda d: d["loads"].update(ground_acceleration={
         "type": "sine", "amplitude": 1.0, "omega": 2.0, "t_start": 2.0, "t_end": 1.0}),
      "loads.ground_acceleration.t_end", "later than t_start"),
+    ("exponent on kelvin", lambda d: d["contact"][0].update(scheme="penalty", law="kelvin", stiffness=1e4,
+                                                            exponent=1.5), "contact[0].exponent", "fixed at 1"),
+    ("damping on linear", lambda d: d["contact"][0].update(scheme="penalty", law="linear", stiffness=1e4,
+                                                           damping=3.0), "contact[0].damping", "elastic"),
+    ("flores with e = 0", lambda d: d["contact"][0].update(scheme="penalty", law="flores", stiffness=1e4,
+                                                           restitution=0.0), "contact[0].restitution", "e > 0"),
+    ("link as a table", lambda d: d.update(link={"type": "spring", "a": "mass", "b": "ground", "k": 1.0}),
+     "link", "[[link]]"),
+    ("duplicate link name", lambda d: d["link"].append(dict(d["link"][0])), "link[1].name", "unique"),
+    ("zeta on a fixed node", lambda d: (d["node"].append({"name": "s", "mass": 0.0, "fixed": True}),
+                                        d["link"].append({"type": "dashpot", "a": "s", "b": "ground", "zeta": 0.05})),
+     "link[1].zeta", "free node"),
+    ("missing record", lambda d: d["loads"].update(ground_acceleration={"type": "record", "file": "no.at2"}),
+     "loads.ground_acceleration.file", "relative to the scene"),
     ("check without tolerance", lambda d: d.update(check={"closed_form": "x", "params": {}, "compare": [
         {"result": "nodes.mass.u", "oracle": "u", "why": "w"}]}), "check.compare[0]", "rtol or atol"),
 ]
@@ -115,3 +129,39 @@ def test_every_catalogue_scene_is_valid():
     assert files, "the catalogue must not be empty"
     for f in files:
         scene.load(f)
+
+
+@pytest.mark.parametrize("check,field,words", [
+    ({"closed_form": "field", "params": {}, "compare": []}, "check.closed_form", "public function"),
+    ({"closed_form": "math", "params": {}, "compare": []}, "check.closed_form", "public function"),
+    ({"closed_form": "linear_contact_time", "params": {"mstar": 1.0, "k": 1.0},
+      "compare": [{"result": "nodes.mass.u", "oracle": "u", "rtol": 1e-9, "why": "w"}]},
+     "check.closed_form", "named values"),
+    ({"closed_form": "mass_on_plane_static", "params": {"m": 1.0},
+      "compare": [{"result": "nodes.mass.u", "oracle": "u", "rtol": 1e-9, "why": "w"}]},
+     "check.params", "parameters"),
+    ({"closed_form": "mass_on_plane_static", "params": {"m": 1.0, "k": 100.0, "h": 0.05, "g": 9.81},
+      "compare": [{"result": "nodes.mass.u", "oracle": "nope", "rtol": 1e-9, "why": "w"}]},
+     "check.compare[0].oracle", "valid:"),
+    ({"closed_form": "mass_on_plane_static", "params": {"m": 1.0, "k": 100.0, "h": 0.05, "g": 9.81},
+      "compare": [{"result": "nodes.ball.u", "oracle": "u", "rtol": 1e-9, "why": "w"}]},
+     "check.compare[0].result", "dotted path"),
+])
+def test_check_table_errors_name_the_field(check, field, words):
+    from martello.check import verify
+    from martello.run import run
+    d = p1_dict()
+    d["check"] = check
+    s = scene.from_dict(d, source="chk.toml")
+    with pytest.raises(SceneError) as info:
+        verify(s, run(s))
+    assert info.value.field == field and words in str(info.value), str(info.value)
+
+
+def test_static_run_names_what_it_ignores():
+    from martello.run import run
+    d = p1_dict()
+    d["node"][0]["v0"] = 1.0
+    d["link"].append({"type": "dashpot", "a": "mass", "b": "ground", "c": 1.0})
+    w = run(scene.from_dict(d))["warnings"]
+    assert any("static analysis ignores: dashpots and fluid dampers, initial velocities" in x for x in w), w
