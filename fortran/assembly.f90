@@ -181,13 +181,21 @@ contains
                0.5_dp*(s%con_f(j) + s%con_f_trial(j))*(s%con_pen_trial(j) - s%con_pen(j))
          end do
       end if
-      s%link_f = s%link_f_trial
-      s%con_f = s%con_f_trial
-      s%con_pen = s%con_pen_trial
+      ! committed ← trial by swapping the arrays, not copying them (a chain step is
+      ! memory-bound); the stale trial arrays are rewritten by the next evaluation
+      call swap(s%link_f, s%link_f_trial)
+      call swap(s%con_f, s%con_f_trial)
+      s%con_pen = s%con_pen_trial      ! kept: the activation test below reads the trial
       s%con_on = s%con_pen_trial > 0.0_dp .and. s%is_penalty .and. .not. s%forced_off
       s%forced_off = .false.
-      s%con_vin = s%con_vin_trial
+      call swap(s%con_vin, s%con_vin_trial)
    end subroutine mech_commit
+
+   subroutine swap(x, y)
+      real(dp), allocatable, intent(inout) :: x(:), y(:)
+      real(dp), allocatable :: tmp(:)
+      call move_alloc(x, tmp); call move_alloc(y, x); call move_alloc(tmp, y)
+   end subroutine swap
 
    !> Gravity on M·1, nodal forces, and −M·1·ü_g (relative coordinates), at time t.
    subroutine external_forces(m, mass_row_sum, t, fext)

@@ -151,30 +151,21 @@ contains
    !> extremes of u, |v|, |a|, penetration and force, and the largest local maximum of u
    !> interpolated between the previous and this state by u + vτ + ½aτ², τ = −v/a (O(h²) in
    !> time where the step maxima are O(h)).
-   subroutine results_track(r, t, u, v, a, pen, force, link_f, link_du)
+   subroutine results_track(r, t, u, v, a, pen, force, link_f, link_du, u_prev, v_prev, a_prev)
       type(results_t), intent(inout) :: r
       real(dp), intent(in) :: t, u(:), v(:), a(:), pen(:), force(:)
       real(dp), intent(in), optional :: link_f(:), link_du(:)
+      !> the previous accepted state, if the caller keeps it (saves a copy per step)
+      real(dp), intent(in), optional :: u_prev(:), v_prev(:), a_prev(:)
       integer :: i
       real(dp) :: tau, up, h
       h = t - r%prev_t
-      associate (umax => r%u_max, umin => r%u_min, vmax => r%v_absmax, amax => r%a_absmax, &
-                 upk => r%u_peak, tpk => r%t_peak, un => r%prev_u, vn => r%prev_v, an => r%prev_a)
-         do i = 1, size(u)
-            umax(i) = max(umax(i), u(i)); umin(i) = min(umin(i), u(i))
-            vmax(i) = max(vmax(i), abs(v(i))); amax(i) = max(amax(i), abs(a(i)))
-            if (r%prev_t >= 0.0_dp .and. vn(i) > 0.0_dp .and. v(i) <= 0.0_dp) then
-               if (an(i) < 0.0_dp) then
-                  tau = min(-vn(i)/an(i), h)
-                  up = un(i) + vn(i)*tau + 0.5_dp*an(i)*tau*tau
-                  if (up > upk(i)) then
-                     upk(i) = up; tpk(i) = r%prev_t + tau
-                  end if
-               end if
-            end if
-         end do
-         un = u; vn = v; an = a
-      end associate
+      if (present(u_prev)) then
+         call peaks(u_prev, v_prev, a_prev)
+      else
+         call peaks(r%prev_u, r%prev_v, r%prev_a)
+         r%prev_u = u; r%prev_v = v; r%prev_a = a
+      end if
       r%prev_t = t
       do i = 1, size(pen)
          r%pen_max(i) = max(r%pen_max(i), pen(i))
@@ -187,5 +178,25 @@ contains
             if (.not. (r%link_du_absmax(i) >= abs(link_du(i)))) r%link_du_absmax(i) = abs(link_du(i))
          end do
       end if
+   contains
+      subroutine peaks(un, vn, an)
+         real(dp), intent(in) :: un(:), vn(:), an(:)
+         associate (umax => r%u_max, umin => r%u_min, vmax => r%v_absmax, amax => r%a_absmax, &
+                    upk => r%u_peak, tpk => r%t_peak)
+            do i = 1, size(u)
+               umax(i) = max(umax(i), u(i)); umin(i) = min(umin(i), u(i))
+               vmax(i) = max(vmax(i), abs(v(i))); amax(i) = max(amax(i), abs(a(i)))
+               if (r%prev_t >= 0.0_dp .and. vn(i) > 0.0_dp .and. v(i) <= 0.0_dp) then
+                  if (an(i) < 0.0_dp) then
+                     tau = min(-vn(i)/an(i), h)
+                     up = un(i) + vn(i)*tau + 0.5_dp*an(i)*tau*tau
+                     if (up > upk(i)) then
+                        upk(i) = up; tpk(i) = r%prev_t + tau
+                     end if
+                  end if
+               end if
+            end do
+         end associate
+      end subroutine peaks
    end subroutine results_track
 end module martello_results

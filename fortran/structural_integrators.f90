@@ -123,7 +123,9 @@ contains
       e0 = e_kin + e_links + e_cont
       w_ext = 0.0_dp; d_damp = 0.0_dp; d_links = 0.0_dp; d_contact = 0.0_dp; w_abs = 0.0_dp
       t = 0.0_dp
-      call results_track(r, t, u(1:n), v(1:n), a(1:n), ms%con_pen, ms%con_f, ms%link_f, ms%link_u)
+      un = u; vn = v; an = a
+      call results_track(r, t, u(1:n), v(1:n), a(1:n), ms%con_pen, ms%con_f, ms%link_f, ms%link_u, &
+                            un(1:n), vn(1:n), an(1:n))
       call record()
 
       do step = 1, nsteps
