@@ -258,3 +258,36 @@ def test_history_columns_and_decimation(tmp_path):
     assert header[:3] == ["t", "u:m1", "u:m2"] and "force:impact" in header
     data = np.loadtxt(tmp_path / "history.csv", delimiter=",", skiprows=1)
     assert data.shape[0] == 101 and data[1, 0] == pytest.approx(1e-5, rel=1e-12)
+
+
+# --- ground motion from records ---------------------------------------------------------------
+
+@pytest.mark.parametrize("name", ["peer_keyed_comma.AT2", "peer_fixed.AT2", "csv_g_header.csv"])
+def test_record_ground_motion_equals_the_same_table(name):
+    # A record drives the scene exactly as the table of its samples (in m/s², scaled) does:
+    # same native table function, so the two runs agree to round-off; the units of the file
+    # (g here) are converted by martello.records, checked independently in test_records.py.
+    from pathlib import Path
+    from martello.records import read_record
+    f = Path(__file__).parent / "data" / "records" / name
+    rec = read_record(f, scale=1.25)
+    base = sdof(1.0, 400.0, links=[{"type": "dashpot", "a": "m", "b": "ground", "zeta": 0.05}],
+                analysis=dynamic(dt=rec.t[-1] / 200, t_end=float(rec.t[-1])))
+    with_record = dict(base, loads={"ground_acceleration": {"type": "record", "file": str(f), "scale": 1.25}})
+    with_table = dict(base, loads={"ground_acceleration": {"type": "table", "t": list(rec.t),
+                                                          "values": list(rec.accel)}})
+    s1, h1 = execute(with_record)
+    s2, h2 = execute(with_table)
+    np.testing.assert_array_equal(h1["u:m"], h2["u:m"])
+    assert np.max(np.abs(h1["u:m"])) > 0
+    assert s1["energy"]["input"] != 0.0
+
+
+def test_bad_record_in_a_scene_names_the_file_and_line():
+    from pathlib import Path
+    from martello.errors import RecordError
+    f = Path(__file__).parent / "data" / "records" / "csv_nan.csv"
+    d = sdof(analysis=dynamic(dt=1e-3, t_end=0.1))
+    d["loads"] = {"ground_acceleration": {"type": "record", "file": str(f)}}
+    with pytest.raises(RecordError, match=r"csv_nan\.csv:\d+"):
+        execute(d)
