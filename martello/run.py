@@ -239,6 +239,11 @@ def _dynamic(scene, model, raise_on_failure=True):
             "phase_max_force": [float(x) for x in mine[:, 5]]}
         if len(closed):
             contacts[c["name"]]["contact_time"] = float(closed[0, 1] - closed[0, 0])  # first phase
+        if c["name"] in an["output"]["contacts"] and len(hist):
+            # the state at t_end: a persistent contact's multiplier (e.g. k h − m g after Zeno)
+            k = 1 + 3 * len(an["output"]["nodes"]) + an["output"]["contacts"].index(c["name"])
+            contacts[c["name"]]["penetration_final"] = float(hist[-1, k])
+            contacts[c["name"]]["force_final"] = float(hist[-1, k + len(an["output"]["contacts"])])
     scale = max(abs(energy["initial"]), abs(energy["input"]), 1e-300)
     energy.update(balance_max=extra["balance_max"], balance_relative=extra["balance_max"] / scale)
     summary = {
