@@ -13,6 +13,9 @@ int martello_model_topology(const martello_model *model, int *n, int *n_contacts
                             int *fixed, int *con_a, int *con_b, int *scheme, double *gap,
                             double *restitution, int *n_couplings);
 
+/* Initial displacements and velocities of every node (fixed nodes: u0, v = 0). */
+int martello_model_initial_state(const martello_model *model, double *u0, double *v0);
+
 int martello_eval_create(martello_model *model, martello_eval **ev);
 void martello_eval_free(martello_eval **ev);
 /* a = M^-1 (f_ext(t) - f_int(u, v)), zero on fixed nodes; penalty contacts included, link
@@ -21,6 +24,8 @@ int martello_eval_acceleration(martello_eval *ev, double t, const double *u, con
                                double *a);
 int martello_eval_forces(martello_eval *ev, double t, const double *u, const double *v,
                          double *fint, double *fext);
+/* The force of every penalty contact at the last evaluation (0 for other schemes). */
+int martello_eval_contact_forces(martello_eval *ev, double *force);
 /* x <- M^-1 x on the free nodes (0 on fixed ones). */
 int martello_eval_solve_mass(martello_eval *ev, double *x);
 int martello_eval_contacts(martello_eval *ev, const double *u, const double *v, double *pen,

@@ -15,6 +15,7 @@ module martello_api
    use martello_moreau_jean, only: run_moreau_jean
    use martello_newmark_lagrange, only: run_newmark_lagrange
    use martello_evaluator
+   use martello_stability, only: mass_positive_definite
    use martello_results
    implicit none
    private
@@ -383,6 +384,13 @@ contains
       call results_init(rp%results, mp%n, mp%ncontact, rp%out_nodes, rp%out_contacts, cap, &
                         mp%nlink, rp%out_links)
       call check_compatibility(mp, rp, stat)
+      if (stat == MARTELLO_OK .and. mp%ncoupling > 0) then
+         if (.not. mass_positive_definite(mp)) then
+            stat = MARTELLO_ERR_ARGUMENT
+            rp%results%message = 'the mass matrix (node masses plus mass couplings) is not'// &
+               ' positive definite: a coupling is larger than the masses it joins allow'
+         end if
+      end if
       if (stat == MARTELLO_OK) then
          select case (rp%settings%kind)
          case (INT_NEWMARK, INT_HHT, INT_GENERALIZED_ALPHA, INT_CENTRAL_DIFFERENCE)
@@ -466,6 +474,33 @@ contains
       end if
       c_model_topology = MARTELLO_OK
    end function c_model_topology
+
+   !> Initial displacements and velocities of the nodes (fixed nodes: u0, v = 0).
+   integer(c_int) function c_model_initial_state(handle, u0, v0) bind(C, name='martello_model_initial_state')
+      type(c_ptr), value :: handle
+      real(c_double), intent(out) :: u0(*), v0(*)
+      type(model_t), pointer :: mp
+      mp => get_model(handle)
+      c_model_initial_state = MARTELLO_ERR_ARGUMENT
+      if (.not. associated(mp)) return
+      u0(1:mp%n) = mp%u0
+      v0(1:mp%n) = merge(0.0_dp, mp%v0, mp%fixed)
+      c_model_initial_state = MARTELLO_OK
+   end function c_model_initial_state
+
+   !> The force of every penalty contact at the last evaluation (0 for other schemes).
+   integer(c_int) function c_eval_contact_forces(handle, force) bind(C, name='martello_eval_contact_forces')
+      type(c_ptr), value :: handle
+      real(c_double), intent(out) :: force(*)
+      type(evaluator_t), pointer :: ep
+      integer :: nc
+      ep => get_eval(handle)
+      c_eval_contact_forces = MARTELLO_ERR_ARGUMENT
+      if (.not. associated(ep)) return
+      nc = ep%m%ncontact
+      force(1:nc) = merge(ep%ms%con_f_trial(1:nc), 0.0_dp, ep%ms%is_penalty(1:nc))
+      c_eval_contact_forces = MARTELLO_OK
+   end function c_eval_contact_forces
 
    function get_eval(handle) result(ep)
       type(c_ptr), value :: handle

@@ -11,9 +11,16 @@ module martello_stability
    use martello_contact_laws, only: LAW_LINEAR, LAW_KELVIN, P_STIFF
    implicit none
    private
-   public :: omega_max
+   public :: omega_max, mass_positive_definite
 
    interface
+      subroutine dpbtrf(uplo, n, kd, ab, ldab, info)
+         import :: dp
+         character, intent(in) :: uplo
+         integer, intent(in) :: n, kd, ldab
+         real(dp), intent(inout) :: ab(ldab, *)
+         integer, intent(out) :: info
+      end subroutine dpbtrf
       subroutine dsbgvx(jobz, range, uplo, n, ka, kb, ab, ldab, bb, ldbb, q, ldq, vl, vu, il, &
                         iu, abstol, m, w, z, ldz, work, iwork, ifail, info)
          import :: dp
@@ -91,4 +98,33 @@ contains
          band(kd + 1 + r - c, c) = band(kd + 1 + r - c, c) + val
       end subroutine put
    end subroutine omega_max
+   !> Whether M (lumped diagonal plus consistent couplings) is positive definite on the free
+   !> nodes: banded Cholesky (dpbtrf) succeeds. Couplings from a scene can make it indefinite.
+   logical function mass_positive_definite(m) result(ok)
+      type(model_t), intent(in) :: m
+      integer :: kd, nf, i, j, info, ia, ib
+      integer, allocatable :: dof(:)
+      real(dp), allocatable :: mb(:, :)
+      kd = max(model_bandwidth(m), 0)
+      allocate (dof(0:m%n)); dof = 0; nf = 0
+      do i = 1, m%n
+         if (.not. m%fixed(i)) then
+            nf = nf + 1; dof(i) = nf
+         end if
+      end do
+      ok = .true.
+      if (nf == 0) return
+      allocate (mb(kd + 1, nf)); mb = 0.0_dp
+      do i = 1, m%n
+         if (dof(i) > 0) mb(kd + 1, dof(i)) = m%mass(i)
+      end do
+      do j = 1, m%ncoupling
+         ia = dof(m%mc_a(j)); ib = dof(m%mc_b(j))
+         if (ia == 0 .or. ib == 0) cycle
+         mb(kd + 1 + min(ia, ib) - max(ia, ib), max(ia, ib)) = &
+            mb(kd + 1 + min(ia, ib) - max(ia, ib), max(ia, ib)) + m%mc_value(j)
+      end do
+      call dpbtrf('U', nf, kd, mb, kd + 1, info)
+      ok = info == 0
+   end function mass_positive_definite
 end module martello_stability

@@ -13,12 +13,21 @@ DIGITS_CAP = 16.0   # a double carries ~15.95 digits; an exact match is reported
 
 
 def lookup(summary, path):
-    node = summary
-    for part in path.split("."):
-        if isinstance(node, list) and part.isdigit() and int(part) < len(node):
-            node = node[int(part)]
-        elif isinstance(node, dict) and part in node:
-            node = node[part]
+    """Follow a dotted path; names may contain dots themselves (chain links such as
+    b1.spring): at each level the longest key that the rest of the path starts with wins."""
+    node, rest = summary, path
+    while rest:
+        if isinstance(node, list):
+            head, _, tail = rest.partition(".")
+            if not (head.isdigit() and int(head) < len(node)):
+                raise KeyError(path)
+            node, rest = node[int(head)], tail
+        elif isinstance(node, dict):
+            keys = [k for k in node if rest == k or rest.startswith(k + ".")]
+            if not keys:
+                raise KeyError(path)
+            k = max(keys, key=len)
+            node, rest = node[k], rest[len(k) + 1:]
         else:
             raise KeyError(path)
     if node is None:

@@ -246,13 +246,17 @@ def _dynamic(scene, model, raise_on_failure=True):
             contacts[c["name"]]["force_final"] = float(hist[-1, k + len(an["output"]["contacts"])])
     scale = max(abs(energy["initial"]), abs(energy["input"]), 1e-300)
     energy.update(balance_max=extra["balance_max"], balance_relative=extra["balance_max"] / scale)
+    warnings = []
+    if st >= 0 and energy["balance_relative"] > 1e-2:
+        warnings.append(f"energy balance error {100 * energy['balance_relative']:.1f} % of the energy put in: "
+                        "the step is too large for this scene (the result is inaccurate)")
     summary = {
         "title": scene.title, "problem": scene.problem,
         "analysis": {k: v for k, v in an.items() if k != "output"} | {"output_every": an["output"]["every"]},
         "integrator": integrator_description(an),
         "status": native.status_name(st),
         "message": message,
-        "warnings": [],
+        "warnings": warnings,
         "t_reached": extra["t_reached"],
         "nodes": nodes, "contacts": contacts, "energy": energy,
         "links": {l["name"]: {"type": l["type"], "max_abs_force": _finite_or_none(link_f[i]),
