@@ -1,9 +1,1065 @@
-/* Event-driven integration on GSL odeiv2 (placeholder until the Nonsmooth issue lands it). */
+/* Event-driven integration of a scene on GSL odeiv2 (rkf45, rk8pd, msbdf); the method, the
+ * sign conventions and the choices made are in docs/event-driven.md.
+ *
+ *  - The state y = [u; v; W_ext; W_int] (n nodes; the two work integrals ride along outside
+ *    the error control) is advanced by gsl_odeiv2_evolve_apply one accepted step at a time,
+ *    stepping exactly onto the output times. Every accepted step commits the path-dependent
+ *    link states (martello_eval_commit) and feeds the peaks (martello_run_track).
+ *  - Events are roots located to event_tol in time by Illinois iterations on states
+ *    re-integrated from the start of the step (the stepper's own one-step method with a
+ *    shorter step; for msbdf, whose multistep history cannot restart there, an adaptive
+ *    A-stable rk4imp): the gap of a restitution/Lagrange contact closing (impact), the gap of
+ *    a penalty contact crossing 0 either way (no step straddles the kink of the law), and the
+ *    multiplier of a persistent contact turning tensile (release). A quintic Hermite
+ *    interpolant of the gap on the step (u, v, a at both ends) screens for an extremum that
+ *    crosses 0 inside one step (PROBLEMS.md P7, grazing contacts); the crossing is then
+ *    confirmed on re-integrated states.
+ *  - At an event the unilateral contacts touching within tolerance are resolved together by
+ *    Newton's law at the velocity level, 0 <= g'+ + e g'- _|_ P >= 0: an impulse LCP on the
+ *    Delassus matrix W = G M^-1 G^T (consistent mass through martello_eval_solve_mass),
+ *    momentum conserved. An accumulation of impacts (the predicted rest of the geometric
+ *    series of flight times, or the next flight's apex, below tolerance) makes the contact a
+ *    bilateral constraint whose multiplier is the contact force; an acceleration-level LCP
+ *    decides which contacts stay closed. */
+#include <float.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <gsl/gsl_errno.h>
+#include <gsl/gsl_odeiv2.h>
 #include "martello.h"
 #include "martello_internal.h"
+#include "event_driven_lcp.h"
+
+/* Slots of the result arrays (fortran/results.f90 E_*, C_*, EV_*, 0-based here). */
+enum { E_KINETIC, E_RECOVERABLE, E_INPUT, E_DAMPING, E_PLASTIC, E_CONTACT, E_BALANCE,
+       E_INITIAL, E_IMPACT };
+enum { C_STEPS, C_REJECTED, C_NEWTON, C_RESIDUALS, C_FACTORIZATIONS, C_EVENTS, C_JACOBIANS,
+       C_ROOT_EVALS, C_CHATTER };
+enum { EV_T_ON, EV_T_OFF, EV_V_IN, EV_V_OUT, EV_MAX_PEN, EV_MAX_FORCE };
+
+/* What a contact waits for. After an event the state is the far end of the final bracket
+ * (within event_tol of the root), so the status committed there is the new one. */
+enum { ROOT_IMPACT,      /* unilateral gap closing: delta >= 0                     */
+       ROOT_ONSET,       /* penalty gap: delta > 0 (the law's force starts)         */
+       ROOT_SEPARATION,  /* penalty gap: delta <= 0                                */
+       ROOT_PEAK,        /* penalty contact at its deepest: delta' <= 0 (no change of
+                            state; the step ends there so the peak force and
+                            penetration are observed, not interpolated)             */
+       ROOT_RELEASE };   /* persistent contact: multiplier P below -tolerance       */
+
+/* Accumulation (Zeno), docs/event-driven.md: a contact is held once the next flight would
+ * rise less than ZENO_FACTOR integration tolerances off the contact, or the predicted rest
+ * of its flight times is below ZENO_FACTOR event tolerances. */
+#define ZENO_FACTOR 1.0e3
+/* events without time advancing before the run is declared stuck */
+#define MAX_EVENTS_AT_ONCE 1000
+
+typedef struct {
+  martello_model *model;
+  martello_run *run;
+  martello_eval *ev;
+  int kind, n, nc, nu;            /* integrator; nodes, contacts, unilateral contacts */
+  size_t dim;                     /* 2n + 2 */
+  double t_end, dt_out, rtol, atol, event_tol, h_max;
+  int every;
+  /* topology */
+  double *mass, *gap, *e;
+  int *fixed, *con_a, *con_b, *scheme, *is_pen, *uni, *inert;
+  double *Cm;                     /* M^-1 G_j^T of unilateral contact j: column uni[j] */
+  /* ODE */
+  gsl_odeiv2_system sys;
+  gsl_odeiv2_driver *drv;         /* the main stepper with its control and evolve */
+  gsl_odeiv2_step *rstep;         /* rkf45, rk8pd: one step from the step start */
+  gsl_odeiv2_driver *rdrv;        /* msbdf: adaptive rk4imp from the step start */
+  double *scale_abs;
+  double *y, *y0, *yb, *ybest, *yc, *yerr, *fstart, *f, *f1, *fj, *yj, *fint, *fext;
+  /* contact kinematics at the step start (0), the step end (1) and the current state */
+  double *pen0, *rate0, *acc0, *pen1, *rate1, *acc1, *pen, *rate, *force;
+  double *lam, *lam0, *lam1, *lamtol;
+  /* persistent (held) contacts: the list and W_H factored */
+  int nh, *hlist, *held;
+  double *Wh, *rh;
+  /* LCPs */
+  martello_lcp *lcp;
+  int *ilist;
+  double *Wl, *ql, *pl, *wl, *sl;
+  /* contact phases: a penalty contact in contact, a persistent unilateral contact */
+  int *ph_open;
+  double *ph_t, *ph_v, *ph_pen, *ph_f, *t_hold;
+  /* results */
+  long long cnt[MARTELLO_NCOUNTERS];
+  double e_initial, e_rec0, e_impact, balance_max, energy[MARTELLO_NENERGY];
+  int rhs_status;                 /* why the RHS stopped GSL */
+  char msg[512];
+} ed_t;
+
+/* ---- helpers --------------------------------------------------------------------------- */
+
+static int fail(ed_t *w, int status, double t, const char *what) {
+  snprintf(w->msg, sizeof w->msg, "%s (t = %.9e s)", what, t);
+  martello_run_set_message(w->run, w->msg);
+  return status;
+}
+
+static int fail_eval(ed_t *w, int status, double t) {
+  const char *why = status == MARTELLO_ERR_SINGULAR
+                        ? "event-driven: the mass matrix is singular on the free nodes"
+                    : status == MARTELLO_ERR_DIVERGED
+                        ? "event-driven: diverged, non-finite accelerations or work (NaN/inf)"
+                        : "event-driven: the force evaluation failed";
+  return fail(w, status, t, why);
+}
+
+/* G_j x = x_a - x_b (ground: x = 0). */
+static double gdot(const ed_t *w, int j, const double *x) {
+  double s = 0.0;
+  if (w->con_a[j] >= 0) s += x[w->con_a[j]];
+  if (w->con_b[j] >= 0) s -= x[w->con_b[j]];
+  return s;
+}
+
+static const double *ccol(const ed_t *w, int j) { return w->Cm + (size_t)w->uni[j] * w->n; }
+
+/* W_jk = G_j M^-1 G_k^T */
+static double delassus(const ed_t *w, int j, int k) { return gdot(w, j, ccol(w, k)); }
+
+static int all_finite(const double *x, size_t n) {
+  size_t i;
+  for (i = 0; i < n; i++)
+    if (!isfinite(x[i])) return 0;
+  return 1;
+}
+
+/* |x_a| + |x_b|: the magnitude from which G_j x is computed. */
+static double node_sum(const ed_t *w, int j, const double *x) {
+  double s = 0.0;
+  if (w->con_a[j] >= 0) s += fabs(x[w->con_a[j]]);
+  if (w->con_b[j] >= 0) s += fabs(x[w->con_b[j]]);
+  return s;
+}
+
+/* |u_a| + |u_b| + |gap|: the magnitude from which the gap is computed. */
+static double gap_scale(const ed_t *w, int j, const double *u) {
+  return node_sum(w, j, u) + fabs(w->gap[j]);
+}
+
+/* A unilateral contact within this of a zero gap touches: the rounding of the gap plus the
+ * absolute integration tolerance. */
+static double gap_tol(const ed_t *w, int j, const double *u) {
+  return 16.0 * DBL_EPSILON * gap_scale(w, j, u) + w->atol;
+}
+
+/* ---- the right-hand side --------------------------------------------------------------- */
+
+/* a -= M^-1 G_H^T P_H with W_H P_H = G_H a: accelerations with the held contacts as
+ * bilateral constraints; P (compression > 0) is the multiplier. */
+static void constrain(ed_t *w, double *a) {
+  int k, i;
+  for (k = 0; k < w->nh; k++) w->rh[k] = gdot(w, w->hlist[k], a);
+  martello_chol_solve(w->nh, w->Wh, w->rh);
+  for (k = 0; k < w->nh; k++) {
+    const double *c = ccol(w, w->hlist[k]);
+    for (i = 0; i < w->n; i++) a[i] -= w->rh[k] * c[i];
+    w->lam[w->hlist[k]] = w->rh[k];
+  }
+}
+
+/* y' = [v; a; f_ext.v; f_int.v]. GSL_EBADFUNC stops GSL; the reason is in w->rhs_status. */
+static int ed_rhs(double t, const double y[], double dydt[], void *params) {
+  ed_t *w = params;
+  const int n = w->n;
+  const double *u = y, *v = y + n;
+  double *a = dydt + n, pe = 0.0, pi = 0.0;
+  int i, st;
+  w->cnt[C_RESIDUALS]++;
+  st = martello_eval_forces(w->ev, t, u, v, w->fint, w->fext);
+  if (st == MARTELLO_OK) {
+    for (i = 0; i < n; i++) a[i] = w->fext[i] - w->fint[i];
+    st = martello_eval_solve_mass(w->ev, a);
+  }
+  if (st != MARTELLO_OK) {
+    w->rhs_status = st;
+    return GSL_EBADFUNC;
+  }
+  if (w->nh > 0) constrain(w, a);
+  for (i = 0; i < n; i++) {
+    dydt[i] = w->fixed[i] ? 0.0 : v[i];
+    if (!w->fixed[i]) {
+      pe += w->fext[i] * v[i];
+      pi += w->fint[i] * v[i];
+    }
+  }
+  dydt[2 * n] = pe;
+  dydt[2 * n + 1] = pi;
+  if (!all_finite(dydt, w->dim)) {
+    w->rhs_status = MARTELLO_ERR_DIVERGED;
+    return GSL_EBADFUNC;
+  }
+  return GSL_SUCCESS;
+}
+
+/* Jacobian for msbdf and rk4imp: forward differences of the RHS, dense, row-major
+ * dfdy[i*dim + j] (GSL's layout); 2n + 2 RHS evaluations; u' = v is set exactly. */
+static int ed_jacobian(double t, const double y[], double *dfdy, double dfdt[], void *params) {
+  ed_t *w = params;
+  const size_t n = (size_t)w->n, dim = w->dim;
+  const double sq = sqrt(DBL_EPSILON);
+  double umax = 0.0, vmax = 0.0, ht;
+  size_t i, j;
+  w->cnt[C_JACOBIANS]++;
+  if (ed_rhs(t, y, w->fj, w) != GSL_SUCCESS) return GSL_EBADFUNC;
+  for (i = 0; i < n; i++) {
+    umax = fmax(umax, fabs(y[i]));
+    vmax = fmax(vmax, fabs(y[n + i]));
+  }
+  memset(dfdy, 0, dim * dim * sizeof *dfdy);
+  memcpy(w->yj, y, dim * sizeof *y);
+  for (j = 0; j < 2 * n; j++) {
+    double step, hh;
+    if (w->fixed[j % n]) continue;
+    step = sq * fmax(fmax(fabs(y[j]), 1e-3 * (j < n ? umax : vmax)), w->atol);
+    w->yj[j] = y[j] + step;
+    hh = w->yj[j] - y[j];
+    if (ed_rhs(t, w->yj, w->f1, w) != GSL_SUCCESS) return GSL_EBADFUNC;
+    w->yj[j] = y[j];
+    for (i = n; i < dim; i++) dfdy[i * dim + j] = (w->f1[i] - w->fj[i]) / hh;
+  }
+  for (i = 0; i < n; i++)
+    if (!w->fixed[i]) dfdy[i * dim + n + i] = 1.0;
+  ht = sq * fmax(fabs(t), w->dt_out);
+  if (ed_rhs(t + ht, y, w->f1, w) != GSL_SUCCESS) return GSL_EBADFUNC;
+  for (i = 0; i < dim; i++) dfdt[i] = (w->f1[i] - w->fj[i]) / ht;
+  return GSL_SUCCESS;
+}
+
+/* The RHS at (t, y) into f, the multipliers of the held contacts into lam (0 elsewhere). */
+static int eval_point(ed_t *w, double t, const double *y, double *f, double *lam) {
+  if (ed_rhs(t, y, f, w) != GSL_SUCCESS) return w->rhs_status;
+  if (lam) {
+    int k;
+    for (k = 0; k < w->nc; k++) lam[k] = 0.0;
+    for (k = 0; k < w->nh; k++) lam[w->hlist[k]] = w->lam[w->hlist[k]];
+  }
+  return MARTELLO_OK;
+}
+
+/* Gap, rate and (with a) second derivative of every contact. */
+static void kinematics(const ed_t *w, const double *y, const double *a, double *pen, double *rate,
+                       double *acc) {
+  int j;
+  for (j = 0; j < w->nc; j++) {
+    pen[j] = gdot(w, j, y) - w->gap[j];
+    rate[j] = gdot(w, j, y + w->n);
+    if (acc) acc[j] = gdot(w, j, a);
+  }
+}
+
+static void add_event(ed_t *w, int j, double t_on, double t_off, double v_in, double v_out,
+                      double pen, double force) {
+  double vals[MARTELLO_NEVENT];
+  vals[EV_T_ON] = t_on; vals[EV_T_OFF] = t_off; vals[EV_V_IN] = v_in; vals[EV_V_OUT] = v_out;
+  vals[EV_MAX_PEN] = pen; vals[EV_MAX_FORCE] = force;
+  martello_run_add_event(w->run, j, vals);
+}
+
+/* ---- persistent contacts --------------------------------------------------------------- */
+
+static int factor_held(ed_t *w, double t) {
+  int k, l;
+  for (k = 0; k < w->nh; k++)
+    for (l = 0; l < w->nh; l++) w->Wh[k * w->nh + l] = delassus(w, w->hlist[k], w->hlist[l]);
+  w->cnt[C_FACTORIZATIONS]++;
+  if (martello_chol_factor(w->nh, w->Wh) != MARTELLO_OK)
+    return fail(w, MARTELLO_ERR_SINGULAR, t,
+                "event-driven: the persistent contacts are redundant (singular Delassus matrix "
+                "G M^-1 G^T)");
+  return MARTELLO_OK;
+}
+
+/* Which of the contacts in list[0..m) (all at zero gap and zero gap rate) stay closed: the
+ * acceleration-level law 0 <= -g'' _|_ P >= 0, i.e. the LCP  W P - G a_free >= 0 _|_ P >= 0.
+ * Contacts leaving the held set close their phase at t; entering ones open one that starts
+ * at their predicted accumulation time t_hold. */
+static int update_held(ed_t *w, double t, const int *list, int m) {
+  int k, l, st, piv, nh_old = w->nh;
+  w->nh = 0;
+  st = eval_point(w, t, w->y, w->f, NULL);   /* free accelerations */
+  w->nh = nh_old;
+  if (st != MARTELLO_OK) return fail_eval(w, st, t);
+  for (k = 0; k < m; k++) {
+    for (l = 0; l < m; l++) w->Wl[k * m + l] = delassus(w, list[k], list[l]);
+    w->ql[k] = -gdot(w, list[k], w->f + w->n);
+  }
+  st = martello_lcp_solve(w->lcp, m, w->Wl, w->ql, w->pl, w->wl, &piv);
+  w->cnt[C_FACTORIZATIONS] += piv + 1;
+  if (st != MARTELLO_OK)
+    return fail(w, st, t, st == MARTELLO_ERR_SINGULAR
+                ? "event-driven: contacts held together are redundant (singular Delassus matrix)"
+                : "event-driven: the contact-force LCP did not converge");
+  for (k = 0; k < w->nc; k++) w->sl[k] = 0.0;
+  for (k = 0; k < m; k++) w->sl[list[k]] = w->pl[k];
+  for (k = 0; k < w->nh; k++) {
+    int j = w->hlist[k];
+    if (w->sl[j] > 0.0) continue;
+    add_event(w, j, w->ph_t[j], t, w->ph_v[j], gdot(w, j, w->y + w->n), w->ph_pen[j], w->ph_f[j]);
+    w->ph_open[j] = 0;
+    w->held[j] = 0;
+    w->cnt[C_EVENTS]++;
+  }
+  w->nh = 0;
+  for (k = 0; k < w->nc; k++) {
+    if (!(w->sl[k] > 0.0)) continue;
+    w->hlist[w->nh++] = k;
+    if (!w->held[k]) {
+      int a = w->con_a[k], b = w->con_b[k];
+      double fs = 0.0;
+      if (a >= 0) fs += fabs(w->fext[a]) + fabs(w->fint[a]);
+      if (b >= 0) fs += fabs(w->fext[b]) + fabs(w->fint[b]);
+      w->held[k] = 1;
+      w->ph_open[k] = 1;
+      w->ph_t[k] = w->t_hold[k]; w->ph_v[k] = 0.0; w->ph_pen[k] = 0.0; w->ph_f[k] = 0.0;
+      /* a release needs a tension beyond the rounding of the forces at the contact */
+      w->lamtol[k] = 1e3 * DBL_EPSILON * fmax(fs, w->sl[k]);
+      w->cnt[C_EVENTS]++;
+    }
+  }
+  return factor_held(w, t);
+}
+
+/* Put the contacts in list on gap = 0 and gap rate = 0 by the mass-weighted projection
+ * x -= M^-1 G^T (G M^-1 G^T)^-1 (G x - b); the kinetic energy removed (what the remaining
+ * micro-impacts of an accumulation would dissipate) goes to E_IMPACT. */
+static int project(ed_t *w, double t, const int *list, int m) {
+  int k, l, i;
+  double *u = w->y, *v = w->y + w->n, de = 0.0;
+  for (k = 0; k < m; k++)
+    for (l = 0; l < m; l++) w->Wl[k * m + l] = delassus(w, list[k], list[l]);
+  w->cnt[C_FACTORIZATIONS]++;
+  if (martello_chol_factor(m, w->Wl) != MARTELLO_OK)
+    return fail(w, MARTELLO_ERR_SINGULAR, t,
+                "event-driven: contacts held together are redundant (singular Delassus matrix)");
+  for (k = 0; k < m; k++) w->ql[k] = w->pl[k] = gdot(w, list[k], v);
+  martello_chol_solve(m, w->Wl, w->pl);
+  for (k = 0; k < m; k++) de += 0.5 * w->pl[k] * w->ql[k];   /* 1/2 P (g'- + g'+), g'+ = 0 */
+  for (k = 0; k < m; k++) {
+    const double *c = ccol(w, list[k]);
+    for (i = 0; i < w->n; i++) v[i] -= w->pl[k] * c[i];
+  }
+  for (k = 0; k < m; k++) w->pl[k] = gdot(w, list[k], u) - w->gap[list[k]];
+  martello_chol_solve(m, w->Wl, w->pl);
+  for (k = 0; k < m; k++) {
+    const double *c = ccol(w, list[k]);
+    for (i = 0; i < w->n; i++) u[i] -= w->pl[k] * c[i];
+  }
+  w->e_impact += de;
+  return MARTELLO_OK;
+}
+
+/* ---- impacts and accumulations ---------------------------------------------------------- */
+
+/* Newton's law on the touching unilateral contacts: the impulse LCP W P + q >= 0 _|_ P >= 0
+ * with q_j = -(g'-_j + e_j max(g'-_j, 0)) (a contact already separating may not be pulled
+ * closed), then v+ = v- - M^-1 G^T P. Impacts on free contacts are events. */
+static int impacts(ed_t *w, double t, int *n_impacts) {
+  int j, k, m = 0, st, piv, approaching = 0;
+  double *u = w->y, *v = w->y + w->n;
+  *n_impacts = 0;
+  for (j = 0; j < w->nc; j++) {
+    double d, r;
+    if (w->is_pen[j] || w->inert[j]) continue;
+    d = gdot(w, j, u) - w->gap[j];
+    r = gdot(w, j, v);
+    if (!w->held[j] && d < -(gap_tol(w, j, u) + w->event_tol * fmax(r, 0.0))) continue;
+    w->ilist[m] = j;
+    w->sl[m] = r;
+    w->ql[m] = -(r + (w->held[j] ? 0.0 : w->e[j]) * fmax(r, 0.0));
+    /* an approach beyond the rounding of v_a - v_b calls for impulses (a contact released
+     * with zero relative speed is not an impact) */
+    if (r > 64.0 * DBL_EPSILON * node_sum(w, j, v)) approaching = 1;
+    m++;
+  }
+  if (!approaching) return MARTELLO_OK;
+  for (k = 0; k < m; k++)
+    for (j = 0; j < m; j++) w->Wl[k * m + j] = delassus(w, w->ilist[k], w->ilist[j]);
+  st = martello_lcp_solve(w->lcp, m, w->Wl, w->ql, w->pl, w->wl, &piv);
+  w->cnt[C_FACTORIZATIONS] += piv + 1;
+  if (st != MARTELLO_OK)
+    return fail(w, st, t, st == MARTELLO_ERR_SINGULAR
+                ? "event-driven: simultaneous impacts on redundant contacts (singular Delassus "
+                  "matrix)"
+                : "event-driven: the impact LCP did not converge");
+  for (k = 0; k < m; k++) {
+    const double *c = ccol(w, w->ilist[k]);
+    int i;
+    if (w->pl[k] == 0.0) continue;
+    for (i = 0; i < w->n; i++) v[i] -= w->pl[k] * c[i];
+  }
+  for (k = 0; k < m; k++) {
+    int jj = w->ilist[k];
+    double r_after;
+    if (w->pl[k] == 0.0) continue;
+    r_after = gdot(w, jj, v);
+    /* kinetic energy lost, 1/2 (v- + v+)^T G^T P: exact to rounding, no cancellation */
+    w->e_impact += 0.5 * w->pl[k] * (w->sl[k] + r_after);
+    if (w->held[jj]) continue;   /* a persistent contact takes its share without an event */
+    add_event(w, jj, t, t, w->sl[k], r_after, fmax(gdot(w, jj, u) - w->gap[jj], 0.0), w->pl[k]);
+    w->cnt[C_EVENTS]++;
+    (*n_impacts)++;
+  }
+  return MARTELLO_OK;
+}
+
+/* Would contact j, leaving with separation speed s while g'' > 0 presses it, only make
+ * flights below resolution? The next apex is s^2/(2 g''); the flights that follow sum to
+ * 2 s/(g''(1 - e)) (the free-fall series); *tail receives that sum (0 if e = 1). */
+static int accumulates(const ed_t *w, int j, double s, double acc, double *tail) {
+  const double apex_tol = ZENO_FACTOR * (w->atol + w->rtol * gap_scale(w, j, w->y));
+  *tail = 0.0;
+  if (s == 0.0) return 1;
+  if (!(acc > 0.0)) return 0;
+  if (w->e[j] < 1.0) *tail = 2.0 * s / (acc * (1.0 - w->e[j]));
+  return s * s / (2.0 * acc) <= apex_tol || (w->e[j] < 1.0 && *tail <= ZENO_FACTOR * w->event_tol);
+}
+
+/* After the impacts: touching contacts whose micro-impacts accumulate (or that touch at rest
+ * while pressed) join the held set; held contacts that an impulse set flying leave it. */
+static int accumulations(ed_t *w, double t, int *changed) {
+  int j, k, m = 0, st;
+  double *u = w->y, *v = w->y + w->n, tail;
+  *changed = 0;
+  st = eval_point(w, t, w->y, w->f, w->lam1);
+  if (st != MARTELLO_OK) return fail_eval(w, st, t);
+  for (j = 0; j < w->nc; j++) {
+    double s, acc;
+    if (w->is_pen[j] || w->inert[j]) continue;
+    s = fmax(-gdot(w, j, v), 0.0);
+    if (w->held[j]) {
+      /* the free system presses a held contact with (W P)_j */
+      for (acc = 0.0, k = 0; k < w->nh; k++)
+        acc += delassus(w, j, w->hlist[k]) * w->lam1[w->hlist[k]];
+      if (accumulates(w, j, s, acc, &tail)) {
+        w->ilist[m++] = j;
+      } else {
+        *changed = 1;
+      }
+      continue;
+    }
+    if (gdot(w, j, u) - w->gap[j] < -gap_tol(w, j, u)) continue;
+    acc = gdot(w, j, w->f + w->n);
+    if (!(acc > 0.0) || !accumulates(w, j, s, acc, &tail)) continue;
+    w->t_hold[j] = t + tail;
+    w->ilist[m++] = j;
+    *changed = 1;
+  }
+  if (!*changed) return MARTELLO_OK;
+  if (m > 0) {
+    st = project(w, t, w->ilist, m);
+    if (st != MARTELLO_OK) return st;
+  }
+  return update_held(w, t, w->ilist, m);
+}
+
+/* Everything that happens at time t with the state w->y: penalty phases opening or
+ * closing, persistent contacts released, impacts, accumulations. */
+static int process_events(ed_t *w, double t) {
+  int j, st, ni, changed;
+  st = eval_point(w, t, w->y, w->f, w->lam1);
+  if (st != MARTELLO_OK) return fail_eval(w, st, t);
+  kinematics(w, w->y, w->f + w->n, w->pen, w->rate, NULL);
+  for (j = 0; j < w->nc; j++) {
+    if (!w->is_pen[j] || w->inert[j]) continue;
+    if (w->pen[j] > 0.0 && !w->ph_open[j]) {
+      w->ph_open[j] = 1; w->ph_t[j] = t; w->ph_v[j] = w->rate[j];
+      w->ph_pen[j] = w->pen[j]; w->ph_f[j] = 0.0;
+      w->cnt[C_EVENTS]++;
+    } else if (!(w->pen[j] > 0.0) && w->ph_open[j]) {
+      add_event(w, j, w->ph_t[j], t, w->ph_v[j], w->rate[j], w->ph_pen[j], w->ph_f[j]);
+      w->ph_open[j] = 0;
+      w->cnt[C_EVENTS]++;
+    }
+  }
+  for (j = 0; j < w->nh; j++)
+    if (w->lam1[w->hlist[j]] < -w->lamtol[w->hlist[j]]) break;
+  if (j < w->nh) {   /* a persistent contact turned tensile: decide the held set again */
+    int m = w->nh;
+    memcpy(w->ilist, w->hlist, (size_t)m * sizeof *w->ilist);
+    st = update_held(w, t, w->ilist, m);
+    if (st != MARTELLO_OK) return st;
+  }
+  st = impacts(w, t, &ni);
+  if (st != MARTELLO_OK) return st;
+  return accumulations(w, t, &changed);
+}
+
+/* ---- event location -------------------------------------------------------------------- */
+
+/* y(t0 + tau) from the step start w->y0 into yout: the stepper's one-step method with the
+ * shorter step (rkf45, rk8pd: tau = h reproduces the accepted step), or for msbdf an
+ * adaptive rk4imp run. */
+static int reintegrate(ed_t *w, double t0, double tau, double *yout) {
+  int st = GSL_SUCCESS;
+  memcpy(yout, w->y0, w->dim * sizeof *yout);
+  if (tau <= 0.0) return MARTELLO_OK;
+  if (w->rstep != NULL) {
+    st = gsl_odeiv2_step_apply(w->rstep, t0, tau, yout, w->yerr, w->fstart, NULL, &w->sys);
+  } else {
+    double t = t0;
+    gsl_odeiv2_driver_reset_hstart(w->rdrv, tau);
+    st = gsl_odeiv2_driver_apply(w->rdrv, &t, t0 + tau, yout);
+  }
+  if (st == GSL_EBADFUNC) return fail_eval(w, w->rhs_status, t0 + tau);
+  if (st != GSL_SUCCESS) {
+    snprintf(w->msg, sizeof w->msg,
+             "event-driven: re-integration for event location failed at t = %.9e s: "
+             "gsl: %s (status %d)", t0 + tau, gsl_strerror(st), st);
+    martello_run_set_message(w->run, w->msg);
+    return MARTELLO_ERR_EXTERNAL;
+  }
+  return MARTELLO_OK;
+}
+
+/* The root function of contact j on a state: its sign says on which side of the event the
+ * state lies; see after(). Gap types also give their rate in the same sign convention. */
+static int root_value(ed_t *w, int j, int type, double t, const double *y, double *g,
+                      double *rate) {
+  const double sgn = type == ROOT_SEPARATION ? -1.0 : 1.0;
+  w->cnt[C_ROOT_EVALS]++;
+  if (type == ROOT_RELEASE) {
+    int st = eval_point(w, t, y, w->f1, NULL);
+    if (st != MARTELLO_OK) return fail_eval(w, st, t);
+    *g = -(w->lam[j] + w->lamtol[j]);
+    if (rate) *rate = 0.0;
+    return MARTELLO_OK;
+  }
+  if (type == ROOT_PEAK) {
+    *g = -gdot(w, j, y + w->n);
+    if (rate) *rate = 0.0;
+    return MARTELLO_OK;
+  }
+  *g = sgn * (gdot(w, j, y) - w->gap[j]);
+  if (rate) *rate = sgn * gdot(w, j, y + w->n);
+  return MARTELLO_OK;
+}
+
+static int after(int type, double g) {
+  return (type == ROOT_ONSET || type == ROOT_RELEASE) ? g > 0.0 : g >= 0.0;
+}
+
+/* Shrink the bracket [ta, tb] (before/after the event) to event_tol by Illinois iterations,
+ * bisecting when three iterations have not halved it. yb holds the state at tb throughout. */
+static int illinois(ed_t *w, int j, int type, double t0, double ta, double ga, double *tb,
+                    double gb, double *yb) {
+  int side = 0, it, stall = 0, st;
+  double width = *tb - ta;
+  for (it = 0; it < 300 && *tb - ta > w->event_tol; it++) {
+    double tm, gm;
+    tm = (stall >= 3 || !(gb - ga > 0.0)) ? 0.5 * (ta + *tb) : *tb - gb * (*tb - ta) / (gb - ga);
+    tm = fmin(fmax(tm, ta + 0.25 * w->event_tol), *tb - 0.25 * w->event_tol);
+    st = reintegrate(w, t0, tm - t0, w->yc);
+    if (st != MARTELLO_OK) return st;
+    st = root_value(w, j, type, tm, w->yc, &gm, NULL);
+    if (st != MARTELLO_OK) return st;
+    if (after(type, gm)) {
+      *tb = tm; gb = gm;
+      memcpy(yb, w->yc, w->dim * sizeof *yb);
+      if (side == 1) ga *= 0.5;
+      side = 1;
+    } else {
+      ta = tm; ga = gm;
+      if (side == -1) gb *= 0.5;
+      side = -1;
+    }
+    if (*tb - ta <= 0.5 * width) {
+      width = *tb - ta;
+      stall = 0;
+    } else {
+      stall++;
+    }
+  }
+  return MARTELLO_OK;
+}
+
+/* Quintic Hermite interpolant of a scalar on a step of length h in theta in [0, 1] (value,
+ * rate, second derivative at both ends), and the cubic one (value and rate). */
+typedef struct { double c[6], k[4]; } hermite_t;
+
+static void hermite_build(hermite_t *p, double h, double y0, double r0, double q0, double y1,
+                          double r1, double q1) {
+  const double d0 = h * r0, d1 = h * r1, s0 = h * h * q0, s1 = h * h * q1;
+  const double A = y1 - y0 - d0 - 0.5 * s0, B = d1 - d0 - s0, C = s1 - s0;
+  p->c[0] = y0; p->c[1] = d0; p->c[2] = 0.5 * s0;
+  p->c[3] = 10.0 * A - 4.0 * B + 0.5 * C;
+  p->c[4] = -15.0 * A + 7.0 * B - C;
+  p->c[5] = 6.0 * A - 3.0 * B + 0.5 * C;
+  p->k[0] = y0; p->k[1] = d0;
+  p->k[2] = 3.0 * (y1 - y0) - 2.0 * d0 - d1;
+  p->k[3] = 2.0 * (y0 - y1) + d0 + d1;
+}
+
+static double hermite_value(const hermite_t *p, double x) {
+  return p->c[0] + x * (p->c[1] + x * (p->c[2] + x * (p->c[3] + x * (p->c[4] + x * p->c[5]))));
+}
+
+static double hermite_rate(const hermite_t *p, double x) {
+  return p->c[1] +
+         x * (2.0 * p->c[2] + x * (3.0 * p->c[3] + x * (4.0 * p->c[4] + x * 5.0 * p->c[5])));
+}
+
+/* The interior extremum of the quintic (its rate changes sign on [0, 1]), by bisection; the
+ * quintic-minus-cubic difference there serves as its error estimate. */
+static void hermite_extremum(const hermite_t *p, double *value, double *err) {
+  double lo = 0.0, hi = 1.0, x;
+  const int rising = hermite_rate(p, 0.0) > 0.0;
+  int it;
+  for (it = 0; it < 60; it++) {
+    double mid = 0.5 * (lo + hi);
+    if ((hermite_rate(p, mid) > 0.0) == rising) lo = mid; else hi = mid;
+  }
+  x = 0.5 * (lo + hi);
+  *value = hermite_value(p, x);
+  *err = fabs(*value - (p->k[0] + x * (p->k[1] + x * (p->k[2] + x * p->k[3]))));
+}
+
+/* Search re-integrated states of the step for one on the wanted side of the event (want_after
+ * = 1: past it; 0: before it), iterating towards the extremum of the gap (the root of its
+ * rate, which changes sign between r0 at t0 and r1 at t1). Returns 1 with the time, root
+ * value (and, for want_after, the state in yb) when found, 0 otherwise. */
+static int search_extremum(ed_t *w, int j, int type, double t0, double t1, double r0, double r1,
+                           int want_after, double *tf, double *gf, double *yb) {
+  double ta = t0, tc = t1, ra = r0, rc = r1;
+  int it, side = 0, st;
+  for (it = 0; it < 300 && tc - ta > w->event_tol; it++) {
+    double tm = (it % 3 == 2 || !(fabs(rc - ra) > 0.0)) ? 0.5 * (ta + tc)
+                                                          : tc - rc * (tc - ta) / (rc - ra);
+    double g, rm;
+    tm = fmin(fmax(tm, ta + 0.25 * w->event_tol), tc - 0.25 * w->event_tol);
+    st = reintegrate(w, t0, tm - t0, w->yc);
+    if (st != MARTELLO_OK) return st;
+    st = root_value(w, j, type, tm, w->yc, &g, &rm);
+    if (st != MARTELLO_OK) return st;
+    if (after(type, g) == want_after) {
+      *tf = tm; *gf = g;
+      if (yb) memcpy(yb, w->yc, w->dim * sizeof *yb);
+      return 1;
+    }
+    if ((rm > 0.0) == (ra > 0.0)) {
+      ta = tm; ra = rm;
+      if (side == -1) rc *= 0.5;
+      side = -1;
+    } else {
+      tc = tm; rc = rm;
+      if (side == 1) ra *= 0.5;
+      side = 1;
+    }
+  }
+  return 0;
+}
+
+/* The bracket of contact j's next event in the step [t0, t1], if there is one: before at
+ * *ta (value *ga), past at *tb (value *gb, state in w->yb). Returns 1, 0 (none) or < 0. */
+static int bracket(ed_t *w, int j, int type, double t0, double t1, double *ta, double *ga,
+                   double *tb, double *gb) {
+  const double sgn = type == ROOT_SEPARATION ? -1.0 : 1.0;
+  double r0, r1;
+  int st;
+  *ta = t0; *tb = t1;
+  if (type == ROOT_RELEASE || type == ROOT_PEAK) {
+    *ga = type == ROOT_PEAK ? -w->rate0[j] : -(w->lam0[j] + w->lamtol[j]);
+    *gb = type == ROOT_PEAK ? -w->rate1[j] : -(w->lam1[j] + w->lamtol[j]);
+    if (after(type, *ga) || !after(type, *gb)) return 0;
+    memcpy(w->yb, w->y, w->dim * sizeof *w->yb);
+    return 1;
+  }
+  *ga = sgn * w->pen0[j]; *gb = sgn * w->pen1[j];
+  r0 = sgn * w->rate0[j]; r1 = sgn * w->rate1[j];
+  if (!after(type, *ga)) {
+    hermite_t p;
+    double val, err;
+    if (after(type, *gb)) {
+      memcpy(w->yb, w->y, w->dim * sizeof *w->yb);
+      return 1;
+    }
+    if (!(r0 > 0.0 && r1 < 0.0)) return 0;
+    /* both ends before the event, the gap turns inside the step: can it cross? */
+    hermite_build(&p, t1 - t0, *ga, r0, sgn * w->acc0[j], *gb, r1, sgn * w->acc1[j]);
+    hermite_extremum(&p, &val, &err);
+    if (val + 2.0 * err + gap_tol(w, j, w->y0) < 0.0) return 0;
+    return search_extremum(w, j, type, t0, t1, r0, r1, 1, tb, gb, w->yb);
+  }
+  /* touching at the step start (just after an impact or a release): an event only if the
+   * gap opened and closed again inside the step */
+  if (type != ROOT_IMPACT || !(r0 <= 0.0 && r1 > 0.0 && after(type, *gb))) return 0;
+  memcpy(w->yb, w->y, w->dim * sizeof *w->yb);
+  st = search_extremum(w, j, type, t0, t1, r0, r1, 0, ta, ga, NULL);
+  if (st < 0) return st;
+  if (st == 0) *ta = *tb;   /* never opened beyond tolerance: resolve at the step end */
+  return 1;
+}
+
+/* Contact j's event of the given type in the step, if it comes before the earliest found so
+ * far (*found, *best, state in w->ybest): located to event_tol, it becomes the earliest. */
+static int consider(ed_t *w, int j, int type, double t0, double t1, int *found, double *best) {
+  double ta, tb, ga, gb;
+  int st = bracket(w, j, type, t0, t1, &ta, &ga, &tb, &gb);
+  if (st <= 0) return st;
+  if (*found) {
+    if (ta >= *best) return 0;
+    if (tb > *best) {   /* an earlier event exists: this one counts only if past by then */
+      st = root_value(w, j, type, *best, w->ybest, &gb, NULL);
+      if (st != MARTELLO_OK) return st;
+      if (!after(type, gb)) return 0;
+      tb = *best;
+      memcpy(w->yb, w->ybest, w->dim * sizeof *w->yb);
+    }
+  }
+  if (ta < tb) {
+    st = illinois(w, j, type, t0, ta, ga, &tb, gb, w->yb);
+    if (st != MARTELLO_OK) return st;
+  }
+  if (!*found || tb < *best) {
+    *best = tb;
+    *found = 1;
+    memcpy(w->ybest, w->yb, w->dim * sizeof *w->ybest);
+  }
+  return 0;
+}
+
+/* The earliest event in the step (t0, y0) -> (t1, y1 = w->y). Returns 1 and moves w->y to
+ * the state just past it at *te, 0 if there is none, or a negative status. Events of other
+ * contacts within event_tol of it are resolved with it (process_events works on the state). */
+static int locate(ed_t *w, double t0, double t1, double *te) {
+  int j, st = 0, found = 0;
+  double best = t1;
+  for (j = 0; j < w->nc && st >= 0; j++) {
+    if (w->inert[j]) continue;
+    if (w->is_pen[j] && w->pen0[j] > 0.0) {
+      /* a penalty contact in contact waits for its peak and for its separation */
+      st = consider(w, j, ROOT_PEAK, t0, t1, &found, &best);
+      if (st >= 0) st = consider(w, j, ROOT_SEPARATION, t0, t1, &found, &best);
+    } else {
+      st = consider(w, j, w->is_pen[j] ? ROOT_ONSET : w->held[j] ? ROOT_RELEASE : ROOT_IMPACT,
+                    t0, t1, &found, &best);
+    }
+  }
+  if (st < 0) return st;
+  if (!found) return 0;
+  memcpy(w->y, w->ybest, w->dim * sizeof *w->y);
+  *te = best;
+  return 1;
+}
+
+/* ---- observation ----------------------------------------------------------------------- */
+
+/* At an accepted (committed) state: accelerations, contact forces, peaks, energies, and a
+ * history row if asked. Leaves the RHS in w->fstart and the multipliers in w->lam0: the
+ * start of the next step. */
+static int observe(ed_t *w, double t, int record) {
+  const int n = w->n;
+  double ke = 0.0, rec = 0.0, *e = w->energy;
+  int j, st;
+  st = eval_point(w, t, w->y, w->fstart, w->lam0);
+  if (st != MARTELLO_OK) return fail_eval(w, st, t);
+  kinematics(w, w->y, w->fstart + n, w->pen, w->rate, NULL);
+  st = martello_eval_contact_forces(w->ev, w->force);   /* penalty forces at (t, y) */
+  if (st != MARTELLO_OK) return fail(w, st, t, "event-driven: martello_eval_contact_forces failed");
+  for (j = 0; j < w->nc; j++) {
+    if (!w->is_pen[j]) w->force[j] = w->held[j] ? w->lam0[j] : 0.0;
+    if (w->ph_open[j]) {
+      w->ph_pen[j] = fmax(w->ph_pen[j], w->pen[j]);
+      w->ph_f[j] = fmax(w->ph_f[j], w->force[j]);
+    }
+  }
+  st = martello_run_track(w->run, t, w->y, w->y + n, w->fstart + n, w->pen, w->force);
+  if (st == MARTELLO_OK) st = martello_eval_energy(w->ev, w->y, w->y + n, &ke, &rec);
+  if (st != MARTELLO_OK) return fail(w, st, t, "event-driven: recording the results failed");
+  /* work-energy identity: initial + input = kinetic + recoverable + dissipated + impact */
+  e[E_KINETIC] = ke;
+  e[E_RECOVERABLE] = rec;
+  e[E_INPUT] = w->y[2 * n];
+  e[E_DAMPING] = w->y[2 * n + 1] - (rec - w->e_rec0);
+  e[E_PLASTIC] = 0.0;
+  e[E_CONTACT] = 0.0;
+  e[E_INITIAL] = w->e_initial;
+  e[E_IMPACT] = w->e_impact;
+  e[E_BALANCE] = e[E_INITIAL] + e[E_INPUT] - ke - rec - e[E_DAMPING] - e[E_IMPACT];
+  w->balance_max = fmax(w->balance_max, fabs(e[E_BALANCE]));
+  if (record) {
+    st = martello_run_record(w->run, t, w->y, w->y + n, w->fstart + n, w->pen, w->force, e);
+    if (st != MARTELLO_OK) return fail(w, st, t, "event-driven: recording the results failed");
+  }
+  return MARTELLO_OK;
+}
+
+/* ---- set-up and tear-down -------------------------------------------------------------- */
+
+static void ed_free(ed_t *w) {
+  void *bufs[] = {w->mass, w->gap, w->e, w->fixed, w->con_a, w->con_b, w->scheme, w->is_pen,
+                  w->uni, w->inert, w->Cm, w->scale_abs, w->y, w->y0, w->yb, w->ybest, w->yc,
+                  w->yerr, w->fstart, w->f, w->f1, w->fj, w->yj, w->fint, w->fext,
+                  w->pen0, w->rate0, w->acc0, w->pen1, w->rate1, w->acc1, w->pen, w->rate,
+                  w->force, w->lam, w->lam0, w->lam1, w->lamtol, w->hlist, w->held, w->Wh,
+                  w->rh, w->ilist, w->Wl, w->ql, w->pl, w->wl, w->sl, w->ph_open, w->ph_t,
+                  w->ph_v, w->ph_pen, w->ph_f, w->t_hold};
+  size_t i;
+  for (i = 0; i < sizeof bufs / sizeof bufs[0]; i++) free(bufs[i]);
+  if (w->drv) gsl_odeiv2_driver_free(w->drv);
+  if (w->rdrv) gsl_odeiv2_driver_free(w->rdrv);
+  if (w->rstep) gsl_odeiv2_step_free(w->rstep);
+  martello_lcp_free(&w->lcp);
+  if (w->ev) martello_eval_free(&w->ev);
+}
+
+/* p = calloc(count) (at least one element); true on success */
+#define ALLOC(p, count) \
+  ((p) = calloc((size_t)(count) > 0 ? (size_t)(count) : 1, sizeof *(p)), (p) != NULL)
+
+/* Everything the run needs, allocated once before the time loop. */
+static int ed_setup(ed_t *w) {
+  const int n = w->n, nc = w->nc;
+  const size_t dim = (size_t)(2 * n + 2);
+  const gsl_odeiv2_step_type *T;
+  double h0;
+  int j, st, nn;
+  w->dim = dim;
+  if (!(ALLOC(w->mass, n) && ALLOC(w->fixed, n) && ALLOC(w->gap, nc) && ALLOC(w->e, nc) &&
+        ALLOC(w->con_a, nc) && ALLOC(w->con_b, nc) && ALLOC(w->scheme, nc) &&
+        ALLOC(w->is_pen, nc) &&
+        ALLOC(w->uni, nc) && ALLOC(w->inert, nc)))
+    return MARTELLO_ERR_MEMORY;
+  st = martello_model_topology(w->model, &nn, &nn, w->mass, w->fixed, w->con_a, w->con_b,
+                               w->scheme, w->gap, w->e, &nn);
+  if (st != MARTELLO_OK) return fail(w, st, 0.0, "event-driven: martello_model_topology failed");
+  for (j = 0; j < n; j++)
+    if (w->mass[j] < 0.0) {
+      martello_run_set_message(w->run, "event-driven: every node must be set before a run");
+      return MARTELLO_ERR_STATE;
+    }
+  w->nu = 0;
+  for (j = 0; j < nc; j++) {
+    w->is_pen[j] = w->scheme[j] == MARTELLO_SCHEME_PENALTY;
+    w->uni[j] = w->is_pen[j] ? -1 : w->nu++;
+    /* Newton's e; a Lagrange contact without one is plastic (e = 0) */
+    if (w->e[j] < 0.0) w->e[j] = 0.0;
+  }
+  if (!(ALLOC(w->Cm, (size_t)n * (size_t)w->nu) && ALLOC(w->scale_abs, dim) && ALLOC(w->y, dim) &&
+        ALLOC(w->y0, dim) && ALLOC(w->yb, dim) && ALLOC(w->ybest, dim) && ALLOC(w->yc, dim) &&
+        ALLOC(w->yerr, dim) && ALLOC(w->fstart, dim) && ALLOC(w->f, dim) && ALLOC(w->f1, dim) &&
+        ALLOC(w->fj, dim) && ALLOC(w->yj, dim) && ALLOC(w->fint, n) && ALLOC(w->fext, n) &&
+        ALLOC(w->pen0, nc) && ALLOC(w->rate0, nc) && ALLOC(w->acc0, nc) &&
+        ALLOC(w->pen1, nc) && ALLOC(w->rate1, nc) && ALLOC(w->acc1, nc) && ALLOC(w->pen, nc) &&
+        ALLOC(w->rate, nc) && ALLOC(w->force, nc) && ALLOC(w->lam, nc) && ALLOC(w->lam0, nc) &&
+        ALLOC(w->lam1, nc) && ALLOC(w->lamtol, nc) && ALLOC(w->hlist, nc) && ALLOC(w->held, nc) &&
+        ALLOC(w->Wh, (size_t)w->nu * (size_t)w->nu) && ALLOC(w->rh, nc) && ALLOC(w->ilist, nc) &&
+        ALLOC(w->Wl, (size_t)w->nu * (size_t)w->nu) && ALLOC(w->ql, nc) && ALLOC(w->pl, nc) &&
+        ALLOC(w->wl, nc) && ALLOC(w->sl, nc) && ALLOC(w->ph_open, nc) && ALLOC(w->ph_t, nc) &&
+        ALLOC(w->ph_v, nc) && ALLOC(w->ph_pen, nc) && ALLOC(w->ph_f, nc) && ALLOC(w->t_hold, nc)))
+    return MARTELLO_ERR_MEMORY;
+  w->lcp = martello_lcp_alloc(w->nu);
+  if (w->lcp == NULL) return MARTELLO_ERR_MEMORY;
+  st = martello_eval_create(w->model, &w->ev);
+  if (st != MARTELLO_OK) return fail(w, st, 0.0, "event-driven: martello_eval_create failed");
+  /* M^-1 G_j^T of every unilateral contact; a contact between two immovable sides is inert */
+  for (j = 0; j < nc; j++) {
+    double *c;
+    int i;
+    if (w->is_pen[j]) {
+      w->inert[j] = (w->con_a[j] < 0 || w->fixed[w->con_a[j]]) &&
+                    (w->con_b[j] < 0 || w->fixed[w->con_b[j]]);
+      continue;
+    }
+    c = w->Cm + (size_t)w->uni[j] * n;
+    for (i = 0; i < n; i++) c[i] = 0.0;
+    if (w->con_a[j] >= 0) c[w->con_a[j]] += 1.0;
+    if (w->con_b[j] >= 0) c[w->con_b[j]] -= 1.0;
+    st = martello_eval_solve_mass(w->ev, c);
+    if (st != MARTELLO_OK) return fail_eval(w, st, 0.0);
+    w->inert[j] = !(delassus(w, j, j) > 0.0);
+  }
+  /* the work integrals are outside the error control: an absolute scale that makes their
+   * tolerance irrelevant */
+  for (j = 0; j < (int)dim; j++) w->scale_abs[j] = j < 2 * n ? 1.0 : 1e100 / w->atol;
+  w->sys.function = ed_rhs;
+  w->sys.jacobian = ed_jacobian;
+  w->sys.dimension = dim;
+  w->sys.params = w;
+  T = w->kind == MARTELLO_INT_RKF45 ? gsl_odeiv2_step_rkf45
+      : w->kind == MARTELLO_INT_RK8PD ? gsl_odeiv2_step_rk8pd : gsl_odeiv2_step_msbdf;
+  h0 = 1e-3 * fmin(w->dt_out, w->t_end);
+  if (w->h_max > 0.0) h0 = fmin(h0, w->h_max);
+  w->drv = gsl_odeiv2_driver_alloc_scaled_new(&w->sys, T, h0, w->atol, w->rtol, 1.0, 0.0,
+                                              w->scale_abs);
+  if (w->drv == NULL) return MARTELLO_ERR_MEMORY;
+  if (w->kind == MARTELLO_INT_MSBDF) {
+    w->rdrv = gsl_odeiv2_driver_alloc_scaled_new(&w->sys, gsl_odeiv2_step_rk4imp, h0, w->atol,
+                                                 w->rtol, 1.0, 0.0, w->scale_abs);
+    if (w->rdrv == NULL) return MARTELLO_ERR_MEMORY;
+  } else {
+    w->rstep = gsl_odeiv2_step_alloc(T, dim);
+    if (w->rstep == NULL) return MARTELLO_ERR_MEMORY;
+  }
+  return MARTELLO_OK;
+}
+
+static int check_settings(ed_t *w) {
+  const char *bad = NULL;
+  /* a relative tolerance near the rounding unit cannot be met: the steps would shrink to
+   * where the error estimates are rounding noise and the run would crawl */
+  if (!(w->rtol >= 10.0 * DBL_EPSILON)) bad = "rtol must be >= 10 machine epsilons (2.2e-15)";
+  else if (!(w->atol > 0.0)) bad = "atol must be > 0";
+  else if (!(w->event_tol > 0.0)) bad = "event_tol must be > 0";
+  else if (!(w->h_max >= 0.0)) bad = "h_max must be >= 0 (0: no limit)";
+  else if (!(w->dt_out > 0.0 && w->t_end > 0.0)) bad = "dt (output interval) and t_end must be > 0";
+  else if (w->every < 1) bad = "every must be >= 1";
+  if (bad == NULL) return MARTELLO_OK;
+  snprintf(w->msg, sizeof w->msg, "event-driven: %s", bad);
+  martello_run_set_message(w->run, w->msg);
+  return MARTELLO_ERR_ARGUMENT;
+}
+
+/* The error of gsl_odeiv2_evolve_apply as a martello status and message. */
+static int gsl_failure(ed_t *w, int st, double t, double h) {
+  if (st == GSL_EBADFUNC) return fail_eval(w, w->rhs_status, t);
+  if (st == GSL_FAILURE) {
+    snprintf(w->msg, sizeof w->msg,
+             "event-driven: step size underflow at t = %.9e s (h = %.3e s): the stepper cannot "
+             "meet rtol = %.3e, atol = %.3e (gsl_odeiv2_evolve_apply: %s)",
+             t, h, w->rtol, w->atol, gsl_strerror(st));
+    martello_run_set_message(w->run, w->msg);
+    return MARTELLO_ERR_STEP_UNDERFLOW;
+  }
+  snprintf(w->msg, sizeof w->msg, "event-driven: gsl_odeiv2_evolve_apply failed at t = %.9e s: "
+           "%s (gsl status %d)", t, gsl_strerror(st), st);
+  martello_run_set_message(w->run, w->msg);
+  return MARTELLO_ERR_EXTERNAL;
+}
+
+/* ---- the run --------------------------------------------------------------------------- */
+
+static int ed_integrate(ed_t *w, double *t_reached) {
+  const int n = w->n;
+  const long n_out = (long)ceil(w->t_end / w->dt_out * (1.0 - 1e-12));
+  long k_out = 1;
+  double t = 0.0, h, ke0 = 0.0;
+  int st, j, stuck = 0;
+
+  /* initial state; contacts must start open or touching */
+  st = martello_model_initial_state(w->model, w->y, w->y + n);
+  if (st != MARTELLO_OK)
+    return fail(w, st, 0.0, "event-driven: martello_model_initial_state failed");
+  for (j = 0; j < n; j++)
+    if (w->fixed[j]) w->y[n + j] = 0.0;
+  for (j = 0; j < w->nc; j++) {
+    double d = gdot(w, j, w->y) - w->gap[j];
+    if (!w->is_pen[j] && !w->inert[j] && d > gap_tol(w, j, w->y)) {
+      snprintf(w->msg, sizeof w->msg,
+               "event-driven: contact %d starts penetrated by %.3e m; a restitution or lagrange "
+               "contact must start open or touching (gap >= 0)", j, d);
+      martello_run_set_message(w->run, w->msg);
+      return MARTELLO_ERR_ARGUMENT;
+    }
+  }
+  st = martello_eval_energy(w->ev, w->y, w->y + n, &ke0, &w->e_rec0);
+  if (st != MARTELLO_OK) return fail(w, st, 0.0, "event-driven: energy evaluation failed");
+  w->e_initial = ke0 + w->e_rec0;
+  st = process_events(w, 0.0);
+  if (st != MARTELLO_OK) return st;
+  st = martello_eval_commit(w->ev, w->y, w->y + n);
+  if (st == MARTELLO_OK) st = observe(w, 0.0, 1);
+  if (st != MARTELLO_OK) return st;
+
+  h = 1e-3 * fmin(w->dt_out, w->t_end);
+  while (t < w->t_end) {
+    const double t_out = k_out >= n_out ? w->t_end : (double)k_out * w->dt_out;
+    const double t0 = t;
+    unsigned long failed = w->drv->e->failed_steps;
+    double hs = (w->h_max > 0.0) ? fmin(h, w->h_max) : h, te;
+    int ev, record;
+    /* the step start: state, RHS (from observe), gap kinematics */
+    memcpy(w->y0, w->y, w->dim * sizeof *w->y);
+    kinematics(w, w->y0, w->fstart + n, w->pen0, w->rate0, w->acc0);
+    st = gsl_odeiv2_evolve_apply(w->drv->e, w->drv->c, w->drv->s, &w->sys, &t, t_out, &hs, w->y);
+    w->cnt[C_REJECTED] += (long long)(w->drv->e->failed_steps - failed);
+    if (st != GSL_SUCCESS) {
+      *t_reached = t;
+      return gsl_failure(w, st, t, hs);
+    }
+    if (t < t_out) h = hs;   /* the last step onto an output time keeps the suggestion */
+    w->cnt[C_STEPS]++;
+    *t_reached = t;
+    if (!all_finite(w->y, w->dim))
+      return fail(w, MARTELLO_ERR_DIVERGED, t, "event-driven: diverged, non-finite state (NaN/inf)");
+    /* the step end: gap kinematics and multipliers, then the earliest event inside */
+    st = eval_point(w, t, w->y, w->f1, w->lam1);
+    if (st != MARTELLO_OK) return fail_eval(w, st, t);
+    kinematics(w, w->y, w->f1 + n, w->pen1, w->rate1, w->acc1);
+    ev = locate(w, t0, t, &te);
+    if (ev < 0) return ev;
+    if (ev == 1) {
+      t = te;
+      *t_reached = t;
+      st = process_events(w, t);
+      if (st != MARTELLO_OK) return st;
+      /* the motion is not smooth across an event: the stepper starts afresh */
+      gsl_odeiv2_driver_reset(w->drv);
+      stuck = (t - t0 <= w->event_tol) ? stuck + 1 : 0;
+      if (stuck > MAX_EVENTS_AT_ONCE)
+        return fail(w, MARTELLO_ERR_STEP_UNDERFLOW, t,
+                    "event-driven: events accumulate without time advancing (an unresolved "
+                    "Zeno point or chattering contact)");
+    }
+    st = martello_eval_commit(w->ev, w->y, w->y + n);
+    if (st != MARTELLO_OK) return fail(w, st, t, "event-driven: commit failed");
+    record = 0;
+    if (t >= t_out) {
+      record = (k_out % w->every == 0) || k_out >= n_out;
+      k_out++;
+    }
+    st = observe(w, t, record);
+    if (st != MARTELLO_OK) return st;
+  }
+  return MARTELLO_OK;
+}
 
 int martello_event_driven_run(martello_model *model, martello_run *run) {
-  (void)model;
-  martello_run_set_message(run, "event-driven integration (GSL) is not built yet");
-  return MARTELLO_ERR_UNSUPPORTED;
+  ed_t w;
+  double par[MARTELLO_NPAR_INTEGRATOR], t_reached = 0.0;
+  int st, j, nco;
+  memset(&w, 0, sizeof w);
+  w.model = model;
+  w.run = run;
+  if (model == NULL || run == NULL) return MARTELLO_ERR_ARGUMENT;
+  st = martello_run_settings(run, &w.kind, par);
+  if (st != MARTELLO_OK) return st;
+  if (w.kind != MARTELLO_INT_RKF45 && w.kind != MARTELLO_INT_RK8PD &&
+      w.kind != MARTELLO_INT_MSBDF) {
+    martello_run_set_message(run, "event-driven: the integrator must be rkf45, rk8pd or msbdf");
+    return MARTELLO_ERR_ARGUMENT;
+  }
+  w.dt_out = par[MARTELLO_R_DT];
+  w.t_end = par[MARTELLO_R_T_END];
+  w.rtol = par[MARTELLO_R_RTOL];
+  w.atol = par[MARTELLO_R_ATOL];
+  w.event_tol = par[MARTELLO_R_EVENT_TOL];
+  w.h_max = par[MARTELLO_R_H_MAX];
+  w.every = (int)lround(par[MARTELLO_R_EVERY]);
+  st = check_settings(&w);
+  if (st != MARTELLO_OK) return st;
+  st = martello_model_topology(model, &w.n, &w.nc, NULL, NULL, NULL, NULL, NULL, NULL, NULL, &nco);
+  if (st != MARTELLO_OK) return st;
+  st = ed_setup(&w);
+  if (st == MARTELLO_ERR_MEMORY) martello_run_set_message(run, "event-driven: out of memory");
+  if (st == MARTELLO_OK) st = ed_integrate(&w, &t_reached);
+  if (st == MARTELLO_OK) {
+    for (j = 0; j < w.nc; j++)
+      if (w.ph_open[j]) add_event(&w, j, w.ph_t[j], -1.0, w.ph_v[j], 0.0, w.ph_pen[j], w.ph_f[j]);
+    t_reached = w.t_end;
+  }
+  if (w.ev != NULL) {
+    martello_run_add_counts(run, w.cnt);
+    martello_run_finish(run, t_reached, w.energy, w.balance_max);
+  }
+  ed_free(&w);
+  return st;
 }

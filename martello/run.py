@@ -244,6 +244,13 @@ def _dynamic(scene, model, raise_on_failure=True):
             k = 1 + 3 * len(an["output"]["nodes"]) + an["output"]["contacts"].index(c["name"])
             contacts[c["name"]]["penetration_final"] = float(hist[-1, k])
             contacts[c["name"]]["force_final"] = float(hist[-1, k + len(an["output"]["contacts"])])
+            contacts[c["name"]]["lambda_final"] = 0.0 - contacts[c["name"]]["force_final"]  # seed sign
+        if c["scheme"] in ("restitution", "lagrange"):
+            # the start of the first lasting contact phase: the accumulation (Zeno) time of
+            # an impact sequence, or a plastic impact's instant (impacts have t_off = t_on)
+            lasting = [row for row in mine if row[1] < 0 or row[1] > row[0]]
+            if lasting:
+                contacts[c["name"]]["persistent_from"] = float(lasting[0][0])
     scale = max(abs(energy["initial"]), abs(energy["input"]), 1e-300)
     energy.update(balance_max=extra["balance_max"], balance_relative=extra["balance_max"] / scale)
     warnings = []
