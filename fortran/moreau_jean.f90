@@ -102,8 +102,8 @@ contains
       theta = s%theta
       hth = h*theta
       hth2 = hth*hth
-      nsteps = nint(s%t_end/h)
-      if (abs(nsteps*h - s%t_end) > 1.0e-9_dp*s%t_end) nsteps = ceiling(s%t_end/h)
+      ! whole steps until t_end is reached; the last time is nsteps·h (reported as t_reached)
+      nsteps = max(1, ceiling(s%t_end/h*(1.0_dp - 1.0e-12_dp)))
       kd = model_bandwidth(m)
 
       allocate (u(0:n), v(0:n), un(0:n), vn(0:n), a(0:n), fint(0:n), fint_n(0:n), fext(0:n), &
@@ -161,8 +161,7 @@ contains
       do step = 1, nsteps
          un = u; vn = v; fint_n = fint; fext_n = fext
          t_prev = t
-         t = min(step*h, s%t_end)
-         if (step == nsteps) t = s%t_end
+         t = step*h
          call external_forces(m, mrow, t, fext)
 
          ! Ŵ = M + hθ C + h²θ² K from the tangents of the committed state

@@ -76,8 +76,8 @@ contains
       call check_scene(stat)
       if (stat /= MARTELLO_OK) return
       h = s%dt
-      nsteps = nint(s%t_end/h)
-      if (abs(nsteps*h - s%t_end) > 1.0e-9_dp*s%t_end) nsteps = ceiling(s%t_end/h)
+      ! whole steps until t_end is reached; the last time is nsteps·h (reported as t_reached)
+      nsteps = max(1, ceiling(s%t_end/h*(1.0_dp - 1.0e-12_dp)))
       kd = model_bandwidth(m)
 
       allocate (u(0:n), v(0:n), a(0:n), un(0:n), vn(0:n), an(0:n), fint(0:n), fint_n(0:n), &
@@ -136,8 +136,7 @@ contains
       do step = 1, nsteps
          un = u; vn = v; an = a; fint_n = fint; fext_n = fext; lam_n = lam
          t_prev = t
-         t = min(step*h, s%t_end)
-         if (step == nsteps) t = s%t_end
+         t = step*h
          call external_forces(m, mrow, t, fext)
 
          ! 1. trial step, average acceleration, persistent contacts held; release tensile ones
