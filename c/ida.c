@@ -1,9 +1,1257 @@
-/* DAE integration on SUNDIALS IDA (placeholder until the Nonsmooth issue lands it). */
+/* DAE integration on SUNDIALS IDA (issue 4, item 3; docs/ida.md).
+ *
+ * State y, node by node: [u_i, v_i] followed, after the first node of each rigid contact r
+ * (scheme lagrange or restitution), by its multiplier P_r and its GGL multiplier mu_r, so that
+ * a chain keeps a narrow band. Residual (acceleration form, a = M^-1 (f_ext - f_int) from the
+ * kernels' evaluator, penalty contacts inside f_int):
+ *
+ *   F_u = u' - v + M^-1 B mu          F_v = v' - a(t, u, v) + M^-1 B P
+ *   closed rigid contact r:  F_P = B_r^T v   (velocity constraint, delta_r' = 0)
+ *                            F_mu = delta_r  (position constraint, Gear-Gupta-Leimkuhler)
+ *   open rigid contact r:    F_P = P_r,  F_mu = mu_r  (both held at 0)
+ *
+ * B_r = e_a - e_b, delta_r = u_a - u_b - gap_r, P_r >= 0 compresses (pushes a back). The
+ * closed-contact rows are the stabilised index-2 (GGL) form: no drift, P and mu algebraic
+ * (IDASetId 0) and out of the local error test (IDASetSuppressAlg), as usual for index 2.
+ *
+ * Events are roots of IDA (IDARootInit), two per contact: delta_j and its rate for open
+ * contacts and penalty contacts (the rate root stops at every extremum of the gap, which
+ * gives the exact peak penetration and catches a contact that opens and closes inside one
+ * step), P_r for closed rigid contacts (release when it turns tensile). At an onset or a
+ * separation of a penalty contact, an impact (Newton's law with restitution e, all contacts
+ * at zero gap at once: an impulse-level LCP), a closing (e = 0, or a rebound too small to resolve: Zeno accumulation) or a
+ * release, the state is made consistent and IDA restarts there (IDAReInit) instead of
+ * stepping across the kink. Steps are taken in IDA_ONE_STEP mode so that path-dependent
+ * links commit at every accepted step; output times are stop times (IDASetStopTime), so
+ * every history row is an accepted, committed state. */
+#include <float.h>
+#include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include <ida/ida.h>
+#include <nvector/nvector_serial.h>
+#include <sundials/sundials_context.h>
+#include <sunlinsol/sunlinsol_band.h>
+#include <sunlinsol/sunlinsol_dense.h>
+#include <sunmatrix/sunmatrix_band.h>
+#include <sunmatrix/sunmatrix_dense.h>
+
 #include "martello.h"
 #include "martello_internal.h"
 
+/* Slots of the result arrays (fortran/results.f90, 0-based here); events are written in the
+ * order EV_T_ON, EV_T_OFF, EV_V_IN, EV_V_OUT, EV_MAX_PEN, EV_MAX_FORCE. */
+enum { CNT_STEPS, CNT_REJECTED, CNT_NEWTON, CNT_RESIDUALS, CNT_FACTORIZATIONS, CNT_EVENTS,
+       CNT_JACOBIANS, CNT_ROOT_EVALS, CNT_CHATTER };
+enum { EN_KINETIC, EN_RECOVERABLE, EN_INPUT, EN_DAMPING, EN_PLASTIC, EN_CONTACT, EN_BALANCE,
+       EN_INITIAL, EN_IMPACT };
+
+/* What happens to a contact at a restart. */
+enum { ACT_NONE, ACT_ONSET, ACT_SEPARATION, ACT_IMPACT, ACT_RELEASE };
+
+/* Position tolerance of a rigid contact, in units of IDA's own: a rebound whose flight
+ * height v^2/(2 a_n) stays below it cannot be resolved by the integrator, so the contact
+ * closes (Zeno accumulation). */
+#define ZENO_HEIGHT_FACTOR 10.0
+#define MAX_STEPS 100000000L
+
+typedef struct {
+  martello_model *model;
+  martello_run *run;
+  martello_eval *ev;
+  /* scene (martello_model_topology) */
+  int n, nc, nr, ncoupling;
+  double *mass, *gap, *rest;
+  int *fixed, *con_a, *con_b, *scheme;
+  int *rig;      /* contact -> rigid index, or -1 (penalty) */
+  int *rig_con;  /* rigid index -> contact */
+  /* layout of y */
+  sunindextype N;
+  sunindextype *iu, *iv, *ip, *im;
+  /* modes */
+  int *closed;   /* per rigid contact: constraint active */
+  int *touching; /* per contact: phase open (penalty delta > 0, rigid closed) */
+  int *act;      /* per contact: ACT_* at the restart being prepared */
+  int *opened;   /* per rigid contact: opened by the multiplier check at this restart */
+  int *was_closed, *hit, *cand; /* per rigid contact, at an impact */
+  double *w_in;  /* per contact: approach speed of the impact being resolved */
+  /* work */
+  double *u, *v, *a, *x, *uq, *vq, *fint, *fext, *pen, *rate, *force, *lam;
+  double *S, *rhs, *mb;
+  int *aset, *map;
+  double *S2, *q;
+  /* settings */
+  double rtol, atol, event_tol, t_end, h_max, out_dt, divergence_factor;
+  /* contact phases */
+  double *ph_t, *ph_v, *ph_pen, *ph_f;
+  /* energy */
+  double e0, erec0, w_ext, w_int, w_abs, e_impact, balance_max;
+  double e_kin, e_rec;
+  /* diagnostics */
+  int nan_seen;
+  char ida_msg[240];
+  long long events;
+  long cnt_last[9];
+} ida_problem;
+
+/* ---- small helpers ------------------------------------------------------------------ */
+
+static int fail(ida_problem *P, int code, const char *fmt, ...) {
+  char buf[480];
+  va_list ap;
+  va_start(ap, fmt);
+  vsnprintf(buf, sizeof buf, fmt, ap);
+  va_end(ap);
+  martello_run_set_message(P->run, buf);
+  return code;
+}
+
+static double node_u(int i, const double *u) { return i < 0 ? 0.0 : u[i]; }
+
+/* delta = (u_a - u_b) - gap, in the kernels' order of operations (fortran/evaluator.f90). */
+static double penetration(const ida_problem *P, int j, const double *u) {
+  return (node_u(P->con_a[j], u) - node_u(P->con_b[j], u)) - P->gap[j];
+}
+
+static double pen_rate(const ida_problem *P, int j, const double *v) {
+  return node_u(P->con_a[j], v) - node_u(P->con_b[j], v);
+}
+
+static void gather(const ida_problem *P, const double *y, double *u, double *v) {
+  for (int i = 0; i < P->n; i++) {
+    u[i] = y[P->iu[i]];
+    v[i] = y[P->iv[i]];
+  }
+}
+
+/* x <- B lambda over the closed rigid contacts (x has length n). */
+static void apply_B(const ida_problem *P, const double *lam, double *x) {
+  memset(x, 0, sizeof(double) * (size_t)P->n);
+  for (int r = 0; r < P->nr; r++) {
+    if (!P->closed[r] || lam[r] == 0.0) continue;
+    int j = P->rig_con[r];
+    if (P->con_a[j] >= 0) x[P->con_a[j]] += lam[r];
+    if (P->con_b[j] >= 0) x[P->con_b[j]] -= lam[r];
+  }
+}
+
+/* mb <- M^-1 B_r (one contact). */
+static int mass_column(ida_problem *P, int j, double *mb) {
+  memset(mb, 0, sizeof(double) * (size_t)P->n);
+  if (P->con_a[j] >= 0) mb[P->con_a[j]] += 1.0;
+  if (P->con_b[j] >= 0) mb[P->con_b[j]] -= 1.0;
+  return martello_eval_solve_mass(P->ev, mb);
+}
+
+static double dot_B(const ida_problem *P, int j, const double *x) { return pen_rate(P, j, x); }
+
+/* Height below which a rigid contact's bounce is not resolved (see ZENO_HEIGHT_FACTOR). */
+static double height_tol(const ida_problem *P, int j, const double *u) {
+  double s = fabs(P->gap[j]);
+  s = fmax(s, fabs(node_u(P->con_a[j], u)));
+  s = fmax(s, fabs(node_u(P->con_b[j], u)));
+  return ZENO_HEIGHT_FACTOR * (P->rtol * s + P->atol);
+}
+
+static double speed_tol(const ida_problem *P, const double *v) {
+  double vm = 0.0;
+  for (int i = 0; i < P->n; i++) vm = fmax(vm, fabs(v[i]));
+  return 64.0 * DBL_EPSILON * vm + DBL_MIN;
+}
+
+/* Move contact j strictly to side sgn (+1: delta > 0, -1: delta < 0) by the smallest shift of
+ * one free node: the kernels decide a penalty law's regime by the sign of delta, so a restart
+ * exactly at delta = 0 would not know on which side it is. */
+static void nudge(ida_problem *P, int j, int sgn, double *u) {
+  int a = P->con_a[j], b = P->con_b[j];
+  int node = (a >= 0 && !P->fixed[a]) ? a : ((b >= 0 && !P->fixed[b]) ? b : -1);
+  if (node < 0) return;
+  double dir = node == a ? 1.0 : -1.0;
+  double eta = 4.0 * DBL_EPSILON *
+               (fabs(P->gap[j]) + fabs(node_u(a, u)) + fabs(node_u(b, u))) + DBL_MIN;
+  for (int k = 0; k < 80; k++) {
+    double d = penetration(P, j, u);
+    if (sgn * d > 0.0) return;
+    u[node] += dir * sgn * (fabs(d) + eta);
+    eta *= 2.0;
+  }
+}
+
+/* Dense LU with partial pivoting of the m x m row-major A, solving A x = b in place. */
+static int small_solve(int m, double *A, double *b) {
+  for (int k = 0; k < m; k++) {
+    int p = k;
+    for (int i = k + 1; i < m; i++)
+      if (fabs(A[i * m + k]) > fabs(A[p * m + k])) p = i;
+    if (!(fabs(A[p * m + k]) > 0.0)) return -1;
+    if (p != k) {
+      for (int c = 0; c < m; c++) {
+        double t = A[k * m + c];
+        A[k * m + c] = A[p * m + c];
+        A[p * m + c] = t;
+      }
+      double t = b[k];
+      b[k] = b[p];
+      b[p] = t;
+    }
+    for (int i = k + 1; i < m; i++) {
+      double f = A[i * m + k] / A[k * m + k];
+      for (int c = k; c < m; c++) A[i * m + c] -= f * A[k * m + c];
+      b[i] -= f * b[k];
+    }
+  }
+  for (int k = m - 1; k >= 0; k--) {
+    double s = b[k];
+    for (int c = k + 1; c < m; c++) s -= A[k * m + c] * b[c];
+    b[k] = s / A[k * m + k];
+  }
+  return 0;
+}
+
+/* The Delassus matrix S = B_A^T M^-1 B_A of the closed rigid contacts (aset[0..m)), row-major. */
+static int delassus(ida_problem *P, int m) {
+  for (int c = 0; c < m; c++) {
+    int st = mass_column(P, P->rig_con[P->aset[c]], P->mb);
+    if (st != MARTELLO_OK) return st;
+    for (int rr = 0; rr < m; rr++) P->S[rr * m + c] = dot_B(P, P->rig_con[P->aset[rr]], P->mb);
+  }
+  return MARTELLO_OK;
+}
+
+static int closed_set(ida_problem *P) {
+  int m = 0;
+  for (int r = 0; r < P->nr; r++)
+    if (P->closed[r]) P->aset[m++] = r;
+  return m;
+}
+
+/* ---- IDA callbacks ------------------------------------------------------------------ */
+
+static int residual(realtype t, N_Vector yy, N_Vector yp, N_Vector rr, void *data) {
+  ida_problem *P = data;
+  const double *y = N_VGetArrayPointer(yy), *d = N_VGetArrayPointer(yp);
+  double *res = N_VGetArrayPointer(rr);
+  gather(P, y, P->u, P->v);
+  if (martello_eval_acceleration(P->ev, t, P->u, P->v, P->a) != MARTELLO_OK) return -1;
+  int any_closed = 0;
+  for (int r = 0; r < P->nr; r++) any_closed |= P->closed[r];
+  if (any_closed) {
+    /* M^-1 B P into fint, M^-1 B mu into fext (used here as work arrays) */
+    for (int r = 0; r < P->nr; r++) P->lam[r] = y[P->ip[r]];
+    apply_B(P, P->lam, P->fint);
+    if (martello_eval_solve_mass(P->ev, P->fint) != MARTELLO_OK) return -1;
+    for (int r = 0; r < P->nr; r++) P->lam[r] = y[P->im[r]];
+    apply_B(P, P->lam, P->fext);
+    if (martello_eval_solve_mass(P->ev, P->fext) != MARTELLO_OK) return -1;
+  } else {
+    memset(P->fint, 0, sizeof(double) * (size_t)P->n);
+    memset(P->fext, 0, sizeof(double) * (size_t)P->n);
+  }
+  for (int i = 0; i < P->n; i++) {
+    res[P->iu[i]] = d[P->iu[i]] - P->v[i] + P->fext[i];
+    res[P->iv[i]] = d[P->iv[i]] - P->a[i] + P->fint[i];
+  }
+  for (int r = 0; r < P->nr; r++) {
+    int j = P->rig_con[r];
+    if (P->closed[r]) {
+      res[P->ip[r]] = pen_rate(P, j, P->v);
+      res[P->im[r]] = penetration(P, j, P->u);
+    } else {
+      res[P->ip[r]] = y[P->ip[r]];
+      res[P->im[r]] = y[P->im[r]];
+    }
+  }
+  for (sunindextype k = 0; k < P->N; k++)
+    if (!isfinite(res[k])) {
+      P->nan_seen = 1;
+      return 1; /* recoverable: IDA retries with a smaller step, then gives up */
+    }
+  return 0;
+}
+
+/* Two root functions per contact: (delta, delta') while open or penalty, (P, 1) while a rigid
+ * contact is closed. */
+static int roots(realtype t, N_Vector yy, N_Vector yp, realtype *g, void *data) {
+  ida_problem *P = data;
+  const double *y = N_VGetArrayPointer(yy);
+  (void)t;
+  (void)yp;
+  gather(P, y, P->uq, P->vq);
+  for (int j = 0; j < P->nc; j++) {
+    int r = P->rig[j];
+    if (r >= 0 && P->closed[r]) {
+      g[2 * j] = y[P->ip[r]];
+      g[2 * j + 1] = 1.0;
+    } else {
+      g[2 * j] = penetration(P, j, P->uq);
+      g[2 * j + 1] = pen_rate(P, j, P->vq);
+    }
+  }
+  return 0;
+}
+
+static void error_handler(int code, const char *module, const char *function, char *msg,
+                          void *data) {
+  ida_problem *P = data;
+  (void)module;
+  if (code < 0) snprintf(P->ida_msg, sizeof P->ida_msg, "%s: %s", function, msg);
+}
+
+/* ---- counters, energy, output -------------------------------------------------------- */
+
+/* Add IDA's counters since the last call to the run (IDAReInit and the linear solver's
+ * first call after it start them from 0 again). */
+static int flush_counts(ida_problem *P, void *mem) {
+  long c[9] = {0}, cf = 0, nre_ls = 0;
+  int st = 0;
+  st |= IDAGetNumSteps(mem, &c[CNT_STEPS]);
+  st |= IDAGetNumErrTestFails(mem, &c[CNT_REJECTED]);
+  st |= IDAGetNumNonlinSolvConvFails(mem, &cf);
+  st |= IDAGetNumNonlinSolvIters(mem, &c[CNT_NEWTON]);
+  st |= IDAGetNumResEvals(mem, &c[CNT_RESIDUALS]);
+  st |= IDAGetNumLinResEvals(mem, &nre_ls);
+  st |= IDAGetNumLinSolvSetups(mem, &c[CNT_FACTORIZATIONS]);
+  st |= IDAGetNumJacEvals(mem, &c[CNT_JACOBIANS]);
+  st |= IDAGetNumGEvals(mem, &c[CNT_ROOT_EVALS]);
+  if (st != IDA_SUCCESS) return fail(P, MARTELLO_ERR_EXTERNAL, "IDA: could not read the counters");
+  c[CNT_REJECTED] += cf;
+  c[CNT_RESIDUALS] += nre_ls;
+  long long inc[MARTELLO_NCOUNTERS] = {0};
+  for (int k = 0; k < 9; k++) {
+    if (k == CNT_EVENTS || k == CNT_CHATTER) continue;
+    long d = c[k] >= P->cnt_last[k] ? c[k] - P->cnt_last[k] : c[k];
+    inc[k] = d;
+    P->cnt_last[k] = c[k];
+  }
+  inc[CNT_EVENTS] = P->events;
+  P->events = 0;
+  return martello_run_add_counts(P->run, inc);
+}
+
+static void reset_count_baseline(ida_problem *P) {
+  for (int k = 0; k < 9; k++) P->cnt_last[k] = 0;
+}
+
+/* Per-contact force of the state last evaluated (every caller has just committed or
+ * evaluated it): P_r for closed rigid contacts, the kernels' penalty force otherwise (NaN in
+ * the history, 0 in the peaks, should the door refuse). */
+static void contact_forces(ida_problem *P, const double *y, double *force, int for_history) {
+  int have = martello_eval_contact_forces(P->ev, force) == MARTELLO_OK;
+  for (int j = 0; j < P->nc; j++) {
+    int r = P->rig[j];
+    if (r >= 0)
+      force[j] = P->closed[r] ? y[P->ip[r]] : 0.0;
+    else if (!have)
+      force[j] = for_history ? NAN : 0.0;
+  }
+}
+
+static void energy_vector(ida_problem *P, double e[MARTELLO_NENERGY]) {
+  for (int k = 0; k < MARTELLO_NENERGY; k++) e[k] = 0.0;
+  e[EN_KINETIC] = P->e_kin;
+  e[EN_RECOVERABLE] = P->e_rec;
+  e[EN_INPUT] = P->w_ext;
+  /* all non-recoverable internal work (dampers, plasticity, contact dashpots): the door gives
+   * node forces, not element forces (docs/ida.md) */
+  e[EN_DAMPING] = P->w_int - (P->e_rec - P->erec0);
+  e[EN_INITIAL] = P->e0;
+  e[EN_IMPACT] = P->e_impact;
+  e[EN_BALANCE] = P->e0 + P->w_ext - P->e_kin - P->e_rec - e[EN_DAMPING] - P->e_impact;
+}
+
+/* Energies of the committed state (u, v). */
+static int energies(ida_problem *P, const double *u, const double *v) {
+  int st = martello_eval_energy(P->ev, u, v, &P->e_kin, &P->e_rec);
+  if (st != MARTELLO_OK) return fail(P, st, "IDA: energy evaluation failed");
+  double e[MARTELLO_NENERGY];
+  energy_vector(P, e);
+  P->balance_max = fmax(P->balance_max, fabs(e[EN_BALANCE]));
+  return MARTELLO_OK;
+}
+
+/* Peaks and phase maxima at an accepted (committed) state y, yp. */
+static int track(ida_problem *P, double t, const double *y, const double *yp, int record) {
+  gather(P, y, P->u, P->v);
+  for (int i = 0; i < P->n; i++) P->a[i] = yp[P->iv[i]];
+  for (int j = 0; j < P->nc; j++) {
+    P->pen[j] = penetration(P, j, P->u);
+    P->rate[j] = pen_rate(P, j, P->v);
+  }
+  contact_forces(P, y, P->force, 0);
+  for (int j = 0; j < P->nc; j++)
+    if (P->touching[j]) {
+      P->ph_pen[j] = fmax(P->ph_pen[j], P->pen[j]);
+      P->ph_f[j] = fmax(P->ph_f[j], P->force[j]);
+    }
+  int st = martello_run_track(P->run, t, P->u, P->v, P->a, P->pen, P->force);
+  if (st != MARTELLO_OK) return fail(P, st, "IDA: could not track the peaks");
+  if (record) {
+    double e[MARTELLO_NENERGY];
+    energy_vector(P, e);
+    contact_forces(P, y, P->force, 1);
+    st = martello_run_record(P->run, t, P->u, P->v, P->a, P->pen, P->force, e);
+    if (st != MARTELLO_OK) return fail(P, st, "IDA: could not record the history");
+  }
+  return MARTELLO_OK;
+}
+
+/* Work of the external and internal forces over [t0, t1] on the step's interpolant,
+ * 3-point Gauss-Legendre (order 6), with the link states committed at t0 (as IDA's residuals
+ * saw them). */
+static int work_quadrature(ida_problem *P, void *mem, double t0, double t1, N_Vector ytmp) {
+  static const double xg[3] = {-0.7745966692414834, 0.0, 0.7745966692414834};
+  static const double wg[3] = {5.0 / 18.0, 8.0 / 18.0, 5.0 / 18.0};
+  if (!(t1 > t0)) return MARTELLO_OK;
+  double h = t1 - t0, we = 0.0, wi = 0.0;
+  for (int k = 0; k < 3; k++) {
+    double tk = t0 + 0.5 * h * (1.0 + xg[k]);
+    int flag = IDAGetDky(mem, tk, 0, ytmp);
+    if (flag != IDA_SUCCESS)
+      return fail(P, MARTELLO_ERR_EXTERNAL, "IDAGetDky failed at t = %.9e s: %s", tk,
+                  IDAGetReturnFlagName(flag));
+    gather(P, N_VGetArrayPointer(ytmp), P->uq, P->vq);
+    int st = martello_eval_forces(P->ev, tk, P->uq, P->vq, P->fint, P->fext);
+    if (st != MARTELLO_OK) return fail(P, st, "IDA: force evaluation failed at t = %.9e s", tk);
+    double pe = 0.0, pi = 0.0;
+    for (int i = 0; i < P->n; i++) {
+      if (P->fixed[i]) continue;
+      pe += P->fext[i] * P->vq[i];
+      pi += P->fint[i] * P->vq[i];
+    }
+    we += wg[k] * pe;
+    wi += wg[k] * pi;
+  }
+  P->w_ext += h * we;
+  P->w_int += h * wi;
+  P->w_abs += fabs(h * we);
+  return MARTELLO_OK;
+}
+
+/* ---- contact events ------------------------------------------------------------------- */
+
+/* The impulse-level LCP of the contacts in aset[0..m): impulses p >= 0 with post-impact rates
+ * delta'+ = delta'- - S p and complementarity  S p - q >= 0 (delta'+ <= -e delta'-)  ⊥  p >= 0,
+ * q_k = (1 + e_k) delta'-_k for an approaching contact, delta'-_k otherwise. Solved by an
+ * active-set (principal pivoting) iteration on the small dense Delassus matrix P->S. */
+static int impulse_lcp(ida_problem *P, int m, const double *q, double *p) {
+  int *in = P->cand + P->nr; /* second half of the work array */
+  double qmax = 0.0;
+  for (int k = 0; k < m; k++) {
+    in[k] = q[k] > 0.0;
+    qmax = fmax(qmax, fabs(q[k]));
+  }
+  double tol = 64.0 * DBL_EPSILON * qmax;
+  for (int it = 0; it < 4 * m + 16; it++) {
+    int mi = 0;
+    for (int k = 0; k < m; k++) {
+      p[k] = 0.0;
+      if (in[k]) P->map[mi++] = k;
+    }
+    for (int a = 0; a < mi; a++) {
+      P->rhs[a] = q[P->map[a]];
+      for (int c = 0; c < mi; c++) P->S2[a * mi + c] = P->S[P->map[a] * m + P->map[c]];
+    }
+    if (mi > 0 && small_solve(mi, P->S2, P->rhs) != 0) return -1;
+    int worst = -1;
+    double vmin = -tol;
+    for (int a = 0; a < mi; a++) {
+      p[P->map[a]] = P->rhs[a];
+      if (P->rhs[a] < vmin) {
+        vmin = P->rhs[a];
+        worst = P->map[a];
+      }
+    }
+    if (worst >= 0) {
+      in[worst] = 0;
+      continue;
+    }
+    for (int k = 0; k < m; k++) {
+      if (in[k]) continue;
+      double w = -q[k];
+      for (int c = 0; c < m; c++) w += P->S[k * m + c] * p[c];
+      if (w < vmin) {
+        vmin = w;
+        worst = k;
+      }
+    }
+    if (worst < 0) {
+      for (int k = 0; k < m; k++) p[k] = fmax(p[k], 0.0);
+      return 0;
+    }
+    in[worst] = 1;
+  }
+  return -1;
+}
+
+/* Newton's impact law on the rigid contacts that touch (closed, flagged ACT_IMPACT, or open
+ * at zero gap within the position tolerance), all at once through impulse_lcp (simultaneous
+ * impacts in a chain), restitution e (0 for a closed contact). P->hit and P->w_in say which
+ * contacts took an impulse and their approach speed. Then the closing rule and, for the
+ * closed set, zero rates and positions. */
+static int rigid_impacts(ida_problem *P, double t, double *u, double *v) {
+  int st, m = 0;
+  for (int r = 0; r < P->nr; r++) {
+    int j = P->rig_con[r];
+    P->hit[r] = 0;
+    P->cand[r] = P->closed[r] || P->act[j] == ACT_IMPACT || penetration(P, j, u) >= -height_tol(P, j, u);
+    if (P->cand[r]) P->aset[m++] = r;
+  }
+  if (m > 0) {
+    if ((st = delassus(P, m)) != MARTELLO_OK) return fail(P, st, "IDA: singular mass at an impact");
+    for (int k = 0; k < m; k++) {
+      int r = P->aset[k], j = P->rig_con[r];
+      double w = pen_rate(P, j, v), e = P->closed[r] ? 0.0 : (P->rest[j] >= 0.0 ? P->rest[j] : 0.0);
+      P->q[k] = w > 0.0 ? (1.0 + e) * w : w;
+    }
+    if (impulse_lcp(P, m, P->q, P->lam) != 0)
+      return fail(P, MARTELLO_ERR_NOT_CONVERGED, "IDA: the impact LCP of %d contacts did not settle at t = %.9e s", m, t);
+    for (int k = 0; k < m; k++) {
+      int r = P->aset[k], j = P->rig_con[r];
+      if (P->lam[k] > 0.0 && !P->closed[r]) {
+        P->hit[r] = 1;
+        P->w_in[j] = pen_rate(P, j, v);
+        if (P->act[j] != ACT_IMPACT) P->events++;
+      }
+    }
+    memset(P->x, 0, sizeof(double) * (size_t)P->n);
+    for (int k = 0; k < m; k++) {
+      int j = P->rig_con[P->aset[k]];
+      if (P->con_a[j] >= 0) P->x[P->con_a[j]] += P->lam[k];
+      if (P->con_b[j] >= 0) P->x[P->con_b[j]] -= P->lam[k];
+    }
+    if ((st = martello_eval_solve_mass(P->ev, P->x)) != MARTELLO_OK) return fail(P, st, "IDA: singular mass at an impact");
+    for (int i = 0; i < P->n; i++) v[i] -= P->x[i];
+    /* a closed contact that the impact sets apart (p = 0, separating) opens */
+    double vtol = speed_tol(P, v);
+    for (int r = 0; r < P->nr; r++)
+      if (P->closed[r] && pen_rate(P, P->rig_con[r], v) < -vtol) {
+        P->closed[r] = 0;
+        P->opened[r] = 1;
+      }
+  }
+  /* closing: e = 0, or a rebound whose flight height v^2/(2 a_n) is below the position
+   * tolerance (Zeno accumulation) */
+  int have_a = 0;
+  for (int r = 0; r < P->nr; r++) {
+    int j = P->rig_con[r];
+    if (P->closed[r] || !(P->hit[r] || P->act[j] == ACT_IMPACT)) continue;
+    if (!have_a) {
+      st = martello_eval_acceleration(P->ev, t, u, v, P->a);
+      if (st != MARTELLO_OK) return fail(P, st, "IDA: acceleration failed at t = %.9e s", t);
+      have_a = 1;
+    }
+    /* tentative: rigid_multipliers opens it again if its multiplier comes out tensile (the
+     * free normal acceleration a_n ignores the other closed contacts) */
+    double an = dot_B(P, j, P->a), rebound = -pen_rate(P, j, v);
+    double e = P->rest[j] >= 0.0 ? P->rest[j] : 0.0;
+    double thr = sqrt(2.0 * fabs(an) * height_tol(P, j, u));
+    if (e == 0.0 || rebound < thr) P->closed[r] = 1;
+  }
+  m = closed_set(P);
+  if (m == 0) return MARTELLO_OK;
+  /* zero the rates of the closed set (for a closing rebound below the threshold this removes
+   * an unresolvable bounce: its energy goes to E_IMPACT), then put it on delta = 0 by the
+   * mass-weighted projection u -= M^-1 B S^-1 delta */
+  for (int pass = 0; pass < 2; pass++) {
+    if ((st = delassus(P, m)) != MARTELLO_OK) return fail(P, st, "IDA: singular mass in the constraint projection");
+    for (int k = 0; k < m; k++) {
+      int j = P->rig_con[P->aset[k]];
+      P->rhs[k] = pass == 0 ? pen_rate(P, j, v) : penetration(P, j, u);
+    }
+    if (small_solve(m, P->S, P->rhs) != 0)
+      return fail(P, MARTELLO_ERR_SINGULAR, "IDA: redundant closed contacts at t = %.9e s (B^T M^-1 B singular)", t);
+    for (int r = 0; r < P->nr; r++) P->lam[r] = 0.0;
+    for (int k = 0; k < m; k++) P->lam[P->aset[k]] = P->rhs[k];
+    apply_B(P, P->lam, P->x);
+    if ((st = martello_eval_solve_mass(P->ev, P->x)) != MARTELLO_OK) return fail(P, st, "IDA: singular mass");
+    double *z = pass == 0 ? v : u;
+    for (int i = 0; i < P->n; i++) z[i] -= P->x[i];
+  }
+  return MARTELLO_OK;
+}
+
+/* Multipliers of the closed set from the acceleration-level constraint S P = B^T a_free;
+ * a contact whose P comes out tensile opens (active-set iteration on the small LCP). Leaves
+ * a_free in P->a and the multipliers in P->lam. */
+static int rigid_multipliers(ida_problem *P, double t, double *u, double *v) {
+  int st = martello_eval_acceleration(P->ev, t, u, v, P->a);
+  if (st != MARTELLO_OK) return fail(P, st, "IDA: acceleration failed at t = %.9e s", t);
+  for (int r = 0; r < P->nr; r++) P->lam[r] = 0.0;
+  for (int it = 0; it <= P->nr; it++) {
+    int m = closed_set(P);
+    if (m == 0) return MARTELLO_OK;
+    if ((st = delassus(P, m)) != MARTELLO_OK) return fail(P, st, "IDA: singular mass");
+    for (int k = 0; k < m; k++) P->rhs[k] = dot_B(P, P->rig_con[P->aset[k]], P->a);
+    if (small_solve(m, P->S, P->rhs) != 0)
+      return fail(P, MARTELLO_ERR_SINGULAR, "IDA: redundant closed contacts at t = %.9e s (B^T M^-1 B singular)", t);
+    int worst = -1;
+    double pmin = 0.0;
+    for (int k = 0; k < m; k++)
+      if (P->rhs[k] < pmin) {
+        pmin = P->rhs[k];
+        worst = P->aset[k];
+      }
+    if (worst < 0) {
+      for (int r = 0; r < P->nr; r++) P->lam[r] = 0.0;
+      for (int k = 0; k < m; k++) P->lam[P->aset[k]] = P->rhs[k];
+      return MARTELLO_OK;
+    }
+    P->closed[worst] = 0;
+    P->opened[worst] = 1;
+  }
+  return fail(P, MARTELLO_ERR_NOT_CONVERGED, "IDA: active set of the closed contacts did not settle at t = %.9e s", t);
+}
+
+static int add_event(ida_problem *P, int j, double t_on, double t_off, double v_in, double v_out,
+                     double pen_max, double f_max) {
+  double ev[MARTELLO_NEVENT] = {t_on, t_off, v_in, v_out, pen_max, f_max};
+  int st = martello_run_add_event(P->run, j, ev);
+  return st == MARTELLO_OK ? st : fail(P, st, "IDA: could not add an event");
+}
+
+static void open_phase(ida_problem *P, int j, double t, double v_in) {
+  P->touching[j] = 1;
+  P->ph_t[j] = t;
+  P->ph_v[j] = v_in;
+  P->ph_pen[j] = 0.0;
+  P->ph_f[j] = 0.0;
+}
+
+/* Make the state at a restart consistent with the actions in P->act: penalty regimes,
+ * impacts, closings, releases; commit; multipliers; y and y' for IDA. u, v hold the state. */
+static int prepare_restart(ida_problem *P, double t, double *u, double *v, N_Vector yy,
+                           N_Vector yp) {
+  int st, any_rigid = 0;
+  double ke0 = 0.0, ke1 = 0.0, dummy;
+  if ((st = martello_eval_energy(P->ev, u, v, &ke0, &dummy)) != MARTELLO_OK)
+    return fail(P, st, "IDA: energy evaluation failed");
+  for (int r = 0; r < P->nr; r++) P->opened[r] = 0;
+  for (int j = 0; j < P->nc; j++) {
+    int r = P->rig[j];
+    double w = pen_rate(P, j, v);
+    switch (P->act[j]) {
+    case ACT_ONSET:
+      nudge(P, j, +1, u);
+      open_phase(P, j, t, w);
+      P->events++;
+      break;
+    case ACT_SEPARATION:
+      nudge(P, j, -1, u);
+      P->touching[j] = 0;
+      if ((st = add_event(P, j, P->ph_t[j], t, P->ph_v[j], w, P->ph_pen[j], P->ph_f[j])) != MARTELLO_OK) return st;
+      P->events++;
+      break;
+    case ACT_IMPACT:
+      P->w_in[j] = w;
+      any_rigid = 1;
+      P->events++;
+      break;
+    case ACT_RELEASE:
+      P->closed[r] = 0;
+      P->touching[j] = 0;
+      nudge(P, j, -1, u);
+      if ((st = add_event(P, j, P->ph_t[j], t, P->ph_v[j], w, P->ph_pen[j], P->ph_f[j])) != MARTELLO_OK) return st;
+      any_rigid = 1;
+      P->events++;
+      break;
+    default:
+      break;
+    }
+  }
+  for (int r = 0; r < P->nr; r++) {
+    P->was_closed[r] = P->closed[r];
+    P->hit[r] = 0;
+  }
+  if (any_rigid && (st = rigid_impacts(P, t, u, v)) != MARTELLO_OK) return st;
+  /* rebounding (not closed) contacts leave from delta < 0 so that the gap root sees the
+   * next approach as a sign change */
+  for (int r = 0; r < P->nr; r++) {
+    int j = P->rig_con[r];
+    if ((P->hit[r] || P->act[j] == ACT_IMPACT) && !P->closed[r]) nudge(P, j, -1, u);
+  }
+  if ((st = martello_eval_commit(P->ev, u, v)) != MARTELLO_OK) return fail(P, st, "IDA: commit failed");
+  if (P->nr > 0 && (st = rigid_multipliers(P, t, u, v)) != MARTELLO_OK) return st;
+  if (P->nr == 0 && (st = martello_eval_acceleration(P->ev, t, u, v, P->a)) != MARTELLO_OK)
+    return fail(P, st, "IDA: acceleration failed at t = %.9e s", t);
+  for (int r = 0; r < P->nr; r++) {
+    int j = P->rig_con[r];
+    if (P->opened[r]) nudge(P, j, -1, u);
+    if ((P->hit[r] || P->act[j] == ACT_IMPACT) && !P->was_closed[r]) {
+      double w_in = P->hit[r] ? P->w_in[j] : 0.0;
+      if (P->closed[r]) {
+        open_phase(P, j, t, w_in);
+      } else if (P->hit[r] &&
+                 (st = add_event(P, j, t, t, w_in, pen_rate(P, j, v), 0.0, 0.0)) != MARTELLO_OK) {
+        return st;
+      }
+    } else if (P->opened[r] && P->touching[j]) {
+      P->touching[j] = 0;
+      if ((st = add_event(P, j, P->ph_t[j], t, P->ph_v[j], pen_rate(P, j, v), P->ph_pen[j], P->ph_f[j])) != MARTELLO_OK) return st;
+    }
+  }
+  if ((st = martello_eval_energy(P->ev, u, v, &ke1, &dummy)) != MARTELLO_OK)
+    return fail(P, st, "IDA: energy evaluation failed");
+  P->e_impact += ke0 - ke1;
+  /* y and y' */
+  double *y = N_VGetArrayPointer(yy), *d = N_VGetArrayPointer(yp);
+  apply_B(P, P->lam, P->x);
+  if (P->nr > 0 && (st = martello_eval_solve_mass(P->ev, P->x)) != MARTELLO_OK) return fail(P, st, "IDA: singular mass");
+  for (int i = 0; i < P->n; i++) {
+    y[P->iu[i]] = u[i];
+    y[P->iv[i]] = v[i];
+    d[P->iu[i]] = v[i];
+    d[P->iv[i]] = P->a[i] - (P->nr > 0 ? P->x[i] : 0.0);
+  }
+  for (int r = 0; r < P->nr; r++) {
+    y[P->ip[r]] = P->closed[r] ? P->lam[r] : 0.0;
+    y[P->im[r]] = 0.0;
+    d[P->ip[r]] = 0.0;
+    d[P->im[r]] = 0.0;
+  }
+  for (int j = 0; j < P->nc; j++) P->act[j] = ACT_NONE;
+  return energies(P, u, v);
+}
+
+/* Bisection on the interpolant of the current step for the crossing of delta_j between
+ * tl (side sl = sign of delta there) and tr; returns a time on the tl side within event_tol. */
+static int locate(ida_problem *P, void *mem, int j, double tl, double tr, N_Vector ytmp,
+                  double *t_cross) {
+  int flag = IDAGetDky(mem, tl, 0, ytmp);
+  if (flag != IDA_SUCCESS)
+    return fail(P, MARTELLO_ERR_EXTERNAL, "IDAGetDky failed at t = %.9e s: %s", tl, IDAGetReturnFlagName(flag));
+  gather(P, N_VGetArrayPointer(ytmp), P->uq, P->vq);
+  int left_positive = penetration(P, j, P->uq) > 0.0;
+  for (int it = 0; it < 200 && tr - tl > fmax(P->event_tol, 4.0 * DBL_EPSILON * fabs(tr)); it++) {
+    double tm = 0.5 * (tl + tr);
+    flag = IDAGetDky(mem, tm, 0, ytmp);
+    if (flag != IDA_SUCCESS)
+      return fail(P, MARTELLO_ERR_EXTERNAL, "IDAGetDky failed at t = %.9e s: %s", tm, IDAGetReturnFlagName(flag));
+    gather(P, N_VGetArrayPointer(ytmp), P->uq, P->vq);
+    if ((penetration(P, j, P->uq) > 0.0) == left_positive)
+      tl = tm;
+    else
+      tr = tm;
+  }
+  *t_cross = tl;
+  return MARTELLO_OK;
+}
+
+/* Decide what the roots reported at tret mean. Returns 1 (and *t_r, P->act) if IDA must
+ * restart, 0 if the roots were only extrema of gaps, < 0 on failure. */
+static int classify_roots(ida_problem *P, void *mem, double t_last, double tret, const double *y,
+                          const int *found, N_Vector ytmp, double *t_r) {
+  gather(P, y, P->u, P->v);
+  double best = tret;
+  int jbest = -1, kbest = ACT_NONE;
+  /* extrema of gaps: peaks, and contacts that opened and closed inside one step */
+  for (int j = 0; j < P->nc; j++) {
+    int r = P->rig[j];
+    if (!found[2 * j + 1] || found[2 * j]) continue;
+    if (r >= 0 && P->closed[r]) continue;
+    double d = penetration(P, j, P->u);
+    int want = ACT_NONE;
+    if (r < 0) {
+      if (P->touching[j] && d > 0.0) P->ph_pen[j] = fmax(P->ph_pen[j], d); /* exact peak */
+      else if (!P->touching[j] && d > 0.0) want = ACT_ONSET;
+      else if (P->touching[j] && d < 0.0) want = ACT_SEPARATION;
+    } else if (d > 0.0) {
+      want = ACT_IMPACT;
+    }
+    if (want == ACT_NONE) continue;
+    double tc;
+    int st = locate(P, mem, j, t_last, tret, ytmp, &tc);
+    if (st != MARTELLO_OK) return st;
+    if (jbest < 0 || tc < best) {
+      best = tc;
+      jbest = j;
+      kbest = want;
+    }
+  }
+  if (jbest >= 0) {
+    P->act[jbest] = kbest;
+    *t_r = best;
+    return 1;
+  }
+  int any = 0;
+  for (int j = 0; j < P->nc; j++) {
+    int r = P->rig[j], dir = found[2 * j];
+    if (dir == 0) continue;
+    if (r < 0) {
+      if (dir > 0 && !P->touching[j]) P->act[j] = ACT_ONSET;
+      else if (dir < 0 && P->touching[j]) P->act[j] = ACT_SEPARATION;
+    } else if (!P->closed[r]) {
+      if (dir > 0) P->act[j] = ACT_IMPACT;
+    } else if (dir < 0) {
+      P->act[j] = ACT_RELEASE;
+    }
+    any |= P->act[j] != ACT_NONE;
+  }
+  *t_r = tret;
+  return any;
+}
+
+/* A reported root whose function is exactly 0 at the return stays 0 when two nodes move
+ * identically (identical neighbours never touch, PROBLEMS.md P7; rigid clusters of a chain):
+ * IDA would stop on it again at once and fail with "root found at and very near t". A
+ * restart with no event lets IDA treat it as inactive until it moves away from 0. */
+static int root_stays_zero(ida_problem *P, const double *y, const int *found) {
+  gather(P, y, P->uq, P->vq);
+  for (int j = 0; j < P->nc; j++) {
+    int r = P->rig[j];
+    if (r >= 0 && P->closed[r]) {
+      if (found[2 * j] && y[P->ip[r]] == 0.0) return 1;
+    } else if ((found[2 * j] && penetration(P, j, P->uq) == 0.0) ||
+               (found[2 * j + 1] && pen_rate(P, j, P->vq) == 0.0)) {
+      return 1;
+    }
+  }
+  return 0;
+}
+
+/* After a step that ended without a root: a contact whose gap lies on the wrong side of its
+ * regime (an analytic event time that coincides with a stop time lands exactly on
+ * delta = 0, where IDA reports no sign change, and the kink would then sit at the start of
+ * every following step). Returns 1 with P->act and *t_r set if IDA must restart. */
+static int boundary_events(ida_problem *P, void *mem, double t_last, double tret, const double *y,
+                           N_Vector ytmp, double *t_r) {
+  gather(P, y, P->u, P->v);
+  double best = tret, h_last = 0.0;
+  int jbest = -1, kbest = ACT_NONE;
+  if (IDAGetLastStep(mem, &h_last) != IDA_SUCCESS) h_last = 0.0;
+  double vmax = 0.0;
+  for (int i = 0; i < P->n; i++) vmax = fmax(vmax, fabs(P->v[i]));
+  double wtol = 10.0 * (P->rtol * vmax + P->atol);
+  for (int j = 0; j < P->nc; j++) {
+    int r = P->rig[j], want = ACT_NONE;
+    if (r >= 0 && P->closed[r]) continue;
+    double d = penetration(P, j, P->u), w = pen_rate(P, j, P->v);
+    /* on the surface within round-off of the gap, or of the time */
+    double on = 64.0 * DBL_EPSILON *
+                (fabs(node_u(P->con_a[j], P->u)) + fabs(node_u(P->con_b[j], P->u)) + fabs(P->gap[j]) +
+                 fabs(w) * (fabs(tret) + fabs(h_last)));
+    /* ... and moving across it faster than the integration error of a rate: two bodies
+     * that travel together at zero gap are not a new event */
+    if (r < 0) {
+      if (!P->touching[j] && (d > 0.0 || (d >= -on && w > wtol))) want = ACT_ONSET;
+      else if (P->touching[j] && (d < 0.0 || (d <= on && w < -wtol))) want = ACT_SEPARATION;
+    } else if (d > 0.0 || (d >= -on && w > wtol)) {
+      want = ACT_IMPACT;
+    }
+    if (want == ACT_NONE) continue;
+    double tc = tret;
+    int wrong_side = r < 0 ? (P->touching[j] ? d < 0.0 : d > 0.0) : d > 0.0;
+    if (wrong_side && fabs(d) > on && tret > t_last) {
+      int st = locate(P, mem, j, t_last, tret, ytmp, &tc);
+      if (st != MARTELLO_OK) return st;
+    }
+    if (jbest < 0 || tc < best) {
+      best = tc;
+      jbest = j;
+      kbest = want;
+    }
+  }
+  if (jbest < 0) return 0;
+  P->act[jbest] = kbest;
+  *t_r = best;
+  return 1;
+}
+
+/* ---- set-up ----------------------------------------------------------------------------- */
+
+static void *take(size_t count, size_t size, int *ok) {
+  void *p = calloc(count > 0 ? count : 1, size);
+  if (!p) *ok = 0;
+  return p;
+}
+
+static void release(ida_problem *P) {
+  void *all[] = {P->mass, P->gap, P->rest, P->fixed, P->con_a, P->con_b, P->scheme, P->rig,
+                 P->rig_con, P->iu, P->iv, P->ip, P->im, P->closed, P->touching, P->act,
+                 P->opened, P->was_closed, P->hit, P->cand, P->map, P->q, P->S2, P->w_in, P->u, P->v, P->a, P->x, P->uq, P->vq, P->fint, P->fext,
+                 P->pen, P->rate, P->force, P->lam, P->S, P->rhs, P->mb, P->aset, P->ph_t,
+                 P->ph_v, P->ph_pen, P->ph_f};
+  for (size_t k = 0; k < sizeof all / sizeof all[0]; k++) free(all[k]);
+  if (P->ev) martello_eval_free(&P->ev);
+}
+
+/* Half-bandwidth of the Jacobian in the interleaved layout: the node couplings are probed
+ * (which accelerations change when one node's u or v does, at the initial state) and
+ * completed with the contacts of the topology (penalty contacts are open at t = 0). */
+static int bandwidth(ida_problem *P, const double *u0, const double *v0, sunindextype *bw) {
+  int n = P->n, st, dnode = 0;
+  double *base = P->a, *pert = P->fint, *up = P->uq, *vp = P->vq;
+  if ((st = martello_eval_acceleration(P->ev, 0.0, u0, v0, base)) != MARTELLO_OK) return st;
+  memcpy(up, u0, sizeof(double) * (size_t)n);
+  memcpy(vp, v0, sizeof(double) * (size_t)n);
+  for (int k = 0; k < n; k++) {
+    if (P->fixed[k]) continue;
+    /* u_k and v_k together: a stiffness or a damping coupling shows either way */
+    up[k] += 1e-6 * (fabs(up[k]) + 1.0);
+    vp[k] += 1e-6 * (fabs(vp[k]) + 1.0);
+    if ((st = martello_eval_acceleration(P->ev, 0.0, up, vp, pert)) != MARTELLO_OK) return st;
+    for (int i = 0; i < n; i++)
+      if (pert[i] != base[i]) dnode = abs(i - k) > dnode ? abs(i - k) : dnode;
+    up[k] = u0[k];
+    vp[k] = v0[k];
+  }
+  for (int j = 0; j < P->nc; j++)
+    if (P->con_a[j] >= 0 && P->con_b[j] >= 0 && P->rig[j] < 0)
+      dnode = abs(P->con_a[j] - P->con_b[j]) > dnode ? abs(P->con_a[j] - P->con_b[j]) : dnode;
+  sunindextype b = 1;
+#define WIDEN(p, q) do { sunindextype d_ = (p) > (q) ? (p) - (q) : (q) - (p); if (d_ > b) b = d_; } while (0)
+  for (int i = 0; i < n; i++)
+    for (int k = i - dnode; k <= i + dnode; k++) {
+      if (k < 0 || k >= n) continue;
+      WIDEN(P->iv[i], P->iu[k]);
+      WIDEN(P->iv[i], P->iv[k]);
+    }
+  for (int r = 0; r < P->nr; r++) {
+    int j = P->rig_con[r], ends[2] = {P->con_a[j], P->con_b[j]};
+    for (int e = 0; e < 2; e++) {
+      if (ends[e] < 0) continue;
+      WIDEN(P->ip[r], P->iv[ends[e]]);
+      WIDEN(P->im[r], P->iu[ends[e]]);
+    }
+  }
+#undef WIDEN
+  *bw = b;
+  return MARTELLO_OK;
+}
+
+static int setup(ida_problem *P, martello_model *model, martello_run *run) {
+  int st, ok = 1, kind, n, nc, ncp;
+  double par[MARTELLO_NPAR_INTEGRATOR];
+  P->model = model;
+  P->run = run;
+  if ((st = martello_run_settings(run, &kind, par)) != MARTELLO_OK) return st;
+  P->rtol = par[MARTELLO_R_RTOL];
+  P->atol = par[MARTELLO_R_ATOL];
+  P->event_tol = par[MARTELLO_R_EVENT_TOL] > 0.0 ? par[MARTELLO_R_EVENT_TOL] : 1e-12;
+  P->t_end = par[MARTELLO_R_T_END];
+  P->h_max = par[MARTELLO_R_H_MAX];
+  P->out_dt = par[MARTELLO_R_DT] * (par[MARTELLO_R_EVERY] >= 1.0 ? par[MARTELLO_R_EVERY] : 1.0);
+  P->divergence_factor = par[MARTELLO_R_DIVERGENCE_FACTOR];
+  if (!(P->rtol >= 0.0 && P->atol >= 0.0 && P->rtol + P->atol > 0.0))
+    return fail(P, MARTELLO_ERR_ARGUMENT, "IDA needs rtol >= 0 and atol >= 0, not both 0");
+  if (!(P->t_end > 0.0 && P->out_dt > 0.0))
+    return fail(P, MARTELLO_ERR_ARGUMENT, "IDA needs t_end > 0 and an output interval dt > 0");
+  if ((st = martello_model_topology(model, &n, &nc, NULL, NULL, NULL, NULL, NULL, NULL, NULL,
+                                    &ncp)) != MARTELLO_OK)
+    return fail(P, st, "IDA: could not read the model");
+  P->n = n;
+  P->nc = nc;
+  P->ncoupling = ncp;
+  P->mass = take((size_t)n, sizeof(double), &ok);
+  P->fixed = take((size_t)n, sizeof(int), &ok);
+  P->con_a = take((size_t)nc, sizeof(int), &ok);
+  P->con_b = take((size_t)nc, sizeof(int), &ok);
+  P->scheme = take((size_t)nc, sizeof(int), &ok);
+  P->gap = take((size_t)nc, sizeof(double), &ok);
+  P->rest = take((size_t)nc, sizeof(double), &ok);
+  if (!ok) return fail(P, MARTELLO_ERR_MEMORY, "IDA: out of memory");
+  if ((st = martello_model_topology(model, &n, &nc, P->mass, P->fixed, P->con_a, P->con_b,
+                                    P->scheme, P->gap, P->rest, &ncp)) != MARTELLO_OK)
+    return fail(P, st, "IDA: could not read the model");
+  P->rig = take((size_t)nc, sizeof(int), &ok);
+  P->rig_con = take((size_t)nc, sizeof(int), &ok);
+  if (!ok) return fail(P, MARTELLO_ERR_MEMORY, "IDA: out of memory");
+  P->nr = 0;
+  for (int j = 0; j < nc; j++) {
+    if (P->scheme[j] == MARTELLO_SCHEME_LAGRANGE || P->scheme[j] == MARTELLO_SCHEME_RESTITUTION) {
+      P->rig[j] = P->nr;
+      P->rig_con[P->nr++] = j;
+    } else if (P->scheme[j] == MARTELLO_SCHEME_PENALTY) {
+      P->rig[j] = -1;
+    } else {
+      return fail(P, MARTELLO_ERR_UNSUPPORTED, "contact %d: this scheme cannot run on IDA", j);
+    }
+  }
+  size_t nr = (size_t)P->nr, un = (size_t)n, ucn = (size_t)nc;
+  P->iu = take(un, sizeof(sunindextype), &ok);
+  P->iv = take(un, sizeof(sunindextype), &ok);
+  P->ip = take(nr, sizeof(sunindextype), &ok);
+  P->im = take(nr, sizeof(sunindextype), &ok);
+  P->closed = take(nr, sizeof(int), &ok);
+  P->opened = take(nr, sizeof(int), &ok);
+  P->was_closed = take(nr, sizeof(int), &ok);
+  P->hit = take(nr, sizeof(int), &ok);
+  P->cand = take(2 * nr, sizeof(int), &ok);
+  P->map = take(nr, sizeof(int), &ok);
+  P->q = take(nr, sizeof(double), &ok);
+  P->S2 = take(nr * nr, sizeof(double), &ok);
+  P->aset = take(nr, sizeof(int), &ok);
+  P->lam = take(nr, sizeof(double), &ok);
+  P->rhs = take(nr, sizeof(double), &ok);
+  P->S = take(nr * nr, sizeof(double), &ok);
+  P->touching = take(ucn, sizeof(int), &ok);
+  P->act = take(ucn, sizeof(int), &ok);
+  P->w_in = take(ucn, sizeof(double), &ok);
+  P->pen = take(ucn, sizeof(double), &ok);
+  P->rate = take(ucn, sizeof(double), &ok);
+  P->force = take(ucn, sizeof(double), &ok);
+  P->ph_t = take(ucn, sizeof(double), &ok);
+  P->ph_v = take(ucn, sizeof(double), &ok);
+  P->ph_pen = take(ucn, sizeof(double), &ok);
+  P->ph_f = take(ucn, sizeof(double), &ok);
+  double **work[] = {&P->u, &P->v, &P->a, &P->x, &P->uq, &P->vq, &P->fint, &P->fext, &P->mb};
+  for (size_t k = 0; k < sizeof work / sizeof work[0]; k++) *work[k] = take(un, sizeof(double), &ok);
+  if (!ok) return fail(P, MARTELLO_ERR_MEMORY, "IDA: out of memory");
+  /* layout: node i's (u, v), then the (P, mu) of the rigid contacts whose first node is i
+   * (between the two nodes of a chain link: half-bandwidth 3, 5 with links) */
+  sunindextype pos = 0;
+  for (int i = 0; i < n; i++) {
+    P->iu[i] = pos++;
+    P->iv[i] = pos++;
+    for (int r = 0; r < P->nr; r++) {
+      int j = P->rig_con[r], a = P->con_a[j], b = P->con_b[j];
+      int first = (a >= 0 && b >= 0) ? (a < b ? a : b) : (a > b ? a : b);
+      if (first == i) {
+        P->ip[r] = pos++;
+        P->im[r] = pos++;
+      }
+    }
+  }
+  P->N = pos;
+  if ((st = martello_eval_create(model, &P->ev)) != MARTELLO_OK)
+    return fail(P, st, "IDA: could not create the force evaluator");
+  return MARTELLO_OK;
+}
+
+/* ---- the run ------------------------------------------------------------------------------ */
+
+static int check(ida_problem *P, int flag, const char *call) {
+  if (flag >= 0) return MARTELLO_OK;
+  return fail(P, MARTELLO_ERR_EXTERNAL, "%s failed: %s", call, IDAGetReturnFlagName(flag));
+}
+
+static int integrate(ida_problem *P, SUNContext sunctx, void **memp, N_Vector yy, N_Vector yp,
+                     N_Vector id, N_Vector ytmp, SUNMatrix *Jp, SUNLinearSolver *LSp,
+                     double *t_reached) {
+  int st, n = P->n;
+  double *u0 = P->u, *v0 = P->v;
+  *t_reached = 0.0;
+  if ((st = martello_model_initial_state(P->model, u0, v0)) != MARTELLO_OK)
+    return fail(P, st, "IDA: could not read the initial state");
+  for (int i = 0; i < n; i++)
+    if (P->fixed[i]) v0[i] = 0.0;
+
+  /* linear solver: band in the interleaved layout when it pays (chains), dense otherwise or
+   * with consistent-mass couplings (M^-1 is full) */
+  sunindextype bw = P->N;
+  if (P->ncoupling == 0 && P->N > 8 && (st = bandwidth(P, u0, v0, &bw)) != MARTELLO_OK)
+    return fail(P, st, "IDA: force evaluation failed while probing the bandwidth");
+  int banded = 2 * bw + 1 < P->N / 2;
+
+  /* initial contact states: penalty contacts already penetrated are in a phase from t = 0;
+   * rigid contacts at zero gap that approach or rest are resolved as impacts at t = 0 */
+  double vtol = speed_tol(P, v0);
+  for (int j = 0; j < P->nc; j++) {
+    double d = penetration(P, j, u0), w = pen_rate(P, j, v0);
+    if (P->rig[j] < 0) {
+      if (d > 0.0) open_phase(P, j, 0.0, w);
+      else if (d == 0.0 && w > 0.0) P->act[j] = ACT_ONSET;
+    } else {
+      double htol = height_tol(P, j, u0);
+      if (d > htol)
+        return fail(P, MARTELLO_ERR_ARGUMENT, "contact %d starts penetrated by %.3e m (rigid contacts need delta <= 0 at t = 0)", j, d);
+      if (d >= -htol && w >= -vtol) P->act[j] = ACT_IMPACT;
+    }
+  }
+  if ((st = martello_eval_energy(P->ev, u0, v0, &P->e_kin, &P->erec0)) != MARTELLO_OK)
+    return fail(P, st, "IDA: energy evaluation failed");
+  P->e0 = P->e_kin + P->erec0;
+  P->e_rec = P->erec0;
+  if ((st = prepare_restart(P, 0.0, u0, v0, yy, yp)) != MARTELLO_OK) return st;
+
+  /* IDA: create, init, options (SUNDIALS lifecycle) */
+  void *mem = IDACreate(sunctx);
+  if (!mem) return fail(P, MARTELLO_ERR_MEMORY, "IDACreate failed");
+  *memp = mem;
+  if ((st = check(P, IDASetErrHandlerFn(mem, error_handler, P), "IDASetErrHandlerFn"))) return st;
+  if ((st = check(P, IDAInit(mem, residual, 0.0, yy, yp), "IDAInit"))) return st;
+  /* vector tolerances: atol for u, v and P; the GGL multiplier mu is out of the Newton test.
+   * mu vanishes on the exact solution and only absorbs the round-off of delta = 0, amplified
+   * by c_j ~ 1/h in the index-2 Newton matrix (a node-to-node gap is zero only to ~eps|u|,
+   * which gives mu ~ c_j m eps |u|): judged with atol it would fail every short step. Its
+   * effect on u is tested through u itself. */
+  double *av = N_VGetArrayPointer(id);
+  for (sunindextype k = 0; k < P->N; k++) av[k] = P->atol;
+  for (int r = 0; r < P->nr; r++) av[P->im[r]] = 1e30;
+  if ((st = check(P, IDASVtolerances(mem, P->rtol, id), "IDASVtolerances"))) return st;
+  if ((st = check(P, IDASetUserData(mem, P), "IDASetUserData"))) return st;
+  *Jp = banded ? SUNBandMatrix(P->N, bw, bw, sunctx) : SUNDenseMatrix(P->N, P->N, sunctx);
+  if (!*Jp) return fail(P, MARTELLO_ERR_MEMORY, "IDA: could not create the Jacobian matrix");
+  *LSp = banded ? SUNLinSol_Band(yy, *Jp, sunctx) : SUNLinSol_Dense(yy, *Jp, sunctx);
+  if (!*LSp) return fail(P, MARTELLO_ERR_MEMORY, "IDA: could not create the linear solver");
+  if ((st = check(P, IDASetLinearSolver(mem, *LSp, *Jp), "IDASetLinearSolver"))) return st;
+  if (P->h_max > 0.0 && (st = check(P, IDASetMaxStep(mem, P->h_max), "IDASetMaxStep"))) return st;
+  double *idv = N_VGetArrayPointer(id);
+  for (sunindextype k = 0; k < P->N; k++) idv[k] = 1.0;
+  for (int r = 0; r < P->nr; r++) idv[P->ip[r]] = idv[P->im[r]] = 0.0;
+  if ((st = check(P, IDASetId(mem, id), "IDASetId"))) return st;
+  if (P->nr > 0 && (st = check(P, IDASetSuppressAlg(mem, SUNTRUE), "IDASetSuppressAlg"))) return st;
+  if (P->nc > 0) {
+    if ((st = check(P, IDARootInit(mem, 2 * P->nc, roots), "IDARootInit"))) return st;
+    if ((st = check(P, IDASetNoInactiveRootWarn(mem), "IDASetNoInactiveRootWarn"))) return st;
+  }
+
+  int k_out = 1;
+  double t_out = fmin(P->out_dt, P->t_end), t_last = 0.0;
+  if ((st = track(P, 0.0, N_VGetArrayPointer(yy), N_VGetArrayPointer(yp), 1)) != MARTELLO_OK) return st;
+  if ((st = check(P, IDASetStopTime(mem, t_out), "IDASetStopTime"))) return st;
+  int *found = calloc((size_t)(2 * P->nc + 1), sizeof(int));
+  if (!found) return fail(P, MARTELLO_ERR_MEMORY, "IDA: out of memory");
+  long steps = 0;
+  int same_time = 0;
+  double t_prev_restart = -1.0;
+  st = MARTELLO_OK;
+  while (t_last < P->t_end) {
+    double tret = t_last;
+    int flag = IDASolve(mem, t_out, &tret, yy, yp, IDA_ONE_STEP);
+    if (flag < 0) {
+      double tcur = t_last;
+      if (IDAGetCurrentTime(mem, &tcur) != IDA_SUCCESS) tcur = t_last;
+      if (P->nan_seen)
+        st = fail(P, MARTELLO_ERR_DIVERGED, "IDA diverged at t = %.9e s: non-finite residual (NaN/inf); %s (%s)", tcur, IDAGetReturnFlagName(flag), P->ida_msg);
+      else
+        st = fail(P, MARTELLO_ERR_EXTERNAL, "IDASolve failed at t = %.9e s: %s (%s)", tcur, IDAGetReturnFlagName(flag), P->ida_msg);
+      *t_reached = tcur;
+      break;
+    }
+    P->nan_seen = 0;
+    if (++steps > MAX_STEPS) {
+      st = fail(P, MARTELLO_ERR_NOT_CONVERGED, "IDA: more than %ld steps before t = %.9e s", MAX_STEPS, tret);
+      break;
+    }
+    int restart = 0;
+    double t_r = tret;
+    if (flag == IDA_ROOT_RETURN) {
+      if ((st = check(P, IDAGetRootInfo(mem, found), "IDAGetRootInfo"))) break;
+      restart = classify_roots(P, mem, t_last, tret, N_VGetArrayPointer(yy), found, ytmp, &t_r);
+      if (restart < 0) {
+        st = restart;
+        break;
+      }
+      if (!restart) restart = root_stays_zero(P, N_VGetArrayPointer(yy), found);
+    }
+    if (!restart) {
+      restart = boundary_events(P, mem, t_last, tret, N_VGetArrayPointer(yy), ytmp, &t_r);
+      if (restart < 0) {
+        st = restart;
+        break;
+      }
+    }
+    if (restart && t_r < tret) {
+      int f0 = IDAGetDky(mem, t_r, 0, yy), f1 = IDAGetDky(mem, t_r, 1, yp);
+      if ((st = check(P, f0 < 0 ? f0 : f1, "IDAGetDky"))) break;
+    }
+    if ((st = work_quadrature(P, mem, t_last, t_r, ytmp)) != MARTELLO_OK) break;
+    t_last = t_r;
+    *t_reached = t_r;
+    const double *y = N_VGetArrayPointer(yy);
+    gather(P, y, P->u, P->v);
+    if (!isfinite(P->w_int + P->w_ext)) {
+      st = fail(P, MARTELLO_ERR_DIVERGED, "IDA diverged at t = %.9e s: non-finite state (NaN/inf)", t_r);
+      break;
+    }
+    if (restart) {
+      same_time = t_r - t_prev_restart <= 1e-12 * fmax(fabs(t_r), P->out_dt) ? same_time + 1 : 0;
+      t_prev_restart = t_r;
+      if (same_time > 8 * (P->nc + 2)) {
+        st = fail(P, MARTELLO_ERR_NOT_CONVERGED, "IDA: contact events keep recurring at t = %.9e s without progress", t_r);
+        break;
+      }
+      if ((st = flush_counts(P, mem)) != MARTELLO_OK) break;
+      if ((st = prepare_restart(P, t_r, P->u, P->v, yy, yp)) != MARTELLO_OK) break;
+    } else {
+      if ((st = martello_eval_commit(P->ev, P->u, P->v)) != MARTELLO_OK) {
+        st = fail(P, st, "IDA: commit failed");
+        break;
+      }
+      if ((st = energies(P, P->u, P->v)) != MARTELLO_OK) break;
+    }
+    for (sunindextype k = 0; k < P->N; k++)
+      if (!isfinite(N_VGetArrayPointer(yy)[k])) {
+        st = fail(P, MARTELLO_ERR_DIVERGED, "IDA diverged at t = %.9e s: non-finite state (NaN/inf)", t_r);
+        break;
+      }
+    if (st != MARTELLO_OK) break;
+    double e_mech = P->e_kin + P->e_rec, scale = P->e0 + P->w_abs;
+    if (scale > 0.0 && e_mech > P->divergence_factor * scale) {
+      st = fail(P, MARTELLO_ERR_DIVERGED, "IDA diverged at t = %.9e s: mechanical energy %.3e J exceeds %.3g x (initial energy + input work)", t_r, e_mech, P->divergence_factor);
+      break;
+    }
+    /* an output time reached (tstop), or passed within round-off by a restart */
+    int at_output = (flag == IDA_TSTOP_RETURN && t_r == tret) || t_out - t_r <= 1e-9 * P->out_dt;
+    if ((st = track(P, t_r, N_VGetArrayPointer(yy), N_VGetArrayPointer(yp), at_output)) != MARTELLO_OK) break;
+    if (at_output) {
+      if (t_out >= P->t_end) {
+        t_last = P->t_end;
+        break;
+      }
+      k_out++;
+      t_out = fmin(k_out * P->out_dt, P->t_end);
+      if (P->t_end - t_out <= 1e-9 * P->out_dt) t_out = P->t_end;
+    }
+    if (restart) {
+      if ((st = check(P, IDAReInit(mem, t_r, yy, yp), "IDAReInit"))) break;
+      reset_count_baseline(P);
+    }
+    if (restart || at_output)
+      if ((st = check(P, IDASetStopTime(mem, t_out), "IDASetStopTime"))) break;
+  }
+  free(found);
+  int st2 = flush_counts(P, mem);
+  if (st == MARTELLO_OK) st = st2;
+  if (st == MARTELLO_OK) *t_reached = t_last;
+  return st;
+}
+
 int martello_ida_run(martello_model *model, martello_run *run) {
-  (void)model;
-  martello_run_set_message(run, "IDA integration is not built yet");
-  return MARTELLO_ERR_UNSUPPORTED;
+  ida_problem prob;
+  ida_problem *P = &prob;
+  memset(P, 0, sizeof *P);
+  P->run = run;
+  if (!model || !run) return MARTELLO_ERR_ARGUMENT;
+  int st = setup(P, model, run);
+  SUNContext sunctx = NULL;
+  void *mem = NULL;
+  N_Vector yy = NULL, yp = NULL, id = NULL, ytmp = NULL;
+  SUNMatrix J = NULL;
+  SUNLinearSolver LS = NULL;
+  double t_reached = 0.0;
+  if (st == MARTELLO_OK && SUNContext_Create(NULL, &sunctx) != 0)
+    st = fail(P, MARTELLO_ERR_EXTERNAL, "SUNContext_Create failed");
+  if (st == MARTELLO_OK) {
+    yy = N_VNew_Serial(P->N, sunctx);
+    yp = N_VNew_Serial(P->N, sunctx);
+    id = N_VNew_Serial(P->N, sunctx);
+    ytmp = N_VNew_Serial(P->N, sunctx);
+    if (!yy || !yp || !id || !ytmp) st = fail(P, MARTELLO_ERR_MEMORY, "IDA: could not create the vectors");
+  }
+  if (st == MARTELLO_OK) st = integrate(P, sunctx, &mem, yy, yp, id, ytmp, &J, &LS, &t_reached);
+  /* contact phases still open at the end (t_off = -1), and the final energy terms; a
+   * failed run keeps what it computed */
+  int st2 = MARTELLO_OK;
+  if (P->touching)
+    for (int j = 0; j < P->nc && st2 == MARTELLO_OK; j++)
+      if (P->touching[j]) st2 = add_event(P, j, P->ph_t[j], -1.0, P->ph_v[j], 0.0, P->ph_pen[j], P->ph_f[j]);
+  double e[MARTELLO_NENERGY];
+  energy_vector(P, e);
+  if (martello_run_finish(run, t_reached, e, P->balance_max) != MARTELLO_OK && st2 == MARTELLO_OK)
+    st2 = fail(P, MARTELLO_ERR_ARGUMENT, "IDA: could not finish the run");
+  if (st == MARTELLO_OK) st = st2;
+  if (mem) IDAFree(&mem);
+  if (LS) SUNLinSolFree(LS);
+  if (J) SUNMatDestroy(J);
+  if (yy) N_VDestroy(yy);
+  if (yp) N_VDestroy(yp);
+  if (id) N_VDestroy(id);
+  if (ytmp) N_VDestroy(ytmp);
+  if (sunctx) SUNContext_Free(&sunctx);
+  release(P);
+  return st;
 }
