@@ -30,6 +30,7 @@ module martello_moreau_jean
    use martello_assembly, only: mech_state_t, mech_init, internal_forces, external_forces, &
       mech_commit, recoverable_energy, mass_times, assemble_mass
    use martello_results
+   use martello_run_checks, only: check_run_settings, check_divergence
    use martello_integrator_settings, only: integrator_settings_t, integrator_name, scheme_supported
    use martello_contact_laws, only: P_RESTITUTION
    use martello_lcp, only: lcp_lemke, lcp_pgs, LCP_OK
@@ -246,19 +247,9 @@ contains
          call recoverable_energy(m, ms, u, e_links, e_cont)
          if (recording) call record()
          e_mech = e_kin + e_links + e_cont
-         if (.not. (ieee_is_finite(e_mech) .and. all(ieee_is_finite(u)) .and. all(ieee_is_finite(v)))) then
-            write (r%message, '(a,es12.5,a)') 'Moreau-Jean diverged at t = ', t, &
-               ' s: non-finite state (NaN/inf)'
-            stat = MARTELLO_ERR_DIVERGED; r%t_end_reached = t
-            return
-         end if
-         if (e_mech > s%divergence_factor*(e0 + w_abs) + tiny(1.0_dp) .and. e0 + w_abs > 0.0_dp) then
-            write (r%message, '(a,es12.5,a,es10.3,a,es10.3,a)') 'Moreau-Jean diverged at t = ', t, &
-               ' s: mechanical energy ', e_mech, ' J exceeds ', s%divergence_factor, &
-               ' x (initial energy + input work); the linearised smooth forces need a smaller step'
-            stat = MARTELLO_ERR_DIVERGED; r%t_end_reached = t
-            return
-         end if
+         call check_divergence(s, t, e_mech, e0, w_abs, u, v, &
+                               'the linearised smooth forces need a smaller step', r, stat)
+         if (stat /= MARTELLO_OK) return
       end do
       call close_open_phases()
       r%t_end_reached = t
@@ -267,30 +258,12 @@ contains
 
       subroutine check_scene(st)
          integer, intent(out) :: st
-         integer :: jj
-         character(len=16) :: num
-         st = MARTELLO_OK
-         if (.not. (s%dt > 0.0_dp .and. s%t_end > 0.0_dp .and. s%every >= 1)) then
-            st = MARTELLO_ERR_ARGUMENT
-            r%message = 'dynamic run: need dt > 0, t_end > 0 and every >= 1'
-            return
-         end if
+         call check_run_settings(m, s, r, st)
+         if (st /= MARTELLO_OK) return
          if (.not. (s%theta >= 0.5_dp .and. s%theta <= 1.0_dp)) then
             st = MARTELLO_ERR_ARGUMENT
             r%message = 'Moreau-Jean: theta must lie in [0.5, 1] (theta < 1/2 is unstable)'
             return
-         end if
-         do jj = 1, m%ncontact
-            if (.not. scheme_supported(s%kind, m%con_scheme(jj))) then
-               write (num, '(i0)') jj - 1
-               st = MARTELLO_ERR_UNSUPPORTED
-               r%message = 'contact '//trim(num)//': scheme '//scheme_name(m%con_scheme(jj))// &
-                  ' cannot run on '//integrator_name(s%kind)//' (see docs/integrators.md)'
-               return
-            end if
-         end do
-         if (any(m%mass < 0.0_dp)) then
-            st = MARTELLO_ERR_STATE; r%message = 'every node must be set before a run'
          end if
       end subroutine check_scene
 

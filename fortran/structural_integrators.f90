@@ -14,6 +14,7 @@ module martello_structural_integrators
    use martello_assembly
    use martello_results
    use martello_stability, only: omega_max
+   use martello_run_checks, only: check_run_settings, check_divergence
    use martello_integrator_settings
    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
    implicit none
@@ -68,7 +69,7 @@ contains
 
       stat = MARTELLO_OK
       n = m%n
-      call check_scene(stat)
+      call check_run_settings(m, s, r, stat)
       if (stat /= MARTELLO_OK) return
       h = s%dt
       ! Whole steps of h until t_end is reached: the last recorded time is nsteps·h ≥ t_end
@@ -188,47 +189,14 @@ contains
 
          ! divergence: NaN, or mechanical energy far beyond what was put in
          e_mech = e_kin + e_links + e_cont
-         if (.not. (ieee_is_finite(e_mech) .and. all(ieee_is_finite(u)))) then
-            write (r%message, '(a,es12.5,a)') 'diverged at t = ', t, ' s: non-finite state (NaN/inf)'
-            stat = MARTELLO_ERR_DIVERGED; r%t_end_reached = t
-            return
-         end if
-         if (e_mech > s%divergence_factor*(e0 + w_abs) + tiny(1.0_dp) .and. e0 + w_abs > 0.0_dp) then
-            write (r%message, '(a,es12.5,a,es10.3,a,es10.3,a)') 'diverged at t = ', t, &
-               ' s: mechanical energy ', e_mech, ' J exceeds ', s%divergence_factor, &
-               ' x (initial energy + input work); the step is past the stability limit'
-            stat = MARTELLO_ERR_DIVERGED; r%t_end_reached = t
-            return
-         end if
+         call check_divergence(s, t, e_mech, e0, w_abs, u, v, &
+                               'the step is past the stability limit', r, stat)
+         if (stat /= MARTELLO_OK) return
       end do
       call close_open_phases()
       r%t_end_reached = t
 
    contains
-
-      subroutine check_scene(st)
-         integer, intent(out) :: st
-         integer :: jj
-         character(len=16) :: num
-         st = MARTELLO_OK
-         if (.not. (s%dt > 0.0_dp .and. s%t_end > 0.0_dp .and. s%every >= 1)) then
-            st = MARTELLO_ERR_ARGUMENT
-            r%message = 'dynamic run: need dt > 0, t_end > 0 and every >= 1'
-            return
-         end if
-         do jj = 1, m%ncontact
-            if (.not. scheme_supported(s%kind, m%con_scheme(jj))) then
-               write (num, '(i0)') jj - 1
-               st = MARTELLO_ERR_UNSUPPORTED
-               r%message = 'contact '//trim(num)//': scheme '//scheme_name(m%con_scheme(jj))// &
-                  ' cannot run on '//integrator_name(s%kind)//' (see docs/integrators.md)'
-               return
-            end if
-         end do
-         if (any(m%mass < 0.0_dp)) then
-            st = MARTELLO_ERR_STATE; r%message = 'every node must be set before a run'
-         end if
-      end subroutine check_scene
 
       subroutine fail(code, msg)
          integer, intent(in) :: code
@@ -309,7 +277,7 @@ contains
       !> contact_chatter_resolutions counter).
       subroutine newton_step(converged)
          logical, intent(out) :: converged
-         integer :: i, restart
+         integer :: restart
          integer :: flips(m%ncontact)
          logical :: was_on(m%ncontact)
          converged = .false.
