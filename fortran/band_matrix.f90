@@ -6,6 +6,7 @@
 !> falling back to dgbsv if a pivot collapses. Workspaces are allocated once, in band_init.
 module martello_band_matrix
    use martello_kinds, only: dp
+   use martello_lapack, only: dgbsv
    implicit none
    private
    public :: band_t, band_init, band_zero, band_add, band_add_pair, band_solve, band_matvec, &
@@ -18,14 +19,6 @@ module martello_band_matrix
       integer, allocatable :: ipiv(:)
    end type band_t
 
-   interface
-      subroutine dgbsv(n, kl, ku, nrhs, ab, ldab, ipiv, b, ldb, info)
-         import :: dp
-         integer, intent(in) :: n, kl, ku, nrhs, ldab, ldb
-         real(dp), intent(inout) :: ab(ldab, *), b(ldb, *)
-         integer, intent(out) :: ipiv(*), info
-      end subroutine dgbsv
-   end interface
 
 contains
 

@@ -12,6 +12,7 @@
 !> W(i, j) lives in wb(kw + 1 + i − j, j).
 module martello_lcp
    use martello_kinds, only: dp
+   use martello_lapack, only: dgbsv
    implicit none
    private
    public :: lcp_lemke, lcp_pgs, LCP_OK, LCP_RAY, LCP_MAX_ITER
@@ -20,14 +21,6 @@ module martello_lcp
    integer, parameter :: LCP_RAY = 1          !< Lemke ended on a secondary ray: no solution found
    integer, parameter :: LCP_MAX_ITER = 2     !< iteration limit reached
 
-   interface
-      subroutine dgbsv(n, kl, ku, nrhs, ab, ldab, ipiv, b, ldb, info)
-         import :: dp
-         integer, intent(in) :: n, kl, ku, nrhs, ldab, ldb
-         real(dp), intent(inout) :: ab(ldab, *), b(ldb, *)
-         integer, intent(out) :: ipiv(*), info
-      end subroutine dgbsv
-   end interface
 
 contains
 

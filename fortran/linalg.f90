@@ -3,68 +3,12 @@
 !> Matrices are column-major (Fortran/LAPACK order).
 module martello_linalg
    use martello_kinds, only: dp
+   use martello_lapack, only: dpotrf, dpotrs, dpocon, dsytrf, dsytrs, dsycon, dlansy
    use martello_status, only: MARTELLO_OK, MARTELLO_ERR_SINGULAR, MARTELLO_ERR_LAPACK
    implicit none
    private
    public :: solve_spd, solve_symmetric_indefinite, lapack_status, tridiagonal_solve
 
-   interface
-      subroutine dpotrf(uplo, n, a, lda, info)
-         import :: dp
-         character, intent(in) :: uplo
-         integer, intent(in) :: n, lda
-         real(dp), intent(inout) :: a(lda, *)
-         integer, intent(out) :: info
-      end subroutine dpotrf
-      subroutine dpotrs(uplo, n, nrhs, a, lda, b, ldb, info)
-         import :: dp
-         character, intent(in) :: uplo
-         integer, intent(in) :: n, nrhs, lda, ldb
-         real(dp), intent(in) :: a(lda, *)
-         real(dp), intent(inout) :: b(ldb, *)
-         integer, intent(out) :: info
-      end subroutine dpotrs
-      subroutine dpocon(uplo, n, a, lda, anorm, rcond, work, iwork, info)
-         import :: dp
-         character, intent(in) :: uplo
-         integer, intent(in) :: n, lda
-         real(dp), intent(in) :: a(lda, *), anorm
-         real(dp), intent(out) :: rcond, work(*)
-         integer, intent(out) :: iwork(*), info
-      end subroutine dpocon
-      subroutine dsytrf(uplo, n, a, lda, ipiv, work, lwork, info)
-         import :: dp
-         character, intent(in) :: uplo
-         integer, intent(in) :: n, lda, lwork
-         real(dp), intent(inout) :: a(lda, *)
-         integer, intent(out) :: ipiv(*), info
-         real(dp), intent(out) :: work(*)
-      end subroutine dsytrf
-      subroutine dsytrs(uplo, n, nrhs, a, lda, ipiv, b, ldb, info)
-         import :: dp
-         character, intent(in) :: uplo
-         integer, intent(in) :: n, nrhs, lda, ldb, ipiv(*)
-         real(dp), intent(in) :: a(lda, *)
-         real(dp), intent(inout) :: b(ldb, *)
-         integer, intent(out) :: info
-      end subroutine dsytrs
-      subroutine dsycon(uplo, n, a, lda, ipiv, anorm, rcond, work, iwork, info)
-         import :: dp
-         character, intent(in) :: uplo
-         integer, intent(in) :: n, lda, ipiv(*)
-         real(dp), intent(in) :: a(lda, *), anorm
-         real(dp), intent(out) :: rcond, work(*)
-         integer, intent(out) :: iwork(*), info
-      end subroutine dsycon
-      function dlansy(norm, uplo, n, a, lda, work) result(r)
-         import :: dp
-         character, intent(in) :: norm, uplo
-         integer, intent(in) :: n, lda
-         real(dp), intent(in) :: a(lda, *)
-         real(dp), intent(out) :: work(*)
-         real(dp) :: r
-      end function dlansy
-   end interface
 
 contains
 

@@ -24,6 +24,7 @@
 !> (zero up to round-off for θ = ½ and linear forces).
 module martello_moreau_jean
    use martello_kinds, only: dp, i8
+   use martello_lapack, only: dgbtrf, dgbtrs
    use martello_status
    use martello_model, only: model_t, model_bandwidth, SCHEME_PENALTY, scheme_name
    use martello_band_matrix, only: band_t, band_init, band_matvec
@@ -47,22 +48,6 @@ module martello_moreau_jean
    real(dp), parameter :: PGS_TOL = 1.0e-14_dp
    integer, parameter :: PGS_MAX_SWEEPS = 100000
 
-   interface
-      subroutine dgbtrf(m, n, kl, ku, ab, ldab, ipiv, info)
-         import :: dp
-         integer, intent(in) :: m, n, kl, ku, ldab
-         real(dp), intent(inout) :: ab(ldab, *)
-         integer, intent(out) :: ipiv(*), info
-      end subroutine dgbtrf
-      subroutine dgbtrs(trans, n, kl, ku, nrhs, ab, ldab, ipiv, b, ldb, info)
-         import :: dp
-         character, intent(in) :: trans
-         integer, intent(in) :: n, kl, ku, nrhs, ldab, ldb, ipiv(*)
-         real(dp), intent(in) :: ab(ldab, *)
-         real(dp), intent(inout) :: b(ldb, *)
-         integer, intent(out) :: info
-      end subroutine dgbtrs
-   end interface
 
 contains
 

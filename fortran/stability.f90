@@ -6,6 +6,7 @@
 !> on the penetration, so only the run-time divergence detector guards them.
 module martello_stability
    use martello_kinds, only: dp
+   use martello_lapack, only: dpbtrf, dsbgvx
    use martello_model, only: model_t, model_bandwidth, SCHEME_PENALTY
    use martello_links, only: LINK_SPRING, LINK_BAR, LINK_BILINEAR, L_STIFF
    use martello_contact_laws, only: LAW_LINEAR, LAW_KELVIN, P_STIFF
@@ -13,25 +14,6 @@ module martello_stability
    private
    public :: omega_max, mass_positive_definite
 
-   interface
-      subroutine dpbtrf(uplo, n, kd, ab, ldab, info)
-         import :: dp
-         character, intent(in) :: uplo
-         integer, intent(in) :: n, kd, ldab
-         real(dp), intent(inout) :: ab(ldab, *)
-         integer, intent(out) :: info
-      end subroutine dpbtrf
-      subroutine dsbgvx(jobz, range, uplo, n, ka, kb, ab, ldab, bb, ldbb, q, ldq, vl, vu, il, &
-                        iu, abstol, m, w, z, ldz, work, iwork, ifail, info)
-         import :: dp
-         character, intent(in) :: jobz, range, uplo
-         integer, intent(in) :: n, ka, kb, ldab, ldbb, ldq, il, iu, ldz
-         real(dp), intent(inout) :: ab(ldab, *), bb(ldbb, *)
-         real(dp), intent(out) :: q(ldq, *), w(*), z(ldz, *), work(*)
-         real(dp), intent(in) :: vl, vu, abstol
-         integer, intent(out) :: m, iwork(*), ifail(*), info
-      end subroutine dsbgvx
-   end interface
 
 contains
 
