@@ -580,15 +580,8 @@ contains
       !> linearised nonlinear forces.
       subroutine record()
          real(dp) :: e(NENERGY)
-         e = 0.0_dp
-         e(E_KINETIC) = e_kin; e(E_RECOVERABLE) = e_links + e_cont; e(E_INPUT) = w_ext
-         e(E_DAMPING) = d_damp
-         e(E_PLASTIC) = d_links - (e_links - e_links0)
-         e(E_CONTACT) = d_contact - (e_cont - e_cont0)
-         e(E_INITIAL) = e0
-         e(E_IMPACT) = d_impact
-         e(E_BALANCE) = e0 + w_ext - e_kin - e(E_RECOVERABLE) - e(E_DAMPING) - e(E_PLASTIC) &
-                        - e(E_CONTACT) - e(E_IMPACT)
+         e = energy_terms(e0, w_ext, e_kin, e_links, e_cont, e_links0, e_cont0, d_damp, d_links, &
+                          d_contact, d_impact, 0.0_dp, 0.0_dp)
          r%energy = e
          r%energy_balance_max = max(r%energy_balance_max, abs(e(E_BALANCE)))
          call results_record(r, t, u(1:n), v(1:n), a(1:n), pen, force, e, ms%link_f, ms%link_u)

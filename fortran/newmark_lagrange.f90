@@ -168,7 +168,7 @@ contains
                dd0 = vn(m%con_a(c)) - vn(m%con_b(c))
                ddd0 = an(m%con_a(c)) - an(m%con_b(c))
                tau = 0.0_dp
-               if (d0 < 0.0_dp) tau = crossing(d0, dd0, ddd0, 0.0_dp, h)
+               if (d0 < 0.0_dp) tau = free_side_crossing(d0, dd0, ddd0, 0.0_dp, h)
                if (tau/h < best_alpha) then
                   best_alpha = tau/h; imp_c = c
                end if
@@ -499,46 +499,12 @@ contains
       !> from the stereomechanical impact plus the smooth work.
       subroutine record()
          real(dp) :: e(NENERGY)
-         e = 0.0_dp
-         e(E_KINETIC) = e_kin; e(E_RECOVERABLE) = e_links + e_cont; e(E_INPUT) = w_ext
-         e(E_DAMPING) = d_damp
-         e(E_PLASTIC) = d_links - (e_links - e_links0)
-         e(E_CONTACT) = d_contact - (e_cont - e_cont0)
-         e(E_INITIAL) = e0
-         e(E_IMPACT) = d_impact
-         e(E_BALANCE) = e0 + w_ext - e_kin - e(E_RECOVERABLE) - e(E_DAMPING) - e(E_PLASTIC) &
-                        - e(E_CONTACT) - e(E_IMPACT)
+         e = energy_terms(e0, w_ext, e_kin, e_links, e_cont, e_links0, e_cont0, d_damp, d_links, &
+                          d_contact, d_impact, 0.0_dp, 0.0_dp)
          r%energy = e
          r%energy_balance_max = max(r%energy_balance_max, abs(e(E_BALANCE)))
          call results_record(r, t, u(1:n), v(1:n), a(1:n), pen, force, e, ms%link_f, ms%link_u)
       end subroutine record
 
-      !> Root of d + rate·τ + ½acc·τ² in [lo, hi] (the first one), linear fallback, else hi.
-      pure real(dp) function crossing(d, rate, acc, lo, hi) result(tau)
-         real(dp), intent(in) :: d, rate, acc, lo, hi
-         real(dp) :: disc, t1, t2, q
-         tau = hi
-         if (abs(acc) > 0.0_dp) then
-            disc = rate*rate - 2.0_dp*acc*d
-            if (disc >= 0.0_dp) then
-               q = -0.5_dp*(rate + sign(sqrt(disc), rate))
-               if (q /= 0.0_dp) then
-                  t1 = q/(0.5_dp*acc); t2 = d/q
-               else
-                  t1 = 0.0_dp; t2 = 0.0_dp
-               end if
-               if (t1 >= lo .and. t1 <= hi .and. (t1 <= t2 .or. t2 < lo .or. t2 > hi)) then
-                  tau = t1; return
-               end if
-               if (t2 >= lo .and. t2 <= hi) then
-                  tau = t2; return
-               end if
-            end if
-         end if
-         if (rate /= 0.0_dp) then
-            tau = -d/rate
-            tau = min(max(tau, lo), hi)
-         end if
-      end function crossing
    end subroutine run_newmark_lagrange
 end module martello_newmark_lagrange

@@ -8,6 +8,7 @@ module martello_results
    implicit none
    private
    public :: results_t, results_init, results_record, results_add_event, results_track, &
+      energy_terms, free_side_crossing, &
       NCOUNTERS, C_STEPS, C_REJECTED, C_NEWTON, C_RESIDUALS, C_FACTORIZATIONS, C_EVENTS, &
       C_JACOBIANS, C_ROOT_EVALS, C_CHATTER, NENERGY, E_KINETIC, E_RECOVERABLE, E_INPUT, E_DAMPING, &
       E_PLASTIC, E_CONTACT, E_BALANCE, E_INITIAL, E_IMPACT, NEVENT, EV_T_ON, EV_T_OFF, &
@@ -199,4 +200,54 @@ contains
          end associate
       end subroutine peaks
    end subroutine results_track
+   !> The energy terms of a run from its accumulated works (W: trapezoidal, since t = 0) and
+   !> recoverable energies: the dissipation of links (plasticity) and contacts is their work
+   !> minus the change of their recoverable energy, so the balance is the work–energy identity
+   !> KE0 + W_ext − KE − W_damp − W_links − W_contact − W_impact (≈ 0 to the method's accuracy).
+   !> ke_corr, ke_corr0: a method's correction to ½vᵀMv in its conserved energy, now and at
+   !> t = 0 (central difference; 0 for the others).
+   pure function energy_terms(e0, w_ext, e_kin, e_links, e_cont, e_links0, e_cont0, d_damp, &
+                              d_links, d_contact, d_impact, ke_corr, ke_corr0) result(e)
+      real(dp), intent(in) :: e0, w_ext, e_kin, e_links, e_cont, e_links0, e_cont0, d_damp, &
+                              d_links, d_contact, d_impact, ke_corr, ke_corr0
+      real(dp) :: e(NENERGY)
+      e = 0.0_dp
+      e(E_KINETIC) = e_kin; e(E_RECOVERABLE) = e_links + e_cont; e(E_INPUT) = w_ext
+      e(E_DAMPING) = d_damp
+      e(E_PLASTIC) = d_links - (e_links - e_links0)
+      e(E_CONTACT) = d_contact - (e_cont - e_cont0)
+      e(E_INITIAL) = e0
+      e(E_IMPACT) = d_impact
+      e(E_BALANCE) = (e0 - ke_corr0) + w_ext - (e_kin - ke_corr) - e(E_RECOVERABLE) - e(E_DAMPING) &
+                     - e(E_PLASTIC) - e(E_CONTACT) - e(E_IMPACT)
+   end function energy_terms
+
+   !> Event location on the free side of a step: the first root of d + rate·τ + ½acc·τ² in
+   !> [lo, hi] (O(h³) in time when the free motion is smooth); linear fallback, else hi.
+   pure real(dp) function free_side_crossing(d, rate, acc, lo, hi) result(tau)
+      real(dp), intent(in) :: d, rate, acc, lo, hi
+      real(dp) :: disc, t1, t2, q
+      tau = hi
+      if (abs(acc) > 0.0_dp) then
+         disc = rate*rate - 2.0_dp*acc*d
+         if (disc >= 0.0_dp) then
+            q = -0.5_dp*(rate + sign(sqrt(disc), rate))
+            if (q /= 0.0_dp) then
+               t1 = q/(0.5_dp*acc); t2 = d/q
+            else
+               t1 = 0.0_dp; t2 = 0.0_dp
+            end if
+            if (t1 >= lo .and. t1 <= hi .and. (t1 <= t2 .or. t2 < lo .or. t2 > hi)) then
+               tau = t1; return
+            end if
+            if (t2 >= lo .and. t2 <= hi) then
+               tau = t2; return
+            end if
+         end if
+      end if
+      if (rate /= 0.0_dp) then
+         tau = -d/rate
+         tau = min(max(tau, lo), hi)
+      end if
+   end function free_side_crossing
 end module martello_results

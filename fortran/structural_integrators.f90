@@ -466,7 +466,7 @@ contains
             ia = m%con_a(c); ib = m%con_b(c)
             if (.not. ph_open(c) .and. ms%con_on(c)) then
                d0 = un(ia) - un(ib) - m%con_gap(c); r0 = vn(ia) - vn(ib); q0 = an(ia) - an(ib)
-               tau = crossing(d0, r0, q0, 0.0_dp, h)
+               tau = free_side_crossing(d0, r0, q0, 0.0_dp, h)
                ph_open(c) = .true.
                ph_t(c) = t - h + tau; ph_v(c) = r0 + q0*tau
                ph_pen(c) = 0.0_dp; ph_f(c) = 0.0_dp
@@ -477,7 +477,7 @@ contains
                ph_pen(c) = max(ph_pen(c), ms%con_pen(c)); ph_f(c) = max(ph_f(c), ms%con_f(c))
                if (.not. ms%con_on(c)) then
                   d0 = u(ia) - u(ib) - m%con_gap(c); r0 = v(ia) - v(ib); q0 = a(ia) - a(ib)
-                  tau = crossing(d0, r0, q0, -h, 0.0_dp)
+                  tau = free_side_crossing(d0, r0, q0, -h, 0.0_dp)
                   call results_add_event(r, c, [ph_t(c), t + tau, ph_v(c), r0 + q0*tau, &
                                                 ph_pen(c), ph_f(c)])
                   ph_open(c) = .false.
@@ -500,45 +500,12 @@ contains
       !> KE0 + W_ext − KE − W_damp − W_links − W_contact (≈ 0 to the integrator's accuracy).
       subroutine record()
          real(dp) :: e(NENERGY)
-         e = 0.0_dp
-         e(E_KINETIC) = e_kin; e(E_RECOVERABLE) = e_links + e_cont; e(E_INPUT) = w_ext
-         e(E_DAMPING) = d_damp
-         e(E_PLASTIC) = d_links - (e_links - e_links0)
-         e(E_CONTACT) = d_contact - (e_cont - e_cont0)
-         e(E_INITIAL) = e0
-         e(E_BALANCE) = e0_alg + w_ext - (e_kin - ke_corr) - e(E_RECOVERABLE) - e(E_DAMPING) - e(E_PLASTIC) &
-                        - e(E_CONTACT)
+         e = energy_terms(e0, w_ext, e_kin, e_links, e_cont, e_links0, e_cont0, d_damp, d_links, &
+                          d_contact, 0.0_dp, ke_corr, e0 - e0_alg)
          r%energy = e
          r%energy_balance_max = max(r%energy_balance_max, abs(e(E_BALANCE)))
          call results_record(r, t, u(1:n), v(1:n), a(1:n), ms%con_pen, ms%con_f, e, ms%link_f, ms%link_u)
       end subroutine record
 
-      pure real(dp) function crossing(d, rate, acc, lo, hi) result(tau)
-         real(dp), intent(in) :: d, rate, acc, lo, hi
-         real(dp) :: disc, t1, t2, q
-         ! root of d + rate·τ + ½acc·τ² in [lo, hi]; linear fallback, then the bracket end
-         tau = hi
-         if (abs(acc) > 0.0_dp) then
-            disc = rate*rate - 2.0_dp*acc*d
-            if (disc >= 0.0_dp) then
-               q = -0.5_dp*(rate + sign(sqrt(disc), rate))
-               if (q /= 0.0_dp) then
-                  t1 = q/(0.5_dp*acc); t2 = d/q
-               else
-                  t1 = 0.0_dp; t2 = 0.0_dp
-               end if
-               if (t1 >= lo .and. t1 <= hi .and. (t1 <= t2 .or. t2 < lo .or. t2 > hi)) then
-                  tau = t1; return
-               end if
-               if (t2 >= lo .and. t2 <= hi) then
-                  tau = t2; return
-               end if
-            end if
-         end if
-         if (rate /= 0.0_dp) then
-            tau = -d/rate
-            tau = min(max(tau, lo), hi)
-         end if
-      end function crossing
    end subroutine run_structural
 end module martello_structural_integrators
