@@ -1,7 +1,252 @@
-"""`martello compare` (placeholder until the Studies issue lands it)."""
+"""`martello compare THEIR.csv --against SCENE`: score another code's time history with the
+metrics martello uses on its own runs (martello.metrics), so a researcher can verify a code
+against martello's closed forms and reference data. The CSV format is documented in
+docs/compare.md: a header row, then one row per time; column t (s) and any of u:<node>,
+v:<node>, a:<node> (m, m/s, m/s²), penetration:<contact> (m, > 0 in contact), force:<contact>
+(N, compressive > 0) and energy:kinetic, energy:recoverable (J) — exactly as in martello's own
+history.csv, so a martello run can be fed back as a self-check."""
 
+from __future__ import annotations
+
+import csv
+import json
+import math
+import sys
+from pathlib import Path
+
+import numpy as np
+
+from . import check, metrics
+from . import scene as scene_mod
 from .errors import MartelloError
+
+NODE_KINDS = ("u", "v", "a")
+CONTACT_KINDS = ("penetration", "force")
+ENERGY_COLUMNS = ("energy:kinetic", "energy:recoverable", "energy:input", "energy:damping",
+                  "energy:plastic", "energy:contact", "energy:balance", "energy:initial",
+                  "energy:impact")
+
+
+class HistoryError(MartelloError):
+    """A history CSV is unreadable or inconsistent: the message names the file, the row or
+    column, and what would be valid."""
+
+    def __init__(self, file, problem, fix=None, row=None):
+        where = f"{file}:{row}" if row is not None else str(file)
+        super().__init__(f"{where}: {problem}" + (f" ({fix})" if fix else ""))
+
+
+def read_history(path, scene=None):
+    """Read and validate a history CSV; returns (columns, 2D array). Lines starting with #
+    are comments. Errors name the line: a missing t column, a column that names no node or
+    contact of the scene, a non-numeric or non-finite value, times that do not increase."""
+    path = Path(path)
+    if not path.exists():
+        raise HistoryError(path, "does not exist")
+    with open(path, newline="") as fh:
+        lines = [(i + 1, ln) for i, ln in enumerate(fh.read().splitlines())
+                 if ln.strip() and not ln.lstrip().startswith("#")]
+    if not lines:
+        raise HistoryError(path, "is empty", "a header row (t,u:<node>,...) and data rows")
+    hline, header = lines[0][0], [c.strip() for c in next(csv.reader([lines[0][1]]))]
+    if "t" not in header:
+        raise HistoryError(path, "missing column t", "the first row must name the columns, "
+                           "one of them t (time in s); see docs/compare.md", row=hline)
+    if len(set(header)) != len(header):
+        dup = sorted({c for c in header if header.count(c) > 1})
+        raise HistoryError(path, f"duplicate column(s) {', '.join(dup)}", row=hline)
+    if scene is not None:
+        nodes = {n["name"] for n in scene.nodes}
+        contacts = {c["name"] for c in scene.contacts}
+        for c in header:
+            kind, sep, name = c.partition(":")
+            if c == "t" or c in ENERGY_COLUMNS:
+                continue
+            if not sep or kind not in NODE_KINDS + CONTACT_KINDS:
+                raise HistoryError(path, f"unknown column {c!r}",
+                                   "valid: t, u:<node>, v:<node>, a:<node>, penetration:<contact>, "
+                                   "force:<contact>, energy:kinetic, energy:recoverable, ...", row=hline)
+            if kind in NODE_KINDS and name not in nodes:
+                raise HistoryError(path, f"column {c!r} names no node of {scene.source}",
+                                   "nodes: " + ", ".join(sorted(nodes)), row=hline)
+            if kind in CONTACT_KINDS and name not in contacts:
+                raise HistoryError(path, f"column {c!r} names no contact of {scene.source}",
+                                   "contacts: " + ", ".join(sorted(contacts)) if contacts else "it has none",
+                                   row=hline)
+    rows = []
+    for lineno, ln in lines[1:]:
+        cells = next(csv.reader([ln]))
+        if len(cells) != len(header):
+            raise HistoryError(path, f"{len(cells)} values for {len(header)} columns", row=lineno)
+        vals = []
+        for c, cell in zip(header, cells):
+            try:
+                x = float(cell)
+            except ValueError:
+                raise HistoryError(path, f"column {c}: {cell.strip()!r} is not a number", row=lineno) from None
+            if not math.isfinite(x):
+                raise HistoryError(path, f"column {c} is {cell.strip()} (NaN or inf)",
+                                   "a history must be finite; cut it before the solver failed", row=lineno)
+            vals.append(x)
+        rows.append((lineno, vals))
+    if len(rows) < 2:
+        raise HistoryError(path, f"{len(rows)} data row(s)", "a history needs at least two times")
+    data = np.array([v for _, v in rows], float)
+    t = data[:, header.index("t")]
+    bad = np.nonzero(np.diff(t) <= 0)[0]
+    if len(bad):
+        i = int(bad[0]) + 1
+        raise HistoryError(path, f"t = {float(t[i])!r} does not follow t = {float(t[i - 1])!r}",
+                           "times must increase strictly: remove repeated or unsorted rows",
+                           row=rows[i][0])
+    return header, data
+
+
+def comparable(columns, ref):
+    """The columns of a history that the reference also has, u first."""
+    order = {"u": 0, "v": 1, "a": 2, "penetration": 3, "force": 4, "energy": 5}
+    cols = [c for c in columns if c != "t" and c in ref.columns]
+    return sorted(cols, key=lambda c: (order.get(c.partition(":")[0], 9), c))
+
+
+def compare(history_path, scene_path):
+    """Score a history CSV against a scene's reference; returns the report dict."""
+    sc = scene_mod.load(scene_path)
+    if sc.analysis.get("type") != "dynamic":
+        raise MartelloError(f"{scene_path}: a static scene has no time history to compare with "
+                            "(compare its nodal values with `martello check`)")
+    columns, data = read_history(history_path, sc)
+    ref = metrics.reference_for_scene(sc)
+    if ref is None:
+        raise MartelloError(f"{scene_path}: no reference to compare with: no closed-form history "
+                            "and no stored reference data (reference/references.toml; "
+                            "scripts/regenerate_reference)")
+    cols = comparable(columns, ref)
+    if not cols:
+        raise HistoryError(history_path, "no column can be compared with the reference",
+                           "the reference has " + ", ".join(c for c in ref.columns))
+    h = metrics.history_dict((columns, data))
+    t = h["t"]
+    if t[0] > ref.t_end or t[-1] < 0:
+        raise HistoryError(history_path, f"its times [{t[0]}, {t[-1]}] s miss the reference's "
+                           f"[0, {ref.t_end}] s")
+    # a closed form is exact anywhere: compare at their times; stored data at its samples
+    times = t[t <= ref.t_end * (1 + 1e-12)] if ref.kind == "closed-form" else None
+    summary = metrics.summary_from_history(sc, (columns, data))
+    u_cols = [c for c in cols if c.startswith("u:")] or cols[:1]
+    m = metrics.score(summary, (columns, data), ref, columns=u_cols, times=times)
+    per_column = {}
+    for c in cols:
+        e = metrics.history_errors((columns, data), ref, [c], times)
+        per_column[c] = {"max_abs_error": e.get(f"max_abs_error:{c}"), "max_rel_error": e["max_rel_error"],
+                         "scd": e["scd"], "mescd": e["mescd"]}
+    checks = []
+    if sc.check:
+        try:
+            oracle = check.oracle_values(sc.check, sc.source)
+        except MartelloError:
+            oracle = {}
+        for item in sc.check["compare"]:
+            try:
+                value = float(check.lookup(summary, item["result"]))
+            except (KeyError, TypeError, ValueError):
+                checks.append({"quantity": item["result"], "note": "not derivable from a history"})
+                continue
+            refv = float(oracle[item["oracle"]])
+            tol = (item.get("atol") or 0.0) + (item.get("rtol") or 0.0) * abs(refv)
+            checks.append({"quantity": item["result"], "value": value, "reference": refv,
+                           "digits": check.digits(value, refv), "tolerance": tol,
+                           "within_catalogue_tolerance": abs(value - refv) <= tol})
+    span = [float(t[0]), float(min(t[-1], ref.t_end))]
+    return {"history": str(history_path), "scene": str(scene_path), "reference": ref.name,
+            "reference_kind": ref.kind, "reference_digits": ref.trusted_digits(u_cols),
+            "compared_columns": cols, "time_span": span, "rows": int(len(t)),
+            "score_scd": m.get("scd"), "metrics": {k: v for k, v in m.items() if k not in metrics.COST_KEYS},
+            "per_column": per_column, "checks": checks,
+            "derived_events": {k: {kk: v[kk] for kk in ("impact_times", "restitution",
+                                                        "phase_max_penetration")}
+                               for k, v in summary["contacts"].items()}}
+
+
+DESCRIPTIONS = [
+    ("scd", "significant correct digits of u, −log10(max error / peak |u_ref|)"),
+    ("max_rel_error", "max |u − u_ref| / max |u_ref| (normwise, over the compared span)"),
+    ("mescd", "mixed significant correct digits (atol 1e-12, rtol 1e-6), pointwise"),
+    ("scd_final", "correct digits of u at the last common time"),
+    ("impact_count", "impacts found in the history (penetration sign changes)"),
+    ("impact_count_ref", "impacts of the reference over the same span"),
+    ("impacts_missing", "reference impacts with no partner in the history"),
+    ("impacts_extra", "history impacts with no partner in the reference"),
+    ("impact_time_error", "max |Δt| of matched impacts [s]"),
+    ("peak_penetration_error", "relative error of the largest penetration"),
+    ("peak_force_error", "relative error of the largest contact force"),
+    ("phase_penetration_error", "max relative error of each matched phase's peak penetration"),
+    ("restitution", "mean realised restitution −δ̇_out/δ̇_in of the history"),
+    ("restitution_ref", "the same for the reference"),
+    ("restitution_error", "max |e − e_ref| over matched, non-grazing phases"),
+    ("energy_error", "error of kinetic + recoverable energy at the end (relative)"),
+]
+
+
+def _fmt(v):
+    if v is None or (isinstance(v, float) and math.isnan(v)):
+        return "–"
+    if isinstance(v, float):
+        return f"{v:.6g}"
+    return str(v)
+
+
+def print_report(rep, stream=sys.stdout):
+    print(f"{rep['history']} against {rep['scene']}", file=stream)
+    print(f"reference: {rep['reference']} (trusted to {rep['reference_digits']:.1f} digits); "
+          f"{rep['rows']} rows over [{rep['time_span'][0]:g}, {rep['time_span'][1]:g}] s; "
+          f"compared: {', '.join(rep['compared_columns'])}", file=stream)
+    print(f"{'metric':<26} {'value':>14}  meaning", file=stream)
+    print("-" * 100, file=stream)
+    for key, what in DESCRIPTIONS:
+        if key in rep["metrics"]:
+            print(f"{key:<26} {_fmt(rep['metrics'][key]):>14}  {what}", file=stream)
+    print(f"\n{'column':<26} {'max abs error':>14} {'max rel error':>14} {'scd':>6}", file=stream)
+    for c, e in rep["per_column"].items():
+        print(f"{c:<26} {_fmt(e['max_abs_error']):>14} {_fmt(e['max_rel_error']):>14} "
+              f"{_fmt(round(e['scd'], 2) if e['scd'] == e['scd'] else e['scd']):>6}", file=stream)
+    if rep["checks"]:
+        print("\nscene [check] quantities, from the history:", file=stream)
+        for c in rep["checks"]:
+            if "note" in c:
+                print(f"  {c['quantity']:<40} {c['note']}", file=stream)
+            else:
+                print(f"  {c['quantity']:<40} {c['value']:.10g} vs {c['reference']:.10g}: "
+                      f"{c['digits']:.1f} digits", file=stream)
+    d = rep["reference_digits"]
+    if rep["score_scd"] is not None and d == d and rep["score_scd"] > d - 0.5:
+        print(f"\nnote: the history agrees with the reference to about the reference's own accuracy "
+              f"({d:.1f} digits): the score is limited by the reference, not by the history", file=stream)
 
 
 def main(args):
-    raise MartelloError("martello compare is not built yet")
+    rep = compare(args.history, args.against)
+    print_report(rep)
+    if args.output:
+        Path(args.output).parent.mkdir(parents=True, exist_ok=True)
+        Path(args.output).write_text(json.dumps(_finite(rep), indent=1, default=_json_default) + "\n")
+    return 0
+
+
+def _finite(x):
+    """NaN and inf become null: the JSON stays strict (readable by any parser)."""
+    if isinstance(x, dict):
+        return {k: _finite(v) for k, v in x.items()}
+    if isinstance(x, (list, tuple)):
+        return [_finite(v) for v in x]
+    if isinstance(x, (float, np.floating)) and not math.isfinite(x):
+        return None
+    return x
+
+
+def _json_default(x):
+    if isinstance(x, (np.floating, np.integer)):
+        return x.item()
+    if isinstance(x, np.ndarray):
+        return x.tolist()
+    return str(x)

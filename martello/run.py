@@ -137,12 +137,16 @@ def run(scene):
     return run_full(scene)[0]
 
 
-def run_full(scene):
-    """(summary, history) — history is None for static runs, else (columns, 2D array)."""
+def run_full(scene, raise_on_failure=True):
+    """(summary, history) — history is None for static runs, else (columns, 2D array).
+
+    With raise_on_failure=False a failed dynamic run (diverged, unstable, not converged)
+    returns its summary with the failure status and message instead of raising: studies
+    classify such runs; nothing else should write them out as results."""
     with build_model(scene) as model:
         if scene.analysis["type"] == "static":
             return _static(scene, model), None
-        return _dynamic(scene, model)
+        return _dynamic(scene, model, raise_on_failure)
 
 
 INTEGRATOR_CONST = {"newmark": "INT_NEWMARK", "hht": "INT_HHT",
