@@ -25,7 +25,7 @@ module martello_assembly
       ! link and contact forces at the committed step (for trapezoidal work) and at the trial
       real(dp), allocatable :: link_f(:), link_f_trial(:)
       real(dp), allocatable :: con_f(:), con_f_trial(:), con_pen(:), con_pen_trial(:)
-      real(dp), allocatable :: con_rate_trial(:)
+      real(dp), allocatable :: con_rate_trial(:), con_rate(:)
       logical, allocatable :: con_on(:)                 !< committed: in contact
       real(dp), allocatable :: con_vin(:), con_vin_trial(:)
       logical, allocatable :: is_penalty(:)
@@ -44,7 +44,7 @@ contains
       allocate (s%link_fc(m%nlink), s%link_u(m%nlink), s%link_fc_trial(m%nlink), &
                 s%link_f(m%nlink), s%link_f_trial(m%nlink))
       allocate (s%con_f(m%ncontact), s%con_f_trial(m%ncontact), s%con_pen(m%ncontact), &
-                s%con_pen_trial(m%ncontact), s%con_rate_trial(m%ncontact), &
+                s%con_pen_trial(m%ncontact), s%con_rate_trial(m%ncontact), s%con_rate(m%ncontact), &
                 s%con_on(m%ncontact), s%con_vin(m%ncontact), s%con_vin_trial(m%ncontact), &
                 s%is_penalty(m%ncontact))
       s%is_penalty = m%con_scheme(1:m%ncontact) == SCHEME_PENALTY
@@ -57,7 +57,7 @@ contains
          if (m%link_kind(j) == LINK_SPRING .or. m%link_kind(j) == LINK_BAR .or. &
              m%link_kind(j) == LINK_BILINEAR) s%link_fc(j) = m%link_par(L_STIFF, j)*s%link_u(j)
       end do
-      s%con_on = .false.; s%con_vin = 0.0_dp
+      s%con_on = .false.; s%con_vin = 0.0_dp; s%con_rate = 0.0_dp
       allocate (f(0:m%n))
       call internal_forces(m, s, u, v, f)
       call mech_commit(m, s, u)
@@ -115,8 +115,10 @@ contains
          rate = v(a) - v(b)
          s%con_pen_trial(j) = pen; s%con_rate_trial(j) = rate
          if (pen > 0.0_dp .and. .not. s%forced_off(j)) then
+            ! onset speed: the committed (start-of-step, free-side) rate, not the in-contact
+            ! one — exact for a free impact, so the 1/v_in laws keep their order
             vin = s%con_vin(j)
-            if (.not. s%con_on(j)) vin = max(rate, ONSET_SPEED_FLOOR)
+            if (.not. s%con_on(j)) vin = max(s%con_rate(j), rate, ONSET_SPEED_FLOOR)
             s%con_vin_trial(j) = vin
             if (m%con_law(j) == LAW_LINEAR) then
                dfd = m%con_par(P_STIFF, j); dfv = 0.0_dp; f = dfd*pen
@@ -189,6 +191,7 @@ contains
       s%con_on = s%con_pen_trial > 0.0_dp .and. s%is_penalty .and. .not. s%forced_off
       s%forced_off = .false.
       call swap(s%con_vin, s%con_vin_trial)
+      s%con_rate = s%con_rate_trial
    end subroutine mech_commit
 
    subroutine swap(x, y)
