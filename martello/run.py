@@ -225,8 +225,11 @@ def _dynamic(scene, model, raise_on_failure=True):
             nodes[n["name"]].update(u_final=float(hist[-1, 1 + k]),
                                     v_final=float(hist[-1, 1 + len(an["output"]["nodes"]) + k]))
     contacts = {}
+    # events grouped by contact once (a long chain has one or more per contact)
+    order = np.argsort(ev_contacts, kind="stable")
+    bounds = np.searchsorted(ev_contacts[order], np.arange(len(scene.contacts) + 1))
     for j, c in enumerate(scene.contacts):
-        mine = ev[ev_contacts == j]
+        mine = ev[order[bounds[j]:bounds[j + 1]]]
         closed = mine[mine[:, 1] >= 0]
         contacts[c["name"]] = {
             "scheme": c["scheme"], "law": c.get("law"),

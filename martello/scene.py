@@ -332,7 +332,7 @@ def from_dict(data, source="<scene>", base_dir=Path("."), digest=None):
     if "force" in data.get("loads", {}) and not isinstance(data["loads"]["force"], list):
         raise SceneError(src, "loads.force", "must be an array of tables", "write [[loads.force]]")
     # links
-    links = []
+    links, lnames = [], set()
     for i, tab in enumerate(data.get("link", [])):
         where = f"link[{i}]"
         if not isinstance(tab, dict) or "type" not in tab:
@@ -344,8 +344,9 @@ def from_dict(data, source="<scene>", base_dir=Path("."), digest=None):
         if lk["a"] == lk["b"]:
             raise SceneError(src, f"{where}.b", "connects a node to itself", "name two different nodes")
         lk["name"] = lk["name"] or f"link{i}"
-        if any(l["name"] == lk["name"] for l in links):
+        if lk["name"] in lnames:
             raise SceneError(src, f"{where}.name", f"duplicate name {lk['name']!r}", "names must be unique")
+        lnames.add(lk["name"])
         if kind == "dashpot" and (lk["c"] is None) == (lk["zeta"] is None):
             raise SceneError(src, where, "needs exactly one of c or zeta",
                              "c = damping [N s/m], or zeta = damping ratio of a node-to-ground oscillator")
