@@ -142,9 +142,7 @@ contains
       e0_alg = e0 - ke_corr
       w_ext = 0.0_dp; d_damp = 0.0_dp; d_links = 0.0_dp; d_contact = 0.0_dp; w_abs = 0.0_dp
       t = 0.0_dp
-      un = u; vn = v; an = a
-      call results_track(r, t, u(1:n), v(1:n), a(1:n), ms%con_pen, ms%con_f, ms%link_f, ms%link_u, &
-                            un(1:n), vn(1:n), an(1:n))
+      call results_track(r, t, u(1:n), v(1:n), a(1:n), ms%con_pen, ms%con_f, ms%link_f, ms%link_u)
       call record()
 
       do step = 1, nsteps
@@ -174,7 +172,9 @@ contains
          end do
          w_ext = w_ext + wd; w_abs = w_abs + abs(wd)
          call track_events()
-         call results_track(r, t, u(1:n), v(1:n), a(1:n), ms%con_pen, ms%con_f, ms%link_f, ms%link_u)
+         ! the previous state is the integrator's own (un, vn, an): no copy in the results
+         call results_track(r, t, u(1:n), v(1:n), a(1:n), ms%con_pen, ms%con_f, ms%link_f, ms%link_u, &
+                            un(1:n), vn(1:n), an(1:n))
          recording = mod(step, s%every) == 0 .or. step == nsteps
          ! kinetic and recoverable energy (two passes over the model) only where needed: at
          ! recorded steps and every ENERGY_CHECK steps for the divergence test
