@@ -13,7 +13,7 @@ module martello_model
    private
    public :: model_t, model_init, model_set_node, model_add_link, model_add_contact, &
       model_add_mass_coupling, model_add_nodal_force, model_set_ground_acceleration, &
-      model_bandwidth, SCHEME_PENALTY, SCHEME_LAGRANGE, SCHEME_AUGMENTED, &
+      model_bandwidth, rigid_contact_sides, SCHEME_PENALTY, SCHEME_LAGRANGE, SCHEME_AUGMENTED, &
       SCHEME_RESTITUTION, scheme_name
 
    integer, parameter :: SCHEME_PENALTY = 1      !< force law on the penetration
@@ -266,4 +266,27 @@ contains
          kd = max(kd, abs(m%mc_a(j) - m%mc_b(j)))
       end do
    end function model_bandwidth
+   !> For the impulse-level integrators: which contacts are rigid (restitution or Lagrange,
+   !> solved by complementarity), their restitution (Lagrange without one: 0, plastic), and
+   !> their moving sides — a side on ground or on a fixed node does not move, so its column of
+   !> the constraint matrix B is left out (sa/sb = 0); movable = rigid with a moving side.
+   pure subroutine rigid_contact_sides(m, rigid, e, sa, sb, movable)
+      type(model_t), intent(in) :: m
+      logical, intent(out) :: rigid(:), movable(:)
+      real(dp), intent(out) :: e(:)
+      integer, intent(out) :: sa(:), sb(:)
+      integer :: c
+      do c = 1, m%ncontact
+         rigid(c) = m%con_scheme(c) /= SCHEME_PENALTY
+         e(c) = max(m%con_par(P_RESTITUTION, c), 0.0_dp)
+         sa(c) = m%con_a(c); sb(c) = m%con_b(c)
+         if (sa(c) > 0) then
+            if (m%fixed(sa(c))) sa(c) = 0
+         end if
+         if (sb(c) > 0) then
+            if (m%fixed(sb(c))) sb(c) = 0
+         end if
+         movable(c) = rigid(c) .and. (sa(c) > 0 .or. sb(c) > 0)
+      end do
+   end subroutine rigid_contact_sides
 end module martello_model

@@ -26,14 +26,13 @@ module martello_moreau_jean
    use martello_kinds, only: dp, i8
    use martello_lapack, only: dgbtrf, dgbtrs
    use martello_status
-   use martello_model, only: model_t, model_bandwidth, SCHEME_PENALTY, scheme_name
+   use martello_model, only: model_t, model_bandwidth, rigid_contact_sides
    use martello_band_matrix, only: band_t, band_init, band_matvec
    use martello_assembly, only: mech_state_t, mech_init, internal_forces, external_forces, &
       mech_commit, recoverable_energy, mass_times, assemble_mass
    use martello_results
    use martello_run_checks, only: check_run_settings, check_divergence
    use martello_integrator_settings, only: integrator_settings_t, integrator_name, scheme_supported
-   use martello_contact_laws, only: P_RESTITUTION
    use martello_lcp, only: lcp_lemke, lcp_pgs, LCP_OK
    use martello_linalg, only: lapack_status
    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
@@ -104,20 +103,7 @@ contains
       call band_init(cband, n, kd)
       call band_init(what, n, kd)
 
-      ! Contacts solved by complementarity ("rigid": restitution and Lagrange). A side on
-      ! ground or on a fixed node does not move: its column of B is left out (sa/sb = 0).
-      do c = 1, nc
-         rigid(c) = m%con_scheme(c) /= SCHEME_PENALTY
-         e_con(c) = max(m%con_par(P_RESTITUTION, c), 0.0_dp)
-         sa(c) = m%con_a(c); sb(c) = m%con_b(c)
-         if (sa(c) > 0) then
-            if (m%fixed(sa(c))) sa(c) = 0
-         end if
-         if (sb(c) > 0) then
-            if (m%fixed(sb(c))) sb(c) = 0
-         end if
-         movable(c) = rigid(c) .and. (sa(c) > 0 .or. sb(c) > 0)
-      end do
+      call rigid_contact_sides(m, rigid, e_con, sa, sb, movable)
       call node_adjacency()
 
       ! initial state

@@ -29,14 +29,13 @@
 module martello_newmark_lagrange
    use martello_kinds, only: dp, i8
    use martello_status
-   use martello_model, only: model_t, model_bandwidth, SCHEME_PENALTY, scheme_name
+   use martello_model, only: model_t, model_bandwidth, rigid_contact_sides
    use martello_band_matrix, only: band_t, band_init
    use martello_assembly, only: mech_state_t, mech_init, internal_forces, external_forces, &
       mech_commit, recoverable_energy, mass_times
    use martello_results
    use martello_run_checks, only: check_run_settings, check_divergence
    use martello_integrator_settings, only: integrator_settings_t, integrator_name, scheme_supported
-   use martello_contact_laws, only: P_RESTITUTION
    use martello_linalg, only: solve_symmetric_indefinite
    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
    implicit none
@@ -97,17 +96,8 @@ contains
          call mass_times(m, work, ma)
          mdense(:, i) = ma(1:n)
       end do
+      call rigid_contact_sides(m, rigid, e_con, sa, sb, movable)
       do c = 1, nc
-         rigid(c) = m%con_scheme(c) /= SCHEME_PENALTY
-         e_con(c) = max(m%con_par(P_RESTITUTION, c), 0.0_dp)
-         sa(c) = m%con_a(c); sb(c) = m%con_b(c)
-         if (sa(c) > 0) then
-            if (m%fixed(sa(c))) sa(c) = 0
-         end if
-         if (sb(c) > 0) then
-            if (m%fixed(sb(c))) sb(c) = 0
-         end if
-         movable(c) = rigid(c) .and. (sa(c) > 0 .or. sb(c) > 0)
          ! effective mass of the contact, 1/(B M⁻¹ Bᵀ), for the impact energy loss
          mstar(c) = 0.0_dp
          if (movable(c)) mstar(c) = effective_mass(c)
