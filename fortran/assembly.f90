@@ -13,7 +13,7 @@ module martello_assembly
    implicit none
    private
    public :: mech_state_t, mech_init, internal_forces, external_forces, mech_commit, &
-      recoverable_energy, mass_times, assemble_mass, ONSET_SPEED_FLOOR
+      recoverable_energy, mass_times, external_work, assemble_mass, ONSET_SPEED_FLOOR
 
    !> Hunt–Crossley-type laws scale damping by 1/v_in; a contact first seen while δ̇ ≤ 0
    !> (grazing, or a step that lands inside) uses this floor [m/s] instead of a division by 0.
@@ -271,4 +271,15 @@ contains
          call band_add(jac, m%mc_b(j), m%mc_a(j), c*m%mc_value(j))
       end do
    end subroutine assemble_mass
+   !> Trapezoidal work of the external forces over a step, ½(f_n + f_{n+1})·(u_{n+1} − u_n),
+   !> on the free nodes.
+   pure real(dp) function external_work(m, fext_n, fext, un, u) result(w)
+      type(model_t), intent(in) :: m
+      real(dp), intent(in) :: fext_n(0:), fext(0:), un(0:), u(0:)
+      integer :: i
+      w = 0.0_dp
+      do i = 1, m%n
+         if (.not. m%fixed(i)) w = w + 0.5_dp*(fext_n(i) + fext(i))*(u(i) - un(i))
+      end do
+   end function external_work
 end module martello_assembly

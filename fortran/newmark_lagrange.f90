@@ -32,7 +32,7 @@ module martello_newmark_lagrange
    use martello_model, only: model_t, model_bandwidth, rigid_contact_sides
    use martello_band_matrix, only: band_t, band_init
    use martello_assembly, only: mech_state_t, mech_init, internal_forces, external_forces, &
-      mech_commit, recoverable_energy, mass_times
+      mech_commit, recoverable_energy, mass_times, external_work
    use martello_results
    use martello_run_checks, only: check_run_settings, check_divergence
    use martello_integrator_settings, only: integrator_settings_t, integrator_name, scheme_supported
@@ -201,10 +201,7 @@ contains
          r%counters(C_STEPS) = r%counters(C_STEPS) + 1_i8
          call mech_commit(m, ms, u, wdl, wll, wcl)
          d_damp = d_damp + wdl; d_links = d_links + wll; d_contact = d_contact + wcl
-         dw = 0.0_dp
-         do i = 1, n
-            if (.not. m%fixed(i)) dw = dw + 0.5_dp*(fext_n(i) + fext(i))*(u(i) - un(i))
-         end do
+         dw = external_work(m, fext_n, fext, un, u)
          w_ext = w_ext + dw; w_abs = w_abs + abs(dw)
          call contact_state()
          call track_events()

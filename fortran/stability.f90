@@ -28,12 +28,7 @@ contains
       real(dp) :: q(1, 1), z(1, 1)
 
       kd = max(model_bandwidth(m), 0)
-      allocate (dof(0:m%n)); dof = 0; nf = 0
-      do i = 1, m%n
-         if (.not. m%fixed(i)) then
-            nf = nf + 1; dof(i) = nf
-         end if
-      end do
+      call free_dofs(m, dof, nf)
       w_max = 0.0_dp; info = 0
       if (nf == 0) return
       ! upper band storage: A(i,j), i <= j, in ab(kd+1+i−j, j)
@@ -88,12 +83,7 @@ contains
       integer, allocatable :: dof(:)
       real(dp), allocatable :: mb(:, :)
       kd = max(model_bandwidth(m), 0)
-      allocate (dof(0:m%n)); dof = 0; nf = 0
-      do i = 1, m%n
-         if (.not. m%fixed(i)) then
-            nf = nf + 1; dof(i) = nf
-         end if
-      end do
+      call free_dofs(m, dof, nf)
       ok = .true.
       if (nf == 0) return
       allocate (mb(kd + 1, nf)); mb = 0.0_dp
@@ -109,4 +99,17 @@ contains
       call dpbtrf('U', nf, kd, mb, kd + 1, info)
       ok = info == 0
    end function mass_positive_definite
+   !> Numbering of the free nodes: dof(i) in 1..nf, 0 for fixed nodes and ground (dof(0)).
+   pure subroutine free_dofs(m, dof, nf)
+      type(model_t), intent(in) :: m
+      integer, allocatable, intent(out) :: dof(:)
+      integer, intent(out) :: nf
+      integer :: i
+      allocate (dof(0:m%n)); dof = 0; nf = 0
+      do i = 1, m%n
+         if (.not. m%fixed(i)) then
+            nf = nf + 1; dof(i) = nf
+         end if
+      end do
+   end subroutine free_dofs
 end module martello_stability

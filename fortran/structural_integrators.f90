@@ -166,10 +166,7 @@ contains
          ! energy balance: trapezoidal work of every force over the step (elements in commit)
          call mech_commit(m, ms, u, wd, wl, wc)
          d_damp = d_damp + wd; d_links = d_links + wl; d_contact = d_contact + wc
-         wd = 0.0_dp
-         do j = 1, n
-            if (.not. m%fixed(j)) wd = wd + 0.5_dp*(fext_n(j) + fext(j))*(u(j) - un(j))
-         end do
+         wd = external_work(m, fext_n, fext, un, u)
          w_ext = w_ext + wd; w_abs = w_abs + abs(wd)
          call track_events()
          ! the previous state is the integrator's own (un, vn, an): no copy in the results
