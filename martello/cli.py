@@ -48,7 +48,8 @@ def cmd_run(args):
     path = write_results(summary, out, history)
     for w in summary.get("warnings", []):
         print(f"warning: {w}", file=sys.stderr)
-    print(f"{s.title}: {summary['status']} -> {path}")
+    written = f"{path}" + (f" and {path.parent / 'history.csv'}" if history is not None else "")
+    print(f"{s.title}: {summary['status']} -> {written}")
     if args.print:
         print(json.dumps(summary, indent=2, default=float))
     return 0
@@ -61,11 +62,16 @@ def cmd_check(args):
     return 0 if ok else 1
 
 
+def _print_version(args):
+    print(f"martello {native.version()} ({native.library_versions()})")
+    return 0
+
+
 def main(argv=None):
     parser = argparse.ArgumentParser(prog="martello", description=DESCRIPTION,
                                      formatter_class=argparse.RawDescriptionHelpFormatter)
-    parser.add_argument("--version", action="version",
-                        version=f"martello (Python front end); library: see `martello version`")
+    parser.add_argument("--version", action="store_true",
+                        help="print the versions of martello and the libraries it links")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND")
 
     p = sub.add_parser("list", help="list the benchmark catalogue, one line per scene")
@@ -111,9 +117,11 @@ def main(argv=None):
     p.set_defaults(func=lambda a: __import__("martello.compare", fromlist=["main"]).main(a))
 
     p = sub.add_parser("version", help="versions of martello and the libraries it links")
-    p.set_defaults(func=lambda a: print(f"martello {native.version()} ({native.library_versions()})") or 0)
+    p.set_defaults(func=_print_version)
 
     args = parser.parse_args(argv)
+    if args.version:
+        args.command, args.func = "version", _print_version
     if not args.command:
         parser.print_help()
         return 2
