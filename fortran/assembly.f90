@@ -13,7 +13,7 @@ module martello_assembly
    implicit none
    private
    public :: mech_state_t, mech_init, internal_forces, external_forces, mech_commit, &
-      recoverable_energy, mass_times, external_work, assemble_mass, ONSET_SPEED_FLOOR
+      recoverable_energy, mass_times, external_work, kinetic_energy, assemble_mass, ONSET_SPEED_FLOOR
 
    !> Hunt–Crossley-type laws scale damping by 1/v_in; a contact first seen while δ̇ ≤ 0
    !> (grazing, or a step that lands inside) uses this floor [m/s] instead of a division by 0.
@@ -282,4 +282,12 @@ contains
          if (.not. m%fixed(i)) w = w + 0.5_dp*(fext_n(i) + fext(i))*(u(i) - un(i))
       end do
    end function external_work
+   !> ½ vᵀ M v (work: scratch of length 0:n for M v).
+   real(dp) function kinetic_energy(m, v, work) result(e)
+      type(model_t), intent(in) :: m
+      real(dp), intent(in) :: v(0:)
+      real(dp), intent(out) :: work(0:)
+      call mass_times(m, v, work)
+      e = 0.5_dp*dot_product(v(1:m%n), work(1:m%n))
+   end function kinetic_energy
 end module martello_assembly

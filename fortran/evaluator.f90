@@ -124,8 +124,7 @@ contains
       real(dp), intent(out) :: kinetic, recoverable
       real(dp) :: el, ec
       call load(ev, u, v)
-      call mass_times(ev%m, ev%v, ev%work)
-      kinetic = 0.5_dp*dot_product(ev%v(1:), ev%work(1:))
+      kinetic = kinetic_energy(ev%m, ev%v, ev%work)
       call recoverable_energy(ev%m, ev%ms, ev%u, el, ec)
       recoverable = el + ec
    end subroutine evaluator_energy

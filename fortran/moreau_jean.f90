@@ -29,7 +29,7 @@ module martello_moreau_jean
    use martello_model, only: model_t, model_bandwidth, rigid_contact_sides
    use martello_band_matrix, only: band_t, band_init, band_matvec
    use martello_assembly, only: mech_state_t, mech_init, internal_forces, external_forces, &
-      mech_commit, recoverable_energy, mass_times, assemble_mass
+      mech_commit, recoverable_energy, mass_times, assemble_mass, kinetic_energy
    use martello_results
    use martello_run_checks, only: check_run_settings, check_divergence
    use martello_integrator_settings, only: integrator_settings_t, integrator_name, scheme_supported
@@ -120,7 +120,7 @@ contains
       r%counters(C_RESIDUALS) = r%counters(C_RESIDUALS) + 1_i8
       r%counters(C_JACOBIANS) = r%counters(C_JACOBIANS) + 1_i8
 
-      e_kin = kinetic(v)
+      e_kin = kinetic_energy(m, v, ma)
       call recoverable_energy(m, ms, u, e_links, e_cont)
       e_links0 = e_links; e_cont0 = e_cont
       e0 = e_kin + e_links + e_cont
@@ -214,7 +214,7 @@ contains
          recording = mod(step, s%every) == 0 .or. step == nsteps
          if (.not. (recording .or. mod(step, ENERGY_CHECK) == 0 .or. &
                     .not. ieee_is_finite(dw + d_impact + d_links + d_contact + d_damp))) cycle
-         e_kin = kinetic(v)
+         e_kin = kinetic_energy(m, v, ma)
          call recoverable_energy(m, ms, u, e_links, e_cont)
          if (recording) call record()
          e_mech = e_kin + e_links + e_cont
@@ -238,11 +238,6 @@ contains
          end if
       end subroutine check_scene
 
-      real(dp) function kinetic(vel)
-         real(dp), intent(in) :: vel(0:)
-         call mass_times(m, vel, ma)
-         kinetic = 0.5_dp*dot_product(vel(1:n), ma(1:n))
-      end function kinetic
 
       !> Replace row and column i by the identity (a fixed DOF: Δv_i = 0).
       subroutine pin_row(b, i)

@@ -32,7 +32,7 @@ module martello_newmark_lagrange
    use martello_model, only: model_t, model_bandwidth, rigid_contact_sides
    use martello_band_matrix, only: band_t, band_init
    use martello_assembly, only: mech_state_t, mech_init, internal_forces, external_forces, &
-      mech_commit, recoverable_energy, mass_times, external_work
+      mech_commit, recoverable_energy, mass_times, external_work, kinetic_energy
    use martello_results
    use martello_run_checks, only: check_run_settings, check_divergence
    use martello_integrator_settings, only: integrator_settings_t, integrator_name, scheme_supported
@@ -114,7 +114,7 @@ contains
       call equilibrium_acceleration(converged)
       if (.not. converged) return
 
-      e_kin = kinetic(v)
+      e_kin = kinetic_energy(m, v, ma)
       call recoverable_energy(m, ms, u, e_links, e_cont)
       e_links0 = e_links; e_cont0 = e_cont
       e0 = e_kin + e_links + e_cont
@@ -214,7 +214,7 @@ contains
          recording = mod(step, s%every) == 0 .or. step == nsteps
          if (.not. (recording .or. mod(step, ENERGY_CHECK) == 0 .or. &
                     .not. ieee_is_finite(dw + d_impact + d_links + d_damp))) cycle
-         e_kin = kinetic(v)
+         e_kin = kinetic_energy(m, v, ma)
          call recoverable_energy(m, ms, u, e_links, e_cont)
          if (recording) call record()
          e_mech = e_kin + e_links + e_cont
@@ -247,11 +247,6 @@ contains
          closed_tol = 8.0_dp*epsilon(1.0_dp)*(abs(u(m%con_a(cc))) + abs(u(m%con_b(cc))) + abs(m%con_gap(cc)))
       end function closed_tol
 
-      real(dp) function kinetic(vel)
-         real(dp), intent(in) :: vel(0:)
-         call mass_times(m, vel, ma)
-         kinetic = 0.5_dp*dot_product(vel(1:n), ma(1:n))
-      end function kinetic
 
       !> 1/(B M⁻¹ Bᵀ) of contact cc (M restricted to the free nodes).
       real(dp) function effective_mass(cc)

@@ -135,7 +135,7 @@ contains
       cm = (1.0_dp - am)/(beta*h*h)
       mmax = max(maxval(m%mass), tiny(1.0_dp))
       cv = gamma/(beta*h)
-      e_kin = kinetic(v); ke_corr = kinetic_correction()
+      e_kin = kinetic_energy(m, v, ma); ke_corr = kinetic_correction()
       call recoverable_energy(m, ms, u, e_links, e_cont)
       e_links0 = e_links; e_cont0 = e_cont
       e0 = e_kin + e_links + e_cont
@@ -177,7 +177,7 @@ contains
          ! recorded steps and every ENERGY_CHECK steps for the divergence test
          if (.not. (recording .or. mod(step, ENERGY_CHECK) == 0 .or. &
                     .not. ieee_is_finite(wd + d_links + d_contact + d_damp))) cycle
-         e_kin = kinetic(v); ke_corr = kinetic_correction()
+         e_kin = kinetic_energy(m, v, ma); ke_corr = kinetic_correction()
          call recoverable_energy(m, ms, u, e_links, e_cont)
          r%energy_balance_max = max(r%energy_balance_max, abs(e0_alg + w_ext - (e_kin - ke_corr) - e_links - e_cont &
                                                               - d_damp - d_links - d_contact + &
@@ -213,11 +213,6 @@ contains
          kinetic_correction = 0.125_dp*h*h*dot_product(a(1:n), ma(1:n))
       end function kinetic_correction
 
-      real(dp) function kinetic(vel)
-         real(dp), intent(in) :: vel(0:)
-         call mass_times(m, vel, ma)
-         kinetic = 0.5_dp*dot_product(vel(1:n), ma(1:n))
-      end function kinetic
 
       !> M a = fext − fint on the free nodes (fixed nodes: a = 0).
       subroutine solve_mass(rhs, ok)
