@@ -821,15 +821,16 @@ static int ed_setup(ed_t *w) {
   const size_t dim = (size_t)(2 * n + 2);
   const gsl_odeiv2_step_type *T;
   double h0;
-  int j, st, nn;
+  int j, st, nn, nc_read, ncoup;
   w->dim = dim;
   if (!(ALLOC(w->mass, n) && ALLOC(w->fixed, n) && ALLOC(w->gap, nc) && ALLOC(w->e, nc) &&
         ALLOC(w->con_a, nc) && ALLOC(w->con_b, nc) && ALLOC(w->scheme, nc) &&
         ALLOC(w->is_pen, nc) &&
         ALLOC(w->uni, nc) && ALLOC(w->inert, nc)))
     return MARTELLO_ERR_MEMORY;
-  st = martello_model_topology(w->model, &nn, &nn, w->mass, w->fixed, w->con_a, w->con_b,
-                               w->scheme, w->gap, w->e, &nn);
+  /* three distinct outputs: the Fortran dummies are intent(out) and must not alias */
+  st = martello_model_topology(w->model, &nn, &nc_read, w->mass, w->fixed, w->con_a, w->con_b,
+                               w->scheme, w->gap, w->e, &ncoup);
   if (st != MARTELLO_OK) return fail(w, st, 0.0, "event-driven: martello_model_topology failed");
   for (j = 0; j < n; j++)
     if (w->mass[j] < 0.0) {

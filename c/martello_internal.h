@@ -37,7 +37,6 @@ int martello_eval_energy(martello_eval *ev, const double *u, const double *v, do
 
 /* The run being filled. */
 int martello_run_settings(const martello_run *run, int *kind, double par[MARTELLO_NPAR_INTEGRATOR]);
-int martello_run_begin(martello_run *run, const martello_model *model);
 int martello_run_track(martello_run *run, double t, const double *u, const double *v,
                        const double *a, const double *pen, const double *force);
 int martello_run_record(martello_run *run, double t, const double *u, const double *v,

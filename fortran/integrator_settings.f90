@@ -8,12 +8,23 @@ module martello_integrator_settings
    private
    public :: integrator_settings_t, integrator_name, scheme_supported, &
       INT_NEWMARK, INT_HHT, INT_GENERALIZED_ALPHA, INT_CENTRAL_DIFFERENCE, INT_MOREAU_JEAN, &
-      INT_NEWMARK_LAGRANGE, INT_RKF45, INT_RK8PD, INT_MSBDF, INT_IDA, INT_LAST
+      INT_NEWMARK_LAGRANGE, INT_RKF45, INT_RK8PD, INT_MSBDF, INT_IDA, INT_LAST, &
+      NPAR_INTEGRATOR, R_DT, R_T_END, R_BETA, R_GAMMA, R_ALPHA, R_RHO_INF, R_TOL_RESIDUAL, &
+      R_TOL_INCREMENT, R_MAX_NEWTON, R_CHECK_STABILITY, R_EVERY, R_DIVERGENCE_FACTOR, R_RTOL, &
+      R_ATOL, R_THETA, R_EVENT_TOL, R_H_MAX
 
    integer, parameter :: INT_NEWMARK = 1, INT_HHT = 2, INT_GENERALIZED_ALPHA = 3, &
                          INT_CENTRAL_DIFFERENCE = 4, INT_MOREAU_JEAN = 5, &
                          INT_NEWMARK_LAGRANGE = 6, INT_RKF45 = 7, INT_RK8PD = 8, INT_MSBDF = 9, &
                          INT_IDA = 10, INT_LAST = 10
+
+   !> Slots of the integrator parameter array of martello_run_set_integrator (0-based in C).
+   integer, parameter :: NPAR_INTEGRATOR = 17
+   integer, parameter :: R_DT = 1, R_T_END = 2, R_BETA = 3, R_GAMMA = 4, R_ALPHA = 5, &
+                         R_RHO_INF = 6, R_TOL_RESIDUAL = 7, R_TOL_INCREMENT = 8, &
+                         R_MAX_NEWTON = 9, R_CHECK_STABILITY = 10, R_EVERY = 11, &
+                         R_DIVERGENCE_FACTOR = 12, R_RTOL = 13, R_ATOL = 14, R_THETA = 15, &
+                         R_EVENT_TOL = 16, R_H_MAX = 17
 
    type :: integrator_settings_t
       integer :: kind = INT_NEWMARK

@@ -4,12 +4,12 @@ module martello_run_checks
    use martello_kinds, only: dp
    use martello_status
    use martello_model, only: model_t, scheme_name
-   use martello_integrator_settings, only: integrator_settings_t, integrator_name, scheme_supported
+   use martello_integrator_settings, only: integrator_settings_t, integrator_name, scheme_supported, INT_LAST
    use martello_results, only: results_t
    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
    implicit none
    private
-   public :: check_run_settings, check_divergence
+   public :: check_run_settings, check_schemes, check_divergence
 
 contains
 
@@ -20,27 +20,45 @@ contains
       type(integrator_settings_t), intent(in) :: s
       type(results_t), intent(inout) :: r
       integer, intent(out) :: stat
-      integer :: j
-      character(len=16) :: num
       stat = MARTELLO_OK
       if (.not. (s%dt > 0.0_dp .and. s%t_end > 0.0_dp .and. s%every >= 1)) then
          stat = MARTELLO_ERR_ARGUMENT
          r%message = 'dynamic run: need dt > 0, t_end > 0 and every >= 1'
          return
       end if
-      do j = 1, m%ncontact
-         if (.not. scheme_supported(s%kind, m%con_scheme(j))) then
-            write (num, '(i0)') j - 1
-            stat = MARTELLO_ERR_UNSUPPORTED
-            r%message = 'contact '//trim(num)//': scheme '//scheme_name(m%con_scheme(j))// &
-               ' cannot run on '//integrator_name(s%kind)//' (see docs/integrators.md)'
-            return
-         end if
-      end do
+      call check_schemes(m, s%kind, r%message, stat)
+      if (stat /= MARTELLO_OK) return
       if (any(m%mass < 0.0_dp)) then
          stat = MARTELLO_ERR_STATE; r%message = 'every node must be set before a run'
       end if
    end subroutine check_run_settings
+
+   !> Every contact's scheme must run on the integrator kind; the message names the
+   !> integrators that would (the compatibility table of martello_integrator_settings).
+   subroutine check_schemes(m, kind, message, stat)
+      type(model_t), intent(in) :: m
+      integer, intent(in) :: kind
+      character(len=*), intent(inout) :: message
+      integer, intent(out) :: stat
+      integer :: j, k
+      character(len=16) :: num
+      character(len=256) :: works
+      stat = MARTELLO_OK
+      do j = 1, m%ncontact
+         if (scheme_supported(kind, m%con_scheme(j))) cycle
+         works = ''
+         do k = 1, INT_LAST
+            if (scheme_supported(k, m%con_scheme(j))) works = trim(works)//' '//integrator_name(k)
+         end do
+         write (num, '(i0)') j - 1
+         stat = MARTELLO_ERR_UNSUPPORTED
+         message = 'contact '//trim(num)//': scheme '//scheme_name(m%con_scheme(j))// &
+            ' cannot run on '//integrator_name(kind)//'; integrators that can:'//trim(works)
+         if (len_trim(works) == 0) message = 'contact '//trim(num)//': scheme '// &
+            scheme_name(m%con_scheme(j))//' is static only; use analysis type static'
+         return
+      end do
+   end subroutine check_schemes
 
    !> Divergence at time t: a non-finite state, or e_mech > divergence_factor·(e0 + Σ|ΔW|).
    !> advice ends the message (what to change).

@@ -1,0 +1,49 @@
+!> Handles of the C API: an opaque C pointer ↔ the Fortran object it stands for, and the
+!> NUL-terminated message copy every door uses. A null handle maps to a null pointer, which
+!> each door turns into MARTELLO_ERR_ARGUMENT.
+module martello_api_handles
+   use, intrinsic :: iso_c_binding
+   use martello_model, only: model_t
+   use martello_run, only: run_t
+   use martello_evaluator, only: evaluator_t
+   implicit none
+   private
+   public :: get_model, get_run, get_eval, copy_message
+
+contains
+
+   !> Handle → model pointer; a null handle is an argument error.
+   function get_model(handle) result(mp)
+      type(c_ptr), value :: handle
+      type(model_t), pointer :: mp
+      mp => null()
+      if (c_associated(handle)) call c_f_pointer(handle, mp)
+   end function get_model
+
+   function get_run(handle) result(rp)
+      type(c_ptr), value :: handle
+      type(run_t), pointer :: rp
+      rp => null()
+      if (c_associated(handle)) call c_f_pointer(handle, rp)
+   end function get_run
+
+   function get_eval(handle) result(ep)
+      type(c_ptr), value :: handle
+      type(evaluator_t), pointer :: ep
+      ep => null()
+      if (c_associated(handle)) call c_f_pointer(handle, ep)
+   end function get_eval
+
+   !> Copy msg into buf (NUL-terminated, truncated to buflen − 1 characters).
+   subroutine copy_message(msg, buf, buflen)
+      character(len=*), intent(in) :: msg
+      integer(c_int), intent(in) :: buflen
+      character(kind=c_char), intent(out) :: buf(*)
+      integer :: i, n
+      n = min(len_trim(msg), int(buflen) - 1)
+      do i = 1, n
+         buf(i) = msg(i:i)
+      end do
+      buf(n + 1) = c_null_char
+   end subroutine copy_message
+end module martello_api_handles

@@ -1,0 +1,195 @@
+!> The C door of the model handle (martello_model_* and martello_static_solve of
+!> c/martello.h): converts arguments (0-based C nodes, −1 = ground → 1-based, 0 = ground)
+!> and calls martello_model / martello_statics. Nothing is computed here.
+module martello_api_model
+   use, intrinsic :: iso_c_binding
+   use martello_kinds, only: dp
+   use martello_status
+   use martello_model
+   use martello_time_functions, only: NPAR_TF
+   use martello_contact_laws, only: NPAR_CONTACT
+   use martello_links, only: NPAR_LINK
+   use martello_statics, only: static_result_t, static_solve
+   use martello_api_handles, only: get_model, copy_message
+   implicit none
+   private
+
+contains
+
+   integer(c_int) function c_model_create(n_nodes, max_links, max_contacts, max_forces, &
+                                          max_couplings, handle) bind(C, name='martello_model_create')
+      integer(c_int), value :: n_nodes, max_links, max_contacts, max_forces, max_couplings
+      type(c_ptr), intent(out) :: handle
+      type(model_t), pointer :: mp
+      integer :: stat
+      handle = c_null_ptr
+      allocate (mp, stat=stat)
+      if (stat /= 0) then
+         c_model_create = MARTELLO_ERR_MEMORY; return
+      end if
+      call model_init(mp, int(n_nodes), int(max_links), int(max_contacts), int(max_forces), &
+                      int(max_couplings), stat)
+      if (stat /= MARTELLO_OK) then
+         deallocate (mp); c_model_create = stat; return
+      end if
+      handle = c_loc(mp)
+      c_model_create = MARTELLO_OK
+   end function c_model_create
+
+   subroutine c_model_free(handle) bind(C, name='martello_model_free')
+      type(c_ptr), intent(inout) :: handle
+      type(model_t), pointer :: mp
+      mp => get_model(handle)
+      if (associated(mp)) deallocate (mp)
+      handle = c_null_ptr
+   end subroutine c_model_free
+
+   integer(c_int) function c_model_set_node(handle, node, mass, u0, v0, fixed) &
+      bind(C, name='martello_model_set_node')
+      type(c_ptr), value :: handle
+      integer(c_int), value :: node, fixed
+      real(c_double), value :: mass, u0, v0
+      type(model_t), pointer :: mp
+      integer :: stat
+      mp => get_model(handle)
+      if (.not. associated(mp)) then
+         c_model_set_node = MARTELLO_ERR_ARGUMENT; return
+      end if
+      call model_set_node(mp, int(node) + 1, mass, u0, v0, fixed /= 0, stat)
+      c_model_set_node = stat
+   end function c_model_set_node
+
+   integer(c_int) function c_model_add_link(handle, kind, a, b, par) bind(C, name='martello_model_add_link')
+      type(c_ptr), value :: handle
+      integer(c_int), value :: kind, a, b
+      real(c_double), intent(in) :: par(NPAR_LINK)
+      type(model_t), pointer :: mp
+      integer :: stat
+      mp => get_model(handle)
+      if (.not. associated(mp)) then
+         c_model_add_link = MARTELLO_ERR_ARGUMENT; return
+      end if
+      call model_add_link(mp, int(kind), int(a) + 1, int(b) + 1, par, stat)
+      c_model_add_link = stat
+   end function c_model_add_link
+
+   integer(c_int) function c_model_add_contact(handle, a, b, gap, scheme, law, par) &
+      bind(C, name='martello_model_add_contact')
+      type(c_ptr), value :: handle
+      integer(c_int), value :: a, b, scheme, law
+      real(c_double), value :: gap
+      real(c_double), intent(in) :: par(NPAR_CONTACT)
+      type(model_t), pointer :: mp
+      integer :: stat
+      mp => get_model(handle)
+      if (.not. associated(mp)) then
+         c_model_add_contact = MARTELLO_ERR_ARGUMENT; return
+      end if
+      call model_add_contact(mp, int(a) + 1, int(b) + 1, gap, int(scheme), int(law), par, stat)
+      c_model_add_contact = stat
+   end function c_model_add_contact
+
+   integer(c_int) function c_model_add_mass_coupling(handle, a, b, value) &
+      bind(C, name='martello_model_add_mass_coupling')
+      type(c_ptr), value :: handle
+      integer(c_int), value :: a, b
+      real(c_double), value :: value
+      type(model_t), pointer :: mp
+      integer :: stat
+      mp => get_model(handle)
+      if (.not. associated(mp)) then
+         c_model_add_mass_coupling = MARTELLO_ERR_ARGUMENT; return
+      end if
+      call model_add_mass_coupling(mp, int(a) + 1, int(b) + 1, value, stat)
+      c_model_add_mass_coupling = stat
+   end function c_model_add_mass_coupling
+
+   integer(c_int) function c_model_set_gravity(handle, g) bind(C, name='martello_model_set_gravity')
+      type(c_ptr), value :: handle
+      real(c_double), value :: g
+      type(model_t), pointer :: mp
+      mp => get_model(handle)
+      c_model_set_gravity = MARTELLO_ERR_ARGUMENT
+      if (.not. associated(mp)) return
+      if (g /= g .or. abs(g) > huge(g)) then
+         mp%errmsg = 'set_gravity: g must be finite'; return
+      end if
+      mp%gravity = g
+      c_model_set_gravity = MARTELLO_OK
+   end function c_model_set_gravity
+
+   integer(c_int) function c_model_add_nodal_force(handle, node, kind, par, ntab, t, y) &
+      bind(C, name='martello_model_add_nodal_force')
+      type(c_ptr), value :: handle
+      integer(c_int), value :: node, kind, ntab
+      real(c_double), intent(in) :: par(NPAR_TF), t(*), y(*)
+      type(model_t), pointer :: mp
+      integer :: stat
+      mp => get_model(handle)
+      if (.not. associated(mp) .or. ntab < 0) then
+         c_model_add_nodal_force = MARTELLO_ERR_ARGUMENT; return
+      end if
+      call model_add_nodal_force(mp, int(node) + 1, int(kind), par, t(1:ntab), y(1:ntab), stat)
+      c_model_add_nodal_force = stat
+   end function c_model_add_nodal_force
+
+   integer(c_int) function c_model_set_ground_acceleration(handle, kind, par, ntab, t, y) &
+      bind(C, name='martello_model_set_ground_acceleration')
+      type(c_ptr), value :: handle
+      integer(c_int), value :: kind, ntab
+      real(c_double), intent(in) :: par(NPAR_TF), t(*), y(*)
+      type(model_t), pointer :: mp
+      integer :: stat
+      mp => get_model(handle)
+      if (.not. associated(mp) .or. ntab < 0) then
+         c_model_set_ground_acceleration = MARTELLO_ERR_ARGUMENT; return
+      end if
+      call model_set_ground_acceleration(mp, int(kind), par, t(1:ntab), y(1:ntab), stat)
+      c_model_set_ground_acceleration = stat
+   end function c_model_set_ground_acceleration
+
+   !> Copy the model's last error or warning message into buf (NUL-terminated, truncated).
+   integer(c_int) function c_model_message(handle, buf, buflen) bind(C, name='martello_model_message')
+      type(c_ptr), value :: handle
+      integer(c_int), value :: buflen
+      character(kind=c_char), intent(out) :: buf(*)
+      type(model_t), pointer :: mp
+      mp => get_model(handle)
+      c_model_message = MARTELLO_ERR_ARGUMENT
+      if (.not. associated(mp) .or. buflen < 1) return
+      call copy_message(mp%errmsg, buf, buflen)
+      c_model_message = MARTELLO_OK
+   end function c_model_message
+
+   integer(c_int) function c_static_solve(handle, tol, max_iter, u, force, penetration, active, &
+                                          counters, conditioning) bind(C, name='martello_static_solve')
+      type(c_ptr), value :: handle
+      real(c_double), value :: tol
+      integer(c_int), value :: max_iter
+      real(c_double), intent(out) :: u(*), force(*), penetration(*), conditioning(4)
+      integer(c_int), intent(out) :: active(*), counters(3)
+      type(model_t), pointer :: mp
+      type(static_result_t) :: r
+      integer :: stat, n, nc
+      mp => get_model(handle)
+      c_static_solve = MARTELLO_ERR_ARGUMENT
+      if (.not. associated(mp)) return
+      if (.not. (tol > 0.0_dp) .or. max_iter < 1) then
+         mp%errmsg = 'static_solve: need tol > 0 and max_iter >= 1'; return
+      end if
+      if (any(mp%mass(1:mp%n) < 0.0_dp)) then
+         mp%errmsg = 'static_solve: every node must be set (set_node) before solving'
+         c_static_solve = MARTELLO_ERR_STATE; return
+      end if
+      mp%errmsg = ''
+      call static_solve(mp, tol, int(max_iter), r, stat)
+      n = mp%n; nc = mp%ncontact
+      if (allocated(r%u)) then
+         u(1:n) = r%u; force(1:nc) = r%force; penetration(1:nc) = r%penetration
+         active(1:nc) = merge(1, 0, r%active)
+      end if
+      counters = [r%active_set_iterations, r%uzawa_iterations, r%solves]
+      conditioning = [r%rcond, r%digits_lost, r%penalty_ratio, r%penalised_rcond]
+      c_static_solve = stat
+   end function c_static_solve
+end module martello_api_model

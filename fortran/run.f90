@@ -1,0 +1,87 @@
+!> A dynamic run: its settings, outputs and results (run_t, what a martello_run handle points
+!> to), and run_dynamic, which validates the run against the model and dispatches it to the
+!> integrator. The C door (martello_api_run) only converts arguments and calls this.
+module martello_run
+   use, intrinsic :: iso_c_binding, only: c_int, c_ptr, c_loc
+   use martello_kinds, only: dp
+   use martello_status
+   use martello_model, only: model_t
+   use martello_integrator_settings
+   use martello_structural_integrators, only: run_structural
+   use martello_moreau_jean, only: run_moreau_jean
+   use martello_newmark_lagrange, only: run_newmark_lagrange
+   use martello_stability, only: mass_positive_definite
+   use martello_run_checks, only: check_schemes
+   use martello_results
+   implicit none
+   private
+   public :: run_t, run_dynamic
+
+   !> Dispatched to the C integrators (c/event_driven.c, c/ida.c).
+   interface
+      integer(c_int) function c_event_driven_run(model, run) bind(C, name='martello_event_driven_run')
+         import :: c_int, c_ptr
+         type(c_ptr), value :: model, run
+      end function c_event_driven_run
+      integer(c_int) function c_ida_run(model, run) bind(C, name='martello_ida_run')
+         import :: c_int, c_ptr
+         type(c_ptr), value :: model, run
+      end function c_ida_run
+   end interface
+
+   type :: run_t
+      type(integrator_settings_t) :: settings
+      type(results_t) :: results
+      integer, allocatable :: out_nodes(:), out_contacts(:), out_links(:)
+      logical :: configured = .false., done = .false.
+   end type run_t
+
+contains
+
+   !> Validate the run against the model (outputs in range, schemes runnable by the
+   !> integrator, a positive definite mass matrix), size the results and run the integrator.
+   subroutine run_dynamic(mp, rp, stat)
+      type(model_t), pointer, intent(in) :: mp
+      type(run_t), pointer, intent(in) :: rp
+      integer, intent(out) :: stat
+      integer :: cap
+      stat = MARTELLO_ERR_ARGUMENT
+      if (.not. rp%configured) then
+         rp%results%message = 'dynamic_run: call martello_run_set_integrator first'
+         stat = MARTELLO_ERR_STATE; return
+      end if
+      if (any(rp%out_nodes < 1 .or. rp%out_nodes > mp%n) .or. &
+          any(rp%out_contacts < 1 .or. rp%out_contacts > mp%ncontact)) then
+         rp%results%message = 'dynamic_run: an output node or contact is out of range'; return
+      end if
+      if (any(rp%out_links < 1 .or. rp%out_links > mp%nlink)) then
+         rp%results%message = 'dynamic_run: an output link is out of range'; return
+      end if
+      cap = int(min(rp%settings%t_end/rp%settings%dt/rp%settings%every + 3.0_dp, 1.0e7_dp))
+      call results_init(rp%results, mp%n, mp%ncontact, rp%out_nodes, rp%out_contacts, cap, &
+                        mp%nlink, rp%out_links)
+      call check_schemes(mp, rp%settings%kind, rp%results%message, stat)
+      if (stat == MARTELLO_OK .and. mp%ncoupling > 0) then
+         if (.not. mass_positive_definite(mp)) then
+            stat = MARTELLO_ERR_ARGUMENT
+            rp%results%message = 'the mass matrix (node masses plus mass couplings) is not'// &
+               ' positive definite: a coupling is larger than the masses it joins allow'
+         end if
+      end if
+      if (stat == MARTELLO_OK) then
+         select case (rp%settings%kind)
+         case (INT_NEWMARK, INT_HHT, INT_GENERALIZED_ALPHA, INT_CENTRAL_DIFFERENCE)
+            call run_structural(mp, rp%settings, rp%results, stat)
+         case (INT_MOREAU_JEAN)
+            call run_moreau_jean(mp, rp%settings, rp%results, stat)
+         case (INT_NEWMARK_LAGRANGE)
+            call run_newmark_lagrange(mp, rp%settings, rp%results, stat)
+         case (INT_RKF45, INT_RK8PD, INT_MSBDF)
+            stat = c_event_driven_run(c_loc(mp), c_loc(rp))
+         case (INT_IDA)
+            stat = c_ida_run(c_loc(mp), c_loc(rp))
+         end select
+      end if
+      rp%done = .true.
+   end subroutine run_dynamic
+end module martello_run
