@@ -1,10 +1,12 @@
 /* Event-driven integration of a scene on GSL odeiv2 (rkf45, rk8pd, msbdf); the method, the
  * sign conventions and the choices made are in docs/event-driven.md.
  *
- *  - The state y = [u; v; W_ext; W_int] (n nodes; the two work integrals ride along outside
- *    the error control) is advanced by gsl_odeiv2_evolve_apply one accepted step at a time,
+ *  - The state y = [u; v; W_ext; W_int; W_links; W_contact] (n nodes; the work integrals
+ *    of the external forces, of all internal forces, of the links other than dampers and of
+ *    the penalty contacts ride along outside the error control) is advanced by gsl_odeiv2_evolve_apply one accepted step at a time,
  *    stepping exactly onto the output times. Every accepted step commits the path-dependent
- *    link states (martello_eval_commit) and feeds the peaks (martello_run_track).
+ *    link states (martello_eval_commit) and is a sample of the run's observer, which
+ *    measures it as it measures every integrator (martello_observer_*, docs/run-layer.md).
  *  - Events are roots located to event_tol in time by Illinois iterations on states
  *    re-integrated from the start of the step (the stepper's own one-step method with a
  *    shorter step; for msbdf, whose multistep history cannot restart there, an adaptive
@@ -32,12 +34,9 @@
 #include "martello_internal.h"
 #include "event_driven_lcp.h"
 
-/* Slots of the result arrays (fortran/results.f90 E_*, C_*, EV_*, 0-based here). */
-enum { E_KINETIC, E_RECOVERABLE, E_INPUT, E_DAMPING, E_PLASTIC, E_CONTACT, E_BALANCE,
-       E_INITIAL, E_IMPACT };
+/* Slots of the cost counters (fortran/observer.f90 C_*, 0-based here). */
 enum { C_STEPS, C_REJECTED, C_NEWTON, C_RESIDUALS, C_FACTORIZATIONS, C_EVENTS, C_JACOBIANS,
        C_ROOT_EVALS, C_CHATTER };
-enum { EV_T_ON, EV_T_OFF, EV_V_IN, EV_V_OUT, EV_MAX_PEN, EV_MAX_FORCE };
 
 /* What a contact waits for. After an event the state is the far end of the final bracket
  * (within event_tol of the root), so the status committed there is the new one. */
@@ -59,9 +58,10 @@ enum { ROOT_IMPACT,      /* unilateral gap closing: delta >= 0                  
 typedef struct {
   martello_model *model;
   martello_run *run;
+  martello_observer *obs;         /* what the run measures */
   martello_eval *ev;
   int kind, n, nc, nu;            /* integrator; nodes, contacts, unilateral contacts */
-  size_t dim;                     /* 2n + 2 */
+  size_t dim;                     /* 2n + 4 */
   double t_end, dt_out, rtol, atol, event_tol, h_max;
   int every;
   /* topology */
@@ -85,12 +85,10 @@ typedef struct {
   martello_lcp *lcp;
   int *ilist;
   double *Wl, *ql, *pl, *wl, *sl;
-  /* contact phases: a penalty contact in contact, a persistent unilateral contact */
-  int *ph_open;
-  double *ph_t, *ph_v, *ph_pen, *ph_f, *t_hold;
-  /* results */
+  double *t_hold;                 /* predicted accumulation time of a contact being held */
+  /* cost counters; kinetic energy taken out by impulses since the last commit */
   long long cnt[MARTELLO_NCOUNTERS];
-  double e_initial, e_rec0, e_impact, balance_max, energy[MARTELLO_NENERGY];
+  double e_impact;
   int rhs_status;                 /* why the RHS stopped GSL */
   char msg[512];
 } ed_t;
@@ -99,17 +97,14 @@ typedef struct {
 
 static int fail(ed_t *w, int status, double t, const char *what) {
   snprintf(w->msg, sizeof w->msg, "%s (t = %.9e s)", what, t);
-  martello_run_set_message(w->run, w->msg);
-  return status;
+  return martello_observer_fail(w->obs, status, t, w->msg);
 }
 
 static int fail_eval(ed_t *w, int status, double t) {
-  const char *why = status == MARTELLO_ERR_SINGULAR
-                        ? "event-driven: the mass matrix is singular on the free nodes"
-                    : status == MARTELLO_ERR_DIVERGED
-                        ? "event-driven: diverged, non-finite accelerations or work (NaN/inf)"
-                        : "event-driven: the force evaluation failed";
-  return fail(w, status, t, why);
+  if (status == MARTELLO_ERR_DIVERGED) return martello_observer_fail_nonfinite(w->obs, t);
+  return fail(w, status, t, status == MARTELLO_ERR_SINGULAR
+                                ? "event-driven: the mass matrix is singular on the free nodes"
+                                : "event-driven: the force evaluation failed");
 }
 
 /* G_j x = x_a - x_b (ground: x = 0). */
@@ -166,15 +161,17 @@ static void constrain(ed_t *w, double *a) {
   }
 }
 
-/* y' = [v; a; f_ext.v; f_int.v]. GSL_EBADFUNC stops GSL; the reason is in w->rhs_status. */
+/* y' = [v; a; f_ext.v; f_int.v; link and contact power]. GSL_EBADFUNC stops GSL; the
+ * reason is in w->rhs_status. */
 static int ed_rhs(double t, const double y[], double dydt[], void *params) {
   ed_t *w = params;
   const int n = w->n;
   const double *u = y, *v = y + n;
-  double *a = dydt + n, pe = 0.0, pi = 0.0;
+  double *a = dydt + n, pe = 0.0, pi = 0.0, power[3];
   int i, st;
   w->cnt[C_RESIDUALS]++;
   st = martello_eval_forces(w->ev, t, u, v, w->fint, w->fext);
+  if (st == MARTELLO_OK) st = martello_eval_power(w->ev, power);
   if (st == MARTELLO_OK) {
     for (i = 0; i < n; i++) a[i] = w->fext[i] - w->fint[i];
     st = martello_eval_solve_mass(w->ev, a);
@@ -193,6 +190,8 @@ static int ed_rhs(double t, const double y[], double dydt[], void *params) {
   }
   dydt[2 * n] = pe;
   dydt[2 * n + 1] = pi;
+  dydt[2 * n + 2] = power[1];
+  dydt[2 * n + 3] = power[2];
   if (!all_finite(dydt, w->dim)) {
     w->rhs_status = MARTELLO_ERR_DIVERGED;
     return GSL_EBADFUNC;
@@ -256,12 +255,11 @@ static void kinematics(const ed_t *w, const double *y, const double *a, double *
   }
 }
 
-static void add_event(ed_t *w, int j, double t_on, double t_off, double v_in, double v_out,
-                      double pen, double force) {
-  double vals[MARTELLO_NEVENT];
-  vals[EV_T_ON] = t_on; vals[EV_T_OFF] = t_off; vals[EV_V_IN] = v_in; vals[EV_V_OUT] = v_out;
-  vals[EV_MAX_PEN] = pen; vals[EV_MAX_FORCE] = force;
-  martello_run_add_event(w->run, j, vals);
+/* Is contact j in a contact phase (a penalty contact in contact, a held unilateral one)? */
+static int in_phase(const ed_t *w, int j) {
+  int open = 0;
+  martello_observer_in_phase(w->obs, j, &open);
+  return open;
 }
 
 /* ---- persistent contacts --------------------------------------------------------------- */
@@ -303,8 +301,7 @@ static int update_held(ed_t *w, double t, const int *list, int m) {
   for (k = 0; k < w->nh; k++) {
     int j = w->hlist[k];
     if (w->sl[j] > 0.0) continue;
-    add_event(w, j, w->ph_t[j], t, w->ph_v[j], gdot(w, j, w->y + w->n), w->ph_pen[j], w->ph_f[j]);
-    w->ph_open[j] = 0;
+    martello_observer_close_phase(w->obs, j, t, gdot(w, j, w->y + w->n));
     w->held[j] = 0;
     w->cnt[C_EVENTS]++;
   }
@@ -318,8 +315,7 @@ static int update_held(ed_t *w, double t, const int *list, int m) {
       if (a >= 0) fs += fabs(w->fext[a]) + fabs(w->fint[a]);
       if (b >= 0) fs += fabs(w->fext[b]) + fabs(w->fint[b]);
       w->held[k] = 1;
-      w->ph_open[k] = 1;
-      w->ph_t[k] = w->t_hold[k]; w->ph_v[k] = 0.0; w->ph_pen[k] = 0.0; w->ph_f[k] = 0.0;
+      martello_observer_open_phase(w->obs, k, w->t_hold[k], 0.0);
       /* a release needs a tension beyond the rounding of the forces at the contact */
       w->lamtol[k] = 1e3 * DBL_EPSILON * fmax(fs, w->sl[k]);
       w->cnt[C_EVENTS]++;
@@ -404,7 +400,8 @@ static int impacts(ed_t *w, double t, int *n_impacts) {
     /* kinetic energy lost, 1/2 (v- + v+)^T G^T P: exact to rounding, no cancellation */
     w->e_impact += 0.5 * w->pl[k] * (w->sl[k] + r_after);
     if (w->held[jj]) continue;   /* a persistent contact takes its share without an event */
-    add_event(w, jj, t, t, w->sl[k], r_after, fmax(gdot(w, jj, u) - w->gap[jj], 0.0), w->pl[k]);
+    martello_observer_add_impact(w->obs, jj, t, w->sl[k], r_after,
+                                 fmax(gdot(w, jj, u) - w->gap[jj], 0.0), w->pl[k]);
     w->cnt[C_EVENTS]++;
     (*n_impacts)++;
   }
@@ -470,13 +467,11 @@ static int process_events(ed_t *w, double t) {
   kinematics(w, w->y, w->f + w->n, w->pen, w->rate, NULL);
   for (j = 0; j < w->nc; j++) {
     if (!w->is_pen[j] || w->inert[j]) continue;
-    if (w->pen[j] > 0.0 && !w->ph_open[j]) {
-      w->ph_open[j] = 1; w->ph_t[j] = t; w->ph_v[j] = w->rate[j];
-      w->ph_pen[j] = w->pen[j]; w->ph_f[j] = 0.0;
+    if (w->pen[j] > 0.0 && !in_phase(w, j)) {
+      martello_observer_open_phase(w->obs, j, t, w->rate[j]);
       w->cnt[C_EVENTS]++;
-    } else if (!(w->pen[j] > 0.0) && w->ph_open[j]) {
-      add_event(w, j, w->ph_t[j], t, w->ph_v[j], w->rate[j], w->ph_pen[j], w->ph_f[j]);
-      w->ph_open[j] = 0;
+    } else if (!(w->pen[j] > 0.0) && in_phase(w, j)) {
+      martello_observer_close_phase(w->obs, j, t, w->rate[j]);
       w->cnt[C_EVENTS]++;
     }
   }
@@ -514,8 +509,7 @@ static int reintegrate(ed_t *w, double t0, double tau, double *yout) {
     snprintf(w->msg, sizeof w->msg,
              "event-driven: re-integration for event location failed at t = %.9e s: "
              "gsl: %s (status %d)", t0 + tau, gsl_strerror(st), st);
-    martello_run_set_message(w->run, w->msg);
-    return MARTELLO_ERR_EXTERNAL;
+    return martello_observer_fail(w->obs, MARTELLO_ERR_EXTERNAL, t0 + tau, w->msg);
   }
   return MARTELLO_OK;
 }
@@ -752,44 +746,33 @@ static int locate(ed_t *w, double t0, double t1, double *te) {
 
 /* ---- observation ----------------------------------------------------------------------- */
 
-/* At an accepted (committed) state: accelerations, contact forces, peaks, energies, and a
- * history row if asked. Leaves the RHS in w->fstart and the multipliers in w->lam0: the
- * start of the next step. */
-static int observe(ed_t *w, double t, int record) {
+/* Accept the state w->y at t: path-dependent links commit, and the works since the last
+ * accepted state go to the observer (w_start: the work integrals y[2n .. 2n+3] there). */
+static int commit(ed_t *w, double t, const double *w_start) {
+  const double *wk = w->y + 2 * w->n;
+  int st = martello_eval_commit(w->ev, w->y, w->y + w->n);
+  if (st == MARTELLO_OK)
+    st = martello_observer_work(w->obs, wk[0] - w_start[0], wk[1] - w_start[1],
+                                wk[2] - w_start[2], wk[3] - w_start[3], w->e_impact);
+  w->e_impact = 0.0;
+  return st == MARTELLO_OK ? st : fail(w, st, t, "event-driven: commit failed");
+}
+
+/* A sample of the observer at an accepted (committed) state; k: the output grid point t =
+ * k dt, or -1. Leaves the RHS in w->fstart and the multipliers in w->lam0: the start of the
+ * next step. */
+static int observe(ed_t *w, double t, int k) {
   const int n = w->n;
-  double ke = 0.0, rec = 0.0, *e = w->energy;
   int j, st;
   st = eval_point(w, t, w->y, w->fstart, w->lam0);
   if (st != MARTELLO_OK) return fail_eval(w, st, t);
   kinematics(w, w->y, w->fstart + n, w->pen, w->rate, NULL);
   st = martello_eval_contact_forces(w->ev, w->force);   /* penalty forces at (t, y) */
   if (st != MARTELLO_OK) return fail(w, st, t, "event-driven: martello_eval_contact_forces failed");
-  for (j = 0; j < w->nc; j++) {
+  for (j = 0; j < w->nc; j++)
     if (!w->is_pen[j]) w->force[j] = w->held[j] ? w->lam0[j] : 0.0;
-    if (w->ph_open[j]) {
-      w->ph_pen[j] = fmax(w->ph_pen[j], w->pen[j]);
-      w->ph_f[j] = fmax(w->ph_f[j], w->force[j]);
-    }
-  }
-  st = martello_run_track(w->run, t, w->y, w->y + n, w->fstart + n, w->pen, w->force);
-  if (st == MARTELLO_OK) st = martello_eval_energy(w->ev, w->y, w->y + n, &ke, &rec);
-  if (st != MARTELLO_OK) return fail(w, st, t, "event-driven: recording the results failed");
-  /* work-energy identity: initial + input = kinetic + recoverable + dissipated + impact */
-  e[E_KINETIC] = ke;
-  e[E_RECOVERABLE] = rec;
-  e[E_INPUT] = w->y[2 * n];
-  e[E_DAMPING] = w->y[2 * n + 1] - (rec - w->e_rec0);
-  e[E_PLASTIC] = 0.0;
-  e[E_CONTACT] = 0.0;
-  e[E_INITIAL] = w->e_initial;
-  e[E_IMPACT] = w->e_impact;
-  e[E_BALANCE] = e[E_INITIAL] + e[E_INPUT] - ke - rec - e[E_DAMPING] - e[E_IMPACT];
-  w->balance_max = fmax(w->balance_max, fabs(e[E_BALANCE]));
-  if (record) {
-    st = martello_run_record(w->run, t, w->y, w->y + n, w->fstart + n, w->pen, w->force, e);
-    if (st != MARTELLO_OK) return fail(w, st, t, "event-driven: recording the results failed");
-  }
-  return MARTELLO_OK;
+  return martello_observer_sample(w->obs, w->ev, t, w->y, w->y + n, w->fstart + n, w->pen,
+                                  w->force, k);
 }
 
 /* ---- set-up and tear-down -------------------------------------------------------------- */
@@ -800,8 +783,7 @@ static void ed_free(ed_t *w) {
                   w->yerr, w->fstart, w->f, w->f1, w->fj, w->yj, w->fint, w->fext,
                   w->pen0, w->rate0, w->acc0, w->pen1, w->rate1, w->acc1, w->pen, w->rate,
                   w->force, w->lam, w->lam0, w->lam1, w->lamtol, w->hlist, w->held, w->Wh,
-                  w->rh, w->ilist, w->Wl, w->ql, w->pl, w->wl, w->sl, w->ph_open, w->ph_t,
-                  w->ph_v, w->ph_pen, w->ph_f, w->t_hold};
+                  w->rh, w->ilist, w->Wl, w->ql, w->pl, w->wl, w->sl, w->t_hold};
   size_t i;
   for (i = 0; i < sizeof bufs / sizeof bufs[0]; i++) free(bufs[i]);
   if (w->drv) gsl_odeiv2_driver_free(w->drv);
@@ -818,7 +800,7 @@ static void ed_free(ed_t *w) {
 /* Everything the run needs, allocated once before the time loop. */
 static int ed_setup(ed_t *w) {
   const int n = w->n, nc = w->nc;
-  const size_t dim = (size_t)(2 * n + 2);
+  const size_t dim = (size_t)(2 * n + 4);
   const gsl_odeiv2_step_type *T;
   double h0;
   int j, st, nn, nc_read, ncoup;
@@ -834,8 +816,8 @@ static int ed_setup(ed_t *w) {
   if (st != MARTELLO_OK) return fail(w, st, 0.0, "event-driven: martello_model_topology failed");
   for (j = 0; j < n; j++)
     if (w->mass[j] < 0.0) {
-      martello_run_set_message(w->run, "event-driven: every node must be set before a run");
-      return MARTELLO_ERR_STATE;
+      return martello_observer_fail(w->obs, MARTELLO_ERR_STATE, 0.0,
+                                    "event-driven: every node must be set before a run");
     }
   w->nu = 0;
   for (j = 0; j < nc; j++) {
@@ -854,8 +836,7 @@ static int ed_setup(ed_t *w) {
         ALLOC(w->lam1, nc) && ALLOC(w->lamtol, nc) && ALLOC(w->hlist, nc) && ALLOC(w->held, nc) &&
         ALLOC(w->Wh, (size_t)w->nu * (size_t)w->nu) && ALLOC(w->rh, nc) && ALLOC(w->ilist, nc) &&
         ALLOC(w->Wl, (size_t)w->nu * (size_t)w->nu) && ALLOC(w->ql, nc) && ALLOC(w->pl, nc) &&
-        ALLOC(w->wl, nc) && ALLOC(w->sl, nc) && ALLOC(w->ph_open, nc) && ALLOC(w->ph_t, nc) &&
-        ALLOC(w->ph_v, nc) && ALLOC(w->ph_pen, nc) && ALLOC(w->ph_f, nc) && ALLOC(w->t_hold, nc)))
+        ALLOC(w->wl, nc) && ALLOC(w->sl, nc) && ALLOC(w->t_hold, nc)))
     return MARTELLO_ERR_MEMORY;
   w->lcp = martello_lcp_alloc(w->nu);
   if (w->lcp == NULL) return MARTELLO_ERR_MEMORY;
@@ -915,8 +896,7 @@ static int check_settings(ed_t *w) {
   else if (w->every < 1) bad = "every must be >= 1";
   if (bad == NULL) return MARTELLO_OK;
   snprintf(w->msg, sizeof w->msg, "event-driven: %s", bad);
-  martello_run_set_message(w->run, w->msg);
-  return MARTELLO_ERR_ARGUMENT;
+  return martello_observer_fail(w->obs, MARTELLO_ERR_ARGUMENT, 0.0, w->msg);
 }
 
 /* The error of gsl_odeiv2_evolve_apply as a martello status and message. */
@@ -927,22 +907,20 @@ static int gsl_failure(ed_t *w, int st, double t, double h) {
              "event-driven: step size underflow at t = %.9e s (h = %.3e s): the stepper cannot "
              "meet rtol = %.3e, atol = %.3e (gsl_odeiv2_evolve_apply: %s)",
              t, h, w->rtol, w->atol, gsl_strerror(st));
-    martello_run_set_message(w->run, w->msg);
-    return MARTELLO_ERR_STEP_UNDERFLOW;
+    return martello_observer_fail(w->obs, MARTELLO_ERR_STEP_UNDERFLOW, t, w->msg);
   }
   snprintf(w->msg, sizeof w->msg, "event-driven: gsl_odeiv2_evolve_apply failed at t = %.9e s: "
            "%s (gsl status %d)", t, gsl_strerror(st), st);
-  martello_run_set_message(w->run, w->msg);
-  return MARTELLO_ERR_EXTERNAL;
+  return martello_observer_fail(w->obs, MARTELLO_ERR_EXTERNAL, t, w->msg);
 }
 
 /* ---- the run --------------------------------------------------------------------------- */
 
-static int ed_integrate(ed_t *w, double *t_reached) {
+static int ed_integrate(ed_t *w) {
   const int n = w->n;
   const long n_out = (long)ceil(w->t_end / w->dt_out * (1.0 - 1e-12));
   long k_out = 1;
-  double t = 0.0, h, ke0 = 0.0;
+  double t = 0.0, h;
   int st, j, stuck = 0;
 
   /* initial state; contacts must start open or touching */
@@ -957,17 +935,15 @@ static int ed_integrate(ed_t *w, double *t_reached) {
       snprintf(w->msg, sizeof w->msg,
                "event-driven: contact %d starts penetrated by %.3e m; a restitution or lagrange "
                "contact must start open or touching (gap >= 0)", j, d);
-      martello_run_set_message(w->run, w->msg);
-      return MARTELLO_ERR_ARGUMENT;
+      return martello_observer_fail(w->obs, MARTELLO_ERR_ARGUMENT, 0.0, w->msg);
     }
   }
-  st = martello_eval_energy(w->ev, w->y, w->y + n, &ke0, &w->e_rec0);
-  if (st != MARTELLO_OK) return fail(w, st, 0.0, "event-driven: energy evaluation failed");
-  w->e_initial = ke0 + w->e_rec0;
+  /* energies at every sample: an adaptive step costs far more than their evaluation */
+  st = martello_observer_begin(w->obs, w->ev, w->y, w->y + n, 1, "tighten rtol and atol");
+  if (st != MARTELLO_OK) return fail(w, st, 0.0, "event-driven: martello_observer_begin failed");
   st = process_events(w, 0.0);
-  if (st != MARTELLO_OK) return st;
-  st = martello_eval_commit(w->ev, w->y, w->y + n);
-  if (st == MARTELLO_OK) st = observe(w, 0.0, 1);
+  if (st == MARTELLO_OK) st = commit(w, 0.0, w->y + 2 * n);
+  if (st == MARTELLO_OK) st = observe(w, 0.0, 0);
   if (st != MARTELLO_OK) return st;
 
   h = 1e-3 * fmin(w->dt_out, w->t_end);
@@ -976,22 +952,16 @@ static int ed_integrate(ed_t *w, double *t_reached) {
     const double t0 = t;
     unsigned long failed = w->drv->e->failed_steps;
     double hs = (w->h_max > 0.0) ? fmin(h, w->h_max) : h, te;
-    int ev, record;
+    int ev, k = -1;
     /* the step start: state, RHS (from observe), gap kinematics */
     memcpy(w->y0, w->y, w->dim * sizeof *w->y);
     kinematics(w, w->y0, w->fstart + n, w->pen0, w->rate0, w->acc0);
     st = gsl_odeiv2_evolve_apply(w->drv->e, w->drv->c, w->drv->s, &w->sys, &t, t_out, &hs, w->y);
     w->cnt[C_REJECTED] += (long long)(w->drv->e->failed_steps - failed);
-    if (st != GSL_SUCCESS) {
-      *t_reached = t;
-      return gsl_failure(w, st, t, hs);
-    }
+    if (st != GSL_SUCCESS) return gsl_failure(w, st, t, hs);
     if (t < t_out) h = hs;   /* the last step onto an output time keeps the suggestion */
     w->cnt[C_STEPS]++;
-    *t_reached = t;
-    if (!all_finite(w->y, w->dim))
-      return fail(w, MARTELLO_ERR_DIVERGED, t, "event-driven: diverged, non-finite state (NaN/inf)");
-    /* the step end: gap kinematics and multipliers, then the earliest event inside */
+    /* the step end (a non-finite state stops the RHS here: a divergence): gap kinematics and multipliers, then the earliest event inside */
     st = eval_point(w, t, w->y, w->f1, w->lam1);
     if (st != MARTELLO_OK) return fail_eval(w, st, t);
     kinematics(w, w->y, w->f1 + n, w->pen1, w->rate1, w->acc1);
@@ -999,7 +969,6 @@ static int ed_integrate(ed_t *w, double *t_reached) {
     if (ev < 0) return ev;
     if (ev == 1) {
       t = te;
-      *t_reached = t;
       st = process_events(w, t);
       if (st != MARTELLO_OK) return st;
       /* the motion is not smooth across an event: the stepper starts afresh */
@@ -1010,14 +979,10 @@ static int ed_integrate(ed_t *w, double *t_reached) {
                     "event-driven: events accumulate without time advancing (an unresolved "
                     "Zeno point or chattering contact)");
     }
-    st = martello_eval_commit(w->ev, w->y, w->y + n);
-    if (st != MARTELLO_OK) return fail(w, st, t, "event-driven: commit failed");
-    record = 0;
-    if (t >= t_out) {
-      record = (k_out % w->every == 0) || k_out >= n_out;
-      k_out++;
-    }
-    st = observe(w, t, record);
+    st = commit(w, t, w->y0 + 2 * n);
+    if (st != MARTELLO_OK) return st;
+    if (t >= t_out) k = (int)k_out++;   /* on the output grid: the observer may record it */
+    st = observe(w, t, k);
     if (st != MARTELLO_OK) return st;
   }
   return MARTELLO_OK;
@@ -1025,19 +990,20 @@ static int ed_integrate(ed_t *w, double *t_reached) {
 
 int martello_event_driven_run(martello_model *model, martello_run *run) {
   ed_t w;
-  double par[MARTELLO_NPAR_INTEGRATOR], t_reached = 0.0;
-  int st, j, nco;
+  double par[MARTELLO_NPAR_INTEGRATOR];
+  int st, nco;
   memset(&w, 0, sizeof w);
   w.model = model;
   w.run = run;
   if (model == NULL || run == NULL) return MARTELLO_ERR_ARGUMENT;
+  st = martello_run_observer(run, &w.obs);
+  if (st != MARTELLO_OK) return st;
   st = martello_run_settings(run, &w.kind, par);
   if (st != MARTELLO_OK) return st;
   if (w.kind != MARTELLO_INT_RKF45 && w.kind != MARTELLO_INT_RK8PD &&
-      w.kind != MARTELLO_INT_MSBDF) {
-    martello_run_set_message(run, "event-driven: the integrator must be rkf45, rk8pd or msbdf");
-    return MARTELLO_ERR_ARGUMENT;
-  }
+      w.kind != MARTELLO_INT_MSBDF)
+    return martello_observer_fail(w.obs, MARTELLO_ERR_ARGUMENT, 0.0,
+                                  "event-driven: the integrator must be rkf45, rk8pd or msbdf");
   w.dt_out = par[MARTELLO_R_DT];
   w.t_end = par[MARTELLO_R_T_END];
   w.rtol = par[MARTELLO_R_RTOL];
@@ -1050,17 +1016,11 @@ int martello_event_driven_run(martello_model *model, martello_run *run) {
   st = martello_model_topology(model, &w.n, &w.nc, NULL, NULL, NULL, NULL, NULL, NULL, NULL, &nco);
   if (st != MARTELLO_OK) return st;
   st = ed_setup(&w);
-  if (st == MARTELLO_ERR_MEMORY) martello_run_set_message(run, "event-driven: out of memory");
-  if (st == MARTELLO_OK) st = ed_integrate(&w, &t_reached);
-  if (st == MARTELLO_OK) {
-    for (j = 0; j < w.nc; j++)
-      if (w.ph_open[j]) add_event(&w, j, w.ph_t[j], -1.0, w.ph_v[j], 0.0, w.ph_pen[j], w.ph_f[j]);
-    t_reached = w.t_end;
-  }
-  if (w.ev != NULL) {
-    martello_run_add_counts(run, w.cnt);
-    martello_run_finish(run, t_reached, w.energy, w.balance_max);
-  }
+  if (st == MARTELLO_ERR_MEMORY)
+    martello_observer_fail(w.obs, st, 0.0, "event-driven: out of memory");
+  if (st == MARTELLO_OK) st = ed_integrate(&w);
+  martello_observer_add_counts(w.obs, w.cnt);
+  if (st == MARTELLO_OK) martello_observer_finish(w.obs, w.t_end);
   ed_free(&w);
   return st;
 }

@@ -23,7 +23,9 @@
  * release, the state is made consistent and IDA restarts there (IDAReInit) instead of
  * stepping across the kink. Steps are taken in IDA_ONE_STEP mode so that path-dependent
  * links commit at every accepted step; output times are stop times (IDASetStopTime), so
- * every history row is an accepted, committed state. */
+ * every history row is an accepted, committed state. Every accepted state is a sample of
+ * the run's observer, which measures it as it measures every integrator
+ * (martello_observer_*, docs/run-layer.md). */
 #include <float.h>
 #include <math.h>
 #include <stdarg.h>
@@ -42,12 +44,9 @@
 #include "martello.h"
 #include "martello_internal.h"
 
-/* Slots of the result arrays (fortran/results.f90, 0-based here); events are written in the
- * order EV_T_ON, EV_T_OFF, EV_V_IN, EV_V_OUT, EV_MAX_PEN, EV_MAX_FORCE. */
+/* Slots of the cost counters (fortran/observer.f90 C_*, 0-based here). */
 enum { CNT_STEPS, CNT_REJECTED, CNT_NEWTON, CNT_RESIDUALS, CNT_FACTORIZATIONS, CNT_EVENTS,
        CNT_JACOBIANS, CNT_ROOT_EVALS, CNT_CHATTER };
-enum { EN_KINETIC, EN_RECOVERABLE, EN_INPUT, EN_DAMPING, EN_PLASTIC, EN_CONTACT, EN_BALANCE,
-       EN_INITIAL, EN_IMPACT };
 
 /* What happens to a contact at a restart. */
 enum { ACT_NONE, ACT_ONSET, ACT_SEPARATION, ACT_IMPACT, ACT_RELEASE };
@@ -61,6 +60,7 @@ enum { ACT_NONE, ACT_ONSET, ACT_SEPARATION, ACT_IMPACT, ACT_RELEASE };
 typedef struct {
   martello_model *model;
   martello_run *run;
+  martello_observer *obs; /* what the run measures */
   martello_eval *ev;
   /* scene (martello_model_topology) */
   int n, nc, nr, ncoupling;
@@ -73,7 +73,6 @@ typedef struct {
   sunindextype *iu, *iv, *ip, *im;
   /* modes */
   int *closed;   /* per rigid contact: constraint active */
-  int *touching; /* per contact: phase open (penalty delta > 0, rigid closed) */
   int *act;      /* per contact: ACT_* at the restart being prepared */
   int *opened;   /* per rigid contact: opened by the multiplier check at this restart */
   int *was_closed, *hit, *cand; /* per rigid contact, at an impact */
@@ -84,13 +83,14 @@ typedef struct {
   int *aset, *map;
   double *S2, *q;
   /* settings */
-  double rtol, atol, event_tol, t_end, h_max, out_dt, divergence_factor;
-  /* contact phases */
-  double *ph_t, *ph_v, *ph_pen, *ph_f;
-  /* energy */
-  double e0, erec0, w_ext, w_int, w_abs, e_impact, balance_max;
-  double e_kin, e_rec;
+  double rtol, atol, event_tol, t_end, h_max, out_dt;
+  int every;     /* output intervals dt per stop time out_dt */
+  /* works since the last hand-over to the observer: external, internal, of the links other
+   * than dampers and of the penalty contacts (quadrature), kinetic energy taken out at
+   * restarts */
+  double dw_ext, dw_int, dw_links, dw_contact, e_impact;
   /* diagnostics */
+  double t_now;  /* where the integration stands (the t_reached of a failure) */
   int nan_seen;
   char ida_msg[240];
   long long events;
@@ -105,8 +105,14 @@ static int fail(ida_problem *P, int code, const char *fmt, ...) {
   va_start(ap, fmt);
   vsnprintf(buf, sizeof buf, fmt, ap);
   va_end(ap);
-  martello_run_set_message(P->run, buf);
-  return code;
+  return martello_observer_fail(P->obs, code, P->t_now, buf);
+}
+
+/* A phase open on contact j: a penalty contact in contact, a closed rigid contact. */
+static int touching(const ida_problem *P, int j) {
+  int open = 0;
+  martello_observer_in_phase(P->obs, j, &open);
+  return open;
 }
 
 static double node_u(int i, const double *u) { return i < 0 ? 0.0 : u[i]; }
@@ -328,84 +334,45 @@ static int flush_counts(ida_problem *P, void *mem) {
   }
   inc[CNT_EVENTS] = P->events;
   P->events = 0;
-  return martello_run_add_counts(P->run, inc);
+  return martello_observer_add_counts(P->obs, inc);
 }
 
 static void reset_count_baseline(ida_problem *P) {
   for (int k = 0; k < 9; k++) P->cnt_last[k] = 0;
 }
 
-/* Per-contact force of the state last evaluated (every caller has just committed or
- * evaluated it): P_r for closed rigid contacts, the kernels' penalty force otherwise (NaN in
- * the history, 0 in the peaks, should the door refuse). */
-static void contact_forces(ida_problem *P, const double *y, double *force, int for_history) {
-  int have = martello_eval_contact_forces(P->ev, force) == MARTELLO_OK;
-  for (int j = 0; j < P->nc; j++) {
-    int r = P->rig[j];
-    if (r >= 0)
-      force[j] = P->closed[r] ? y[P->ip[r]] : 0.0;
-    else if (!have)
-      force[j] = for_history ? NAN : 0.0;
-  }
+/* Hand the works since the last hand-over to the observer (once per commit). */
+static int hand_work(ida_problem *P) {
+  int st = martello_observer_work(P->obs, P->dw_ext, P->dw_int, P->dw_links, P->dw_contact,
+                                  P->e_impact);
+  P->dw_ext = P->dw_int = P->dw_links = P->dw_contact = P->e_impact = 0.0;
+  return st == MARTELLO_OK ? st : fail(P, st, "IDA: could not hand the works to the observer");
 }
 
-static void energy_vector(ida_problem *P, double e[MARTELLO_NENERGY]) {
-  for (int k = 0; k < MARTELLO_NENERGY; k++) e[k] = 0.0;
-  e[EN_KINETIC] = P->e_kin;
-  e[EN_RECOVERABLE] = P->e_rec;
-  e[EN_INPUT] = P->w_ext;
-  /* all non-recoverable internal work (dampers, plasticity, contact dashpots): the door gives
-   * node forces, not element forces (docs/ida.md) */
-  e[EN_DAMPING] = P->w_int - (P->e_rec - P->erec0);
-  e[EN_INITIAL] = P->e0;
-  e[EN_IMPACT] = P->e_impact;
-  e[EN_BALANCE] = P->e0 + P->w_ext - P->e_kin - P->e_rec - e[EN_DAMPING] - P->e_impact;
-}
-
-/* Energies of the committed state (u, v). */
-static int energies(ida_problem *P, const double *u, const double *v) {
-  int st = martello_eval_energy(P->ev, u, v, &P->e_kin, &P->e_rec);
-  if (st != MARTELLO_OK) return fail(P, st, "IDA: energy evaluation failed");
-  double e[MARTELLO_NENERGY];
-  energy_vector(P, e);
-  P->balance_max = fmax(P->balance_max, fabs(e[EN_BALANCE]));
-  return MARTELLO_OK;
-}
-
-/* Peaks and phase maxima at an accepted (committed) state y, yp. */
-static int track(ida_problem *P, double t, const double *y, const double *yp, int record) {
+/* An accepted (committed) state y, yp at t as a sample of the observer; k: the output grid
+ * point t = k dt, or -1. Contact forces: P_r for closed rigid contacts, the kernels'
+ * penalty force otherwise. */
+static int observe(ida_problem *P, double t, const double *y, const double *yp, int k) {
   gather(P, y, P->u, P->v);
   for (int i = 0; i < P->n; i++) P->a[i] = yp[P->iv[i]];
+  for (int j = 0; j < P->nc; j++) P->pen[j] = penetration(P, j, P->u);
+  if (martello_eval_contact_forces(P->ev, P->force) != MARTELLO_OK)
+    return fail(P, MARTELLO_ERR_ARGUMENT, "IDA: martello_eval_contact_forces failed");
   for (int j = 0; j < P->nc; j++) {
-    P->pen[j] = penetration(P, j, P->u);
-    P->rate[j] = pen_rate(P, j, P->v);
+    int r = P->rig[j];
+    if (r >= 0) P->force[j] = P->closed[r] ? y[P->ip[r]] : 0.0;
   }
-  contact_forces(P, y, P->force, 0);
-  for (int j = 0; j < P->nc; j++)
-    if (P->touching[j]) {
-      P->ph_pen[j] = fmax(P->ph_pen[j], P->pen[j]);
-      P->ph_f[j] = fmax(P->ph_f[j], P->force[j]);
-    }
-  int st = martello_run_track(P->run, t, P->u, P->v, P->a, P->pen, P->force);
-  if (st != MARTELLO_OK) return fail(P, st, "IDA: could not track the peaks");
-  if (record) {
-    double e[MARTELLO_NENERGY];
-    energy_vector(P, e);
-    contact_forces(P, y, P->force, 1);
-    st = martello_run_record(P->run, t, P->u, P->v, P->a, P->pen, P->force, e);
-    if (st != MARTELLO_OK) return fail(P, st, "IDA: could not record the history");
-  }
-  return MARTELLO_OK;
+  return martello_observer_sample(P->obs, P->ev, t, P->u, P->v, P->a, P->pen, P->force, k);
 }
 
-/* Work of the external and internal forces over [t0, t1] on the step's interpolant,
- * 3-point Gauss-Legendre (order 6), with the link states committed at t0 (as IDA's residuals
- * saw them). */
+/* Work of the external and internal forces (and of the links other than dampers and of the
+ * penalty contacts) over [t0, t1] on the step's interpolant, 3-point Gauss-Legendre (order
+ * 6), with the link states committed at t0 (as IDA's residuals saw them). */
 static int work_quadrature(ida_problem *P, void *mem, double t0, double t1, N_Vector ytmp) {
   static const double xg[3] = {-0.7745966692414834, 0.0, 0.7745966692414834};
   static const double wg[3] = {5.0 / 18.0, 8.0 / 18.0, 5.0 / 18.0};
   if (!(t1 > t0)) return MARTELLO_OK;
-  double h = t1 - t0, we = 0.0, wi = 0.0;
+  double h = t1 - t0, we = 0.0, wi = 0.0, wl = 0.0, wc = 0.0, power[3];
   for (int k = 0; k < 3; k++) {
     double tk = t0 + 0.5 * h * (1.0 + xg[k]);
     int flag = IDAGetDky(mem, tk, 0, ytmp);
@@ -414,6 +381,7 @@ static int work_quadrature(ida_problem *P, void *mem, double t0, double t1, N_Ve
                   IDAGetReturnFlagName(flag));
     gather(P, N_VGetArrayPointer(ytmp), P->uq, P->vq);
     int st = martello_eval_forces(P->ev, tk, P->uq, P->vq, P->fint, P->fext);
+    if (st == MARTELLO_OK) st = martello_eval_power(P->ev, power);
     if (st != MARTELLO_OK) return fail(P, st, "IDA: force evaluation failed at t = %.9e s", tk);
     double pe = 0.0, pi = 0.0;
     for (int i = 0; i < P->n; i++) {
@@ -423,10 +391,13 @@ static int work_quadrature(ida_problem *P, void *mem, double t0, double t1, N_Ve
     }
     we += wg[k] * pe;
     wi += wg[k] * pi;
+    wl += wg[k] * power[1];
+    wc += wg[k] * power[2];
   }
-  P->w_ext += h * we;
-  P->w_int += h * wi;
-  P->w_abs += fabs(h * we);
+  P->dw_ext += h * we;
+  P->dw_int += h * wi;
+  P->dw_links += h * wl;
+  P->dw_contact += h * wc;
   return MARTELLO_OK;
 }
 
@@ -605,21 +576,6 @@ static int rigid_multipliers(ida_problem *P, double t, double *u, double *v) {
   return fail(P, MARTELLO_ERR_NOT_CONVERGED, "IDA: active set of the closed contacts did not settle at t = %.9e s", t);
 }
 
-static int add_event(ida_problem *P, int j, double t_on, double t_off, double v_in, double v_out,
-                     double pen_max, double f_max) {
-  double ev[MARTELLO_NEVENT] = {t_on, t_off, v_in, v_out, pen_max, f_max};
-  int st = martello_run_add_event(P->run, j, ev);
-  return st == MARTELLO_OK ? st : fail(P, st, "IDA: could not add an event");
-}
-
-static void open_phase(ida_problem *P, int j, double t, double v_in) {
-  P->touching[j] = 1;
-  P->ph_t[j] = t;
-  P->ph_v[j] = v_in;
-  P->ph_pen[j] = 0.0;
-  P->ph_f[j] = 0.0;
-}
-
 /* Make the state at a restart consistent with the actions in P->act: penalty regimes,
  * impacts, closings, releases; commit; multipliers; y and y' for IDA. u, v hold the state. */
 static int prepare_restart(ida_problem *P, double t, double *u, double *v, N_Vector yy,
@@ -635,13 +591,12 @@ static int prepare_restart(ida_problem *P, double t, double *u, double *v, N_Vec
     switch (P->act[j]) {
     case ACT_ONSET:
       nudge(P, j, +1, u);
-      open_phase(P, j, t, w);
+      martello_observer_open_phase(P->obs, j, t, w);
       P->events++;
       break;
     case ACT_SEPARATION:
       nudge(P, j, -1, u);
-      P->touching[j] = 0;
-      if ((st = add_event(P, j, P->ph_t[j], t, P->ph_v[j], w, P->ph_pen[j], P->ph_f[j])) != MARTELLO_OK) return st;
+      martello_observer_close_phase(P->obs, j, t, w);
       P->events++;
       break;
     case ACT_IMPACT:
@@ -651,9 +606,8 @@ static int prepare_restart(ida_problem *P, double t, double *u, double *v, N_Vec
       break;
     case ACT_RELEASE:
       P->closed[r] = 0;
-      P->touching[j] = 0;
       nudge(P, j, -1, u);
-      if ((st = add_event(P, j, P->ph_t[j], t, P->ph_v[j], w, P->ph_pen[j], P->ph_f[j])) != MARTELLO_OK) return st;
+      martello_observer_close_phase(P->obs, j, t, w);
       any_rigid = 1;
       P->events++;
       break;
@@ -681,15 +635,12 @@ static int prepare_restart(ida_problem *P, double t, double *u, double *v, N_Vec
     if (P->opened[r]) nudge(P, j, -1, u);
     if ((P->hit[r] || P->act[j] == ACT_IMPACT) && !P->was_closed[r]) {
       double w_in = P->hit[r] ? P->w_in[j] : 0.0;
-      if (P->closed[r]) {
-        open_phase(P, j, t, w_in);
-      } else if (P->hit[r] &&
-                 (st = add_event(P, j, t, t, w_in, pen_rate(P, j, v), 0.0, 0.0)) != MARTELLO_OK) {
-        return st;
-      }
-    } else if (P->opened[r] && P->touching[j]) {
-      P->touching[j] = 0;
-      if ((st = add_event(P, j, P->ph_t[j], t, P->ph_v[j], pen_rate(P, j, v), P->ph_pen[j], P->ph_f[j])) != MARTELLO_OK) return st;
+      if (P->closed[r])
+        martello_observer_open_phase(P->obs, j, t, w_in);
+      else if (P->hit[r])
+        martello_observer_add_impact(P->obs, j, t, w_in, pen_rate(P, j, v), 0.0, 0.0);
+    } else if (P->opened[r] && touching(P, j)) {
+      martello_observer_close_phase(P->obs, j, t, pen_rate(P, j, v));
     }
   }
   if ((st = martello_eval_energy(P->ev, u, v, &ke1, &dummy)) != MARTELLO_OK)
@@ -712,7 +663,7 @@ static int prepare_restart(ida_problem *P, double t, double *u, double *v, N_Vec
     d[P->im[r]] = 0.0;
   }
   for (int j = 0; j < P->nc; j++) P->act[j] = ACT_NONE;
-  return energies(P, u, v);
+  return hand_work(P);
 }
 
 /* Bisection on the interpolant of the current step for the crossing of delta_j between
@@ -754,9 +705,9 @@ static int classify_roots(ida_problem *P, void *mem, double t_last, double tret,
     double d = penetration(P, j, P->u);
     int want = ACT_NONE;
     if (r < 0) {
-      if (P->touching[j] && d > 0.0) P->ph_pen[j] = fmax(P->ph_pen[j], d); /* exact peak */
-      else if (!P->touching[j] && d > 0.0) want = ACT_ONSET;
-      else if (P->touching[j] && d < 0.0) want = ACT_SEPARATION;
+      /* a penalty contact at its deepest in contact: the exact peak, sampled there */
+      if (!touching(P, j) && d > 0.0) want = ACT_ONSET;
+      else if (touching(P, j) && d < 0.0) want = ACT_SEPARATION;
     } else if (d > 0.0) {
       want = ACT_IMPACT;
     }
@@ -780,8 +731,8 @@ static int classify_roots(ida_problem *P, void *mem, double t_last, double tret,
     int r = P->rig[j], dir = found[2 * j];
     if (dir == 0) continue;
     if (r < 0) {
-      if (dir > 0 && !P->touching[j]) P->act[j] = ACT_ONSET;
-      else if (dir < 0 && P->touching[j]) P->act[j] = ACT_SEPARATION;
+      if (dir > 0 && !touching(P, j)) P->act[j] = ACT_ONSET;
+      else if (dir < 0 && touching(P, j)) P->act[j] = ACT_SEPARATION;
     } else if (!P->closed[r]) {
       if (dir > 0) P->act[j] = ACT_IMPACT;
     } else if (dir < 0) {
@@ -835,14 +786,14 @@ static int boundary_events(ida_problem *P, void *mem, double t_last, double tret
     /* ... and moving across it faster than the integration error of a rate: two bodies
      * that travel together at zero gap are not a new event */
     if (r < 0) {
-      if (!P->touching[j] && (d > 0.0 || (d >= -on && w > wtol))) want = ACT_ONSET;
-      else if (P->touching[j] && (d < 0.0 || (d <= on && w < -wtol))) want = ACT_SEPARATION;
+      if (!touching(P, j) && (d > 0.0 || (d >= -on && w > wtol))) want = ACT_ONSET;
+      else if (touching(P, j) && (d < 0.0 || (d <= on && w < -wtol))) want = ACT_SEPARATION;
     } else if (d > 0.0 || (d >= -on && w > wtol)) {
       want = ACT_IMPACT;
     }
     if (want == ACT_NONE) continue;
     double tc = tret;
-    int wrong_side = r < 0 ? (P->touching[j] ? d < 0.0 : d > 0.0) : d > 0.0;
+    int wrong_side = r < 0 ? (touching(P, j) ? d < 0.0 : d > 0.0) : d > 0.0;
     if (wrong_side && fabs(d) > on && tret > t_last) {
       int st = locate(P, mem, j, t_last, tret, ytmp, &tc);
       if (st != MARTELLO_OK) return st;
@@ -869,10 +820,9 @@ static void *take(size_t count, size_t size, int *ok) {
 
 static void release(ida_problem *P) {
   void *all[] = {P->mass, P->gap, P->rest, P->fixed, P->con_a, P->con_b, P->scheme, P->rig,
-                 P->rig_con, P->iu, P->iv, P->ip, P->im, P->closed, P->touching, P->act,
+                 P->rig_con, P->iu, P->iv, P->ip, P->im, P->closed, P->act,
                  P->opened, P->was_closed, P->hit, P->cand, P->map, P->q, P->S2, P->w_in, P->u, P->v, P->a, P->x, P->uq, P->vq, P->fint, P->fext,
-                 P->pen, P->rate, P->force, P->lam, P->S, P->rhs, P->mb, P->aset, P->ph_t,
-                 P->ph_v, P->ph_pen, P->ph_f};
+                 P->pen, P->rate, P->force, P->lam, P->S, P->rhs, P->mb, P->aset};
   for (size_t k = 0; k < sizeof all / sizeof all[0]; k++) free(all[k]);
   if (P->ev) martello_eval_free(&P->ev);
 }
@@ -932,8 +882,8 @@ static int setup(ida_problem *P, martello_model *model, martello_run *run) {
   P->event_tol = par[MARTELLO_R_EVENT_TOL] > 0.0 ? par[MARTELLO_R_EVENT_TOL] : 1e-12;
   P->t_end = par[MARTELLO_R_T_END];
   P->h_max = par[MARTELLO_R_H_MAX];
+  P->every = par[MARTELLO_R_EVERY] >= 1.0 ? (int)par[MARTELLO_R_EVERY] : 1;
   P->out_dt = par[MARTELLO_R_DT] * (par[MARTELLO_R_EVERY] >= 1.0 ? par[MARTELLO_R_EVERY] : 1.0);
-  P->divergence_factor = par[MARTELLO_R_DIVERGENCE_FACTOR];
   if (!(P->rtol >= 0.0 && P->atol >= 0.0 && P->rtol + P->atol > 0.0))
     return fail(P, MARTELLO_ERR_ARGUMENT, "IDA needs rtol >= 0 and atol >= 0, not both 0");
   if (!(P->t_end > 0.0 && P->out_dt > 0.0))
@@ -986,16 +936,11 @@ static int setup(ida_problem *P, martello_model *model, martello_run *run) {
   P->lam = take(nr, sizeof(double), &ok);
   P->rhs = take(nr, sizeof(double), &ok);
   P->S = take(nr * nr, sizeof(double), &ok);
-  P->touching = take(ucn, sizeof(int), &ok);
   P->act = take(ucn, sizeof(int), &ok);
   P->w_in = take(ucn, sizeof(double), &ok);
   P->pen = take(ucn, sizeof(double), &ok);
   P->rate = take(ucn, sizeof(double), &ok);
   P->force = take(ucn, sizeof(double), &ok);
-  P->ph_t = take(ucn, sizeof(double), &ok);
-  P->ph_v = take(ucn, sizeof(double), &ok);
-  P->ph_pen = take(ucn, sizeof(double), &ok);
-  P->ph_f = take(ucn, sizeof(double), &ok);
   double **work[] = {&P->u, &P->v, &P->a, &P->x, &P->uq, &P->vq, &P->fint, &P->fext, &P->mb};
   for (size_t k = 0; k < sizeof work / sizeof work[0]; k++) *work[k] = take(un, sizeof(double), &ok);
   if (!ok) return fail(P, MARTELLO_ERR_MEMORY, "IDA: out of memory");
@@ -1028,11 +973,9 @@ static int check(ida_problem *P, int flag, const char *call) {
 }
 
 static int integrate(ida_problem *P, SUNContext sunctx, void **memp, N_Vector yy, N_Vector yp,
-                     N_Vector id, N_Vector ytmp, SUNMatrix *Jp, SUNLinearSolver *LSp,
-                     double *t_reached) {
+                     N_Vector id, N_Vector ytmp, SUNMatrix *Jp, SUNLinearSolver *LSp) {
   int st, n = P->n;
   double *u0 = P->u, *v0 = P->v;
-  *t_reached = 0.0;
   if ((st = martello_model_initial_state(P->model, u0, v0)) != MARTELLO_OK)
     return fail(P, st, "IDA: could not read the initial state");
   for (int i = 0; i < n; i++)
@@ -1051,7 +994,7 @@ static int integrate(ida_problem *P, SUNContext sunctx, void **memp, N_Vector yy
   for (int j = 0; j < P->nc; j++) {
     double d = penetration(P, j, u0), w = pen_rate(P, j, v0);
     if (P->rig[j] < 0) {
-      if (d > 0.0) open_phase(P, j, 0.0, w);
+      if (d > 0.0) martello_observer_open_phase(P->obs, j, 0.0, w);
       else if (d == 0.0 && w > 0.0) P->act[j] = ACT_ONSET;
     } else {
       double htol = height_tol(P, j, u0);
@@ -1060,10 +1003,9 @@ static int integrate(ida_problem *P, SUNContext sunctx, void **memp, N_Vector yy
       if (d >= -htol && w >= -vtol) P->act[j] = ACT_IMPACT;
     }
   }
-  if ((st = martello_eval_energy(P->ev, u0, v0, &P->e_kin, &P->erec0)) != MARTELLO_OK)
-    return fail(P, st, "IDA: energy evaluation failed");
-  P->e0 = P->e_kin + P->erec0;
-  P->e_rec = P->erec0;
+  /* energies at every sample: an adaptive step costs far more than their evaluation */
+  if ((st = martello_observer_begin(P->obs, P->ev, u0, v0, 1, "tighten rtol and atol")) != MARTELLO_OK)
+    return fail(P, st, "IDA: martello_observer_begin failed");
   if ((st = prepare_restart(P, 0.0, u0, v0, yy, yp)) != MARTELLO_OK) return st;
 
   /* IDA: create, init, options (SUNDIALS lifecycle) */
@@ -1100,7 +1042,7 @@ static int integrate(ida_problem *P, SUNContext sunctx, void **memp, N_Vector yy
 
   int k_out = 1;
   double t_out = fmin(P->out_dt, P->t_end), t_last = 0.0;
-  if ((st = track(P, 0.0, N_VGetArrayPointer(yy), N_VGetArrayPointer(yp), 1)) != MARTELLO_OK) return st;
+  if ((st = observe(P, 0.0, N_VGetArrayPointer(yy), N_VGetArrayPointer(yp), 0)) != MARTELLO_OK) return st;
   if ((st = check(P, IDASetStopTime(mem, t_out), "IDASetStopTime"))) return st;
   int *found = calloc((size_t)(2 * P->nc + 1), sizeof(int));
   if (!found) return fail(P, MARTELLO_ERR_MEMORY, "IDA: out of memory");
@@ -1114,11 +1056,11 @@ static int integrate(ida_problem *P, SUNContext sunctx, void **memp, N_Vector yy
     if (flag < 0) {
       double tcur = t_last;
       if (IDAGetCurrentTime(mem, &tcur) != IDA_SUCCESS) tcur = t_last;
+      P->t_now = tcur;
       if (P->nan_seen)
-        st = fail(P, MARTELLO_ERR_DIVERGED, "IDA diverged at t = %.9e s: non-finite residual (NaN/inf); %s (%s)", tcur, IDAGetReturnFlagName(flag), P->ida_msg);
+        st = martello_observer_fail_nonfinite(P->obs, tcur);
       else
         st = fail(P, MARTELLO_ERR_EXTERNAL, "IDASolve failed at t = %.9e s: %s (%s)", tcur, IDAGetReturnFlagName(flag), P->ida_msg);
-      *t_reached = tcur;
       break;
     }
     P->nan_seen = 0;
@@ -1150,13 +1092,9 @@ static int integrate(ida_problem *P, SUNContext sunctx, void **memp, N_Vector yy
     }
     if ((st = work_quadrature(P, mem, t_last, t_r, ytmp)) != MARTELLO_OK) break;
     t_last = t_r;
-    *t_reached = t_r;
+    P->t_now = t_r;
     const double *y = N_VGetArrayPointer(yy);
     gather(P, y, P->u, P->v);
-    if (!isfinite(P->w_int + P->w_ext)) {
-      st = fail(P, MARTELLO_ERR_DIVERGED, "IDA diverged at t = %.9e s: non-finite state (NaN/inf)", t_r);
-      break;
-    }
     if (restart) {
       same_time = t_r - t_prev_restart <= 1e-12 * fmax(fabs(t_r), P->out_dt) ? same_time + 1 : 0;
       t_prev_restart = t_r;
@@ -1171,22 +1109,14 @@ static int integrate(ida_problem *P, SUNContext sunctx, void **memp, N_Vector yy
         st = fail(P, st, "IDA: commit failed");
         break;
       }
-      if ((st = energies(P, P->u, P->v)) != MARTELLO_OK) break;
+      if ((st = hand_work(P)) != MARTELLO_OK) break;
     }
-    for (sunindextype k = 0; k < P->N; k++)
-      if (!isfinite(N_VGetArrayPointer(yy)[k])) {
-        st = fail(P, MARTELLO_ERR_DIVERGED, "IDA diverged at t = %.9e s: non-finite state (NaN/inf)", t_r);
-        break;
-      }
-    if (st != MARTELLO_OK) break;
-    double e_mech = P->e_kin + P->e_rec, scale = P->e0 + P->w_abs;
-    if (scale > 0.0 && e_mech > P->divergence_factor * scale) {
-      st = fail(P, MARTELLO_ERR_DIVERGED, "IDA diverged at t = %.9e s: mechanical energy %.3e J exceeds %.3g x (initial energy + input work)", t_r, e_mech, P->divergence_factor);
-      break;
-    }
-    /* an output time reached (tstop), or passed within round-off by a restart */
+    /* an output time reached (tstop), or passed within round-off by a restart: the grid
+     * point k_out every of the output interval dt (the observer records it) */
     int at_output = (flag == IDA_TSTOP_RETURN && t_r == tret) || t_out - t_r <= 1e-9 * P->out_dt;
-    if ((st = track(P, t_r, N_VGetArrayPointer(yy), N_VGetArrayPointer(yp), at_output)) != MARTELLO_OK) break;
+    if ((st = observe(P, t_r, N_VGetArrayPointer(yy), N_VGetArrayPointer(yp),
+                      at_output ? k_out * P->every : -1)) != MARTELLO_OK)
+      break;
     if (at_output) {
       if (t_out >= P->t_end) {
         t_last = P->t_end;
@@ -1206,7 +1136,7 @@ static int integrate(ida_problem *P, SUNContext sunctx, void **memp, N_Vector yy
   free(found);
   int st2 = flush_counts(P, mem);
   if (st == MARTELLO_OK) st = st2;
-  if (st == MARTELLO_OK) *t_reached = t_last;
+  if (st == MARTELLO_OK) st = martello_observer_finish(P->obs, t_last);
   return st;
 }
 
@@ -1216,13 +1146,14 @@ int martello_ida_run(martello_model *model, martello_run *run) {
   memset(P, 0, sizeof *P);
   P->run = run;
   if (!model || !run) return MARTELLO_ERR_ARGUMENT;
-  int st = setup(P, model, run);
+  int st = martello_run_observer(run, &P->obs);
+  if (st != MARTELLO_OK) return st;
+  st = setup(P, model, run);
   SUNContext sunctx = NULL;
   void *mem = NULL;
   N_Vector yy = NULL, yp = NULL, id = NULL, ytmp = NULL;
   SUNMatrix J = NULL;
   SUNLinearSolver LS = NULL;
-  double t_reached = 0.0;
   if (st == MARTELLO_OK && SUNContext_Create(NULL, &sunctx) != 0)
     st = fail(P, MARTELLO_ERR_EXTERNAL, "SUNContext_Create failed");
   if (st == MARTELLO_OK) {
@@ -1232,18 +1163,8 @@ int martello_ida_run(martello_model *model, martello_run *run) {
     ytmp = N_VNew_Serial(P->N, sunctx);
     if (!yy || !yp || !id || !ytmp) st = fail(P, MARTELLO_ERR_MEMORY, "IDA: could not create the vectors");
   }
-  if (st == MARTELLO_OK) st = integrate(P, sunctx, &mem, yy, yp, id, ytmp, &J, &LS, &t_reached);
-  /* contact phases still open at the end (t_off = -1), and the final energy terms; a
-   * failed run keeps what it computed */
-  int st2 = MARTELLO_OK;
-  if (P->touching)
-    for (int j = 0; j < P->nc && st2 == MARTELLO_OK; j++)
-      if (P->touching[j]) st2 = add_event(P, j, P->ph_t[j], -1.0, P->ph_v[j], 0.0, P->ph_pen[j], P->ph_f[j]);
-  double e[MARTELLO_NENERGY];
-  energy_vector(P, e);
-  if (martello_run_finish(run, t_reached, e, P->balance_max) != MARTELLO_OK && st2 == MARTELLO_OK)
-    st2 = fail(P, MARTELLO_ERR_ARGUMENT, "IDA: could not finish the run");
-  if (st == MARTELLO_OK) st = st2;
+  /* a failed run keeps what it computed (the observer closed its open phases) */
+  if (st == MARTELLO_OK) st = integrate(P, sunctx, &mem, yy, yp, id, ytmp, &J, &LS);
   if (mem) IDAFree(&mem);
   if (LS) SUNLinSolFree(LS);
   if (J) SUNMatDestroy(J);

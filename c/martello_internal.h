@@ -1,11 +1,13 @@
 /* The door between the Fortran kernels and the C integrators (GSL, SUNDIALS): force
- * evaluation of a scene and the recording of results. Not part of the public API.
- * Node arrays have length n (0-based nodes), contact arrays length n_contacts. */
+ * evaluation of a scene and the observer that measures the run (fortran/observer.f90,
+ * docs/run-layer.md). Not part of the public API. Node arrays have length n (0-based
+ * nodes), contact arrays length n_contacts; contacts are 0-based. */
 #ifndef MARTELLO_INTERNAL_H
 #define MARTELLO_INTERNAL_H
 #include "martello.h"
 
 typedef struct martello_eval martello_eval;
+typedef struct martello_observer martello_observer;
 
 /* Scene topology for impact laws. con_a/con_b are 0-based nodes, -1 = ground; fixed[i] is 0/1;
  * restitution[j] is the contact's e (or -1 if none given). Pass NULL for what you don't need. */
@@ -32,22 +34,53 @@ int martello_eval_contacts(martello_eval *ev, const double *u, const double *v, 
                            double *rate);
 /* Accept (u, v) at the end of a step: path-dependent links (hysteresis) commit. */
 int martello_eval_commit(martello_eval *ev, const double *u, const double *v);
+/* power[3]: the power of the dampers, the other links and the penalty contacts at the last
+ * force evaluation, sum of f (v_a - v_b): the integrands of martello_observer_work's split. */
+int martello_eval_power(martello_eval *ev, double power[3]);
 int martello_eval_energy(martello_eval *ev, const double *u, const double *v, double *kinetic,
                          double *recoverable);
 
-/* The run being filled. */
+/* The run being filled: its settings, and its observer. */
 int martello_run_settings(const martello_run *run, int *kind, double par[MARTELLO_NPAR_INTEGRATOR]);
-int martello_run_track(martello_run *run, double t, const double *u, const double *v,
-                       const double *a, const double *pen, const double *force);
-int martello_run_record(martello_run *run, double t, const double *u, const double *v,
-                        const double *a, const double *pen, const double *force,
-                        const double energy[MARTELLO_NENERGY]);
-int martello_run_add_event(martello_run *run, int contact, const double values[MARTELLO_NEVENT]);
-int martello_run_add_counts(martello_run *run, const long long inc[MARTELLO_NCOUNTERS]);
-int martello_run_set_message(martello_run *run, const char *message);
-/* energy: the final energy terms; balance_max: max |balance| seen; t_reached: where it stopped */
-int martello_run_finish(martello_run *run, double t_reached,
-                        const double energy[MARTELLO_NENERGY], double balance_max);
+int martello_run_observer(martello_run *run, martello_observer **obs);
+
+/* The observer's contract (docs/run-layer.md). Every call returns MARTELLO_OK or
+ * MARTELLO_ERR_ARGUMENT (a null handle, a contact out of range) unless said otherwise.
+ *
+ * begin: the initial state (u, v) at t = 0, before its first sample: the energies the
+ * balance starts from. energy_interval: samples between energy evaluations (1: every one);
+ * advice ends a divergence message. */
+int martello_observer_begin(martello_observer *obs, martello_eval *ev, const double *u,
+                            const double *v, int energy_interval, const char *advice);
+/* An accepted state at t, committed in ev (its link states are read there), after the
+ * phase changes found at t: peaks, phase maxima, energy terms and the divergence test, a
+ * history row where recorded. k: the output grid point t = k dt it lies on, or -1.
+ * Returns MARTELLO_ERR_DIVERGED (message set) when the run must stop. */
+int martello_observer_sample(martello_observer *obs, martello_eval *ev, double t, const double *u,
+                             const double *v, const double *a, const double *pen,
+                             const double *force, int k);
+/* Work increments since the last call [J], integrated along the method's own solution:
+ * external, total internal (f_int . v), of the links other than dampers and of the penalty
+ * contacts (martello_eval_power), and the kinetic energy impulses took out. Damping is
+ * internal - links - contacts. */
+int martello_observer_work(martello_observer *obs, double w_ext, double w_int, double w_links,
+                           double w_contact, double w_impact);
+/* Contact phases located by the method: a phase opens at t_on approaching at v_in, closes at
+ * t_off leaving at v_out (nothing if not open); an impact is an instantaneous phase with its
+ * penetration and impulse. in_phase: *open = 1 while a phase is open. */
+int martello_observer_open_phase(martello_observer *obs, int contact, double t_on, double v_in);
+int martello_observer_close_phase(martello_observer *obs, int contact, double t_off, double v_out);
+int martello_observer_add_impact(martello_observer *obs, int contact, double t, double v_in,
+                                 double v_out, double pen, double impulse);
+int martello_observer_in_phase(const martello_observer *obs, int contact, int *open);
+int martello_observer_add_counts(martello_observer *obs, const long long inc[MARTELLO_NCOUNTERS]);
+/* The method failed with status at t_reached: returns status once the message is set. */
+int martello_observer_fail(martello_observer *obs, int status, double t_reached,
+                           const char *message);
+/* A non-finite state, force or work at t: returns MARTELLO_ERR_DIVERGED (one wording). */
+int martello_observer_fail_nonfinite(martello_observer *obs, double t);
+/* The run reached t_reached: open phases become events with t_off = -1. */
+int martello_observer_finish(martello_observer *obs, double t_reached);
 
 /* The C integrators, dispatched by martello_dynamic_run. */
 int martello_event_driven_run(martello_model *model, martello_run *run);

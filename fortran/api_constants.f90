@@ -8,7 +8,7 @@ module martello_api_constants
    use martello_contact_laws
    use martello_links
    use martello_integrator_settings
-   use martello_results, only: NCOUNTERS, NENERGY, NEVENT
+   use martello_observer, only: NCOUNTERS, NENERGY, NEVENT
    implicit none
    private
 

@@ -6,9 +6,10 @@ module martello_api_handles
    use martello_model, only: model_t
    use martello_run, only: run_t
    use martello_evaluator, only: evaluator_t
+   use martello_observer, only: observer_t
    implicit none
    private
-   public :: get_model, get_run, get_eval, copy_message
+   public :: get_model, get_run, get_eval, get_observer, copy_message
 
 contains
 
@@ -33,6 +34,14 @@ contains
       ep => null()
       if (c_associated(handle)) call c_f_pointer(handle, ep)
    end function get_eval
+
+   !> The observer of a run (martello_run_observer points into its run).
+   function get_observer(handle) result(op)
+      type(c_ptr), value :: handle
+      type(observer_t), pointer :: op
+      op => null()
+      if (c_associated(handle)) call c_f_pointer(handle, op)
+   end function get_observer
 
    !> Copy msg into buf (NUL-terminated, truncated to buflen − 1 characters).
    subroutine copy_message(msg, buf, buflen)

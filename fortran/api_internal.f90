@@ -1,5 +1,6 @@
 !> The door between the kernels and the C integrators (c/martello_internal.h, not public):
-!> the scene's topology, force evaluation, and the recording of a run's results.
+!> the scene's topology, force evaluation, and the observer of the run (martello_observer,
+!> docs/run-layer.md), through which they measure a run as the fixed-step methods do.
 module martello_api_internal
    use, intrinsic :: iso_c_binding
    use martello_kinds, only: dp
@@ -8,9 +9,9 @@ module martello_api_internal
    use martello_evaluator
    use martello_contact_laws, only: P_RESTITUTION
    use martello_integrator_settings
-   use martello_results
+   use martello_observer
    use martello_run, only: run_t
-   use martello_api_handles, only: get_model, get_run, get_eval
+   use martello_api_handles, only: get_model, get_run, get_eval, get_observer
    implicit none
    private
 
@@ -166,6 +167,17 @@ contains
       c_eval_commit = MARTELLO_OK
    end function c_eval_commit
 
+   integer(c_int) function c_eval_power(handle, power) bind(C, name='martello_eval_power')
+      type(c_ptr), value :: handle
+      real(c_double), intent(out) :: power(3)
+      type(evaluator_t), pointer :: ep
+      ep => get_eval(handle)
+      c_eval_power = MARTELLO_ERR_ARGUMENT
+      if (.not. associated(ep)) return
+      call evaluator_power(ep, power)
+      c_eval_power = MARTELLO_OK
+   end function c_eval_power
+
    integer(c_int) function c_eval_energy(handle, u, v, kinetic, recoverable) bind(C, name='martello_eval_energy')
       type(c_ptr), value :: handle
       real(c_double), intent(in) :: u(*), v(*)
@@ -200,88 +212,192 @@ contains
       c_run_settings = MARTELLO_OK
    end function c_run_settings
 
-   integer(c_int) function c_run_track(handle, t, u, v, a, pen, force) bind(C, name='martello_run_track')
+   integer(c_int) function c_run_observer(handle, obs) bind(C, name='martello_run_observer')
       type(c_ptr), value :: handle
+      type(c_ptr), intent(out) :: obs
+      type(run_t), pointer :: rp
+      rp => get_run(handle)
+      obs = c_null_ptr
+      c_run_observer = MARTELLO_ERR_ARGUMENT
+      if (.not. associated(rp)) return
+      obs = c_loc(rp%results)
+      c_run_observer = MARTELLO_OK
+   end function c_run_observer
+
+   integer(c_int) function c_observer_begin(handle, ehandle, u, v, energy_interval, advice) &
+      bind(C, name='martello_observer_begin')
+      type(c_ptr), value :: handle, ehandle
+      real(c_double), intent(in) :: u(*), v(*)
+      integer(c_int), value :: energy_interval
+      character(kind=c_char), intent(in) :: advice(*)
+      type(observer_t), pointer :: op
+      type(evaluator_t), pointer :: ep
+      op => get_observer(handle); ep => get_eval(ehandle)
+      c_observer_begin = MARTELLO_ERR_ARGUMENT
+      if (.not. (associated(op) .and. associated(ep))) return
+      call evaluator_load(ep, u(1:ep%m%n), v(1:ep%m%n))
+      ! the C integrators conserve ½vᵀMv itself (no Verlet correction): a = 0 serves
+      op%acc = 0.0_dp
+      call observer_begin(op, ep%m, ep%ms, ep%u, ep%v, op%acc, int(energy_interval), &
+                          c_string(advice), 0.0_dp)
+      c_observer_begin = MARTELLO_OK
+   end function c_observer_begin
+
+   integer(c_int) function c_observer_sample(handle, ehandle, t, u, v, a, pen, force, k) &
+      bind(C, name='martello_observer_sample')
+      type(c_ptr), value :: handle, ehandle
       real(c_double), value :: t
       real(c_double), intent(in) :: u(*), v(*), a(*), pen(*), force(*)
-      type(run_t), pointer :: rp
-      integer :: n, nc
-      rp => get_run(handle)
-      c_run_track = MARTELLO_ERR_ARGUMENT
-      if (.not. associated(rp)) return
-      n = size(rp%results%u_max); nc = size(rp%results%pen_max)
-      call results_track(rp%results, t, u(1:n), v(1:n), a(1:n), pen(1:nc), force(1:nc))
-      c_run_track = MARTELLO_OK
-   end function c_run_track
+      integer(c_int), value :: k
+      type(observer_t), pointer :: op
+      type(evaluator_t), pointer :: ep
+      integer :: n, nc, stat
+      op => get_observer(handle); ep => get_eval(ehandle)
+      c_observer_sample = MARTELLO_ERR_ARGUMENT
+      if (.not. (associated(op) .and. associated(ep))) return
+      n = ep%m%n; nc = ep%m%ncontact
+      call evaluator_load(ep, u(1:n), v(1:n))
+      op%acc(0) = 0.0_dp; op%acc(1:n) = a(1:n)
+      ! the link states are the evaluator's, committed at this state
+      call observer_sample(op, ep%m, ep%ms, t, ep%u, ep%v, op%acc, pen(1:nc), force(1:nc), int(k), &
+                           stat, ep%ms%link_f, ep%ms%link_u)
+      c_observer_sample = stat
+   end function c_observer_sample
 
-   integer(c_int) function c_run_record(handle, t, u, v, a, pen, force, energy) bind(C, name='martello_run_record')
+   integer(c_int) function c_observer_work(handle, w_ext, w_int, w_links, w_contact, w_impact) &
+      bind(C, name='martello_observer_work')
       type(c_ptr), value :: handle
-      real(c_double), value :: t
-      real(c_double), intent(in) :: u(*), v(*), a(*), pen(*), force(*), energy(NENERGY)
-      type(run_t), pointer :: rp
-      integer :: n, nc
-      rp => get_run(handle)
-      c_run_record = MARTELLO_ERR_ARGUMENT
-      if (.not. associated(rp)) return
-      n = size(rp%results%u_max); nc = size(rp%results%pen_max)
-      call results_record(rp%results, t, u(1:n), v(1:n), a(1:n), pen(1:nc), force(1:nc), energy)
-      rp%results%energy = energy
-      rp%results%energy_balance_max = max(rp%results%energy_balance_max, abs(energy(E_BALANCE)))
-      c_run_record = MARTELLO_OK
-   end function c_run_record
+      real(c_double), value :: w_ext, w_int, w_links, w_contact, w_impact
+      type(observer_t), pointer :: op
+      op => get_observer(handle)
+      c_observer_work = MARTELLO_ERR_ARGUMENT
+      if (.not. associated(op)) return
+      call observer_work(op, external=w_ext, links=w_links, contact=w_contact, impact=w_impact, &
+                         internal=w_int)
+      c_observer_work = MARTELLO_OK
+   end function c_observer_work
 
-   integer(c_int) function c_run_add_event(handle, contact, values) bind(C, name='martello_run_add_event')
+   integer(c_int) function c_observer_open_phase(handle, contact, t_on, v_in) &
+      bind(C, name='martello_observer_open_phase')
       type(c_ptr), value :: handle
       integer(c_int), value :: contact
-      real(c_double), intent(in) :: values(NEVENT)
-      type(run_t), pointer :: rp
-      rp => get_run(handle)
-      c_run_add_event = MARTELLO_ERR_ARGUMENT
-      if (.not. associated(rp)) return
-      if (contact < 0 .or. contact >= size(rp%results%impacts)) return
-      call results_add_event(rp%results, int(contact) + 1, values)
-      rp%results%impacts(contact + 1) = rp%results%impacts(contact + 1) + 1
-      c_run_add_event = MARTELLO_OK
-   end function c_run_add_event
+      real(c_double), value :: t_on, v_in
+      type(observer_t), pointer :: op
+      op => observer_of(handle, contact)
+      c_observer_open_phase = MARTELLO_ERR_ARGUMENT
+      if (.not. associated(op)) return
+      call observer_open_phase(op, int(contact) + 1, t_on, v_in)
+      c_observer_open_phase = MARTELLO_OK
+   end function c_observer_open_phase
 
-   integer(c_int) function c_run_add_counts(handle, inc) bind(C, name='martello_run_add_counts')
+   integer(c_int) function c_observer_close_phase(handle, contact, t_off, v_out) &
+      bind(C, name='martello_observer_close_phase')
+      type(c_ptr), value :: handle
+      integer(c_int), value :: contact
+      real(c_double), value :: t_off, v_out
+      type(observer_t), pointer :: op
+      op => observer_of(handle, contact)
+      c_observer_close_phase = MARTELLO_ERR_ARGUMENT
+      if (.not. associated(op)) return
+      if (op%ph_open(contact + 1)) call observer_close_phase(op, int(contact) + 1, t_off, v_out)
+      c_observer_close_phase = MARTELLO_OK
+   end function c_observer_close_phase
+
+   integer(c_int) function c_observer_add_impact(handle, contact, t, v_in, v_out, pen, force) &
+      bind(C, name='martello_observer_add_impact')
+      type(c_ptr), value :: handle
+      integer(c_int), value :: contact
+      real(c_double), value :: t, v_in, v_out, pen, force
+      type(observer_t), pointer :: op
+      op => observer_of(handle, contact)
+      c_observer_add_impact = MARTELLO_ERR_ARGUMENT
+      if (.not. associated(op)) return
+      call observer_add_impact(op, int(contact) + 1, t, v_in, v_out, pen, force)
+      c_observer_add_impact = MARTELLO_OK
+   end function c_observer_add_impact
+
+   integer(c_int) function c_observer_in_phase(handle, contact, open) bind(C, name='martello_observer_in_phase')
+      type(c_ptr), value :: handle
+      integer(c_int), value :: contact
+      integer(c_int), intent(out) :: open
+      type(observer_t), pointer :: op
+      op => observer_of(handle, contact)
+      open = 0
+      c_observer_in_phase = MARTELLO_ERR_ARGUMENT
+      if (.not. associated(op)) return
+      open = merge(1, 0, op%ph_open(contact + 1))
+      c_observer_in_phase = MARTELLO_OK
+   end function c_observer_in_phase
+
+   integer(c_int) function c_observer_add_counts(handle, inc) bind(C, name='martello_observer_add_counts')
       type(c_ptr), value :: handle
       integer(c_long_long), intent(in) :: inc(NCOUNTERS)
-      type(run_t), pointer :: rp
-      rp => get_run(handle)
-      c_run_add_counts = MARTELLO_ERR_ARGUMENT
-      if (.not. associated(rp)) return
-      rp%results%counters = rp%results%counters + inc
-      c_run_add_counts = MARTELLO_OK
-   end function c_run_add_counts
+      type(observer_t), pointer :: op
+      op => get_observer(handle)
+      c_observer_add_counts = MARTELLO_ERR_ARGUMENT
+      if (.not. associated(op)) return
+      op%counters = op%counters + inc
+      c_observer_add_counts = MARTELLO_OK
+   end function c_observer_add_counts
 
-   integer(c_int) function c_run_set_message(handle, msg) bind(C, name='martello_run_set_message')
+   !> Returns status (the method's failure code) once recorded, MARTELLO_ERR_ARGUMENT for a
+   !> null handle.
+   integer(c_int) function c_observer_fail(handle, status, t_reached, message) bind(C, name='martello_observer_fail')
       type(c_ptr), value :: handle
-      character(kind=c_char), intent(in) :: msg(*)
-      type(run_t), pointer :: rp
+      integer(c_int), value :: status
+      real(c_double), value :: t_reached
+      character(kind=c_char), intent(in) :: message(*)
+      type(observer_t), pointer :: op
+      integer :: stat
+      op => get_observer(handle)
+      c_observer_fail = MARTELLO_ERR_ARGUMENT
+      if (.not. associated(op)) return
+      call observer_fail(op, int(status), t_reached, c_string(message), stat)
+      c_observer_fail = stat
+   end function c_observer_fail
+
+   integer(c_int) function c_observer_fail_nonfinite(handle, t) bind(C, name='martello_observer_fail_nonfinite')
+      type(c_ptr), value :: handle
+      real(c_double), value :: t
+      type(observer_t), pointer :: op
+      integer :: stat
+      op => get_observer(handle)
+      c_observer_fail_nonfinite = MARTELLO_ERR_ARGUMENT
+      if (.not. associated(op)) return
+      call observer_fail_nonfinite(op, t, stat)
+      c_observer_fail_nonfinite = stat
+   end function c_observer_fail_nonfinite
+
+   integer(c_int) function c_observer_finish(handle, t_reached) bind(C, name='martello_observer_finish')
+      type(c_ptr), value :: handle
+      real(c_double), value :: t_reached
+      type(observer_t), pointer :: op
+      op => get_observer(handle)
+      c_observer_finish = MARTELLO_ERR_ARGUMENT
+      if (.not. associated(op)) return
+      call observer_finish(op, t_reached)
+      c_observer_finish = MARTELLO_OK
+   end function c_observer_finish
+
+   !> The observer of a handle if contact (0-based) is one of its contacts, else null.
+   function observer_of(handle, contact) result(op)
+      type(c_ptr), value :: handle
+      integer(c_int), intent(in) :: contact
+      type(observer_t), pointer :: op
+      op => get_observer(handle)
+      if (.not. associated(op)) return
+      if (contact < 0 .or. contact >= size(op%ph_open)) op => null()
+   end function observer_of
+
+   !> A NUL-terminated C string as a Fortran one (at most 512 characters).
+   function c_string(cs) result(fs)
+      character(kind=c_char), intent(in) :: cs(*)
+      character(len=:), allocatable :: fs
       integer :: i
-      rp => get_run(handle)
-      c_run_set_message = MARTELLO_ERR_ARGUMENT
-      if (.not. associated(rp)) return
-      rp%results%message = ''
-      do i = 1, len(rp%results%message)
-         if (msg(i) == c_null_char) exit
-         rp%results%message(i:i) = msg(i)
+      do i = 1, 512
+         if (cs(i) == c_null_char) exit
       end do
-      c_run_set_message = MARTELLO_OK
-   end function c_run_set_message
-
-   integer(c_int) function c_run_finish(handle, t_reached, energy, balance_max) bind(C, name='martello_run_finish')
-      type(c_ptr), value :: handle
-      real(c_double), value :: t_reached, balance_max
-      real(c_double), intent(in) :: energy(NENERGY)
-      type(run_t), pointer :: rp
-      rp => get_run(handle)
-      c_run_finish = MARTELLO_ERR_ARGUMENT
-      if (.not. associated(rp)) return
-      rp%results%t_end_reached = t_reached
-      rp%results%energy = energy
-      rp%results%energy_balance_max = max(rp%results%energy_balance_max, balance_max)
-      c_run_finish = MARTELLO_OK
-   end function c_run_finish
+      allocate (character(len=i - 1) :: fs)
+      fs = transfer(cs(1:i - 1), fs)
+   end function c_string
 end module martello_api_internal

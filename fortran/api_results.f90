@@ -1,10 +1,11 @@
 !> The C door of a finished run's results (martello_run_history … martello_run_energy of
-!> c/martello.h): copies out of martello_results. Nothing is computed here.
+!> c/martello.h): copies out of the run's observer (martello_observer). Nothing is computed
+!> here.
 module martello_api_results
    use, intrinsic :: iso_c_binding
    use martello_kinds, only: dp
    use martello_status
-   use martello_results
+   use martello_observer, only: NCOUNTERS, NENERGY, NEVENT
    use martello_run, only: run_t
    use martello_api_handles, only: get_run
    implicit none

@@ -13,7 +13,8 @@ module martello_assembly
    implicit none
    private
    public :: mech_state_t, mech_init, internal_forces, external_forces, mech_commit, &
-      recoverable_energy, mass_times, external_work, kinetic_energy, assemble_mass, ONSET_SPEED_FLOOR
+      element_power, recoverable_energy, mass_times, external_work, kinetic_energy, &
+      assemble_mass, ONSET_SPEED_FLOOR
 
    !> Hunt–Crossley-type laws scale damping by 1/v_in; a contact first seen while δ̇ ≤ 0
    !> (grazing, or a step that lands inside) uses this floor [m/s] instead of a division by 0.
@@ -168,7 +169,7 @@ contains
          du = u(m%link_a(j)) - u(m%link_b(j))
          if (present(w_damp)) then
             w = 0.5_dp*(s%link_f(j) + s%link_f_trial(j))*(du - s%link_u(j))
-            if (m%link_kind(j) == LINK_DASHPOT .or. m%link_kind(j) == LINK_FLUID_DAMPER) then
+            if (is_damper(m%link_kind(j))) then
                w_damp = w_damp + w
             else
                w_links = w_links + w
@@ -193,6 +194,37 @@ contains
       call swap(s%con_vin, s%con_vin_trial)
       s%con_rate = s%con_rate_trial
    end subroutine mech_commit
+
+   !> The power the elements absorb at the trial state of the last internal_forces call,
+   !> Σ f·(v_a − v_b), split as mech_commit's works (dampers, other links, penalty contacts):
+   !> the integrands of the works for integrators that integrate them along their own
+   !> solution (the adaptive C integrators, docs/run-layer.md).
+   pure subroutine element_power(m, s, v, p_damp, p_links, p_contact)
+      type(model_t), intent(in) :: m
+      type(mech_state_t), intent(in) :: s
+      real(dp), intent(in) :: v(0:)
+      real(dp), intent(out) :: p_damp, p_links, p_contact
+      integer :: j
+      real(dp) :: p
+      p_damp = 0.0_dp; p_links = 0.0_dp; p_contact = 0.0_dp
+      do j = 1, m%nlink
+         p = s%link_f_trial(j)*(v(m%link_a(j)) - v(m%link_b(j)))
+         if (is_damper(m%link_kind(j))) then
+            p_damp = p_damp + p
+         else
+            p_links = p_links + p
+         end if
+      end do
+      do j = 1, m%ncontact
+         if (s%is_penalty(j)) p_contact = p_contact + s%con_f_trial(j)*s%con_rate_trial(j)
+      end do
+   end subroutine element_power
+
+   !> Links whose work is damping (no recoverable energy): the energy balance's split.
+   pure logical function is_damper(kind)
+      integer, intent(in) :: kind
+      is_damper = kind == LINK_DASHPOT .or. kind == LINK_FLUID_DAMPER
+   end function is_damper
 
    subroutine swap(x, y)
       real(dp), allocatable, intent(inout) :: x(:), y(:)

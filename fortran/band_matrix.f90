@@ -9,8 +9,8 @@ module martello_band_matrix
    use martello_lapack, only: dgbsv
    implicit none
    private
-   public :: band_t, band_init, band_zero, band_add, band_add_pair, band_solve, band_matvec, &
-      band_get
+   public :: band_t, band_init, band_zero, band_add, band_add_pair, band_pin, band_solve, &
+      band_matvec, band_get
 
    type :: band_t
       integer :: n = 0, kd = 0
@@ -64,6 +64,19 @@ contains
          b%ab(r + j - i, i) = b%ab(r + j - i, i) - s
       end if
    end subroutine band_add_pair
+
+   !> Replace row and column i by the identity: a fixed DOF (its increment is 0).
+   pure subroutine band_pin(b, i)
+      type(band_t), intent(inout) :: b
+      integer, intent(in) :: i
+      integer :: j, r
+      r = 2*b%kd + 1
+      do j = max(1, i - b%kd), min(b%n, i + b%kd)
+         b%ab(r + i - j, j) = 0.0_dp      ! row i
+         b%ab(r + j - i, i) = 0.0_dp      ! column i
+      end do
+      b%ab(r, i) = 1.0_dp
+   end subroutine band_pin
 
    !> y = A x (A as assembled, before any solve).
    pure subroutine band_matvec(b, x, y)

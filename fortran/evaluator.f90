@@ -9,8 +9,9 @@ module martello_evaluator
    use martello_band_matrix
    implicit none
    private
-   public :: evaluator_t, evaluator_init, evaluator_acceleration, evaluator_forces, &
-      evaluator_solve_mass, evaluator_contacts, evaluator_commit, evaluator_energy
+   public :: evaluator_t, evaluator_init, evaluator_load, evaluator_acceleration, &
+      evaluator_forces, evaluator_solve_mass, evaluator_contacts, evaluator_commit, &
+      evaluator_energy, evaluator_power
 
    type :: evaluator_t
       type(model_t), pointer :: m => null()
@@ -38,19 +39,20 @@ contains
       ev%fixed_nodes = pack([(j, j = 1, n)], m%fixed)
    end subroutine evaluator_init
 
-   subroutine load(ev, u, v)
+   !> ev%u, ev%v (0:n, 0 = ground) ← (u, v), fixed nodes at u0 and at rest.
+   subroutine evaluator_load(ev, u, v)
       type(evaluator_t), intent(inout) :: ev
       real(dp), intent(in) :: u(:), v(:)
       ev%u(1:) = u; ev%v(1:) = v
       ev%u(ev%fixed_nodes) = ev%m%u0(ev%fixed_nodes); ev%v(ev%fixed_nodes) = 0.0_dp
-   end subroutine load
+   end subroutine evaluator_load
 
    !> fint and fext (length n) at (t, u, v); links from the committed state.
    subroutine evaluator_forces(ev, t, u, v, fint, fext)
       type(evaluator_t), intent(inout) :: ev
       real(dp), intent(in) :: t, u(:), v(:)
       real(dp), intent(out) :: fint(:), fext(:)
-      call load(ev, u, v)
+      call evaluator_load(ev, u, v)
       call internal_forces(ev%m, ev%ms, ev%u, ev%v, ev%f)
       call external_forces(ev%m, ev%mrow, t, ev%fext)
       fint = ev%f(1:); fext = ev%fext(1:)
@@ -74,7 +76,7 @@ contains
       type(evaluator_t), intent(inout) :: ev
       real(dp), intent(inout) :: x(:)
       logical, intent(out) :: ok
-      integer :: k, i, rr, jj
+      integer :: k, i
       if (ev%m%ncoupling == 0) then
          x = x/merge(1.0_dp, ev%m%mass, ev%m%fixed)
          x(ev%fixed_nodes) = 0.0_dp
@@ -83,14 +85,9 @@ contains
       end if
       call band_zero(ev%mband)
       call assemble_mass(ev%m, 1.0_dp, ev%mband)
-      rr = 2*ev%mband%kd + 1
       do k = 1, size(ev%fixed_nodes)
          i = ev%fixed_nodes(k)
-         do jj = max(1, i - ev%mband%kd), min(ev%m%n, i + ev%mband%kd)
-            ev%mband%ab(rr + i - jj, jj) = 0.0_dp
-            ev%mband%ab(rr + jj - i, i) = 0.0_dp
-         end do
-         ev%mband%ab(rr, i) = 1.0_dp
+         call band_pin(ev%mband, i)
          x(i) = 0.0_dp
       end do
       call band_solve(ev%mband, x, ok)
@@ -102,7 +99,7 @@ contains
       real(dp), intent(in) :: u(:), v(:)
       real(dp), intent(out) :: pen(:), rate(:)
       integer :: j
-      call load(ev, u, v)
+      call evaluator_load(ev, u, v)
       do j = 1, ev%m%ncontact
          pen(j) = ev%u(ev%m%con_a(j)) - ev%u(ev%m%con_b(j)) - ev%m%con_gap(j)
          rate(j) = ev%v(ev%m%con_a(j)) - ev%v(ev%m%con_b(j))
@@ -113,17 +110,25 @@ contains
    subroutine evaluator_commit(ev, u, v)
       type(evaluator_t), intent(inout) :: ev
       real(dp), intent(in) :: u(:), v(:)
-      call load(ev, u, v)
+      call evaluator_load(ev, u, v)
       call internal_forces(ev%m, ev%ms, ev%u, ev%v, ev%f)
       call mech_commit(ev%m, ev%ms, ev%u)
    end subroutine evaluator_commit
+
+   !> The power of the dampers, the other links and the penalty contacts at the state of the
+   !> last force evaluation (element_power).
+   subroutine evaluator_power(ev, power)
+      type(evaluator_t), intent(in) :: ev
+      real(dp), intent(out) :: power(3)
+      call element_power(ev%m, ev%ms, ev%v, power(1), power(2), power(3))
+   end subroutine evaluator_power
 
    subroutine evaluator_energy(ev, u, v, kinetic, recoverable)
       type(evaluator_t), intent(inout) :: ev
       real(dp), intent(in) :: u(:), v(:)
       real(dp), intent(out) :: kinetic, recoverable
       real(dp) :: el, ec
-      call load(ev, u, v)
+      call evaluator_load(ev, u, v)
       kinetic = kinetic_energy(ev%m, ev%v, ev%work)
       call recoverable_energy(ev%m, ev%ms, ev%u, el, ec)
       recoverable = el + ec

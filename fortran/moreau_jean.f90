@@ -22,23 +22,26 @@
 !> + Δqᵀ f_ext,θ + ġ_θᵀ p_{k+1}; the impulse work ġ_θ p = (1 − θ(1+e)) ġ_k p is ≤ 0 iff
 !> θ(1+e) ≤ 1. E_IMPACT accumulates −ġ_θᵀ p; the θ-dissipation is what E_BALANCE shows
 !> (zero up to round-off for θ = ½ and linear forces).
+!>
+!> A stepper of the fixed-step strategy (martello_stepper, docs/run-layer.md): the step and
+!> its impulse problem are here, the time loop and the measurement are the strategy's and
+!> the observer's.
 module martello_moreau_jean
    use martello_kinds, only: dp, i8
    use martello_lapack, only: dgbtrf, dgbtrs
    use martello_status
    use martello_model, only: model_t, model_bandwidth, rigid_contact_sides
-   use martello_band_matrix, only: band_t, band_init, band_matvec
-   use martello_assembly, only: mech_state_t, mech_init, internal_forces, external_forces, &
-      mech_commit, recoverable_energy, mass_times, assemble_mass, kinetic_energy
-   use martello_results
-   use martello_run_checks, only: check_run_settings, check_divergence
-   use martello_integrator_settings, only: integrator_settings_t, integrator_name, scheme_supported
+   use martello_band_matrix, only: band_t, band_init, band_matvec, band_pin
+   use martello_assembly, only: internal_forces, external_forces, mech_commit, assemble_mass
+   use martello_observer, only: observer_t, observer_work, observer_fail, observer_open_phase, &
+      observer_close_phase, C_NEWTON, C_RESIDUALS, C_FACTORIZATIONS, C_EVENTS, C_JACOBIANS
+   use martello_integrator_settings, only: integrator_settings_t
+   use martello_stepper, only: stepper_t, stepper_start
    use martello_lcp, only: lcp_lemke, lcp_pgs, LCP_OK
    use martello_linalg, only: lapack_status
-   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
    implicit none
    private
-   public :: run_moreau_jean, LEMKE_MAX
+   public :: moreau_jean_t, LEMKE_MAX
 
    !> Up to this many active contacts the LCP is solved by Lemke on a dense W (exact, O(n³)
    !> at worst); beyond, by projected Gauss–Seidel on the band of W.
@@ -47,100 +50,140 @@ module martello_moreau_jean
    real(dp), parameter :: PGS_TOL = 1.0e-14_dp
    integer, parameter :: PGS_MAX_SWEEPS = 100000
 
+   type, extends(stepper_t) :: moreau_jean_t
+      integer :: kd = 0, na = 0, kw = 0, iters = 0
+      real(dp) :: theta = 0.5_dp, hth = 0.0_dp, hth2 = 0.0_dp
+      logical :: thomas = .false.
+      real(dp), allocatable :: fint(:), fint_n(:), fext(:), fext_n(:), rhs(:), work(:)
+      real(dp), allocatable :: e_con(:), p(:), p_prev(:), ph_last(:)
+      integer, allocatable :: sa(:), sb(:), act(:), pos(:), ipiv(:), node_ptr(:), node_con(:)
+      logical, allocatable :: rigid(:), movable(:)
+      ! Delassus operator: dense (Lemke) and band (PGS), the columns Ŵ⁻¹Bᵀ (kd > 0), LCP data
+      real(dp), allocatable :: wd_(:, :), wb(:, :), zcol(:, :), qlcp(:), zlcp(:)
+      type(band_t) :: kband, cband, what
+   contains
+      procedure :: init
+      procedure :: step
+   end type moreau_jean_t
 
 contains
 
-   !> Run a scene from t = 0 to t_end with a fixed step. stat < 0 on failure, with
-   !> r%message saying where and why (the results so far stay in r for diagnosis).
-   subroutine run_moreau_jean(m, s, r, stat)
-      type(model_t), intent(inout) :: m
+   !> The state at t = 0 with the tangents K, C of the smooth forces committed there.
+   subroutine init(self, m, s, o, stat)
+      class(moreau_jean_t), intent(inout) :: self
+      type(model_t), intent(in) :: m
       type(integrator_settings_t), intent(in) :: s
-      type(results_t), intent(inout) :: r
+      type(observer_t), intent(inout) :: o
       integer, intent(out) :: stat
+      integer :: n, nc
+      stat = MARTELLO_OK
+      if (.not. (s%theta >= 0.5_dp .and. s%theta <= 1.0_dp)) then
+         call observer_fail(o, MARTELLO_ERR_ARGUMENT, 0.0_dp, &
+                            'Moreau-Jean: theta must lie in [0.5, 1] (theta < 1/2 is unstable)', stat)
+         return
+      end if
+      call stepper_start(self, m, s)
+      n = m%n; nc = m%ncontact
+      self%advice = 'the linearised smooth forces need a smaller step'
+      self%theta = s%theta
+      self%hth = self%h*self%theta
+      self%hth2 = self%hth*self%hth
+      self%kd = model_bandwidth(m)
+      allocate (self%fint(0:n), self%fint_n(0:n), self%fext(0:n), self%fext_n(0:n), &
+                self%rhs(0:n), self%work(0:n), self%ipiv(n))
+      allocate (self%e_con(nc), self%p(nc), self%p_prev(nc), self%ph_last(nc), self%sa(nc), &
+                self%sb(nc), self%act(nc), self%pos(nc), self%rigid(nc), self%movable(nc))
+      self%p = 0.0_dp; self%p_prev = 0.0_dp; self%ph_last = 0.0_dp
+      call band_init(self%kband, n, self%kd)
+      call band_init(self%cband, n, self%kd)
+      call band_init(self%what, n, self%kd)
+      call rigid_contact_sides(m, self%rigid, self%e_con, self%sa, self%sb, self%movable)
+      call node_adjacency()
+      self%kband%ab = 0.0_dp; self%cband%ab = 0.0_dp
+      call internal_forces(m, self%ms, self%u, self%v, self%fint, self%kband%ab, 1.0_dp, 0.0_dp, &
+                           self%cband%ab)
+      call mech_commit(m, self%ms, self%u)
+      call external_forces(m, self%mrow, 0.0_dp, self%fext)
+      o%counters(C_RESIDUALS) = o%counters(C_RESIDUALS) + 1_i8
+      o%counters(C_JACOBIANS) = o%counters(C_JACOBIANS) + 1_i8
+      call contact_state(self, m)
 
-      integer :: n, kd, nc, nsteps, step, i, j, c, na, kw, info, iters
-      real(dp), allocatable :: u(:), v(:), un(:), vn(:), a(:), fint(:), fint_n(:), fext(:), &
-                               fext_n(:), rhs(:), work(:), mrow(:), ma(:)
-      real(dp), allocatable :: e_con(:), p(:), p_prev(:), pen(:), force(:)
-      integer, allocatable :: sa(:), sb(:), act(:), pos(:), fixed_nodes(:), ipiv(:)
-      integer, allocatable :: node_ptr(:), node_con(:)
-      ! Delassus operator: dense (Lemke) and band (PGS), the columns Ŵ⁻¹Bᵀ (kd > 0), LCP data
-      real(dp), allocatable :: wd_(:, :), wb(:, :), zcol(:, :), qlcp(:), zlcp(:)
-      ! open contact phases
-      real(dp), allocatable :: ph_t(:), ph_v(:), ph_pen(:), ph_f(:), ph_last(:)
-      logical, allocatable :: ph_open(:), rigid(:), movable(:)
-      type(mech_state_t) :: ms
-      type(band_t) :: kband, cband, what
-      real(dp) :: h, t, t_prev, theta, hth, hth2, e_kin, e_links, e_cont, e_links0, e_cont0, e0, &
-                  w_ext, d_damp, d_links, d_contact, d_impact, w_abs, wdl, wll, wcl, e_mech, &
-                  dw, gdot_theta, t_imp
-      logical :: recording, thomas
-      integer, parameter :: ENERGY_CHECK = 16
+   contains
+
+      !> Contacts touching each node (rigid ones only): node_con(node_ptr(i):node_ptr(i+1)−1).
+      subroutine node_adjacency()
+         integer :: cnt(0:n), k
+         associate (sa => self%sa, sb => self%sb)
+            cnt = 0
+            do k = 1, nc
+               if (.not. self%movable(k)) cycle
+               if (sa(k) > 0) cnt(sa(k)) = cnt(sa(k)) + 1
+               if (sb(k) > 0) cnt(sb(k)) = cnt(sb(k)) + 1
+            end do
+            allocate (self%node_ptr(n + 2), self%node_con(max(1, sum(cnt(1:n)))))
+            self%node_ptr(1) = 1
+            do k = 1, n
+               self%node_ptr(k + 1) = self%node_ptr(k) + cnt(k)
+            end do
+            cnt = 0
+            do k = 1, nc
+               if (.not. self%movable(k)) cycle
+               if (sa(k) > 0) then
+                  self%node_con(self%node_ptr(sa(k)) + cnt(sa(k))) = k; cnt(sa(k)) = cnt(sa(k)) + 1
+               end if
+               if (sb(k) > 0) then
+                  self%node_con(self%node_ptr(sb(k)) + cnt(sb(k))) = k; cnt(sb(k)) = cnt(sb(k)) + 1
+               end if
+            end do
+         end associate
+      end subroutine node_adjacency
+   end subroutine init
+
+   !> Penetration and force of every contact at the current state: penalty contacts from
+   !> the committed law, rigid ones δ = u_a − u_b − gap and the mean force p/h.
+   subroutine contact_state(self, m)
+      class(moreau_jean_t), intent(inout) :: self
+      type(model_t), intent(in) :: m
+      integer :: k
+      do k = 1, m%ncontact
+         if (self%rigid(k)) then
+            self%pen(k) = self%u(m%con_a(k)) - self%u(m%con_b(k)) - m%con_gap(k)
+            self%force(k) = self%p(k)/self%h
+         else
+            self%pen(k) = self%ms%con_pen(k); self%force(k) = self%ms%con_f(k)
+         end if
+      end do
+   end subroutine contact_state
+
+   !> One step: free velocity, index set, impulses, positions; the smooth forces and their
+   !> tangents committed at the new state; works and the phases of the rigid contacts.
+   subroutine step(self, m, t, o, stat)
+      class(moreau_jean_t), intent(inout) :: self
+      type(model_t), intent(in) :: m
+      real(dp), intent(in) :: t
+      type(observer_t), intent(inout) :: o
+      integer, intent(out) :: stat
+      integer :: n, nc, i, j, c, info, code
+      real(dp) :: h, t_prev, theta, hth, wdl, wll, wcl, dw, gdot_theta
+      character(len=512) :: msg
 
       stat = MARTELLO_OK
-      n = m%n
-      nc = m%ncontact
-      t = 0.0_dp
-      call check_scene(stat)
-      if (stat /= MARTELLO_OK) return
-      h = s%dt
-      theta = s%theta
-      hth = h*theta
-      hth2 = hth*hth
-      ! whole steps until t_end is reached; the last time is nsteps·h (reported as t_reached)
-      nsteps = max(1, ceiling(s%t_end/h*(1.0_dp - 1.0e-12_dp)))
-      kd = model_bandwidth(m)
-
-      allocate (u(0:n), v(0:n), un(0:n), vn(0:n), a(0:n), fint(0:n), fint_n(0:n), fext(0:n), &
-                fext_n(0:n), rhs(0:n), work(0:n), mrow(0:n), ma(0:n), ipiv(n))
-      allocate (e_con(nc), p(nc), p_prev(nc), pen(nc), force(nc), sa(nc), sb(nc), act(nc), &
-                pos(nc), rigid(nc), movable(nc))
-      allocate (ph_t(nc), ph_v(nc), ph_pen(nc), ph_f(nc), ph_last(nc), ph_open(nc))
-      ph_open = .false.
-      p = 0.0_dp; p_prev = 0.0_dp; pen = 0.0_dp; force = 0.0_dp
-      fixed_nodes = pack([(j, j = 1, n)], m%fixed)
-      call band_init(kband, n, kd)
-      call band_init(cband, n, kd)
-      call band_init(what, n, kd)
-
-      call rigid_contact_sides(m, rigid, e_con, sa, sb, movable)
-      call node_adjacency()
-
-      ! initial state
-      u(0) = 0.0_dp; v(0) = 0.0_dp
-      u(1:n) = m%u0; v(1:n) = merge(0.0_dp, m%v0, m%fixed)
-      a = 0.0_dp
-      work = 1.0_dp; work(0) = 0.0_dp
-      call mass_times(m, work, mrow)
-      call mech_init(m, ms, u, v)
-      kband%ab = 0.0_dp; cband%ab = 0.0_dp
-      call internal_forces(m, ms, u, v, fint, kband%ab, 1.0_dp, 0.0_dp, cband%ab)
-      call mech_commit(m, ms, u)
-      call external_forces(m, mrow, 0.0_dp, fext)
-      r%counters(C_RESIDUALS) = r%counters(C_RESIDUALS) + 1_i8
-      r%counters(C_JACOBIANS) = r%counters(C_JACOBIANS) + 1_i8
-
-      e_kin = kinetic_energy(m, v, ma)
-      call recoverable_energy(m, ms, u, e_links, e_cont)
-      e_links0 = e_links; e_cont0 = e_cont
-      e0 = e_kin + e_links + e_cont
-      w_ext = 0.0_dp; d_damp = 0.0_dp; d_links = 0.0_dp; d_contact = 0.0_dp; d_impact = 0.0_dp
-      w_abs = 0.0_dp
-      call contact_state()
-      call results_track(r, t, u(1:n), v(1:n), a(1:n), pen, force, ms%link_f, ms%link_u)
-      call record()
-
-      do step = 1, nsteps
-         un = u; vn = v; fint_n = fint; fext_n = fext
-         t_prev = t
-         t = step*h
-         call external_forces(m, mrow, t, fext)
+      n = self%n; nc = self%nc; h = self%h; theta = self%theta; hth = self%hth
+      t_prev = self%t0
+      associate (u => self%u, v => self%v, un => self%un, vn => self%vn, a => self%a, &
+                 fint => self%fint, fint_n => self%fint_n, fext => self%fext, &
+                 fext_n => self%fext_n, rhs => self%rhs, work => self%work, p => self%p, &
+                 p_prev => self%p_prev, sa => self%sa, sb => self%sb, act => self%act, &
+                 na => self%na, kband => self%kband, cband => self%cband, what => self%what, &
+                 fixed_nodes => self%fixed_nodes)
+         fint_n = fint; fext_n = fext
+         call external_forces(m, self%mrow, t, fext)
 
          ! Ŵ = M + hθ C + h²θ² K from the tangents of the committed state
-         what%ab = hth2*kband%ab + hth*cband%ab
+         what%ab = self%hth2*kband%ab + hth*cband%ab
          call assemble_mass(m, 1.0_dp, what)
          do i = 1, size(fixed_nodes)
-            call pin_row(what, fixed_nodes(i))
+            call band_pin(what, fixed_nodes(i))
          end do
          ! free velocity: Ŵ Δv_free = h (f_ext,θ − fint_k − hθ K v_k)
          call band_matvec(kband, vn(1:n), work(1:n))
@@ -151,10 +194,9 @@ contains
          rhs(fixed_nodes) = 0.0_dp
          call factorise(info)
          if (info /= 0) then
-            call lapack_status('dgbtrf', info, stat, r%message)
-            r%message = 'Moreau-Jean: the step matrix M + h theta C + (h theta)^2 K is singular ('// &
-               trim(r%message)//')'
-            r%t_end_reached = t_prev
+            call lapack_status('dgbtrf', info, code, msg)
+            call observer_fail(o, code, t_prev, 'Moreau-Jean: the step matrix M + h theta C + '// &
+                               '(h theta)^2 K is singular ('//trim(msg)//')', stat)
             return
          end if
          call solve_what(rhs(1:n))
@@ -189,68 +231,28 @@ contains
 
          ! smooth forces and tangents at the new state, committed
          kband%ab = 0.0_dp; cband%ab = 0.0_dp
-         call internal_forces(m, ms, u, v, fint, kband%ab, 1.0_dp, 0.0_dp, cband%ab)
-         call mech_commit(m, ms, u, wdl, wll, wcl)
-         r%counters(C_RESIDUALS) = r%counters(C_RESIDUALS) + 1_i8
-         r%counters(C_JACOBIANS) = r%counters(C_JACOBIANS) + 1_i8
-         r%counters(C_STEPS) = r%counters(C_STEPS) + 1_i8
+         call internal_forces(m, self%ms, u, v, fint, kband%ab, 1.0_dp, 0.0_dp, cband%ab)
+         call mech_commit(m, self%ms, u, wdl, wll, wcl)
+         o%counters(C_RESIDUALS) = o%counters(C_RESIDUALS) + 1_i8
+         o%counters(C_JACOBIANS) = o%counters(C_JACOBIANS) + 1_i8
 
          ! energy: external work Δqᵀ f_ext,θ; impulse work ġ_θ p (dissipated: its negative)
-         d_damp = d_damp + wdl; d_links = d_links + wll; d_contact = d_contact + wcl
+         call observer_work(o, damping=wdl, links=wll, contact=wcl)
          dw = 0.0_dp
          do i = 1, n
             if (.not. m%fixed(i)) dw = dw + (theta*fext(i) + (1.0_dp - theta)*fext_n(i))*(u(i) - un(i))
          end do
-         w_ext = w_ext + dw; w_abs = w_abs + abs(dw)
+         call observer_work(o, external=dw)
          do j = 1, na
             c = act(j)
             gdot_theta = theta*(v(sb(c)) - v(sa(c))) + (1.0_dp - theta)*(vn(sb(c)) - vn(sa(c)))
-            d_impact = d_impact - gdot_theta*p(c)
+            call observer_work(o, impact=-gdot_theta*p(c))
          end do
-
-         call contact_state()
-         call track_events()
-         call results_track(r, t, u(1:n), v(1:n), a(1:n), pen, force, ms%link_f, ms%link_u)
-         recording = mod(step, s%every) == 0 .or. step == nsteps
-         if (.not. (recording .or. mod(step, ENERGY_CHECK) == 0 .or. &
-                    .not. ieee_is_finite(dw + d_impact + d_links + d_contact + d_damp))) cycle
-         e_kin = kinetic_energy(m, v, ma)
-         call recoverable_energy(m, ms, u, e_links, e_cont)
-         if (recording) call record()
-         e_mech = e_kin + e_links + e_cont
-         call check_divergence(s, t, e_mech, e0, w_abs, u, v, &
-                               'the linearised smooth forces need a smaller step', r, stat)
-         if (stat /= MARTELLO_OK) return
-      end do
-      call close_open_phases()
-      r%t_end_reached = t
+      end associate
+      call contact_state(self, m)
+      call rigid_phases()
 
    contains
-
-      subroutine check_scene(st)
-         integer, intent(out) :: st
-         call check_run_settings(m, s, r, st)
-         if (st /= MARTELLO_OK) return
-         if (.not. (s%theta >= 0.5_dp .and. s%theta <= 1.0_dp)) then
-            st = MARTELLO_ERR_ARGUMENT
-            r%message = 'Moreau-Jean: theta must lie in [0.5, 1] (theta < 1/2 is unstable)'
-            return
-         end if
-      end subroutine check_scene
-
-
-      !> Replace row and column i by the identity (a fixed DOF: Δv_i = 0).
-      subroutine pin_row(b, i)
-         type(band_t), intent(inout) :: b
-         integer, intent(in) :: i
-         integer :: jj, rr
-         rr = 2*b%kd + 1
-         do jj = max(1, i - b%kd), min(n, i + b%kd)
-            b%ab(rr + i - jj, jj) = 0.0_dp
-            b%ab(rr + jj - i, i) = 0.0_dp
-         end do
-         b%ab(rr, i) = 1.0_dp
-      end subroutine pin_row
 
       !> LU of Ŵ once a step (a diagonal Ŵ needs none); info > 0: singular. A chain (kd = 1)
       !> is factorised without pivoting — Ŵ is symmetric positive definite, diagonally
@@ -259,93 +261,73 @@ contains
          integer, intent(out) :: inf
          integer :: k
          inf = 0
-         r%counters(C_FACTORIZATIONS) = r%counters(C_FACTORIZATIONS) + 1_i8
-         thomas = .false.
-         select case (kd)
-         case (0)
-            do k = 1, n
-               if (what%ab(1, k) == 0.0_dp) then
-                  inf = k; return
-               end if
-            end do
-         case (1)
-            ! A(k,k) = ab(3,k), A(k+1,k) = ab(4,k), A(k,k+1) = ab(2,k+1)
-            what%d = what%ab(3, :)
-            thomas = .true.
-            do k = 2, n
-               if (abs(what%d(k - 1)) <= 1.0e-14_dp*abs(what%ab(3, k - 1))) then
-                  thomas = .false.; exit
-               end if
-               what%dl(k) = what%ab(4, k - 1)/what%d(k - 1)
-               what%d(k) = what%d(k) - what%dl(k)*what%ab(2, k)
-            end do
-            if (thomas .and. what%d(n) == 0.0_dp) thomas = .false.
-            if (.not. thomas) call dgbtrf(n, n, kd, kd, what%ab, size(what%ab, 1), ipiv, inf)
-         case default
-            call dgbtrf(n, n, kd, kd, what%ab, size(what%ab, 1), ipiv, inf)
-         end select
+         o%counters(C_FACTORIZATIONS) = o%counters(C_FACTORIZATIONS) + 1_i8
+         associate (what => self%what, thomas => self%thomas, kd => self%kd)
+            thomas = .false.
+            select case (kd)
+            case (0)
+               do k = 1, n
+                  if (what%ab(1, k) == 0.0_dp) then
+                     inf = k; return
+                  end if
+               end do
+            case (1)
+               ! A(k,k) = ab(3,k), A(k+1,k) = ab(4,k), A(k,k+1) = ab(2,k+1)
+               what%d = what%ab(3, :)
+               thomas = .true.
+               do k = 2, n
+                  if (abs(what%d(k - 1)) <= 1.0e-14_dp*abs(what%ab(3, k - 1))) then
+                     thomas = .false.; exit
+                  end if
+                  what%dl(k) = what%ab(4, k - 1)/what%d(k - 1)
+                  what%d(k) = what%d(k) - what%dl(k)*what%ab(2, k)
+               end do
+               if (thomas .and. what%d(n) == 0.0_dp) thomas = .false.
+               if (.not. thomas) call dgbtrf(n, n, kd, kd, what%ab, size(what%ab, 1), self%ipiv, inf)
+            case default
+               call dgbtrf(n, n, kd, kd, what%ab, size(what%ab, 1), self%ipiv, inf)
+            end select
+         end associate
       end subroutine factorise
 
       subroutine solve_what(x)
          real(dp), intent(inout) :: x(:)
          integer :: inf, k
-         if (kd == 0) then
-            x = x/what%ab(1, :)
-         else if (thomas) then
-            do k = 2, n
-               x(k) = x(k) - what%dl(k)*x(k - 1)
-            end do
-            x(n) = x(n)/what%d(n)
-            do k = n - 1, 1, -1
-               x(k) = (x(k) - what%ab(2, k + 1)*x(k + 1))/what%d(k)
-            end do
-         else
-            call dgbtrs('N', n, kd, kd, 1, what%ab, size(what%ab, 1), ipiv, x, n, inf)
-         end if
+         associate (what => self%what)
+            if (self%kd == 0) then
+               x = x/what%ab(1, :)
+            else if (self%thomas) then
+               do k = 2, n
+                  x(k) = x(k) - what%dl(k)*x(k - 1)
+               end do
+               x(n) = x(n)/what%d(n)
+               do k = n - 1, 1, -1
+                  x(k) = (x(k) - what%ab(2, k + 1)*x(k + 1))/what%d(k)
+               end do
+            else
+               call dgbtrs('N', n, self%kd, self%kd, 1, what%ab, size(what%ab, 1), self%ipiv, x, n, inf)
+            end if
+         end associate
       end subroutine solve_what
-
-      !> Contacts touching each node (rigid ones only): node_con(node_ptr(i):node_ptr(i+1)−1).
-      subroutine node_adjacency()
-         integer :: cnt(0:n), k
-         cnt = 0
-         do k = 1, nc
-            if (.not. movable(k)) cycle
-            if (sa(k) > 0) cnt(sa(k)) = cnt(sa(k)) + 1
-            if (sb(k) > 0) cnt(sb(k)) = cnt(sb(k)) + 1
-         end do
-         allocate (node_ptr(n + 2), node_con(max(1, sum(cnt(1:n)))))
-         node_ptr(1) = 1
-         do k = 1, n
-            node_ptr(k + 1) = node_ptr(k) + cnt(k)
-         end do
-         cnt = 0
-         do k = 1, nc
-            if (.not. movable(k)) cycle
-            if (sa(k) > 0) then
-               node_con(node_ptr(sa(k)) + cnt(sa(k))) = k; cnt(sa(k)) = cnt(sa(k)) + 1
-            end if
-            if (sb(k) > 0) then
-               node_con(node_ptr(sb(k)) + cnt(sb(k))) = k; cnt(sb(k)) = cnt(sb(k)) + 1
-            end if
-         end do
-      end subroutine node_adjacency
 
       !> Acary's index set: δ(q_k + ½h v_k) ≥ 0, the gap extrapolated to mid-step has closed.
       subroutine active_set()
          real(dp) :: dpred
          integer :: k
-         na = 0
-         pos = 0
-         do k = 1, nc
-            if (.not. movable(k)) cycle
-            dpred = (un(m%con_a(k)) + (0.5_dp*h)*vn(m%con_a(k))) &
-                    - (un(m%con_b(k)) + (0.5_dp*h)*vn(m%con_b(k))) - m%con_gap(k)
-            if (dpred >= 0.0_dp) then
-               na = na + 1
-               act(na) = k
-               pos(k) = na
-            end if
-         end do
+         associate (na => self%na, act => self%act, pos => self%pos, un => self%un, vn => self%vn)
+            na = 0
+            pos = 0
+            do k = 1, nc
+               if (.not. self%movable(k)) cycle
+               dpred = (un(m%con_a(k)) + (0.5_dp*h)*vn(m%con_a(k))) &
+                       - (un(m%con_b(k)) + (0.5_dp*h)*vn(m%con_b(k))) - m%con_gap(k)
+               if (dpred >= 0.0_dp) then
+                  na = na + 1
+                  act(na) = k
+                  pos(k) = na
+               end if
+            end do
+         end associate
       end subroutine active_set
 
       !> W, q of the LCP on the active contacts, solved; p(act) the impulses.
@@ -353,219 +335,157 @@ contains
          integer, intent(out) :: inf
          integer :: ii, jj, k, node, side, cj
          real(dp) :: si
-         inf = 0
-         if (allocated(qlcp)) then
-            if (size(qlcp) < na) deallocate (qlcp, zlcp)
-         end if
-         if (.not. allocated(qlcp)) allocate (qlcp(nc), zlcp(nc))
-         ! q = B v_free + e B v_k
-         do ii = 1, na
-            k = act(ii)
-            qlcp(ii) = (v(sb(k)) - v(sa(k))) + e_con(k)*(vn(sb(k)) - vn(sa(k)))
-         end do
-         if (kd == 0) then
-            ! Ŵ diagonal: W_ij = Σ over the nodes the two contacts share of s_i s_j / Ŵ_nn.
-            ! Its bandwidth in the active ordering is kw (1 for a chain).
-            kw = 0
+         associate (na => self%na, kw => self%kw, kd => self%kd, act => self%act, &
+                    pos => self%pos, sa => self%sa, sb => self%sb, v => self%v, vn => self%vn, &
+                    e_con => self%e_con, node_ptr => self%node_ptr, node_con => self%node_con, &
+                    what => self%what, iters => self%iters, p => self%p, p_prev => self%p_prev)
+            inf = 0
+            if (.not. allocated(self%qlcp)) allocate (self%qlcp(nc), self%zlcp(nc))
+            ! q = B v_free + e B v_k
             do ii = 1, na
                k = act(ii)
-               do side = 1, 2
-                  node = merge(sa(k), sb(k), side == 1)
-                  if (node == 0) cycle
-                  do jj = node_ptr(node), node_ptr(node + 1) - 1
-                     cj = node_con(jj)
-                     if (pos(cj) > 0) kw = max(kw, abs(pos(cj) - ii))
-                  end do
-               end do
+               self%qlcp(ii) = (v(sb(k)) - v(sa(k))) + e_con(k)*(vn(sb(k)) - vn(sa(k)))
             end do
-            call ensure_band(kw)
-            wb(:, 1:na) = 0.0_dp
-            do ii = 1, na
-               k = act(ii)
-               do side = 1, 2
-                  node = merge(sa(k), sb(k), side == 1)
-                  if (node == 0) cycle
-                  si = merge(-1.0_dp, 1.0_dp, side == 1)
-                  do jj = node_ptr(node), node_ptr(node + 1) - 1
-                     cj = node_con(jj)
-                     if (pos(cj) == 0) cycle
-                     ! s_j at this node: −1 if it is cj's a side, +1 if its b side
-                     wb(kw + 1 + ii - pos(cj), pos(cj)) = wb(kw + 1 + ii - pos(cj), pos(cj)) + &
-                        si*merge(-1.0_dp, 1.0_dp, sa(cj) == node)/what%ab(1, node)
-                  end do
-               end do
-            end do
-            if (na <= LEMKE_MAX) then
-               call ensure_dense()
-               wd_(1:na, 1:na) = 0.0_dp
-               do jj = 1, na
-                  do ii = max(1, jj - kw), min(na, jj + kw)
-                     wd_(ii, jj) = wb(kw + 1 + ii - jj, jj)
-                  end do
-               end do
-            end if
-         else
-            ! W = B Ŵ⁻¹ Bᵀ from the columns Ŵ⁻¹ B_jᵀ (one multi-right-hand-side solve)
-            if (allocated(zcol)) then
-               if (size(zcol, 2) < na) deallocate (zcol)
-            end if
-            if (.not. allocated(zcol)) allocate (zcol(n, max(na, 1)))
-            zcol(:, 1:na) = 0.0_dp
-            do jj = 1, na
-               k = act(jj)
-               if (sa(k) > 0) zcol(sa(k), jj) = -1.0_dp
-               if (sb(k) > 0) zcol(sb(k), jj) = 1.0_dp
-            end do
-            if (thomas) then
-               do jj = 1, na
-                  call solve_what(zcol(:, jj))
-               end do
-            else
-               call dgbtrs('N', n, kd, kd, na, what%ab, size(what%ab, 1), ipiv, zcol, n, inf)
-            end if
-            call ensure_dense()
-            do jj = 1, na
+            if (kd == 0) then
+               ! Ŵ diagonal: W_ij = Σ over the nodes the two contacts share of s_i s_j / Ŵ_nn.
+               ! Its bandwidth in the active ordering is kw (1 for a chain).
+               kw = 0
                do ii = 1, na
                   k = act(ii)
-                  wd_(ii, jj) = 0.0_dp
-                  if (sb(k) > 0) wd_(ii, jj) = wd_(ii, jj) + zcol(sb(k), jj)
-                  if (sa(k) > 0) wd_(ii, jj) = wd_(ii, jj) - zcol(sa(k), jj)
-               end do
-            end do
-            if (na > LEMKE_MAX) then
-               kw = na - 1
-               call ensure_band(kw)
-               do jj = 1, na
-                  do ii = 1, na
-                     wb(kw + 1 + ii - jj, jj) = wd_(ii, jj)
+                  do side = 1, 2
+                     node = merge(sa(k), sb(k), side == 1)
+                     if (node == 0) cycle
+                     do jj = node_ptr(node), node_ptr(node + 1) - 1
+                        cj = node_con(jj)
+                        if (pos(cj) > 0) kw = max(kw, abs(pos(cj) - ii))
+                     end do
                   end do
                end do
+               call ensure_band(kw)
+               self%wb(:, 1:na) = 0.0_dp
+               do ii = 1, na
+                  k = act(ii)
+                  do side = 1, 2
+                     node = merge(sa(k), sb(k), side == 1)
+                     if (node == 0) cycle
+                     si = merge(-1.0_dp, 1.0_dp, side == 1)
+                     do jj = node_ptr(node), node_ptr(node + 1) - 1
+                        cj = node_con(jj)
+                        if (pos(cj) == 0) cycle
+                        ! s_j at this node: −1 if it is cj's a side, +1 if its b side
+                        self%wb(kw + 1 + ii - pos(cj), pos(cj)) = self%wb(kw + 1 + ii - pos(cj), pos(cj)) + &
+                           si*merge(-1.0_dp, 1.0_dp, sa(cj) == node)/what%ab(1, node)
+                     end do
+                  end do
+               end do
+               if (na <= LEMKE_MAX) then
+                  call ensure_dense()
+                  self%wd_(1:na, 1:na) = 0.0_dp
+                  do jj = 1, na
+                     do ii = max(1, jj - kw), min(na, jj + kw)
+                        self%wd_(ii, jj) = self%wb(kw + 1 + ii - jj, jj)
+                     end do
+                  end do
+               end if
+            else
+               ! W = B Ŵ⁻¹ Bᵀ from the columns Ŵ⁻¹ B_jᵀ (one multi-right-hand-side solve)
+               if (allocated(self%zcol)) then
+                  if (size(self%zcol, 2) < na) deallocate (self%zcol)
+               end if
+               if (.not. allocated(self%zcol)) allocate (self%zcol(n, max(na, 1)))
+               self%zcol(:, 1:na) = 0.0_dp
+               do jj = 1, na
+                  k = act(jj)
+                  if (sa(k) > 0) self%zcol(sa(k), jj) = -1.0_dp
+                  if (sb(k) > 0) self%zcol(sb(k), jj) = 1.0_dp
+               end do
+               if (self%thomas) then
+                  do jj = 1, na
+                     call solve_what(self%zcol(:, jj))
+                  end do
+               else
+                  call dgbtrs('N', n, kd, kd, na, what%ab, size(what%ab, 1), self%ipiv, self%zcol, n, inf)
+               end if
+               call ensure_dense()
+               do jj = 1, na
+                  do ii = 1, na
+                     k = act(ii)
+                     self%wd_(ii, jj) = 0.0_dp
+                     if (sb(k) > 0) self%wd_(ii, jj) = self%wd_(ii, jj) + self%zcol(sb(k), jj)
+                     if (sa(k) > 0) self%wd_(ii, jj) = self%wd_(ii, jj) - self%zcol(sa(k), jj)
+                  end do
+               end do
+               if (na > LEMKE_MAX) then
+                  kw = na - 1
+                  call ensure_band(kw)
+                  do jj = 1, na
+                     do ii = 1, na
+                        self%wb(kw + 1 + ii - jj, jj) = self%wd_(ii, jj)
+                     end do
+                  end do
+               end if
             end if
-         end if
-         if (na <= LEMKE_MAX) then
-            call lcp_lemke(wd_(1:na, 1:na), qlcp(1:na), zlcp(1:na), iters, inf)
-         else
+            if (na <= LEMKE_MAX) then
+               call lcp_lemke(self%wd_(1:na, 1:na), self%qlcp(1:na), self%zlcp(1:na), iters, inf)
+            else
+               do ii = 1, na
+                  self%zlcp(ii) = p_prev(act(ii))          ! warm start from the last step
+               end do
+               call lcp_pgs(self%wb(:, 1:na), kw, self%qlcp(1:na), self%zlcp(1:na), PGS_TOL, &
+                            PGS_MAX_SWEEPS, iters, inf)
+            end if
+            o%counters(C_NEWTON) = o%counters(C_NEWTON) + int(iters, i8)
+            if (inf /= LCP_OK) then
+               write (msg, '(a,i0,a,es12.5,a,i0,a)') 'Moreau-Jean: the impulse LCP on ', na, &
+                  ' active contacts failed at t = ', t, ' s (', iters, &
+                  ' iterations; redundant constraints or a contact between immobile sides?)'
+               call observer_fail(o, MARTELLO_ERR_NOT_CONVERGED, t_prev, msg, stat)
+               return
+            end if
             do ii = 1, na
-               zlcp(ii) = p_prev(act(ii))          ! warm start from the last step
+               p(act(ii)) = self%zlcp(ii)
             end do
-            call lcp_pgs(wb(:, 1:na), kw, qlcp(1:na), zlcp(1:na), PGS_TOL, PGS_MAX_SWEEPS, iters, inf)
-         end if
-         r%counters(C_NEWTON) = r%counters(C_NEWTON) + int(iters, i8)
-         if (inf /= LCP_OK) then
-            write (r%message, '(a,i0,a,es12.5,a,i0,a)') 'Moreau-Jean: the impulse LCP on ', na, &
-               ' active contacts failed at t = ', t, ' s (', iters, &
-               ' iterations; redundant constraints or a contact between immobile sides?)'
-            stat = MARTELLO_ERR_NOT_CONVERGED; r%t_end_reached = t_prev
-            return
-         end if
-         do ii = 1, na
-            p(act(ii)) = zlcp(ii)
-         end do
+         end associate
       end subroutine impulses
 
       subroutine ensure_band(k)
          integer, intent(in) :: k
-         if (allocated(wb)) then
-            if (size(wb, 1) < 2*k + 1 .or. size(wb, 2) < na) deallocate (wb)
+         if (allocated(self%wb)) then
+            if (size(self%wb, 1) < 2*k + 1 .or. size(self%wb, 2) < self%na) deallocate (self%wb)
          end if
-         if (.not. allocated(wb)) allocate (wb(2*k + 1, max(na, nc)))
+         if (.not. allocated(self%wb)) allocate (self%wb(2*k + 1, max(self%na, nc)))
       end subroutine ensure_band
 
       subroutine ensure_dense()
-         if (allocated(wd_)) then
-            if (size(wd_, 1) < na) deallocate (wd_)
+         if (allocated(self%wd_)) then
+            if (size(self%wd_, 1) < self%na) deallocate (self%wd_)
          end if
-         if (.not. allocated(wd_)) allocate (wd_(na, na))
+         if (.not. allocated(self%wd_)) allocate (self%wd_(self%na, self%na))
       end subroutine ensure_dense
 
-      !> Penetration and force of every contact at the current state: penalty contacts from
-      !> the committed law, rigid ones δ = u_a − u_b − gap and the mean force p/h.
-      subroutine contact_state()
-         integer :: k
-         do k = 1, nc
-            if (rigid(k)) then
-               pen(k) = u(m%con_a(k)) - u(m%con_b(k)) - m%con_gap(k)
-               force(k) = p(k)/h
-            else
-               pen(k) = ms%con_pen(k); force(k) = ms%con_f(k)
-            end if
-         end do
-      end subroutine contact_state
-
-      !> Contact phases. Rigid contacts: a phase is a run of steps with p > 0; it starts at
-      !> the instant t_k + (1−θ)h where the scheme's piecewise-linear path switches from v_k
-      !> to v_{k+1} (q_{k+1} = q_k + (1−θ)h v_k + θh v_{k+1}), v_in is δ̇_k before the first
-      !> impulse, v_out δ̇ after the last one, t_off the switching instant of the last
-      !> impulse step (a single-step impact has t_off = t_on: it is instantaneous).
-      !> Penalty contacts: δ > 0, onset and separation by linear interpolation of δ.
-      subroutine track_events()
+      !> Contact phases of the rigid contacts (the penalty ones are the strategy's): a phase
+      !> is a run of steps with p > 0; it starts at the instant t_k + (1−θ)h where the
+      !> scheme's piecewise-linear path switches from v_k to v_{k+1} (q_{k+1} = q_k +
+      !> (1−θ)h v_k + θh v_{k+1}), v_in is δ̇_k before the first impulse, v_out δ̇ after the
+      !> last one, t_off the switching instant of the last impulse step (a single-step impact
+      !> has t_off = t_on: it is instantaneous).
+      subroutine rigid_phases()
          integer :: k, ia, ib
-         real(dp) :: d0, d1, tau
+         real(dp) :: t_imp
+         t_imp = t_prev + (1.0_dp - theta)*(t - t_prev)
          do k = 1, nc
+            if (.not. self%rigid(k)) cycle
             ia = m%con_a(k); ib = m%con_b(k)
-            if (rigid(k)) then
-               t_imp = t_prev + (1.0_dp - theta)*(t - t_prev)
-               if (p(k) > 0.0_dp) then
-                  if (.not. ph_open(k)) then
-                     ph_open(k) = .true.
-                     ph_t(k) = t_imp; ph_v(k) = vn(ia) - vn(ib)
-                     ph_pen(k) = -huge(1.0_dp); ph_f(k) = 0.0_dp
-                     r%impacts(k) = r%impacts(k) + 1
-                     r%counters(C_EVENTS) = r%counters(C_EVENTS) + 1_i8
-                  end if
-                  ph_last(k) = t_imp
-                  ph_pen(k) = max(ph_pen(k), pen(k)); ph_f(k) = max(ph_f(k), force(k))
-               else if (ph_open(k)) then
-                  call results_add_event(r, k, [ph_t(k), ph_last(k), ph_v(k), vn(ia) - vn(ib), &
-                                                max(ph_pen(k), 0.0_dp), ph_f(k)])
-                  ph_open(k) = .false.
+            if (self%p(k) > 0.0_dp) then
+               if (.not. o%ph_open(k)) then
+                  call observer_open_phase(o, k, t_imp, self%vn(ia) - self%vn(ib))
+                  o%counters(C_EVENTS) = o%counters(C_EVENTS) + 1_i8
                end if
-            else
-               d0 = un(ia) - un(ib) - m%con_gap(k)
-               d1 = pen(k)
-               if (.not. ph_open(k) .and. ms%con_on(k)) then
-                  tau = 0.0_dp
-                  if (d1 > d0) tau = min(max(-d0/(d1 - d0), 0.0_dp), 1.0_dp)
-                  ph_open(k) = .true.
-                  ph_t(k) = t_prev + tau*(t - t_prev)
-                  ph_v(k) = vn(ia) - vn(ib) + tau*((v(ia) - v(ib)) - (vn(ia) - vn(ib)))
-                  ph_pen(k) = 0.0_dp; ph_f(k) = 0.0_dp
-                  r%impacts(k) = r%impacts(k) + 1
-                  r%counters(C_EVENTS) = r%counters(C_EVENTS) + 1_i8
-               end if
-               if (ph_open(k)) then
-                  ph_pen(k) = max(ph_pen(k), pen(k)); ph_f(k) = max(ph_f(k), force(k))
-                  if (.not. ms%con_on(k)) then
-                     tau = 1.0_dp
-                     if (d0 > d1) tau = min(max(d0/(d0 - d1), 0.0_dp), 1.0_dp)
-                     call results_add_event(r, k, [ph_t(k), t_prev + tau*(t - t_prev), ph_v(k), &
-                                                   vn(ia) - vn(ib) + tau*((v(ia) - v(ib)) - (vn(ia) - vn(ib))), &
-                                                   ph_pen(k), ph_f(k)])
-                     ph_open(k) = .false.
-                  end if
-               end if
+               self%ph_last(k) = t_imp
+            else if (o%ph_open(k)) then
+               call observer_close_phase(o, k, self%ph_last(k), self%vn(ia) - self%vn(ib))
             end if
          end do
-      end subroutine track_events
-
-      subroutine close_open_phases()
-         integer :: k
-         do k = 1, nc
-            if (ph_open(k)) call results_add_event(r, k, [ph_t(k), -1.0_dp, ph_v(k), 0.0_dp, &
-                                                          max(ph_pen(k), 0.0_dp), ph_f(k)])
-         end do
-      end subroutine close_open_phases
-
-      !> Energy terms as in the structural integrators, plus E_IMPACT = −Σ ġ_θ p (the energy
-      !> the impulses took out); E_BALANCE then holds the θ-dissipation and the error of the
-      !> linearised nonlinear forces.
-      subroutine record()
-         real(dp) :: e(NENERGY)
-         e = energy_terms(e0, w_ext, e_kin, e_links, e_cont, e_links0, e_cont0, d_damp, d_links, &
-                          d_contact, d_impact, 0.0_dp, 0.0_dp)
-         r%energy = e
-         r%energy_balance_max = max(r%energy_balance_max, abs(e(E_BALANCE)))
-         call results_record(r, t, u(1:n), v(1:n), a(1:n), pen, force, e, ms%link_f, ms%link_u)
-      end subroutine record
-   end subroutine run_moreau_jean
+      end subroutine rigid_phases
+   end subroutine step
 end module martello_moreau_jean

@@ -7,12 +7,15 @@ module martello_run
    use martello_status
    use martello_model, only: model_t
    use martello_integrator_settings
-   use martello_structural_integrators, only: run_structural
-   use martello_moreau_jean, only: run_moreau_jean
-   use martello_newmark_lagrange, only: run_newmark_lagrange
    use martello_stability, only: mass_positive_definite
    use martello_run_checks, only: check_schemes
-   use martello_results
+   use martello_observer, only: observer_t, observer_init
+   use martello_fixed_step, only: run_fixed_step
+   use martello_stepper, only: stepper_t
+   use martello_generalized_alpha, only: generalized_alpha_t
+   use martello_central_difference, only: central_difference_t
+   use martello_moreau_jean, only: moreau_jean_t
+   use martello_newmark_lagrange, only: newmark_lagrange_t
    implicit none
    private
    public :: run_t, run_dynamic
@@ -31,7 +34,7 @@ module martello_run
 
    type :: run_t
       type(integrator_settings_t) :: settings
-      type(results_t) :: results
+      type(observer_t) :: results     !< what the run measured (martello_observer)
       integer, allocatable :: out_nodes(:), out_contacts(:), out_links(:)
       logical :: configured = .false., done = .false.
    end type run_t
@@ -39,12 +42,14 @@ module martello_run
 contains
 
    !> Validate the run against the model (outputs in range, schemes runnable by the
-   !> integrator, a positive definite mass matrix), size the results and run the integrator.
+   !> integrator, a positive definite mass matrix), size the results and run the integrator:
+   !> a one-step method on the fixed-step strategy, or a C integrator (docs/run-layer.md).
    subroutine run_dynamic(mp, rp, stat)
       type(model_t), pointer, intent(in) :: mp
       type(run_t), pointer, intent(in) :: rp
       integer, intent(out) :: stat
       integer :: cap
+      class(stepper_t), allocatable :: stepper
       stat = MARTELLO_ERR_ARGUMENT
       if (.not. rp%configured) then
          rp%results%message = 'dynamic_run: call martello_run_set_integrator first'
@@ -58,8 +63,8 @@ contains
          rp%results%message = 'dynamic_run: an output link is out of range'; return
       end if
       cap = int(min(rp%settings%t_end/rp%settings%dt/rp%settings%every + 3.0_dp, 1.0e7_dp))
-      call results_init(rp%results, mp%n, mp%ncontact, rp%out_nodes, rp%out_contacts, cap, &
-                        mp%nlink, rp%out_links)
+      call observer_init(rp%results, rp%settings, mp%n, mp%ncontact, rp%out_nodes, &
+                         rp%out_contacts, cap, mp%nlink, rp%out_links)
       call check_schemes(mp, rp%settings%kind, rp%results%message, stat)
       if (stat == MARTELLO_OK .and. mp%ncoupling > 0) then
          if (.not. mass_positive_definite(mp)) then
@@ -70,17 +75,20 @@ contains
       end if
       if (stat == MARTELLO_OK) then
          select case (rp%settings%kind)
-         case (INT_NEWMARK, INT_HHT, INT_GENERALIZED_ALPHA, INT_CENTRAL_DIFFERENCE)
-            call run_structural(mp, rp%settings, rp%results, stat)
+         case (INT_NEWMARK, INT_HHT, INT_GENERALIZED_ALPHA)
+            allocate (generalized_alpha_t :: stepper)
+         case (INT_CENTRAL_DIFFERENCE)
+            allocate (central_difference_t :: stepper)
          case (INT_MOREAU_JEAN)
-            call run_moreau_jean(mp, rp%settings, rp%results, stat)
+            allocate (moreau_jean_t :: stepper)
          case (INT_NEWMARK_LAGRANGE)
-            call run_newmark_lagrange(mp, rp%settings, rp%results, stat)
+            allocate (newmark_lagrange_t :: stepper)
          case (INT_RKF45, INT_RK8PD, INT_MSBDF)
             stat = c_event_driven_run(c_loc(mp), c_loc(rp))
          case (INT_IDA)
             stat = c_ida_run(c_loc(mp), c_loc(rp))
          end select
+         if (allocated(stepper)) call run_fixed_step(mp, rp%settings, rp%results, stepper, stat)
       end if
       rp%done = .true.
    end subroutine run_dynamic

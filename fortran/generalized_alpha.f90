@@ -1,0 +1,324 @@
+!> The generalized-α family as a stepper of the fixed-step strategy (docs/integrators.md):
+!> one Newton kernel for Newmark (any β, γ; α_m = α_f = 0), HHT-α (α_m = 0, α_f = −α) and
+!> Chung–Hulbert generalized-α (ρ∞). Residual with the forces interpolated between the old
+!> and new states (Hilber et al. 1977; Chung & Hulbert 1993, eqs 3–5), consistent tangent,
+!> and a residual-plus-increment convergence test. Every step is O(n·kd²): band assembly and
+!> solve, workspaces allocated once per run.
+module martello_generalized_alpha
+   use martello_kinds, only: dp, i8
+   use martello_status
+   use martello_model, only: model_t, model_bandwidth
+   use martello_band_matrix
+   use martello_assembly
+   use martello_observer, only: observer_t, observer_work, observer_fail, C_NEWTON, C_RESIDUALS, &
+      C_FACTORIZATIONS, C_JACOBIANS, C_CHATTER
+   use martello_integrator_settings
+   use martello_stepper, only: stepper_t, stepper_rest_start, stepper_fail
+   implicit none
+   private
+   public :: generalized_alpha_t, generalized_alpha_coefficients
+
+   type, extends(stepper_t) :: generalized_alpha_t
+      integer :: kd = 0, max_newton = 30
+      real(dp) :: am = 0.0_dp, af = 0.0_dp, beta = 0.25_dp, gamma = 0.5_dp, cm = 0.0_dp, &
+                  cv = 0.0_dp, mmax = 0.0_dp, tol_residual = 0.0_dp, tol_increment = 0.0_dp
+      real(dp), allocatable :: fint(:), fint_n(:), fext(:), fext_n(:), res(:), du(:), work(:), &
+                               ma(:), man(:)
+      type(band_t) :: jac, mband, cjac
+      !> J of the last converged iterate is intact (kd ≤ 1): the next step starts from it
+      logical :: tangent_valid = .false.
+   contains
+      procedure :: init
+      procedure :: step
+   end type generalized_alpha_t
+
+contains
+
+   !> (α_m, α_f, β, γ) of the family member; α's weigh the old state.
+   pure subroutine generalized_alpha_coefficients(s, am, af, beta, gamma)
+      type(integrator_settings_t), intent(in) :: s
+      real(dp), intent(out) :: am, af, beta, gamma
+      select case (s%kind)
+      case (INT_HHT)                 ! Hilber–Hughes–Taylor (1977)
+         am = 0.0_dp; af = -s%alpha
+         gamma = 0.5_dp - s%alpha; beta = 0.25_dp*(1.0_dp - s%alpha)**2
+      case (INT_GENERALIZED_ALPHA)   ! Chung & Hulbert (1993), eq. 25
+         am = (2.0_dp*s%rho_inf - 1.0_dp)/(s%rho_inf + 1.0_dp)
+         af = s%rho_inf/(s%rho_inf + 1.0_dp)
+         gamma = 0.5_dp - am + af; beta = 0.25_dp*(1.0_dp - am + af)**2
+      case default                   ! Newmark (1959)
+         am = 0.0_dp; af = 0.0_dp; beta = s%beta; gamma = s%gamma
+      end select
+   end subroutine generalized_alpha_coefficients
+
+   !> The state at t = 0 with a = M⁻¹(f_ext − f_int) (M·1 carries gravity and ground motion).
+   subroutine init(self, m, s, o, stat)
+      class(generalized_alpha_t), intent(inout) :: self
+      type(model_t), intent(in) :: m
+      type(integrator_settings_t), intent(in) :: s
+      type(observer_t), intent(inout) :: o
+      integer, intent(out) :: stat
+      integer :: n
+      n = m%n
+      self%kd = model_bandwidth(m)
+      allocate (self%fint(0:n), self%fint_n(0:n), self%fext(0:n), self%fext_n(0:n), &
+                self%res(0:n), self%du(n), self%work(0:n), self%ma(0:n), self%man(0:n))
+      call band_init(self%jac, n, self%kd)
+      call band_init(self%mband, n, self%kd)
+      call band_init(self%cjac, n, self%kd)
+      call stepper_rest_start(self, m, s, self%mband, self%fint, self%fext, o, stat)
+      if (stat /= MARTELLO_OK) return
+      self%advice = 'the step is past the stability limit'
+      self%max_newton = s%max_newton
+      self%tol_residual = s%tol_residual; self%tol_increment = s%tol_increment
+      call generalized_alpha_coefficients(s, self%am, self%af, self%beta, self%gamma)
+      self%cm = (1.0_dp - self%am)/(self%beta*self%h*self%h)
+      self%mmax = max(maxval(m%mass), tiny(1.0_dp))
+      self%cv = self%gamma/(self%beta*self%h)
+   end subroutine init
+
+   !> One Newton-solved step, its trapezoidal works handed to the observer.
+   subroutine step(self, m, t, o, stat)
+      class(generalized_alpha_t), intent(inout) :: self
+      type(model_t), intent(in) :: m
+      real(dp), intent(in) :: t
+      type(observer_t), intent(inout) :: o
+      integer, intent(out) :: stat
+      real(dp) :: rnorm, incr, fscale, uscale, fmag, fext_mag, wd, wl, wc, h
+      integer :: n
+      logical :: ok, converged
+      character(len=256) :: msg
+
+      stat = MARTELLO_OK
+      n = self%n; h = self%h
+      self%fint_n = self%fint; self%fext_n = self%fext
+      call mass_times(m, self%an, self%man)
+      call external_forces(m, self%mrow, t, self%fext)
+      fext_mag = maxval(abs(self%fext))
+      call newton_step(converged)
+      if (.not. converged) return
+      ! energy balance: trapezoidal work of every force over the step (elements in commit)
+      call mech_commit(m, self%ms, self%u, wd, wl, wc)
+      call observer_work(o, damping=wd, links=wl, contact=wc)
+      call observer_work(o, external=external_work(m, self%fext_n, self%fext, self%un, self%u))
+      self%pen = self%ms%con_pen; self%force = self%ms%con_f
+
+   contains
+
+      subroutine fail(code, what)
+         integer, intent(in) :: code
+         character(len=*), intent(in) :: what
+         call stepper_fail(o, code, t, what, stat)
+      end subroutine fail
+
+      !> Newmark relations for a trial u: a(u), v(u).
+      subroutine kinematics()
+         integer :: i, k
+         associate (u => self%u, v => self%v, a => self%a, un => self%un, vn => self%vn, &
+                    an => self%an, beta => self%beta, gamma => self%gamma)
+            a(1:n) = (u(1:n) - un(1:n) - h*vn(1:n))/(beta*h*h) - (0.5_dp - beta)/beta*an(1:n)
+            v(1:n) = vn(1:n) + h*((1.0_dp - gamma)*an(1:n) + gamma*a(1:n))
+            do k = 1, size(self%fixed_nodes)
+               i = self%fixed_nodes(k)
+               u(i) = un(i); v(i) = 0.0_dp; a(i) = 0.0_dp
+            end do
+         end associate
+      end subroutine kinematics
+
+      !> Newton on the step. A law whose force jumps at δ = 0 (Kelvin: cδ̇ at first touch and
+      !> at separation) can leave the step without any root: the iterates then flip the
+      !> contact on and off. Chatter rule: a contact that flips in three iterations of one
+      !> step is held open (F = 0) for this step and Newton restarts; the onset is thus
+      !> delayed, or the separation advanced, by at most one step (O(h), counted in the
+      !> contact_chatter_resolutions counter).
+      subroutine newton_step(converged)
+         logical, intent(out) :: converged
+         integer :: restart
+         integer :: flips(m%ncontact)
+         logical :: was_on(m%ncontact)
+         converged = .false.
+         do restart = 0, 1
+            flips = 0; was_on = self%ms%con_on
+            if (restart == 0 .and. self%tangent_valid) then
+               ! First iterate from the committed state with the tangent assembled there at
+               ! the end of the last step: no element loop is needed for it, so a step whose
+               ! laws stay on one branch costs a single evaluation.
+               call linearised_first_iterate(ok)
+               if (.not. ok) then
+                  call fail(MARTELLO_ERR_SINGULAR, 'singular effective stiffness in the Newton step')
+                  return
+               end if
+               call newton_iterations(converged, flips, was_on, 1)
+            else
+               ! predictor: constant acceleration
+               self%u(1:n) = self%un(1:n) + h*self%vn(1:n) + 0.5_dp*h*h*self%an(1:n)
+               call newton_iterations(converged, flips, was_on, 0)
+            end if
+            self%tangent_valid = converged .and. self%kd <= 1
+            if (converged .or. stat /= MARTELLO_OK) return
+            if (.not. any(flips >= 3)) exit
+            self%ms%forced_off = self%ms%forced_off .or. flips >= 3
+            o%counters(C_CHATTER) = o%counters(C_CHATTER) + 1_i8
+         end do
+         if (.not. converged) then
+            write (msg, '(a,es12.5,a,i0,a,es9.2,a,es9.2,a)') 'Newton did not converge at t = ', t, &
+               ' s after ', self%max_newton, ' iterations (residual ', rnorm/fscale, &
+               ' of the force scale, tolerance ', self%tol_residual, '); reduce dt'
+            call observer_fail(o, MARTELLO_ERR_NOT_CONVERGED, t, msg, stat)
+         end if
+      end subroutine newton_step
+
+      !> u = u_n + Δu with J Δu = −r(u_n), where r(u_n) uses the committed internal force and
+      !> the damping tangent C of the last evaluation for the velocity change (exact for
+      !> linear dampers). J is intact: the kd ≤ 1 solve works on copies.
+      subroutine linearised_first_iterate(ok)
+         logical, intent(out) :: ok
+         associate (u => self%u, v => self%v, a => self%a, un => self%un, vn => self%vn, &
+                    fint_n => self%fint_n, fext => self%fext, fext_n => self%fext_n, &
+                    res => self%res, du => self%du, work => self%work, ma => self%ma, &
+                    man => self%man, am => self%am, af => self%af)
+            u = un
+            call kinematics()
+            work(1:n) = v(1:n) - vn(1:n)
+            call band_matvec(self%cjac, work(1:n), res(1:n))   ! C_t Δv
+            res(0) = 0.0_dp
+            call mass_times(m, a, ma)
+            res = (1.0_dp - am)*ma + am*man + (1.0_dp - af)*(fint_n + res) + af*fint_n &
+                  - (1.0_dp - af)*fext - af*fext_n
+            res(self%fixed_nodes) = 0.0_dp
+            du = -res(1:n)
+            call band_solve(self%jac, du, ok)
+            o%counters(C_FACTORIZATIONS) = o%counters(C_FACTORIZATIONS) + 1_i8
+            o%counters(C_NEWTON) = o%counters(C_NEWTON) + 1_i8
+            u(1:n) = un(1:n) + du
+         end associate
+      end subroutine linearised_first_iterate
+
+      !> Residual of the step at the current u, the effective stiffness
+      !> J = c_m M + (1−α_f)(K_t + c_v C_t) with fixed rows pinned, min_i J_ii, and the
+      !> damping tangent C_t (kept for the next step's first iterate).
+      subroutine evaluate(want_jac)
+         logical, intent(in) :: want_jac
+         integer :: i
+         associate (u => self%u, v => self%v, a => self%a, fint => self%fint, &
+                    fint_n => self%fint_n, fext => self%fext, fext_n => self%fext_n, &
+                    res => self%res, ma => self%ma, man => self%man, jac => self%jac, &
+                    cjac => self%cjac, am => self%am, af => self%af, kd => self%kd)
+            call kinematics()
+            if (want_jac) then
+               jac%ab = 0.0_dp; cjac%ab = 0.0_dp
+               call internal_forces(m, self%ms, u, v, fint, jac%ab, 1.0_dp - af, (1.0_dp - af)*self%cv, &
+                                    cjac%ab)
+               call assemble_mass(m, self%cm, jac)
+               o%counters(C_JACOBIANS) = o%counters(C_JACOBIANS) + 1_i8
+               do i = 1, size(self%fixed_nodes)
+                  call band_pin(jac, self%fixed_nodes(i))
+               end do
+            else
+               call internal_forces(m, self%ms, u, v, fint)
+            end if
+            o%counters(C_RESIDUALS) = o%counters(C_RESIDUALS) + 1_i8
+            call mass_times(m, a, ma)
+            ! residual and the magnitudes for the convergence test, in one pass
+            rnorm = 0.0_dp; fmag = fext_mag
+            do i = 1, n
+               res(i) = (1.0_dp - am)*ma(i) + am*man(i) + (1.0_dp - af)*fint(i) + af*fint_n(i) &
+                        - (1.0_dp - af)*fext(i) - af*fext_n(i)
+               fmag = max(fmag, abs(fint(i)), abs(ma(i)))
+            end do
+            res(0) = 0.0_dp
+            res(self%fixed_nodes) = 0.0_dp
+            rnorm = maxval(abs(res(1:n)))
+            ! the next Newton increment, estimated node by node as |r_i|/J_ii (exact for a
+            ! diagonal J, within a factor 2 for the diagonally dominant J of a chain): a light
+            ! node next to a heavy one is judged by its own stiffness, not the global minimum
+            incr = 0.0_dp
+            if (want_jac) then
+               do i = 1, n
+                  if (res(i) /= 0.0_dp) incr = max(incr, abs(res(i))/abs(jac%ab(2*kd + 1, i)))
+               end do
+            end if
+         end associate
+      end subroutine evaluate
+
+      subroutine newton_iterations(converged, flips, was_on, first)
+         logical, intent(out) :: converged
+         integer, intent(inout) :: flips(:)
+         logical, intent(inout) :: was_on(:)
+         integer, intent(in) :: first
+         integer :: i, it
+         logical :: on
+         converged = .false.
+         associate (u => self%u, un => self%un, vn => self%vn, an => self%an, du => self%du, &
+                    res => self%res)
+            uscale = tiny(1.0_dp)
+            do i = 1, n
+               uscale = max(uscale, abs(un(i)), h*abs(vn(i)), h*h*abs(an(i)))
+            end do
+            do it = first, self%max_newton
+               ! J is assembled at every iterate: the converged one serves the next step
+               call evaluate(.true.)
+               do i = 1, m%ncontact
+                  on = self%ms%con_pen_trial(i) > 0.0_dp .and. .not. self%ms%forced_off(i)
+                  if (on .neqv. was_on(i)) flips(i) = flips(i) + 1
+                  was_on(i) = on
+               end do
+               ! The inertia term cm·M·u is evaluated with rounding error ~ε·cm·m·|u|, which can
+               ! exceed the physical forces by far (small h, free flight): it floors the scale.
+               fscale = max(fmag, 64.0_dp*epsilon(1.0_dp)/self%tol_residual*self%cm*self%mmax*uscale, &
+                            tiny(1.0_dp))
+               ! residual test, and the increment the next iteration would make, both small
+               if (it == 1) uscale = max(uscale, maxval(abs(u)))
+               if (it > 0 .and. rnorm <= self%tol_residual*fscale .and. &
+                   incr <= self%tol_increment*uscale) then
+                  converged = .true.
+                  exit
+               end if
+               if (it == self%max_newton) exit
+               du = -res(1:n)
+               call band_solve(self%jac, du, ok)
+               o%counters(C_FACTORIZATIONS) = o%counters(C_FACTORIZATIONS) + 1_i8
+               o%counters(C_NEWTON) = o%counters(C_NEWTON) + 1_i8
+               if (.not. ok) then
+                  call fail(MARTELLO_ERR_SINGULAR, 'singular effective stiffness in the Newton step')
+                  return
+               end if
+               if (it >= 2) then
+                  call line_search(rnorm)
+               else
+                  u(1:n) = u(1:n) + du
+               end if
+            end do
+         end associate
+      end subroutine newton_iterations
+
+      !> Backtracking on ‖r‖∞ once plain Newton has taken two steps without converging: laws
+      !> whose tangent is unbounded at first touch (Jankowski: ∂F/∂δ ~ δ^{−3/4}) or that switch
+      !> branch inside a step make full steps overshoot; halving restores a decrease.
+      subroutine line_search(r0)
+         real(dp), intent(in) :: r0
+         real(dp) :: lam, rtrial
+         integer :: k
+         associate (u => self%u, v => self%v, a => self%a, fint => self%fint, &
+                    fint_n => self%fint_n, fext => self%fext, fext_n => self%fext_n, &
+                    res => self%res, du => self%du, work => self%work, ma => self%ma, &
+                    man => self%man, am => self%am, af => self%af)
+            work(1:n) = u(1:n)
+            lam = 1.0_dp
+            do k = 1, 12
+               u(1:n) = work(1:n) + lam*du
+               call kinematics()
+               call internal_forces(m, self%ms, u, v, fint)
+               call mass_times(m, a, ma)
+               res = (1.0_dp - am)*ma + am*man + (1.0_dp - af)*fint + af*fint_n &
+                     - (1.0_dp - af)*fext - af*fext_n
+               res(self%fixed_nodes) = 0.0_dp
+               o%counters(C_RESIDUALS) = o%counters(C_RESIDUALS) + 1_i8
+               rtrial = maxval(abs(res(1:n)))
+               if (rtrial < r0) return
+               lam = 0.5_dp*lam
+            end do
+         end associate
+      end subroutine line_search
+   end subroutine step
+end module martello_generalized_alpha

@@ -1,0 +1,546 @@
+!> The observer of a dynamic run (docs/run-layer.md): everything measured along a run,
+!> whatever integrator makes it — the decimated history and its recording cadence, contact
+!> phases and their events, peaks over every accepted state, the energy balance, divergence
+!> detection, the cost counters and the final message. The fixed-step strategy
+!> (martello_fixed_step) and the C integrators (through c/martello_internal.h) hand it what
+!> their method knows — accepted states, work increments, phase changes located exactly —
+!> and it measures every method the same way.
+!>
+!> results_t is what a finished run exposes (read by martello_api_results); observer_t adds
+!> the working state of the measurement (open phases, work accumulators, initial energies).
+module martello_observer
+   use martello_kinds, only: dp, i8
+   use martello_status
+   use martello_model, only: model_t
+   use martello_assembly, only: mech_state_t, kinetic_energy, recoverable_energy, mass_times
+   use martello_integrator_settings, only: integrator_settings_t, integrator_name
+   use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan, ieee_is_finite
+   implicit none
+   private
+   public :: results_t, observer_t, observer_init, observer_begin, observer_energy_due, &
+      observer_sample, observer_work, observer_open_phase, observer_close_phase, &
+      observer_add_impact, observer_penalty_phases, observer_fail, observer_fail_nonfinite, &
+      observer_finish, output_points, free_side_crossing, &
+      NCOUNTERS, C_STEPS, C_REJECTED, C_NEWTON, C_RESIDUALS, C_FACTORIZATIONS, C_EVENTS, &
+      C_JACOBIANS, C_ROOT_EVALS, C_CHATTER, NENERGY, E_KINETIC, E_RECOVERABLE, E_INPUT, E_DAMPING, &
+      E_PLASTIC, E_CONTACT, E_BALANCE, E_INITIAL, E_IMPACT, NEVENT, EV_T_ON, EV_T_OFF, &
+      EV_V_IN, EV_V_OUT, EV_MAX_PEN, EV_MAX_FORCE
+
+   ! cost counters
+   integer, parameter :: NCOUNTERS = 9
+   integer, parameter :: C_STEPS = 1, C_REJECTED = 2, C_NEWTON = 3, C_RESIDUALS = 4, &
+                         C_FACTORIZATIONS = 5, C_EVENTS = 6, C_JACOBIANS = 7, C_ROOT_EVALS = 8, &
+                         C_CHATTER = 9
+   ! energy terms [J]: balance = initial + input − kinetic − recoverable − dissipated (≈ 0)
+   integer, parameter :: NENERGY = 9
+   integer, parameter :: E_KINETIC = 1, E_RECOVERABLE = 2, E_INPUT = 3, E_DAMPING = 4, &
+                         E_PLASTIC = 5, E_CONTACT = 6, E_BALANCE = 7, E_INITIAL = 8, E_IMPACT = 9
+   ! one contact phase
+   integer, parameter :: NEVENT = 6
+   integer, parameter :: EV_T_ON = 1, EV_T_OFF = 2, EV_V_IN = 3, EV_V_OUT = 4, &
+                         EV_MAX_PEN = 5, EV_MAX_FORCE = 6
+
+   type :: results_t
+      ! history: hist(:, k) = [t, (u, v, a of each output node), (δ, P of each output
+      ! contact), (force, elongation of each output link), energy(1:NENERGY)]
+      integer :: ncol = 0, nrec = 0
+      real(dp), allocatable :: hist(:, :)
+      integer, allocatable :: out_nodes(:), out_contacts(:), out_links(:)
+      ! events: one per contact phase
+      integer :: nevents = 0
+      integer, allocatable :: ev_contact(:)
+      real(dp), allocatable :: ev(:, :)
+      ! peaks over every accepted step
+      real(dp), allocatable :: u_max(:), u_min(:), v_absmax(:), a_absmax(:)
+      !> the largest local maximum of u, interpolated between steps (u_peak at t_peak); the
+      !> step maxima above are O(h) in time, these are O(h²)
+      real(dp), allocatable :: u_peak(:), t_peak(:)
+      real(dp), allocatable :: pen_max(:), force_max(:)
+      !> per link: max |force| and max |elongation| (storey shear and drift of a frame)
+      real(dp), allocatable :: link_force_absmax(:), link_du_absmax(:)
+      integer, allocatable :: impacts(:)
+      real(dp) :: energy(NENERGY) = 0.0_dp
+      real(dp) :: energy_balance_max = 0.0_dp   !< max |balance| over the run
+      integer(i8) :: counters(NCOUNTERS) = 0_i8
+      real(dp) :: t_end_reached = 0.0_dp
+      real(dp) :: dt_critical = 0.0_dp          !< explicit stability limit (0: not computed)
+      real(dp) :: omega_max = 0.0_dp
+      character(len=512) :: message = ''
+   end type results_t
+
+   type, extends(results_t) :: observer_t
+      ! what the run asked for
+      integer :: kind = 0, every = 1
+      integer :: n_grid = 1                     !< output grid points t = k·dt, k = 1 … n_grid
+      real(dp) :: divergence_factor = 10.0_dp
+      ! energy: evaluated every energy_interval-th sample (and where recorded)
+      integer :: energy_interval = 1, nsamples = -1
+      character(len=:), allocatable :: advice   !< ends a divergence message: what to change
+      real(dp) :: e0 = 0.0_dp, e_links0 = 0.0_dp, e_cont0 = 0.0_dp, ke_corr0 = 0.0_dp
+      !> the method conserves ½vᵀMv − ke_aMa·aᵀMa (central difference: h²/8; else 0)
+      real(dp) :: ke_aMa = 0.0_dp
+      ! works since t = 0; w_abs = Σ|ΔW_ext| (the divergence scale); w_last the last ΔW_ext
+      real(dp) :: w_ext = 0.0_dp, w_abs = 0.0_dp, w_last = 0.0_dp, d_damp = 0.0_dp, &
+                  d_links = 0.0_dp, d_contact = 0.0_dp, d_impact = 0.0_dp
+      ! open contact phases: onset time and speed, running maxima of δ and P
+      logical, allocatable :: ph_open(:)
+      real(dp), allocatable :: ph_t(:), ph_v(:), ph_pen(:), ph_f(:)
+      ! the previous accepted state, for the interpolated peaks when the method keeps none
+      real(dp), allocatable :: prev_u(:), prev_v(:), prev_a(:)
+      real(dp) :: prev_t = -1.0_dp
+      real(dp), allocatable :: work(:)          !< scratch (0:n): M v
+      real(dp), allocatable :: acc(:)           !< (0:n): a C integrator's accelerations
+   end type observer_t
+
+contains
+
+   !> Whole output intervals dt until t_end is reached: the last grid point n·dt ≥ t_end
+   !> (reported as t_reached), never a shortened interval labelled t_end.
+   pure integer function output_points(t_end, dt) result(n)
+      real(dp), intent(in) :: t_end, dt
+      n = max(1, ceiling(t_end/dt*(1.0_dp - 1.0e-12_dp)))
+   end function output_points
+
+   !> Size the results of a run (every integrator) and take the settings the measurement
+   !> needs: the output grid, the recording cadence and the divergence rule.
+   subroutine observer_init(o, s, n_nodes, n_contacts, out_nodes, out_contacts, capacity, &
+                            n_links, out_links)
+      type(observer_t), intent(inout) :: o
+      type(integrator_settings_t), intent(in) :: s
+      integer, intent(in) :: n_nodes, n_contacts, out_nodes(:), out_contacts(:), capacity, &
+                             n_links, out_links(:)
+      o%kind = s%kind; o%every = max(s%every, 1); o%divergence_factor = s%divergence_factor
+      o%n_grid = 1
+      if (s%dt > 0.0_dp .and. s%t_end > 0.0_dp) o%n_grid = output_points(s%t_end, s%dt)
+      o%out_nodes = out_nodes; o%out_contacts = out_contacts; o%out_links = out_links
+      o%ncol = 1 + 3*size(out_nodes) + 2*size(out_contacts) + 2*size(out_links) + NENERGY
+      o%nrec = 0
+      if (allocated(o%hist)) deallocate (o%hist)
+      allocate (o%hist(o%ncol, max(capacity, 2)))
+      o%nevents = 0
+      if (allocated(o%ev)) deallocate (o%ev, o%ev_contact)
+      allocate (o%ev(NEVENT, 16), o%ev_contact(16))
+      if (allocated(o%u_max)) deallocate (o%u_max, o%u_min, o%v_absmax, o%a_absmax, o%pen_max, &
+                                          o%force_max, o%impacts, o%u_peak, o%t_peak, &
+                                          o%link_force_absmax, o%link_du_absmax, o%prev_u, &
+                                          o%prev_v, o%prev_a, o%work, o%acc, o%ph_open, o%ph_t, &
+                                          o%ph_v, o%ph_pen, o%ph_f)
+      allocate (o%u_max(n_nodes), o%u_min(n_nodes), o%v_absmax(n_nodes), o%a_absmax(n_nodes), &
+                o%pen_max(n_contacts), o%force_max(n_contacts), o%impacts(n_contacts), &
+                o%u_peak(n_nodes), o%t_peak(n_nodes), o%link_force_absmax(n_links), &
+                o%link_du_absmax(n_links), o%prev_u(n_nodes), o%prev_v(n_nodes), &
+                o%prev_a(n_nodes), o%work(0:n_nodes), o%acc(0:n_nodes), o%ph_open(n_contacts), &
+                o%ph_t(n_contacts), o%ph_v(n_contacts), o%ph_pen(n_contacts), o%ph_f(n_contacts))
+      ! NaN until a state is tracked (a run that fails before its first step)
+      o%link_force_absmax = ieee_value(1.0_dp, ieee_quiet_nan)
+      o%link_du_absmax = ieee_value(1.0_dp, ieee_quiet_nan)
+      o%u_peak = -huge(1.0_dp); o%t_peak = -1.0_dp
+      o%u_max = -huge(1.0_dp); o%u_min = huge(1.0_dp); o%v_absmax = 0.0_dp
+      o%a_absmax = 0.0_dp; o%pen_max = -huge(1.0_dp); o%force_max = 0.0_dp; o%impacts = 0
+      o%prev_t = -1.0_dp
+      o%ph_open = .false.
+      o%energy = 0.0_dp; o%energy_balance_max = 0.0_dp
+      o%counters = 0_i8
+      o%message = ''
+      o%t_end_reached = 0.0_dp
+   end subroutine observer_init
+
+   !> The state at t = 0, before its first sample: the initial energies the balance starts
+   !> from. energy_interval: samples between energy evaluations (the strategy's choice: 16
+   !> for cheap fixed steps, 1 for adaptive ones); advice ends a divergence message;
+   !> ke_aMa: the method conserves ½vᵀMv − ke_aMa·aᵀMa (Verlet; 0 for the others).
+   subroutine observer_begin(o, m, ms, u, v, a, energy_interval, advice, ke_aMa)
+      type(observer_t), intent(inout) :: o
+      type(model_t), intent(in) :: m
+      type(mech_state_t), intent(in) :: ms
+      real(dp), intent(in) :: u(0:), v(0:), a(0:)
+      integer, intent(in) :: energy_interval
+      character(len=*), intent(in) :: advice
+      real(dp), intent(in) :: ke_aMa
+      real(dp) :: e_kin
+      e_kin = kinetic_energy(m, v, o%work)
+      call recoverable_energy(m, ms, u, o%e_links0, o%e_cont0)
+      o%e0 = e_kin + o%e_links0 + o%e_cont0
+      o%ke_aMa = ke_aMa
+      ! the balance starts from the method's conserved energy e0 − ke_corr
+      o%ke_corr0 = o%e0 - (o%e0 - kinetic_correction(o, m, a))
+      o%energy_interval = max(energy_interval, 1)
+      o%advice = advice
+      o%nsamples = -1
+      o%w_ext = 0.0_dp; o%w_abs = 0.0_dp; o%w_last = 0.0_dp
+      o%d_damp = 0.0_dp; o%d_links = 0.0_dp; o%d_contact = 0.0_dp; o%d_impact = 0.0_dp
+   end subroutine observer_begin
+
+   !> Work increments of one step [J], as the method has them: external work, work of the
+   !> dampers, of the other links and of the penalty contacts (mech_commit's trapezoidal
+   !> element works), and the kinetic energy the impulses took out. A method that integrates
+   !> the total internal power more accurately than the element split (the adaptive C
+   !> integrators) hands it as internal: damping is then internal − links − contact, so the
+   !> balance keeps the method's own accuracy.
+   subroutine observer_work(o, external, damping, links, contact, impact, internal)
+      type(observer_t), intent(inout) :: o
+      real(dp), intent(in), optional :: external, damping, links, contact, impact, internal
+      if (present(external)) then
+         o%w_ext = o%w_ext + external; o%w_abs = o%w_abs + abs(external)
+         o%w_last = external
+      end if
+      if (present(internal)) then
+         o%d_damp = o%d_damp + (internal - links - contact)
+      else if (present(damping)) then
+         o%d_damp = o%d_damp + damping
+      end if
+      if (present(links)) o%d_links = o%d_links + links
+      if (present(contact)) o%d_contact = o%d_contact + contact
+      if (present(impact)) o%d_impact = o%d_impact + impact
+   end subroutine observer_work
+
+   !> Will the next sample evaluate the energies? (at recorded states, every
+   !> energy_interval-th sample, and as soon as a work is not finite). k as in
+   !> observer_sample. A method whose energy needs a correction computes it only then.
+   logical function observer_energy_due(o, k) result(due)
+      type(observer_t), intent(in) :: o
+      integer, intent(in) :: k
+      due = recorded(o, k) .or. mod(o%nsamples + 1, o%energy_interval) == 0 .or. &
+            .not. ieee_is_finite(o%w_last + o%d_damp + o%d_links + o%d_contact + o%d_impact)
+   end function observer_energy_due
+
+   !> ke_aMa·aᵀMa: velocity Verlet conserves ½vᵀMv − (h²/8)aᵀMa exactly against trapezoidal
+   !> work (the a-terms of ΔKE telescope), so its balance is an identity to round-off, like
+   !> average acceleration's (docs/integrators.md "energy balance").
+   real(dp) function kinetic_correction(o, m, a) result(kc)
+      type(observer_t), intent(inout) :: o
+      type(model_t), intent(in) :: m
+      real(dp), intent(in) :: a(0:)
+      kc = 0.0_dp
+      if (o%ke_aMa == 0.0_dp) return
+      call mass_times(m, a, o%work)
+      kc = o%ke_aMa*dot_product(a(1:m%n), o%work(1:m%n))
+   end function kinetic_correction
+
+   !> The recording cadence: t = 0, every every-th output grid point, and the last one.
+   pure logical function recorded(o, k)
+      type(observer_t), intent(in) :: o
+      integer, intent(in) :: k
+      recorded = k == 0
+      if (k > 0) recorded = mod(k, o%every) == 0 .or. k >= o%n_grid
+   end function recorded
+
+   !> An accepted state of the run at time t (every integrator, once per accepted step and
+   !> once at t = 0, after the method's phase changes of the step): phase maxima, peaks;
+   !> where due, the energy terms and the divergence test; where recorded, a history row.
+   !> k: the output grid point t = k·dt this state lies on, or −1 (a step between them).
+   !> u, v, a run 0:n (0 = ground); pen, force per contact; link states where the method
+   !> has them; u_prev … the previous accepted state if the method keeps it (saves a copy).
+   !> stat: MARTELLO_ERR_DIVERGED with the message set when the run must stop.
+   subroutine observer_sample(o, m, ms, t, u, v, a, pen, force, k, stat, link_f, link_du, &
+                              u_prev, v_prev, a_prev)
+      type(observer_t), intent(inout) :: o
+      type(model_t), intent(in) :: m
+      type(mech_state_t), intent(in) :: ms
+      real(dp), intent(in) :: t, u(0:), v(0:), a(0:), pen(:), force(:)
+      integer, intent(in) :: k
+      integer, intent(out) :: stat
+      real(dp), intent(in), optional :: link_f(:), link_du(:), u_prev(:), v_prev(:), a_prev(:)
+      real(dp) :: e_kin, e_links, e_cont, kc
+      logical :: due
+      integer :: c
+      stat = MARTELLO_OK
+      due = observer_energy_due(o, k)
+      o%nsamples = o%nsamples + 1
+      do c = 1, size(pen)
+         if (.not. o%ph_open(c)) cycle
+         o%ph_pen(c) = max(o%ph_pen(c), pen(c)); o%ph_f(c) = max(o%ph_f(c), force(c))
+      end do
+      call track(o, t, u(1:), v(1:), a(1:), pen, force, link_f, link_du, u_prev, v_prev, a_prev)
+      if (due) then
+         e_kin = kinetic_energy(m, v, o%work)
+         kc = kinetic_correction(o, m, a)
+         call recoverable_energy(m, ms, u, e_links, e_cont)
+         o%energy = energy_terms(o%e0, o%w_ext, e_kin, e_links, e_cont, o%e_links0, o%e_cont0, &
+                                 o%d_damp, o%d_links, o%d_contact, o%d_impact, kc, o%ke_corr0)
+         o%energy_balance_max = max(o%energy_balance_max, abs(o%energy(E_BALANCE)))
+      end if
+      if (recorded(o, k)) call record(o, t, u(1:), v(1:), a(1:), pen, force, link_f, link_du)
+      if (due) call check_divergence(o, t, e_kin + e_links + e_cont, u, v, stat)
+   end subroutine observer_sample
+
+   !> Divergence at time t, one rule for every integrator: a non-finite state or work, or
+   !> the mechanical energy beyond divergence_factor·(e0 + Σ|ΔW_ext|), what the run was
+   !> given (docs/integrators.md "divergence detection").
+   subroutine check_divergence(o, t, e_mech, u, v, stat)
+      type(observer_t), intent(inout) :: o
+      real(dp), intent(in) :: t, e_mech, u(0:), v(0:)
+      integer, intent(out) :: stat
+      stat = MARTELLO_OK
+      if (.not. (ieee_is_finite(e_mech) .and. all(ieee_is_finite(u)) .and. all(ieee_is_finite(v)) &
+                 .and. ieee_is_finite(o%w_ext + o%d_damp + o%d_links + o%d_contact + o%d_impact))) then
+         call observer_fail_nonfinite(o, t, stat)
+      else if (e_mech > o%divergence_factor*(o%e0 + o%w_abs) + tiny(1.0_dp) .and. &
+               o%e0 + o%w_abs > 0.0_dp) then
+         write (o%message, '(a,a,es12.5,a,es10.3,a,es10.3,a,a)') integrator_name(o%kind), &
+            ' diverged at t = ', t, ' s: mechanical energy ', e_mech, ' J exceeds ', &
+            o%divergence_factor*(o%e0 + o%w_abs), &
+            ' J (divergence_factor x (initial energy + input work)); ', o%advice
+         stat = MARTELLO_ERR_DIVERGED
+         call stop_at(o, t)
+      end if
+   end subroutine check_divergence
+
+   !> A non-finite state, force or work at t (found here or by the method, e.g. in a
+   !> right-hand side): the run has diverged.
+   subroutine observer_fail_nonfinite(o, t, stat)
+      type(observer_t), intent(inout) :: o
+      real(dp), intent(in) :: t
+      integer, intent(out) :: stat
+      write (o%message, '(a,a,es12.5,a)') integrator_name(o%kind), ' diverged at t = ', t, &
+         ' s: non-finite state (NaN/inf)'
+      stat = MARTELLO_ERR_DIVERGED
+      call stop_at(o, t)
+   end subroutine observer_fail_nonfinite
+
+   !> The method failed (code < 0) at t_reached, saying why. The results so far stay for
+   !> diagnosis, open phases included (t_off = −1); they are not a result.
+   subroutine observer_fail(o, code, t_reached, message, stat)
+      type(observer_t), intent(inout) :: o
+      integer, intent(in) :: code
+      real(dp), intent(in) :: t_reached
+      character(len=*), intent(in) :: message
+      integer, intent(out) :: stat
+      o%message = message
+      stat = code
+      call stop_at(o, t_reached)
+   end subroutine observer_fail
+
+   !> The run reached t_reached: phases still open become events with t_off = −1.
+   subroutine observer_finish(o, t_reached)
+      type(observer_t), intent(inout) :: o
+      real(dp), intent(in) :: t_reached
+      call stop_at(o, t_reached)
+   end subroutine observer_finish
+
+   subroutine stop_at(o, t)
+      type(observer_t), intent(inout) :: o
+      real(dp), intent(in) :: t
+      integer :: c
+      o%t_end_reached = t
+      do c = 1, size(o%ph_open)
+         if (o%ph_open(c)) call observer_close_phase(o, c, -1.0_dp, 0.0_dp)
+      end do
+   end subroutine stop_at
+
+   !> Contact c starts a phase at t_on, approaching at v_in (δ̇ > 0).
+   subroutine observer_open_phase(o, c, t_on, v_in)
+      type(observer_t), intent(inout) :: o
+      integer, intent(in) :: c
+      real(dp), intent(in) :: t_on, v_in
+      o%ph_open(c) = .true.
+      o%ph_t(c) = t_on; o%ph_v(c) = v_in; o%ph_pen(c) = 0.0_dp; o%ph_f(c) = 0.0_dp
+      o%impacts(c) = o%impacts(c) + 1
+   end subroutine observer_open_phase
+
+   !> Contact c ends its phase at t_off, leaving at v_out. pen, force: the contact's state at
+   !> the sample that closes it, when the method decides the closing on that state (it then
+   !> enters the phase maxima, as the states of the phase's other steps do).
+   subroutine observer_close_phase(o, c, t_off, v_out, pen, force)
+      type(observer_t), intent(inout) :: o
+      integer, intent(in) :: c
+      real(dp), intent(in) :: t_off, v_out
+      real(dp), intent(in), optional :: pen, force
+      if (present(pen)) o%ph_pen(c) = max(o%ph_pen(c), pen)
+      if (present(force)) o%ph_f(c) = max(o%ph_f(c), force)
+      call add_event(o, c, [o%ph_t(c), t_off, o%ph_v(c), v_out, o%ph_pen(c), o%ph_f(c)])
+      o%ph_open(c) = .false.
+   end subroutine observer_close_phase
+
+   !> An instantaneous phase of contact c at t (an impact resolved by an impulse): approach
+   !> and separation speeds, penetration and force (or impulse) at the impact.
+   subroutine observer_add_impact(o, c, t, v_in, v_out, pen, force)
+      type(observer_t), intent(inout) :: o
+      integer, intent(in) :: c
+      real(dp), intent(in) :: t, v_in, v_out, pen, force
+      call add_event(o, c, [t, t, v_in, v_out, pen, force])
+      o%impacts(c) = o%impacts(c) + 1
+   end subroutine observer_add_impact
+
+   !> Phases of the penalty contacts of a fixed step (t − h, t], from the committed state
+   !> ms: a contact that closed starts a phase at the onset located on the free side of the
+   !> step by the quadratic δ + δ̇τ + ½δ̈τ² = 0 from the start (O(h³) in time, speed
+   !> extrapolated likewise; one event of the method); one that opened ends it at the
+   !> separation located likewise back from the end. un … the state at t − h, u … at t.
+   subroutine observer_penalty_phases(o, m, ms, un, vn, an, u, v, a, t, h)
+      type(observer_t), intent(inout) :: o
+      type(model_t), intent(in) :: m
+      type(mech_state_t), intent(in) :: ms
+      real(dp), intent(in) :: un(0:), vn(0:), an(0:), u(0:), v(0:), a(0:), t, h
+      integer :: c, ia, ib
+      real(dp) :: d0, r0, q0, tau
+      do c = 1, m%ncontact
+         if (.not. ms%is_penalty(c)) cycle
+         ia = m%con_a(c); ib = m%con_b(c)
+         if (.not. o%ph_open(c) .and. ms%con_on(c)) then
+            d0 = un(ia) - un(ib) - m%con_gap(c); r0 = vn(ia) - vn(ib); q0 = an(ia) - an(ib)
+            tau = free_side_crossing(d0, r0, q0, 0.0_dp, h)
+            call observer_open_phase(o, c, t - h + tau, r0 + q0*tau)
+            o%counters(C_EVENTS) = o%counters(C_EVENTS) + 1_i8
+         end if
+         if (o%ph_open(c)) then
+            o%ph_pen(c) = max(o%ph_pen(c), ms%con_pen(c)); o%ph_f(c) = max(o%ph_f(c), ms%con_f(c))
+            if (.not. ms%con_on(c)) then
+               d0 = u(ia) - u(ib) - m%con_gap(c); r0 = v(ia) - v(ib); q0 = a(ia) - a(ib)
+               tau = free_side_crossing(d0, r0, q0, -h, 0.0_dp)
+               call observer_close_phase(o, c, t + tau, r0 + q0*tau)
+            end if
+         end if
+      end do
+   end subroutine observer_penalty_phases
+
+   !> Event location on the free side of a step: the first root of d + rate·τ + ½acc·τ² in
+   !> [lo, hi] (O(h³) in time when the free motion is smooth); linear fallback, else hi.
+   pure real(dp) function free_side_crossing(d, rate, acc, lo, hi) result(tau)
+      real(dp), intent(in) :: d, rate, acc, lo, hi
+      real(dp) :: disc, t1, t2, q
+      tau = hi
+      if (abs(acc) > 0.0_dp) then
+         disc = rate*rate - 2.0_dp*acc*d
+         if (disc >= 0.0_dp) then
+            q = -0.5_dp*(rate + sign(sqrt(disc), rate))
+            if (q /= 0.0_dp) then
+               t1 = q/(0.5_dp*acc); t2 = d/q
+            else
+               t1 = 0.0_dp; t2 = 0.0_dp
+            end if
+            if (t1 >= lo .and. t1 <= hi .and. (t1 <= t2 .or. t2 < lo .or. t2 > hi)) then
+               tau = t1; return
+            end if
+            if (t2 >= lo .and. t2 <= hi) then
+               tau = t2; return
+            end if
+         end if
+      end if
+      if (rate /= 0.0_dp) then
+         tau = -d/rate
+         tau = min(max(tau, lo), hi)
+      end if
+   end function free_side_crossing
+
+   !> The energy terms from the accumulated works (W, since t = 0) and recoverable energies:
+   !> the dissipation of links (plasticity) and contacts is their work minus the change of
+   !> their recoverable energy, so the balance is the work–energy identity
+   !> KE0 + W_ext − KE − W_damp − W_links − W_contact − W_impact (≈ 0 to the method's accuracy).
+   !> ke_corr, ke_corr0: a method's correction to ½vᵀMv in its conserved energy, now and at
+   !> t = 0 (central difference; 0 for the others).
+   pure function energy_terms(e0, w_ext, e_kin, e_links, e_cont, e_links0, e_cont0, d_damp, &
+                              d_links, d_contact, d_impact, ke_corr, ke_corr0) result(e)
+      real(dp), intent(in) :: e0, w_ext, e_kin, e_links, e_cont, e_links0, e_cont0, d_damp, &
+                              d_links, d_contact, d_impact, ke_corr, ke_corr0
+      real(dp) :: e(NENERGY)
+      e = 0.0_dp
+      e(E_KINETIC) = e_kin; e(E_RECOVERABLE) = e_links + e_cont; e(E_INPUT) = w_ext
+      e(E_DAMPING) = d_damp
+      e(E_PLASTIC) = d_links - (e_links - e_links0)
+      e(E_CONTACT) = d_contact - (e_cont - e_cont0)
+      e(E_INITIAL) = e0
+      e(E_IMPACT) = d_impact
+      e(E_BALANCE) = (e0 - ke_corr0) + w_ext - (e_kin - ke_corr) - e(E_RECOVERABLE) - e(E_DAMPING) &
+                     - e(E_PLASTIC) - e(E_CONTACT) - e(E_IMPACT)
+   end function energy_terms
+
+   !> Append one history row (grows by doubling when a variable-step integrator needs it).
+   subroutine record(r, t, u, v, a, pen, force, link_f, link_du)
+      class(results_t), intent(inout) :: r
+      real(dp), intent(in) :: t, u(:), v(:), a(:), pen(:), force(:)
+      real(dp), intent(in), optional :: link_f(:), link_du(:)   !< absent: NaN columns
+      real(dp), allocatable :: tmp(:, :)
+      integer :: k, c, nn, nc, nl
+      if (r%nrec == size(r%hist, 2)) then
+         allocate (tmp(r%ncol, 2*size(r%hist, 2)))
+         tmp(:, 1:r%nrec) = r%hist(:, 1:r%nrec)
+         call move_alloc(tmp, r%hist)
+      end if
+      r%nrec = r%nrec + 1
+      k = r%nrec; c = 1
+      nn = size(r%out_nodes); nc = size(r%out_contacts); nl = size(r%out_links)
+      r%hist(c, k) = t
+      r%hist(c + 1:c + nn, k) = u(r%out_nodes); c = c + nn
+      r%hist(c + 1:c + nn, k) = v(r%out_nodes); c = c + nn
+      r%hist(c + 1:c + nn, k) = a(r%out_nodes); c = c + nn
+      r%hist(c + 1:c + nc, k) = pen(r%out_contacts); c = c + nc
+      r%hist(c + 1:c + nc, k) = force(r%out_contacts); c = c + nc
+      if (present(link_f) .and. present(link_du)) then
+         r%hist(c + 1:c + nl, k) = link_f(r%out_links); c = c + nl
+         r%hist(c + 1:c + nl, k) = link_du(r%out_links); c = c + nl
+      else
+         r%hist(c + 1:c + 2*nl, k) = ieee_value(1.0_dp, ieee_quiet_nan)
+         c = c + 2*nl
+      end if
+      r%hist(c + 1:c + NENERGY, k) = r%energy
+   end subroutine record
+
+   subroutine add_event(r, contact, values)
+      class(results_t), intent(inout) :: r
+      integer, intent(in) :: contact
+      real(dp), intent(in) :: values(NEVENT)
+      real(dp), allocatable :: tmp(:, :)
+      integer, allocatable :: itmp(:)
+      if (r%nevents == size(r%ev, 2)) then
+         allocate (tmp(NEVENT, 2*size(r%ev, 2)), itmp(2*size(r%ev, 2)))
+         tmp(:, 1:r%nevents) = r%ev(:, 1:r%nevents)
+         itmp(1:r%nevents) = r%ev_contact(1:r%nevents)
+         call move_alloc(tmp, r%ev); call move_alloc(itmp, r%ev_contact)
+      end if
+      r%nevents = r%nevents + 1
+      r%ev(:, r%nevents) = values
+      r%ev_contact(r%nevents) = contact
+   end subroutine add_event
+
+   !> Peaks over every accepted state: extremes of u, |v|, |a|, penetration and force, and
+   !> the largest local maximum of u interpolated between the previous and this state by
+   !> u + vτ + ½aτ², τ = −v/a (O(h²) in time where the step maxima are O(h)).
+   subroutine track(o, t, u, v, a, pen, force, link_f, link_du, u_prev, v_prev, a_prev)
+      type(observer_t), intent(inout) :: o
+      real(dp), intent(in) :: t, u(:), v(:), a(:), pen(:), force(:)
+      real(dp), intent(in), optional :: link_f(:), link_du(:)
+      real(dp), intent(in), optional :: u_prev(:), v_prev(:), a_prev(:)
+      integer :: i
+      real(dp) :: tau, up, h
+      h = t - o%prev_t
+      if (present(u_prev)) then
+         call peaks(u_prev, v_prev, a_prev)
+      else
+         call peaks(o%prev_u, o%prev_v, o%prev_a)
+         o%prev_u = u; o%prev_v = v; o%prev_a = a
+      end if
+      o%prev_t = t
+      do i = 1, size(pen)
+         o%pen_max(i) = max(o%pen_max(i), pen(i))
+         o%force_max(i) = max(o%force_max(i), force(i))
+      end do
+      if (present(link_f) .and. present(link_du)) then
+         do i = 1, size(link_f)
+            ! written as "not ≥" so that the NaN the maxima start from is replaced
+            if (.not. (o%link_force_absmax(i) >= abs(link_f(i)))) o%link_force_absmax(i) = abs(link_f(i))
+            if (.not. (o%link_du_absmax(i) >= abs(link_du(i)))) o%link_du_absmax(i) = abs(link_du(i))
+         end do
+      end if
+   contains
+      subroutine peaks(un, vn, an)
+         real(dp), intent(in) :: un(:), vn(:), an(:)
+         associate (umax => o%u_max, umin => o%u_min, vmax => o%v_absmax, amax => o%a_absmax, &
+                    upk => o%u_peak, tpk => o%t_peak)
+            do i = 1, size(u)
+               umax(i) = max(umax(i), u(i)); umin(i) = min(umin(i), u(i))
+               vmax(i) = max(vmax(i), abs(v(i))); amax(i) = max(amax(i), abs(a(i)))
+               if (o%prev_t >= 0.0_dp .and. vn(i) > 0.0_dp .and. v(i) <= 0.0_dp) then
+                  if (an(i) < 0.0_dp) then
+                     tau = min(-vn(i)/an(i), h)
+                     up = un(i) + vn(i)*tau + 0.5_dp*an(i)*tau*tau
+                     if (up > upk(i)) then
+                        upk(i) = up; tpk(i) = o%prev_t + tau
+                     end if
+                  end if
+               end if
+            end do
+         end associate
+      end subroutine peaks
+   end subroutine track
+end module martello_observer
