@@ -101,7 +101,8 @@ static int fail(ed_t *w, int status, double t, const char *what) {
 }
 
 static int fail_eval(ed_t *w, int status, double t) {
-  if (status == MARTELLO_ERR_DIVERGED) return martello_observer_fail_nonfinite(w->obs, t);
+  if (status == MARTELLO_ERR_DIVERGED)
+    return martello_observer_fail(w->obs, MARTELLO_ERR_DIVERGED, t, NULL);
   return fail(w, status, t, status == MARTELLO_ERR_SINGULAR
                                 ? "event-driven: the mass matrix is singular on the free nodes"
                                 : "event-driven: the force evaluation failed");
@@ -258,7 +259,7 @@ static void kinematics(const ed_t *w, const double *y, const double *a, double *
 /* Is contact j in a contact phase (a penalty contact in contact, a held unilateral one)? */
 static int in_phase(const ed_t *w, int j) {
   int open = 0;
-  martello_observer_in_phase(w->obs, j, &open);
+  martello_observer_get_phase(w->obs, j, &open);
   return open;
 }
 
@@ -301,7 +302,7 @@ static int update_held(ed_t *w, double t, const int *list, int m) {
   for (k = 0; k < w->nh; k++) {
     int j = w->hlist[k];
     if (w->sl[j] > 0.0) continue;
-    martello_observer_close_phase(w->obs, j, t, gdot(w, j, w->y + w->n));
+    martello_observer_set_phase(w->obs, j, 0, t, gdot(w, j, w->y + w->n));
     w->held[j] = 0;
     w->cnt[C_EVENTS]++;
   }
@@ -315,7 +316,7 @@ static int update_held(ed_t *w, double t, const int *list, int m) {
       if (a >= 0) fs += fabs(w->fext[a]) + fabs(w->fint[a]);
       if (b >= 0) fs += fabs(w->fext[b]) + fabs(w->fint[b]);
       w->held[k] = 1;
-      martello_observer_open_phase(w->obs, k, w->t_hold[k], 0.0);
+      martello_observer_set_phase(w->obs, k, 1, w->t_hold[k], 0.0);
       /* a release needs a tension beyond the rounding of the forces at the contact */
       w->lamtol[k] = 1e3 * DBL_EPSILON * fmax(fs, w->sl[k]);
       w->cnt[C_EVENTS]++;
@@ -468,10 +469,10 @@ static int process_events(ed_t *w, double t) {
   for (j = 0; j < w->nc; j++) {
     if (!w->is_pen[j] || w->inert[j]) continue;
     if (w->pen[j] > 0.0 && !in_phase(w, j)) {
-      martello_observer_open_phase(w->obs, j, t, w->rate[j]);
+      martello_observer_set_phase(w->obs, j, 1, t, w->rate[j]);
       w->cnt[C_EVENTS]++;
     } else if (!(w->pen[j] > 0.0) && in_phase(w, j)) {
-      martello_observer_close_phase(w->obs, j, t, w->rate[j]);
+      martello_observer_set_phase(w->obs, j, 0, t, w->rate[j]);
       w->cnt[C_EVENTS]++;
     }
   }
@@ -758,21 +759,16 @@ static int commit(ed_t *w, double t, const double *w_start) {
   return st == MARTELLO_OK ? st : fail(w, st, t, "event-driven: commit failed");
 }
 
-/* A sample of the observer at an accepted (committed) state; k: the output grid point t =
- * k dt, or -1. Leaves the RHS in w->fstart and the multipliers in w->lam0: the start of the
- * next step. */
+/* A sample of the observer at an accepted (committed) state (the force of a held contact
+ * is its multiplier); k: the output grid point t = k dt, or -1. Leaves the RHS in
+ * w->fstart and the multipliers in w->lam0: the start of the next step. */
 static int observe(ed_t *w, double t, int k) {
   const int n = w->n;
   int j, st;
   st = eval_point(w, t, w->y, w->fstart, w->lam0);
   if (st != MARTELLO_OK) return fail_eval(w, st, t);
-  kinematics(w, w->y, w->fstart + n, w->pen, w->rate, NULL);
-  st = martello_eval_contact_forces(w->ev, w->force);   /* penalty forces at (t, y) */
-  if (st != MARTELLO_OK) return fail(w, st, t, "event-driven: martello_eval_contact_forces failed");
-  for (j = 0; j < w->nc; j++)
-    if (!w->is_pen[j]) w->force[j] = w->held[j] ? w->lam0[j] : 0.0;
-  return martello_observer_sample(w->obs, w->ev, t, w->y, w->y + n, w->fstart + n, w->pen,
-                                  w->force, k);
+  for (j = 0; j < w->nc; j++) w->force[j] = w->held[j] ? w->lam0[j] : 0.0;
+  return martello_observer_sample(w->obs, w->ev, t, w->y, w->y + n, w->fstart + n, w->force, k);
 }
 
 /* ---- set-up and tear-down -------------------------------------------------------------- */

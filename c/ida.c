@@ -78,7 +78,7 @@ typedef struct {
   int *was_closed, *hit, *cand; /* per rigid contact, at an impact */
   double *w_in;  /* per contact: approach speed of the impact being resolved */
   /* work */
-  double *u, *v, *a, *x, *uq, *vq, *fint, *fext, *pen, *rate, *force, *lam;
+  double *u, *v, *a, *x, *uq, *vq, *fint, *fext, *force, *lam;
   double *S, *rhs, *mb;
   int *aset, *map;
   double *S2, *q;
@@ -111,7 +111,7 @@ static int fail(ida_problem *P, int code, const char *fmt, ...) {
 /* A phase open on contact j: a penalty contact in contact, a closed rigid contact. */
 static int touching(const ida_problem *P, int j) {
   int open = 0;
-  martello_observer_in_phase(P->obs, j, &open);
+  martello_observer_get_phase(P->obs, j, &open);
   return open;
 }
 
@@ -349,20 +349,16 @@ static int hand_work(ida_problem *P) {
   return st == MARTELLO_OK ? st : fail(P, st, "IDA: could not hand the works to the observer");
 }
 
-/* An accepted (committed) state y, yp at t as a sample of the observer; k: the output grid
- * point t = k dt, or -1. Contact forces: P_r for closed rigid contacts, the kernels'
- * penalty force otherwise. */
+/* An accepted (committed) state y, yp at t as a sample of the observer (the force of a
+ * closed rigid contact is its multiplier P_r); k: the output grid point t = k dt, or -1. */
 static int observe(ida_problem *P, double t, const double *y, const double *yp, int k) {
   gather(P, y, P->u, P->v);
   for (int i = 0; i < P->n; i++) P->a[i] = yp[P->iv[i]];
-  for (int j = 0; j < P->nc; j++) P->pen[j] = penetration(P, j, P->u);
-  if (martello_eval_contact_forces(P->ev, P->force) != MARTELLO_OK)
-    return fail(P, MARTELLO_ERR_ARGUMENT, "IDA: martello_eval_contact_forces failed");
   for (int j = 0; j < P->nc; j++) {
     int r = P->rig[j];
-    if (r >= 0) P->force[j] = P->closed[r] ? y[P->ip[r]] : 0.0;
+    P->force[j] = r >= 0 && P->closed[r] ? y[P->ip[r]] : 0.0;
   }
-  return martello_observer_sample(P->obs, P->ev, t, P->u, P->v, P->a, P->pen, P->force, k);
+  return martello_observer_sample(P->obs, P->ev, t, P->u, P->v, P->a, P->force, k);
 }
 
 /* Work of the external and internal forces (and of the links other than dampers and of the
@@ -591,12 +587,12 @@ static int prepare_restart(ida_problem *P, double t, double *u, double *v, N_Vec
     switch (P->act[j]) {
     case ACT_ONSET:
       nudge(P, j, +1, u);
-      martello_observer_open_phase(P->obs, j, t, w);
+      martello_observer_set_phase(P->obs, j, 1, t, w);
       P->events++;
       break;
     case ACT_SEPARATION:
       nudge(P, j, -1, u);
-      martello_observer_close_phase(P->obs, j, t, w);
+      martello_observer_set_phase(P->obs, j, 0, t, w);
       P->events++;
       break;
     case ACT_IMPACT:
@@ -607,7 +603,7 @@ static int prepare_restart(ida_problem *P, double t, double *u, double *v, N_Vec
     case ACT_RELEASE:
       P->closed[r] = 0;
       nudge(P, j, -1, u);
-      martello_observer_close_phase(P->obs, j, t, w);
+      martello_observer_set_phase(P->obs, j, 0, t, w);
       any_rigid = 1;
       P->events++;
       break;
@@ -636,11 +632,11 @@ static int prepare_restart(ida_problem *P, double t, double *u, double *v, N_Vec
     if ((P->hit[r] || P->act[j] == ACT_IMPACT) && !P->was_closed[r]) {
       double w_in = P->hit[r] ? P->w_in[j] : 0.0;
       if (P->closed[r])
-        martello_observer_open_phase(P->obs, j, t, w_in);
+        martello_observer_set_phase(P->obs, j, 1, t, w_in);
       else if (P->hit[r])
         martello_observer_add_impact(P->obs, j, t, w_in, pen_rate(P, j, v), 0.0, 0.0);
     } else if (P->opened[r] && touching(P, j)) {
-      martello_observer_close_phase(P->obs, j, t, pen_rate(P, j, v));
+      martello_observer_set_phase(P->obs, j, 0, t, pen_rate(P, j, v));
     }
   }
   if ((st = martello_eval_energy(P->ev, u, v, &ke1, &dummy)) != MARTELLO_OK)
@@ -822,7 +818,7 @@ static void release(ida_problem *P) {
   void *all[] = {P->mass, P->gap, P->rest, P->fixed, P->con_a, P->con_b, P->scheme, P->rig,
                  P->rig_con, P->iu, P->iv, P->ip, P->im, P->closed, P->act,
                  P->opened, P->was_closed, P->hit, P->cand, P->map, P->q, P->S2, P->w_in, P->u, P->v, P->a, P->x, P->uq, P->vq, P->fint, P->fext,
-                 P->pen, P->rate, P->force, P->lam, P->S, P->rhs, P->mb, P->aset};
+                 P->force, P->lam, P->S, P->rhs, P->mb, P->aset};
   for (size_t k = 0; k < sizeof all / sizeof all[0]; k++) free(all[k]);
   if (P->ev) martello_eval_free(&P->ev);
 }
@@ -938,8 +934,6 @@ static int setup(ida_problem *P, martello_model *model, martello_run *run) {
   P->S = take(nr * nr, sizeof(double), &ok);
   P->act = take(ucn, sizeof(int), &ok);
   P->w_in = take(ucn, sizeof(double), &ok);
-  P->pen = take(ucn, sizeof(double), &ok);
-  P->rate = take(ucn, sizeof(double), &ok);
   P->force = take(ucn, sizeof(double), &ok);
   double **work[] = {&P->u, &P->v, &P->a, &P->x, &P->uq, &P->vq, &P->fint, &P->fext, &P->mb};
   for (size_t k = 0; k < sizeof work / sizeof work[0]; k++) *work[k] = take(un, sizeof(double), &ok);
@@ -994,7 +988,7 @@ static int integrate(ida_problem *P, SUNContext sunctx, void **memp, N_Vector yy
   for (int j = 0; j < P->nc; j++) {
     double d = penetration(P, j, u0), w = pen_rate(P, j, v0);
     if (P->rig[j] < 0) {
-      if (d > 0.0) martello_observer_open_phase(P->obs, j, 0.0, w);
+      if (d > 0.0) martello_observer_set_phase(P->obs, j, 1, 0.0, w);
       else if (d == 0.0 && w > 0.0) P->act[j] = ACT_ONSET;
     } else {
       double htol = height_tol(P, j, u0);
@@ -1058,7 +1052,7 @@ static int integrate(ida_problem *P, SUNContext sunctx, void **memp, N_Vector yy
       if (IDAGetCurrentTime(mem, &tcur) != IDA_SUCCESS) tcur = t_last;
       P->t_now = tcur;
       if (P->nan_seen)
-        st = martello_observer_fail_nonfinite(P->obs, tcur);
+        st = martello_observer_fail(P->obs, MARTELLO_ERR_DIVERGED, tcur, NULL);
       else
         st = fail(P, MARTELLO_ERR_EXTERNAL, "IDASolve failed at t = %.9e s: %s (%s)", tcur, IDAGetReturnFlagName(flag), P->ida_msg);
       break;

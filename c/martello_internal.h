@@ -26,12 +26,8 @@ int martello_eval_acceleration(martello_eval *ev, double t, const double *u, con
                                double *a);
 int martello_eval_forces(martello_eval *ev, double t, const double *u, const double *v,
                          double *fint, double *fext);
-/* The force of every penalty contact at the last evaluation (0 for other schemes). */
-int martello_eval_contact_forces(martello_eval *ev, double *force);
 /* x <- M^-1 x on the free nodes (0 on fixed ones). */
 int martello_eval_solve_mass(martello_eval *ev, double *x);
-int martello_eval_contacts(martello_eval *ev, const double *u, const double *v, double *pen,
-                           double *rate);
 /* Accept (u, v) at the end of a step: path-dependent links (hysteresis) commit. */
 int martello_eval_commit(martello_eval *ev, const double *u, const double *v);
 /* power[3]: the power of the dampers, the other links and the penalty contacts at the last
@@ -52,33 +48,31 @@ int martello_run_observer(martello_run *run, martello_observer **obs);
  * advice ends a divergence message. */
 int martello_observer_begin(martello_observer *obs, martello_eval *ev, const double *u,
                             const double *v, int energy_interval, const char *advice);
-/* An accepted state at t, committed in ev (its link states are read there), after the
- * phase changes found at t: peaks, phase maxima, energy terms and the divergence test, a
- * history row where recorded. k: the output grid point t = k dt it lies on, or -1.
+/* An accepted state at t, committed in ev, after the phase changes found at t: peaks, phase
+ * maxima, energy terms and the divergence test, a history row where recorded. force: the
+ * force of each contact that is not a penalty one (the link states, penetrations and
+ * penalty forces are read in ev). k: the output grid point t = k dt it lies on, or -1.
  * Returns MARTELLO_ERR_DIVERGED (message set) when the run must stop. */
 int martello_observer_sample(martello_observer *obs, martello_eval *ev, double t, const double *u,
-                             const double *v, const double *a, const double *pen,
-                             const double *force, int k);
+                             const double *v, const double *a, const double *force, int k);
 /* Work increments since the last call [J], integrated along the method's own solution:
  * external, total internal (f_int . v), of the links other than dampers and of the penalty
  * contacts (martello_eval_power), and the kinetic energy impulses took out. Damping is
  * internal - links - contacts. */
 int martello_observer_work(martello_observer *obs, double w_ext, double w_int, double w_links,
                            double w_contact, double w_impact);
-/* Contact phases located by the method: a phase opens at t_on approaching at v_in, closes at
- * t_off leaving at v_out (nothing if not open); an impact is an instantaneous phase with its
- * penetration and impulse. in_phase: *open = 1 while a phase is open. */
-int martello_observer_open_phase(martello_observer *obs, int contact, double t_on, double v_in);
-int martello_observer_close_phase(martello_observer *obs, int contact, double t_off, double v_out);
+/* Contact phases located by the method: set open = 1 starts one at t approaching at v, 0
+ * ends the open one at t leaving at v; get: *open = 1 while one is open. An impact is an
+ * instantaneous phase with its penetration and impulse. */
+int martello_observer_set_phase(martello_observer *obs, int contact, int open, double t, double v);
+int martello_observer_get_phase(const martello_observer *obs, int contact, int *open);
 int martello_observer_add_impact(martello_observer *obs, int contact, double t, double v_in,
                                  double v_out, double pen, double impulse);
-int martello_observer_in_phase(const martello_observer *obs, int contact, int *open);
 int martello_observer_add_counts(martello_observer *obs, const long long inc[MARTELLO_NCOUNTERS]);
-/* The method failed with status at t_reached: returns status once the message is set. */
+/* The method failed with status at t_reached: returns status once the message is set. A
+ * NULL message: a non-finite state, force or work (MARTELLO_ERR_DIVERGED, one wording). */
 int martello_observer_fail(martello_observer *obs, int status, double t_reached,
                            const char *message);
-/* A non-finite state, force or work at t: returns MARTELLO_ERR_DIVERGED (one wording). */
-int martello_observer_fail_nonfinite(martello_observer *obs, double t);
 /* The run reached t_reached: open phases become events with t_off = -1. */
 int martello_observer_finish(martello_observer *obs, double t_reached);
 

@@ -68,20 +68,6 @@ contains
       c_model_initial_state = MARTELLO_OK
    end function c_model_initial_state
 
-   !> The force of every penalty contact at the last evaluation (0 for other schemes).
-   integer(c_int) function c_eval_contact_forces(handle, force) bind(C, name='martello_eval_contact_forces')
-      type(c_ptr), value :: handle
-      real(c_double), intent(out) :: force(*)
-      type(evaluator_t), pointer :: ep
-      integer :: nc
-      ep => get_eval(handle)
-      c_eval_contact_forces = MARTELLO_ERR_ARGUMENT
-      if (.not. associated(ep)) return
-      nc = ep%m%ncontact
-      force(1:nc) = merge(ep%ms%con_f_trial(1:nc), 0.0_dp, ep%ms%is_penalty(1:nc))
-      c_eval_contact_forces = MARTELLO_OK
-   end function c_eval_contact_forces
-
    integer(c_int) function c_eval_create(mhandle, handle) bind(C, name='martello_eval_create')
       type(c_ptr), value :: mhandle
       type(c_ptr), intent(out) :: handle
@@ -143,18 +129,6 @@ contains
       call evaluator_solve_mass(ep, x(1:ep%m%n), ok)
       c_eval_solve_mass = merge(MARTELLO_OK, MARTELLO_ERR_SINGULAR, ok)
    end function c_eval_solve_mass
-
-   integer(c_int) function c_eval_contacts(handle, u, v, pen, rate) bind(C, name='martello_eval_contacts')
-      type(c_ptr), value :: handle
-      real(c_double), intent(in) :: u(*), v(*)
-      real(c_double), intent(out) :: pen(*), rate(*)
-      type(evaluator_t), pointer :: ep
-      ep => get_eval(handle)
-      c_eval_contacts = MARTELLO_ERR_ARGUMENT
-      if (.not. associated(ep)) return
-      call evaluator_contacts(ep, u(1:ep%m%n), v(1:ep%m%n), pen(1:ep%m%ncontact), rate(1:ep%m%ncontact))
-      c_eval_contacts = MARTELLO_OK
-   end function c_eval_contacts
 
    integer(c_int) function c_eval_commit(handle, u, v) bind(C, name='martello_eval_commit')
       type(c_ptr), value :: handle
@@ -243,23 +217,28 @@ contains
       c_observer_begin = MARTELLO_OK
    end function c_observer_begin
 
-   integer(c_int) function c_observer_sample(handle, ehandle, t, u, v, a, pen, force, k) &
+   integer(c_int) function c_observer_sample(handle, ehandle, t, u, v, a, force, k) &
       bind(C, name='martello_observer_sample')
       type(c_ptr), value :: handle, ehandle
       real(c_double), value :: t
-      real(c_double), intent(in) :: u(*), v(*), a(*), pen(*), force(*)
+      real(c_double), intent(in) :: u(*), v(*), a(*), force(*)
       integer(c_int), value :: k
       type(observer_t), pointer :: op
       type(evaluator_t), pointer :: ep
-      integer :: n, nc, stat
+      integer :: n, j, stat
       op => get_observer(handle); ep => get_eval(ehandle)
       c_observer_sample = MARTELLO_ERR_ARGUMENT
       if (.not. (associated(op) .and. associated(ep))) return
-      n = ep%m%n; nc = ep%m%ncontact
+      n = ep%m%n
       call evaluator_load(ep, u(1:n), v(1:n))
       op%acc(0) = 0.0_dp; op%acc(1:n) = a(1:n)
-      ! the link states are the evaluator's, committed at this state
-      call observer_sample(op, ep%m, ep%ms, t, ep%u, ep%v, op%acc, pen(1:nc), force(1:nc), int(k), &
+      ! δ of every contact; the forces of the penalty contacts and the link states are the
+      ! evaluator's, committed at this state
+      do j = 1, ep%m%ncontact
+         op%c_pen(j) = ep%u(ep%m%con_a(j)) - ep%u(ep%m%con_b(j)) - ep%m%con_gap(j)
+         op%c_force(j) = merge(ep%ms%con_f(j), force(j), ep%ms%is_penalty(j))
+      end do
+      call observer_sample(op, ep%m, ep%ms, t, ep%u, ep%v, op%acc, op%c_pen, op%c_force, int(k), &
                            stat, ep%ms%link_f, ep%ms%link_u)
       c_observer_sample = stat
    end function c_observer_sample
@@ -277,31 +256,23 @@ contains
       c_observer_work = MARTELLO_OK
    end function c_observer_work
 
-   integer(c_int) function c_observer_open_phase(handle, contact, t_on, v_in) &
-      bind(C, name='martello_observer_open_phase')
+   !> open = 1: contact starts a phase at t approaching at v; 0: ends it at t leaving at v.
+   integer(c_int) function c_observer_set_phase(handle, contact, open, t, v) &
+      bind(C, name='martello_observer_set_phase')
       type(c_ptr), value :: handle
-      integer(c_int), value :: contact
-      real(c_double), value :: t_on, v_in
+      integer(c_int), value :: contact, open
+      real(c_double), value :: t, v
       type(observer_t), pointer :: op
       op => observer_of(handle, contact)
-      c_observer_open_phase = MARTELLO_ERR_ARGUMENT
+      c_observer_set_phase = MARTELLO_ERR_ARGUMENT
       if (.not. associated(op)) return
-      call observer_open_phase(op, int(contact) + 1, t_on, v_in)
-      c_observer_open_phase = MARTELLO_OK
-   end function c_observer_open_phase
-
-   integer(c_int) function c_observer_close_phase(handle, contact, t_off, v_out) &
-      bind(C, name='martello_observer_close_phase')
-      type(c_ptr), value :: handle
-      integer(c_int), value :: contact
-      real(c_double), value :: t_off, v_out
-      type(observer_t), pointer :: op
-      op => observer_of(handle, contact)
-      c_observer_close_phase = MARTELLO_ERR_ARGUMENT
-      if (.not. associated(op)) return
-      if (op%ph_open(contact + 1)) call observer_close_phase(op, int(contact) + 1, t_off, v_out)
-      c_observer_close_phase = MARTELLO_OK
-   end function c_observer_close_phase
+      if (open /= 0) then
+         call observer_open_phase(op, int(contact) + 1, t, v)
+      else if (op%ph_open(contact + 1)) then
+         call observer_close_phase(op, int(contact) + 1, t, v)
+      end if
+      c_observer_set_phase = MARTELLO_OK
+   end function c_observer_set_phase
 
    integer(c_int) function c_observer_add_impact(handle, contact, t, v_in, v_out, pen, force) &
       bind(C, name='martello_observer_add_impact')
@@ -316,18 +287,18 @@ contains
       c_observer_add_impact = MARTELLO_OK
    end function c_observer_add_impact
 
-   integer(c_int) function c_observer_in_phase(handle, contact, open) bind(C, name='martello_observer_in_phase')
+   integer(c_int) function c_observer_get_phase(handle, contact, open) bind(C, name='martello_observer_get_phase')
       type(c_ptr), value :: handle
       integer(c_int), value :: contact
       integer(c_int), intent(out) :: open
       type(observer_t), pointer :: op
       op => observer_of(handle, contact)
       open = 0
-      c_observer_in_phase = MARTELLO_ERR_ARGUMENT
+      c_observer_get_phase = MARTELLO_ERR_ARGUMENT
       if (.not. associated(op)) return
       open = merge(1, 0, op%ph_open(contact + 1))
-      c_observer_in_phase = MARTELLO_OK
-   end function c_observer_in_phase
+      c_observer_get_phase = MARTELLO_OK
+   end function c_observer_get_phase
 
    integer(c_int) function c_observer_add_counts(handle, inc) bind(C, name='martello_observer_add_counts')
       type(c_ptr), value :: handle
@@ -341,32 +312,26 @@ contains
    end function c_observer_add_counts
 
    !> Returns status (the method's failure code) once recorded, MARTELLO_ERR_ARGUMENT for a
-   !> null handle.
+   !> null handle; a null message is the observer's non-finite divergence.
    integer(c_int) function c_observer_fail(handle, status, t_reached, message) bind(C, name='martello_observer_fail')
       type(c_ptr), value :: handle
       integer(c_int), value :: status
       real(c_double), value :: t_reached
-      character(kind=c_char), intent(in) :: message(*)
+      type(c_ptr), value :: message
+      character(kind=c_char), pointer :: cs(:)
       type(observer_t), pointer :: op
       integer :: stat
       op => get_observer(handle)
       c_observer_fail = MARTELLO_ERR_ARGUMENT
       if (.not. associated(op)) return
-      call observer_fail(op, int(status), t_reached, c_string(message), stat)
+      if (c_associated(message)) then
+         call c_f_pointer(message, cs, [512])
+         call observer_fail(op, int(status), t_reached, c_string(cs), stat)
+      else
+         call observer_fail_nonfinite(op, t_reached, stat)
+      end if
       c_observer_fail = stat
    end function c_observer_fail
-
-   integer(c_int) function c_observer_fail_nonfinite(handle, t) bind(C, name='martello_observer_fail_nonfinite')
-      type(c_ptr), value :: handle
-      real(c_double), value :: t
-      type(observer_t), pointer :: op
-      integer :: stat
-      op => get_observer(handle)
-      c_observer_fail_nonfinite = MARTELLO_ERR_ARGUMENT
-      if (.not. associated(op)) return
-      call observer_fail_nonfinite(op, t, stat)
-      c_observer_fail_nonfinite = stat
-   end function c_observer_fail_nonfinite
 
    integer(c_int) function c_observer_finish(handle, t_reached) bind(C, name='martello_observer_finish')
       type(c_ptr), value :: handle

@@ -11,7 +11,7 @@ module martello_central_difference
       C_FACTORIZATIONS
    use martello_integrator_settings, only: integrator_settings_t
    use martello_stability, only: omega_max
-   use martello_stepper, only: stepper_t, stepper_rest_start, solve_free_mass, stepper_fail
+   use martello_fixed_step, only: stepper_t, stepper_rest_start, solve_free_mass, stepper_fail
    implicit none
    private
    public :: central_difference_t

@@ -10,7 +10,7 @@ module martello_evaluator
    implicit none
    private
    public :: evaluator_t, evaluator_init, evaluator_load, evaluator_acceleration, &
-      evaluator_forces, evaluator_solve_mass, evaluator_contacts, evaluator_commit, &
+      evaluator_forces, evaluator_solve_mass, evaluator_commit, &
       evaluator_energy, evaluator_power
 
    type :: evaluator_t
@@ -92,19 +92,6 @@ contains
       end do
       call band_solve(ev%mband, x, ok)
    end subroutine evaluator_solve_mass
-
-   !> Penetration δ = u_a − u_b − gap and its rate, for every contact (any scheme).
-   subroutine evaluator_contacts(ev, u, v, pen, rate)
-      type(evaluator_t), intent(inout) :: ev
-      real(dp), intent(in) :: u(:), v(:)
-      real(dp), intent(out) :: pen(:), rate(:)
-      integer :: j
-      call evaluator_load(ev, u, v)
-      do j = 1, ev%m%ncontact
-         pen(j) = ev%u(ev%m%con_a(j)) - ev%u(ev%m%con_b(j)) - ev%m%con_gap(j)
-         rate(j) = ev%v(ev%m%con_a(j)) - ev%v(ev%m%con_b(j))
-      end do
-   end subroutine evaluator_contacts
 
    !> Accept (u, v) as the state at the end of a step: path-dependent links commit.
    subroutine evaluator_commit(ev, u, v)

@@ -13,7 +13,7 @@ module martello_generalized_alpha
    use martello_observer, only: observer_t, observer_work, observer_fail, C_NEWTON, C_RESIDUALS, &
       C_FACTORIZATIONS, C_JACOBIANS, C_CHATTER
    use martello_integrator_settings
-   use martello_stepper, only: stepper_t, stepper_rest_start, stepper_fail
+   use martello_fixed_step, only: stepper_t, stepper_rest_start, stepper_fail, newmark_kinematics
    implicit none
    private
    public :: generalized_alpha_t, generalized_alpha_coefficients
@@ -105,26 +105,6 @@ contains
 
    contains
 
-      subroutine fail(code, what)
-         integer, intent(in) :: code
-         character(len=*), intent(in) :: what
-         call stepper_fail(o, code, t, what, stat)
-      end subroutine fail
-
-      !> Newmark relations for a trial u: a(u), v(u).
-      subroutine kinematics()
-         integer :: i, k
-         associate (u => self%u, v => self%v, a => self%a, un => self%un, vn => self%vn, &
-                    an => self%an, beta => self%beta, gamma => self%gamma)
-            a(1:n) = (u(1:n) - un(1:n) - h*vn(1:n))/(beta*h*h) - (0.5_dp - beta)/beta*an(1:n)
-            v(1:n) = vn(1:n) + h*((1.0_dp - gamma)*an(1:n) + gamma*a(1:n))
-            do k = 1, size(self%fixed_nodes)
-               i = self%fixed_nodes(k)
-               u(i) = un(i); v(i) = 0.0_dp; a(i) = 0.0_dp
-            end do
-         end associate
-      end subroutine kinematics
-
       !> Newton on the step. A law whose force jumps at δ = 0 (Kelvin: cδ̇ at first touch and
       !> at separation) can leave the step without any root: the iterates then flip the
       !> contact on and off. Chatter rule: a contact that flips in three iterations of one
@@ -145,7 +125,7 @@ contains
                ! laws stay on one branch costs a single evaluation.
                call linearised_first_iterate(ok)
                if (.not. ok) then
-                  call fail(MARTELLO_ERR_SINGULAR, 'singular effective stiffness in the Newton step')
+                  call stepper_fail(o, MARTELLO_ERR_SINGULAR, t, 'singular effective stiffness in the Newton step', stat)
                   return
                end if
                call newton_iterations(converged, flips, was_on, 1)
@@ -178,7 +158,7 @@ contains
                     res => self%res, du => self%du, work => self%work, ma => self%ma, &
                     man => self%man, am => self%am, af => self%af)
             u = un
-            call kinematics()
+            call newmark_kinematics(self, self%beta, self%gamma)
             work(1:n) = v(1:n) - vn(1:n)
             call band_matvec(self%cjac, work(1:n), res(1:n))   ! C_t Δv
             res(0) = 0.0_dp
@@ -204,7 +184,7 @@ contains
                     fint_n => self%fint_n, fext => self%fext, fext_n => self%fext_n, &
                     res => self%res, ma => self%ma, man => self%man, jac => self%jac, &
                     cjac => self%cjac, am => self%am, af => self%af, kd => self%kd)
-            call kinematics()
+            call newmark_kinematics(self, self%beta, self%gamma)
             if (want_jac) then
                jac%ab = 0.0_dp; cjac%ab = 0.0_dp
                call internal_forces(m, self%ms, u, v, fint, jac%ab, 1.0_dp - af, (1.0_dp - af)*self%cv, &
@@ -280,7 +260,7 @@ contains
                o%counters(C_FACTORIZATIONS) = o%counters(C_FACTORIZATIONS) + 1_i8
                o%counters(C_NEWTON) = o%counters(C_NEWTON) + 1_i8
                if (.not. ok) then
-                  call fail(MARTELLO_ERR_SINGULAR, 'singular effective stiffness in the Newton step')
+                  call stepper_fail(o, MARTELLO_ERR_SINGULAR, t, 'singular effective stiffness in the Newton step', stat)
                   return
                end if
                if (it >= 2) then
@@ -307,7 +287,7 @@ contains
             lam = 1.0_dp
             do k = 1, 12
                u(1:n) = work(1:n) + lam*du
-               call kinematics()
+               call newmark_kinematics(self, self%beta, self%gamma)
                call internal_forces(m, self%ms, u, v, fint)
                call mass_times(m, a, ma)
                res = (1.0_dp - am)*ma + am*man + (1.0_dp - af)*fint + af*fint_n &

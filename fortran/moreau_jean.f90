@@ -23,7 +23,7 @@
 !> θ(1+e) ≤ 1. E_IMPACT accumulates −ġ_θᵀ p; the θ-dissipation is what E_BALANCE shows
 !> (zero up to round-off for θ = ½ and linear forces).
 !>
-!> A stepper of the fixed-step strategy (martello_stepper, docs/run-layer.md): the step and
+!> A stepper of the fixed-step strategy (martello_fixed_step, docs/run-layer.md): the step and
 !> its impulse problem are here, the time loop and the measurement are the strategy's and
 !> the observer's.
 module martello_moreau_jean
@@ -36,7 +36,7 @@ module martello_moreau_jean
    use martello_observer, only: observer_t, observer_work, observer_fail, observer_open_phase, &
       observer_close_phase, C_NEWTON, C_RESIDUALS, C_FACTORIZATIONS, C_EVENTS, C_JACOBIANS
    use martello_integrator_settings, only: integrator_settings_t
-   use martello_stepper, only: stepper_t, stepper_start
+   use martello_fixed_step, only: stepper_t, stepper_start
    use martello_lcp, only: lcp_lemke, lcp_pgs, LCP_OK
    use martello_linalg, only: lapack_status
    implicit none

@@ -27,7 +27,7 @@
 !> less than one step (2 e v_imp < h δ̈) is made plastic and the contact persistent.
 !> Dense KKT solves (LAPACK dsytrf): a scheme for the small problems P2 and P5.
 !>
-!> A stepper of the fixed-step strategy (martello_stepper, docs/run-layer.md).
+!> A stepper of the fixed-step strategy (martello_fixed_step, docs/run-layer.md).
 module martello_newmark_lagrange
    use martello_kinds, only: dp, i8
    use martello_status
@@ -39,7 +39,7 @@ module martello_newmark_lagrange
       observer_close_phase, free_side_crossing, C_REJECTED, C_NEWTON, C_RESIDUALS, &
       C_FACTORIZATIONS, C_EVENTS
    use martello_integrator_settings, only: integrator_settings_t
-   use martello_stepper, only: stepper_t, stepper_start
+   use martello_fixed_step, only: stepper_t, stepper_start, newmark_kinematics
    use martello_linalg, only: solve_symmetric_indefinite
    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
    implicit none
@@ -333,21 +333,6 @@ contains
                                               abs(m%con_gap(cc)))
       end function closed_tol
 
-      !> Newmark relations for the current u with (bt, gm).
-      subroutine kinematics(bt, gm)
-         real(dp), intent(in) :: bt, gm
-         integer :: k
-         associate (u => self%u, v => self%v, a => self%a, un => self%un, vn => self%vn, &
-                    an => self%an, fixed_nodes => self%fixed_nodes)
-            a(1:n) = (u(1:n) - un(1:n) - h*vn(1:n))/(bt*h*h) - (0.5_dp - bt)/bt*an(1:n)
-            v(1:n) = vn(1:n) + h*((1.0_dp - gm)*an(1:n) + gm*a(1:n))
-            do k = 1, size(fixed_nodes)
-               u(fixed_nodes(k)) = un(fixed_nodes(k)); v(fixed_nodes(k)) = 0.0_dp
-               a(fixed_nodes(k)) = 0.0_dp
-            end do
-         end associate
-      end subroutine kinematics
-
       !> Newton on the constrained Newmark step: unknowns u_{n+1} and the multipliers λ of
       !> the active contacts; KKT matrix [J −Bᵀ; −B 0], J = M/(βh²) + γ/(βh) C + K.
       subroutine newmark_solve(bt, gm, ok)
@@ -375,7 +360,7 @@ contains
             end do
             ok = .false.
             do it = 0, self%max_newton
-               call kinematics(bt, gm)
+               call newmark_kinematics(self, bt, gm)
                kband%ab = 0.0_dp; cband%ab = 0.0_dp
                call internal_forces(m, self%ms, u, v, fint, kband%ab, 1.0_dp, 0.0_dp, cband%ab)
                o%counters(C_RESIDUALS) = o%counters(C_RESIDUALS) + 1_i8

@@ -17,10 +17,10 @@ module martello_observer
    use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan, ieee_is_finite
    implicit none
    private
-   public :: results_t, observer_t, observer_init, observer_begin, observer_energy_due, &
-      observer_sample, observer_work, observer_open_phase, observer_close_phase, &
-      observer_add_impact, observer_penalty_phases, observer_fail, observer_fail_nonfinite, &
-      observer_finish, output_points, free_side_crossing, &
+   public :: results_t, observer_t, observer_init, observer_begin, observer_sample, &
+      observer_work, observer_open_phase, observer_close_phase, observer_add_impact, &
+      observer_penalty_phases, observer_fail, observer_fail_nonfinite, observer_finish, &
+      free_side_crossing, &
       NCOUNTERS, C_STEPS, C_REJECTED, C_NEWTON, C_RESIDUALS, C_FACTORIZATIONS, C_EVENTS, &
       C_JACOBIANS, C_ROOT_EVALS, C_CHATTER, NENERGY, E_KINETIC, E_RECOVERABLE, E_INPUT, E_DAMPING, &
       E_PLASTIC, E_CONTACT, E_BALANCE, E_INITIAL, E_IMPACT, NEVENT, EV_T_ON, EV_T_OFF, &
@@ -89,47 +89,36 @@ module martello_observer
       real(dp), allocatable :: prev_u(:), prev_v(:), prev_a(:)
       real(dp) :: prev_t = -1.0_dp
       real(dp), allocatable :: work(:)          !< scratch (0:n): M v
-      real(dp), allocatable :: acc(:)           !< (0:n): a C integrator's accelerations
+      !> a C integrator's accelerations (0:n), contact penetrations and forces
+      real(dp), allocatable :: acc(:), c_pen(:), c_force(:)
    end type observer_t
 
 contains
 
-   !> Whole output intervals dt until t_end is reached: the last grid point n·dt ≥ t_end
-   !> (reported as t_reached), never a shortened interval labelled t_end.
-   pure integer function output_points(t_end, dt) result(n)
-      real(dp), intent(in) :: t_end, dt
-      n = max(1, ceiling(t_end/dt*(1.0_dp - 1.0e-12_dp)))
-   end function output_points
-
    !> Size the results of a run (every integrator) and take the settings the measurement
-   !> needs: the output grid, the recording cadence and the divergence rule.
+   !> needs: the output grid t = k·dt, k ≤ n_grid (whole intervals until t_end is reached:
+   !> the last one is reported as t_reached, never a shortened one labelled t_end), the
+   !> recording cadence and the divergence rule.
    subroutine observer_init(o, s, n_nodes, n_contacts, out_nodes, out_contacts, capacity, &
                             n_links, out_links)
       type(observer_t), intent(inout) :: o
       type(integrator_settings_t), intent(in) :: s
       integer, intent(in) :: n_nodes, n_contacts, out_nodes(:), out_contacts(:), capacity, &
                              n_links, out_links(:)
+      type(observer_t) :: fresh
+      o = fresh        ! every field at its default, every array deallocated
       o%kind = s%kind; o%every = max(s%every, 1); o%divergence_factor = s%divergence_factor
-      o%n_grid = 1
-      if (s%dt > 0.0_dp .and. s%t_end > 0.0_dp) o%n_grid = output_points(s%t_end, s%dt)
+      if (s%dt > 0.0_dp .and. s%t_end > 0.0_dp) &
+         o%n_grid = max(1, ceiling(s%t_end/s%dt*(1.0_dp - 1.0e-12_dp)))
       o%out_nodes = out_nodes; o%out_contacts = out_contacts; o%out_links = out_links
       o%ncol = 1 + 3*size(out_nodes) + 2*size(out_contacts) + 2*size(out_links) + NENERGY
-      o%nrec = 0
-      if (allocated(o%hist)) deallocate (o%hist)
-      allocate (o%hist(o%ncol, max(capacity, 2)))
-      o%nevents = 0
-      if (allocated(o%ev)) deallocate (o%ev, o%ev_contact)
-      allocate (o%ev(NEVENT, 16), o%ev_contact(16))
-      if (allocated(o%u_max)) deallocate (o%u_max, o%u_min, o%v_absmax, o%a_absmax, o%pen_max, &
-                                          o%force_max, o%impacts, o%u_peak, o%t_peak, &
-                                          o%link_force_absmax, o%link_du_absmax, o%prev_u, &
-                                          o%prev_v, o%prev_a, o%work, o%acc, o%ph_open, o%ph_t, &
-                                          o%ph_v, o%ph_pen, o%ph_f)
+      allocate (o%hist(o%ncol, max(capacity, 2)), o%ev(NEVENT, 16), o%ev_contact(16))
       allocate (o%u_max(n_nodes), o%u_min(n_nodes), o%v_absmax(n_nodes), o%a_absmax(n_nodes), &
                 o%pen_max(n_contacts), o%force_max(n_contacts), o%impacts(n_contacts), &
                 o%u_peak(n_nodes), o%t_peak(n_nodes), o%link_force_absmax(n_links), &
                 o%link_du_absmax(n_links), o%prev_u(n_nodes), o%prev_v(n_nodes), &
-                o%prev_a(n_nodes), o%work(0:n_nodes), o%acc(0:n_nodes), o%ph_open(n_contacts), &
+                o%prev_a(n_nodes), o%work(0:n_nodes), o%acc(0:n_nodes), o%c_pen(n_contacts), &
+                o%c_force(n_contacts), o%ph_open(n_contacts), &
                 o%ph_t(n_contacts), o%ph_v(n_contacts), o%ph_pen(n_contacts), o%ph_f(n_contacts))
       ! NaN until a state is tracked (a run that fails before its first step)
       o%link_force_absmax = ieee_value(1.0_dp, ieee_quiet_nan)
@@ -137,12 +126,7 @@ contains
       o%u_peak = -huge(1.0_dp); o%t_peak = -1.0_dp
       o%u_max = -huge(1.0_dp); o%u_min = huge(1.0_dp); o%v_absmax = 0.0_dp
       o%a_absmax = 0.0_dp; o%pen_max = -huge(1.0_dp); o%force_max = 0.0_dp; o%impacts = 0
-      o%prev_t = -1.0_dp
       o%ph_open = .false.
-      o%energy = 0.0_dp; o%energy_balance_max = 0.0_dp
-      o%counters = 0_i8
-      o%message = ''
-      o%t_end_reached = 0.0_dp
    end subroutine observer_init
 
    !> The state at t = 0, before its first sample: the initial energies the balance starts
@@ -166,9 +150,6 @@ contains
       o%ke_corr0 = o%e0 - (o%e0 - kinetic_correction(o, m, a))
       o%energy_interval = max(energy_interval, 1)
       o%advice = advice
-      o%nsamples = -1
-      o%w_ext = 0.0_dp; o%w_abs = 0.0_dp; o%w_last = 0.0_dp
-      o%d_damp = 0.0_dp; o%d_links = 0.0_dp; o%d_contact = 0.0_dp; o%d_impact = 0.0_dp
    end subroutine observer_begin
 
    !> Work increments of one step [J], as the method has them: external work, work of the
@@ -194,16 +175,6 @@ contains
       if (present(impact)) o%d_impact = o%d_impact + impact
    end subroutine observer_work
 
-   !> Will the next sample evaluate the energies? (at recorded states, every
-   !> energy_interval-th sample, and as soon as a work is not finite). k as in
-   !> observer_sample. A method whose energy needs a correction computes it only then.
-   logical function observer_energy_due(o, k) result(due)
-      type(observer_t), intent(in) :: o
-      integer, intent(in) :: k
-      due = recorded(o, k) .or. mod(o%nsamples + 1, o%energy_interval) == 0 .or. &
-            .not. ieee_is_finite(o%w_last + o%d_damp + o%d_links + o%d_contact + o%d_impact)
-   end function observer_energy_due
-
    !> ke_aMa·aᵀMa: velocity Verlet conserves ½vᵀMv − (h²/8)aᵀMa exactly against trapezoidal
    !> work (the a-terms of ΔKE telescope), so its balance is an identity to round-off, like
    !> average acceleration's (docs/integrators.md "energy balance").
@@ -227,7 +198,8 @@ contains
 
    !> An accepted state of the run at time t (every integrator, once per accepted step and
    !> once at t = 0, after the method's phase changes of the step): phase maxima, peaks;
-   !> where due, the energy terms and the divergence test; where recorded, a history row.
+   !> the energy terms and the divergence test where recorded, every energy_interval-th
+   !> sample and as soon as a work is not finite; where recorded, a history row.
    !> k: the output grid point t = k·dt this state lies on, or −1 (a step between them).
    !> u, v, a run 0:n (0 = ground); pen, force per contact; link states where the method
    !> has them; u_prev … the previous accepted state if the method keeps it (saves a copy).
@@ -245,8 +217,9 @@ contains
       logical :: due
       integer :: c
       stat = MARTELLO_OK
-      due = observer_energy_due(o, k)
       o%nsamples = o%nsamples + 1
+      due = recorded(o, k) .or. mod(o%nsamples, o%energy_interval) == 0 .or. &
+            .not. ieee_is_finite(o%w_last + o%d_damp + o%d_links + o%d_contact + o%d_impact)
       do c = 1, size(pen)
          if (.not. o%ph_open(c)) cycle
          o%ph_pen(c) = max(o%ph_pen(c), pen(c)); o%ph_f(c) = max(o%ph_f(c), force(c))
@@ -282,7 +255,7 @@ contains
             o%divergence_factor*(o%e0 + o%w_abs), &
             ' J (divergence_factor x (initial energy + input work)); ', o%advice
          stat = MARTELLO_ERR_DIVERGED
-         call stop_at(o, t)
+         call observer_finish(o, t)
       end if
    end subroutine check_divergence
 
@@ -295,7 +268,7 @@ contains
       write (o%message, '(a,a,es12.5,a)') integrator_name(o%kind), ' diverged at t = ', t, &
          ' s: non-finite state (NaN/inf)'
       stat = MARTELLO_ERR_DIVERGED
-      call stop_at(o, t)
+      call observer_finish(o, t)
    end subroutine observer_fail_nonfinite
 
    !> The method failed (code < 0) at t_reached, saying why. The results so far stay for
@@ -308,25 +281,20 @@ contains
       integer, intent(out) :: stat
       o%message = message
       stat = code
-      call stop_at(o, t_reached)
+      call observer_finish(o, t_reached)
    end subroutine observer_fail
 
-   !> The run reached t_reached: phases still open become events with t_off = −1.
+   !> The run stops at t_reached (the end, or a failure): phases still open become events
+   !> with t_off = −1.
    subroutine observer_finish(o, t_reached)
       type(observer_t), intent(inout) :: o
       real(dp), intent(in) :: t_reached
-      call stop_at(o, t_reached)
-   end subroutine observer_finish
-
-   subroutine stop_at(o, t)
-      type(observer_t), intent(inout) :: o
-      real(dp), intent(in) :: t
       integer :: c
-      o%t_end_reached = t
+      o%t_end_reached = t_reached
       do c = 1, size(o%ph_open)
          if (o%ph_open(c)) call observer_close_phase(o, c, -1.0_dp, 0.0_dp)
       end do
-   end subroutine stop_at
+   end subroutine observer_finish
 
    !> Contact c starts a phase at t_on, approaching at v_in (δ̇ > 0).
    subroutine observer_open_phase(o, c, t_on, v_in)

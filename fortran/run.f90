@@ -10,8 +10,7 @@ module martello_run
    use martello_stability, only: mass_positive_definite
    use martello_run_checks, only: check_schemes
    use martello_observer, only: observer_t, observer_init
-   use martello_fixed_step, only: run_fixed_step
-   use martello_stepper, only: stepper_t
+   use martello_fixed_step, only: run_fixed_step, stepper_t
    use martello_generalized_alpha, only: generalized_alpha_t
    use martello_central_difference, only: central_difference_t
    use martello_moreau_jean, only: moreau_jean_t
