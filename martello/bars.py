@@ -282,7 +282,7 @@ def rod_impact_scene(N=10, L_A=1.0, L_B=1.0, wall=False, E=2.0e11, rho=7850.0, A
         contact["restitution"] = restitution
     tau = 2.0 * (L_A if wall else min(L_A, L_B)) / c
     # a whole number of steps: the structural integrators take full steps and label the
-    # last state t_end (fortran/structural_integrators.f90), so t_end must be on the grid
+    # last state t_end (fortran/fixed_step.f90), so t_end must be on the grid
     steps = math.ceil((gap / v0 + t_end_factor * tau) / dt - 1e-9)
     an = {"type": "dynamic", "integrator": integrator, "dt": dt, "t_end": steps * dt,
           "output": {"every": every}}
