@@ -168,7 +168,7 @@ static int ed_rhs(double t, const double y[], double dydt[], void *params) {
   ed_t *w = params;
   const int n = w->n;
   const double *u = y, *v = y + n;
-  double *a = dydt + n, pe = 0.0, pi = 0.0, power[3];
+  double *a = dydt + n, power[5];
   int i, st;
   w->cnt[C_RESIDUALS]++;
   st = martello_eval_forces(w->ev, t, u, v, w->fint, w->fext);
@@ -182,17 +182,11 @@ static int ed_rhs(double t, const double y[], double dydt[], void *params) {
     return GSL_EBADFUNC;
   }
   if (w->nh > 0) constrain(w, a);
-  for (i = 0; i < n; i++) {
-    dydt[i] = w->fixed[i] ? 0.0 : v[i];
-    if (!w->fixed[i]) {
-      pe += w->fext[i] * v[i];
-      pi += w->fint[i] * v[i];
-    }
-  }
-  dydt[2 * n] = pe;
-  dydt[2 * n + 1] = pi;
-  dydt[2 * n + 2] = power[1];
-  dydt[2 * n + 3] = power[2];
+  for (i = 0; i < n; i++) dydt[i] = w->fixed[i] ? 0.0 : v[i];
+  dydt[2 * n] = power[0];
+  dydt[2 * n + 1] = power[1];
+  dydt[2 * n + 2] = power[3];
+  dydt[2 * n + 3] = power[4];
   if (!all_finite(dydt, w->dim)) {
     w->rhs_status = MARTELLO_ERR_DIVERGED;
     return GSL_EBADFUNC;

@@ -368,7 +368,7 @@ static int work_quadrature(ida_problem *P, void *mem, double t0, double t1, N_Ve
   static const double xg[3] = {-0.7745966692414834, 0.0, 0.7745966692414834};
   static const double wg[3] = {5.0 / 18.0, 8.0 / 18.0, 5.0 / 18.0};
   if (!(t1 > t0)) return MARTELLO_OK;
-  double h = t1 - t0, we = 0.0, wi = 0.0, wl = 0.0, wc = 0.0, power[3];
+  double h = t1 - t0, we = 0.0, wi = 0.0, wl = 0.0, wc = 0.0, power[5];
   for (int k = 0; k < 3; k++) {
     double tk = t0 + 0.5 * h * (1.0 + xg[k]);
     int flag = IDAGetDky(mem, tk, 0, ytmp);
@@ -379,16 +379,10 @@ static int work_quadrature(ida_problem *P, void *mem, double t0, double t1, N_Ve
     int st = martello_eval_forces(P->ev, tk, P->uq, P->vq, P->fint, P->fext);
     if (st == MARTELLO_OK) st = martello_eval_power(P->ev, power);
     if (st != MARTELLO_OK) return fail(P, st, "IDA: force evaluation failed at t = %.9e s", tk);
-    double pe = 0.0, pi = 0.0;
-    for (int i = 0; i < P->n; i++) {
-      if (P->fixed[i]) continue;
-      pe += P->fext[i] * P->vq[i];
-      pi += P->fint[i] * P->vq[i];
-    }
-    we += wg[k] * pe;
-    wi += wg[k] * pi;
-    wl += wg[k] * power[1];
-    wc += wg[k] * power[2];
+    we += wg[k] * power[0];
+    wi += wg[k] * power[1];
+    wl += wg[k] * power[3];
+    wc += wg[k] * power[4];
   }
   P->dw_ext += h * we;
   P->dw_int += h * wi;

@@ -30,9 +30,10 @@ int martello_eval_forces(martello_eval *ev, double t, const double *u, const dou
 int martello_eval_solve_mass(martello_eval *ev, double *x);
 /* Accept (u, v) at the end of a step: path-dependent links (hysteresis) commit. */
 int martello_eval_commit(martello_eval *ev, const double *u, const double *v);
-/* power[3]: the power of the dampers, the other links and the penalty contacts at the last
- * force evaluation, sum of f (v_a - v_b): the integrands of martello_observer_work's split. */
-int martello_eval_power(martello_eval *ev, double power[3]);
+/* power[5] at the last force evaluation: of the external and the internal forces on the free
+ * nodes (f . v), and of the dampers, the other links and the penalty contacts (f (v_a - v_b)):
+ * the integrands of martello_observer_work's works. */
+int martello_eval_power(martello_eval *ev, double power[5]);
 int martello_eval_energy(martello_eval *ev, const double *u, const double *v, double *kinetic,
                          double *recoverable);
 

@@ -143,7 +143,7 @@ contains
 
    integer(c_int) function c_eval_power(handle, power) bind(C, name='martello_eval_power')
       type(c_ptr), value :: handle
-      real(c_double), intent(out) :: power(3)
+      real(c_double), intent(out) :: power(5)
       type(evaluator_t), pointer :: ep
       ep => get_eval(handle)
       c_eval_power = MARTELLO_ERR_ARGUMENT

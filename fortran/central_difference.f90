@@ -11,7 +11,8 @@ module martello_central_difference
       C_FACTORIZATIONS
    use martello_integrator_settings, only: integrator_settings_t
    use martello_stability, only: omega_max
-   use martello_fixed_step, only: stepper_t, stepper_rest_start, solve_free_mass, stepper_fail
+   use martello_fixed_step, only: stepper_t, stepper_rest_start, solve_free_mass, stepper_fail, &
+      contact_state
    implicit none
    private
    public :: central_difference_t
@@ -96,7 +97,7 @@ contains
          call mech_commit(m, self%ms, u, wd, wl, wc)
          call observer_work(o, damping=wd, links=wl, contact=wc)
          call observer_work(o, external=external_work(m, self%fext_n, fext, un, u))
-         self%pen = self%ms%con_pen; self%force = self%ms%con_f
+         call contact_state(self, m)
       end associate
    end subroutine step
 end module martello_central_difference

@@ -102,12 +102,20 @@ contains
       call mech_commit(ev%m, ev%ms, ev%u)
    end subroutine evaluator_commit
 
-   !> The power of the dampers, the other links and the penalty contacts at the state of the
-   !> last force evaluation (element_power).
+   !> The powers at the state of the last force evaluation: of the external and the internal
+   !> forces on the free nodes, f·v, and of the dampers, the other links and the penalty
+   !> contacts (element_power): the integrands of a run's works.
    subroutine evaluator_power(ev, power)
       type(evaluator_t), intent(in) :: ev
-      real(dp), intent(out) :: power(3)
-      call element_power(ev%m, ev%ms, ev%v, power(1), power(2), power(3))
+      real(dp), intent(out) :: power(5)
+      integer :: i
+      power(1:2) = 0.0_dp
+      do i = 1, ev%m%n
+         if (ev%m%fixed(i)) cycle
+         power(1) = power(1) + ev%fext(i)*ev%v(i)
+         power(2) = power(2) + ev%f(i)*ev%v(i)
+      end do
+      call element_power(ev%m, ev%ms, ev%v, power(3), power(4), power(5))
    end subroutine evaluator_power
 
    subroutine evaluator_energy(ev, u, v, kinetic, recoverable)

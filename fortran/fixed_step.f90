@@ -25,7 +25,7 @@ module martello_fixed_step
    implicit none
    private
    public :: run_fixed_step, stepper_t, stepper_start, stepper_rest_start, solve_free_mass, &
-      stepper_fail, newmark_kinematics
+      stepper_fail, newmark_kinematics, contact_state
 
    !> Samples between energy evaluations (kinetic and recoverable energy are two passes over
    !> the model, as dear as a cheap step): a NaN is caught at once through the works.
@@ -173,8 +173,27 @@ contains
          return
       end if
       call mech_commit(m, self%ms, self%u)
-      self%pen = self%ms%con_pen; self%force = self%ms%con_f
+      call contact_state(self, m)
    end subroutine stepper_rest_start
+
+   !> pen and force of every contact at the current state: penalty contacts from their
+   !> committed law, the others δ = u_a − u_b − gap and the force the method gives them
+   !> (a multiplier, or an impulse over impulse_step: its mean force).
+   subroutine contact_state(self, m, rigid_force, impulse_step)
+      class(stepper_t), intent(inout) :: self
+      type(model_t), intent(in) :: m
+      real(dp), intent(in), optional :: rigid_force(:), impulse_step
+      integer :: k
+      do k = 1, m%ncontact
+         if (self%ms%is_penalty(k)) then
+            self%pen(k) = self%ms%con_pen(k); self%force(k) = self%ms%con_f(k)
+         else
+            self%pen(k) = self%u(m%con_a(k)) - self%u(m%con_b(k)) - m%con_gap(k)
+            self%force(k) = rigid_force(k)
+            if (present(impulse_step)) self%force(k) = rigid_force(k)/impulse_step
+         end if
+      end do
+   end subroutine contact_state
 
    !> rhs ← M⁻¹ rhs on the free nodes (fixed rows and rhs entries 0); mband of the model's
    !> bandwidth, reassembled here. ok = .false. if M is singular there.

@@ -13,7 +13,8 @@ module martello_generalized_alpha
    use martello_observer, only: observer_t, observer_work, observer_fail, C_NEWTON, C_RESIDUALS, &
       C_FACTORIZATIONS, C_JACOBIANS, C_CHATTER
    use martello_integrator_settings
-   use martello_fixed_step, only: stepper_t, stepper_rest_start, stepper_fail, newmark_kinematics
+   use martello_fixed_step, only: stepper_t, stepper_rest_start, stepper_fail, newmark_kinematics, &
+      contact_state
    implicit none
    private
    public :: generalized_alpha_t, generalized_alpha_coefficients
@@ -101,7 +102,7 @@ contains
       call mech_commit(m, self%ms, self%u, wd, wl, wc)
       call observer_work(o, damping=wd, links=wl, contact=wc)
       call observer_work(o, external=external_work(m, self%fext_n, self%fext, self%un, self%u))
-      self%pen = self%ms%con_pen; self%force = self%ms%con_f
+      call contact_state(self, m)
 
    contains
 

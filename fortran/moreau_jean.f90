@@ -36,7 +36,7 @@ module martello_moreau_jean
    use martello_observer, only: observer_t, observer_work, observer_fail, observer_open_phase, &
       observer_close_phase, C_NEWTON, C_RESIDUALS, C_FACTORIZATIONS, C_EVENTS, C_JACOBIANS
    use martello_integrator_settings, only: integrator_settings_t
-   use martello_fixed_step, only: stepper_t, stepper_start
+   use martello_fixed_step, only: stepper_t, stepper_start, contact_state
    use martello_lcp, only: lcp_lemke, lcp_pgs, LCP_OK
    use martello_linalg, only: lapack_status
    implicit none
@@ -106,7 +106,7 @@ contains
       call external_forces(m, self%mrow, 0.0_dp, self%fext)
       o%counters(C_RESIDUALS) = o%counters(C_RESIDUALS) + 1_i8
       o%counters(C_JACOBIANS) = o%counters(C_JACOBIANS) + 1_i8
-      call contact_state(self, m)
+      call contact_state(self, m, self%p, self%h)
 
    contains
 
@@ -138,22 +138,6 @@ contains
          end associate
       end subroutine node_adjacency
    end subroutine init
-
-   !> Penetration and force of every contact at the current state: penalty contacts from
-   !> the committed law, rigid ones δ = u_a − u_b − gap and the mean force p/h.
-   subroutine contact_state(self, m)
-      class(moreau_jean_t), intent(inout) :: self
-      type(model_t), intent(in) :: m
-      integer :: k
-      do k = 1, m%ncontact
-         if (self%rigid(k)) then
-            self%pen(k) = self%u(m%con_a(k)) - self%u(m%con_b(k)) - m%con_gap(k)
-            self%force(k) = self%p(k)/self%h
-         else
-            self%pen(k) = self%ms%con_pen(k); self%force(k) = self%ms%con_f(k)
-         end if
-      end do
-   end subroutine contact_state
 
    !> One step: free velocity, index set, impulses, positions; the smooth forces and their
    !> tangents committed at the new state; works and the phases of the rigid contacts.
@@ -249,7 +233,7 @@ contains
             call observer_work(o, impact=-gdot_theta*p(c))
          end do
       end associate
-      call contact_state(self, m)
+      call contact_state(self, m, self%p, self%h)
       call rigid_phases()
 
    contains

@@ -39,7 +39,7 @@ module martello_newmark_lagrange
       observer_close_phase, free_side_crossing, C_REJECTED, C_NEWTON, C_RESIDUALS, &
       C_FACTORIZATIONS, C_EVENTS
    use martello_integrator_settings, only: integrator_settings_t
-   use martello_fixed_step, only: stepper_t, stepper_start, newmark_kinematics
+   use martello_fixed_step, only: stepper_t, stepper_start, newmark_kinematics, contact_state
    use martello_linalg, only: solve_symmetric_indefinite
    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
    implicit none
@@ -115,7 +115,7 @@ contains
       call external_forces(m, self%mrow, 0.0_dp, self%fext)
       call equilibrium_acceleration(self, m, 0.0_dp, o, converged, stat)
       if (.not. converged) return
-      call contact_state(self, m)
+      call contact_state(self, m, self%lam)
    end subroutine init
 
    !> 1/(B M⁻¹ Bᵀ) of contact cc (M restricted to the free nodes).
@@ -129,10 +129,7 @@ contains
       x = 0.0_dp
       if (self%sa(cc) > 0) x(self%sa(cc)) = -1.0_dp
       if (self%sb(cc) > 0) x(self%sb(cc)) = 1.0_dp
-      do st = 1, size(self%fixed_nodes)
-         mm(self%fixed_nodes(st), :) = 0.0_dp; mm(:, self%fixed_nodes(st)) = 0.0_dp
-         mm(self%fixed_nodes(st), self%fixed_nodes(st)) = 1.0_dp
-      end do
+      call kkt_constraints(self, mm, [0], 0)      ! the fixed nodes pinned
       call solve_symmetric_indefinite(mm, x, rc, st, msg)
       effective_mass = 0.0_dp
       if (st /= MARTELLO_OK) return
@@ -211,16 +208,6 @@ contains
          kkt(i, i) = 1.0_dp
       end do
    end subroutine kkt_constraints
-
-   subroutine contact_state(self, m)
-      class(newmark_lagrange_t), intent(inout) :: self
-      type(model_t), intent(in) :: m
-      integer :: k
-      do k = 1, m%ncontact
-         self%pen(k) = self%u(m%con_a(k)) - self%u(m%con_b(k)) - m%con_gap(k)
-         self%force(k) = self%lam(k)
-      end do
-   end subroutine contact_state
 
    !> One step: the trial with the persistent contacts held, then, if a free contact closed,
    !> the impact step with (β, γ) tuned to Newton's law; works and phases to the observer.
@@ -318,7 +305,7 @@ contains
          call observer_work(o, damping=wdl, links=wll, contact=wcl)
          call observer_work(o, external=external_work(m, self%fext_n, fext, un, u))
       end associate
-      call contact_state(self, m)
+      call contact_state(self, m, self%lam)
       call phases()
       ! the impulsive acceleration of an impact step must not enter the next predictor
       if (impact) call equilibrium_acceleration(self, m, t, o, converged, stat)
