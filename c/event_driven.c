@@ -3,7 +3,8 @@
  *
  *  - The state y = [u; v; W_ext; W_int; W_links; W_contact] (n nodes; the work integrals
  *    of the external forces, of all internal forces, of the links other than dampers and of
- *    the penalty contacts ride along outside the error control) is advanced by gsl_odeiv2_evolve_apply one accepted step at a time,
+ *    the penalty contacts ride along outside the error control) is advanced by
+ *    gsl_odeiv2_evolve_apply one accepted step at a time,
  *    stepping exactly onto the output times. Every accepted step commits the path-dependent
  *    link states (martello_eval_commit) and is a sample of the run's observer, which
  *    measures it as it measures every integrator (martello_observer_*, docs/run-layer.md).
@@ -250,13 +251,6 @@ static void kinematics(const ed_t *w, const double *y, const double *a, double *
   }
 }
 
-/* Is contact j in a contact phase (a penalty contact in contact, a held unilateral one)? */
-static int in_phase(const ed_t *w, int j) {
-  int open = 0;
-  martello_observer_get_phase(w->obs, j, &open);
-  return open;
-}
-
 /* ---- persistent contacts --------------------------------------------------------------- */
 
 static int factor_held(ed_t *w, double t) {
@@ -462,10 +456,10 @@ static int process_events(ed_t *w, double t) {
   kinematics(w, w->y, w->f + w->n, w->pen, w->rate, NULL);
   for (j = 0; j < w->nc; j++) {
     if (!w->is_pen[j] || w->inert[j]) continue;
-    if (w->pen[j] > 0.0 && !in_phase(w, j)) {
+    if (w->pen[j] > 0.0 && !martello_observer_in_phase(w->obs, j)) {
       martello_observer_set_phase(w->obs, j, 1, t, w->rate[j]);
       w->cnt[C_EVENTS]++;
-    } else if (!(w->pen[j] > 0.0) && in_phase(w, j)) {
+    } else if (!(w->pen[j] > 0.0) && martello_observer_in_phase(w->obs, j)) {
       martello_observer_set_phase(w->obs, j, 0, t, w->rate[j]);
       w->cnt[C_EVENTS]++;
     }
@@ -928,8 +922,7 @@ static int ed_integrate(ed_t *w) {
       return martello_observer_fail(w->obs, MARTELLO_ERR_ARGUMENT, 0.0, w->msg);
     }
   }
-  /* energies at every sample: an adaptive step costs far more than their evaluation */
-  st = martello_observer_begin(w->obs, w->ev, w->y, w->y + n, 1, "tighten rtol and atol");
+  st = martello_observer_begin(w->obs, w->ev, w->y, w->y + n, "tighten rtol and atol");
   if (st != MARTELLO_OK) return fail(w, st, 0.0, "event-driven: martello_observer_begin failed");
   st = process_events(w, 0.0);
   if (st == MARTELLO_OK) st = commit(w, 0.0, w->y + 2 * n);
@@ -951,7 +944,8 @@ static int ed_integrate(ed_t *w) {
     if (st != GSL_SUCCESS) return gsl_failure(w, st, t, hs);
     if (t < t_out) h = hs;   /* the last step onto an output time keeps the suggestion */
     w->cnt[C_STEPS]++;
-    /* the step end (a non-finite state stops the RHS here: a divergence): gap kinematics and multipliers, then the earliest event inside */
+    /* the step end (a non-finite state stops the RHS here: a divergence): gap kinematics
+     * and multipliers, then the earliest event inside */
     st = eval_point(w, t, w->y, w->f1, w->lam1);
     if (st != MARTELLO_OK) return fail_eval(w, st, t);
     kinematics(w, w->y, w->f1 + n, w->pen1, w->rate1, w->acc1);

@@ -108,12 +108,6 @@ static int fail(ida_problem *P, int code, const char *fmt, ...) {
   return martello_observer_fail(P->obs, code, P->t_now, buf);
 }
 
-/* A phase open on contact j: a penalty contact in contact, a closed rigid contact. */
-static int touching(const ida_problem *P, int j) {
-  int open = 0;
-  martello_observer_get_phase(P->obs, j, &open);
-  return open;
-}
 
 static double node_u(int i, const double *u) { return i < 0 ? 0.0 : u[i]; }
 
@@ -629,7 +623,7 @@ static int prepare_restart(ida_problem *P, double t, double *u, double *v, N_Vec
         martello_observer_set_phase(P->obs, j, 1, t, w_in);
       else if (P->hit[r])
         martello_observer_add_impact(P->obs, j, t, w_in, pen_rate(P, j, v), 0.0, 0.0);
-    } else if (P->opened[r] && touching(P, j)) {
+    } else if (P->opened[r] && martello_observer_in_phase(P->obs, j)) {
       martello_observer_set_phase(P->obs, j, 0, t, pen_rate(P, j, v));
     }
   }
@@ -693,11 +687,11 @@ static int classify_roots(ida_problem *P, void *mem, double t_last, double tret,
     if (!found[2 * j + 1] || found[2 * j]) continue;
     if (r >= 0 && P->closed[r]) continue;
     double d = penetration(P, j, P->u);
-    int want = ACT_NONE;
+    int want = ACT_NONE, touching = martello_observer_in_phase(P->obs, j);
     if (r < 0) {
       /* a penalty contact at its deepest in contact: the exact peak, sampled there */
-      if (!touching(P, j) && d > 0.0) want = ACT_ONSET;
-      else if (touching(P, j) && d < 0.0) want = ACT_SEPARATION;
+      if (!touching && d > 0.0) want = ACT_ONSET;
+      else if (touching && d < 0.0) want = ACT_SEPARATION;
     } else if (d > 0.0) {
       want = ACT_IMPACT;
     }
@@ -718,11 +712,11 @@ static int classify_roots(ida_problem *P, void *mem, double t_last, double tret,
   }
   int any = 0;
   for (int j = 0; j < P->nc; j++) {
-    int r = P->rig[j], dir = found[2 * j];
+    int r = P->rig[j], dir = found[2 * j], touching = martello_observer_in_phase(P->obs, j);
     if (dir == 0) continue;
     if (r < 0) {
-      if (dir > 0 && !touching(P, j)) P->act[j] = ACT_ONSET;
-      else if (dir < 0 && touching(P, j)) P->act[j] = ACT_SEPARATION;
+      if (dir > 0 && !touching) P->act[j] = ACT_ONSET;
+      else if (dir < 0 && touching) P->act[j] = ACT_SEPARATION;
     } else if (!P->closed[r]) {
       if (dir > 0) P->act[j] = ACT_IMPACT;
     } else if (dir < 0) {
@@ -766,7 +760,7 @@ static int boundary_events(ida_problem *P, void *mem, double t_last, double tret
   for (int i = 0; i < P->n; i++) vmax = fmax(vmax, fabs(P->v[i]));
   double wtol = 10.0 * (P->rtol * vmax + P->atol);
   for (int j = 0; j < P->nc; j++) {
-    int r = P->rig[j], want = ACT_NONE;
+    int r = P->rig[j], want = ACT_NONE, touching = martello_observer_in_phase(P->obs, j);
     if (r >= 0 && P->closed[r]) continue;
     double d = penetration(P, j, P->u), w = pen_rate(P, j, P->v);
     /* on the surface within round-off of the gap, or of the time */
@@ -776,14 +770,14 @@ static int boundary_events(ida_problem *P, void *mem, double t_last, double tret
     /* ... and moving across it faster than the integration error of a rate: two bodies
      * that travel together at zero gap are not a new event */
     if (r < 0) {
-      if (!touching(P, j) && (d > 0.0 || (d >= -on && w > wtol))) want = ACT_ONSET;
-      else if (touching(P, j) && (d < 0.0 || (d <= on && w < -wtol))) want = ACT_SEPARATION;
+      if (!touching && (d > 0.0 || (d >= -on && w > wtol))) want = ACT_ONSET;
+      else if (touching && (d < 0.0 || (d <= on && w < -wtol))) want = ACT_SEPARATION;
     } else if (d > 0.0 || (d >= -on && w > wtol)) {
       want = ACT_IMPACT;
     }
     if (want == ACT_NONE) continue;
     double tc = tret;
-    int wrong_side = r < 0 ? (touching(P, j) ? d < 0.0 : d > 0.0) : d > 0.0;
+    int wrong_side = r < 0 ? (touching ? d < 0.0 : d > 0.0) : d > 0.0;
     if (wrong_side && fabs(d) > on && tret > t_last) {
       int st = locate(P, mem, j, t_last, tret, ytmp, &tc);
       if (st != MARTELLO_OK) return st;
@@ -991,8 +985,7 @@ static int integrate(ida_problem *P, SUNContext sunctx, void **memp, N_Vector yy
       if (d >= -htol && w >= -vtol) P->act[j] = ACT_IMPACT;
     }
   }
-  /* energies at every sample: an adaptive step costs far more than their evaluation */
-  if ((st = martello_observer_begin(P->obs, P->ev, u0, v0, 1, "tighten rtol and atol")) != MARTELLO_OK)
+  if ((st = martello_observer_begin(P->obs, P->ev, u0, v0, "tighten rtol and atol")) != MARTELLO_OK)
     return fail(P, st, "IDA: martello_observer_begin failed");
   if ((st = prepare_restart(P, 0.0, u0, v0, yy, yp)) != MARTELLO_OK) return st;
 

@@ -41,14 +41,12 @@ int martello_eval_energy(martello_eval *ev, const double *u, const double *v, do
 int martello_run_settings(const martello_run *run, int *kind, double par[MARTELLO_NPAR_INTEGRATOR]);
 int martello_run_observer(martello_run *run, martello_observer **obs);
 
-/* The observer's contract (docs/run-layer.md). Every call returns MARTELLO_OK or
- * MARTELLO_ERR_ARGUMENT (a null handle, a contact out of range) unless said otherwise.
- *
- * begin: the initial state (u, v) at t = 0, before its first sample: the energies the
- * balance starts from. energy_interval: samples between energy evaluations (1: every one);
- * advice ends a divergence message. */
+/* The observer's contract (docs/run-layer.md); MARTELLO_OK, or MARTELLO_ERR_ARGUMENT for a
+ * null handle or a contact out of range, unless said otherwise.
+ * begin: the state (u, v) at t = 0 before its first sample (the energies the balance starts
+ * from; energies at every sample); advice ends a divergence message. */
 int martello_observer_begin(martello_observer *obs, martello_eval *ev, const double *u,
-                            const double *v, int energy_interval, const char *advice);
+                            const double *v, const char *advice);
 /* An accepted state at t, committed in ev, after the phase changes found at t: peaks, phase
  * maxima, energy terms and the divergence test, a history row where recorded. force: the
  * force of each contact that is not a penalty one (the link states, penetrations and
@@ -62,11 +60,11 @@ int martello_observer_sample(martello_observer *obs, martello_eval *ev, double t
  * internal - links - contacts. */
 int martello_observer_work(martello_observer *obs, double w_ext, double w_int, double w_links,
                            double w_contact, double w_impact);
-/* Contact phases located by the method: set open = 1 starts one at t approaching at v, 0
- * ends the open one at t leaving at v; get: *open = 1 while one is open. An impact is an
+/* Contact phases located by the method: open = 1 starts one at t approaching at v, 0 ends
+ * the open one at t leaving at v; in_phase is 1 while one is open (else 0). An impact is an
  * instantaneous phase with its penetration and impulse. */
 int martello_observer_set_phase(martello_observer *obs, int contact, int open, double t, double v);
-int martello_observer_get_phase(const martello_observer *obs, int contact, int *open);
+int martello_observer_in_phase(const martello_observer *obs, int contact);
 int martello_observer_add_impact(martello_observer *obs, int contact, double t, double v_in,
                                  double v_out, double pen, double impulse);
 int martello_observer_add_counts(martello_observer *obs, const long long inc[MARTELLO_NCOUNTERS]);

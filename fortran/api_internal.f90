@@ -198,11 +198,12 @@ contains
       c_run_observer = MARTELLO_OK
    end function c_run_observer
 
-   integer(c_int) function c_observer_begin(handle, ehandle, u, v, energy_interval, advice) &
+   !> The C integrators evaluate the energies at every sample: an adaptive step costs far
+   !> more than their evaluation.
+   integer(c_int) function c_observer_begin(handle, ehandle, u, v, advice) &
       bind(C, name='martello_observer_begin')
       type(c_ptr), value :: handle, ehandle
       real(c_double), intent(in) :: u(*), v(*)
-      integer(c_int), value :: energy_interval
       character(kind=c_char), intent(in) :: advice(*)
       type(observer_t), pointer :: op
       type(evaluator_t), pointer :: ep
@@ -212,8 +213,7 @@ contains
       call evaluator_load(ep, u(1:ep%m%n), v(1:ep%m%n))
       ! the C integrators conserve ½vᵀMv itself (no Verlet correction): a = 0 serves
       op%acc = 0.0_dp
-      call observer_begin(op, ep%m, ep%ms, ep%u, ep%v, op%acc, int(energy_interval), &
-                          c_string(advice), 0.0_dp)
+      call observer_begin(op, ep%m, ep%ms, ep%u, ep%v, op%acc, 1, c_string(advice), 0.0_dp)
       c_observer_begin = MARTELLO_OK
    end function c_observer_begin
 
@@ -287,18 +287,15 @@ contains
       c_observer_add_impact = MARTELLO_OK
    end function c_observer_add_impact
 
-   integer(c_int) function c_observer_get_phase(handle, contact, open) bind(C, name='martello_observer_get_phase')
+   !> 1 while contact is in a phase, else 0 (also for a null handle or a contact out of range).
+   integer(c_int) function c_observer_in_phase(handle, contact) bind(C, name='martello_observer_in_phase')
       type(c_ptr), value :: handle
       integer(c_int), value :: contact
-      integer(c_int), intent(out) :: open
       type(observer_t), pointer :: op
       op => observer_of(handle, contact)
-      open = 0
-      c_observer_get_phase = MARTELLO_ERR_ARGUMENT
-      if (.not. associated(op)) return
-      open = merge(1, 0, op%ph_open(contact + 1))
-      c_observer_get_phase = MARTELLO_OK
-   end function c_observer_get_phase
+      c_observer_in_phase = 0
+      if (associated(op)) c_observer_in_phase = merge(1, 0, op%ph_open(contact + 1))
+   end function c_observer_in_phase
 
    integer(c_int) function c_observer_add_counts(handle, inc) bind(C, name='martello_observer_add_counts')
       type(c_ptr), value :: handle

@@ -1,16 +1,10 @@
-!> The fixed-step strategy (docs/run-layer.md) and the interface of its one-step methods.
-!>
-!> The strategy is one time loop for every stepper: steps t_k = k·h, k = 1 … n until t_end
-!> is reached (the last t_k ≥ t_end is reported as t_reached, never a shortened step
-!> labelled t_end), the phases of the penalty contacts located on the free side of each
-!> step, and one observer sample per accepted step; a failed step stops the run with the
-!> stepper's message.
-!>
-!> A stepper owns one step of its method — the state it advances, its solves, the contact
-!> problem of its impulses — and hands the observer what only it knows: work increments,
-!> the phases of the contacts it resolves itself, its cost counters and failures. A new
-!> fixed-step integrator extends stepper_t with init and step in one file, plus one row of
-!> the integrator registry and one case of run_dynamic's dispatch.
+!> The fixed-step strategy and the interface of its one-step methods (docs/run-layer.md):
+!> one time loop, t_k = k·h until t_end is reached (never a shortened step), the phases of
+!> the penalty contacts located on the free side of each step, one observer sample per
+!> step. A stepper owns one step of its method — its state, its solves, its impulses — and
+!> hands the observer its work increments, the phases it resolves itself, its counters and
+!> failures. A new fixed-step integrator: a type extending stepper_t (init, step) in one
+!> file, one row of the integrator registry, one case of run_dynamic's dispatch.
 module martello_fixed_step
    use martello_kinds, only: dp, i8
    use martello_status

@@ -265,7 +265,7 @@ contains
                   return
                end if
                if (it >= 2) then
-                  call line_search(rnorm)
+                  call line_search()
                else
                   u(1:n) = u(1:n) + du
                end if
@@ -276,30 +276,18 @@ contains
       !> Backtracking on ‖r‖∞ once plain Newton has taken two steps without converging: laws
       !> whose tangent is unbounded at first touch (Jankowski: ∂F/∂δ ~ δ^{−3/4}) or that switch
       !> branch inside a step make full steps overshoot; halving restores a decrease.
-      subroutine line_search(r0)
-         real(dp), intent(in) :: r0
-         real(dp) :: lam, rtrial
+      subroutine line_search()
+         real(dp) :: lam, r0
          integer :: k
-         associate (u => self%u, v => self%v, a => self%a, fint => self%fint, &
-                    fint_n => self%fint_n, fext => self%fext, fext_n => self%fext_n, &
-                    res => self%res, du => self%du, work => self%work, ma => self%ma, &
-                    man => self%man, am => self%am, af => self%af)
-            work(1:n) = u(1:n)
-            lam = 1.0_dp
-            do k = 1, 12
-               u(1:n) = work(1:n) + lam*du
-               call newmark_kinematics(self, self%beta, self%gamma)
-               call internal_forces(m, self%ms, u, v, fint)
-               call mass_times(m, a, ma)
-               res = (1.0_dp - am)*ma + am*man + (1.0_dp - af)*fint + af*fint_n &
-                     - (1.0_dp - af)*fext - af*fext_n
-               res(self%fixed_nodes) = 0.0_dp
-               o%counters(C_RESIDUALS) = o%counters(C_RESIDUALS) + 1_i8
-               rtrial = maxval(abs(res(1:n)))
-               if (rtrial < r0) return
-               lam = 0.5_dp*lam
-            end do
-         end associate
+         r0 = rnorm
+         self%work(1:n) = self%u(1:n)
+         lam = 1.0_dp
+         do k = 1, 12
+            self%u(1:n) = self%work(1:n) + lam*self%du
+            call evaluate(.false.)       ! the residual alone
+            if (rnorm < r0) return
+            lam = 0.5_dp*lam
+         end do
       end subroutine line_search
    end subroutine step
 end module martello_generalized_alpha

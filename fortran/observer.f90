@@ -1,13 +1,9 @@
-!> The observer of a dynamic run (docs/run-layer.md): everything measured along a run,
-!> whatever integrator makes it — the decimated history and its recording cadence, contact
-!> phases and their events, peaks over every accepted state, the energy balance, divergence
-!> detection, the cost counters and the final message. The fixed-step strategy
-!> (martello_fixed_step) and the C integrators (through c/martello_internal.h) hand it what
-!> their method knows — accepted states, work increments, phase changes located exactly —
-!> and it measures every method the same way.
-!>
-!> results_t is what a finished run exposes (read by martello_api_results); observer_t adds
-!> the working state of the measurement (open phases, work accumulators, initial energies).
+!> The observer of a dynamic run (docs/run-layer.md): the history and its recording
+!> cadence, contact phases, peaks, the energy balance, divergence detection, the counters
+!> and the final message, for every integrator. The methods (martello_fixed_step's steppers,
+!> the C integrators through c/martello_internal.h) hand it accepted states, work
+!> increments and the phase changes they locate. results_t is what a finished run exposes
+!> (martello_api_results); observer_t adds the working state of the measurement.
 module martello_observer
    use martello_kinds, only: dp, i8
    use martello_status
@@ -152,12 +148,11 @@ contains
       o%advice = advice
    end subroutine observer_begin
 
-   !> Work increments of one step [J], as the method has them: external work, work of the
-   !> dampers, of the other links and of the penalty contacts (mech_commit's trapezoidal
-   !> element works), and the kinetic energy the impulses took out. A method that integrates
-   !> the total internal power more accurately than the element split (the adaptive C
-   !> integrators) hands it as internal: damping is then internal − links − contact, so the
-   !> balance keeps the method's own accuracy.
+   !> Work increments of one step [J]: external, of the dampers, of the other links and of
+   !> the penalty contacts (a fixed step: mech_commit's trapezoidal works), and the kinetic
+   !> energy impulses took out. A method that integrates the works along its solution (the C
+   !> integrators) may hand the total internal work instead of the dampers': damping is then
+   !> internal − links − contact.
    subroutine observer_work(o, external, damping, links, contact, impact, internal)
       type(observer_t), intent(inout) :: o
       real(dp), intent(in), optional :: external, damping, links, contact, impact, internal
@@ -196,14 +191,12 @@ contains
       if (k > 0) recorded = mod(k, o%every) == 0 .or. k >= o%n_grid
    end function recorded
 
-   !> An accepted state of the run at time t (every integrator, once per accepted step and
-   !> once at t = 0, after the method's phase changes of the step): phase maxima, peaks;
-   !> the energy terms and the divergence test where recorded, every energy_interval-th
-   !> sample and as soon as a work is not finite; where recorded, a history row.
-   !> k: the output grid point t = k·dt this state lies on, or −1 (a step between them).
-   !> u, v, a run 0:n (0 = ground); pen, force per contact; link states where the method
-   !> has them; u_prev … the previous accepted state if the method keeps it (saves a copy).
-   !> stat: MARTELLO_ERR_DIVERGED with the message set when the run must stop.
+   !> An accepted state at t (once per accepted step and at t = 0, after the step's phase
+   !> changes): phase maxima and peaks; the energy terms and the divergence test where
+   !> recorded, every energy_interval-th sample and once a work is not finite; a history row
+   !> where recorded. k: the grid point t = k·dt of the state, or −1. u, v, a on nodes 0:n;
+   !> u_prev … the previous state if the method keeps it (saves a copy). stat:
+   !> MARTELLO_ERR_DIVERGED, with the message, when the run must stop.
    subroutine observer_sample(o, m, ms, t, u, v, a, pen, force, k, stat, link_f, link_du, &
                               u_prev, v_prev, a_prev)
       type(observer_t), intent(inout) :: o
@@ -245,8 +238,9 @@ contains
       real(dp), intent(in) :: t, e_mech, u(0:), v(0:)
       integer, intent(out) :: stat
       stat = MARTELLO_OK
-      if (.not. (ieee_is_finite(e_mech) .and. all(ieee_is_finite(u)) .and. all(ieee_is_finite(v)) &
-                 .and. ieee_is_finite(o%w_ext + o%d_damp + o%d_links + o%d_contact + o%d_impact))) then
+      if (.not. (ieee_is_finite(e_mech) .and. all(ieee_is_finite(u)) .and. &
+                 all(ieee_is_finite(v)) .and. &
+                 ieee_is_finite(o%w_ext + o%d_damp + o%d_links + o%d_contact + o%d_impact))) then
          call observer_fail_nonfinite(o, t, stat)
       else if (e_mech > o%divergence_factor*(o%e0 + o%w_abs) + tiny(1.0_dp) .and. &
                o%e0 + o%w_abs > 0.0_dp) then
