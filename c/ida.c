@@ -970,14 +970,14 @@ static int integrate(ida_problem *P, SUNContext sunctx, void **memp, N_Vector yy
     return fail(P, st, "IDA: force evaluation failed while probing the bandwidth");
   int banded = 2 * bw + 1 < P->N / 2;
 
-  /* initial contact states: penalty contacts already penetrated are in a phase from t = 0;
-   * rigid contacts at zero gap that approach or rest are resolved as impacts at t = 0 */
+  /* initial contact states: penalty contacts already penetrated are in a phase from t = 0
+   * (the observer opens it); rigid contacts at zero gap that approach or rest are resolved as
+   * impacts at t = 0 */
   double vtol = speed_tol(P, v0);
   for (int j = 0; j < P->nc; j++) {
     double d = penetration(P, j, u0), w = pen_rate(P, j, v0);
     if (P->rig[j] < 0) {
-      if (d > 0.0) martello_observer_set_phase(P->obs, j, 1, 0.0, w);
-      else if (d == 0.0 && w > 0.0) P->act[j] = ACT_ONSET;
+      if (d == 0.0 && w > 0.0) P->act[j] = ACT_ONSET;
     } else {
       double htol = height_tol(P, j, u0);
       if (d > htol)

@@ -15,7 +15,7 @@ module martello_fixed_step
    use martello_integrator_settings, only: integrator_settings_t
    use martello_run_checks, only: check_run_settings
    use martello_observer, only: observer_t, observer_begin, observer_sample, observer_fail, &
-      observer_open_phase, observer_penalty_phases, observer_finish, C_STEPS, C_FACTORIZATIONS
+      observer_penalty_phases, observer_finish, C_STEPS, C_FACTORIZATIONS
    implicit none
    private
    public :: run_fixed_step, stepper_t, stepper_start, stepper_rest_start, solve_free_mass, &
@@ -83,7 +83,7 @@ contains
       type(observer_t), intent(inout) :: o
       class(stepper_t), intent(inout) :: stp
       integer, intent(out) :: stat
-      integer :: k, c
+      integer :: k
       real(dp) :: t
 
       call check_run_settings(m, s, o%message, stat)
@@ -91,11 +91,6 @@ contains
       call stp%init(m, s, o, stat)
       if (stat /= MARTELLO_OK) return
       call observer_begin(o, m, stp%ms, stp%u, stp%v, stp%a, ENERGY_CHECK, stp%advice, stp%ke_aMa)
-      ! contacts already closed at t = 0 start a contact phase there (no approach to locate)
-      do c = 1, m%ncontact
-         if (stp%ms%con_on(c)) &
-            call observer_open_phase(o, c, 0.0_dp, stp%v(m%con_a(c)) - stp%v(m%con_b(c)))
-      end do
       t = 0.0_dp
       call sample(0)
       if (stat /= MARTELLO_OK) return

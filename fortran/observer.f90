@@ -126,7 +126,7 @@ contains
    end subroutine observer_init
 
    !> The state at t = 0, before its first sample: the initial energies the balance starts
-   !> from. energy_interval: samples between energy evaluations (the strategy's choice: 16
+   !> from, and a phase opened at t = 0 for every penalty contact closed there. energy_interval: samples between energy evaluations (the strategy's choice: 16
    !> for cheap fixed steps, 1 for adaptive ones); advice ends a divergence message;
    !> ke_aMa: the method conserves ½vᵀMv − ke_aMa·aᵀMa (Verlet; 0 for the others).
    subroutine observer_begin(o, m, ms, u, v, a, energy_interval, advice, ke_aMa)
@@ -138,6 +138,10 @@ contains
       character(len=*), intent(in) :: advice
       real(dp), intent(in) :: ke_aMa
       real(dp) :: e_kin
+      integer :: c
+      do c = 1, m%ncontact
+         if (ms%con_on(c)) call observer_open_phase(o, c, 0.0_dp, v(m%con_a(c)) - v(m%con_b(c)))
+      end do
       e_kin = kinetic_energy(m, v, o%work)
       call recoverable_energy(m, ms, u, o%e_links0, o%e_cont0)
       o%e0 = e_kin + o%e_links0 + o%e_cont0

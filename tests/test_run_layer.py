@@ -194,3 +194,22 @@ def test_history_is_recorded_on_the_same_grid_by_every_integrator(integrator):
     t_end = 0.1013 if integrator in ADAPTIVE else 0.102
     assert s["t_reached"] == pytest.approx(t_end, abs=1e-15)
     np.testing.assert_allclose(h["t"], np.r_[np.arange(0, 21) * 5e-3, t_end], rtol=0, atol=1e-15)
+
+
+@pytest.mark.parametrize("integrator", FIXED + ADAPTIVE)
+def test_a_contact_closed_at_t0_opens_its_phase_there(integrator):
+    # A mass released at rest pressed δ0 into a linear penalty wall: δ = δ0 cos ωt, so the
+    # phase starts at t = 0 with v_in = 0, its deepest state is the initial one (δ0), and it
+    # ends at π/(2ω) leaving at −δ0 ω. Bounds as for the walls above (ω = 100 rad/s, h = 1e-5).
+    d0 = 1e-3
+    d = walls_scene(integrator, rigid=False)
+    d["node"][0].update(u0=GR + d0, v0=0.0)
+    d["analysis"] = analysis(integrator, 0.05, h=1e-5)
+    s, _ = execute(d)
+    c = s["contacts"]["right"]
+    w = math.sqrt(KW / M)
+    assert c["impacts"] == 1 and c["impact_times"] == [0.0] and c["approach_speeds"] == [0.0]
+    assert c["phase_max_penetration"][0] == pytest.approx(d0, rel=1e-9)
+    assert c["separation_times"][0] == pytest.approx(0.5 * math.pi / w, abs=1e-7)
+    assert c["separation_speeds"][0] == pytest.approx(-d0 * w, rel=1e-5)
+    assert s["contacts"]["left"]["impacts"] == 0
