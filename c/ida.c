@@ -689,7 +689,7 @@ static int classify_roots(ida_problem *P, void *mem, double t_last, double tret,
     double d = penetration(P, j, P->u);
     int want = ACT_NONE, touching = martello_observer_in_phase(P->obs, j);
     if (r < 0) {
-      /* a penalty contact at its deepest in contact: the exact peak, sampled there */
+      /* touching with d > 0: the deepest point, sampled there as an accepted state */
       if (!touching && d > 0.0) want = ACT_ONSET;
       else if (touching && d < 0.0) want = ACT_SEPARATION;
     } else if (d > 0.0) {
@@ -1092,8 +1092,8 @@ static int integrate(ida_problem *P, SUNContext sunctx, void **memp, N_Vector yy
       }
       if ((st = hand_work(P)) != MARTELLO_OK) break;
     }
-    /* an output time reached (tstop), or passed within round-off by a restart: the grid
-     * point k_out every of the output interval dt (the observer records it) */
+    /* an output time reached (tstop), or passed within round-off by a restart: grid point
+     * k_out·every of the output interval dt (the observer records it) */
     int at_output = (flag == IDA_TSTOP_RETURN && t_r == tret) || t_out - t_r <= 1e-9 * P->out_dt;
     if ((st = observe(P, t_r, N_VGetArrayPointer(yy), N_VGetArrayPointer(yp),
                       at_output ? k_out * P->every : -1)) != MARTELLO_OK)
