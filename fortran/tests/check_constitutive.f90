@@ -3,7 +3,7 @@
 !> "N passed, M failed"; stops with status 1 if anything failed.
 program check_constitutive
    use, intrinsic :: iso_fortran_env, only: real128, output_unit
-   use, intrinsic :: ieee_arithmetic, only: ieee_is_nan, ieee_is_finite
+   use, intrinsic :: ieee_arithmetic, only: ieee_is_nan, ieee_is_finite, ieee_value, ieee_quiet_nan
    use martello_kinds, only: dp
    use martello_contact_laws
    use martello_links
@@ -46,6 +46,17 @@ contains
       same = abs(a - b) <= 0.0_dp
    end function same
 
+   !> The worse of two error measures, NaN-propagating: Fortran's max() may drop a NaN
+   !> argument, which would hide a failed evaluation behind the other errors.
+   pure real(dp) function worse(a, b)
+      real(dp), intent(in) :: a, b
+      if (ieee_is_nan(a) .or. ieee_is_nan(b)) then
+         worse = ieee_value(1.0_dp, ieee_quiet_nan)
+      else
+         worse = max(a, b)
+      end if
+   end function worse
+
    subroutine check(ok, label, measured, tol)
       logical, intent(in) :: ok
       character(len=*), intent(in) :: label
@@ -75,9 +86,9 @@ contains
          worst_e = 0.0_dp
          do i = 1, size(deltas)
             do j = 1, size(rates)
-               worst = max(worst, fd_error(law, par, deltas(i), rates(j), v_in))
+               worst = worse(worst, fd_error(law, par, deltas(i), rates(j), v_in))
             end do
-            worst_e = max(worst_e, energy_fd_error(law, par, deltas(i), v_in))
+            worst_e = worse(worst_e, energy_fd_error(law, par, deltas(i), v_in))
          end do
          call check(worst <= 1.0_dp, 'contact '//law_name(law)//' derivatives vs central FD (err/tol)', &
                     worst, 1.0_dp)
@@ -89,7 +100,7 @@ contains
       par(P_CLIP) = 0.0_dp
       worst = 0.0_dp
       do j = 1, size(rates)
-         worst = max(worst, fd_error(LAW_KELVIN, par, deltas(1), rates(j), v_in))
+         worst = worse(worst, fd_error(LAW_KELVIN, par, deltas(1), rates(j), v_in))
       end do
       call check(worst <= 1.0_dp, 'contact kelvin unclipped derivatives vs central FD (err/tol)', worst, 1.0_dp)
       ! zero outside contact and NaN for an unknown law
@@ -144,7 +155,7 @@ contains
       call contact_force(law, par, delta, ddelta - h, v_in, fm, dum1, dum2)
       fd = (fp - fm)/(2.0_dp*h)
       scale = max(abs(f), abs(fp), abs(fm))/max(abs(ddelta), v_in) + abs(d2)
-      r = max(r, abs(fd - d2)/(FD_TOL*scale + tiny(1.0_dp)))
+      r = worse(r, abs(fd - d2)/(FD_TOL*scale + tiny(1.0_dp)))
    end function fd_error
 
    !> d/ddelta of contact_elastic_energy against the force at ddelta = 0 (elastic part).
@@ -169,7 +180,7 @@ contains
          e = targets(i)
          xi = damping_from_restitution(LAW_KELVIN, e, par)/(2.0_dp*sqrt(par(P_STIFF)*par(P_MSTAR)))
          eback = exp(-xi*PI/sqrt(1.0_dp - xi*xi))
-         worst = max(worst, abs(eback - e))
+         worst = worse(worst, abs(eback - e))
       end do
       ! xi, c and the inversion each cost a few ulps; 1 - xi^2 amplifies them by at most
       ! ~1/(1 - xi^2) ~ 20 at e = 1e-6, where e itself is tiny: absolute 1e-14 holds.
@@ -208,7 +219,14 @@ contains
          e = targets(i)
          a = exact_hc_factor(e)
          if (.not. (a > 0.0_dp .and. a <= 1.0_dp/e)) worst = huge(1.0_dp)
-         worst = max(worst, hc_root_error_q(a, e))
+         if ((1.0_dp + 1.0_dp/e)*exp(-(1.0_dp + e)/e) < 0.5_dp*epsilon(1.0_dp)) then
+            ! Small e: the root satisfies 1 − e a = (1 + a) exp(−(1 + e) a), below ε/2 at
+            ! a = 1/e, so the correctly rounded root is fl(1/e) (and the log residual is −∞
+            ! there): a must be within one ulp of 1/e.
+            if (abs(a - 1.0_dp/e) > spacing(1.0_dp/e)) worst = huge(1.0_dp)
+         else
+            worst = worse(worst, hc_root_error_q(a, e))
+         end if
       end do
       ! The root is bisected to round-off in t = -ln(1 - e a); a inherits a few ulps
       ! from t and from exp: 1e-14 relative is ~50 ulps.
@@ -222,7 +240,7 @@ contains
          e = 1.0_dp - d
          d = 1.0_dp - e                 ! exact (Sterbenz)
          a = exact_hc_factor(e)
-         worst_asym = max(worst_asym, abs(a/(1.5_dp*d*(1.0_dp + d)) - 1.0_dp))
+         worst_asym = worse(worst_asym, abs(a/(1.5_dp*d*(1.0_dp + d)) - 1.0_dp))
       end do
       call check(worst_asym <= 1.0e-11_dp, 'exact_hc_factor near e = 1 matches 1.5(1-e)(1+(1-e))', &
                  worst_asym, 1.0e-11_dp)
@@ -296,7 +314,7 @@ contains
       worst = 0.0_dp
       do i = 1, 4
          a = alist(i)
-         worst = max(worst, abs(exact_hc_factor(e_from_a(a))/a - 1.0_dp))
+         worst = worse(worst, abs(exact_hc_factor(e_from_a(a))/a - 1.0_dp))
       end do
       ! e is rounded to double (1 ulp ~ 1.1e-16 near 1); a ~ 1.5 (1 - e) for small a, so
       ! da/a ~ ulp/(1 - e) ~ 2e-14 at a = 0.01 (1 - e ~ 0.0067): 1e-12 leaves a margin of 50
@@ -548,7 +566,7 @@ contains
          do i = 1, 100
             u = i*du
             call bilinear_return_map(k, fy, rho, fn, un, u, f, tan, yl)
-            worst = max(worst, abs(f - bilinear_curve(k, fy, rho, u))/abs(bilinear_curve(k, fy, rho, u)))
+            worst = worse(worst, abs(f - bilinear_curve(k, fy, rho, u))/abs(bilinear_curve(k, fy, rho, u)))
             if (u < uy .and. (.not. same(tan, k) .or. yl)) worst = huge(1.0_dp)
             if (un > uy .and. (.not. same(tan, rho*k) .or. .not. yl)) worst = huge(1.0_dp)
             fn = f
@@ -590,7 +608,7 @@ contains
       do j = 1, 10
          u = um - j*0.1_dp*2.0_dp*(1.0_dp - rho)*uy
          call bilinear_return_map(k, fy, rho, fn, um, u, f, tan, yl)
-         worst = max(worst, abs(f - (fn - k*(um - u)))/fy)
+         worst = worse(worst, abs(f - (fn - k*(um - u)))/fy)
          if (yl .or. .not. same(tan, k)) worst = huge(1.0_dp)
       end do
       call check(worst <= 4.0_dp*EPS, 'bilinear unloading elastic over 2(1-rho)uy', worst, 4.0_dp*EPS)
@@ -651,8 +669,8 @@ contains
          jump = abs(f_out - f_in)/(max(d_in, d_out)*(vreg - v_in) + 4.0_dp*EPS*abs(f_out))
          call fluid_damper_force(c, alphas(i), vreg, -v_in, f_in, d_in)
          call fluid_damper_force(c, alphas(i), vreg, -vreg, f_out, d_out)
-         jump = max(jump, abs(f_out - f_in)/(max(d_in, d_out)*(vreg - v_in) + 4.0_dp*EPS*abs(f_out)))
-         worst_c = max(worst_c, jump)
+         jump = worse(jump, abs(f_out - f_in)/(max(d_in, d_out)*(vreg - v_in) + 4.0_dp*EPS*abs(f_out)))
+         worst_c = worse(worst_c, jump)
          ! tangent against central differences on both branches, away from v_reg and 0
          do j = 1, 4
             v = vlist(j)
@@ -660,7 +678,7 @@ contains
             call fluid_damper_force(c, alphas(i), vreg, v + h, fp, dd)
             call fluid_damper_force(c, alphas(i), vreg, v - h, fm, dd)
             call fluid_damper_force(c, alphas(i), vreg, v, f_in, d_in)
-            worst_d = max(worst_d, abs((fp - fm)/(2.0_dp*h) - d_in)/(FD_TOL*(abs(f_in)/abs(v) + d_in)))
+            worst_d = worse(worst_d, abs((fp - fm)/(2.0_dp*h) - d_in)/(FD_TOL*(abs(f_in)/abs(v) + d_in)))
          end do
       end do
       call check(worst_c <= 1.0_dp, 'fluid damper continuous at +-v_reg (jump / one-ulp allowance)', worst_c, 1.0_dp)
