@@ -367,7 +367,7 @@ def test_energy_balance_above_one_percent_is_a_warning(tmp_path):
 def test_central_difference_past_its_limit_can_finish_wrong_and_balanced(tmp_path):
     """check_stability = false at dt = 2.5e-3 s on P2's penalty plane (Δt_crit = 2/ω_max =
     1.9999e-3 s, ω_max = √((k + ε)/m)): the run ends OK, its first contact's peak penetration
-    is far from the closed form 0.8597 mm (measured about twice), and the energy balance does
+    is far from the closed form 0.8598 mm (measured about twice), and the energy balance does
     not show it: central difference balances ½vᵀMv − (h²/8)aᵀMa to round-off at any step."""
     d = p2_penalty(integrator="central-difference", dt=2.5e-3, t_end=0.5, check_stability=False)
     assert 2.5e-3 > 2.0 / math.sqrt((100.0 + 1e6) / 1.0)
@@ -378,15 +378,19 @@ def test_central_difference_past_its_limit_can_finish_wrong_and_balanced(tmp_pat
     assert s["energy"]["balance_relative"] < 1e-10
 
 
-def test_stability_limit_leaves_out_hertz_contacts(tmp_path):
-    """ω_max counts springs and linear/Kelvin contacts as closed, not Hertz-type ones: with a
-    Hertz plane Δt_crit = 2/√(k/m) = 0.2 s, with a linear one 2/√((k + ε)/m). dsbgvx on a 1×1
-    problem: a few ulps, asserted at 1e-12."""
-    for law, dt_crit in (("hertz", 2.0 / math.sqrt(100.0)), ("linear", 2.0 / math.sqrt(100.0 + 1e4))):
-        d = p2_penalty(eps=1e4, integrator="central-difference", dt=1e-4, t_end=1e-3)
-        d["contact"][0]["law"] = law
-        _, s, _ = run_scene(tmp_path, d, name=law)
-        assert s["stability"]["dt_critical"] == pytest.approx(dt_crit, rel=1e-12)
+@pytest.mark.parametrize("law,damped", [("hertz", False), ("linear", False), ("linear", True)])
+def test_stability_limit_leaves_out_hertz_contacts_and_damping(tmp_path, law, damped):
+    """ω_max counts springs and linear/Kelvin contacts as closed, not Hertz-type ones, and no
+    damping: with a Hertz plane Δt_crit = 2/√(k/m) = 0.2 s, with a linear one 2/√((k + ε)/m),
+    with a dashpot of ζ = 0.5 as well still 2/√((k + ε)/m) (the damped explicit limit,
+    (2/ω)(√(1 + ζ²) − ζ), would be lower). dsbgvx on a 1×1 problem: a few ulps, 1e-12."""
+    d = p2_penalty(eps=1e4, integrator="central-difference", dt=1e-4, t_end=1e-3)
+    d["contact"][0]["law"] = law
+    if damped:
+        d["link"].append({"type": "dashpot", "a": "m", "b": "ground", "zeta": 0.5})
+    dt_crit = 2.0 / math.sqrt(100.0 + (1e4 if law == "linear" else 0.0))
+    _, s, _ = run_scene(tmp_path, d)
+    assert s["stability"]["dt_critical"] == pytest.approx(dt_crit, rel=1e-12)
 
 
 def test_conditionally_stable_newmark_is_left_to_the_divergence_detector(tmp_path):
