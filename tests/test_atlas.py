@@ -11,8 +11,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from martello import atlas
-from martello.study import execute
+from martello.batch import execute
+from martello.study import atlas
 
 ROOT = Path(__file__).resolve().parent.parent
 CD = {"label": "central difference", "integrator": "central-difference",

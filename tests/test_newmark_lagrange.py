@@ -10,7 +10,8 @@ import time
 import numpy as np
 import pytest
 
-from martello import closed_forms as cf
+from martello.oracles.p2_bouncing import bouncing_oscillator_restitution
+from martello.oracles.p5_contact_laws import newton_impact
 from dynamics_helpers import execute, slope
 
 EPS = np.finfo(float).eps
@@ -40,7 +41,7 @@ def test_p2_restitution_and_first_impact(p2_run):
     s, h = p2_run
     dt = 1e-4
     c = s["contacts"]["plane"]
-    ref = cf.bouncing_oscillator_restitution(M, K, GAP, G, 0.8, 8)
+    ref = bouncing_oscillator_restitution(M, K, GAP, G, 0.8, 8)
     # Every impact leaves at exactly −e v_in: that is what (β, γ) are solved for; the only
     # error is the rounding of the step (measured 9e-16).
     assert len(c["restitution"]) >= 8
@@ -66,7 +67,7 @@ def test_p2_orders():
         for i in range(n_phase):
             s0 = i / n_phase * dt
             u0, v0 = US * (1 - math.cos(W * s0)), US * W * math.sin(W * s0)
-            ref = cf.bouncing_oscillator_restitution(M, K, GAP, G, 0.8, n_imp, u0=u0, v0=v0)
+            ref = bouncing_oscillator_restitution(M, K, GAP, G, 0.8, n_imp, u0=u0, v0=v0)
             s, _ = p2(dt, 0.9, u0=u0, v0=v0, every=10 ** 6)
             c = s["contacts"]["plane"]
             errs_t.append(np.abs(np.array(c["impact_times"][:n_imp]) - ref.t))
@@ -87,7 +88,7 @@ def test_p2_zeno_rest_on_the_plane(p2_run):
     c = s["contacts"]["plane"]
     assert s["status"] == "MARTELLO_OK"
     assert c["separation_times"][-1] is None                 # the last phase never ends
-    ref = cf.bouncing_oscillator_restitution(M, K, GAP, G, 0.8, 1)
+    ref = bouncing_oscillator_restitution(M, K, GAP, G, 0.8, 1)
     # held from within 2 ms of the exact Zeno time (measured 1.2e-3 s late at h = 1e-4:
     # the impacts shorter than a step are lumped into one plastic impact)
     assert 0 <= c["impact_times"][-1] - ref.zeno_time <= 2e-3
@@ -123,7 +124,7 @@ def test_p5_newton_velocities(e, m2):
         "contact": [{"name": "impact", "a": "m1", "b": "m2", "gap": 1e-3, "scheme": "restitution",
                      "restitution": e}],
         "analysis": {"type": "dynamic", "integrator": "newmark-lagrange", "dt": dt, "t_end": t_end}})
-    ref = cf.newton_impact(m1, m2, v0, 0.0, e)
+    ref = newton_impact(m1, m2, v0, 0.0, e)
     n = round(t_end / dt)
     umax = max(np.abs(h["u:m1"]).max(), np.abs(h["u:m2"]).max())
     tol = 4 * math.sqrt(n) * EPS * umax / dt * v0 / max(v0, 1.0)
@@ -147,7 +148,7 @@ def test_cost_against_moreau_jean(capsys):
     Newmark–Lagrange is more accurate (speeds O(h²) against O(h); times both O(h), constants
     ~1 against ~2.7 over these impacts), at 2–3× the work per step (docs/moreau-jean.md has
     the measured table)."""
-    ref = cf.bouncing_oscillator_restitution(M, K, GAP, G, 0.8, 6)
+    ref = bouncing_oscillator_restitution(M, K, GAP, G, 0.8, 6)
     rows = []
     for dt in (1e-3, 1e-4, 1e-5):
         for integ in ("moreau-jean", "newmark-lagrange"):
@@ -179,12 +180,12 @@ def test_cost_against_moreau_jean(capsys):
 
 def test_penalty_contacts_are_refused():
     """The compatibility table: Newmark–Lagrange is built for rigid impacts."""
-    from martello import scene
     from martello.errors import SceneError
+    from martello.scene.loader import from_dict
     with pytest.raises(SceneError, match="cannot run on integrator newmark-lagrange"):
-        scene.from_dict({
+        from_dict({
             "node": [{"name": "m", "mass": 1.0}],
             "contact": [{"name": "c", "a": "m", "b": "ground", "gap": 0.1, "scheme": "penalty",
-                         "law": "linear", "stiffness": 1e6}],
+                   "law": "linear", "stiffness": 1e6}],
             "analysis": {"type": "dynamic", "integrator": "newmark-lagrange", "dt": 1e-3,
-                         "t_end": 0.01}})
+                   "t_end": 0.01}})
