@@ -20,7 +20,8 @@ def execute(spec):
     metrics need and the history. Never raises for a failed run."""
     out = {"id": spec["id"]}
     try:
-        s = from_dict(spec["scene_dict"], source=spec["scene_file"], base_dir=Path(spec["base_dir"]))
+        s = from_dict(spec["scene_dict"], source=spec["scene_file"],
+                      base_dir=Path(spec["base_dir"]))
     except SceneError as exc:
         return out | {"status": "incompatible", "message": str(exc)}
     try:

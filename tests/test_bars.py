@@ -176,7 +176,7 @@ def test_name_clashes():
 
 @pytest.mark.parametrize("LB,wall", [(1.0, False), (2.0, False), (1.0, True)])
 def test_point_displacement_agrees_with_closed_forms_at_the_face(LB, wall):
-    # two independent codings of d'Alembert: images at depth 0 vs closed_forms' pulse integral
+    # two independent codings of d'Alembert: images at depth 0 vs p4_rod_impact's pulse integral
     t = np.linspace(0.0, 5.0 * 2 * LB / C, 997)
     uA, uB = rod_impact_interface_displacement(t, E, RHO, L, LB, V0, wall=wall)
     a = V0 * t + rod_point_displacement(0.0, t, C, L, LB, V0, "a", wall=wall)

@@ -1,5 +1,6 @@
-"""Tests of the closed-form oracles (martello/closed_forms.py) against every example number
-quoted in /work/shared/PROBLEMS.md, plus internal-consistency checks that could fail.
+"""Tests of the closed-form oracles (martello/oracles/) and the metric formulas
+(martello/metrics/norms.py, event_matching.py) against every example number quoted in
+docs/problems.md, plus internal-consistency checks that could fail.
 
 The tests may integrate ODEs with scipy (solve_ivp at tight tolerance) as an *independent*
 cross-check of a closed form. The oracles themselves never do that.
@@ -39,7 +40,7 @@ from martello.oracles.p6_hysteresis import (bilinear_cycle_energy, elastoplastic
                                             epp_step_load_ductility)
 from martello.oracles.p9_davis import davis_period1_damped, davis_period1_impact_velocity
 
-# system used by P1/P2/P6 examples in PROBLEMS.md
+# system used by P1/P2/P6 examples in docs/problems.md
 M, K, H, G = 1.0, 100.0, 0.05, 9.81
 
 
@@ -61,7 +62,8 @@ def test_p1_lagrange_example():
 
 def test_p1_penalty_example():
     r = mass_on_plane_static(M, K, H, G, "penalty", eps=1e4)
-    # PROBLEMS.md quotes u = 0.0504762376... (truncated, "..."): within one unit of the last digit
+    # docs/problems.md quotes u = 0.0504762376... (truncated, "..."): within one unit of the
+    # last digit
     assert 0 <= r.u - 0.0504762376 < 1e-10   # last quoted digit is the 10th decimal
     # lam = -4.7623762376... (truncated): within one unit of the last quoted digit
     assert 0 <= -r.lam - 4.7623762376 < 1e-10   # last quoted digit is the 10th decimal
@@ -170,7 +172,7 @@ def test_p2_flight_times_reach_the_plane(case):
         # first impact: arcsin(w h / v0)/w, v1 = sqrt(v0^2 - w^2 h^2): few ulps
         assert r.t[0] == pytest.approx(math.asin(0.5 / 2.0) / 10.0, rel=1e-15)
         assert r.v[0] == pytest.approx(math.sqrt(4.0 - 0.25), rel=1e-15)
-        # PROBLEMS.md's no-gravity form (2/w)(pi - atan(e v/(w h))): same number, few ulps
+        # docs/problems.md's no-gravity form (2/w)(pi - atan(e v/(w h))): same number, few ulps
         assert r.tau[0] == pytest.approx(0.2 * (math.pi - math.atan(e * r.v[0] / (10 * H))),
                                          rel=1e-14)
     hh = 0.15 if case == "gravity_short" else H
@@ -187,7 +189,8 @@ def test_p2_flight_times_reach_the_plane(case):
 
 def test_free_fall_ball():
     f = free_fall_ball(1.0, 9.81, 0.9, 30)
-    # PROBLEMS.md: t_inf = 8.578949179 (10 significant digits) -> half a unit in the 9th decimal
+    # docs/problems.md: t_inf = 8.578949179 (10 significant digits) -> half a unit in the 9th
+    # decimal
     assert f["zeno_time"] == pytest.approx(8.578949179, abs=5e-10)
     # energy: the rebound height after impact k equals (e v_k)^2/(2g) = e^{2k} h0 (few ulps)
     np.testing.assert_allclose(f["rebound_height"], (0.9 * f["v"]) ** 2 / (2 * 9.81), rtol=1e-13)
@@ -202,7 +205,7 @@ def test_free_fall_ball():
 def test_kelvin_free_impact_unclipped_and_clipped_restitution():
     """k = 0, g = 0: a free body hits the Kelvin wall once. The semi-analytic phase machinery
     (brentq on the closed form) must realise e = exp(-xi pi/nu) for the unclipped law and the
-    PROBLEMS.md e_F0 formula for the clipped law. These are two independent routes."""
+    docs/problems.md e_F0 formula for the clipped law. These are two independent routes."""
     for xi in (0.05, 0.2, 0.45, 0.65):
         eps = 1e5
         c = kelvin_damping(eps, 1.0, xi)
@@ -487,7 +490,7 @@ def test_kelvin_clipped_restitution_numbers(target, eF0):
 
 
 def test_kelvin_clipped_matches_problems_form_and_brute_force():
-    for xi in (0.1, 0.4, 0.7):                      # PROBLEMS.md form is for xi < 1/sqrt2
+    for xi in (0.1, 0.4, 0.7):                      # docs/problems.md form is for xi < 1/sqrt2
         nu = math.sqrt(1 - xi * xi)
         th = math.pi - math.atan(2 * xi * nu / (1 - 2 * xi * xi))
         ref = math.exp(-xi * th / nu) * ((xi / nu) * math.sin(th) - math.cos(th))
@@ -509,7 +512,7 @@ def test_hertz_constant_by_quadrature():
     f = lambda x: math.sqrt((1 - x) / (1 - x ** 2.5)) if x < 1 else math.sqrt(0.4)
     I, err = integrate.quad(f, 0, 1, weight="alg", wvar=(0, -0.5), epsabs=0, epsrel=2e-14)
     assert 2 * I == pytest.approx(HERTZ_TC_CONSTANT, rel=1e-12)   # quadrature accuracy
-    # PROBLEMS.md value quoted with 10 decimals: half a unit of the 10th decimal
+    # docs/problems.md value quoted with 10 decimals: half a unit of the 10th decimal
     assert HERTZ_TC_CONSTANT == pytest.approx(2.9432751843, abs=5e-11)
 
 
@@ -570,7 +573,7 @@ def test_hunt_crossley_floors():
     targets = np.linspace(0.0, 1.0, 201)
     ln = [hunt_crossley_realised_e(hc_factor_lankarani_nikravesh(t)) for t in targets]
     hc = [hunt_crossley_realised_e(hc_factor_hunt_crossley(t)) for t in targets]
-    # PROBLEMS.md quotes 3 digits (~0.663, ~0.488): half a unit of the third decimal
+    # docs/problems.md quotes 3 digits (~0.663, ~0.488): half a unit of the third decimal
     assert min(ln) == pytest.approx(0.663, abs=5e-4)
     assert min(hc) == pytest.approx(0.488, abs=5e-4)
     # the floor is the target-0 value: realised e is monotone in a, and a is monotone in target
@@ -605,7 +608,7 @@ def _jankowski_ivp(xi):
 def test_jankowski():
     xi = jankowski_xi(0.65)
     e = jankowski_realised_e(xi)
-    # PROBLEMS.md: "target 0.65 realises ~0.647" (3 digits): half a unit of the third decimal
+    # docs/problems.md: "target 0.65 realises ~0.647" (3 digits): half a unit of the third decimal
     assert e == pytest.approx(0.647, abs=5e-4)
     assert e < 0.65                                            # "slightly undershoots"
     # independent time integration (DOP853, rtol 1e-13); observed agreement ~3e-13, and the

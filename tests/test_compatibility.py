@@ -1,6 +1,7 @@
-"""The scheme × integrator compatibility table: the front end's (martello/scene.py) and the
-library's (fortran/integrator_settings.f90) must agree, and an impossible pair is an error
-that names the integrators that would work — at load time and through the C API."""
+"""The scheme × integrator compatibility table: the front end's
+(martello/scene/compatibility.py) and the library's (fortran/integrator_settings.f90) must
+agree, and an impossible pair is an error that names the integrators that would work — at
+load time and through the C API."""
 
 import pytest
 

@@ -1,6 +1,7 @@
-"""Dynamics core (issue 3): penalty impacts against P5, the elasto-plastic SDOF against P6,
-a damped SDOF under ground motion against its exact solution, energy balance, stability of
-central difference, and the error paths of dynamic runs. Oracles: martello.closed_forms."""
+"""Dynamics core (docs/integrators.md): penalty impacts against P5, the elasto-plastic SDOF
+against P6, a damped SDOF under ground motion against its exact solution, energy balance,
+stability of central difference, and the error paths of dynamic runs. Oracles:
+martello.oracles."""
 
 import math
 
@@ -48,7 +49,7 @@ def test_linear_contact_time_and_penetration():
 
 
 def test_hertz_penetration_and_contact_time():
-    # δ_max and t_c = 2.94327518 δ_max/v0 (PROBLEMS.md P5): O(h²) errors, 1e-5 is the issue's bar.
+    # δ_max and t_c = 2.94327518 δ_max/v0 (docs/problems.md P5): O(h²) errors, 1e-5 is the bar.
     kh, m1, m2, v0 = 1e9, 2.0, 2.0, 0.5
     mstar = 1.0
     ref = hertz_impact(mstar, kh, v0)
@@ -64,7 +65,7 @@ def test_hertz_penetration_and_contact_time():
                                    ("flores", 0.4), ("gonthier", 0.7), ("hertzdamp", 0.85),
                                    ("jankowski", 0.65)])
 def test_viscoelastic_laws_realise_their_published_restitution(law, e):
-    # The realised e of each law is a closed form of its damping factor (PROBLEMS.md P5), not
+    # The realised e of each law is a closed form of its damping factor (docs/problems.md P5), not
     # the target: e.g. Lankarani–Nikravesh undershoots damping. Measured errors ≤ 1e-8 for the
     # HC family at this step (force continuous), ~5e-6 for Jankowski (δ^{1/4} damping, low order).
     ref = two_body_impact(law, 1.0, 1.0, 1.0, 1e8, restitution=e)
@@ -92,7 +93,7 @@ def test_elastoplastic_peak_converges_at_second_order(integrator, rho):
         umax, tmax = interpolated_peak(h["t"], h["u:m"], h["v:m"], h["a:m"])
         hs.append(dt); eu.append(abs(umax - ref.u_max)); et.append(abs(tmax - ref.t_max))
     # Both integrators are second order; the yield kink inside a step keeps O(h²) globally.
-    # ±0.1 is the issue's bar; the fit is over an 8× range of h.
+    # ±0.1 is the bar for a measured order; the fit is over an 8× range of h.
     assert slope(hs, eu) == pytest.approx(2.0, abs=0.1), eu
     assert slope(hs, et) == pytest.approx(2.0, abs=0.1), et
     assert eu[-1] < 1e-5 * ref.u_max   # sub-micrometre at the finest step (measured 7.7e-7 relative)
@@ -122,7 +123,7 @@ def test_sdof_sine_ground_motion_converges_at_the_integrator_order(integrator, p
         _, h = execute(d)
         ref = sdof_sine_ground_response(m, k, zeta, A, Om, h["t"])
         hs.append(dt); errs.append(np.max(np.abs(h["u:m"] - ref.u)))
-    # measured slopes are within 0.02 of the theory; ±0.1 as in the issue
+    # measured slopes are within 0.02 of the theory; ±0.1 as for every measured order
     assert slope(hs, errs) == pytest.approx(order, abs=0.1), errs
 
 
@@ -269,7 +270,8 @@ def test_history_columns_and_decimation(tmp_path):
 def test_record_ground_motion_equals_the_same_table(name):
     # A record drives the scene exactly as the table of its samples (in m/s², scaled) does:
     # same native table function, so the two runs agree to round-off; the units of the file
-    # (g here) are converted by martello.records, checked independently in test_records.py.
+    # (g here) are converted by martello.ground_motion.records, checked independently in
+    # test_records.py.
     from pathlib import Path
     from martello.ground_motion.records import read_record
     f = Path(__file__).parent / "data" / "records" / name

@@ -1,10 +1,10 @@
-"""Event-driven integration on GSL odeiv2 (issue 4, items 1, 2 and 6; c/event_driven.c,
-docs/event-driven.md): P2 restitution against its closed form (impact times and speeds, the
-Zeno time, the resting force), P5 Newton velocities to round-off over mass ratios 1e-6…1e6,
+"""Event-driven integration on GSL odeiv2 (c/event_driven.c, docs/event-driven.md): P2
+restitution against its closed form (impact times and speeds, the Zeno time, the resting
+force), P5 Newton velocities to round-off over mass ratios 1e-6…1e6,
 the three steppers against each other, penalty runs converging to the event-driven
 restitution reference at the rate ε^(-1/2) (P2 and a two-oscillator P7 chain), grazing
 contacts inside one step, release of a persistent contact, simultaneous impacts, and every
-error path. Oracles: martello.closed_forms, or closed forms written out here."""
+error path. Oracles: martello.oracles, or closed forms written out here."""
 
 import math
 
@@ -21,7 +21,7 @@ from martello.run import INTEGRATOR_CONST, integrator_par
 from martello.scene.loader import from_dict
 from tests.dynamics_helpers import execute, slope
 
-M, K, H, G = 1.0, 100.0, 0.05, 9.81          # PROBLEMS.md P2 example
+M, K, H, G = 1.0, 100.0, 0.05, 9.81          # docs/problems.md P2 example
 STEPPERS = ("rkf45", "rk8pd", "msbdf")
 TIGHT = {"rtol": 1e-12, "atol": 1e-14}
 EPS = float(np.finfo(float).eps)
@@ -70,7 +70,7 @@ P2_T_END = {0.0: 0.5, 0.5: 1.0, 0.8: 2.0, 1.0: 2.2}
 def test_p2_impact_times_and_speeds(e):
     # rk8pd at rtol 1e-12: the flights are smooth and the roots are located to event_tol =
     # 1e-12 s, so the impact times carry the integration error only (measured ≤ 2.7e-12 s,
-    # speeds ≤ 4e-12 m/s); 1e-9 (absolute, times ~1 s and speeds ~1 m/s) is the issue's bar.
+    # speeds ≤ 4e-12 m/s); 1e-9 (absolute, times ~1 s and speeds ~1 m/s) is the bar.
     s, hist = execute(p2(restitution(e), adaptive(t_end=P2_T_END[e], **TIGHT)))
     ref = bouncing_oscillator_restitution(M, K, H, G, e, 10)
     t, vin, _ = impacts_of(s["contacts"]["plane"])
@@ -250,7 +250,7 @@ def test_grazing_penalty_contact_inside_one_step_is_not_missed():
 def test_penalty_events_on_gsl_match_the_semi_analytic_solution():
     # A linear penalty plane (ε = 1e6 N/m) on rk8pd: onset, peak and separation are located
     # events, so no step straddles the kink of the force and the event times carry only the
-    # integration error against closed_forms.bouncing_kelvin_events (measured ≤ 3e-13 s,
+    # integration error against checks.dispatchers.bouncing_kelvin_events (measured ≤ 3e-13 s,
     # peaks ≤ 1.3e-13 relative; bars 1e-9 s and 1e-10, a thousand rtol).
     eps = 1e6
     s, _ = execute(p2(linear_penalty(eps), adaptive(t_end=0.7, **TIGHT)))

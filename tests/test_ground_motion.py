@@ -67,7 +67,7 @@ def test_response_spectrum_matches_lsim(zeta):
     rs = gm.response_spectrum(ag, dt, PERIODS, zeta)
     for j, T in enumerate(PERIODS):
         ref = lsim_peak(ag, dt, T, zeta)
-        # The requirement is 1e-8; both sides are exact recurrences in double
+        # The requirement is 1e-8; both sides are exact recurrences in double
         # precision, so the agreement is in fact ~1e-13 (round-off accumulated over 1500 steps).
         assert rs.sd[j] == pytest.approx(ref, rel=1e-8, abs=0), f"T={T}, zeta={zeta}"
         w = 2.0 * math.pi / T

@@ -1,7 +1,7 @@
-"""SUNDIALS IDA (issue 4, item 3): penalty scenes as implicit ODEs restarted at every contact
+"""SUNDIALS IDA (docs/ida.md): penalty scenes as implicit ODEs restarted at every contact
 onset and separation, Lagrange/restitution scenes as a stabilised index-2 DAE (GGL) with
-IDA's root finding for impacts, closings and releases (docs/ida.md). Oracles:
-martello.closed_forms, coded independently of the solvers.
+IDA's root finding for impacts, closings and releases. Oracles: martello.oracles, coded
+independently of the solvers.
 
 Tolerances: IDA controls the local error to rtol·|y| + atol per step; what reaches an event
 time is the global error of the flight before it, which accumulates over the steps and the
@@ -19,7 +19,7 @@ from martello.oracles.p2_bouncing import bouncing_oscillator_restitution
 from martello.oracles.p5_contact_laws import linear_contact_time, newton_impact
 from tests.dynamics_helpers import dynamic, execute, two_bodies
 
-M, K, H, G = 1.0, 100.0, 0.05, 9.81          # P2 of PROBLEMS.md
+M, K, H, G = 1.0, 100.0, 0.05, 9.81          # P2 of docs/problems.md
 
 
 def ida(rtol=1e-10, atol=1e-14, dt=1e-3, t_end=0.7, **extra):
@@ -167,7 +167,8 @@ def test_p5_penalty_laws(law, k, e):
 
 
 def test_p5_linear_contact_time():
-    # The issue's P5 check: pi sqrt(m*/k), m* = 2/3, k = 1e6. Measured 1.5e-11 at rtol 1e-10.
+    # The P5 check (docs/problems.md): pi sqrt(m*/k), m* = 2/3, k = 1e6. Measured 1.5e-11 at
+    # rtol 1e-10.
     s, _ = execute(two_bodies("linear", 1e6, 1.0, 2.0, 1.0, gap=1e-3,
                               analysis=ida(rtol=1e-10, atol=1e-15, dt=1e-4, t_end=5e-3)))
     assert s["contacts"]["impact"]["contact_time"] == pytest.approx(
@@ -326,7 +327,7 @@ def test_grazing_contact_inside_a_step_is_found():
     # A free oscillation of amplitude 0.1 m grazes a plane 0.1 um deep: each contact lasts
     # 0.28 ms, while IDA's steps average 0.8 ms. The root on the gap rate stops at the apex,
     # where the gap is positive, and the onset is located on the step's interpolant
-    # (PROBLEMS.md P7: never step over a contact). Peak penetration measured 7.6e-5 low at
+    # (docs/problems.md P7: never step over a contact). Peak penetration measured 7.6e-5 low at
     # rtol = 1e-12 (the global error of u ~ 1e-13 m against a 1e-7 m depth).
     depth = 1e-7
     d = {"node": [{"name": "m", "mass": 1.0, "v0": 1.0}],

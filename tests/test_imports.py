@@ -108,7 +108,8 @@ def loaded_after(module):
 def test_oracles_know_no_solver():
     # the closed forms are written from the mathematics: no run layer, no native library
     for m in (m for m in MODULES if m.startswith("martello.oracles")):
-        bad = {x for x in loaded_after(m) if x == "martello.run" or x.startswith("martello.binding")}
+        bad = {x for x in loaded_after(m)
+               if x == "martello.run" or x.startswith("martello.binding")}
         assert not bad, f"{m} loads {sorted(bad)}"
 
 

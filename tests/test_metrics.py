@@ -1,6 +1,7 @@
-"""Metrics of a run against a reference (martello.metrics; PROBLEMS.md "Metrics"): history
-errors, impacts matched before comparing, peaks, restitution, energy, the closed-form
-references and the scene digest that keys reference data. Oracles: martello.closed_forms."""
+"""Metrics of a run against a reference (martello.metrics; docs/problems.md "Metrics"):
+history errors, impacts matched before comparing, peaks, restitution, energy, the
+closed-form references and the scene digest that keys reference data (martello.reference).
+Oracles: martello.oracles."""
 
 import copy
 import math

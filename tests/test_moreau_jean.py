@@ -1,6 +1,6 @@
-"""Moreau–Jean time stepping (PROBLEMS.md P2, P5 and "Integrators"; issue 4 item 4).
+"""Moreau–Jean time stepping (docs/problems.md P2, P5 and "Integrators"; docs/moreau-jean.md).
 
-Oracles: martello.closed_forms (bouncing_oscillator_restitution, newton_impact) and the
+Oracles: martello.oracles (bouncing_oscillator_restitution, newton_impact) and the
 reference rows of Siconos' bouncing-ball example (reference/siconos_bouncing_ball/). Every
 tolerance says where it comes from; "measured" values are from this implementation."""
 
@@ -17,7 +17,7 @@ from dynamics_helpers import execute, slope
 EPS = np.finfo(float).eps
 REF = Path(__file__).resolve().parent.parent / "reference" / "siconos_bouncing_ball" / "BouncingBallTS_ref_rows.csv"
 
-# P2 of PROBLEMS.md: m = 1, k = 100, plane at h = 0.05, g = 9.81 (u_s = 0.0981 > h: Zeno)
+# P2 of docs/problems.md: m = 1, k = 100, plane at h = 0.05, g = 9.81 (u_s = 0.0981 > h: Zeno)
 M, K, GAP, G = 1.0, 100.0, 0.05, 9.81
 G_EFF = (M * G - K * GAP) / M      # acceleration pressing the mass onto the plane there
 
@@ -90,7 +90,7 @@ def test_p2_impact_times_first_order(theta):
     impact s after t_k, uniform over the phase), so at one h the error is erratic between 0
     and ~h; averaged over 8 equally spaced phases of the start (the exact state at s·h/8 is
     the initial state) the mean error is C·h + o(h). Measured slopes 1.007 (θ = ½) and
-    0.992 (θ = 1) over 5 halvings; the issue asks for 1 ± 0.15."""
+    0.992 (θ = 1) over 5 halvings; the bar is 1 ± 0.15."""
     w, us, n_imp, n_phase = math.sqrt(K / M), M * G / K, 6, 8
     hs = [1e-3 / 2 ** j for j in range(6)]
     mean_err = []

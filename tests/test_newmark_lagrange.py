@@ -1,8 +1,9 @@
-"""The seed's Newmark–Lagrange scheme (Papadrakakis et al. 1991, seed eq. 48; PROBLEMS.md
-"Lagrange + Newmark"; issue 4 item 5): Newmark with the contact held at the displacement
-level by a multiplier and (β, γ) re-chosen in each impact step so that the relative velocity
-leaves at −e times the approach speed. On P2 and P5, against closed forms, and its cost
-against Moreau–Jean on the same scene (run with -s to see the table)."""
+"""The seed's Newmark–Lagrange scheme (Papadrakakis et al. 1991, seed eq. 48;
+docs/problems.md "Integrators", Lagrange + Newmark; docs/integrators.md): Newmark with the
+contact held at the displacement level by a multiplier and (β, γ) re-chosen in each impact
+step so that the relative velocity leaves at −e times the approach speed. On P2 and P5,
+against closed forms, and its cost against Moreau–Jean on the same scene (run with -s to see
+the table)."""
 
 import math
 import time
@@ -47,7 +48,7 @@ def test_p2_restitution_and_first_impact(p2_run):
     assert len(c["restitution"]) >= 8
     np.testing.assert_allclose(c["restitution"], 0.8, rtol=0, atol=64 * EPS)
     # The first impact is located by the quadratic root inside the step, so its time error is
-    # that of the trapezoidal flight before it: the phase lag ω²h²t/12 (PROBLEMS.md: the
+    # that of the trapezoidal flight before it: the phase lag ω²h²t/12 (docs/problems.md: the
     # trapezoidal ω̄ = (2/h)atan(ωh/2)). Measured 8.82e-9 against 8.82e-9 predicted.
     lag = W ** 2 * dt ** 2 * ref.t[0] / 12
     assert c["impact_times"][0] - ref.t[0] == pytest.approx(lag, rel=0.05)

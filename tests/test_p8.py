@@ -1,5 +1,5 @@
 """P8 (seed §5-6): the adjacent-buildings scenes, their gap stiffness rule, the case study's
-aggregation and the committed records (issue 7 items 4-5)."""
+aggregation and the committed records (docs/p8-case-study.md)."""
 
 import importlib.util
 import math

@@ -1,4 +1,4 @@
-"""Tests of martello.records: ground-motion record readers (CSV and PEER AT2)."""
+"""Tests of martello.ground_motion.records: ground-motion record readers (CSV and PEER AT2)."""
 
 import math
 import re

@@ -1,4 +1,4 @@
-"""Reference data in reference/ (issue 6, item 3): each stored history still matches a fresh
+"""Reference data in reference/ (docs/studies.md): each stored history still matches a fresh
 computation to the digits it claims, carries its provenance, and is tied to the physics of
 its scene; the independent event-located reference engine reproduces a closed form."""
 
@@ -86,7 +86,8 @@ def test_fresh_computation_matches_the_stored_data(entry):
 
 
 def test_event_located_engine_reproduces_the_closed_form():
-    # P2 with a Kelvin plane: exact piecewise solution (closed_forms.bouncing_oscillator_kelvin)
+    # P2 with a Kelvin plane: exact piecewise solution
+    # (martello.oracles.p2_bouncing.bouncing_oscillator_kelvin)
     sc = load(ROOT / "benchmarks" / "p2" / "p2_penalty_kelvin.toml")
     grid = np.linspace(0.0, 0.7, 1401)
     out = event_located_run(sc, 1e-12, grid)
@@ -99,7 +100,7 @@ def test_event_located_engine_reproduces_the_closed_form():
 
 def test_event_located_engine_finds_a_contact_inside_one_step():
     # Two free masses whose gap closes for a moment: the gap's maximum is checked, so a
-    # contact shallower than one step's sign test is still found (PROBLEMS.md P7).
+    # contact shallower than one step's sign test is still found (docs/problems.md P7).
     d = {"node": [{"name": "m1", "mass": 1.0, "v0": 1e-3}, {"name": "m2", "mass": 1.0}],
          "link": [{"type": "spring", "a": "m1", "b": "ground", "k": 1.0}],
          "contact": [{"name": "c", "a": "m1", "b": "m2", "gap": 9.9999e-4, "scheme": "penalty",

@@ -1,4 +1,4 @@
-"""Static contact (PROBLEMS.md P1, P3): every scheme against the closed forms, the penalty
+"""Static contact (docs/problems.md P1, P3): every scheme against the closed forms, the penalty
 convergence rate, mesh refinement, and the extremes (ε/k to 1e16, grazing, h = 0)."""
 
 import copy
@@ -42,8 +42,9 @@ def two_bars(scheme, ne=1, F=F, **contact):
                      s["contacts"]["ends"]["force"]]), s
 
 
-# Lagrange and augmented Lagrange: ≤ 1e-12 relative (issue bar). The solves are 2×2 (P1) and
-# 4×4 (P3) with condition ≲ 10 after scaling: errors are a few ulps, far inside 1e-12.
+# Lagrange and augmented Lagrange: ≤ 1e-12 relative (the bar set for P1 and P3). The solves are
+# 2×2 (P1) and 4×4 (P3) with condition ≲ 10 after scaling: errors are a few ulps, far inside
+# 1e-12.
 @pytest.mark.parametrize("scheme,extra", [("lagrange", {}), ("augmented-lagrange", {"stiffness": 1e4}),
                                           ("restitution", {"restitution": 0.5})])
 def test_p1_lagrange_family_matches_closed_form(scheme, extra):
@@ -58,7 +59,7 @@ def test_p1_lagrange_family_matches_closed_form(scheme, extra):
 def test_p1_penalty_matches_its_closed_form():
     ref = mass_on_plane_static(M, K, H, G, scheme="penalty", eps=1e4)
     s = p1("penalty", stiffness=1e4)
-    assert s["nodes"]["mass"]["u"] == pytest.approx(0.0504762376237623762, rel=1e-13)  # PROBLEMS.md digits
+    assert s["nodes"]["mass"]["u"] == pytest.approx(0.0504762376237623762, rel=1e-13)  # problems.md digits
     assert s["nodes"]["mass"]["u"] == pytest.approx(ref.u, rel=1e-13)
     # λ = −εδ: δ = u − h cancels log10(h/δ) ≈ 2 digits of u, so 1e-11 rather than 1e-13
     assert s["contacts"]["plane"]["lambda"] == pytest.approx(ref.lam, rel=1e-11)
@@ -80,7 +81,7 @@ def test_p3_matches_closed_form(scheme, extra, rtol):
                                           ("augmented-lagrange", {"stiffness": 100 * R})])
 def test_p3_refinement_leaves_coarse_nodes_unchanged(scheme, extra):
     # Linear FE is nodally exact for point loads: any refinement gives the same nodal values.
-    # Dense solves up to 195 unknowns with condition ~1e4·(ne)²: 1e-12 is the issue's bar.
+    # Dense solves up to 195 unknowns with condition ~1e4·(ne)²: 1e-12 is the bar set for P3.
     coarse, _ = two_bars(scheme, 1, **extra)
     for ne in (2, 8, 64):
         fine, _ = two_bars(scheme, ne, **extra)
@@ -102,7 +103,7 @@ def test_p1_penalty_error_is_first_order_in_one_over_eps():
     ratios = 10.0 ** np.arange(2, 9)
     err = np.array([abs(p1("penalty", stiffness=K * q)["contacts"]["plane"]["lambda"] - lam_exact)
                     / abs(lam_exact) for q in ratios])
-    # predicted relative error k/(k+ε) (PROBLEMS.md P1); δ keeps ≥ 6 digits at ε/k = 1e8
+    # predicted relative error k/(k+ε) (docs/problems.md P1); δ keeps ≥ 6 digits at ε/k = 1e8
     np.testing.assert_allclose(err, 1.0 / (1.0 + ratios), rtol=1e-3)
     assert log_slope(ratios, err) == pytest.approx(-1.0, abs=0.02)
 
@@ -112,7 +113,7 @@ def test_p3_penalty_error_is_first_order_in_one_over_eps():
     ratios = 10.0 ** np.arange(2, 9)
     err = np.array([abs(two_bars("penalty", stiffness=R * q)[0][3] - p_exact) / p_exact
                     for q in ratios])
-    np.testing.assert_allclose(err, 1.0 / (1.0 + 3 * ratios), rtol=1e-3)   # PROBLEMS.md P3
+    np.testing.assert_allclose(err, 1.0 / (1.0 + 3 * ratios), rtol=1e-3)   # docs/problems.md P3
     assert log_slope(ratios, err) == pytest.approx(-1.0, abs=0.02)
 
 

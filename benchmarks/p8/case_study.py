@@ -1,4 +1,4 @@
-"""P8 case study (seed §5-6, Table 1; PROBLEMS.md P8; issue 7 items 4-5).
+"""P8 case study (seed §5-6, Table 1; docs/problems.md P8; docs/p8-case-study.md).
 
     .venv/bin/python benchmarks/p8/case_study.py                 # all runs, report, plots
     .venv/bin/python benchmarks/p8/case_study.py --write-scenes  # rewrite benchmarks/p8/*.toml

@@ -110,7 +110,8 @@ def _applicability(scene, rods):
         if (abs(ra["c"] - rb["c"]) > REL_SAME * ra["c"]
                 or abs(ra["impedance"] - rb["impedance"]) > REL_SAME * ra["impedance"]):
             return ("the rods differ in wave speed or impedance: only equal bars have the "
-                    "closed forms used here (p4_rod_impact.impedance_plateau_force gives the plateau)")
+                    "closed forms used here (oracles.p4_rod_impact.impedance_plateau_force gives "
+                    "the plateau)")
     if c["gap"] < 0:
         return "negative gap (initial overlap)"
     return c, sides[0], sides[1]

@@ -19,7 +19,8 @@ def closed_forms():
     out = {}
     for mod in MODULES:
         for name, fn in vars(mod).items():
-            if inspect.isfunction(fn) and fn.__module__ == mod.__name__ and not name.startswith("_"):
+            own = inspect.isfunction(fn) and fn.__module__ == mod.__name__
+            if own and not name.startswith("_"):
                 if name in out:
                     raise AssertionError(f"closed form {name} is defined in {out[name].__module__} "
                                          f"and {mod.__name__}")

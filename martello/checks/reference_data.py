@@ -12,8 +12,9 @@ from ..reference.store import find_reference_data
 
 
 def verify_reference_data(scene, summary, history, root=REFERENCE_ROOT, slack=1.0):
-    """Rows for the catalogue verification table (the same keys as check.verify) comparing a
-    run of a scene with its stored reference data, or [] if it has none.
+    """Rows for the catalogue verification table (the same keys as
+    martello.checks.verify.verify) comparing a run of a scene with its stored reference data,
+    or [] if it has none.
 
     The tolerance of each row is measured, not guessed: the stored data say how far the
     scene's own analysis settings (integrator, Δt) were from the reference when it was made

@@ -40,7 +40,8 @@ def oracle_values(check, source="<scene>"):
     fn = closed_form(name)
     if fn is None:
         raise SceneError(source, "check.closed_form", f"unknown closed form {name!r}",
-                         "name a public function of martello.oracles or martello.checks.dispatchers")
+                         "name a public function of martello.oracles or "
+                         "martello.checks.dispatchers")
     try:
         result = fn(**check["params"])
     except (TypeError, ValueError) as exc:

@@ -56,7 +56,7 @@ def kelvin_bounce_reference(t_end, m, k, h, g, eps, c=None, restitution=None, cl
     n = 1
     while True:
         r = bouncing_oscillator_kelvin(m, k, h, g, eps, c, n, clipped=clipped, u0=u0, v0=v0,
-                                          max_phases=4 * n + 4)
+                                       max_phases=4 * n + 4)
         covered = r.end_reason in ("persistent_contact", "no_impact", "escaped")
         if covered or np.isfinite(r.evaluate(np.array([t_end]))[0][0]) or n > 1_000_000:
             break
@@ -165,8 +165,8 @@ def two_body_kelvin_reference(t_end, m1, m2, gap, eps, restitution=None, c=None,
                               v1=0.0, v2=0.0, node1="m1", node2="m2", contact="impact"):
     """Two free bodies and a linear or Kelvin penalty contact between them (P5): the
     relative coordinate x = u1 − u2 is P2's penalty bounce with mass m*, no spring and no
-    gravity (oracles.p2_bouncing.bouncing_oscillator_kelvin with k = g = 0), the centre of mass moves
-    uniformly. Exact at any time."""
+    gravity (oracles.p2_bouncing.bouncing_oscillator_kelvin with k = g = 0), the centre of
+    mass moves uniformly. Exact at any time."""
     ms = m1 * m2 / (m1 + m2)
     rel = kelvin_bounce_reference(t_end, ms, 0.0, gap, 0.0, eps, c=c, restitution=restitution,
                                   u0=u1 - u2, v0=v1 - v2, node="x", contact=contact, mstar=ms)

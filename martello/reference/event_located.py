@@ -50,8 +50,8 @@ def event_located_run(sc, rtol=1e-12, grid=None):
     Models linear springs, bars, dashpots, penalty contacts with the linear, hertz and
     unclipped Kelvin laws, gravity, ground acceleration and nodal forces given by constant,
     sine, rectangular and half-sine functions; anything else raises Unsupported. Returns a
-    dict shaped like execute()'s: status, summary (contacts with events and peaks, energy,
-    cost, provenance) and history on `grid`."""
+    dict shaped like the result of martello.batch.execute: status, summary (contacts with
+    events and peaks, energy, cost, provenance) and history on `grid`."""
     from scipy.integrate import solve_ivp
     t0_wall = time.perf_counter()
     n = len(sc.nodes)
@@ -78,7 +78,7 @@ def event_located_run(sc, rtol=1e-12, grid=None):
         if c["law"] == "kelvin":
             damp = c["damping"] if c["damping"] is not None else \
                 kelvin_damping(c["stiffness"], effective_mass(sc, c["a"], c["b"]),
-                                          kelvin_xi_from_e(c["restitution"]))
+                               kelvin_xi_from_e(c["restitution"]))
         elif c["law"] in hc_laws:
             # Hunt & Crossley family: F = K δ^n (1 + χ δ̇), χ = a / v_in, never pulling
             a_hc = c["damping"] if c["damping"] is not None else \

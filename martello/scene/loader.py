@@ -201,16 +201,16 @@ def from_dict(data, source="<scene>", base_dir=Path("."), digest=None):
     # loads
     loads = data.get("loads", {})
     lt = check_fields(src, loads, "loads", {"gravity": ("float", False, ANY, 0.0),
-                                       "force": ("list", False, None, []),
-                                       "ground_acceleration": ("table", False, None, None)})
+                                            "force": ("list", False, None, []),
+                                            "ground_acceleration": ("table", False, None, None)})
     forces = []
     for i, tab in enumerate(lt["force"]):
         where = f"loads.force[{i}]"
         if not isinstance(tab, dict):
             raise SceneError(src, where, "must be a table", "write [[loads.force]]")
         f = check_fields(src, tab, where, {"node": ("str", True, None, None),
-                                       "value": ("float", False, ANY, None),
-                                       "function": ("table", False, None, None)})
+                                            "value": ("float", False, ANY, None),
+                                            "function": ("table", False, None, None)})
         if (f["value"] is None) == (f["function"] is None):
             raise SceneError(src, where, "needs exactly one of value or function",
                              "value = 10.0 for a constant force, or function = { type = ... }")
@@ -243,8 +243,9 @@ def from_dict(data, source="<scene>", base_dir=Path("."), digest=None):
     couplings = []
     for i, tab in enumerate(data.get("mass_coupling", [])):
         where = f"mass_coupling[{i}]"
-        mc = check_fields(src, tab, where, {"a": ("str", True, None, None), "b": ("str", True, None, None),
-                                       "value": ("float", True, POSITIVE, None)})
+        mc = check_fields(src, tab, where, {"a": ("str", True, None, None),
+                                            "b": ("str", True, None, None),
+                                            "value": ("float", True, POSITIVE, None)})
         mc["a"] = node_ref(f"{where}.a", mc["a"], ground_ok=False)
         mc["b"] = node_ref(f"{where}.b", mc["b"], ground_ok=False)
         if mc["a"] == mc["b"]:
@@ -348,8 +349,8 @@ def _dashpot_from_zeta(src, i, lk, ground_k, nodes):
 
 def _check_table(src, check):
     c = check_fields(src, check, "check", {"closed_form": ("str", True, None, None),
-                                      "params": ("table", True, None, None),
-                                      "compare": ("list", True, None, None)})
+                                           "params": ("table", True, None, None),
+                                           "compare": ("list", True, None, None)})
     for i, item in enumerate(c["compare"]):
         check_fields(src, item, f"check.compare[{i}]", {
             "result": ("str", True, None, None), "oracle": ("str", True, None, None),

@@ -109,8 +109,8 @@ def experiment(kind, dt_ratio=1.0, stiffness_ratio=1e4, restitution=0.8, mass_ra
                  "link": [{"type": "spring", "a": "mass", "b": "ground", "k": K}],
                  "contact": [_contact(e, eps, gap=H)]}
             ref = kelvin_bounce_reference(t_end, M, K, H, 0.0, eps,
-                                                  restitution=e if e < 1 else None,
-                                                  u0=u0, v0=v0, node="mass", contact="wall")
+                                          restitution=e if e < 1 else None,
+                                          u0=u0, v0=v0, node="mass", contact="wall")
             return Experiment(d, ref, w, t_end, False)
         if kind == "zero_gap":
             # the load presses the mass 1 mm into the wall whatever ε is (g scaled with ε), so
@@ -123,8 +123,8 @@ def experiment(kind, dt_ratio=1.0, stiffness_ratio=1e4, restitution=0.8, mass_ra
                  "link": [{"type": "spring", "a": "mass", "b": "ground", "k": K}],
                  "contact": [_contact(e, eps, gap=0.0)], "loads": {"gravity": g_zg}}
             ref = kelvin_bounce_reference(t_end, M, K, 0.0, g_zg, eps,
-                                                  restitution=e if e < 1 else None,
-                                                  u0=u_eq, v0=v0, node="mass", contact="wall")
+                                          restitution=e if e < 1 else None,
+                                          u0=u_eq, v0=v0, node="mass", contact="wall")
             return Experiment(d, ref, w, t_end, True)
         # zeno: P2, released from rest with the spring unstretched
         seq = bouncing_oscillator_restitution(M, K, H, G, e, 200)
@@ -133,8 +133,8 @@ def experiment(kind, dt_ratio=1.0, stiffness_ratio=1e4, restitution=0.8, mass_ra
              "link": [{"type": "spring", "a": "mass", "b": "ground", "k": K}],
              "contact": [_contact(e, eps, gap=H)], "loads": {"gravity": G}}
         ref = kelvin_bounce_reference(t_end, M, K, H, G, eps,
-                                              restitution=e if e < 1 else None,
-                                              node="mass", contact="wall")
+                                      restitution=e if e < 1 else None,
+                                      node="mass", contact="wall")
         return Experiment(d, ref, w, t_end, False)
     if kind == "two_body":
         m1, m2 = 1.0, float(mass_ratio)
@@ -149,8 +149,8 @@ def experiment(kind, dt_ratio=1.0, stiffness_ratio=1e4, restitution=0.8, mass_ra
         d = {"node": [{"name": "m1", "mass": m1, "v0": 1.0}, {"name": "m2", "mass": m2}],
              "contact": [_contact(e, eps, a="m1", b="m2", gap=gap, name="impact")]}
         ref = two_body_kelvin_reference(t_end, m1, m2, gap, eps,
-                                                restitution=e if e < 1 else None,
-                                                v1=1.0, node1="m1", node2="m2", contact="impact")
+                                        restitution=e if e < 1 else None,
+                                        v1=1.0, node1="m1", node2="m2", contact="impact")
         return Experiment(d, ref, w, t_end, False)
     raise StudyError("atlas", "map.experiment", f"unknown experiment {kind!r}",
                      "valid: " + ", ".join(EXPERIMENT_DEFAULTS))

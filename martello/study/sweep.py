@@ -129,8 +129,8 @@ def make_row(study, spec, result, ref):
     summary = result.get("summary")
     if summary is not None and status in ("MARTELLO_OK", "MARTELLO_ILL_CONDITIONED", "MARTELLO_ROOT_FOUND"):
         row.update(score(summary, result["history"], ref, columns=study.compare["histories"],
-                                 atol=study.compare["atol"], rtol=study.compare["rtol"],
-                                 window=study.compare["window"], points=study.compare["points"]))
+                         atol=study.compare["atol"], rtol=study.compare["rtol"],
+                         window=study.compare["window"], points=study.compare["points"]))
         steps = summary["cost"].get("steps") or 0
         row["mean_step"] = case.t_end / steps if steps else math.nan
         d = row.get("reference_digits", math.nan)
