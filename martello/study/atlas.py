@@ -40,7 +40,6 @@ import math
 import os
 import sys
 import time
-import tomllib
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -56,6 +55,7 @@ from ..reference.closed_form import kelvin_bounce_reference, two_body_kelvin_ref
 from ..scene.spec import ADAPTIVE, INTEGRATORS
 from .outcome import status_class
 from .output import Progress, csv_cell, palette_png, slug
+from .study_file import read_toml
 CLASSES = ("accurate", "inaccurate", "unstable", "failed", "unavailable", "no reference")
 CLASS_COLORS = {"accurate": "#2ca02c", "inaccurate": "#ffd92f", "unstable": "#d62728",
                 "failed": "#000000", "unavailable": "#cccccc", "no reference": "#9ecae1"}
@@ -227,7 +227,7 @@ MAP_KEYS = {"name", "title", "experiment", "x", "y", "fixed"}
 
 def load_atlas(path):
     path = Path(path)
-    raw = tomllib.loads(path.read_text())
+    raw = read_toml(path)
     for k in raw:
         if k not in ATLAS_KEYS:
             raise StudyError(path, k, "unknown key", "valid: " + ", ".join(sorted(ATLAS_KEYS)))

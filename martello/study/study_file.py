@@ -94,14 +94,20 @@ def method_label(name, params):
     return name + (f" ({', '.join(fam)})" if fam else "")
 
 
-def load_study(path):
+def read_toml(path):
+    """The parsed TOML of a study or atlas file; StudyError if it is missing or invalid."""
     path = Path(path)
     if not path.exists():
         raise StudyError(path, "(file)", "does not exist")
     try:
-        raw = tomllib.loads(path.read_text())
+        return tomllib.loads(path.read_text())
     except tomllib.TOMLDecodeError as exc:
         raise StudyError(path, "(syntax)", f"not valid TOML: {exc}") from None
+
+
+def load_study(path):
+    path = Path(path)
+    raw = read_toml(path)
     _check_keys(path, "(top level)", raw, STUDY_KEYS)
     compare = raw.get("compare", {})
     _check_keys(path, "compare", compare, COMPARE_KEYS)
@@ -177,11 +183,5 @@ def load_study(path):
 def file_kind(path):
     """"atlas" for a stability-atlas file (martello.study.atlas), else "study": both are run
     by `martello study`."""
-    path = Path(path)
-    if not path.exists():
-        raise StudyError(path, "(file)", "does not exist")
-    try:
-        raw = tomllib.loads(path.read_text())
-    except tomllib.TOMLDecodeError as exc:
-        raise StudyError(path, "(syntax)", f"not valid TOML: {exc}") from None
+    raw = read_toml(path)
     return "atlas" if raw.get("kind") == "atlas" or "atlas" in raw else "study"
