@@ -97,6 +97,36 @@ def test_the_cycle_finder_finds_a_cycle():
     assert find_cycle({"a": {"b"}, "b": set(), "c": {"a", "b"}}) is None
 
 
+# The layers of the package (martello/__init__.py), bottom up: a module imports modules of
+# its own unit (subpackage or top-level module) or of a lower layer, never of a higher one.
+LAYERS = [("martello", "martello.errors", "martello.paths", "martello.history"),
+          ("martello.binding", "martello.oracles"),
+          ("martello.scene", "martello.ground_motion"),
+          ("martello.run",), ("martello.batch",),
+          ("martello.metrics",), ("martello.reference",),
+          ("martello.checks",),
+          ("martello.study", "martello.compare", "martello.report"),
+          ("martello.cli",), ("martello.__main__",)]
+
+
+def unit(module):
+    """The top-level module or subpackage a module belongs to."""
+    return ".".join(module.split(".")[:2])
+
+
+RANK = {u: i for i, layer in enumerate(LAYERS) for u in layer}
+
+
+def test_every_module_has_a_layer():
+    assert sorted({unit(m) for m in FILES} - set(RANK)) == []
+
+
+def test_each_layer_imports_only_the_layers_below():
+    upward = [f"{m} -> {t}" for m in FILES for t in imports_of(m)
+              if unit(t) != unit(m) and RANK[unit(t)] >= RANK[unit(m)]]
+    assert not upward, "imports against the layering:\n" + "\n".join(sorted(upward))
+
+
 def loaded_after(module):
     """The package's modules loaded in a fresh interpreter by `import module`."""
     r = subprocess.run([sys.executable, "-c", f"import sys, {module}; "
