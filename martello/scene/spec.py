@@ -9,7 +9,7 @@ GROUND = "ground"
 
 NODE_KEYS = {
     "name": ("str", True, None, None),
-    "mass": ("float", True, None, None),        # > 0 unless fixed: checked below
+    "mass": ("float", True, None, None),        # > 0 unless fixed: the loader checks it
     "u0": ("float", False, ANY, 0.0),
     "v0": ("float", False, ANY, 0.0),
     "fixed": ("bool", False, None, False),
