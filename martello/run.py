@@ -7,9 +7,9 @@ from pathlib import Path
 
 import numpy as np
 
-from . import native
-from .native import constant
-from .records import read_record
+from .binding import native
+from .binding.native import constant
+from .ground_motion.records import read_record
 
 LAW_CONST = {"linear": "LAW_LINEAR", "hertz": "LAW_HERTZ", "kelvin": "LAW_KELVIN",
              "hunt-crossley": "LAW_HUNT_CROSSLEY", "lankarani-nikravesh": "LAW_LANKARANI_NIKRAVESH",
@@ -288,8 +288,6 @@ def _dynamic(scene, model, raise_on_failure=True):
               [f"link_force:{l}" for l in an["output"]["links"]] + \
               [f"elongation:{l}" for l in an["output"]["links"]] + \
               [f"energy:{e}" for e in native.ENERGY_NAMES]
-    from .measures import attach     # problem-specific measures (e.g. rod impact, P4)
-    attach(scene, summary, (columns, hist))
     return summary, (columns, hist)
 
 

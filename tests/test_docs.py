@@ -10,6 +10,7 @@
 * docs/problems.md keeps the section names code cites and the formulas code quotes."""
 
 import ast
+import importlib
 import re
 from pathlib import Path
 
@@ -83,25 +84,28 @@ def fortran_type_defaults(type_name):
 
 
 def python_namespace(*names):
-    """The module-level definitions of the martello source file that defines all of `names`,
-    evaluated from its text: every top-level assignment and function definition is run in
-    order, and statements that need what is not there (imports) are skipped."""
+    """The definitions of `names` in the martello package (each found by parsing the
+    package's source for a module-level assignment, then taken from the imported module),
+    and the source text of the modules that define them."""
+    ns, texts = {}, []
     for path in sorted((ROOT / "martello").rglob("*.py")):
         tree = ast.parse(path.read_text())
         defined = {t.id for node in tree.body if isinstance(node, ast.Assign)
-                   for t in node.targets if isinstance(t, ast.Name)}
-        if set(names) <= defined:
-            ns = {}
-            for node in tree.body:
-                if isinstance(node, (ast.Assign, ast.FunctionDef)):
-                    try:
-                        exec(compile(ast.Module([node], []), str(path), "exec"), ns)
-                    except (NameError, AttributeError, TypeError, ImportError):
-                        pass
-            missing = [n for n in names if n not in ns]
-            assert not missing, f"{path}: could not evaluate {missing}"
-            return ns, path.read_text()
-    raise AssertionError(f"no file under martello/ defines all of {names}")
+                   for t in node.targets if isinstance(t, ast.Name)} & set(names)
+        if defined - set(ns):
+            module = ".".join(path.relative_to(ROOT).with_suffix("").parts)
+            mod = vars(importlib.import_module(module))
+            ns.update({n: mod[n] for n in defined if n not in ns})
+            texts.append(path.read_text())
+    missing = [n for n in names if n not in ns]
+    assert not missing, f"no module of martello/ defines {missing}"
+    return ns, "\n".join(texts)
+
+
+def martello_source():
+    """The text of every module of the package, for rules written as code (a condition in
+    the loader) rather than as a table."""
+    return "\n".join(p.read_text() for p in sorted((ROOT / "martello").rglob("*.py")))
 
 
 def _split(cell):
@@ -234,7 +238,8 @@ def test_schemes_table_is_the_code():
 
 
 def test_laws_table_is_the_code():
-    ns, scene_src = python_namespace("LAWS", "FIXED_EXPONENT")
+    ns, _ = python_namespace("LAWS", "FIXED_EXPONENT")
+    scene_src = martello_source()
     ns_run, _ = python_namespace("LAW_CONST", "LAW_EXPONENT")
     elastic = ast.literal_eval(re.search(
         r'c\["law"\] in (\([^)]*\)) and \(c\["damping"\] is not None', scene_src)[1])
@@ -326,7 +331,8 @@ def test_compatibility_table_is_the_code():
 
 
 def test_integrator_parameters_table_is_the_code():
-    ns, scene_src = python_namespace("ANALYSIS_TYPES", "OUTPUT_KEYS", "INTEGRATOR_KEYS",
+    scene_src = martello_source()
+    ns, _ = python_namespace("ANALYSIS_TYPES", "OUTPUT_KEYS", "INTEGRATOR_KEYS",
                                      "IMPLICIT_KEYS", "INTEGRATORS", "NEWMARK_PRESETS")
     implicit = ast.literal_eval(re.search(
         r"implicit = IMPLICIT_KEYS if integ in (\([^)]*\))", scene_src)[1])
@@ -398,7 +404,7 @@ def test_energy_terms_table_is_the_code():
 
 def test_history_columns_table_is_the_code():
     rows = read_table("history-columns")
-    _, run_src = python_namespace("INTEGRATOR_CONST")
+    run_src = martello_source()
     columns_stmt = re.search(r"columns = \[\"t\"\](.*?)\n\s*from ", run_src, re.S)
     assert columns_stmt, "the history column list of the run module was not found"
     prefixes = re.findall(r'f"([a-z_]+):\{', columns_stmt[1])

@@ -1,4 +1,4 @@
-"""Scene files: read, validate, and describe a 1D mechanical network (DESIGN.md).
+"""Scene files: read, validate, and describe a 1D mechanical network.
 
 A scene is TOML with tables `[[node]]`, `[[link]]`, `[[contact]]`, `[loads]`, `[analysis]`
 and an optional `[check]` (the closed form it is verified against). The format is documented
@@ -6,147 +6,19 @@ in docs/scene-format.md. Every error names the file, the field and what would be
 
 import hashlib
 import json
-import math
 import tomllib
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from .errors import SceneError
-
-GROUND = "ground"
-
-# --- field specifications -------------------------------------------------------------------
-# Each table lists its keys: (kind, required, check, default). kind is "float", "int", "str",
-# "bool", "list", "table" or "function". check is (predicate, "what is valid").
-
-POSITIVE = (lambda x: x > 0, "a number > 0")
-NONNEG = (lambda x: x >= 0, "a number >= 0")
-ANY = (lambda x: True, "a number")
-
-
-def _unit_interval(lo_open=False, hi_open=False):
-    def ok(x):
-        return (x > 0 if lo_open else x >= 0) and (x < 1 if hi_open else x <= 1)
-    lo, hi = ("(" if lo_open else "["), (")" if hi_open else "]")
-    return (ok, f"a number in {lo}0, 1{hi}")
-
-
-NODE_KEYS = {
-    "name": ("str", True, None, None),
-    "mass": ("float", True, None, None),        # > 0 unless fixed: checked below
-    "u0": ("float", False, ANY, 0.0),
-    "v0": ("float", False, ANY, 0.0),
-    "fixed": ("bool", False, None, False),
-}
-
-LINK_COMMON = {"name": ("str", False, None, None), "type": ("str", True, None, None),
-               "a": ("str", True, None, None), "b": ("str", True, None, None)}
-LINK_TYPES = {
-    "spring": {"k": ("float", True, POSITIVE, None)},
-    "dashpot": {"c": ("float", False, POSITIVE, None),
-                "zeta": ("float", False, (lambda x: 0 < x < 10, "a number in (0, 10)"), None)},
-    "bilinear": {"k": ("float", True, POSITIVE, None), "fy": ("float", True, POSITIVE, None),
-                 "hardening": ("float", False, _unit_interval(hi_open=True), 0.0)},
-    "fluid_damper": {"c": ("float", True, POSITIVE, None),
-                     "alpha": ("float", False, (lambda x: 0 < x <= 2, "a number in (0, 2]"), 1.0),
-                     "v_reg": ("float", False, NONNEG, 1e-6)},
-    "bar": {"EA": ("float", True, POSITIVE, None), "L": ("float", True, POSITIVE, None)},
-}
-
-SCHEMES = ("penalty", "lagrange", "augmented-lagrange", "restitution")
-LAWS = ("linear", "hertz", "kelvin", "hunt-crossley", "lankarani-nikravesh", "flores",
-        "gonthier", "hertzdamp", "jankowski")
-FIXED_EXPONENT = {"linear": 1, "kelvin": 1, "hertzdamp": 1.5, "jankowski": 1.5}
-CONTACT_COMMON = {"name": ("str", True, None, None), "a": ("str", True, None, None),
-                  "b": ("str", True, None, None), "gap": ("float", False, ANY, 0.0),
-                  "scheme": ("str", True, None, None)}
-CONTACT_SCHEMES = {
-    "penalty": {"law": ("str", False, None, "linear"),
-                "stiffness": ("float", True, POSITIVE, None),
-                "exponent": ("float", False, POSITIVE, None),
-                "damping": ("float", False, NONNEG, None),
-                "restitution": ("float", False, _unit_interval(), None),
-                "clipped": ("bool", False, None, False)},
-    "lagrange": {"restitution": ("float", False, _unit_interval(), None)},
-    "augmented-lagrange": {"stiffness": ("float", True, POSITIVE, None)},
-    "restitution": {"restitution": ("float", True, _unit_interval(), None)},
-}
-
-FUNCTION_TYPES = {
-    "constant": {"value": ("float", True, ANY, None)},
-    "sine": {"amplitude": ("float", True, ANY, None), "omega": ("float", True, POSITIVE, None),
-             "phase": ("float", False, ANY, 0.0), "t_start": ("float", False, NONNEG, 0.0),
-             "t_end": ("float", False, POSITIVE, 1e300)},
-    "rectangular": {"amplitude": ("float", True, ANY, None),
-                    "t_start": ("float", False, NONNEG, 0.0), "t_end": ("float", True, POSITIVE, None)},
-    "half_sine": {"amplitude": ("float", True, ANY, None),
-                  "t_start": ("float", False, NONNEG, 0.0), "t_end": ("float", True, POSITIVE, None)},
-    "table": {"t": ("list", True, None, None), "values": ("list", True, None, None),
-              "scale": ("float", False, ANY, 1.0)},
-    "record": {"file": ("str", True, None, None), "format": ("str", False, None, None),
-               "units": ("str", False, None, None), "scale": ("float", False, ANY, 1.0)},
-}
-
-INTEGRATORS = ("newmark", "hht", "generalized-alpha", "central-difference", "moreau-jean",
-               "newmark-lagrange", "rkf45", "rk8pd", "msbdf", "ida")
-STRUCTURAL = ("newmark", "hht", "generalized-alpha", "central-difference")
-ADAPTIVE = ("rkf45", "rk8pd", "msbdf", "ida")
-# Which contact schemes each integrator runs (fortran/integrator_settings.f90 holds the same
-# table for the C API; tests/test_compatibility.py checks they agree). Penalty contacts are
-# smooth forces; lagrange and restitution contacts need event location or impulse-level
-# time stepping; augmented-lagrange is a static scheme.
-COMPATIBLE = {
-    "penalty": tuple(i for i in INTEGRATORS if i != "newmark-lagrange"),
-    "lagrange": ("moreau-jean", "newmark-lagrange", "rkf45", "rk8pd", "msbdf", "ida"),
-    "restitution": ("moreau-jean", "newmark-lagrange", "rkf45", "rk8pd", "msbdf", "ida"),
-    "augmented-lagrange": (),
-}
-NEWMARK_PRESETS = {"average-acceleration": (0.25, 0.5), "linear-acceleration": (1.0 / 6.0, 0.5)}
-ANALYSIS_TYPES = {
-    "static": {"tol": ("float", False, POSITIVE, 1e-14),
-               "max_iter": ("int", False, POSITIVE, 500)},
-    "dynamic": {"integrator": ("str", True, None, None),
-                "dt": ("float", True, POSITIVE, None),
-                "t_end": ("float", True, POSITIVE, None),
-                "preset": ("str", False, None, None),
-                "beta": ("float", False, (lambda x: x > 0, "a number > 0 (beta = 0 is central-difference)"), None),
-                "gamma": ("float", False, (lambda x: x >= 0.5, "a number >= 0.5"), None),
-                "alpha": ("float", False, (lambda x: -1 / 3 <= x <= 0, "a number in [-1/3, 0]"), None),
-                "rho_inf": ("float", False, (lambda x: 0 <= x <= 1, "a number in [0, 1]"), None),
-                "tol_residual": ("float", False, POSITIVE, 1e-9),
-                "tol_increment": ("float", False, POSITIVE, 1e-11),
-                "max_newton": ("int", False, POSITIVE, 30),
-                "check_stability": ("bool", False, None, True),
-                "divergence_factor": ("float", False, (lambda x: x > 1, "a number > 1"), 10.0),
-                "rtol": ("float", False, POSITIVE, 1e-8),
-                "atol": ("float", False, POSITIVE, 1e-12),
-                "theta": ("float", False, (lambda x: 0.5 <= x <= 1, "a number in [0.5, 1]"), 0.5),
-                "event_tol": ("float", False, POSITIVE, 1e-12),
-                "h_max": ("float", False, NONNEG, 0.0),
-                "output": ("table", False, None, None)},
-}
-OUTPUT_KEYS = {"every": ("int", False, POSITIVE, 1), "nodes": ("list", False, None, None),
-               "contacts": ("list", False, None, None), "links": ("list", False, None, [])}
-INTEGRATOR_KEYS = {"newmark": {"preset", "beta", "gamma"}, "hht": {"alpha"},
-                   "generalized-alpha": {"rho_inf"}, "central-difference": {"check_stability"},
-                   "moreau-jean": {"theta"}, "newmark-lagrange": set(),
-                   **{k: {"rtol", "atol", "event_tol", "h_max"} for k in ADAPTIVE}}
-IMPLICIT_KEYS = {"tol_residual", "tol_increment", "max_newton"}
-ALL_SPECIFIC = set().union(*INTEGRATOR_KEYS.values()) | IMPLICIT_KEYS
-
-TOP_KEYS = {"title", "problem", "description", "node", "link", "contact", "loads", "analysis",
-            "check", "chain", "bar", "mass_coupling"}
-
-# [[chain]]: n oscillators in a row (PROBLEMS.md P7), each a mass on a spring to ground
-# (bilinear if fy is given) with an optional dashpot (zeta), and contacts between
-# neighbours: δ_i = u_i − u_{i+1} − gap_i. Scalars apply to every oscillator, lists give one
-# value each (n for oscillators, n − 1 for gaps).
-CHAIN_KEYS = {"prefix": ("str", True, None, None), "n": ("int", True, POSITIVE, None),
-              "mass": ("any", True, None, None), "k": ("any", True, None, None),
-              "fy": ("any", False, None, None), "hardening": ("any", False, None, None),
-              "zeta": ("any", False, None, None), "gap": ("any", False, None, 0.0),
-              "u0": ("any", False, None, None), "v0": ("any", False, None, None),
-              "contact": ("table", False, None, None)}
+from ..errors import SceneError
+from .bars import expand_bars
+from .chain import expand_chains
+from .compatibility import COMPATIBLE
+from .fields import ANY, NONNEG, POSITIVE, check_fields, choice, finite_everywhere, kind_ok
+from .spec import (ALL_SPECIFIC, ANALYSIS_TYPES, CONTACT_COMMON, CONTACT_SCHEMES,
+                   FIXED_EXPONENT, FUNCTION_TYPES, GROUND, IMPLICIT_KEYS, INTEGRATOR_KEYS,
+                   INTEGRATORS, LAWS, LINK_COMMON, LINK_TYPES, NEWMARK_PRESETS, NODE_KEYS,
+                   OUTPUT_KEYS, SCHEMES, TOP_KEYS)
 
 
 @dataclass
@@ -174,64 +46,6 @@ class Scene:
 
 # --- helpers ---------------------------------------------------------------------------------
 
-def _kind_ok(kind, v):
-    if kind == "any":
-        return True
-    if kind == "float":
-        return isinstance(v, (int, float)) and not isinstance(v, bool)
-    if kind == "int":
-        return isinstance(v, int) and not isinstance(v, bool)
-    return isinstance(v, {"str": str, "bool": bool, "list": list, "table": dict}[kind])
-
-
-def _fields(src, table, where, spec, extra_ok=()):
-    """Validate one table against its spec; return a dict with defaults filled in."""
-    if not isinstance(table, dict):
-        raise SceneError(src, where, "must be a table", "write it as [name] or { ... }")
-    for key in table:
-        if key not in spec and key not in extra_ok:
-            valid = ", ".join(sorted(set(spec) | set(extra_ok)))
-            raise SceneError(src, f"{where}.{key}", "unknown key", f"valid keys here: {valid}")
-    out = {}
-    for key, (kind, required, check, default) in spec.items():
-        path = f"{where}.{key}"
-        if key not in table:
-            if required:
-                raise SceneError(src, path, "missing", f"this field is required ({kind})")
-            out[key] = default
-            continue
-        v = table[key]
-        if not _kind_ok(kind, v):
-            raise SceneError(src, path, f"has the wrong type ({type(v).__name__})",
-                             f"expected {kind}")
-        if kind == "float":
-            v = float(v)
-        if check is not None and kind in ("float", "int"):
-            ok, what = check
-            if not ok(v):
-                raise SceneError(src, path, f"invalid value {v!r}", f"must be {what}")
-        out[key] = v
-    return out
-
-
-def _finite_everywhere(src, obj, where):
-    """TOML admits nan and inf literals; a scene never may."""
-    if isinstance(obj, float) and not math.isfinite(obj):
-        raise SceneError(src, where, f"is {obj}", "every number in a scene must be finite")
-    if isinstance(obj, dict):
-        for k, v in obj.items():
-            _finite_everywhere(src, v, f"{where}.{k}" if where else k)
-    elif isinstance(obj, list):
-        for i, v in enumerate(obj):
-            _finite_everywhere(src, v, f"{where}[{i}]")
-
-
-def _choice(src, path, value, choices):
-    if value not in choices:
-        raise SceneError(src, path, f"unknown value {value!r}", "valid: " + ", ".join(choices))
-    return value
-
-
 def _function(src, tab, where, base_dir, allow_record):
     if not isinstance(tab, dict):
         raise SceneError(src, where, "must be a table", "e.g. { type = \"sine\", ... }")
@@ -239,15 +53,15 @@ def _function(src, tab, where, base_dir, allow_record):
         raise SceneError(src, f"{where}.type", "missing",
                          "valid: " + ", ".join(FUNCTION_TYPES))
     kinds = list(FUNCTION_TYPES) if allow_record else [k for k in FUNCTION_TYPES if k != "record"]
-    kind = _choice(src, f"{where}.type", tab["type"], kinds)
-    f = _fields(src, tab, where, FUNCTION_TYPES[kind], extra_ok=("type",))
+    kind = choice(src, f"{where}.type", tab["type"], kinds)
+    f = check_fields(src, tab, where, FUNCTION_TYPES[kind], extra_ok=("type",))
     f["type"] = kind
     if kind in ("rectangular", "half_sine", "sine") and f["t_end"] <= f["t_start"]:
         raise SceneError(src, f"{where}.t_end", "must be later than t_start")
     if kind == "table":
         t, y = f["t"], f["values"]
         for name, arr in (("t", t), ("values", y)):
-            if not all(_kind_ok("float", x) for x in arr):
+            if not all(kind_ok("float", x) for x in arr):
                 raise SceneError(src, f"{where}.{name}", "must be a list of numbers")
         if len(t) < 2 or len(t) != len(y):
             raise SceneError(src, where, f"t has {len(t)} and values {len(y)} entries",
@@ -286,16 +100,15 @@ def from_dict(data, source="<scene>", base_dir=Path("."), digest=None):
     src = source
     if digest is None:
         digest = hashlib.sha256(json.dumps(data, sort_keys=True, default=str).encode()).hexdigest()
-    _finite_everywhere(src, data, "")
+    finite_everywhere(src, data, "")
     for key in data:
         if key not in TOP_KEYS:
             raise SceneError(src, key, "unknown key", "valid top-level keys: " + ", ".join(sorted(TOP_KEYS)))
     extras = {}
     if "chain" in data:
-        data = _expand_chains(src, data)
+        data = expand_chains(src, data)
     if "bar" in data:
-        from .bars import expand_bars     # [[bar]]: axial rods meshed into elements (P4)
-        data, extras["bars"] = expand_bars(src, data)
+        data, extras["bars"] = expand_bars(src, data)   # [[bar]]: rods meshed into elements (P4)
 
     # nodes
     raw_nodes = data.get("node")
@@ -304,7 +117,7 @@ def from_dict(data, source="<scene>", base_dir=Path("."), digest=None):
     nodes, index = [], {}
     for i, tab in enumerate(raw_nodes):
         where = f"node[{i}]"
-        n = _fields(src, tab, where, NODE_KEYS)
+        n = check_fields(src, tab, where, NODE_KEYS)
         if n["name"] == GROUND:
             raise SceneError(src, f"{where}.name", "'ground' is reserved", "choose another name")
         if n["name"] in index:
@@ -337,9 +150,9 @@ def from_dict(data, source="<scene>", base_dir=Path("."), digest=None):
         where = f"link[{i}]"
         if not isinstance(tab, dict) or "type" not in tab:
             raise SceneError(src, f"{where}.type", "missing", "valid: " + ", ".join(LINK_TYPES))
-        kind = _choice(src, f"{where}.type", tab["type"], list(LINK_TYPES))
+        kind = choice(src, f"{where}.type", tab["type"], list(LINK_TYPES))
         spec = dict(LINK_COMMON, **LINK_TYPES[kind])
-        lk = _fields(src, tab, where, spec)
+        lk = check_fields(src, tab, where, spec)
         lk["a"], lk["b"] = node_ref(f"{where}.a", lk["a"]), node_ref(f"{where}.b", lk["b"])
         if lk["a"] == lk["b"]:
             raise SceneError(src, f"{where}.b", "connects a node to itself", "name two different nodes")
@@ -358,8 +171,8 @@ def from_dict(data, source="<scene>", base_dir=Path("."), digest=None):
         where = f"contact[{i}]"
         if not isinstance(tab, dict) or "scheme" not in tab:
             raise SceneError(src, f"{where}.scheme", "missing", "valid: " + ", ".join(SCHEMES))
-        scheme = _choice(src, f"{where}.scheme", tab["scheme"], SCHEMES)
-        c = _fields(src, tab, where, dict(CONTACT_COMMON, **CONTACT_SCHEMES[scheme]))
+        scheme = choice(src, f"{where}.scheme", tab["scheme"], SCHEMES)
+        c = check_fields(src, tab, where, dict(CONTACT_COMMON, **CONTACT_SCHEMES[scheme]))
         if c["name"] in cnames:
             raise SceneError(src, f"{where}.name", f"duplicate name {c['name']!r}", "names must be unique")
         cnames.add(c["name"])
@@ -367,7 +180,7 @@ def from_dict(data, source="<scene>", base_dir=Path("."), digest=None):
         if c["a"] == c["b"]:
             raise SceneError(src, f"{where}.b", "pairs a node with itself", "name two different nodes or ground")
         if scheme == "penalty":
-            _choice(src, f"{where}.law", c["law"], LAWS)
+            choice(src, f"{where}.law", c["law"], LAWS)
             if c["clipped"] and c["law"] != "kelvin":
                 raise SceneError(src, f"{where}.clipped", "applies to law kelvin only", "remove it")
             if c["exponent"] is not None and c["law"] in FIXED_EXPONENT:
@@ -387,17 +200,17 @@ def from_dict(data, source="<scene>", base_dir=Path("."), digest=None):
 
     # loads
     loads = data.get("loads", {})
-    lt = _fields(src, loads, "loads", {"gravity": ("float", False, ANY, 0.0),
-                                       "force": ("list", False, None, []),
-                                       "ground_acceleration": ("table", False, None, None)})
+    lt = check_fields(src, loads, "loads", {"gravity": ("float", False, ANY, 0.0),
+                                            "force": ("list", False, None, []),
+                                            "ground_acceleration": ("table", False, None, None)})
     forces = []
     for i, tab in enumerate(lt["force"]):
         where = f"loads.force[{i}]"
         if not isinstance(tab, dict):
             raise SceneError(src, where, "must be a table", "write [[loads.force]]")
-        f = _fields(src, tab, where, {"node": ("str", True, None, None),
-                                       "value": ("float", False, ANY, None),
-                                       "function": ("table", False, None, None)})
+        f = check_fields(src, tab, where, {"node": ("str", True, None, None),
+                                            "value": ("float", False, ANY, None),
+                                            "function": ("table", False, None, None)})
         if (f["value"] is None) == (f["function"] is None):
             raise SceneError(src, where, "needs exactly one of value or function",
                              "value = 10.0 for a constant force, or function = { type = ... }")
@@ -412,8 +225,8 @@ def from_dict(data, source="<scene>", base_dir=Path("."), digest=None):
     an = data.get("analysis")
     if not isinstance(an, dict) or "type" not in an:
         raise SceneError(src, "analysis.type", "missing", "valid: " + ", ".join(ANALYSIS_TYPES))
-    atype = _choice(src, "analysis.type", an["type"], list(ANALYSIS_TYPES))
-    analysis = _fields(src, an, "analysis", ANALYSIS_TYPES[atype], extra_ok=("type",))
+    atype = choice(src, "analysis.type", an["type"], list(ANALYSIS_TYPES))
+    analysis = check_fields(src, an, "analysis", ANALYSIS_TYPES[atype], extra_ok=("type",))
     analysis["type"] = atype
     if atype == "dynamic":
         _dynamic_analysis(src, an, analysis, index, contacts, links)
@@ -430,8 +243,9 @@ def from_dict(data, source="<scene>", base_dir=Path("."), digest=None):
     couplings = []
     for i, tab in enumerate(data.get("mass_coupling", [])):
         where = f"mass_coupling[{i}]"
-        mc = _fields(src, tab, where, {"a": ("str", True, None, None), "b": ("str", True, None, None),
-                                       "value": ("float", True, POSITIVE, None)})
+        mc = check_fields(src, tab, where, {"a": ("str", True, None, None),
+                                            "b": ("str", True, None, None),
+                                            "value": ("float", True, POSITIVE, None)})
         mc["a"] = node_ref(f"{where}.a", mc["a"], ground_ok=False)
         mc["b"] = node_ref(f"{where}.b", mc["b"], ground_ok=False)
         if mc["a"] == mc["b"]:
@@ -448,71 +262,9 @@ def from_dict(data, source="<scene>", base_dir=Path("."), digest=None):
                  check=check, digest=digest, index=index, couplings=couplings, extras=extras)
 
 
-def _per_item(src, where, value, count, check=None):
-    """A scalar for all, or a list of exactly `count` numbers."""
-    values = value if isinstance(value, list) else [value] * count
-    if len(values) != count:
-        raise SceneError(src, where, f"has {len(values)} values", f"give one number or a list of {count}")
-    for i, v in enumerate(values):
-        path = f"{where}[{i}]" if isinstance(value, list) else where
-        if not _kind_ok("float", v):
-            raise SceneError(src, path, f"has the wrong type ({type(v).__name__})", "expected float")
-        if check is not None and not check[0](float(v)):
-            raise SceneError(src, path, f"invalid value {v!r}", f"must be {check[1]}")
-    return [float(v) for v in values]
-
-
-def _expand_chains(src, data):
-    """Replace [[chain]] tables by the nodes, links and contacts they stand for."""
-    data = dict(data)
-    chains = data.pop("chain")
-    if not isinstance(chains, list):
-        raise SceneError(src, "chain", "must be an array of tables", "write [[chain]]")
-    nodes, links, contacts = list(data.get("node", [])), list(data.get("link", [])), list(data.get("contact", []))
-    for ci, tab in enumerate(chains):
-        w = f"chain[{ci}]"
-        ch = _fields(src, tab, w, CHAIN_KEYS)
-        n, p = ch["n"], ch["prefix"]
-        mass = _per_item(src, f"{w}.mass", ch["mass"], n, POSITIVE)
-        k = _per_item(src, f"{w}.k", ch["k"], n, POSITIVE)
-        fy = _per_item(src, f"{w}.fy", ch["fy"], n, POSITIVE) if ch["fy"] is not None else None
-        rho = _per_item(src, f"{w}.hardening", ch["hardening"] or 0.0, n, _unit_interval(hi_open=True))
-        zeta = _per_item(src, f"{w}.zeta", ch["zeta"], n, (lambda x: 0 <= x < 10, "a number in [0, 10)")) \
-            if ch["zeta"] is not None else None
-        gap = _per_item(src, f"{w}.gap", ch["gap"], n - 1) if n > 1 else []
-        u0 = _per_item(src, f"{w}.u0", ch["u0"], n) if ch["u0"] is not None else [0.0] * n
-        v0 = _per_item(src, f"{w}.v0", ch["v0"], n) if ch["v0"] is not None else [0.0] * n
-        for i in range(n):
-            name = f"{p}{i + 1}"
-            nodes.append({"name": name, "mass": mass[i], "u0": u0[i], "v0": v0[i]})
-            if fy is None:
-                links.append({"name": f"{name}.spring", "type": "spring", "a": name, "b": "ground", "k": k[i]})
-            else:
-                links.append({"name": f"{name}.spring", "type": "bilinear", "a": name, "b": "ground",
-                              "k": k[i], "fy": fy[i], "hardening": rho[i]})
-            if zeta is not None and zeta[i] > 0:
-                links.append({"name": f"{name}.damper", "type": "dashpot", "a": name, "b": "ground",
-                              "zeta": zeta[i]})
-        if ch["fy"] is None and ch["hardening"] is not None:
-            raise SceneError(src, f"{w}.hardening", "given without fy", "give fy (yield force) for a bilinear spring")
-        if n == 1 and (ch["contact"] is not None or tab.get("gap") is not None):
-            raise SceneError(src, f"{w}.contact" if ch["contact"] is not None else f"{w}.gap",
-                             "a chain of one oscillator has no neighbour contact", "remove it or set n > 1")
-        for key in ("name", "a", "b", "gap"):
-            if ch["contact"] is not None and key in ch["contact"]:
-                raise SceneError(src, f"{w}.contact.{key}", "is generated by the chain",
-                                 "remove it (set gaps with the chain's own gap key)")
-        if ch["contact"] is not None and n > 1:
-            for i in range(n - 1):
-                c = {"name": f"{p}{i + 1}-{p}{i + 2}", "a": f"{p}{i + 1}", "b": f"{p}{i + 2}", "gap": gap[i]}
-                c.update(ch["contact"])
-                contacts.append(c)
-    data.update(node=nodes, link=links, contact=contacts)
-    return data
-
 
 def _dynamic_analysis(src, raw, an, index, contacts, links):
-    integ = _choice(src, "analysis.integrator", an["integrator"], INTEGRATORS)
+    integ = choice(src, "analysis.integrator", an["integrator"], INTEGRATORS)
     implicit = IMPLICIT_KEYS if integ in ("newmark", "hht", "generalized-alpha", "newmark-lagrange") else set()
     allowed = INTEGRATOR_KEYS[integ] | implicit
     for key in ALL_SPECIFIC:
@@ -521,7 +273,7 @@ def _dynamic_analysis(src, raw, an, index, contacts, links):
                              "valid here: " + ", ".join(sorted(allowed)))
     if integ == "newmark":
         if an["preset"] is not None:
-            _choice(src, "analysis.preset", an["preset"], list(NEWMARK_PRESETS))
+            choice(src, "analysis.preset", an["preset"], list(NEWMARK_PRESETS))
             if an["beta"] is not None or an["gamma"] is not None:
                 raise SceneError(src, "analysis.preset", "given together with beta/gamma",
                                  "give a preset or beta and gamma")
@@ -546,7 +298,7 @@ def _dynamic_analysis(src, raw, an, index, contacts, links):
     if an["dt"] > an["t_end"]:
         raise SceneError(src, "analysis.dt", f"{an['dt']} is longer than t_end = {an['t_end']}",
                          "choose dt <= t_end")
-    out = _fields(src, an["output"] or {}, "analysis.output", OUTPUT_KEYS)
+    out = check_fields(src, an["output"] or {}, "analysis.output", OUTPUT_KEYS)
     names = list(index)
     # default: every node and contact of a small scene; none of a large one (peaks are always there)
     out["nodes"] = out["nodes"] if out["nodes"] is not None else (names if len(names) <= 50 else [])
@@ -596,11 +348,11 @@ def _dashpot_from_zeta(src, i, lk, ground_k, nodes):
 
 
 def _check_table(src, check):
-    c = _fields(src, check, "check", {"closed_form": ("str", True, None, None),
-                                      "params": ("table", True, None, None),
-                                      "compare": ("list", True, None, None)})
+    c = check_fields(src, check, "check", {"closed_form": ("str", True, None, None),
+                                           "params": ("table", True, None, None),
+                                           "compare": ("list", True, None, None)})
     for i, item in enumerate(c["compare"]):
-        _fields(src, item, f"check.compare[{i}]", {
+        check_fields(src, item, f"check.compare[{i}]", {
             "result": ("str", True, None, None), "oracle": ("str", True, None, None),
             "rtol": ("float", False, NONNEG, None), "atol": ("float", False, NONNEG, None),
             "why": ("str", True, None, None)})

@@ -1,7 +1,8 @@
-"""Elementary one-dimensional wave theory for the impact of elastic rods (PROBLEMS.md P4),
-coded from d'Alembert's solution alone: nothing here calls or imitates a solver. It adds to
-martello.closed_forms (rod_impact, rod_impact_interface_displacement) the displacement of
-any point of either rod, the rectangular force pulse, and the post-impact energy split.
+"""Elementary one-dimensional wave theory for the impact of elastic rods (docs/problems.md
+P4), coded from d'Alembert's solution alone: nothing here calls or imitates a solver. It adds
+to martello.oracles.p4_rod_impact (rod_impact, rod_impact_interface_displacement) the
+displacement of any point of either rod, the rectangular force pulse, and the post-impact
+energy split.
 
 Setting. Rod A (length L_A) meets rod B (length L_B), or a rigid wall, with relative
 approach speed v0 at t = 0; both rods are free at their far ends and have the same wave

@@ -1,13 +1,13 @@
 """Verification of a run against its scene's closed form (the `[check]` table).
 
-The oracle is evaluated from the parameters written in the check table itself, by
-martello.closed_forms, which never calls the solvers: a scene and its reference are two
-independent statements of the same problem."""
+The oracle is evaluated from the parameters written in the check table itself, by a closed
+form of martello.oracles (or a catalogue dispatcher combining them), which never calls the
+solvers: a scene and its reference are two independent statements of the same problem."""
 
 import math
 
-from . import closed_forms
-from .errors import SceneError
+from ..errors import SceneError
+from .oracle_names import closed_form
 
 DIGITS_CAP = 16.0   # a double carries ~15.95 digits; an exact match is reported as 16
 
@@ -36,12 +36,12 @@ def lookup(summary, path):
 
 
 def oracle_values(check, source="<scene>"):
-    import inspect
     name = check["closed_form"]
-    fn = getattr(closed_forms, name, None)
-    if not (inspect.isfunction(fn) and fn.__module__ == closed_forms.__name__ and not name.startswith("_")):
+    fn = closed_form(name)
+    if fn is None:
         raise SceneError(source, "check.closed_form", f"unknown closed form {name!r}",
-                         "name a public function of martello.closed_forms")
+                         "name a public function of martello.oracles or "
+                         "martello.checks.dispatchers")
     try:
         result = fn(**check["params"])
     except (TypeError, ValueError) as exc:

@@ -25,7 +25,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .errors import RecordError
+from ..errors import RecordError
 
 __all__ = [
     "Record",

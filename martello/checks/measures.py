@@ -1,11 +1,14 @@
-"""Problem-specific measures added to a dynamic run's summary.
+"""Problem-specific measures added to a dynamic run's summary: the errors of the run
+against its problem's oracles. The run itself knows no oracle; the callers that report a run
+(`martello run`, `martello check`) run a scene with :func:`run_measured`, which calls
+:func:`attach` on its summary and history.
 
-Rod impact (PROBLEMS.md P4, docs/p4-bars.md). When the scene was built from `[[bar]]`
+Rod impact (docs/problems.md P4, docs/p4-bars.md). When the scene was built from `[[bar]]`
 tables (scene.extras["bars"]) and has exactly one contact, between the end nodes of two
 rods or between a rod's end node and ground (a rigid wall), `summary["measures"]
 ["rod_impact"]` receives the errors of the run against elementary wave theory
-(martello.closed_forms.rod_impact for the plateau force, the duration and the final
-velocities; martello.wave_theory for the displacement field):
+(martello.oracles.p4_rod_impact.rod_impact for the plateau force, the duration and the final
+velocities; martello.oracles.p4_wave_theory for the displacement field):
 
 * contact duration: first onset to the last separation of the first *episode* (phases
   whose open intervals are shorter than the shortest element transit time L_e/c, or one
@@ -32,12 +35,11 @@ Errors are signed value − reference unless called relative. Quantities that ca
 formed are left out and `notes` says why; nothing here raises for a scene that does not fit.
 """
 
-import math
-
 import numpy as np
 
-from . import closed_forms
-from .wave_theory import rod_point_displacement, vibration_energy_fraction
+from ..oracles.p4_rod_impact import rod_impact
+from ..oracles.p4_wave_theory import rod_point_displacement, vibration_energy_fraction
+from ..run import run_full
 
 REL_SAME = 1e-12     # two rods with c and Z equal to this relative tolerance are "the same bar"
 # A held force below this share of P0 is no pulse: rounding-level forces while two faces
@@ -45,10 +47,19 @@ REL_SAME = 1e-12     # two rods with c and Z equal to this relative tolerance ar
 PULSE_THRESHOLD = 1e-6
 
 
+def run_measured(scene):
+    """(summary, history) of run_full(scene) with the problem's measures attached: what
+    `martello run` writes and `martello check` verifies."""
+    summary, history = run_full(scene)
+    attach(scene, summary, history)
+    return summary, history
+
+
 def attach(scene, summary, history):
-    """Add measures that the scene's generators ask for (scene.extras) to the summary."""
+    """Add measures that the scene's generators ask for (scene.extras) to the summary of a
+    dynamic run (a static run, whose history is None, has none)."""
     rods = scene.extras.get("bars") if scene.extras else None
-    if rods and scene.contacts:
+    if rods and scene.contacts and history is not None:
         m = rod_impact_measures(scene, summary, history)
         summary.setdefault("measures", {})["rod_impact"] = m
     return summary
@@ -99,7 +110,8 @@ def _applicability(scene, rods):
         if (abs(ra["c"] - rb["c"]) > REL_SAME * ra["c"]
                 or abs(ra["impedance"] - rb["impedance"]) > REL_SAME * ra["impedance"]):
             return ("the rods differ in wave speed or impedance: only equal bars have the "
-                    "closed forms used here (closed_forms.impedance_plateau_force gives the plateau)")
+                    "closed forms used here (oracles.p4_rod_impact.impedance_plateau_force gives "
+                    "the plateau)")
     if c["gap"] < 0:
         return "negative gap (initial overlap)"
     return c, sides[0], sides[1]
@@ -152,10 +164,10 @@ def rod_impact_measures(scene, summary, history):
     EA, rhoA = some["EA"], some["rhoA"]
     if wall:
         rod = rod_a or rod_b
-        ref = closed_forms.rod_impact(EA, rhoA, 1.0, rod["L"], rod["L"], v_rel, wall=True)
+        ref = rod_impact(EA, rhoA, 1.0, rod["L"], rod["L"], v_rel, wall=True)
         v_ref = {rod["name"]: -(va0 if rod_a else vb0)}
     else:
-        ref = closed_forms.rod_impact(EA, rhoA, 1.0, rod_a["L"], rod_b["L"], v_rel)
+        ref = rod_impact(EA, rhoA, 1.0, rod_a["L"], rod_b["L"], v_rel)
         v_ref = {rod_a["name"]: vb0 + ref.vA, rod_b["name"]: vb0 + ref.vB}
     t_on_ref = c["gap"] / v_rel
     P0, T = ref.force, ref.duration

@@ -1,4 +1,4 @@
-"""The stability atlas (issue 6, item 4): where each method breaks.
+"""The stability atlas: where each method breaks (docs/studies.md).
 
 Small, exactly solvable contact experiments are swept over the step ratio Δt/Δt_crit (with
 Δt_crit = 2/ω_max, ω_max the highest frequency with every contact closed), the penalty
@@ -18,7 +18,7 @@ run is classified
 * unavailable: the integrator is not built yet (shown grey; re-run the atlas when it lands),
 
 and drawn as one map per experiment with one panel per method. The experiments and their
-exact solutions (martello.metrics → martello.closed_forms):
+exact solutions (martello.reference.closed_form → martello.oracles):
 
 * impact: a mass on a spring (ω_s = 10 rad/s) reaches a rigid wall at 1 m/s after 3 steps
   or 3 contact times, whichever is longer, and is followed for 6 more: one impact on a
@@ -40,17 +40,22 @@ import math
 import os
 import sys
 import time
-import tomllib
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
-from . import metrics, scene as scene_mod
-from .errors import MartelloError
-from .study import Progress, StudyError, _cell, _palette_png, _slug, run_specs, status_class
-
-ROOT = Path(__file__).resolve().parent.parent
+from ..batch import run_specs
+from ..binding import native
+from ..errors import StudyError
+from ..history import history_dict
+from ..oracles.p2_bouncing import bouncing_oscillator_restitution
+from ..paths import REPO
+from ..reference.closed_form import kelvin_bounce_reference, two_body_kelvin_reference
+from ..scene.spec import ADAPTIVE, INTEGRATORS
+from .outcome import status_class
+from .output import Progress, csv_cell, palette_png, slug
+from .study_file import read_toml
 CLASSES = ("accurate", "inaccurate", "unstable", "failed", "unavailable", "no reference")
 CLASS_COLORS = {"accurate": "#2ca02c", "inaccurate": "#ffd92f", "unstable": "#d62728",
                 "failed": "#000000", "unavailable": "#cccccc", "no reference": "#9ecae1"}
@@ -68,7 +73,7 @@ MAX_ROWS = 4000                                # output rows per run (every = st
 @dataclass
 class Experiment:
     scene: dict          # scene dict without [analysis]
-    reference: object    # metrics.Reference
+    reference: object    # martello.reference.base.Reference
     omega_max: float     # rad/s, every contact closed
     t_end: float
     persistent: bool     # the contact never opens in the exact solution
@@ -103,9 +108,9 @@ def experiment(kind, dt_ratio=1.0, stiffness_ratio=1e4, restitution=0.8, mass_ra
             d = {"node": [{"name": "mass", "mass": M, "u0": u0, "v0": v0}],
                  "link": [{"type": "spring", "a": "mass", "b": "ground", "k": K}],
                  "contact": [_contact(e, eps, gap=H)]}
-            ref = metrics.kelvin_bounce_reference(t_end, M, K, H, 0.0, eps,
-                                                  restitution=e if e < 1 else None,
-                                                  u0=u0, v0=v0, node="mass", contact="wall")
+            ref = kelvin_bounce_reference(t_end, M, K, H, 0.0, eps,
+                                          restitution=e if e < 1 else None,
+                                          u0=u0, v0=v0, node="mass", contact="wall")
             return Experiment(d, ref, w, t_end, False)
         if kind == "zero_gap":
             # the load presses the mass 1 mm into the wall whatever ε is (g scaled with ε), so
@@ -117,19 +122,19 @@ def experiment(kind, dt_ratio=1.0, stiffness_ratio=1e4, restitution=0.8, mass_ra
             d = {"node": [{"name": "mass", "mass": M, "u0": u_eq, "v0": v0}],
                  "link": [{"type": "spring", "a": "mass", "b": "ground", "k": K}],
                  "contact": [_contact(e, eps, gap=0.0)], "loads": {"gravity": g_zg}}
-            ref = metrics.kelvin_bounce_reference(t_end, M, K, 0.0, g_zg, eps,
-                                                  restitution=e if e < 1 else None,
-                                                  u0=u_eq, v0=v0, node="mass", contact="wall")
+            ref = kelvin_bounce_reference(t_end, M, K, 0.0, g_zg, eps,
+                                          restitution=e if e < 1 else None,
+                                          u0=u_eq, v0=v0, node="mass", contact="wall")
             return Experiment(d, ref, w, t_end, True)
         # zeno: P2, released from rest with the spring unstretched
-        seq = metrics.cf.bouncing_oscillator_restitution(M, K, H, G, e, 200)
+        seq = bouncing_oscillator_restitution(M, K, H, G, e, 200)
         t_end = window or (1.5 * seq.zeno_time if math.isfinite(seq.zeno_time) else 1.5)
         d = {"node": [{"name": "mass", "mass": M}],
              "link": [{"type": "spring", "a": "mass", "b": "ground", "k": K}],
              "contact": [_contact(e, eps, gap=H)], "loads": {"gravity": G}}
-        ref = metrics.kelvin_bounce_reference(t_end, M, K, H, G, eps,
-                                              restitution=e if e < 1 else None,
-                                              node="mass", contact="wall")
+        ref = kelvin_bounce_reference(t_end, M, K, H, G, eps,
+                                      restitution=e if e < 1 else None,
+                                      node="mass", contact="wall")
         return Experiment(d, ref, w, t_end, False)
     if kind == "two_body":
         m1, m2 = 1.0, float(mass_ratio)
@@ -143,9 +148,9 @@ def experiment(kind, dt_ratio=1.0, stiffness_ratio=1e4, restitution=0.8, mass_ra
         t_end = window or (3.0 * s + tc + 6.0 * s)
         d = {"node": [{"name": "m1", "mass": m1, "v0": 1.0}, {"name": "m2", "mass": m2}],
              "contact": [_contact(e, eps, a="m1", b="m2", gap=gap, name="impact")]}
-        ref = metrics.two_body_kelvin_reference(t_end, m1, m2, gap, eps,
-                                                restitution=e if e < 1 else None,
-                                                v1=1.0, node1="m1", node2="m2", contact="impact")
+        ref = two_body_kelvin_reference(t_end, m1, m2, gap, eps,
+                                        restitution=e if e < 1 else None,
+                                        v1=1.0, node1="m1", node2="m2", contact="impact")
         return Experiment(d, ref, w, t_end, False)
     raise StudyError("atlas", "map.experiment", f"unknown experiment {kind!r}",
                      "valid: " + ", ".join(EXPERIMENT_DEFAULTS))
@@ -167,7 +172,7 @@ def classify(result, exp, accurate_tol=0.05, growth_tol=0.1):
         return "unstable", detail
     if cls != "ok":
         return "failed", detail
-    h = metrics.history_dict(result["history"])
+    h = history_dict(result["history"])
     t = h["t"]
     if not all(np.all(np.isfinite(v)) for v in h.values()):
         return "failed", detail
@@ -222,7 +227,7 @@ MAP_KEYS = {"name", "title", "experiment", "x", "y", "fixed"}
 
 def load_atlas(path):
     path = Path(path)
-    raw = tomllib.loads(path.read_text())
+    raw = read_toml(path)
     for k in raw:
         if k not in ATLAS_KEYS:
             raise StudyError(path, k, "unknown key", "valid: " + ", ".join(sorted(ATLAS_KEYS)))
@@ -231,9 +236,9 @@ def load_atlas(path):
         for k in m:
             if k not in METHOD_KEYS:
                 raise StudyError(path, f"method[{i}].{k}", "unknown key", "valid: " + ", ".join(sorted(METHOD_KEYS)))
-        if m.get("integrator") not in scene_mod.INTEGRATORS:
+        if m.get("integrator") not in INTEGRATORS:
             raise StudyError(path, f"method[{i}].integrator", f"unknown integrator {m.get('integrator')!r}",
-                             "valid: " + ", ".join(scene_mod.INTEGRATORS))
+                             "valid: " + ", ".join(INTEGRATORS))
         methods.append({"label": m.get("label", m["integrator"]), "integrator": m["integrator"],
                         "params": dict(m.get("params", {})), "rtol": list(m.get("rtol", []))})
     maps = []
@@ -264,7 +269,7 @@ def point_spec(mp, method, xv, yv, ident):
     (xa, _), (ya, _) = next(iter(mp["x"].items())), next(iter(mp["y"].items()))
     par = dict(EXPERIMENT_DEFAULTS[mp["experiment"]], dt_ratio=1.0)
     par.update(mp["fixed"])
-    adaptive = method["integrator"] in scene_mod.ADAPTIVE
+    adaptive = method["integrator"] in ADAPTIVE
     par[ya] = yv
     if not (adaptive and xa == "dt_ratio"):
         par[xa] = xv
@@ -282,7 +287,7 @@ def point_spec(mp, method, xv, yv, ident):
         every = max(1, steps // MAX_ROWS)
     an["output"] = {"every": every}
     d = dict(exp.scene, analysis=an)
-    spec = {"id": ident, "scene_dict": d, "scene_file": "<atlas>", "base_dir": str(ROOT), "repeat": 1}
+    spec = {"id": ident, "scene_dict": d, "scene_file": "<atlas>", "base_dir": str(REPO), "repeat": 1}
     return spec, exp, par
 
 
@@ -294,7 +299,7 @@ def run_atlas(atlas, outdir, jobs=0, plots=True, stream=sys.stderr):
     for mp in atlas["maps"]:
         (xa, xs), (ya, ys) = next(iter(mp["x"].items())), next(iter(mp["y"].items()))
         for method in atlas["methods"]:
-            adaptive = method["integrator"] in scene_mod.ADAPTIVE
+            adaptive = method["integrator"] in ADAPTIVE
             xvals = method["rtol"] if (adaptive and xa == "dt_ratio") else xs
             for yv in ys:
                 for xv in xvals:
@@ -322,7 +327,7 @@ def run_atlas(atlas, outdir, jobs=0, plots=True, stream=sys.stderr):
         cost = s.get("cost") or {}
         stab = s.get("stability") or {}
         (xa, _), (ya, _) = next(iter(mp["x"].items())), next(iter(mp["y"].items()))
-        adaptive = method["integrator"] in scene_mod.ADAPTIVE
+        adaptive = method["integrator"] in ADAPTIVE
         rows.append({"run": res["id"], "map": mp["name"], "experiment": mp["experiment"],
                      "method": method["label"], "integrator": method["integrator"],
                      "x_axis": "rtol" if (adaptive and xa == "dt_ratio") else xa, "x": xv,
@@ -345,7 +350,7 @@ def run_atlas(atlas, outdir, jobs=0, plots=True, stream=sys.stderr):
     with open(outdir / "atlas.csv", "w", newline="") as fh:
         w = csv.DictWriter(fh, fieldnames=keys)
         w.writeheader()
-        w.writerows({k: _cell(v) for k, v in r.items()} for r in rows)
+        w.writerows({k: csv_cell(v) for k, v in r.items()} for r in rows)
     bounds = boundaries(rows)
     pngs = [plot_map(atlas, mp, rows, outdir) for mp in atlas["maps"]] if plots else []
     _markdown(atlas, rows, bounds, pngs, elapsed, outdir / "atlas.md")
@@ -418,15 +423,14 @@ def plot_map(atlas, mp, rows, outdir):
     fig.suptitle(f"{atlas['title']}: {mp['title'] or mp['name']}  (dashed: Δt = 2/ω_max; "
                  f"numbers: max error, accurate ≤ {atlas['accurate_tol']:g})", fontsize=9)
     fig.tight_layout(rect=(0, 0.07, 1, 0.93))
-    p = outdir / f"atlas__{_slug(mp['name'])}.png"
+    p = outdir / f"atlas__{slug(mp['name'])}.png"
     fig.savefig(p, dpi=90)
-    _palette_png(p)
+    palette_png(p)
     plt.close(fig)
     return p
 
 
 def _markdown(atlas, rows, bounds, pngs, elapsed, path):
-    from . import native
     counts = {}
     for r in rows:
         counts[(r["method"], r["class"])] = counts.get((r["method"], r["class"]), 0) + 1
@@ -448,7 +452,7 @@ def _markdown(atlas, rows, bounds, pngs, elapsed, path):
 
 def main(args):
     atlas = load_atlas(args.study)
-    out = Path(args.output) if args.output else (ROOT / atlas["output"] if atlas["output"]
+    out = Path(args.output) if args.output else (REPO / atlas["output"] if atlas["output"]
                                                  else Path("out") / "studies" / Path(args.study).stem)
     rows, bounds = run_atlas(atlas, out, jobs=getattr(args, "jobs", 0) or 0)
     counts = {}

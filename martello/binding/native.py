@@ -10,9 +10,9 @@ from pathlib import Path
 
 import numpy as np
 
-from .errors import MartelloError, SolverError, DivergenceError
+from ..errors import MartelloError, SolverError, DivergenceError
 
-_REPO = Path(__file__).resolve().parent.parent
+_REPO = Path(__file__).resolve().parents[2]
 _DOUBLE_P = np.ctypeslib.ndpointer(dtype=np.float64, flags="C_CONTIGUOUS")
 _INT_P = np.ctypeslib.ndpointer(dtype=np.int32, flags="C_CONTIGUOUS")
 _VOID_P = ctypes.c_void_p

@@ -1,10 +1,7 @@
 """The benchmark catalogue: every scene file under benchmarks/ (one problem variant each)."""
 
-from pathlib import Path
-
-from . import scene as scene_mod
-
-ROOT = Path(__file__).resolve().parent.parent / "benchmarks"
+from ..paths import BENCHMARKS as ROOT
+from .loader import load
 
 
 def scene_files(root=ROOT):
@@ -14,4 +11,4 @@ def scene_files(root=ROOT):
 
 
 def scenes(root=ROOT):
-    return [scene_mod.load(p) for p in scene_files(root)]
+    return [load(p) for p in scene_files(root)]

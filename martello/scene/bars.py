@@ -1,7 +1,7 @@
-"""[[bar]] tables: axial rods meshed into bar elements (PROBLEMS.md P4, docs/p4-bars.md).
+"""[[bar]] tables: axial rods meshed into bar elements (docs/problems.md P4, docs/p4-bars.md).
 
 A `[[bar]]` table stands for one straight elastic rod along the scene's axis. The loader
-(martello/scene.py) calls :func:`expand_bars` before it validates nodes and links; the rod
+(martello.scene.loader) calls :func:`expand_bars` before it validates nodes and links; the rod
 becomes ordinary `[[node]]`, `[[link]]` (type "bar") and, for a consistent mass matrix,
 `[[mass_coupling]]` entries, so every integrator sees plain scene items.
 
@@ -45,7 +45,8 @@ velocity history without the native model.
 
 import math
 
-from .errors import SceneError
+from ..errors import SceneError
+from .fields import check_fields
 
 BAR_KEYS = {
     "name": ("str", True, None, None),
@@ -138,8 +139,6 @@ def expand_bars(src, data):
 
     Returns (data, info): a new scene dict (the input is not modified) and one dict per rod
     describing it (module docstring)."""
-    from .scene import _fields     # the loader's field checker: same messages everywhere
-
     data = dict(data)
     bars = data.pop("bar")
     if not isinstance(bars, list) or not bars:
@@ -152,7 +151,7 @@ def expand_bars(src, data):
     out_nodes, info, bar_names = [], [], set()
     for bi, tab in enumerate(bars):
         where = f"bar[{bi}]"
-        b = _fields(src, tab, where, BAR_KEYS)
+        b = check_fields(src, tab, where, BAR_KEYS)
         name = b["name"]
         if not name or name == "ground" or "." in name:
             raise SceneError(src, f"{where}.name", f"invalid name {name!r}",
