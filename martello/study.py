@@ -1000,6 +1000,14 @@ def _tf(fn):
     raise Unsupported(f"time function {k!r}")
 
 
+def _two_mass_mstar(mass, fixed, a, b):
+    """m* = m_a m_b/(m_a + m_b) of a contact, a ground (-1) or fixed side infinitely heavy:
+    the reference's own, independent of the library's 1/(B M⁻¹ Bᵀ) (it refuses couplings,
+    so M is diagonal and the two agree)."""
+    ms = [mass[i] for i in (a, b) if i >= 0 and not fixed[i]]
+    return math.inf if not ms else ms[0] if len(ms) == 1 else ms[0] * ms[1] / (ms[0] + ms[1])
+
+
 def event_located_run(sc, rtol=1e-12, grid=None):
     """Integrate a scene with scipy's DOP853 (an 8th-order embedded Runge–Kutta pair with
     dense output) and exact event location: every contact onset and separation is a root
@@ -1037,11 +1045,11 @@ def event_located_run(sc, rtol=1e-12, grid=None):
         if c["scheme"] != "penalty" or c["law"] not in ("linear", "kelvin", "hertz", *hc_laws) \
                 or c["clipped"]:
             raise Unsupported(f"contact {c['name']}: {c['scheme']} {c.get('law')}")
-        from .run import effective_mass, LAW_EXPONENT
+        from .run import LAW_EXPONENT
         damp, a_hc = 0.0, None
         if c["law"] == "kelvin":
             damp = c["damping"] if c["damping"] is not None else \
-                metrics.cf.kelvin_damping(c["stiffness"], effective_mass(sc, c["a"], c["b"]),
+                metrics.cf.kelvin_damping(c["stiffness"], _two_mass_mstar(mass, fixed, c["a"], c["b"]),
                                           metrics.cf.kelvin_xi_from_e(c["restitution"]))
         elif c["law"] in hc_laws:
             # Hunt & Crossley family: F = K δ^n (1 + χ δ̇), χ = a / v_in, never pulling
