@@ -168,6 +168,9 @@ def _dynamic(scene, model, raise_on_failure=True):
         counters = r.counters()
         message = r.message()
 
+    columns = native.history_columns(an["output"]["nodes"], an["output"]["contacts"],
+                                     an["output"]["links"])
+    col = {name: i for i, name in enumerate(columns)}
     nodes = {}
     for i, n in enumerate(scene.nodes):
         nodes[n["name"]] = {"u_max": float(peaks["u_max"][i]), "u_min": float(peaks["u_min"][i]),
@@ -175,10 +178,9 @@ def _dynamic(scene, model, raise_on_failure=True):
                             "a_absmax": float(peaks["a_absmax"][i])}
         if peaks["t_peak"][i] >= 0:
             nodes[n["name"]].update(u_peak=float(peaks["u_peak"][i]), t_peak=float(peaks["t_peak"][i]))
-        if an["output"]["nodes"] and n["name"] in an["output"]["nodes"] and len(hist):
-            k = an["output"]["nodes"].index(n["name"])
-            nodes[n["name"]].update(u_final=float(hist[-1, 1 + k]),
-                                    v_final=float(hist[-1, 1 + len(an["output"]["nodes"]) + k]))
+        if f"u:{n['name']}" in col and len(hist):
+            nodes[n["name"]].update(u_final=float(hist[-1, col[f"u:{n['name']}"]]),
+                                    v_final=float(hist[-1, col[f"v:{n['name']}"]]))
     contacts = {}
     # events grouped by contact once (a long chain has one or more per contact)
     order = np.argsort(ev_contacts, kind="stable")
@@ -203,9 +205,8 @@ def _dynamic(scene, model, raise_on_failure=True):
             contacts[c["name"]]["contact_time"] = float(closed[0, 1] - closed[0, 0])  # first phase
         if c["name"] in an["output"]["contacts"] and len(hist):
             # the state at t_end: a persistent contact's multiplier (e.g. k h − m g after Zeno)
-            k = 1 + 3 * len(an["output"]["nodes"]) + an["output"]["contacts"].index(c["name"])
-            contacts[c["name"]]["penetration_final"] = float(hist[-1, k])
-            contacts[c["name"]]["force_final"] = float(hist[-1, k + len(an["output"]["contacts"])])
+            contacts[c["name"]]["penetration_final"] = float(hist[-1, col[f"penetration:{c['name']}"]])
+            contacts[c["name"]]["force_final"] = float(hist[-1, col[f"force:{c['name']}"]])
             contacts[c["name"]]["lambda_final"] = 0.0 - contacts[c["name"]]["force_final"]  # seed sign
         if c["scheme"] in ("restitution", "lagrange"):
             # the start of the first lasting contact phase: the accumulation (Zeno) time of
@@ -236,8 +237,6 @@ def _dynamic(scene, model, raise_on_failure=True):
         "cost": counters | {"wall_time_s": wall},
         "provenance": provenance(scene),
     }
-    columns = native.history_columns(an["output"]["nodes"], an["output"]["contacts"],
-                                     an["output"]["links"])
     from .measures import attach     # problem-specific measures (e.g. rod impact, P4)
     attach(scene, summary, (columns, hist))
     return summary, (columns, hist)
