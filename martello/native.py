@@ -185,7 +185,7 @@ def in_range(rng, x):
 
 
 @lru_cache(maxsize=None)
-def Settings():
+def settings_type():
     """The ctypes mirror of martello_settings, built from the registry's table settings."""
     ctype = {"double": ctypes.c_double, "int": ctypes.c_int, "bool": ctypes.c_bool}
     types = {int(r.values["value"]): r.name for r in registry("setting_types")}
@@ -197,7 +197,7 @@ def Settings():
 def settings(integrator, **values):
     """martello_settings for the integrator: the library's defaults (martello_settings_default)
     with the given fields set."""
-    s = Settings()()
+    s = settings_type()()
     if lib().martello_settings_default(value("integrators", integrator), ctypes.byref(s)) != 0:
         raise KeyError(integrator)
     for k, v in values.items():

@@ -94,7 +94,7 @@ def test_settings_struct_is_the_registrys_table_field_by_field():
     want = [("int", "kind")] + [(types[int(r.values["type"])], r.name)
                                 for r in native.registry("settings")]
     assert fields == want
-    assert [f for f, _ in native.Settings()._fields_] == [n for _, n in want]
+    assert [f for f, _ in native.settings_type()._fields_] == [n for _, n in want]
 
 
 def test_c_adapters_index_enums_follow_the_registry():
@@ -189,7 +189,7 @@ def test_set_settings_checks_exactly_what_the_integrator_reads(integrator):
     # with a message naming the field (so the library reads the field where the header puts
     # it), and a bad value of a field it does not read is accepted.
     ranges, reads = native.settings_ranges(), native.settings_read(integrator)
-    types = dict(native.Settings()._fields_)
+    types = dict(native.settings_type()._fields_)
     for name, rng in ranges.items():
         if name == "check_stability":
             continue          # a bool has no bad value; see the central-difference test below
