@@ -5,10 +5,10 @@
 !>   m* = 1/(B M⁻¹ Bᵀ)
 !>
 !> (the inverse of the contact's Delassus operator, docs/moreau-jean.md; = m_a m_b/(m_a + m_b)
-!> for a diagonal M, m_a against a wall, infinite if neither side moves). M is the lumped diagonal plus the consistent
-!> couplings (docs/p4-bars.md), restricted to the free nodes. m* sets the damping of a
-!> penalty contact given a target restitution (contact_laws' damping_from_restitution,
-!> PROBLEMS.md P5) and the Jankowski damping coefficient.
+!> for a diagonal M, m_a against a wall, infinite if neither side moves). M is the lumped
+!> diagonal plus the consistent couplings (docs/p4-bars.md), restricted to the free nodes.
+!> m* sets the damping of a penalty contact given a target restitution (contact_laws'
+!> damping_from_restitution, PROBLEMS.md P5) and the Jankowski damping coefficient.
 module martello_effective_mass
    use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_positive_inf, ieee_is_finite
    use martello_kinds, only: dp

@@ -109,7 +109,8 @@ module martello_registry
       named_t('MARTELLO_ERR_UNSUPPORTED', MARTELLO_ERR_UNSUPPORTED, &
               'scheme, integrator or link not possible here'), &
       named_t('MARTELLO_ERR_UNSTABLE', MARTELLO_ERR_UNSTABLE, 'explicit step beyond its stability limit'), &
-      named_t('MARTELLO_ERR_LAPACK', MARTELLO_ERR_LAPACK, 'LAPACK reported an illegal argument (a bug in martello)'), &
+      named_t('MARTELLO_ERR_LAPACK', MARTELLO_ERR_LAPACK, &
+              'LAPACK reported an illegal argument (a bug in martello)'), &
       named_t('MARTELLO_ERR_STEP_UNDERFLOW', MARTELLO_ERR_STEP_UNDERFLOW, &
               'the step size fell below what the time resolves'), &
       named_t('MARTELLO_ERR_EXTERNAL', MARTELLO_ERR_EXTERNAL, 'GSL or SUNDIALS reported a failure'), &
@@ -208,7 +209,8 @@ module martello_registry
       named_t('time-stepping', FAMILY_TIME_STEPPING, 'impulse-level time stepping (docs/moreau-jean.md)'), &
       named_t('constrained-newmark', FAMILY_CONSTRAINED_NEWMARK, &
               'Newmark with Lagrange multipliers and impact steps (docs/moreau-jean.md)'), &
-      named_t('event-driven', FAMILY_EVENT_DRIVEN, 'GSL adaptive ODE steppers with event location (docs/event-driven.md)'), &
+      named_t('event-driven', FAMILY_EVENT_DRIVEN, &
+              'GSL adaptive ODE steppers with event location (docs/event-driven.md)'), &
       named_t('dae', FAMILY_DAE, 'SUNDIALS IDA on the contact DAE with events (docs/ida.md)')]
 
    type(named_t), parameter :: SETTING_TYPES(*) = [named_t('double', T_DOUBLE, 'C double'), &
@@ -376,6 +378,7 @@ contains
       logical, intent(out) :: ok
       integer :: rows, cols, j
       real(dp) :: par(NPAR_CONTACT), n
+      type(named_t), allocatable :: t(:)
       name = ''; text = ''; values = 0.0_dp
       call registry_shape(table, rows, cols, ok)
       ok = ok .and. i >= 1 .and. i <= rows .and. size(values) >= cols
@@ -410,7 +413,11 @@ contains
          values(1:3) = [real(LAWS(i)%value, dp), merge(HERTZ_EXPONENT, n, ieee_is_nan(n)), &
                         merge(0.0_dp, 1.0_dp, ieee_is_nan(n))]
       case default
-         call named_row(named_table(table), i, name, values(1), text)
+         t = named_table(table)
+         ok = i <= size(t)
+         if (ok) then
+            name = t(i)%name; values(1) = t(i)%value; text = t(i)%text
+         end if
       end select
    end subroutine registry_row
 
@@ -469,18 +476,10 @@ contains
       case ('events'); t = EVENT_FIELDS
       case ('constants'); t = CONSTANTS
       case ('history'); t = HISTORY
-      case default; t = HISTORY_PER
+      case ('history_per'); t = HISTORY_PER
+      case default; allocate (t(0))
       end select
    end function named_table
-
-   pure subroutine named_row(t, i, name, value, text)
-      type(named_t), intent(in) :: t(:)
-      integer, intent(in) :: i
-      character(len=NAME_LEN), intent(out) :: name
-      real(dp), intent(out) :: value
-      character(len=TEXT_LEN), intent(out) :: text
-      name = t(i)%name; value = t(i)%value; text = t(i)%text
-   end subroutine named_row
 
    !> A bound of a range as exported: ±infinity for "none".
    pure real(dp) function unbounded(x, sgn)

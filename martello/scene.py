@@ -56,7 +56,8 @@ LINK_TYPES = {
 
 SCHEMES = native.names("schemes")
 LAWS = native.names("laws")
-FIXED_EXPONENT = {r.name: r.values["exponent"] for r in native.registry("laws") if r.values["exponent_fixed"]}
+FIXED_EXPONENT = {r.name: r.values["exponent"] for r in native.registry("laws")
+                  if r.values["exponent_fixed"]}
 CONTACT_COMMON = {"name": ("str", True, None, None), "a": ("str", True, None, None),
                   "b": ("str", True, None, None), "gap": ("float", False, ANY, 0.0),
                   "scheme": ("str", True, None, None)}
