@@ -903,18 +903,12 @@ static int ed_setup(ed_t *w) {
   return MARTELLO_OK;
 }
 
+/* What GSL's steppers need beyond the ranges martello_run_set_settings checked. */
 static int check_settings(ed_t *w) {
-  const char *bad = NULL;
   /* a relative tolerance near the rounding unit cannot be met: the steps would shrink to
    * where the error estimates are rounding noise and the run would crawl */
-  if (!(w->rtol >= 10.0 * DBL_EPSILON)) bad = "rtol must be >= 10 machine epsilons (2.2e-15)";
-  else if (!(w->atol > 0.0)) bad = "atol must be > 0";
-  else if (!(w->event_tol > 0.0)) bad = "event_tol must be > 0";
-  else if (!(w->h_max >= 0.0)) bad = "h_max must be >= 0 (0: no limit)";
-  else if (!(w->dt_out > 0.0 && w->t_end > 0.0)) bad = "dt (output interval) and t_end must be > 0";
-  else if (w->every < 1) bad = "every must be >= 1";
-  if (bad == NULL) return MARTELLO_OK;
-  snprintf(w->msg, sizeof w->msg, "event-driven: %s", bad);
+  if (w->rtol >= 10.0 * DBL_EPSILON) return MARTELLO_OK;
+  snprintf(w->msg, sizeof w->msg, "event-driven: rtol must be >= 10 machine epsilons (2.2e-15)");
   martello_run_set_message(w->run, w->msg);
   return MARTELLO_ERR_ARGUMENT;
 }
@@ -1025,26 +1019,28 @@ static int ed_integrate(ed_t *w, double *t_reached) {
 
 int martello_event_driven_run(martello_model *model, martello_run *run) {
   ed_t w;
-  double par[MARTELLO_NPAR_INTEGRATOR], t_reached = 0.0;
+  martello_settings s;
+  double t_reached = 0.0;
   int st, j, nco;
   memset(&w, 0, sizeof w);
   w.model = model;
   w.run = run;
   if (model == NULL || run == NULL) return MARTELLO_ERR_ARGUMENT;
-  st = martello_run_settings(run, &w.kind, par);
+  st = martello_run_settings(run, &s);
   if (st != MARTELLO_OK) return st;
+  w.kind = s.kind;
   if (w.kind != MARTELLO_INT_RKF45 && w.kind != MARTELLO_INT_RK8PD &&
       w.kind != MARTELLO_INT_MSBDF) {
     martello_run_set_message(run, "event-driven: the integrator must be rkf45, rk8pd or msbdf");
     return MARTELLO_ERR_ARGUMENT;
   }
-  w.dt_out = par[MARTELLO_R_DT];
-  w.t_end = par[MARTELLO_R_T_END];
-  w.rtol = par[MARTELLO_R_RTOL];
-  w.atol = par[MARTELLO_R_ATOL];
-  w.event_tol = par[MARTELLO_R_EVENT_TOL];
-  w.h_max = par[MARTELLO_R_H_MAX];
-  w.every = (int)lround(par[MARTELLO_R_EVERY]);
+  w.dt_out = s.dt;
+  w.t_end = s.t_end;
+  w.rtol = s.rtol;
+  w.atol = s.atol;
+  w.event_tol = s.event_tol;
+  w.h_max = s.h_max;
+  w.every = s.every;
   st = check_settings(&w);
   if (st != MARTELLO_OK) return st;
   st = martello_model_topology(model, &w.n, &w.nc, NULL, NULL, NULL, NULL, NULL, NULL, NULL, &nco);

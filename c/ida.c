@@ -922,22 +922,18 @@ static int bandwidth(ida_problem *P, const double *u0, const double *v0, suninde
 }
 
 static int setup(ida_problem *P, martello_model *model, martello_run *run) {
-  int st, ok = 1, kind, n, nc, ncp;
-  double par[MARTELLO_NPAR_INTEGRATOR];
+  int st, ok = 1, n, nc, ncp;
+  martello_settings s;
   P->model = model;
   P->run = run;
-  if ((st = martello_run_settings(run, &kind, par)) != MARTELLO_OK) return st;
-  P->rtol = par[MARTELLO_R_RTOL];
-  P->atol = par[MARTELLO_R_ATOL];
-  P->event_tol = par[MARTELLO_R_EVENT_TOL] > 0.0 ? par[MARTELLO_R_EVENT_TOL] : 1e-12;
-  P->t_end = par[MARTELLO_R_T_END];
-  P->h_max = par[MARTELLO_R_H_MAX];
-  P->out_dt = par[MARTELLO_R_DT] * (par[MARTELLO_R_EVERY] >= 1.0 ? par[MARTELLO_R_EVERY] : 1.0);
-  P->divergence_factor = par[MARTELLO_R_DIVERGENCE_FACTOR];
-  if (!(P->rtol >= 0.0 && P->atol >= 0.0 && P->rtol + P->atol > 0.0))
-    return fail(P, MARTELLO_ERR_ARGUMENT, "IDA needs rtol >= 0 and atol >= 0, not both 0");
-  if (!(P->t_end > 0.0 && P->out_dt > 0.0))
-    return fail(P, MARTELLO_ERR_ARGUMENT, "IDA needs t_end > 0 and an output interval dt > 0");
+  if ((st = martello_run_settings(run, &s)) != MARTELLO_OK) return st;
+  P->rtol = s.rtol;
+  P->atol = s.atol;
+  P->event_tol = s.event_tol;
+  P->t_end = s.t_end;
+  P->h_max = s.h_max;
+  P->out_dt = s.dt * s.every;
+  P->divergence_factor = s.divergence_factor;
   if ((st = martello_model_topology(model, &n, &nc, NULL, NULL, NULL, NULL, NULL, NULL, NULL,
                                     &ncp)) != MARTELLO_OK)
     return fail(P, st, "IDA: could not read the model");

@@ -35,8 +35,8 @@ int martello_eval_commit(martello_eval *ev, const double *u, const double *v);
 int martello_eval_energy(martello_eval *ev, const double *u, const double *v, double *kinetic,
                          double *recoverable);
 
-/* The run being filled. */
-int martello_run_settings(const martello_run *run, int *kind, double par[MARTELLO_NPAR_INTEGRATOR]);
+/* The run being filled; its settings, as martello_run_set_settings validated them. */
+int martello_run_settings(const martello_run *run, martello_settings *settings);
 int martello_run_track(martello_run *run, double t, const double *u, const double *v,
                        const double *a, const double *pen, const double *force);
 int martello_run_record(martello_run *run, double t, const double *u, const double *v,

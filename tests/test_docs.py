@@ -58,31 +58,6 @@ def fortran_parameters(pattern):
     return out
 
 
-def fortran_name_cases(function):
-    """{CONSTANT: 'name'} of a Fortran `select case` that returns names (integrator_name,
-    scheme_name, ...)."""
-    text = fortran_text()
-    m = re.search(rf"function\s+{function}\b(.*?)end\s+function", text, re.S | re.I)
-    assert m, f"Fortran function {function} not found"
-    return dict(re.findall(r"case\s*\((\w+)\)\s*;?\s*\n?\s*name\s*=\s*'([^']+)'", m[1]))
-
-
-def fortran_type_defaults(type_name):
-    """{component: value} of a derived type's default initialisations."""
-    text = fortran_text()
-    m = re.search(rf"type\s*::\s*{type_name}\b(.*?)end\s+type", text, re.S)
-    assert m, f"Fortran type {type_name} not found"
-    out = {}
-    for decl in re.findall(r"::\s*([^!\n]*)", m[1]):
-        for name, value in re.findall(r"(\w+)\s*=\s*([^,]+)", decl):
-            value = value.strip()
-            if value in (".true.", ".false."):
-                out[name] = value == ".true."
-            elif re.fullmatch(r"-?[\d.]+(e-?\d+)?(_dp|_i8)?", value):
-                out[name] = float(value.replace("_dp", "").replace("_i8", ""))
-    return out
-
-
 def python_namespace(*names):
     """The definitions of `names` in the martello package (each found by parsing the
     package's source for a module-level assignment, then taken from the imported module),
@@ -200,223 +175,163 @@ def test_status_codes_table_is_the_header_enum():
     assert {r["status"]: int(r["value"]) for r in rows} == fortran
 
 
-def test_integrators_table_is_the_code():
-    ns, _ = python_namespace("INTEGRATORS", "STRUCTURAL", "ADAPTIVE")
+def _registry():
+    from martello.binding import native
+    return native
+
+
+def _constant(prefix, name):
+    """The C constant of a registry row: its table's prefix and the name in capitals."""
+    return prefix + name.upper().replace("-", "_")
+
+
+def test_integrators_table_is_the_registry():
+    native = _registry()
+    reg = native.registry("integrators")
+    families = {int(r.values["value"]): r.name for r in native.registry("families")}
     rows = read_table("integrators")
-    assert [r["integrator"] for r in rows] == list(ns["INTEGRATORS"])
+    assert [r["integrator"] for r in rows] == [r.name for r in reg]
     c = c_constants()
-    fortran_values = fortran_parameters(r"INT_[A-Z0-9_]+")
-    fortran_names = fortran_name_cases("integrator_name")
-    for r in rows:
+    for r, g in zip(rows, reg):
         name = r["integrator"]
-        assert c[r["constant"]] == int(r["value"]), name
-        internal = r["constant"].removeprefix("MARTELLO_")
-        assert fortran_names[internal] == name and fortran_values[internal] == int(r["value"]), name
-        assert (r["family"] == "structural") == (name in ns["STRUCTURAL"]), name
-        assert (r["family"] in ("event-driven", "dae")) == (name in ns["ADAPTIVE"]), name
-        assert r["dt is"] == ("output interval" if name in ns["ADAPTIVE"] else "step"), name
+        assert r["constant"] == _constant("MARTELLO_INT_", name), name
+        assert int(r["value"]) == g.values["value"] == c[r["constant"]], name
+        assert r["family"] == families[int(g.values["family"])], name
+        assert r["dt is"] == ("output interval" if g.values["adaptive"] else "step"), name
         assert (DOCS / r["described in"]).exists(), name
-    ns_run, _ = python_namespace("INTEGRATOR_CONST")
-    assert {k: "MARTELLO_" + v for k, v in ns_run["INTEGRATOR_CONST"].items()} == \
-        {r["integrator"]: r["constant"] for r in rows}
 
 
-def test_schemes_table_is_the_code():
-    ns, _ = python_namespace("SCHEMES", "CONTACT_SCHEMES")
-    ns_run, _ = python_namespace("SCHEME_CONST")
+def test_schemes_table_is_the_registry():
+    native = _registry()
+    ns, _ = python_namespace("CONTACT_SCHEMES")
+    reg = native.registry("schemes")
     rows = read_table("schemes")
-    assert [r["scheme"] for r in rows] == list(ns["SCHEMES"])
+    assert [r["scheme"] for r in rows] == [r.name for r in reg]
     c = c_constants()
-    fortran_values = fortran_parameters(r"SCHEME_[A-Z]+")
-    fortran_names = fortran_name_cases("scheme_name")
-    for r in rows:
-        name, internal = r["scheme"], r["constant"].removeprefix("MARTELLO_")
-        assert ns_run["SCHEME_CONST"][name] == internal, name
-        assert c[r["constant"]] == int(r["value"]) == fortran_values[internal], name
-        assert fortran_names[internal] == name, name
+    for r, g in zip(rows, reg):
+        name = r["scheme"]
+        assert r["constant"] == _constant("MARTELLO_SCHEME_", name), name
+        assert int(r["value"]) == g.values["value"] == c[r["constant"]], name
         assert set(_split(r["keys"])) == set(ns["CONTACT_SCHEMES"][name]), name
 
 
-def test_laws_table_is_the_code():
-    ns, _ = python_namespace("LAWS", "FIXED_EXPONENT")
+def test_laws_table_is_the_registry():
+    native = _registry()
+    # which laws refuse damping / e = 0 are rules of the loader, written as conditions
     scene_src = martello_source()
-    ns_run, _ = python_namespace("LAW_CONST", "LAW_EXPONENT")
     elastic = ast.literal_eval(re.search(
         r'c\["law"\] in (\([^)]*\)) and \(c\["damping"\] is not None', scene_src)[1])
     divide_by_e = ast.literal_eval(re.search(
         r'c\["law"\] in (\([^)]*\)) and c\["restitution"\] == 0', scene_src)[1])
+    reg = native.registry("laws")
     rows = read_table("laws")
-    assert [r["law"] for r in rows] == list(ns["LAWS"])
+    assert [r["law"] for r in rows] == [r.name for r in reg]
     c = c_constants()
-    fortran_values = fortran_parameters(r"LAW_[A-Z_]+")
-    for r in rows:
-        law, internal = r["law"], r["constant"].removeprefix("MARTELLO_")
-        assert ns_run["LAW_CONST"][law] == internal, law
-        assert c[r["constant"]] == int(r["value"]) == fortran_values[internal], law
-        if law in ns["FIXED_EXPONENT"]:
-            assert r["exponent"] == f"{ns['FIXED_EXPONENT'][law]:g} (fixed)", law
-            assert ns_run["LAW_EXPONENT"][law] == ns["FIXED_EXPONENT"][law], law
-        else:
-            assert r["exponent"] == f"key, default {ns_run['LAW_EXPONENT'][law]:g}", law
+    for r, g in zip(rows, reg):
+        law = r["law"]
+        assert r["constant"] == _constant("MARTELLO_LAW_", law), law
+        assert int(r["value"]) == g.values["value"] == c[r["constant"]], law
+        n = g.values["exponent"]
+        assert r["exponent"] == (f"{n:g} (fixed)" if g.values["exponent_fixed"] else f"key, default {n:g}"), law
         assert (r["damping"] == "refused") == (law in elastic), law
         expected = "refused" if law in elastic else "(0, 1]" if law in divide_by_e else "[0, 1]"
         assert r["restitution"] == expected, law
 
 
-def test_link_kinds_table_is_the_code():
+def test_link_kinds_table_is_the_registry():
+    native = _registry()
     ns, _ = python_namespace("LINK_TYPES")
-    ns_run, _ = python_namespace("LINK_CONST")
+    reg = native.registry("links")
     rows = read_table("link-kinds")
-    assert [r["link"] for r in rows] == list(ns["LINK_TYPES"])
+    assert [r["link"] for r in rows] == [r.name for r in reg] == list(ns["LINK_TYPES"])
     c = c_constants()
-    fortran_values = fortran_parameters(r"LINK_[A-Z_]+")
-    for r in rows:
-        link, internal = r["link"], r["constant"].removeprefix("MARTELLO_")
-        assert ns_run["LINK_CONST"][link] == internal, link
-        assert c[r["constant"]] == int(r["value"]) == fortran_values[internal], link
+    for r, g in zip(rows, reg):
+        link = r["link"]
+        assert r["constant"] == _constant("MARTELLO_LINK_", link), link
+        assert int(r["value"]) == g.values["value"] == c[r["constant"]], link
         assert _split(r["keys"]) == list(ns["LINK_TYPES"][link]), link
 
 
-def _fortran_scheme_supported():
-    """The compatibility rule of the Fortran library, evaluated from its source: each
-    `case (SCHEME...)` sets `ok = <expression in kind>`, then `if (scheme == S) ok = ...`."""
-    text = fortran_text()
-    m = re.search(r"function\s+scheme_supported\b(.*?)end\s+function", text, re.S)
-    assert m, "Fortran function scheme_supported not found"
-    body = m[1]
-    ints = fortran_parameters(r"INT_[A-Z0-9_]+")
-    schemes = fortran_parameters(r"SCHEME_[A-Z]+")
-
-    def py(expr):
-        expr = expr.split("!")[0].strip()
-        for f, p in ((".false.", "False"), (".true.", "True"), (".and.", " and "),
-                     (".or.", " or "), (".not.", " not "), ("/=", "!=")):
-            expr = expr.replace(f, p)
-        return expr
-
-    cases = re.findall(r"case\s*\(([^)]*)\)\s*(?:!.*)?\n\s*ok\s*=\s*(.+)", body)
-    default = re.search(r"case\s+default.*\n\s*ok\s*=\s*(.+)", body)
-    overrides = re.findall(r"if\s*\(scheme\s*==\s*(\w+)\)\s*ok\s*=\s*(.+)", body)
-
-    def supported(kind, scheme):
-        env = dict(ints, kind=kind)
-        result = None
-        for names, expr in cases:
-            if scheme in [schemes[n.strip()] for n in names.split(",")]:
-                result = eval(py(expr), {}, env)
-        if result is None:
-            result = eval(py(default[1]), {}, env)
-        for name, expr in overrides:
-            if scheme == schemes[name]:
-                result = eval(py(expr), {}, env)
-        return bool(result)
-    return supported, ints, schemes
-
-
-def test_compatibility_table_is_the_code():
-    ns, _ = python_namespace("INTEGRATORS", "COMPATIBLE")
-    ns_run, _ = python_namespace("INTEGRATOR_CONST", "SCHEME_CONST")
+def test_compatibility_table_is_the_registry():
+    native = _registry()
+    reg = {r.name: r.values for r in native.registry("compatibility")}
     rows = read_table("compatibility")
-    assert list(rows[0]) == ["scheme"] + list(ns["INTEGRATORS"])
-    assert {r["scheme"] for r in rows} == set(ns["COMPATIBLE"])
-    supported, ints, schemes = _fortran_scheme_supported()
+    assert list(rows[0]) == ["scheme"] + list(reg)
+    assert [r["scheme"] for r in rows] == [r.name for r in native.registry("schemes")]
     for r in rows:
-        for integ in ns["INTEGRATORS"]:
-            assert r[integ] in ("yes", "no"), (r["scheme"], integ)
-            yes = r[integ] == "yes"
-            assert yes == (integ in ns["COMPATIBLE"][r["scheme"]]), (r["scheme"], integ)
-            kind = ints[ns_run["INTEGRATOR_CONST"][integ]]
-            scheme = schemes[ns_run["SCHEME_CONST"][r["scheme"]]]
-            assert yes == supported(kind, scheme), ("fortran", r["scheme"], integ)
+        for integ, schemes in reg.items():
+            assert r[integ] == ("yes" if schemes[r["scheme"]] else "no"), (r["scheme"], integ)
 
 
-def test_integrator_parameters_table_is_the_code():
-    scene_src = martello_source()
-    ns, _ = python_namespace("ANALYSIS_TYPES", "OUTPUT_KEYS", "INTEGRATOR_KEYS",
-                                     "IMPLICIT_KEYS", "INTEGRATORS", "NEWMARK_PRESETS")
-    implicit = ast.literal_eval(re.search(
-        r"implicit = IMPLICIT_KEYS if integ in (\([^)]*\))", scene_src)[1])
-    # keys the integrator check requires (hht: alpha, generalized-alpha: rho_inf)
-    required_by_integrator = set(re.findall(r'raise SceneError\(src, "analysis\.(\w+)", "missing"', scene_src))
-    spec = {k: v for k, v in ns["ANALYSIS_TYPES"]["dynamic"].items() if k not in ("integrator", "output")}
-    spec["output.every"] = ns["OUTPUT_KEYS"]["every"]
+def test_integrator_parameters_table_is_the_registry():
+    native = _registry()
+    ns, _ = python_namespace("ANALYSIS_TYPES", "OUTPUT_KEYS", "NEWMARK_PRESETS")
+    settings = {r.name: r for r in native.registry("settings")}
+    types = {int(r.values["value"]): r.name for r in native.registry("setting_types")}
+    integrators = native.integrators()
+    reads = {i: native.settings_read(i) for i in integrators}
     rows = read_table("integrator-parameters")
-    assert [r["key"] for r in rows if r["key"] in spec] == [r["key"] for r in rows]
-    assert {r["key"] for r in rows} == set(spec)
-    c = c_constants()
-    fortran = fortran_type_defaults("integrator_settings_t")
-    slots = {k for k in c if k.startswith("MARTELLO_R_")}
-    assert {r["slot"] for r in rows} - {"—"} == slots
-    assert c["MARTELLO_NPAR_INTEGRATOR"] == len(slots)
-    kinds = {"float": "float", "int": "int", "bool": "bool", "str": "string"}
+    keys = {k for k in ns["ANALYSIS_TYPES"]["dynamic"] if k not in ("integrator", "output")}
+    assert {r["key"] for r in rows} == keys | {"output.every"}
+    assert {r["key"].removeprefix("output.") for r in rows} - {"preset"} == set(settings)
+    kinds = {"double": "float", "int": "int", "bool": "bool"}
     for r in rows:
         key = r["key"]
-        kind, required, check, default = spec[key]
-        short = key.split(".")[-1]
-        if short in set().union(*ns["INTEGRATOR_KEYS"].values()) | ns["IMPLICIT_KEYS"]:
-            expected = [i for i in ns["INTEGRATORS"] if short in ns["INTEGRATOR_KEYS"][i]
-                        or (short in ns["IMPLICIT_KEYS"] and i in implicit)]
-            assert _split(r["integrators"]) == expected, key
-        else:
-            assert r["integrators"] == "all", key
-        assert r["type"] == kinds[kind], key
-        if default is not None:
-            cell = r["default"]
-            if kind == "bool":
-                assert cell == str(default).lower(), key
-            else:
-                assert float(cell) == default, key
-                if short in fortran:
-                    assert fortran[short] == default, ("fortran default", key)
-        elif required or short in required_by_integrator:
-            assert r["default"] == "required", key
-        else:
-            assert r["default"] in {"from preset", *ns["NEWMARK_PRESETS"]}, key
-        if check is not None:
-            assert r["valid"] == check[1].removeprefix("a number "), key
-        elif key == "preset":
+        short = key.removeprefix("output.")
+        if short == "preset":
+            assert r["integrators"] == "newmark" and r["type"] == "string", key
             assert _split(r["valid"]) == list(ns["NEWMARK_PRESETS"]), key
+            assert r["settings field"] == "—", key
+            continue
+        g = settings[short]
+        readers = [i for i in integrators if short in reads[i]]
+        assert r["integrators"] == ("all" if readers == list(integrators) else ", ".join(readers)), key
+        assert r["type"] == kinds[types[int(g.values["type"])]], key
+        assert r["settings field"] == short, key
+        assert r["valid"] == g.text.removeprefix("a number "), key
+        spec = ns["OUTPUT_KEYS"]["every"] if key == "output.every" else ns["ANALYSIS_TYPES"]["dynamic"][key]
+        kind, required, check, default = spec
+        if default is not None:
+            assert default == g.values["default"], ("loader default is the registry's", key)
+            cell = r["default"]
+            assert (cell == str(default).lower()) if kind == "bool" else float(cell) == default, key
         else:
-            assert r["valid"] == "—", key
-        slot = f"MARTELLO_R_{short.upper()}"
-        assert r["slot"] == (slot if slot in c else "—"), key
+            assert r["default"] in {"required", "from preset"}, key
 
 
-def test_counters_table_is_the_code():
-    ns, _ = python_namespace("COUNTER_NAMES")
-    rows = read_table("counters")
-    fortran = fortran_parameters(r"C_[A-Z_]+|NCOUNTERS")
-    assert [r["counter"] for r in rows] == list(ns["COUNTER_NAMES"])
-    assert [int(r["index"]) for r in rows] == list(range(len(rows)))
-    assert [fortran[r["fortran"]] - 1 for r in rows] == list(range(len(rows)))
-    assert c_constants()["MARTELLO_NCOUNTERS"] == fortran["NCOUNTERS"] == len(rows)
+def _named_table(doc_table, reg_table, name_col, prefix):
+    native = _registry()
+    reg = native.registry(reg_table)
+    rows = read_table(doc_table)
+    assert [r[name_col] for r in rows] == [r.name for r in reg]
+    c = c_constants()
+    for r, g in zip(rows, reg):
+        assert int(r["index"]) == g.values["value"] == c[r["constant"]], r[name_col]
+        assert r["constant"] == _constant(prefix, r[name_col]), r[name_col]
 
 
-def test_energy_terms_table_is_the_code():
-    ns, _ = python_namespace("ENERGY_NAMES")
-    rows = read_table("energy-terms")
-    fortran = fortran_parameters(r"E_[A-Z_]+|NENERGY")
-    assert [r["term"] for r in rows] == list(ns["ENERGY_NAMES"])
-    assert [int(r["index"]) for r in rows] == list(range(len(rows)))
-    assert [fortran[r["fortran"]] - 1 for r in rows] == list(range(len(rows)))
-    assert c_constants()["MARTELLO_NENERGY"] == fortran["NENERGY"] == len(rows)
+def test_counters_table_is_the_registry():
+    _named_table("counters", "counters", "counter", "MARTELLO_COUNTER_")
 
 
-def test_history_columns_table_is_the_code():
+def test_energy_terms_table_is_the_registry():
+    _named_table("energy-terms", "energy", "term", "MARTELLO_ENERGY_")
+
+
+def test_history_columns_table_is_the_registry():
+    native = _registry()
+    per = {int(r.values["value"]): r.name for r in native.registry("history_per")}
+    docs_per = {"once": "row", "node": "output node", "contact": "output contact",
+                "link": "output link", "energy_term": "energy term"}
+    reg = native.registry("history")
     rows = read_table("history-columns")
-    run_src = martello_source()
-    columns_stmt = re.search(r"columns = \[\"t\"\](.*?)\n\s*from ", run_src, re.S)
-    assert columns_stmt, "the history column list of the run module was not found"
-    prefixes = re.findall(r'f"([a-z_]+):\{', columns_stmt[1])
-    assert [r["columns"].split(":")[0] for r in rows] == ["t"] + prefixes
-    per = {"row": 0, "output node": 0, "output contact": 0, "output link": 0, "energy term": 0}
-    for r in rows:
-        per[r["one per"]] += 1
-    ncol = re.search(r"ncol = 1 \+ (\d)\*size\(out_nodes\) \+ (\d)\*size\(out_contacts\) \+ "
-                     r"(\d)\*size\(r%out_links\) \+ NENERGY", fortran_text())
-    assert ncol, "the history width of the Fortran results was not found"
-    assert (per["row"], per["output node"], per["output contact"], per["output link"], per["energy term"]) == \
-        (1, int(ncol[1]), int(ncol[2]), int(ncol[3]), 1)
+    assert [r["columns"].split(":")[0] for r in rows] == [g.name for g in reg]
+    for r, g in zip(rows, reg):
+        assert r["one per"] == docs_per[per[int(g.values["per"])]], r["columns"]
+    # and a real layout: what the binding builds from the registry for 2 nodes, 1 contact
+    cols = native.history_columns(["n1", "n2"], ["c"], ["l"])
+    assert cols[:7] == ["t", "u:n1", "u:n2", "v:n1", "v:n2", "a:n1", "a:n2"]
+    assert cols[-len(native.energy_names()):] == [f"energy:{e}" for e in native.energy_names()]
 
 
 # --- the examples are the catalogue files ------------------------------------------------------

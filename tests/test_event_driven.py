@@ -17,7 +17,7 @@ from martello.errors import DivergenceError, SolverError
 from martello.oracles.p2_bouncing import (bouncing_oscillator_restitution,
                                           bouncing_oscillator_restitution_no_gravity)
 from martello.oracles.p5_contact_laws import newton_impact
-from martello.run import INTEGRATOR_CONST, integrator_par
+from martello.run import integrator_settings
 from martello.scene.loader import from_dict
 from tests.dynamics_helpers import execute, slope
 
@@ -372,14 +372,16 @@ def test_rtol_at_rounding_level_is_refused():
         execute(p2(restitution(0.5), adaptive(t_end=0.1, rtol=1e-16)))
 
 
-@pytest.mark.parametrize("slot,value,what", [("R_EVENT_TOL", 0.0, "event_tol must be > 0"),
-                                             ("R_ATOL", -1.0, "atol must be > 0"),
-                                             ("R_H_MAX", -1.0, "h_max must be >= 0")])
-def test_bad_settings_through_the_c_api(slot, value, what):
-    # The scene loader refuses these already; the library checks them again for C callers.
+@pytest.mark.parametrize("field,value,what", [
+    ("event_tol", 0.0, "settings.event_tol = 0.0000E+00 is invalid for rk8pd: set it to a number > 0"),
+    ("atol", -1.0, "settings.atol = -1.0000E+00 is invalid for rk8pd: set it to a number > 0"),
+    ("h_max", -1.0, "settings.h_max = -1.0000E+00 is invalid for rk8pd: set it to a number >= 0")])
+def test_bad_settings_through_the_c_api(field, value, what):
+    # The scene loader refuses these already (from the same registry ranges); the library
+    # checks them once, in martello_run_set_settings, for C callers.
     sc = from_dict(p2(restitution(0.5), adaptive(t_end=0.1)))
-    par = integrator_par(sc.analysis)
-    par[constant(slot)] = value
+    s = integrator_settings(sc.analysis)
+    setattr(s, field, value)
     m = Model(1, 1, 1, 0)
     m.set_node(0, M)
     lpar = np.zeros(constant("NPAR_LINK"))
@@ -389,6 +391,8 @@ def test_bad_settings_through_the_c_api(slot, value, what):
     cpar[constant("P_RESTITUTION")] = 0.5
     m.add_contact(0, -1, H, constant("SCHEME_RESTITUTION"), 0, cpar)
     r = Run()
-    r.set_integrator(constant(INTEGRATOR_CONST["rk8pd"]), par)
-    assert r.status_of(m) == constant("MARTELLO_ERR_ARGUMENT")
+    with pytest.raises(SolverError, match="settings") as info:
+        r.set_settings(s)
+    assert info.value.status == constant("MARTELLO_ERR_ARGUMENT")
     assert what in r.message()
+    assert r.status_of(m) == constant("MARTELLO_ERR_STATE")   # refused settings are not kept

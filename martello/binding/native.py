@@ -1,10 +1,14 @@
 """The ctypes binding to libmartello: the only place Python touches the C API.
 
 Status codes become exceptions here (as dftd4 raises RuntimeError from its error handle):
-negative codes raise, positive ones are returned to the caller as outcomes."""
+negative codes raise, positive ones are returned to the caller as outcomes. Every table the
+front end shares with the library (integrators, compatibility, settings and their defaults,
+counters, energy terms, constants) is read from the library's registry (registry(), and the
+functions built on it), never copied here."""
 
 import ctypes
 import os
+from collections import namedtuple
 from functools import lru_cache
 from pathlib import Path
 
@@ -39,7 +43,12 @@ def lib():
         "martello_version": (c_char_p, []),
         "martello_library_versions": (c_int, [c_char_p, c_int]),
         "martello_status_name": (c_char_p, [c_int]),
-        "martello_constant": (c_int, [c_char_p, ctypes.POINTER(c_int)]),
+        "martello_registry_shape": (c_int, [c_char_p, ctypes.POINTER(c_int), ctypes.POINTER(c_int)]),
+        "martello_registry_column": (c_int, [c_char_p, c_int, c_char_p, c_int]),
+        "martello_registry_entry": (c_int, [c_char_p, c_int, c_char_p, c_int, _VOID_P]),
+        "martello_registry_text": (c_int, [c_char_p, c_int, c_char_p, c_int]),
+        "martello_registry_find": (c_int, [c_char_p, c_char_p, ctypes.POINTER(c_int)]),
+        "martello_model_effective_masses": (c_int, [_VOID_P, _DOUBLE_P]),
         "martello_model_create": (c_int, [c_int] * 5 + [ctypes.POINTER(_VOID_P)]),
         "martello_model_free": (None, [ctypes.POINTER(_VOID_P)]),
         "martello_model_set_node": (c_int, [_VOID_P, c_int, c_double, c_double, c_double, c_int]),
@@ -57,7 +66,9 @@ def lib():
                                           _DOUBLE_P, _INT_P, _INT_P, _DOUBLE_P]),
         "martello_run_create": (c_int, [ctypes.POINTER(_VOID_P)]),
         "martello_run_free": (None, [ctypes.POINTER(_VOID_P)]),
-        "martello_run_set_integrator": (c_int, [_VOID_P, c_int, _DOUBLE_P]),
+        "martello_settings_default": (c_int, [c_int, _VOID_P]),
+        "martello_run_set_settings": (c_int, [_VOID_P, _VOID_P]),
+        "martello_run_settings": (c_int, [_VOID_P, _VOID_P]),
         "martello_run_set_outputs": (c_int, [_VOID_P, c_int, _INT_P, c_int, _INT_P]),
         "martello_dynamic_run": (c_int, [_VOID_P, _VOID_P]),
         "martello_run_message": (c_int, [_VOID_P, c_char_p, c_int]),
@@ -76,13 +87,155 @@ def lib():
     return L
 
 
+# --- the registry --------------------------------------------------------------------
+
+Row = namedtuple("Row", "name values text")   # values: column name -> number
+
+
 @lru_cache(maxsize=None)
+def registry(table):
+    """One of the library's tables (fortran/registry.f90, martello_registry_* of
+    c/martello.h) as a tuple of Rows in order; "tables" lists them all."""
+    L, buf = lib(), ctypes.create_string_buffer(256)
+    rows, cols = ctypes.c_int(), ctypes.c_int()
+    if L.martello_registry_shape(table.encode(), ctypes.byref(rows), ctypes.byref(cols)) != 0:
+        raise KeyError(f"the native library has no table {table!r}")
+    columns = []
+    for j in range(cols.value):
+        L.martello_registry_column(table.encode(), j, buf, len(buf))
+        columns.append(buf.value.decode())
+    out, values = [], np.zeros(max(cols.value, 1))
+    for i in range(rows.value):
+        L.martello_registry_entry(table.encode(), i, buf, len(buf), values.ctypes.data_as(_VOID_P))
+        name = buf.value.decode()
+        L.martello_registry_text(table.encode(), i, buf, len(buf))
+        out.append(Row(name, dict(zip(columns, map(float, values[:cols.value]))), buf.value.decode()))
+    return tuple(out)
+
+
+def value(table, name):
+    """The (first) value of the row named name, as an int: a kind, slot or index."""
+    for row in registry(table):
+        if row.name == name:
+            return int(next(iter(row.values.values())))
+    raise KeyError(f"the native table {table!r} has no row {name!r}; "
+                   f"valid: {', '.join(r.name for r in registry(table))}")
+
+
+def names(table):
+    """The row names of a table ordered by their value (indices of counters, energy, ...)."""
+    return tuple(r.name for r in sorted(registry(table), key=lambda r: next(iter(r.values.values()))))
+
+
+@lru_cache(maxsize=None)
+def constants():
+    """Every named constant of c/martello.h without its MARTELLO_ prefix ("LAW_KELVIN",
+    "NPAR_LINK", "MARTELLO_ERR_ARGUMENT" for status codes), from the registry."""
+    out = {r.name: int(r.values["value"]) for r in registry("status")}
+    for t in registry("tables"):
+        if t.text:
+            prefix = t.text.removeprefix("MARTELLO_")
+            for r in registry(t.name):
+                out[prefix + r.name.upper().replace("-", "_")] = int(r.values["value"])
+    return out
+
+
 def constant(name):
     """A named integer constant of the kernels (law, link kind, scheme, slot, status)."""
-    value = ctypes.c_int()
-    if lib().martello_constant(name.encode(), ctypes.byref(value)) != 0:
-        raise KeyError(f"the native library has no constant {name!r}")
-    return value.value
+    try:
+        return constants()[name]
+    except KeyError:
+        raise KeyError(f"the native library has no constant {name!r}") from None
+
+
+def integrators():
+    return names("integrators")
+
+
+def adaptive_integrators():
+    return tuple(r.name for r in registry("integrators") if r.values["adaptive"])
+
+
+def compatibility():
+    """scheme -> the integrators that run its contacts (the registry's table compatibility)."""
+    rows = registry("compatibility")
+    return {s: tuple(r.name for r in rows if r.values[s]) for s in names("schemes")}
+
+
+def settings_read(integrator):
+    """The settings the integrator reads (the registry's table reads)."""
+    row = next((r for r in registry("reads") if r.name == integrator), None)
+    if row is None:
+        raise KeyError(f"no integrator {integrator!r}; valid: {', '.join(integrators())}")
+    return {k for k, v in row.values.items() if v}
+
+
+Range = namedtuple("Range", "lo hi lo_open hi_open text")
+
+
+def settings_ranges():
+    """setting -> its valid Range (text: the range in words, as error messages state it)."""
+    return {r.name: Range(r.values["min"], r.values["max"], bool(r.values["min_open"]),
+                          bool(r.values["max_open"]), r.text) for r in registry("settings")}
+
+
+def in_range(rng, x):
+    return ((x > rng.lo) if rng.lo_open else (x >= rng.lo)) and \
+           ((x < rng.hi) if rng.hi_open else (x <= rng.hi))
+
+
+@lru_cache(maxsize=None)
+def settings_type():
+    """The ctypes mirror of martello_settings, built from the registry's table settings."""
+    ctype = {"double": ctypes.c_double, "int": ctypes.c_int, "bool": ctypes.c_bool}
+    types = {int(r.values["value"]): r.name for r in registry("setting_types")}
+    fields = [("kind", ctypes.c_int)] + [(r.name, ctype[types[int(r.values["type"])]])
+                                         for r in registry("settings")]
+    return type("Settings", (ctypes.Structure,), {"_fields_": fields})
+
+
+def settings(integrator, **values):
+    """martello_settings for the integrator: the library's defaults (martello_settings_default)
+    with the given fields set."""
+    s = settings_type()()
+    if lib().martello_settings_default(value("integrators", integrator), ctypes.byref(s)) != 0:
+        raise KeyError(integrator)
+    for k, v in values.items():
+        if k == "kind" or not hasattr(s, k):
+            raise KeyError(f"martello_settings has no field {k!r}")
+        setattr(s, k, v)
+    return s
+
+
+def settings_defaults(integrator="newmark"):
+    """The library's default settings of an integrator, as a dict (kind left out)."""
+    s = settings(integrator)
+    return {k: getattr(s, k) for k, _ in s._fields_ if k != "kind"}
+
+
+def counter_names():
+    return names("counters")
+
+
+def energy_names():
+    return names("energy")
+
+
+def event_names():
+    return names("events")
+
+
+def history_columns(nodes, contacts, links):
+    """Column names of martello_run_history for these output nodes, contacts and links
+    (the registry's table history): "t", "u:<node>", ..., "energy:<term>"."""
+    per = {r.name: int(r.values["value"]) for r in registry("history_per")}
+    items = {per["once"]: None, per["node"]: nodes, per["contact"]: contacts,
+             per["link"]: links, per["energy_term"]: energy_names()}
+    cols = []
+    for g in registry("history"):
+        each = items[int(g.values["per"])]
+        cols += [g.name] if each is None else [f"{g.name}:{x}" for x in each]
+    return cols
 
 
 def version():
@@ -177,6 +330,12 @@ class Model(_Handle):
     def add_mass_coupling(self, a, b, value):
         self.check(lib().martello_model_add_mass_coupling(self._h, a, b, value), "mass coupling")
 
+    def effective_masses(self):
+        """m* = 1/(B M⁻¹ Bᵀ) of every contact, as the library computes it (inf: immovable)."""
+        out = np.zeros(max(self.n_contacts, 1))
+        self.check(lib().martello_model_effective_masses(self._h, out), "effective masses")
+        return out[: self.n_contacts]
+
     def set_gravity(self, g):
         self.check(lib().martello_model_set_gravity(self._h, g), "gravity")
 
@@ -212,14 +371,6 @@ class Model(_Handle):
         }
 
 
-COUNTER_NAMES = ("steps", "rejected_steps", "newton_iterations", "residual_evaluations",
-                 "factorizations", "events", "jacobian_evaluations", "root_evaluations",
-                 "contact_chatter_resolutions")
-ENERGY_NAMES = ("kinetic", "recoverable", "input", "damping", "plastic", "contact", "balance",
-                "initial", "impact")
-EVENT_NAMES = ("t_on", "t_off", "v_in", "v_out", "max_penetration", "max_force")
-
-
 class Run(_Handle):
     """One dynamic run: its integrator settings and, after execute(), its results."""
 
@@ -230,9 +381,9 @@ class Run(_Handle):
 
     _check = _Handle.check
 
-    def set_integrator(self, kind, par):
-        self._check(lib().martello_run_set_integrator(
-            self._h, kind, _f64(par, constant("NPAR_INTEGRATOR"))), "integrator")
+    def set_settings(self, settings):
+        """Hand the run its settings (a Settings from settings()); the library validates them."""
+        self._check(lib().martello_run_set_settings(self._h, ctypes.byref(settings)), "settings")
 
     def set_outputs(self, nodes, contacts):
         n = np.ascontiguousarray(nodes, dtype=np.int32)
@@ -275,7 +426,7 @@ class Run(_Handle):
     def counters(self):
         c = np.zeros(constant("NCOUNTERS"), dtype=np.int64)
         lib().martello_run_counters(self._h, c)
-        return dict(zip(COUNTER_NAMES, map(int, c)))
+        return dict(zip(counter_names(), map(int, c)))
 
     def peaks(self, n_nodes, n_contacts):
         arrays = [np.zeros(max(n_nodes, 1)) for _ in range(4)] + \
@@ -292,6 +443,6 @@ class Run(_Handle):
     def energy(self):
         e, extra = np.zeros(constant("NENERGY")), np.zeros(4)
         lib().martello_run_energy(self._h, e, extra)
-        d = dict(zip(ENERGY_NAMES, map(float, e)))
+        d = dict(zip(energy_names(), map(float, e)))
         return d, {"balance_max": float(extra[0]), "omega_max": float(extra[1]),
                    "dt_critical": float(extra[2]), "t_reached": float(extra[3])}

@@ -11,7 +11,7 @@ import numpy as np
 from ..binding import native
 from ..errors import MartelloError
 from ..oracles.p5_contact_laws import HC_FACTORS, kelvin_damping, kelvin_xi_from_e
-from ..run import LAW_EXPONENT, effective_mass
+from ..run import LAW_EXPONENT
 
 
 class Unsupported(MartelloError):
@@ -36,6 +36,14 @@ def _tf(fn):
         a, t0, t1 = fn["amplitude"], fn["t_start"], fn["t_end"]
         return (lambda t: a * math.sin(math.pi * (t - t0) / (t1 - t0)) if t0 <= t <= t1 else 0.0), [t0, t1]
     raise Unsupported(f"time function {k!r}")
+
+
+def _two_mass_mstar(mass, fixed, a, b):
+    """m* = m_a m_b/(m_a + m_b) of a contact, a ground (-1) or fixed side infinitely heavy:
+    the reference's own, independent of the library's 1/(B M⁻¹ Bᵀ) (it refuses couplings,
+    so M is diagonal and the two agree)."""
+    ms = [mass[i] for i in (a, b) if i >= 0 and not fixed[i]]
+    return math.inf if not ms else ms[0] if len(ms) == 1 else ms[0] * ms[1] / (ms[0] + ms[1])
 
 
 def event_located_run(sc, rtol=1e-12, grid=None):
@@ -77,7 +85,7 @@ def event_located_run(sc, rtol=1e-12, grid=None):
         damp, a_hc = 0.0, None
         if c["law"] == "kelvin":
             damp = c["damping"] if c["damping"] is not None else \
-                kelvin_damping(c["stiffness"], effective_mass(sc, c["a"], c["b"]),
+                kelvin_damping(c["stiffness"], _two_mass_mstar(mass, fixed, c["a"], c["b"]),
                                kelvin_xi_from_e(c["restitution"]))
         elif c["law"] in hc_laws:
             # Hunt & Crossley family: F = K δ^n (1 + χ δ̇), χ = a / v_in, never pulling

@@ -16,7 +16,7 @@ from .chain import expand_chains
 from .compatibility import COMPATIBLE
 from .fields import ANY, NONNEG, POSITIVE, check_fields, choice, finite_everywhere, kind_ok
 from .spec import (ALL_SPECIFIC, ANALYSIS_TYPES, CONTACT_COMMON, CONTACT_SCHEMES,
-                   FIXED_EXPONENT, FUNCTION_TYPES, GROUND, IMPLICIT_KEYS, INTEGRATOR_KEYS,
+                   FIXED_EXPONENT, FUNCTION_TYPES, GROUND, INTEGRATOR_KEYS,
                    INTEGRATORS, LAWS, LINK_COMMON, LINK_TYPES, NEWMARK_PRESETS, NODE_KEYS,
                    OUTPUT_KEYS, SCHEMES, TOP_KEYS)
 
@@ -185,7 +185,7 @@ def from_dict(data, source="<scene>", base_dir=Path("."), digest=None):
                 raise SceneError(src, f"{where}.clipped", "applies to law kelvin only", "remove it")
             if c["exponent"] is not None and c["law"] in FIXED_EXPONENT:
                 raise SceneError(src, f"{where}.exponent", f"does not apply to law {c['law']}",
-                                 f"its exponent is fixed at {FIXED_EXPONENT[c['law']]}; remove it")
+                                 f"its exponent is fixed at {FIXED_EXPONENT[c['law']]:g}; remove it")
             if c["law"] in ("linear", "hertz") and (c["damping"] is not None or c["restitution"] is not None):
                 key = "damping" if c["damping"] is not None else "restitution"
                 raise SceneError(src, f"{where}.{key}", f"law {c['law']} is elastic (e = 1)",
@@ -265,8 +265,7 @@ def from_dict(data, source="<scene>", base_dir=Path("."), digest=None):
 
 def _dynamic_analysis(src, raw, an, index, contacts, links):
     integ = choice(src, "analysis.integrator", an["integrator"], INTEGRATORS)
-    implicit = IMPLICIT_KEYS if integ in ("newmark", "hht", "generalized-alpha", "newmark-lagrange") else set()
-    allowed = INTEGRATOR_KEYS[integ] | implicit
+    allowed = INTEGRATOR_KEYS[integ]
     for key in ALL_SPECIFIC:
         if key in raw and key not in allowed:
             raise SceneError(src, f"analysis.{key}", f"does not apply to integrator {integ}",

@@ -3,6 +3,7 @@ defaults, the contact schemes and laws, the time functions, the integrators and 
 parameters (docs/scene-format.md). Which integrators run which contact scheme is in
 martello.scene.compatibility."""
 
+from ..binding import native
 from .fields import ANY, NONNEG, POSITIVE, unit_interval
 
 GROUND = "ground"
@@ -29,10 +30,10 @@ LINK_TYPES = {
     "bar": {"EA": ("float", True, POSITIVE, None), "L": ("float", True, POSITIVE, None)},
 }
 
-SCHEMES = ("penalty", "lagrange", "augmented-lagrange", "restitution")
-LAWS = ("linear", "hertz", "kelvin", "hunt-crossley", "lankarani-nikravesh", "flores",
-        "gonthier", "hertzdamp", "jankowski")
-FIXED_EXPONENT = {"linear": 1, "kelvin": 1, "hertzdamp": 1.5, "jankowski": 1.5}
+SCHEMES = native.names("schemes")
+LAWS = native.names("laws")
+FIXED_EXPONENT = {r.name: r.values["exponent"] for r in native.registry("laws")
+                  if r.values["exponent_fixed"]}
 CONTACT_COMMON = {"name": ("str", True, None, None), "a": ("str", True, None, None),
                   "b": ("str", True, None, None), "gap": ("float", False, ANY, 0.0),
                   "scheme": ("str", True, None, None)}
@@ -63,42 +64,51 @@ FUNCTION_TYPES = {
                "units": ("str", False, None, None), "scale": ("float", False, ANY, 1.0)},
 }
 
-INTEGRATORS = ("newmark", "hht", "generalized-alpha", "central-difference", "moreau-jean",
-               "newmark-lagrange", "rkf45", "rk8pd", "msbdf", "ida")
-STRUCTURAL = ("newmark", "hht", "generalized-alpha", "central-difference")
-ADAPTIVE = ("rkf45", "rk8pd", "msbdf", "ida")
+# The integrators are the library's (its registry; tests/test_registry.py).
+INTEGRATORS = native.integrators()
+ADAPTIVE = native.adaptive_integrators()
+
+
+def _setting(kind, name, required=False, default=True):
+    """A key that is a native setting: the library's valid range and, unless required or
+    default=False, its default (the registry's table settings)."""
+    rng = native.settings_ranges()[name]
+    return (kind, required, (lambda x: native.in_range(rng, x), rng.text),
+            native.settings_defaults()[name] if default and not required else None)
+
+
 NEWMARK_PRESETS = {"average-acceleration": (0.25, 0.5), "linear-acceleration": (1.0 / 6.0, 0.5)}
 ANALYSIS_TYPES = {
     "static": {"tol": ("float", False, POSITIVE, 1e-14),
                "max_iter": ("int", False, POSITIVE, 500)},
     "dynamic": {"integrator": ("str", True, None, None),
-                "dt": ("float", True, POSITIVE, None),
-                "t_end": ("float", True, POSITIVE, None),
+                "dt": _setting("float", "dt", required=True),
+                "t_end": _setting("float", "t_end", required=True),
                 "preset": ("str", False, None, None),
-                "beta": ("float", False, (lambda x: x > 0, "a number > 0 (beta = 0 is central-difference)"), None),
-                "gamma": ("float", False, (lambda x: x >= 0.5, "a number >= 0.5"), None),
-                "alpha": ("float", False, (lambda x: -1 / 3 <= x <= 0, "a number in [-1/3, 0]"), None),
-                "rho_inf": ("float", False, (lambda x: 0 <= x <= 1, "a number in [0, 1]"), None),
-                "tol_residual": ("float", False, POSITIVE, 1e-9),
-                "tol_increment": ("float", False, POSITIVE, 1e-11),
-                "max_newton": ("int", False, POSITIVE, 30),
-                "check_stability": ("bool", False, None, True),
-                "divergence_factor": ("float", False, (lambda x: x > 1, "a number > 1"), 10.0),
-                "rtol": ("float", False, POSITIVE, 1e-8),
-                "atol": ("float", False, POSITIVE, 1e-12),
-                "theta": ("float", False, (lambda x: 0.5 <= x <= 1, "a number in [0.5, 1]"), 0.5),
-                "event_tol": ("float", False, POSITIVE, 1e-12),
-                "h_max": ("float", False, NONNEG, 0.0),
+                "beta": _setting("float", "beta", default=False),
+                "gamma": _setting("float", "gamma", default=False),
+                "alpha": _setting("float", "alpha", default=False),
+                "rho_inf": _setting("float", "rho_inf", default=False),
+                "tol_residual": _setting("float", "tol_residual"),
+                "tol_increment": _setting("float", "tol_increment"),
+                "max_newton": _setting("int", "max_newton"),
+                "check_stability": _setting("bool", "check_stability"),
+                "divergence_factor": _setting("float", "divergence_factor"),
+                "rtol": _setting("float", "rtol"),
+                "atol": _setting("float", "atol"),
+                "theta": _setting("float", "theta"),
+                "event_tol": _setting("float", "event_tol"),
+                "h_max": _setting("float", "h_max"),
                 "output": ("table", False, None, None)},
 }
-OUTPUT_KEYS = {"every": ("int", False, POSITIVE, 1), "nodes": ("list", False, None, None),
+OUTPUT_KEYS = {"every": _setting("int", "every"), "nodes": ("list", False, None, None),
                "contacts": ("list", False, None, None), "links": ("list", False, None, [])}
-INTEGRATOR_KEYS = {"newmark": {"preset", "beta", "gamma"}, "hht": {"alpha"},
-                   "generalized-alpha": {"rho_inf"}, "central-difference": {"check_stability"},
-                   "moreau-jean": {"theta"}, "newmark-lagrange": set(),
-                   **{k: {"rtol", "atol", "event_tol", "h_max"} for k in ADAPTIVE}}
-IMPLICIT_KEYS = {"tol_residual", "tol_increment", "max_newton"}
-ALL_SPECIFIC = set().union(*INTEGRATOR_KEYS.values()) | IMPLICIT_KEYS
+# The analysis keys of one integrator or a group: the settings it reads beyond those every
+# integrator reads (the library's table "reads"); Newmark also takes a preset.
+_READ_BY_ALL = set.intersection(*(native.settings_read(i) for i in INTEGRATORS))
+INTEGRATOR_KEYS = {i: native.settings_read(i) - _READ_BY_ALL | ({"preset"} if i == "newmark" else set())
+                   for i in INTEGRATORS}
+ALL_SPECIFIC = set().union(*INTEGRATOR_KEYS.values())
 
 TOP_KEYS = {"title", "problem", "description", "node", "link", "contact", "loads", "analysis",
             "check", "chain", "bar", "mass_coupling"}
