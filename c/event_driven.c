@@ -408,8 +408,7 @@ static int impacts(ed_t *w, double t, int *n_impacts) {
 }
 
 /* After the impacts: touching contacts whose impacts accumulate (martello_impulse_accumulation,
- * docs/impulse.md §4: t_inf within event_tol, or a next flight that stays within the position
- * resolution), or that touch at rest while pressed,
+ * docs/impulse.md §4: a next flight shorter than event_tol or lower than the resolved height), or that touch at rest while pressed,
  * join the held set; held contacts that an impulse set flying leave it unless their new
  * sequence accumulates too. A free contact is a candidate only when the free system presses
  * it (g'' > 0): one that is not pressed would leave the held set at once. */
@@ -430,7 +429,7 @@ static int accumulations(ed_t *w, double t, int *changed) {
       /* the free system presses a held contact with (W_H P_H)_j */
       for (k = 0; k < w->nh && w->hlist[k] != j; k++) continue;
       for (acc = 0.0, l = 0; l < w->nh; l++) acc += w->Wl[k + w->nh * l] * w->lam1[w->hlist[l]];
-      if (martello_impulse_accumulation(w->e[j], s, acc, t, t + w->event_tol, position_res(w, j, u),
+      if (martello_impulse_accumulation(w->e[j], s, acc, t, w->event_tol, position_res(w, j, u),
                                         &t_inf)) {
         w->ilist[m++] = j;
       } else {
@@ -440,7 +439,7 @@ static int accumulations(ed_t *w, double t, int *changed) {
     }
     if (gdot(w, j, u) - w->gap[j] < -gap_tol(w, j, u)) continue;
     acc = gdot(w, j, w->f + w->n);
-    if (!(acc > 0.0) || !martello_impulse_accumulation(w->e[j], s, acc, t, t + w->event_tol,
+    if (!(acc > 0.0) || !martello_impulse_accumulation(w->e[j], s, acc, t, w->event_tol,
                                                        position_res(w, j, u), &t_inf))
       continue;
     w->t_hold[j] = t_inf;

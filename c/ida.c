@@ -454,23 +454,30 @@ static int rigid_impacts(ida_problem *P, double t, double *u, double *v) {
         P->opened[r] = 1;
       }
   }
-  /* closing: the accumulation policy (docs/impulse.md §4) with the free normal acceleration
-   * a_n at the contact, event_tol as time horizon and the position tolerance as touching band */
-  int have_a = 0;
-  for (int r = 0; r < P->nr; r++) {
-    int j = P->rig_con[r];
-    double t_inf;
-    if (P->closed[r] || !(P->hit[r] || P->act[j] == ACT_IMPACT)) continue;
-    if (!have_a) {
-      st = martello_eval_acceleration(P->ev, t, u, v, P->a);
-      if (st != MARTELLO_OK) return fail(P, st, "IDA: acceleration failed at t = %.9e s", t);
-      have_a = 1;
-    }
-    /* tentative: rigid_multipliers opens it again if its multiplier does not come out
-     * compressive (a_n ignores the other closed contacts) */
-    double an = dot_B(P, j, P->a), rebound = fmax(-pen_rate(P, j, v), 0.0);
+  /* closing: the accumulation policy (docs/impulse.md §4) with event_tol and the position
+   * tolerance as the resolution, and the normal acceleration a_n that presses each
+   * contact that took an impulse with the contacts already closed enforced (their forces from
+   * the persistent-contact rule): aset = [closed set, candidates] */
+  int mc = closed_set(P), ma = mc;
+  for (int r = 0; r < P->nr; r++)
+    if (!P->closed[r] && (P->hit[r] || P->act[P->rig_con[r]] == ACT_IMPACT)) P->aset[ma++] = r;
+  if (ma > mc) {
+    st = martello_eval_acceleration(P->ev, t, u, v, P->a);
+    if (st != MARTELLO_OK) return fail(P, st, "IDA: acceleration failed at t = %.9e s", t);
+    door_list(P, ma);
+    st = martello_impulse_delassus(P->n, ma, P->da, P->db, P->cols, P->dc, P->S);
+    if (st == MARTELLO_OK && mc > 0)
+      st = martello_impulse_contact_forces(P->n, mc, P->da, P->db, P->cols, P->dc, P->a, P->w0, &piv);
+    if (st != MARTELLO_OK)
+      return fail(P, st, "IDA: the contact forces of the closed contacts failed at t = %.9e s", t);
+  }
+  for (int k = mc; k < ma; k++) {
+    int r = P->aset[k], j = P->rig_con[r];
+    double t_inf, an = dot_B(P, j, P->a), rebound = fmax(-pen_rate(P, j, v), 0.0);
     double e = P->rest[j] >= 0.0 ? P->rest[j] : 0.0;
-    if (martello_impulse_accumulation(e, rebound, an, t, t + P->event_tol, position_tol(P, j, u),
+    for (int l = 0; l < mc; l++) an -= P->S[k + ma * l] * P->w0[l];
+    /* tentative: rigid_multipliers opens it again if its multiplier is not compressive */
+    if (martello_impulse_accumulation(e, rebound, an, t, P->event_tol, position_tol(P, j, u),
                                       &t_inf))
       P->closed[r] = 1;
   }

@@ -79,11 +79,12 @@ int martello_impulse_factor(int n, int m, const int *a, const int *b, const doub
 int martello_impulse_project(int n, int m, const int *a, const int *b, const double *cols,
                              const int *col, const double *L, const double *target, double *x,
                              double *P);
-/* The accumulation policy (docs/impulse.md §4): 1 if a contact leaving with separation speed
- * s >= 0, pressed by the relative acceleration a, with restitution e, has accumulated: no
- * rebound, or its accumulation point *t_inf = t + 2 s/(a (1 - e)) before t_horizon, or a next
- * flight that stays within height_res of the contact (the integrator's touching band). */
-int martello_impulse_accumulation(double e, double s, double a, double t, double t_horizon,
+/* The accumulation policy (docs/impulse.md §4): 1 if the impacts of a contact leaving at t
+ * with separation speed s >= 0, pressed by the relative acceleration a, restitution e, have
+ * accumulated: no rebound, or a next flight 2 s/a shorter than tau_res or lower than
+ * height_res (the integrator's resolution). *t_inf = the accumulation point t + 2 s/(a (1 - e))
+ * (t without rebound, HUGE_VAL-like when there is none). */
+int martello_impulse_accumulation(double e, double s, double a, double t, double tau_res,
                                   double height_res, double *t_inf);
 
 /* The C integrators, dispatched by martello_dynamic_run. */

@@ -109,12 +109,12 @@ contains
       end if
    end function c_impulse_project
 
-   integer(c_int) function c_impulse_accumulation(e, s, a, t, t_horizon, height_res, t_inf) &
+   integer(c_int) function c_impulse_accumulation(e, s, a, t, tau_res, height_res, t_inf) &
       bind(C, name='martello_impulse_accumulation')
-      real(c_double), value :: e, s, a, t, t_horizon, height_res
+      real(c_double), value :: e, s, a, t, tau_res, height_res
       real(c_double), intent(out) :: t_inf
       logical :: acc
-      call impulse_accumulation(e, s, a, t, t_horizon, height_res, acc, t_inf)
+      call impulse_accumulation(e, s, a, t, tau_res, height_res, acc, t_inf)
       c_impulse_accumulation = merge(1, 0, acc)
    end function c_impulse_accumulation
 

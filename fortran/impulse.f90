@@ -256,32 +256,34 @@ contains
 
    !> The accumulation (Zeno) policy, the one rule of every integrator (docs/impulse.md §4).
    !>
-   !> A contact leaving with separation speed s ≥ 0 while its relative acceleration a > 0
-   !> presses it closed makes the flights 2s/a, 2es/a, 2e²s/a, … (Newton's law shrinks each
-   !> rebound by e; the bouncing ball of Moreau 1988, §9): a geometric series that ends at the
-   !> accumulation point
+   !> A contact leaving at time t with separation speed s ≥ 0 while its relative acceleration
+   !> a > 0 presses it closed makes the flights τ, eτ, e²τ, … with τ = 2s/a (Newton's law
+   !> shrinks each rebound by e; the bouncing ball of Moreau 1988, §9): a geometric series
+   !> that ends at the accumulation point
    !>
-   !>    t∞ = t + 2 s/(a (1 − e)).
+   !>    t∞ = t + 2 s/(a (1 − e)),
    !>
-   !> The sequence has accumulated — the contact is held from t∞ on, its remaining flights no
-   !> longer resolved one by one — when
-   !>  1. there is no rebound (s = 0 or e = 0): the sequence ends at t∞ = t; whether the
-   !>     contact then stays closed is the persistent-contact rule's decision (contact_forces),
-   !>     so a contact with no rebound is a candidate whatever a;
-   !>  2. t∞ comes before t_horizon, the end of the interval within which the integrator does
-   !>     not resolve events apart: the current step of a time-stepping scheme, t + event_tol
-   !>     for the event-driven integrators (events closer than that are simultaneous);
-   !>  3. the next flight would not leave the band of height height_res within which the
-   !>     integrator calls the contact touching (its apex s²/(2a) ≤ height_res): its impact
-   !>     could not be located as a separate event. 0 for time stepping. This clause is not
-   !>     physics but the event-driven integrators' resolution; docs/impulse.md §4 says why a
-   !>     time horizon alone cannot serve them (measured: the rk8pd step as horizon resolves 8
-   !>     of the 10 first impacts of P2 at e = 0.5 and moves t∞ by 2.5e-8 s; event_tol alone
-   !>     drives the flights below the rounding of the gap, where no impact can be located).
+   !> from which the contact is persistent (t_inf; huge when there is no accumulation).
+   !> The integrator stops resolving the flights one by one — the sequence has accumulated —
+   !> when
+   !>  1. there is no rebound (s = 0 or e = 0): t∞ = t; whether the contact then stays closed
+   !>     is the persistent-contact rule's decision (contact_forces), so a contact with no
+   !>     rebound is a candidate whatever a;
+   !>  2. or its next flight is below the integrator's resolution: shorter than tau_res (the
+   !>     step h of a time-stepping scheme, which cannot hold two impacts in one step;
+   !>     event_tol for the event-driven integrators, whose events closer than that are
+   !>     simultaneous), or lower than height_res, s²/(2a) ≤ height_res (0 for time stepping;
+   !>     the heights the event-driven integrators resolve, below which the gap never leaves
+   !>     their position error and the next impact cannot be located).
+   !> Deciding on t∞ itself (accumulated when t∞ falls inside the current interval) was
+   !> measured and rejected, docs/impulse.md §4: with the step as interval Newmark–Lagrange
+   !> chatters (flights shorter than a step whose tail outlasts it are held and released
+   !> every step) and rk8pd resolves 8 of the first 10 impacts of P2 at e = 0.5; with event_tol
+   !> as interval the flights fall below the rounding of the gap before t∞ comes within it.
    !> There is no accumulation without pressing (a ≤ 0: the contact flies off) or without
-   !> dissipation (e ≥ 1: the flights do not shrink); t_inf = huge then.
-   pure subroutine impulse_accumulation(e, s, a, t, t_horizon, height_res, accumulates, t_inf)
-      real(dp), intent(in) :: e, s, a, t, t_horizon, height_res
+   !> dissipation (e ≥ 1: the flights do not shrink).
+   pure subroutine impulse_accumulation(e, s, a, t, tau_res, height_res, accumulates, t_inf)
+      real(dp), intent(in) :: e, s, a, t, tau_res, height_res
       logical, intent(out) :: accumulates
       real(dp), intent(out) :: t_inf
       accumulates = .true.
@@ -291,7 +293,7 @@ contains
       t_inf = huge(1.0_dp)
       if (.not. (a > 0.0_dp) .or. e >= 1.0_dp) return
       t_inf = t + 2.0_dp*s/(a*(1.0_dp - e))
-      accumulates = t_inf <= t_horizon .or. s*s/(2.0_dp*a) <= height_res
+      accumulates = 2.0_dp*s/a <= tau_res .or. s*s/(2.0_dp*a) <= height_res
    end subroutine impulse_accumulation
 
    ! ---- the LCP, dense or band -------------------------------------------------------------

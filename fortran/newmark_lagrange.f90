@@ -23,9 +23,10 @@
 !> acceleration is reset from equilibrium (the impulsive a_{n+1} must not enter the next
 !> Newmark predictor). Steps without impacts use β = ¼, γ = ½ with the persistent contacts
 !> (plastic impacts, Zeno) held by the multiplier, released when it turns tensile.
-!> Zeno: an impact whose sequence of rebounds, at the pressing relative acceleration, would
-!> accumulate before the end of the step (the policy of docs/impulse.md §4,
-!> martello_impulse's impulse_accumulation) is made plastic and the contact persistent.
+!> Zeno: an impact whose next rebound flight, at the pressing relative acceleration, would be
+!> shorter than one step (the accumulation policy of docs/impulse.md §4 with the step as time
+!> resolution, martello_impulse's impulse_accumulation) is made plastic and the contact
+!> persistent.
 !> Dense KKT solves (LAPACK dsytrf): a scheme for the small problems P2 and P5.
 module martello_newmark_lagrange
    use martello_kinds, only: dp, i8
@@ -176,9 +177,10 @@ contains
             ddd0 = an(m%con_a(c)) - an(m%con_b(c))
             v_imp = dd0 + alpha_imp*h*ddd0
             e_eff = e_con(c)
-            ! Zeno: the rebounds under the pressing acceleration δ̈_n accumulate within the step
+            ! Zeno: the next rebound flight under the pressing acceleration δ̈_n is shorter than
+            ! a step (one impact a step is what the tuned (β, γ) resolve)
             call impulse_accumulation(e_eff, e_eff*max(v_imp, 0.0_dp), ddd0, t_prev + alpha_imp*h, &
-                                      t, 0.0_dp, zeno, t_inf)
+                                      h, 0.0_dp, zeno, t_inf)
             if (zeno) e_eff = 0.0_dp
             rr = h*(dd0 + h*ddd0 + e_eff*v_imp)/(d0 + h*dd0 + 0.5_dp*h*h*ddd0)
             if (.not. (rr > 0.0_dp .and. ieee_is_finite(rr)) .or. v_imp <= 0.0_dp) then
