@@ -79,7 +79,7 @@ typedef struct {
   int nh, *hlist, *held, *ha, *hb, *hc;
   double *Wh, *rh;
   /* impulse problems: a contact list as the door takes it, W, data and results */
-  int *ilist, *la, *lb, *lc;
+  int *ilist, *la, *lb, *lc, *hk;    /* hk: the held flag of the persistent-contact rule */
   double *Wl, *ql, *pl, *wl, *sl, *el, *tg;
   /* contact phases: a penalty contact in contact, a persistent unilateral contact */
   int *ph_open;
@@ -289,8 +289,8 @@ static int factor_held(ed_t *w, double t) {
 
 /* Which of the contacts in list[0..m) (all at zero gap and zero gap rate) stay closed: the
  * persistent-contact rule of docs/impulse.md §3, the acceleration-level LCP on the free
- * accelerations (martello_impulse_contact_forces); a contact stays held iff its multiplier
- * is positive. Contacts leaving the held set close their phase at t; entering ones open one
+ * accelerations (martello_impulse_contact_forces): a contact stays held unless the solution
+ * opens it. Contacts leaving the held set close their phase at t; entering ones open one
  * that starts at their predicted accumulation time t_hold. */
 static int update_held(ed_t *w, double t, const int *list, int m) {
   int k, st, piv, nh_old = w->nh;
@@ -300,17 +300,20 @@ static int update_held(ed_t *w, double t, const int *list, int m) {
   if (st != MARTELLO_OK) return fail_eval(w, st, t);
   door_list(w, list, m, w->la, w->lb, w->lc);
   st = martello_impulse_contact_forces(w->n, m, w->la, w->lb, w->Cm, w->lc, w->f + w->n, w->pl,
-                                       &piv);
+                                       w->hk, &piv);
   w->cnt[C_FACTORIZATIONS] += piv;   /* Lemke pivots: rank-one updates of the basis */
   if (st != MARTELLO_OK)
     return fail(w, st, t, st == MARTELLO_ERR_SINGULAR
                 ? "event-driven: contacts held together are redundant (singular Delassus matrix)"
                 : "event-driven: the contact-force LCP did not converge");
-  for (k = 0; k < w->nc; k++) w->sl[k] = 0.0;
-  for (k = 0; k < m; k++) w->sl[list[k]] = w->pl[k];
+  for (k = 0; k < w->nc; k++) w->sl[k] = w->wl[k] = 0.0;
+  for (k = 0; k < m; k++) {
+    w->sl[list[k]] = w->pl[k];
+    w->wl[list[k]] = w->hk[k];   /* held flag per contact */
+  }
   for (k = 0; k < w->nh; k++) {
     int j = w->hlist[k];
-    if (w->sl[j] > 0.0) continue;
+    if (w->wl[j] != 0.0) continue;
     add_event(w, j, w->ph_t[j], t, w->ph_v[j], gdot(w, j, w->y + w->n), w->ph_pen[j], w->ph_f[j]);
     w->ph_open[j] = 0;
     w->held[j] = 0;
@@ -318,7 +321,7 @@ static int update_held(ed_t *w, double t, const int *list, int m) {
   }
   w->nh = 0;
   for (k = 0; k < w->nc; k++) {
-    if (!(w->sl[k] > 0.0)) continue;
+    if (w->wl[k] == 0.0) continue;
     w->hlist[w->nh++] = k;
     if (!w->held[k]) {
       int a = w->con_a[k], b = w->con_b[k];
@@ -793,7 +796,7 @@ static void ed_free(ed_t *w) {
                   w->yerr, w->fstart, w->f, w->f1, w->fj, w->yj, w->fint, w->fext,
                   w->pen0, w->rate0, w->acc0, w->pen1, w->rate1, w->acc1, w->pen, w->rate,
                   w->force, w->lam, w->lam0, w->lam1, w->lamtol, w->hlist, w->held, w->ha,
-                  w->hb, w->hc, w->Wh, w->rh, w->ilist, w->la, w->lb, w->lc, w->Wl, w->ql,
+                  w->hb, w->hc, w->Wh, w->rh, w->ilist, w->la, w->lb, w->lc, w->hk, w->Wl, w->ql,
                   w->pl, w->wl, w->sl, w->el, w->tg, w->ph_open, w->ph_t,
                   w->ph_v, w->ph_pen, w->ph_f, w->t_hold};
   size_t i;
@@ -849,7 +852,7 @@ static int ed_setup(ed_t *w) {
         ALLOC(w->Wl, (size_t)w->nu * (size_t)w->nu) && ALLOC(w->ql, nc) && ALLOC(w->pl, nc) &&
         ALLOC(w->wl, nc) && ALLOC(w->sl, nc) && ALLOC(w->el, nc) && ALLOC(w->tg, nc) &&
         ALLOC(w->ha, nc) && ALLOC(w->hb, nc) && ALLOC(w->hc, nc) && ALLOC(w->la, nc) &&
-        ALLOC(w->lb, nc) && ALLOC(w->lc, nc) && ALLOC(w->ph_open, nc) && ALLOC(w->ph_t, nc) &&
+        ALLOC(w->lb, nc) && ALLOC(w->lc, nc) && ALLOC(w->hk, nc) && ALLOC(w->ph_open, nc) && ALLOC(w->ph_t, nc) &&
         ALLOC(w->ph_v, nc) && ALLOC(w->ph_pen, nc) && ALLOC(w->ph_f, nc) && ALLOC(w->t_hold, nc)))
     return MARTELLO_ERR_MEMORY;
   st = martello_eval_create(w->model, &w->ev);

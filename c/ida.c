@@ -467,7 +467,8 @@ static int rigid_impacts(ida_problem *P, double t, double *u, double *v) {
     door_list(P, ma);
     st = martello_impulse_delassus(P->n, ma, P->da, P->db, P->cols, P->dc, P->S);
     if (st == MARTELLO_OK && mc > 0)
-      st = martello_impulse_contact_forces(P->n, mc, P->da, P->db, P->cols, P->dc, P->a, P->w0, &piv);
+      st = martello_impulse_contact_forces(P->n, mc, P->da, P->db, P->cols, P->dc, P->a, P->w0,
+                                           P->cand, &piv);
     if (st != MARTELLO_OK)
       return fail(P, st, "IDA: the contact forces of the closed contacts failed at t = %.9e s", t);
   }
@@ -498,7 +499,8 @@ static int rigid_impacts(ida_problem *P, double t, double *u, double *v) {
 }
 
 /* Multipliers of the closed set: the persistent-contact rule (martello_impulse_contact_forces
- * on the free accelerations); a contact whose multiplier is not compressive opens. Leaves
+ * on the free accelerations); a contact that the solution opens (lambda = 0, opening
+ * acceleration) opens. Leaves
  * a_free in P->a and the multipliers in P->lam. */
 static int rigid_multipliers(ida_problem *P, double t, double *u, double *v) {
   int st = martello_eval_acceleration(P->ev, t, u, v, P->a), piv;
@@ -508,13 +510,14 @@ static int rigid_multipliers(ida_problem *P, double t, double *u, double *v) {
   if (m == 0) return MARTELLO_OK;
   if ((st = impulse_columns(P)) != MARTELLO_OK) return fail(P, st, "IDA: singular mass");
   door_list(P, m);
-  st = martello_impulse_contact_forces(P->n, m, P->da, P->db, P->cols, P->dc, P->a, P->rhs, &piv);
+  st = martello_impulse_contact_forces(P->n, m, P->da, P->db, P->cols, P->dc, P->a, P->rhs,
+                                       P->cand, &piv);
   if (st != MARTELLO_OK)
     return fail(P, st, "IDA: the contact forces of %d closed contacts failed at t = %.9e s (%s)", m, t,
                 st == MARTELLO_ERR_SINGULAR ? "redundant closed contacts" : "pivot limit");
   for (int k = 0; k < m; k++) {
     int r = P->aset[k];
-    if (P->rhs[k] > 0.0) {
+    if (P->cand[k]) {
       P->lam[r] = P->rhs[k];
     } else {
       P->closed[r] = 0;

@@ -66,11 +66,11 @@ int martello_impulse_newton(int n, int m, const int *a, const int *b, const doub
                             const int *col, const double *e, double *v, double *P,
                             int *iterations);
 /* The contact forces of contacts at zero gap and gap rate, 0 <= gddot _|_ lambda >= 0 with
- * gddot = B acc + W lambda (acc: the accelerations without them); a contact stays held iff
- * lambda_k > 0. */
+ * gddot = B acc + W lambda (acc: the accelerations without them), and the persistent-contact
+ * rule: held[k] = 0 iff the solution opens contact k (lambda_k = 0, gddot_k > 0). */
 int martello_impulse_contact_forces(int n, int m, const int *a, const int *b,
                                     const double *cols, const int *col, const double *acc,
-                                    double *lambda, int *iterations);
+                                    double *lambda, int *held, int *iterations);
 /* W of contacts held together, Cholesky-factored into L (m x m). */
 int martello_impulse_factor(int n, int m, const int *a, const int *b, const double *cols,
                             const int *col, double *L);

@@ -50,14 +50,15 @@ contains
       call apply_impulses(cols(:, col(1:m) + 1), p(1:m), v(1:n))
    end function c_impulse_newton
 
-   integer(c_int) function c_impulse_contact_forces(n, m, a, b, cols, col, acc, lam, iterations) &
-      bind(C, name='martello_impulse_contact_forces')
+   integer(c_int) function c_impulse_contact_forces(n, m, a, b, cols, col, acc, lam, held, &
+                                                    iterations) bind(C, name='martello_impulse_contact_forces')
       integer(c_int), value :: n, m
       integer(c_int), intent(in) :: a(*), b(*), col(*)
       real(c_double), intent(in) :: cols(n, *), acc(*)
       real(c_double), intent(out) :: lam(*)
-      integer(c_int), intent(out) :: iterations
+      integer(c_int), intent(out) :: held(*), iterations
       real(dp) :: w(m, m)
+      logical :: keep(m)
       integer :: info, its
       c_impulse_contact_forces = MARTELLO_ERR_ARGUMENT
       iterations = 0
@@ -65,7 +66,8 @@ contains
       c_impulse_contact_forces = MARTELLO_OK
       if (m == 0) return
       call delassus_columns(side(a, m), side(b, m), cols(:, col(1:m) + 1), w)
-      call contact_forces(w, rates(a, b, m, acc(1:n)), lam(1:m), info, its)
+      call contact_forces(w, rates(a, b, m, acc(1:n)), lam(1:m), keep, info, its)
+      held(1:m) = merge(1, 0, keep)
       iterations = its
       c_impulse_contact_forces = martello_status_of(info)
    end function c_impulse_contact_forces

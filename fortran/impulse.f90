@@ -168,15 +168,19 @@ contains
 
    !> The contact forces λ of contacts at zero gap and zero gap rate (persistent contacts):
    !> Signorini's law at the acceleration level, 0 ≤ g̈ ⊥ λ ≥ 0 with g̈ = g̈_free + W λ
-   !> (Pfeiffer & Glocker 1996, §5.3), the same LCP with q = g̈_free. A contact stays held iff
-   !> its λ > 0; held contacts whose multiplier would turn tensile come out with λ = 0 and
-   !> are released (the persistent-contact rule of docs/impulse.md §3).
-   subroutine contact_forces(w, a_free, lam, info, iterations)
+   !> (Pfeiffer & Glocker 1996, §5.3), the same LCP with q = g̈_free. The persistent-contact
+   !> rule (docs/impulse.md §3): a contact stays held unless the solution opens it, λ = 0 with
+   !> g̈ > 0; held contacts whose multiplier would turn tensile come out that way and are
+   !> released, while a multiplier that only reaches 0 (nothing presses, nothing pulls: g̈ = 0)
+   !> keeps the contact.
+   subroutine contact_forces(w, a_free, lam, held, info, iterations)
       real(dp), intent(in) :: w(:, :), a_free(:)
       real(dp), intent(out) :: lam(:)
+      logical, intent(out) :: held(:)
       integer, intent(out) :: info, iterations
       lam = 0.0_dp
       call solve_dense(w, a_free, lam, info, iterations)
+      held = lam > 0.0_dp .or. .not. (matmul(w, lam) + a_free > 0.0_dp)
    end subroutine contact_forces
 
    !> x ← x + Σ_k p_k c(:, k): the velocity jump of impulses p (or the displacement of a
