@@ -74,12 +74,12 @@ typedef struct {
   /* contact kinematics at the step start (0), the step end (1) and the current state */
   double *pen0, *rate0, *acc0, *pen1, *rate1, *acc1, *pen, *rate, *force;
   double *lam, *lam0, *lam1, *lamtol;
-  /* persistent (held) contacts: the list, its sides and columns for the impulse door, W_H
-   * factored */
-  int nh, *hlist, *held, *ha, *hb, *hc;
+  /* persistent (held) contacts: the list and W_H factored */
+  int nh, *hlist, *held;
   double *Wh, *rh;
-  /* impulse problems: a contact list as the door takes it, W, data and results */
-  int *ilist, *la, *lb, *lc, *hk;    /* hk: the held flag of the persistent-contact rule */
+  /* impulse problems (c/martello_internal.h): contact lists, W, data and results; hk is the
+   * held flag of the persistent-contact rule */
+  int *ilist, *hk;
   double *Wl, *ql, *pl, *wl, *sl, *el, *tg;
   /* contact phases: a penalty contact in contact, a persistent unilateral contact */
   int *ph_open;
@@ -116,15 +116,8 @@ static double gdot(const ed_t *w, int j, const double *x) {
   return s;
 }
 
-/* Contacts list[0..m) as the impulse door takes them: sides and column indices in Cm. */
-static void door_list(const ed_t *w, const int *list, int m, int *a, int *b, int *col) {
-  int k;
-  for (k = 0; k < m; k++) {
-    a[k] = w->con_a[list[k]];
-    b[k] = w->con_b[list[k]];
-    col[k] = w->uni[list[k]];
-  }
-}
+/* The impulse door's topology arguments (c/martello_internal.h): sides and columns in Cm. */
+#define TOPOLOGY(w) (w)->con_a, (w)->con_b, (w)->uni, (w)->Cm
 
 static int all_finite(const double *x, size_t n) {
   size_t i;
@@ -169,7 +162,7 @@ static double position_res(const ed_t *w, int j, const double *u) {
  * multiplier. */
 static int constrain(ed_t *w, double *a) {
   int k, st;
-  st = martello_impulse_project(w->n, w->nh, w->ha, w->hb, w->Cm, w->hc, w->Wh, NULL, a, w->rh);
+  st = martello_impulse_project(w->n, w->nh, w->hlist, TOPOLOGY(w), w->Wh, NULL, a, w->rh);
   for (k = 0; k < w->nh; k++) w->lam[w->hlist[k]] = w->rh[k];
   return st;
 }
@@ -278,9 +271,8 @@ static void add_event(ed_t *w, int j, double t_on, double t_off, double v_in, do
 /* ---- persistent contacts --------------------------------------------------------------- */
 
 static int factor_held(ed_t *w, double t) {
-  door_list(w, w->hlist, w->nh, w->ha, w->hb, w->hc);
   w->cnt[C_FACTORIZATIONS]++;
-  if (martello_impulse_factor(w->n, w->nh, w->ha, w->hb, w->Cm, w->hc, w->Wh) != MARTELLO_OK)
+  if (martello_impulse_factor(w->n, w->nh, w->hlist, TOPOLOGY(w), w->Wh) != MARTELLO_OK)
     return fail(w, MARTELLO_ERR_SINGULAR, t,
                 "event-driven: the persistent contacts are redundant (singular Delassus matrix "
                 "G M^-1 G^T)");
@@ -298,9 +290,8 @@ static int update_held(ed_t *w, double t, const int *list, int m) {
   st = eval_point(w, t, w->y, w->f, NULL);   /* free accelerations */
   w->nh = nh_old;
   if (st != MARTELLO_OK) return fail_eval(w, st, t);
-  door_list(w, list, m, w->la, w->lb, w->lc);
-  st = martello_impulse_contact_forces(w->n, m, w->la, w->lb, w->Cm, w->lc, w->f + w->n, w->pl,
-                                       w->hk, &piv);
+  st = martello_impulse_contact_forces(w->n, m, list, TOPOLOGY(w), w->f + w->n, w->pl, w->hk,
+                                       &piv);
   w->cnt[C_FACTORIZATIONS] += piv;   /* Lemke pivots: rank-one updates of the basis */
   if (st != MARTELLO_OK)
     return fail(w, st, t, st == MARTELLO_ERR_SINGULAR
@@ -345,18 +336,17 @@ static int update_held(ed_t *w, double t, const int *list, int m) {
 static int project(ed_t *w, double t, const int *list, int m) {
   int k, st;
   double *u = w->y, *v = w->y + w->n, de = 0.0;
-  door_list(w, list, m, w->la, w->lb, w->lc);
   w->cnt[C_FACTORIZATIONS]++;
-  if (martello_impulse_factor(w->n, m, w->la, w->lb, w->Cm, w->lc, w->Wl) != MARTELLO_OK)
+  if (martello_impulse_factor(w->n, m, list, TOPOLOGY(w), w->Wl) != MARTELLO_OK)
     return fail(w, MARTELLO_ERR_SINGULAR, t,
                 "event-driven: contacts held together are redundant (singular Delassus matrix)");
   for (k = 0; k < m; k++) {
     w->ql[k] = gdot(w, list[k], v);
     w->tg[k] = -w->gap[list[k]];            /* B u = u_b - u_a = -gap: delta = 0 */
   }
-  st = martello_impulse_project(w->n, m, w->la, w->lb, w->Cm, w->lc, w->Wl, NULL, v, w->pl);
+  st = martello_impulse_project(w->n, m, list, TOPOLOGY(w), w->Wl, NULL, v, w->pl);
   if (st == MARTELLO_OK)
-    st = martello_impulse_project(w->n, m, w->la, w->lb, w->Cm, w->lc, w->Wl, w->tg, u, w->wl);
+    st = martello_impulse_project(w->n, m, list, TOPOLOGY(w), w->Wl, w->tg, u, w->wl);
   if (st != MARTELLO_OK) return fail(w, st, t, "event-driven: the contact projection failed");
   for (k = 0; k < m; k++) de += 0.5 * w->pl[k] * w->ql[k];   /* 1/2 P (g'- + g'+), g'+ = 0 */
   w->e_impact += de;
@@ -387,8 +377,7 @@ static int impacts(ed_t *w, double t, int *n_impacts) {
     m++;
   }
   if (!approaching) return MARTELLO_OK;
-  door_list(w, w->ilist, m, w->la, w->lb, w->lc);
-  st = martello_impulse_newton(w->n, m, w->la, w->lb, w->Cm, w->lc, w->el, v, w->pl, &piv);
+  st = martello_impulse_newton(w->n, m, w->ilist, TOPOLOGY(w), w->el, v, w->pl, &piv);
   w->cnt[C_FACTORIZATIONS] += piv;   /* Lemke pivots */
   if (st != MARTELLO_OK)
     return fail(w, st, t, st == MARTELLO_ERR_SINGULAR
@@ -421,8 +410,9 @@ static int accumulations(ed_t *w, double t, int *changed) {
   *changed = 0;
   st = eval_point(w, t, w->y, w->f, w->lam1);
   if (st != MARTELLO_OK) return fail_eval(w, st, t);
-  if (w->nh > 0 &&
-      (st = martello_impulse_delassus(w->n, w->nh, w->ha, w->hb, w->Cm, w->hc, w->Wl)) != MARTELLO_OK)
+  if (w->nh > 0)
+    st = martello_impulse_delassus(w->n, w->nh, w->hlist, TOPOLOGY(w), w->Wl);
+  if (st != MARTELLO_OK)
     return fail(w, st, t, "event-driven: the Delassus matrix of the held contacts failed");
   for (j = 0; j < w->nc; j++) {
     double s, acc;
@@ -795,9 +785,8 @@ static void ed_free(ed_t *w) {
                   w->uni, w->inert, w->Cm, w->scale_abs, w->y, w->y0, w->yb, w->ybest, w->yc,
                   w->yerr, w->fstart, w->f, w->f1, w->fj, w->yj, w->fint, w->fext,
                   w->pen0, w->rate0, w->acc0, w->pen1, w->rate1, w->acc1, w->pen, w->rate,
-                  w->force, w->lam, w->lam0, w->lam1, w->lamtol, w->hlist, w->held, w->ha,
-                  w->hb, w->hc, w->Wh, w->rh, w->ilist, w->la, w->lb, w->lc, w->hk, w->Wl, w->ql,
-                  w->pl, w->wl, w->sl, w->el, w->tg, w->ph_open, w->ph_t,
+                  w->force, w->lam, w->lam0, w->lam1, w->lamtol, w->hlist, w->held, w->Wh,
+                  w->rh, w->ilist, w->hk, w->Wl, w->ql, w->pl, w->wl, w->sl, w->el, w->tg, w->ph_open, w->ph_t,
                   w->ph_v, w->ph_pen, w->ph_f, w->t_hold};
   size_t i;
   for (i = 0; i < sizeof bufs / sizeof bufs[0]; i++) free(bufs[i]);
@@ -851,8 +840,7 @@ static int ed_setup(ed_t *w) {
         ALLOC(w->Wh, (size_t)w->nu * (size_t)w->nu) && ALLOC(w->rh, nc) && ALLOC(w->ilist, nc) &&
         ALLOC(w->Wl, (size_t)w->nu * (size_t)w->nu) && ALLOC(w->ql, nc) && ALLOC(w->pl, nc) &&
         ALLOC(w->wl, nc) && ALLOC(w->sl, nc) && ALLOC(w->el, nc) && ALLOC(w->tg, nc) &&
-        ALLOC(w->ha, nc) && ALLOC(w->hb, nc) && ALLOC(w->hc, nc) && ALLOC(w->la, nc) &&
-        ALLOC(w->lb, nc) && ALLOC(w->lc, nc) && ALLOC(w->hk, nc) && ALLOC(w->ph_open, nc) && ALLOC(w->ph_t, nc) &&
+        ALLOC(w->hk, nc) && ALLOC(w->ph_open, nc) && ALLOC(w->ph_t, nc) &&
         ALLOC(w->ph_v, nc) && ALLOC(w->ph_pen, nc) && ALLOC(w->ph_f, nc) && ALLOC(w->t_hold, nc)))
     return MARTELLO_ERR_MEMORY;
   st = martello_eval_create(w->model, &w->ev);
@@ -872,8 +860,7 @@ static int ed_setup(ed_t *w) {
     if (w->con_b[j] >= 0) c[w->con_b[j]] += 1.0;
     st = martello_eval_solve_mass(w->ev, c);
     if (st != MARTELLO_OK) return fail_eval(w, st, 0.0);
-    door_list(w, &j, 1, w->la, w->lb, w->lc);
-    st = martello_impulse_delassus(n, 1, w->la, w->lb, w->Cm, w->lc, &wjj);
+    st = martello_impulse_delassus(n, 1, &j, TOPOLOGY(w), &wjj);
     if (st != MARTELLO_OK) return fail(w, st, 0.0, "event-driven: the Delassus matrix failed");
     w->inert[j] = !(wjj > 0.0);
   }

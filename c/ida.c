@@ -87,7 +87,7 @@ typedef struct {
   /* the impulse problem (c/martello_internal.h): M^-1 B_r^T of every rigid contact (column r,
    * B_r = e_b - e_a), built once; the door lists of the contacts in aset */
   double *cols;
-  int cols_ready, *da, *db, *dc;
+  int cols_ready, *dc;
   /* settings */
   double rtol, atol, event_tol, t_end, h_max, out_dt, divergence_factor;
   /* contact phases */
@@ -192,15 +192,13 @@ static int impulse_columns(ida_problem *P) {
   return MARTELLO_OK;
 }
 
-/* The rigid contacts aset[0..m) as the impulse door takes them. */
+/* The rigid contacts aset[0..m) as the impulse door's list (contact indices) into dc. */
 static void door_list(ida_problem *P, int m) {
-  for (int k = 0; k < m; k++) {
-    int j = P->rig_con[P->aset[k]];
-    P->da[k] = P->con_a[j];
-    P->db[k] = P->con_b[j];
-    P->dc[k] = P->aset[k];
-  }
+  for (int k = 0; k < m; k++) P->dc[k] = P->rig_con[P->aset[k]];
 }
+
+/* The impulse door's topology arguments (c/martello_internal.h): sides, columns in cols. */
+#define TOPOLOGY(P) (P)->con_a, (P)->con_b, (P)->rig, (P)->cols
 
 static int closed_set(ida_problem *P) {
   int m = 0;
@@ -434,7 +432,7 @@ static int rigid_impacts(ida_problem *P, double t, double *u, double *v) {
       P->w0[k] = pen_rate(P, j, v);
       P->q[k] = P->closed[r] ? 0.0 : (P->rest[j] >= 0.0 ? P->rest[j] : 0.0);
     }
-    st = martello_impulse_newton(P->n, m, P->da, P->db, P->cols, P->dc, P->q, v, P->rhs, &piv);
+    st = martello_impulse_newton(P->n, m, P->dc, TOPOLOGY(P), P->q, v, P->rhs, &piv);
     if (st != MARTELLO_OK)
       return fail(P, st, "IDA: the impact LCP of %d contacts failed at t = %.9e s (%s)", m, t,
                   st == MARTELLO_ERR_SINGULAR ? "redundant contacts" : "pivot limit");
@@ -465,9 +463,9 @@ static int rigid_impacts(ida_problem *P, double t, double *u, double *v) {
     st = martello_eval_acceleration(P->ev, t, u, v, P->a);
     if (st != MARTELLO_OK) return fail(P, st, "IDA: acceleration failed at t = %.9e s", t);
     door_list(P, ma);
-    st = martello_impulse_delassus(P->n, ma, P->da, P->db, P->cols, P->dc, P->S);
+    st = martello_impulse_delassus(P->n, ma, P->dc, TOPOLOGY(P), P->S);
     if (st == MARTELLO_OK && mc > 0)
-      st = martello_impulse_contact_forces(P->n, mc, P->da, P->db, P->cols, P->dc, P->a, P->w0,
+      st = martello_impulse_contact_forces(P->n, mc, P->dc, TOPOLOGY(P), P->a, P->w0,
                                            P->cand, &piv);
     if (st != MARTELLO_OK)
       return fail(P, st, "IDA: the contact forces of the closed contacts failed at t = %.9e s", t);
@@ -488,12 +486,12 @@ static int rigid_impacts(ida_problem *P, double t, double *u, double *v) {
    * bounces: their energy goes to E_IMPACT), then put it on delta = 0 (B u = -gap) by the
    * mass-weighted projection */
   door_list(P, m);
-  if ((st = martello_impulse_factor(P->n, m, P->da, P->db, P->cols, P->dc, P->S)) != MARTELLO_OK)
+  if ((st = martello_impulse_factor(P->n, m, P->dc, TOPOLOGY(P), P->S)) != MARTELLO_OK)
     return fail(P, MARTELLO_ERR_SINGULAR, "IDA: redundant closed contacts at t = %.9e s (B^T M^-1 B singular)", t);
   for (int k = 0; k < m; k++) P->q[k] = -P->gap[P->rig_con[P->aset[k]]];
-  st = martello_impulse_project(P->n, m, P->da, P->db, P->cols, P->dc, P->S, NULL, v, P->rhs);
+  st = martello_impulse_project(P->n, m, P->dc, TOPOLOGY(P), P->S, NULL, v, P->rhs);
   if (st == MARTELLO_OK)
-    st = martello_impulse_project(P->n, m, P->da, P->db, P->cols, P->dc, P->S, P->q, u, P->rhs);
+    st = martello_impulse_project(P->n, m, P->dc, TOPOLOGY(P), P->S, P->q, u, P->rhs);
   if (st != MARTELLO_OK) return fail(P, st, "IDA: the constraint projection failed at t = %.9e s", t);
   return MARTELLO_OK;
 }
@@ -510,7 +508,7 @@ static int rigid_multipliers(ida_problem *P, double t, double *u, double *v) {
   if (m == 0) return MARTELLO_OK;
   if ((st = impulse_columns(P)) != MARTELLO_OK) return fail(P, st, "IDA: singular mass");
   door_list(P, m);
-  st = martello_impulse_contact_forces(P->n, m, P->da, P->db, P->cols, P->dc, P->a, P->rhs,
+  st = martello_impulse_contact_forces(P->n, m, P->dc, TOPOLOGY(P), P->a, P->rhs,
                                        P->cand, &piv);
   if (st != MARTELLO_OK)
     return fail(P, st, "IDA: the contact forces of %d closed contacts failed at t = %.9e s (%s)", m, t,
@@ -793,7 +791,7 @@ static void release(ida_problem *P) {
   void *all[] = {P->mass, P->gap, P->rest, P->fixed, P->con_a, P->con_b, P->scheme, P->rig,
                  P->rig_con, P->iu, P->iv, P->ip, P->im, P->closed, P->touching, P->act,
                  P->opened, P->was_closed, P->hit, P->cand, P->q, P->w0, P->w_in, P->u, P->v, P->a, P->x, P->uq, P->vq, P->fint, P->fext,
-                 P->pen, P->rate, P->force, P->lam, P->S, P->rhs, P->cols, P->da, P->db, P->dc, P->aset, P->ph_t,
+                 P->pen, P->rate, P->force, P->lam, P->S, P->rhs, P->cols, P->dc, P->aset, P->ph_t,
                  P->ph_v, P->ph_pen, P->ph_f};
   for (size_t k = 0; k < sizeof all / sizeof all[0]; k++) free(all[k]);
   if (P->ev) martello_eval_free(&P->ev);
@@ -903,8 +901,6 @@ static int setup(ida_problem *P, martello_model *model, martello_run *run) {
   P->cand = take(nr, sizeof(int), &ok);
   P->q = take(nr, sizeof(double), &ok);
   P->w0 = take(nr, sizeof(double), &ok);
-  P->da = take(nr, sizeof(int), &ok);
-  P->db = take(nr, sizeof(int), &ok);
   P->dc = take(nr, sizeof(int), &ok);
   P->cols = take(nr * un, sizeof(double), &ok);
   P->aset = take(nr, sizeof(int), &ok);

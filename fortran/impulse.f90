@@ -14,6 +14,7 @@
 module martello_impulse
    use martello_kinds, only: dp
    use martello_lcp, only: lcp_lemke, lcp_pgs, LCP_OK, LCP_RAY
+   use martello_lapack, only: dpotrf, dpotrs
    implicit none
    private
    public :: contact_graph_t, contact_graph, delassus_columns, delassus_bandwidth, &
@@ -194,67 +195,43 @@ contains
       end do
    end subroutine apply_impulses
 
-   !> Cholesky factorisation in place, W = L Lᵀ (L in the lower triangle), of the Delassus
-   !> matrix of contacts held together. IMPULSE_SINGULAR when a pivot falls to the rounding
-   !> of the largest diagonal (64 ε m max W_ii: the Cholesky backward error bound, Higham 2002
-   !> Thm 10.3, with a margin): the contacts are redundant, W is only semi-definite. A single
-   !> contact is kept as W itself: the solve is then one division, exact to one rounding.
-   pure subroutine delassus_factor(w, info)
+   !> Cholesky factorisation in place (LAPACK dpotrf, L in the lower triangle) of the Delassus
+   !> matrix of contacts held together. IMPULSE_SINGULAR when a pivot falls to the rounding of
+   !> the largest diagonal, L_jj² ≤ 64 ε m max W_ii (the Cholesky backward error bound, Higham
+   !> 2002 Thm 10.3, with a margin): the contacts are redundant, W only semi-definite.
+   subroutine delassus_factor(w, info)
       real(dp), intent(inout) :: w(:, :)
       integer, intent(out) :: info
-      integer :: i, j, m
-      real(dp) :: d, dmax
+      real(dp) :: dmax
+      integer :: j, m, lapack_info
       m = size(w, 1)
       info = IMPULSE_OK
       if (m == 0) return
-      dmax = 0.0_dp
-      do i = 1, m
-         dmax = max(dmax, abs(w(i, i)))
-      end do
-      if (m == 1) then
-         if (.not. (w(1, 1) > 0.0_dp)) info = IMPULSE_SINGULAR
-         return
+      dmax = maxval([(abs(w(j, j)), j = 1, m)])
+      call dpotrf('L', m, w, m, lapack_info)
+      if (lapack_info /= 0) then
+         info = IMPULSE_SINGULAR
+      else if (.not. all([(w(j, j)**2 > 64.0_dp*epsilon(1.0_dp)*m*dmax, j = 1, m)])) then
+         info = IMPULSE_SINGULAR
       end if
-      do j = 1, m
-         d = w(j, j) - dot_product(w(j, 1:j - 1), w(j, 1:j - 1))
-         if (.not. (d > 64.0_dp*epsilon(1.0_dp)*m*dmax)) then
-            info = IMPULSE_SINGULAR
-            return
-         end if
-         d = sqrt(d)
-         w(j, j) = d
-         do i = j + 1, m
-            w(i, j) = (w(i, j) - dot_product(w(i, 1:j - 1), w(j, 1:j - 1)))/d
-         end do
-      end do
    end subroutine delassus_factor
 
    !> The mass-weighted projection of x onto B x = target for contacts held together
    !> (Acary & Brogliato 2008, §4.2: the closest point in the metric A⁻¹): with W factored
-   !> by delassus_factor, P = W⁻¹ (target − B x) and x ← x + Σ P_k c(:, k). Applied to the
-   !> velocities with target 0 it is the plastic impulse of the held set (P ≥ 0 for contacts
-   !> that approached); to the accelerations, the bilateral contact forces; to the
-   !> displacements with target −gap, the return onto δ = 0.
-   pure subroutine project_factored(sa, sb, c, l, target, x, p)
+   !> by delassus_factor, P = W⁻¹ (target − B x) and x ← x + Σ P_k c(:, k). On the velocities
+   !> with target 0 it is the plastic impulse of the held set; on the accelerations, the
+   !> bilateral contact forces; on the displacements with target −gap, the return onto δ = 0.
+   subroutine project_factored(sa, sb, c, l, target, x, p)
       integer, intent(in) :: sa(:), sb(:)
       real(dp), intent(in) :: c(:, :), l(:, :), target(:)
       real(dp), intent(inout) :: x(:)
       real(dp), intent(out) :: p(:)
-      integer :: k, m
+      integer :: k, m, info
       m = size(sa)
       do k = 1, m
          p(k) = target(k) - (side(x, sb(k)) - side(x, sa(k)))
       end do
-      if (m == 1) then
-         p(1) = p(1)/l(1, 1)
-      else
-         do k = 1, m                                  ! L y = r
-            p(k) = (p(k) - dot_product(l(k, 1:k - 1), p(1:k - 1)))/l(k, k)
-         end do
-         do k = m, 1, -1                              ! Lᵀ P = y
-            p(k) = (p(k) - dot_product(l(k + 1:m, k), p(k + 1:m)))/l(k, k)
-         end do
-      end if
+      call dpotrs('L', m, 1, l, m, p, m, info)
       call apply_impulses(c, p, x)
    end subroutine project_factored
 

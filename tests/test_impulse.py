@@ -28,11 +28,10 @@ def door():
     """The impulse door of c/martello_internal.h (not part of the public API)."""
     L = ctypes.CDLL(str(library_path()))
     ci, cd = ctypes.c_int, ctypes.c_double
-    L.martello_impulse_newton.argtypes = [ci, ci, _I, _I, _D, _I, _D, _D, _D,
-                                          ctypes.POINTER(ci)]
-    L.martello_impulse_contact_forces.argtypes = [ci, ci, _I, _I, _D, _I, _D, _D, _I,
-                                                  ctypes.POINTER(ci)]
-    L.martello_impulse_delassus.argtypes = [ci, ci, _I, _I, _D, _I, _D]
+    topology = [ci, ci, _I, _I, _I, _I, _D]              # n, m, list, a, b, col, cols
+    L.martello_impulse_newton.argtypes = topology + [_D, _D, _D, ctypes.POINTER(ci)]
+    L.martello_impulse_contact_forces.argtypes = topology + [_D, _D, _I, ctypes.POINTER(ci)]
+    L.martello_impulse_delassus.argtypes = topology + [_D]
     L.martello_impulse_accumulation.argtypes = [cd, cd, cd, cd, cd, cd, ctypes.POINTER(cd)]
     for f in ("newton", "contact_forces", "delassus", "accumulation"):
         getattr(L, "martello_impulse_" + f).restype = ci
@@ -40,8 +39,10 @@ def door():
 
 
 def _lists(a, b):
+    """The door's topology of contacts (a[j], b[j]) with column j: list, a, b, col."""
     a, b = np.asarray(a, dtype=np.int32), np.asarray(b, dtype=np.int32)
-    return a, b, np.arange(len(a), dtype=np.int32)
+    idx = np.arange(len(a), dtype=np.int32)
+    return idx, a, b, idx
 
 
 def lumped_columns(mass, a, b):
@@ -57,12 +58,12 @@ def lumped_columns(mass, a, b):
 
 def newton(door, mass, a, b, e, v):
     """Newton's law on all contacts at once: (status, impulses, v⁺)."""
-    a, b, col = _lists(a, b)
+    lst, a, b, col = _lists(a, b)
     cols = lumped_columns(mass, a, b)
     v = np.array(v, dtype=float, order="F")
     p = np.zeros(len(a), order="F")
     its = ctypes.c_int()
-    st = door.martello_impulse_newton(len(mass), len(a), a, b, cols, col,
+    st = door.martello_impulse_newton(len(mass), len(a), lst, a, b, col, cols,
                                       np.asfortranarray(e, dtype=float), v, p, ctypes.byref(its))
     return st, p, v
 
@@ -72,11 +73,11 @@ def contact_forces_of(door, W, q, held=False):
     the ground, so B = −I and the columns −W give W_kl = B_k C_l; the accelerations −q give
     B acc = q. With held: also the persistent-contact rule's flags."""
     m = len(q)
-    a, b, col = _lists(np.arange(m), -np.ones(m))
+    lst, a, b, col = _lists(np.arange(m), -np.ones(m))
     z = np.zeros(m, order="F")
     keep = np.zeros(m, dtype=np.int32)
     its = ctypes.c_int()
-    st = door.martello_impulse_contact_forces(m, m, a, b, np.asfortranarray(-W), col,
+    st = door.martello_impulse_contact_forces(m, m, lst, a, b, col, np.asfortranarray(-W),
                                               np.asfortranarray(-q), z, keep, ctypes.byref(its))
     return (st, z, keep) if held else (st, z)
 
@@ -197,9 +198,14 @@ def test_contact_forces_release_the_tensile_contact(door):
 def test_delassus_matrix_of_a_chain(door):
     # three masses, contacts (0, 1), (1, 2), (2, ground): W = B M⁻¹ Bᵀ written out
     mass = np.array([1.0, 2.0, 4.0])
-    a, b, col = _lists([0, 1, 2], [1, 2, -1])
+    lst, a, b, col = _lists([0, 1, 2], [1, 2, -1])
     W = np.zeros((3, 3), order="F")
-    assert door.martello_impulse_delassus(3, 3, a, b, lumped_columns(mass, a, b), col, W) == OK
+    assert door.martello_impulse_delassus(3, 3, lst, a, b, col, lumped_columns(mass, a, b), W) == OK
+    # a sub-problem: contacts 2 and 0 of the topology, in that order
+    sub = np.zeros((2, 2), order="F")
+    lst2 = np.array([2, 0], dtype=np.int32)
+    assert door.martello_impulse_delassus(3, 2, lst2, a, b, col, lumped_columns(mass, a, b), sub) == OK
+    np.testing.assert_array_equal(sub, W[np.ix_([2, 0], [2, 0])])
     ref = np.array([[1 + 1 / 2, -1 / 2, 0.0], [-1 / 2, 1 / 2 + 1 / 4, -1 / 4], [0.0, -1 / 4, 1 / 4]])
     np.testing.assert_array_equal(W, ref)
 
