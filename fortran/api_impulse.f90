@@ -50,7 +50,7 @@ contains
       call delassus_columns(pb%sa, pb%sb, cols(:, pb%ic), w)
       g = rates(pb, v(1:n))
       p(1:m) = 0.0_dp
-      call newton_impulses(w, g, min(g, 0.0_dp), e(1:m), p(1:m), info, its)   ! an impact
+      call newton_impulses(g, min(g, 0.0_dp), e(1:m), p(1:m), info, its, w=w)   ! an impact
       iterations = its
       c_impulse_newton = martello_status_of(info)
       if (info == IMPULSE_OK) call apply_impulses(cols(:, pb%ic), p(1:m), v(1:n))

@@ -35,7 +35,7 @@ module martello_moreau_jean
    use martello_run_checks, only: check_run_settings, check_divergence
    use martello_integrator_settings, only: integrator_settings_t, integrator_name, scheme_supported
    use martello_impulse, only: contact_graph_t, contact_graph, delassus_columns, &
-      delassus_bandwidth, delassus_diagonal_band, newton_impulses, newton_impulses_band, IMPULSE_OK
+      delassus_bandwidth, delassus_diagonal_band, newton_impulses, IMPULSE_OK
    use martello_linalg, only: lapack_status
    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
    implicit none
@@ -339,8 +339,8 @@ contains
             kw = delassus_bandwidth(graph, sa, sb, act(1:na), pos)
             call ensure_band(kw)
             call delassus_diagonal_band(graph, sa, sb, act(1:na), pos, what%ab(1, :), kw, wb)
-            call newton_impulses_band(wb, kw, qlcp(1:na), gref(1:na), eact(1:na), zlcp(1:na), &
-                                      inf, iters)
+            call newton_impulses(qlcp(1:na), gref(1:na), eact(1:na), zlcp(1:na), inf, iters, &
+                                 wb=wb, kw=kw)
          else
             ! W = B Ŵ⁻¹ Bᵀ from the columns Ŵ⁻¹ B_jᵀ (one multi-right-hand-side solve)
             if (allocated(zcol)) then
@@ -362,8 +362,8 @@ contains
             end if
             call ensure_dense()
             call delassus_columns(sa(act(1:na)), sb(act(1:na)), zcol(:, 1:na), wd_(1:na, 1:na))
-            call newton_impulses(wd_(1:na, 1:na), qlcp(1:na), gref(1:na), eact(1:na), zlcp(1:na), &
-                                 inf, iters)
+            call newton_impulses(qlcp(1:na), gref(1:na), eact(1:na), zlcp(1:na), inf, iters, &
+                                 w=wd_(1:na, 1:na))
          end if
          r%counters(C_NEWTON) = r%counters(C_NEWTON) + int(iters, i8)
          if (inf /= IMPULSE_OK) then
