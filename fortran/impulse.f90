@@ -175,7 +175,8 @@ contains
    !> Cholesky factorisation in place (LAPACK dpotrf, L in the lower triangle) of the Delassus
    !> matrix of contacts held together. IMPULSE_SINGULAR when a pivot falls to the rounding of
    !> the largest diagonal, L_jj² ≤ 64 ε m max W_ii (the Cholesky backward error bound, Higham
-   !> 2002 Thm 10.3, with a margin): the contacts are redundant, W only semi-definite.
+   !> 2002 Thm 10.3, with a margin): the contacts are redundant, W only semi-definite. One
+   !> contact keeps W itself: its solve is then one division, exact to one rounding.
    subroutine delassus_factor(w, info)
       real(dp), intent(inout) :: w(:, :)
       integer, intent(out) :: info
@@ -185,6 +186,10 @@ contains
       info = IMPULSE_OK
       if (m == 0) return
       dmax = maxval([(abs(w(j, j)), j = 1, m)])
+      if (m == 1) then
+         if (.not. (w(1, 1) > 0.0_dp)) info = IMPULSE_SINGULAR
+         return
+      end if
       call dpotrf('L', m, w, m, lapack_info)
       if (lapack_info /= 0) then
          info = IMPULSE_SINGULAR
@@ -208,7 +213,11 @@ contains
       do k = 1, m
          p(k) = target(k) - (side(x, sb(k)) - side(x, sa(k)))
       end do
-      call dpotrs('L', m, 1, l, m, p, m, info)
+      if (m == 1) then
+         p(1) = p(1)/l(1, 1)
+      else
+         call dpotrs('L', m, 1, l, m, p, m, info)
+      end if
       call apply_impulses(c, p, x)
    end subroutine project_factored
 
