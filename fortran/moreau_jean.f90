@@ -14,9 +14,10 @@
 !>
 !>   0 ≤ ġ_{k+1} + e ġ_k ⊥ p_{k+1} ≥ 0,   ġ = B v = v_b − v_a = −δ̇,
 !>
-!> an LCP on the Delassus operator W = B Ŵ⁻¹ Bᵀ (martello_lcp: Lemke for up to LEMKE_MAX
-!> active contacts, projected Gauss–Seidel beyond, on a tridiagonal W when Ŵ is diagonal).
-!> Lagrange contacts are the same law with e = their restitution (default 0).
+!> an LCP on the Delassus operator W = B Ŵ⁻¹ Bᵀ, the shared impulse problem (martello_impulse,
+!> docs/impulse.md: Lemke for up to LEMKE_MAX active contacts, projected Gauss–Seidel beyond,
+!> on a tridiagonal W when Ŵ is diagonal). Lagrange contacts are the same law with e = their
+!> restitution (default 0).
 !>
 !> Discrete energy identity (linear forces): E_{k+1} − E_k = −(θ − ½)(‖Δv‖²_M + ‖Δq‖²_K)
 !> + Δqᵀ f_ext,θ + ġ_θᵀ p_{k+1}; the impulse work ġ_θ p = (1 − θ(1+e)) ġ_k p is ≤ 0 iff
@@ -33,19 +34,13 @@ module martello_moreau_jean
    use martello_results
    use martello_run_checks, only: check_run_settings, check_divergence
    use martello_integrator_settings, only: integrator_settings_t, integrator_name, scheme_supported
-   use martello_lcp, only: lcp_lemke, lcp_pgs, LCP_OK
+   use martello_impulse, only: contact_graph_t, contact_graph, delassus_columns, &
+      delassus_bandwidth, delassus_diagonal_band, newton_impulses, IMPULSE_OK
    use martello_linalg, only: lapack_status
    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
    implicit none
    private
-   public :: run_moreau_jean, LEMKE_MAX
-
-   !> Up to this many active contacts the LCP is solved by Lemke on a dense W (exact, O(n³)
-   !> at worst); beyond, by projected Gauss–Seidel on the band of W.
-   integer, parameter :: LEMKE_MAX = 64
-   !> PGS: stop when a sweep changes no impulse by more than PGS_TOL·max impulse
-   real(dp), parameter :: PGS_TOL = 1.0e-14_dp
-   integer, parameter :: PGS_MAX_SWEEPS = 100000
+   public :: run_moreau_jean
 
 
 contains
@@ -63,9 +58,9 @@ contains
                                fext_n(:), rhs(:), work(:), mrow(:), ma(:)
       real(dp), allocatable :: e_con(:), p(:), p_prev(:), pen(:), force(:)
       integer, allocatable :: sa(:), sb(:), act(:), pos(:), fixed_nodes(:), ipiv(:)
-      integer, allocatable :: node_ptr(:), node_con(:)
-      ! Delassus operator: dense (Lemke) and band (PGS), the columns Ŵ⁻¹Bᵀ (kd > 0), LCP data
-      real(dp), allocatable :: wd_(:, :), wb(:, :), zcol(:, :), qlcp(:), zlcp(:)
+      type(contact_graph_t) :: graph
+      ! Delassus operator: dense (kd > 0, from the columns Ŵ⁻¹Bᵀ) or band (kd = 0), LCP data
+      real(dp), allocatable :: wd_(:, :), wb(:, :), zcol(:, :), qlcp(:), zlcp(:), gref(:), eact(:)
       ! open contact phases
       real(dp), allocatable :: ph_t(:), ph_v(:), ph_pen(:), ph_f(:), ph_last(:)
       logical, allocatable :: ph_open(:), rigid(:), movable(:)
@@ -104,7 +99,7 @@ contains
       call band_init(what, n, kd)
 
       call rigid_contact_sides(m, rigid, e_con, sa, sb, movable)
-      call node_adjacency()
+      call contact_graph(n, sa, sb, movable, graph)
 
       ! initial state
       u(0) = 0.0_dp; v(0) = 0.0_dp
@@ -304,32 +299,6 @@ contains
          end if
       end subroutine solve_what
 
-      !> Contacts touching each node (rigid ones only): node_con(node_ptr(i):node_ptr(i+1)−1).
-      subroutine node_adjacency()
-         integer :: cnt(0:n), k
-         cnt = 0
-         do k = 1, nc
-            if (.not. movable(k)) cycle
-            if (sa(k) > 0) cnt(sa(k)) = cnt(sa(k)) + 1
-            if (sb(k) > 0) cnt(sb(k)) = cnt(sb(k)) + 1
-         end do
-         allocate (node_ptr(n + 2), node_con(max(1, sum(cnt(1:n)))))
-         node_ptr(1) = 1
-         do k = 1, n
-            node_ptr(k + 1) = node_ptr(k) + cnt(k)
-         end do
-         cnt = 0
-         do k = 1, nc
-            if (.not. movable(k)) cycle
-            if (sa(k) > 0) then
-               node_con(node_ptr(sa(k)) + cnt(sa(k))) = k; cnt(sa(k)) = cnt(sa(k)) + 1
-            end if
-            if (sb(k) > 0) then
-               node_con(node_ptr(sb(k)) + cnt(sb(k))) = k; cnt(sb(k)) = cnt(sb(k)) + 1
-            end if
-         end do
-      end subroutine node_adjacency
-
       !> Acary's index set: δ(q_k + ½h v_k) ≥ 0, the gap extrapolated to mid-step has closed.
       subroutine active_set()
          real(dp) :: dpred
@@ -348,62 +317,30 @@ contains
          end do
       end subroutine active_set
 
-      !> W, q of the LCP on the active contacts, solved; p(act) the impulses.
+      !> W of the active contacts (martello_impulse) and Newton's law on them; p(act) the
+      !> impulses. ġ_free = B v_free, ġ_ref = B v_k.
       subroutine impulses(inf)
          integer, intent(out) :: inf
-         integer :: ii, jj, k, node, side, cj
-         real(dp) :: si
+         integer :: ii, jj, k
          inf = 0
          if (allocated(qlcp)) then
-            if (size(qlcp) < na) deallocate (qlcp, zlcp)
+            if (size(qlcp) < na) deallocate (qlcp, zlcp, gref, eact)
          end if
-         if (.not. allocated(qlcp)) allocate (qlcp(nc), zlcp(nc))
-         ! q = B v_free + e B v_k
+         if (.not. allocated(qlcp)) allocate (qlcp(nc), zlcp(nc), gref(nc), eact(nc))
          do ii = 1, na
             k = act(ii)
-            qlcp(ii) = (v(sb(k)) - v(sa(k))) + e_con(k)*(vn(sb(k)) - vn(sa(k)))
+            qlcp(ii) = v(sb(k)) - v(sa(k))
+            gref(ii) = vn(sb(k)) - vn(sa(k))
+            eact(ii) = e_con(k)
+            zlcp(ii) = p_prev(k)                   ! warm start from the last step (PGS)
          end do
          if (kd == 0) then
-            ! Ŵ diagonal: W_ij = Σ over the nodes the two contacts share of s_i s_j / Ŵ_nn.
-            ! Its bandwidth in the active ordering is kw (1 for a chain).
-            kw = 0
-            do ii = 1, na
-               k = act(ii)
-               do side = 1, 2
-                  node = merge(sa(k), sb(k), side == 1)
-                  if (node == 0) cycle
-                  do jj = node_ptr(node), node_ptr(node + 1) - 1
-                     cj = node_con(jj)
-                     if (pos(cj) > 0) kw = max(kw, abs(pos(cj) - ii))
-                  end do
-               end do
-            end do
+            ! Ŵ diagonal: W banded in the active ordering (tridiagonal for a chain)
+            kw = delassus_bandwidth(graph, sa, sb, act(1:na), pos)
             call ensure_band(kw)
-            wb(:, 1:na) = 0.0_dp
-            do ii = 1, na
-               k = act(ii)
-               do side = 1, 2
-                  node = merge(sa(k), sb(k), side == 1)
-                  if (node == 0) cycle
-                  si = merge(-1.0_dp, 1.0_dp, side == 1)
-                  do jj = node_ptr(node), node_ptr(node + 1) - 1
-                     cj = node_con(jj)
-                     if (pos(cj) == 0) cycle
-                     ! s_j at this node: −1 if it is cj's a side, +1 if its b side
-                     wb(kw + 1 + ii - pos(cj), pos(cj)) = wb(kw + 1 + ii - pos(cj), pos(cj)) + &
-                        si*merge(-1.0_dp, 1.0_dp, sa(cj) == node)/what%ab(1, node)
-                  end do
-               end do
-            end do
-            if (na <= LEMKE_MAX) then
-               call ensure_dense()
-               wd_(1:na, 1:na) = 0.0_dp
-               do jj = 1, na
-                  do ii = max(1, jj - kw), min(na, jj + kw)
-                     wd_(ii, jj) = wb(kw + 1 + ii - jj, jj)
-                  end do
-               end do
-            end if
+            call delassus_diagonal_band(graph, sa, sb, act(1:na), pos, what%ab(1, :), kw, wb)
+            call newton_impulses(qlcp(1:na), gref(1:na), eact(1:na), zlcp(1:na), inf, iters, &
+                                 wb=wb, kw=kw)
          else
             ! W = B Ŵ⁻¹ Bᵀ from the columns Ŵ⁻¹ B_jᵀ (one multi-right-hand-side solve)
             if (allocated(zcol)) then
@@ -424,34 +361,12 @@ contains
                call dgbtrs('N', n, kd, kd, na, what%ab, size(what%ab, 1), ipiv, zcol, n, inf)
             end if
             call ensure_dense()
-            do jj = 1, na
-               do ii = 1, na
-                  k = act(ii)
-                  wd_(ii, jj) = 0.0_dp
-                  if (sb(k) > 0) wd_(ii, jj) = wd_(ii, jj) + zcol(sb(k), jj)
-                  if (sa(k) > 0) wd_(ii, jj) = wd_(ii, jj) - zcol(sa(k), jj)
-               end do
-            end do
-            if (na > LEMKE_MAX) then
-               kw = na - 1
-               call ensure_band(kw)
-               do jj = 1, na
-                  do ii = 1, na
-                     wb(kw + 1 + ii - jj, jj) = wd_(ii, jj)
-                  end do
-               end do
-            end if
-         end if
-         if (na <= LEMKE_MAX) then
-            call lcp_lemke(wd_(1:na, 1:na), qlcp(1:na), zlcp(1:na), iters, inf)
-         else
-            do ii = 1, na
-               zlcp(ii) = p_prev(act(ii))          ! warm start from the last step
-            end do
-            call lcp_pgs(wb(:, 1:na), kw, qlcp(1:na), zlcp(1:na), PGS_TOL, PGS_MAX_SWEEPS, iters, inf)
+            call delassus_columns(sa(act(1:na)), sb(act(1:na)), zcol(:, 1:na), wd_(1:na, 1:na))
+            call newton_impulses(qlcp(1:na), gref(1:na), eact(1:na), zlcp(1:na), inf, iters, &
+                                 w=wd_(1:na, 1:na))
          end if
          r%counters(C_NEWTON) = r%counters(C_NEWTON) + int(iters, i8)
-         if (inf /= LCP_OK) then
+         if (inf /= IMPULSE_OK) then
             write (r%message, '(a,i0,a,es12.5,a,i0,a)') 'Moreau-Jean: the impulse LCP on ', na, &
                ' active contacts failed at t = ', t, ' s (', iters, &
                ' iterations; redundant constraints or a contact between immobile sides?)'

@@ -23,8 +23,10 @@
 !> acceleration is reset from equilibrium (the impulsive a_{n+1} must not enter the next
 !> Newmark predictor). Steps without impacts use β = ¼, γ = ½ with the persistent contacts
 !> (plastic impacts, Zeno) held by the multiplier, released when it turns tensile.
-!> Zeno: an impact whose rebound flight, at the pressing relative acceleration, would last
-!> less than one step (2 e v_imp < h δ̈) is made plastic and the contact persistent.
+!> Zeno: an impact whose next rebound flight, at the pressing relative acceleration, would be
+!> shorter than one step (the accumulation policy of docs/impulse.md §4 with the step as time
+!> resolution, martello_impulse's impulse_accumulation) is made plastic and the contact
+!> persistent.
 !> Dense KKT solves (LAPACK dsytrf): a scheme for the small problems P2 and P5.
 module martello_newmark_lagrange
    use martello_kinds, only: dp, i8
@@ -37,6 +39,7 @@ module martello_newmark_lagrange
    use martello_run_checks, only: check_run_settings, check_divergence
    use martello_integrator_settings, only: integrator_settings_t, integrator_name, scheme_supported
    use martello_linalg, only: solve_symmetric_indefinite
+   use martello_impulse, only: impulse_accumulation
    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
    implicit none
    private
@@ -64,8 +67,8 @@ contains
       type(band_t) :: kband, cband
       real(dp) :: h, t, t_prev, beta, gamma, e_kin, e_links, e_cont, e_links0, e_cont0, e0, &
                   w_ext, d_damp, d_links, d_contact, d_impact, w_abs, wdl, wll, wcl, e_mech, dw, &
-                  alpha_imp, v_imp, e_eff, rr, d0, dd0, ddd0, tau, best_alpha, lam_tol
-      logical :: converged, recording, impact, released
+                  alpha_imp, v_imp, e_eff, rr, d0, dd0, ddd0, tau, best_alpha, lam_tol, t_inf
+      logical :: converged, recording, impact, released, zeno
       integer :: imp_c
       integer, parameter :: ENERGY_CHECK = 16
 
@@ -174,8 +177,11 @@ contains
             ddd0 = an(m%con_a(c)) - an(m%con_b(c))
             v_imp = dd0 + alpha_imp*h*ddd0
             e_eff = e_con(c)
-            ! Zeno: the rebound flight under the pressing acceleration would be < one step
-            if (ddd0 > 0.0_dp .and. 2.0_dp*e_eff*v_imp < h*ddd0) e_eff = 0.0_dp
+            ! Zeno: the next rebound flight under the pressing acceleration δ̈_n is shorter than
+            ! a step (one impact a step is what the tuned (β, γ) resolve)
+            call impulse_accumulation(e_eff, e_eff*max(v_imp, 0.0_dp), ddd0, t_prev + alpha_imp*h, &
+                                      h, 0.0_dp, zeno, t_inf)
+            if (zeno) e_eff = 0.0_dp
             rr = h*(dd0 + h*ddd0 + e_eff*v_imp)/(d0 + h*dd0 + 0.5_dp*h*h*ddd0)
             if (.not. (rr > 0.0_dp .and. ieee_is_finite(rr)) .or. v_imp <= 0.0_dp) then
                ! a graze (no approach speed): hold it as a persistent contact
