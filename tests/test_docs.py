@@ -20,7 +20,8 @@ from tests.docs_tables import DOCS, ROOT, parse_table, registry_tables, read_tab
 
 REGISTRY = {"integrators", "schemes", "laws", "link-kinds", "compatibility",
             "integrator-parameters", "counters", "energy-terms", "history-columns",
-            "status-codes"}
+            "status-codes", "families", "setting-types", "contact-parameters",
+            "link-parameters", "time-functions", "events", "constants"}
 
 
 # --- reading the source text ---------------------------------------------------------------
@@ -173,6 +174,8 @@ def test_status_codes_table_is_the_header_enum():
     assert [(r["status"], int(r["value"])) for r in rows] == c_status_enum()
     fortran = fortran_parameters(r"MARTELLO_(OK|ILL_CONDITIONED|ROOT_FOUND|ERR_[A-Z_]+)")
     assert {r["status"]: int(r["value"]) for r in rows} == fortran
+    reg = _registry().registry("status")
+    assert [(r["status"], int(r["value"])) for r in rows] == [(g.name, g.values["value"]) for g in reg]
 
 
 def _registry():
@@ -332,6 +335,54 @@ def test_history_columns_table_is_the_registry():
     cols = native.history_columns(["n1", "n2"], ["c"], ["l"])
     assert cols[:7] == ["t", "u:n1", "u:n2", "v:n1", "v:n2", "a:n1", "a:n2"]
     assert cols[-len(native.energy_names()):] == [f"energy:{e}" for e in native.energy_names()]
+
+
+# Where each registry table is documented: a docs table of its own, or the docs table that
+# carries it as a column (settings and reads are the rows and the "integrators" column of
+# integrator-parameters; history_per is the "one per" column of history-columns).
+REGISTRY_DOCS = {
+    "status": "status-codes", "integrators": "integrators", "families": "families",
+    "compatibility": "compatibility", "settings": "integrator-parameters",
+    "reads": "integrator-parameters", "setting_types": "setting-types", "schemes": "schemes",
+    "laws": "laws", "links": "link-kinds", "contact_parameters": "contact-parameters",
+    "link_parameters": "link-parameters", "time_functions": "time-functions",
+    "counters": "counters", "energy": "energy-terms", "events": "events",
+    "constants": "constants", "history": "history-columns", "history_per": "history-columns",
+    "tables": None,   # the list of tables itself: docs/c-api.md's overview
+}
+
+
+def test_every_registry_table_is_documented():
+    native = _registry()
+    tables = [r.name for r in native.registry("tables")]
+    assert set(tables) == set(REGISTRY_DOCS), "a registry table without a docs table (or gone)"
+    documented = set(registry_tables())
+    for t in tables:
+        if REGISTRY_DOCS[t] is not None:
+            assert REGISTRY_DOCS[t] in documented, (t, REGISTRY_DOCS[t])
+    overview = (DOCS / "c-api.md").read_text()
+    for t in tables:
+        assert f"`{t}`" in overview, f"docs/c-api.md does not name the registry table {t}"
+
+
+@pytest.mark.parametrize("table,label", [
+    ("families", "families"), ("setting_types", "setting-types"),
+    ("contact_parameters", "contact-parameters"), ("link_parameters", "link-parameters"),
+    ("time_functions", "time-functions"), ("events", "events"), ("constants", "constants")])
+def test_c_api_tables_are_the_registry(table, label):
+    native = _registry()
+    prefix = {r.name: r.text for r in native.registry("tables")}[table]
+    reg = native.registry(table)
+    rows = read_table(label)
+    assert [r["name"] for r in rows] == [g.name for g in reg]
+    c = c_constants()
+    for r, g in zip(rows, reg):
+        assert float(r["value"]) == g.values["value"], r["name"]
+        assert r["meaning"] == g.text, r["name"]
+        if prefix:
+            assert r["constant"] == _constant(prefix, g.name), r["name"]
+            if r["constant"] != "MARTELLO_GROUND":      # a #define, not an enum
+                assert c[r["constant"]] == g.values["value"], r["name"]
 
 
 # --- the examples are the catalogue files ------------------------------------------------------
