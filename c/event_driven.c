@@ -20,10 +20,10 @@
  *  - At an event the unilateral contacts touching within tolerance are resolved together by
  *    Newton's law at the velocity level, 0 <= g'+ + e g'- _|_ P >= 0: an impulse LCP on the
  *    Delassus matrix W = G M^-1 G^T (consistent mass through martello_eval_solve_mass),
- *    momentum conserved. An accumulation of impacts (the predicted rest of the geometric
- *    series of flight times, or the next flight's apex, below tolerance) makes the contact a
- *    bilateral constraint whose multiplier is the contact force; an acceleration-level LCP
- *    decides which contacts stay closed. */
+ *    momentum conserved. An accumulation of impacts (the policy of docs/impulse.md §4) makes the contact a bilateral
+ *    constraint whose multiplier is the contact force; an acceleration-level LCP decides which
+ *    contacts stay closed. Delassus matrices, LCPs, projections and the accumulation policy
+ *    are the shared impulse problem (fortran/impulse.f90, c/martello_internal.h). */
 #include <float.h>
 #include <math.h>
 #include <stdio.h>
@@ -33,11 +33,6 @@
 #include <gsl/gsl_odeiv2.h>
 #include "martello.h"
 #include "martello_internal.h"
-#include "event_driven_lcp.h"
-
-/* Slots of the cost counters (fortran/observer.f90 C_*, 0-based here). */
-enum { C_STEPS, C_REJECTED, C_NEWTON, C_RESIDUALS, C_FACTORIZATIONS, C_EVENTS, C_JACOBIANS,
-       C_ROOT_EVALS, C_CHATTER };
 
 /* What a contact waits for. After an event the state is the far end of the final bracket
  * (within event_tol of the root), so the status committed there is the new one. */
@@ -49,10 +44,6 @@ enum { ROOT_IMPACT,      /* unilateral gap closing: delta >= 0                  
                             penetration are observed, not interpolated)             */
        ROOT_RELEASE };   /* persistent contact: multiplier P below -tolerance       */
 
-/* Accumulation (Zeno), docs/event-driven.md: a contact is held once the next flight would
- * rise less than ZENO_FACTOR integration tolerances off the contact, or the predicted rest
- * of its flight times is below ZENO_FACTOR event tolerances. */
-#define ZENO_FACTOR 1.0e3
 /* events without time advancing before the run is declared stuck */
 #define MAX_EVENTS_AT_ONCE 1000
 
@@ -68,7 +59,8 @@ typedef struct {
   /* topology */
   double *mass, *gap, *e;
   int *fixed, *con_a, *con_b, *scheme, *is_pen, *uni, *inert;
-  double *Cm;                     /* M^-1 G_j^T of unilateral contact j: column uni[j] */
+  double *Cm;                     /* M^-1 B_j^T of unilateral contact j (B_j = e_b - e_a, the
+                                     impulse door's sign): column uni[j] */
   /* ODE */
   gsl_odeiv2_system sys;
   gsl_odeiv2_driver *drv;         /* the main stepper with its control and evolve */
@@ -82,10 +74,10 @@ typedef struct {
   /* persistent (held) contacts: the list and W_H factored */
   int nh, *hlist, *held;
   double *Wh, *rh;
-  /* LCPs */
-  martello_lcp *lcp;
-  int *ilist;
-  double *Wl, *ql, *pl, *wl, *sl;
+  /* impulse problems (c/martello_internal.h): contact lists, W, data and results; hk is the
+   * held flag of the persistent-contact rule */
+  int *ilist, *hk;
+  double *Wl, *ql, *pl, *wl, *sl, *el, *tg;
   double *t_hold;                 /* predicted accumulation time of a contact being held */
   /* cost counters; kinetic energy taken out by impulses since the last commit */
   long long cnt[MARTELLO_NCOUNTERS];
@@ -117,10 +109,8 @@ static double gdot(const ed_t *w, int j, const double *x) {
   return s;
 }
 
-static const double *ccol(const ed_t *w, int j) { return w->Cm + (size_t)w->uni[j] * w->n; }
-
-/* W_jk = G_j M^-1 G_k^T */
-static double delassus(const ed_t *w, int j, int k) { return gdot(w, j, ccol(w, k)); }
+/* The impulse door's topology arguments (c/martello_internal.h): sides and columns in Cm. */
+#define TOPOLOGY(w) (w)->con_a, (w)->con_b, (w)->uni, (w)->Cm
 
 static int all_finite(const double *x, size_t n) {
   size_t i;
@@ -148,19 +138,26 @@ static double gap_tol(const ed_t *w, int j, const double *u) {
   return 16.0 * DBL_EPSILON * gap_scale(w, j, u) + w->atol;
 }
 
+/* The height of the flights the integrator resolves (the band of the accumulation policy,
+ * docs/impulse.md §4): RESOLUTION_MARGIN times the position error it controls, atol + rtol
+ * (|u_a| + |u_b| + |gap|). A margin of 1 is not enough: msbdf locates events on rk4imp runs
+ * that do not resolve flights at their own error level (measured on P2, e = 0.8, rtol 1e-12:
+ * the Zeno time moves by 5.0e-6 s with a margin of 1, 2.5e-7 s with 1e3). */
+#define RESOLUTION_MARGIN 1.0e3
+static double position_res(const ed_t *w, int j, const double *u) {
+  return RESOLUTION_MARGIN * (w->atol + w->rtol * gap_scale(w, j, u));
+}
+
 /* ---- the right-hand side --------------------------------------------------------------- */
 
-/* a -= M^-1 G_H^T P_H with W_H P_H = G_H a: accelerations with the held contacts as
- * bilateral constraints; P (compression > 0) is the multiplier. */
-static void constrain(ed_t *w, double *a) {
-  int k, i;
-  for (k = 0; k < w->nh; k++) w->rh[k] = gdot(w, w->hlist[k], a);
-  martello_chol_solve(w->nh, w->Wh, w->rh);
-  for (k = 0; k < w->nh; k++) {
-    const double *c = ccol(w, w->hlist[k]);
-    for (i = 0; i < w->n; i++) a[i] -= w->rh[k] * c[i];
-    w->lam[w->hlist[k]] = w->rh[k];
-  }
+/* Accelerations with the held contacts as bilateral constraints: the projection onto
+ * B_H a = 0, a += M^-1 B_H^T P_H with W_H P_H = -B_H a; P (compression > 0) is the
+ * multiplier. */
+static int constrain(ed_t *w, double *a) {
+  int k, st;
+  st = martello_impulse_project(w->n, w->nh, w->hlist, TOPOLOGY(w), w->Wh, NULL, a, w->rh);
+  for (k = 0; k < w->nh; k++) w->lam[w->hlist[k]] = w->rh[k];
+  return st;
 }
 
 /* y' = [v; a; f_ext.v; f_int.v; link and contact power]. GSL_EBADFUNC stops GSL; the
@@ -171,7 +168,7 @@ static int ed_rhs(double t, const double y[], double dydt[], void *params) {
   const double *u = y, *v = y + n;
   double *a = dydt + n, power[5];
   int i, st;
-  w->cnt[C_RESIDUALS]++;
+  w->cnt[MARTELLO_COUNTER_RESIDUAL_EVALUATIONS]++;
   st = martello_eval_forces(w->ev, t, u, v, w->fint, w->fext);
   if (st == MARTELLO_OK) st = martello_eval_power(w->ev, power);
   if (st == MARTELLO_OK) {
@@ -182,7 +179,10 @@ static int ed_rhs(double t, const double y[], double dydt[], void *params) {
     w->rhs_status = st;
     return GSL_EBADFUNC;
   }
-  if (w->nh > 0) constrain(w, a);
+  if (w->nh > 0 && (st = constrain(w, a)) != MARTELLO_OK) {
+    w->rhs_status = st;
+    return GSL_EBADFUNC;
+  }
   for (i = 0; i < n; i++) dydt[i] = w->fixed[i] ? 0.0 : v[i];
   dydt[2 * n] = power[0];
   dydt[2 * n + 1] = power[1];
@@ -203,7 +203,7 @@ static int ed_jacobian(double t, const double y[], double *dfdy, double dfdt[], 
   const double sq = sqrt(DBL_EPSILON);
   double umax = 0.0, vmax = 0.0, ht;
   size_t i, j;
-  w->cnt[C_JACOBIANS]++;
+  w->cnt[MARTELLO_COUNTER_JACOBIAN_EVALUATIONS]++;
   if (ed_rhs(t, y, w->fj, w) != GSL_SUCCESS) return GSL_EBADFUNC;
   for (i = 0; i < n; i++) {
     umax = fmax(umax, fabs(y[i]));
@@ -254,11 +254,8 @@ static void kinematics(const ed_t *w, const double *y, const double *a, double *
 /* ---- persistent contacts --------------------------------------------------------------- */
 
 static int factor_held(ed_t *w, double t) {
-  int k, l;
-  for (k = 0; k < w->nh; k++)
-    for (l = 0; l < w->nh; l++) w->Wh[k * w->nh + l] = delassus(w, w->hlist[k], w->hlist[l]);
-  w->cnt[C_FACTORIZATIONS]++;
-  if (martello_chol_factor(w->nh, w->Wh) != MARTELLO_OK)
+  w->cnt[MARTELLO_COUNTER_FACTORIZATIONS]++;
+  if (martello_impulse_factor(w->n, w->nh, w->hlist, TOPOLOGY(w), w->Wh) != MARTELLO_OK)
     return fail(w, MARTELLO_ERR_SINGULAR, t,
                 "event-driven: the persistent contacts are redundant (singular Delassus matrix "
                 "G M^-1 G^T)");
@@ -266,37 +263,38 @@ static int factor_held(ed_t *w, double t) {
 }
 
 /* Which of the contacts in list[0..m) (all at zero gap and zero gap rate) stay closed: the
- * acceleration-level law 0 <= -g'' _|_ P >= 0, i.e. the LCP  W P - G a_free >= 0 _|_ P >= 0.
- * Contacts leaving the held set close their phase at t; entering ones open one that starts
- * at their predicted accumulation time t_hold. */
+ * persistent-contact rule of docs/impulse.md §3, the acceleration-level LCP on the free
+ * accelerations (martello_impulse_contact_forces): a contact stays held unless the solution
+ * opens it. Contacts leaving the held set close their phase at t; entering ones open one
+ * that starts at their predicted accumulation time t_hold. */
 static int update_held(ed_t *w, double t, const int *list, int m) {
-  int k, l, st, piv, nh_old = w->nh;
+  int k, st, piv, nh_old = w->nh;
   w->nh = 0;
   st = eval_point(w, t, w->y, w->f, NULL);   /* free accelerations */
   w->nh = nh_old;
   if (st != MARTELLO_OK) return fail_eval(w, st, t);
-  for (k = 0; k < m; k++) {
-    for (l = 0; l < m; l++) w->Wl[k * m + l] = delassus(w, list[k], list[l]);
-    w->ql[k] = -gdot(w, list[k], w->f + w->n);
-  }
-  st = martello_lcp_solve(w->lcp, m, w->Wl, w->ql, w->pl, w->wl, &piv);
-  w->cnt[C_FACTORIZATIONS] += piv + 1;
+  st = martello_impulse_contact_forces(w->n, m, list, TOPOLOGY(w), w->f + w->n, w->pl, w->hk,
+                                       &piv);
+  w->cnt[MARTELLO_COUNTER_FACTORIZATIONS] += piv;   /* Lemke pivots: rank-one updates of the basis */
   if (st != MARTELLO_OK)
     return fail(w, st, t, st == MARTELLO_ERR_SINGULAR
                 ? "event-driven: contacts held together are redundant (singular Delassus matrix)"
                 : "event-driven: the contact-force LCP did not converge");
-  for (k = 0; k < w->nc; k++) w->sl[k] = 0.0;
-  for (k = 0; k < m; k++) w->sl[list[k]] = w->pl[k];
+  for (k = 0; k < w->nc; k++) w->sl[k] = w->wl[k] = 0.0;
+  for (k = 0; k < m; k++) {
+    w->sl[list[k]] = w->pl[k];
+    w->wl[list[k]] = w->hk[k];   /* held flag per contact */
+  }
   for (k = 0; k < w->nh; k++) {
     int j = w->hlist[k];
-    if (w->sl[j] > 0.0) continue;
+    if (w->wl[j] != 0.0) continue;
     martello_observer_set_phase(w->obs, j, 0, t, gdot(w, j, w->y + w->n));
     w->held[j] = 0;
-    w->cnt[C_EVENTS]++;
+    w->cnt[MARTELLO_COUNTER_EVENTS]++;
   }
   w->nh = 0;
   for (k = 0; k < w->nc; k++) {
-    if (!(w->sl[k] > 0.0)) continue;
+    if (w->wl[k] == 0.0) continue;
     w->hlist[w->nh++] = k;
     if (!w->held[k]) {
       int a = w->con_a[k], b = w->con_b[k];
@@ -307,46 +305,40 @@ static int update_held(ed_t *w, double t, const int *list, int m) {
       martello_observer_set_phase(w->obs, k, 1, w->t_hold[k], 0.0);
       /* a release needs a tension beyond the rounding of the forces at the contact */
       w->lamtol[k] = 1e3 * DBL_EPSILON * fmax(fs, w->sl[k]);
-      w->cnt[C_EVENTS]++;
+      w->cnt[MARTELLO_COUNTER_EVENTS]++;
     }
   }
   return factor_held(w, t);
 }
 
 /* Put the contacts in list on gap = 0 and gap rate = 0 by the mass-weighted projection
- * x -= M^-1 G^T (G M^-1 G^T)^-1 (G x - b); the kinetic energy removed (what the remaining
- * micro-impacts of an accumulation would dissipate) goes to E_IMPACT. */
+ * (martello_impulse_project: B v = 0, then B u = -gap); the kinetic energy removed (what the
+ * remaining micro-impacts of an accumulation would dissipate) goes to E_IMPACT. */
 static int project(ed_t *w, double t, const int *list, int m) {
-  int k, l, i;
+  int k, st;
   double *u = w->y, *v = w->y + w->n, de = 0.0;
-  for (k = 0; k < m; k++)
-    for (l = 0; l < m; l++) w->Wl[k * m + l] = delassus(w, list[k], list[l]);
-  w->cnt[C_FACTORIZATIONS]++;
-  if (martello_chol_factor(m, w->Wl) != MARTELLO_OK)
+  w->cnt[MARTELLO_COUNTER_FACTORIZATIONS]++;
+  if (martello_impulse_factor(w->n, m, list, TOPOLOGY(w), w->Wl) != MARTELLO_OK)
     return fail(w, MARTELLO_ERR_SINGULAR, t,
                 "event-driven: contacts held together are redundant (singular Delassus matrix)");
-  for (k = 0; k < m; k++) w->ql[k] = w->pl[k] = gdot(w, list[k], v);
-  martello_chol_solve(m, w->Wl, w->pl);
+  for (k = 0; k < m; k++) {
+    w->ql[k] = gdot(w, list[k], v);
+    w->tg[k] = -w->gap[list[k]];            /* B u = u_b - u_a = -gap: delta = 0 */
+  }
+  st = martello_impulse_project(w->n, m, list, TOPOLOGY(w), w->Wl, NULL, v, w->pl);
+  if (st == MARTELLO_OK)
+    st = martello_impulse_project(w->n, m, list, TOPOLOGY(w), w->Wl, w->tg, u, w->wl);
+  if (st != MARTELLO_OK) return fail(w, st, t, "event-driven: the contact projection failed");
   for (k = 0; k < m; k++) de += 0.5 * w->pl[k] * w->ql[k];   /* 1/2 P (g'- + g'+), g'+ = 0 */
-  for (k = 0; k < m; k++) {
-    const double *c = ccol(w, list[k]);
-    for (i = 0; i < w->n; i++) v[i] -= w->pl[k] * c[i];
-  }
-  for (k = 0; k < m; k++) w->pl[k] = gdot(w, list[k], u) - w->gap[list[k]];
-  martello_chol_solve(m, w->Wl, w->pl);
-  for (k = 0; k < m; k++) {
-    const double *c = ccol(w, list[k]);
-    for (i = 0; i < w->n; i++) u[i] -= w->pl[k] * c[i];
-  }
   w->e_impact += de;
   return MARTELLO_OK;
 }
 
 /* ---- impacts and accumulations ---------------------------------------------------------- */
 
-/* Newton's law on the touching unilateral contacts: the impulse LCP W P + q >= 0 _|_ P >= 0
- * with q_j = -(g'-_j + e_j max(g'-_j, 0)) (a contact already separating may not be pulled
- * closed), then v+ = v- - M^-1 G^T P. Impacts on free contacts are events. */
+/* Newton's law on the touching unilateral contacts at once (martello_impulse_newton,
+ * docs/impulse.md §2; a held contact with e = 0), momentum conserved. Impacts on free
+ * contacts are events. */
 static int impacts(ed_t *w, double t, int *n_impacts) {
   int j, k, m = 0, st, piv, approaching = 0;
   double *u = w->y, *v = w->y + w->n;
@@ -359,28 +351,20 @@ static int impacts(ed_t *w, double t, int *n_impacts) {
     if (!w->held[j] && d < -(gap_tol(w, j, u) + w->event_tol * fmax(r, 0.0))) continue;
     w->ilist[m] = j;
     w->sl[m] = r;
-    w->ql[m] = -(r + (w->held[j] ? 0.0 : w->e[j]) * fmax(r, 0.0));
+    w->el[m] = w->held[j] ? 0.0 : w->e[j];
     /* an approach beyond the rounding of v_a - v_b calls for impulses (a contact released
      * with zero relative speed is not an impact) */
     if (r > 64.0 * DBL_EPSILON * node_sum(w, j, v)) approaching = 1;
     m++;
   }
   if (!approaching) return MARTELLO_OK;
-  for (k = 0; k < m; k++)
-    for (j = 0; j < m; j++) w->Wl[k * m + j] = delassus(w, w->ilist[k], w->ilist[j]);
-  st = martello_lcp_solve(w->lcp, m, w->Wl, w->ql, w->pl, w->wl, &piv);
-  w->cnt[C_FACTORIZATIONS] += piv + 1;
+  st = martello_impulse_newton(w->n, m, w->ilist, TOPOLOGY(w), w->el, v, w->pl, &piv);
+  w->cnt[MARTELLO_COUNTER_FACTORIZATIONS] += piv;   /* Lemke pivots */
   if (st != MARTELLO_OK)
     return fail(w, st, t, st == MARTELLO_ERR_SINGULAR
                 ? "event-driven: simultaneous impacts on redundant contacts (singular Delassus "
                   "matrix)"
                 : "event-driven: the impact LCP did not converge");
-  for (k = 0; k < m; k++) {
-    const double *c = ccol(w, w->ilist[k]);
-    int i;
-    if (w->pl[k] == 0.0) continue;
-    for (i = 0; i < w->n; i++) v[i] -= w->pl[k] * c[i];
-  }
   for (k = 0; k < m; k++) {
     int jj = w->ilist[k];
     double r_after;
@@ -391,41 +375,37 @@ static int impacts(ed_t *w, double t, int *n_impacts) {
     if (w->held[jj]) continue;   /* a persistent contact takes its share without an event */
     martello_observer_add_impact(w->obs, jj, t, w->sl[k], r_after,
                                  fmax(gdot(w, jj, u) - w->gap[jj], 0.0), w->pl[k]);
-    w->cnt[C_EVENTS]++;
+    w->cnt[MARTELLO_COUNTER_EVENTS]++;
     (*n_impacts)++;
   }
   return MARTELLO_OK;
 }
 
-/* Would contact j, leaving with separation speed s while g'' > 0 presses it, only make
- * flights below resolution? The next apex is s^2/(2 g''); the flights that follow sum to
- * 2 s/(g''(1 - e)) (the free-fall series); *tail receives that sum (0 if e = 1). */
-static int accumulates(const ed_t *w, int j, double s, double acc, double *tail) {
-  const double apex_tol = ZENO_FACTOR * (w->atol + w->rtol * gap_scale(w, j, w->y));
-  *tail = 0.0;
-  if (s == 0.0) return 1;
-  if (!(acc > 0.0)) return 0;
-  if (w->e[j] < 1.0) *tail = 2.0 * s / (acc * (1.0 - w->e[j]));
-  return s * s / (2.0 * acc) <= apex_tol || (w->e[j] < 1.0 && *tail <= ZENO_FACTOR * w->event_tol);
-}
-
-/* After the impacts: touching contacts whose micro-impacts accumulate (or that touch at rest
- * while pressed) join the held set; held contacts that an impulse set flying leave it. */
+/* After the impacts: touching contacts whose impacts accumulate (martello_impulse_accumulation,
+ * docs/impulse.md §4: a next flight shorter than event_tol or lower than the resolved height),
+ * or that touch at rest while pressed, join the held set; held contacts that an impulse set flying leave it unless their new
+ * sequence accumulates too. A free contact is a candidate only when the free system presses
+ * it (g'' > 0): one that is not pressed would leave the held set at once. */
 static int accumulations(ed_t *w, double t, int *changed) {
-  int j, k, m = 0, st;
-  double *u = w->y, *v = w->y + w->n, tail;
+  int j, k, l, m = 0, st;
+  double *u = w->y, *v = w->y + w->n, t_inf;
   *changed = 0;
   st = eval_point(w, t, w->y, w->f, w->lam1);
   if (st != MARTELLO_OK) return fail_eval(w, st, t);
+  if (w->nh > 0)
+    st = martello_impulse_delassus(w->n, w->nh, w->hlist, TOPOLOGY(w), w->Wl);
+  if (st != MARTELLO_OK)
+    return fail(w, st, t, "event-driven: the Delassus matrix of the held contacts failed");
   for (j = 0; j < w->nc; j++) {
     double s, acc;
     if (w->is_pen[j] || w->inert[j]) continue;
     s = fmax(-gdot(w, j, v), 0.0);
     if (w->held[j]) {
-      /* the free system presses a held contact with (W P)_j */
-      for (acc = 0.0, k = 0; k < w->nh; k++)
-        acc += delassus(w, j, w->hlist[k]) * w->lam1[w->hlist[k]];
-      if (accumulates(w, j, s, acc, &tail)) {
+      /* the free system presses a held contact with (W_H P_H)_j */
+      for (k = 0; k < w->nh && w->hlist[k] != j; k++) continue;
+      for (acc = 0.0, l = 0; l < w->nh; l++) acc += w->Wl[k + w->nh * l] * w->lam1[w->hlist[l]];
+      if (martello_impulse_accumulation(w->e[j], s, acc, t, w->event_tol, position_res(w, j, u),
+                                        &t_inf)) {
         w->ilist[m++] = j;
       } else {
         *changed = 1;
@@ -434,8 +414,10 @@ static int accumulations(ed_t *w, double t, int *changed) {
     }
     if (gdot(w, j, u) - w->gap[j] < -gap_tol(w, j, u)) continue;
     acc = gdot(w, j, w->f + w->n);
-    if (!(acc > 0.0) || !accumulates(w, j, s, acc, &tail)) continue;
-    w->t_hold[j] = t + tail;
+    if (!(acc > 0.0) || !martello_impulse_accumulation(w->e[j], s, acc, t, w->event_tol,
+                                                       position_res(w, j, u), &t_inf))
+      continue;
+    w->t_hold[j] = t_inf;
     w->ilist[m++] = j;
     *changed = 1;
   }
@@ -458,10 +440,10 @@ static int process_events(ed_t *w, double t) {
     if (!w->is_pen[j] || w->inert[j]) continue;
     if (w->pen[j] > 0.0 && !martello_observer_in_phase(w->obs, j)) {
       martello_observer_set_phase(w->obs, j, 1, t, w->rate[j]);
-      w->cnt[C_EVENTS]++;
+      w->cnt[MARTELLO_COUNTER_EVENTS]++;
     } else if (!(w->pen[j] > 0.0) && martello_observer_in_phase(w->obs, j)) {
       martello_observer_set_phase(w->obs, j, 0, t, w->rate[j]);
-      w->cnt[C_EVENTS]++;
+      w->cnt[MARTELLO_COUNTER_EVENTS]++;
     }
   }
   for (j = 0; j < w->nh; j++)
@@ -508,7 +490,7 @@ static int reintegrate(ed_t *w, double t0, double tau, double *yout) {
 static int root_value(ed_t *w, int j, int type, double t, const double *y, double *g,
                       double *rate) {
   const double sgn = type == ROOT_SEPARATION ? -1.0 : 1.0;
-  w->cnt[C_ROOT_EVALS]++;
+  w->cnt[MARTELLO_COUNTER_ROOT_EVALUATIONS]++;
   if (type == ROOT_RELEASE) {
     int st = eval_point(w, t, y, w->f1, NULL);
     if (st != MARTELLO_OK) return fail_eval(w, st, t);
@@ -767,13 +749,12 @@ static void ed_free(ed_t *w) {
                   w->yerr, w->fstart, w->f, w->f1, w->fj, w->yj, w->fint, w->fext,
                   w->pen0, w->rate0, w->acc0, w->pen1, w->rate1, w->acc1, w->pen, w->rate,
                   w->force, w->lam, w->lam0, w->lam1, w->lamtol, w->hlist, w->held, w->Wh,
-                  w->rh, w->ilist, w->Wl, w->ql, w->pl, w->wl, w->sl, w->t_hold};
+                  w->rh, w->ilist, w->hk, w->Wl, w->ql, w->pl, w->wl, w->sl, w->el, w->tg, w->t_hold};
   size_t i;
   for (i = 0; i < sizeof bufs / sizeof bufs[0]; i++) free(bufs[i]);
   if (w->drv) gsl_odeiv2_driver_free(w->drv);
   if (w->rdrv) gsl_odeiv2_driver_free(w->rdrv);
   if (w->rstep) gsl_odeiv2_step_free(w->rstep);
-  martello_lcp_free(&w->lcp);
   if (w->ev) martello_eval_free(&w->ev);
 }
 
@@ -820,28 +801,25 @@ static int ed_setup(ed_t *w) {
         ALLOC(w->lam1, nc) && ALLOC(w->lamtol, nc) && ALLOC(w->hlist, nc) && ALLOC(w->held, nc) &&
         ALLOC(w->Wh, (size_t)w->nu * (size_t)w->nu) && ALLOC(w->rh, nc) && ALLOC(w->ilist, nc) &&
         ALLOC(w->Wl, (size_t)w->nu * (size_t)w->nu) && ALLOC(w->ql, nc) && ALLOC(w->pl, nc) &&
-        ALLOC(w->wl, nc) && ALLOC(w->sl, nc) && ALLOC(w->t_hold, nc)))
+        ALLOC(w->wl, nc) && ALLOC(w->sl, nc) && ALLOC(w->el, nc) && ALLOC(w->tg, nc) &&
+        ALLOC(w->hk, nc) && ALLOC(w->t_hold, nc)))
     return MARTELLO_ERR_MEMORY;
-  w->lcp = martello_lcp_alloc(w->nu);
-  if (w->lcp == NULL) return MARTELLO_ERR_MEMORY;
   st = martello_eval_create(w->model, &w->ev);
   if (st != MARTELLO_OK) return fail(w, st, 0.0, "event-driven: martello_eval_create failed");
-  /* M^-1 G_j^T of every unilateral contact; a contact between two immovable sides is inert */
+  /* M^-1 B_j^T of every unilateral contact; a contact between two immovable sides is inert */
   for (j = 0; j < nc; j++) {
     double *c;
     int i;
-    if (w->is_pen[j]) {
-      w->inert[j] = (w->con_a[j] < 0 || w->fixed[w->con_a[j]]) &&
-                    (w->con_b[j] < 0 || w->fixed[w->con_b[j]]);
-      continue;
-    }
+    /* both sides immovable: W_jj = 0 (M is positive definite on the free nodes) */
+    w->inert[j] = (w->con_a[j] < 0 || w->fixed[w->con_a[j]]) &&
+                  (w->con_b[j] < 0 || w->fixed[w->con_b[j]]);
+    if (w->is_pen[j]) continue;
     c = w->Cm + (size_t)w->uni[j] * n;
     for (i = 0; i < n; i++) c[i] = 0.0;
-    if (w->con_a[j] >= 0) c[w->con_a[j]] += 1.0;
-    if (w->con_b[j] >= 0) c[w->con_b[j]] -= 1.0;
+    if (w->con_a[j] >= 0) c[w->con_a[j]] -= 1.0;
+    if (w->con_b[j] >= 0) c[w->con_b[j]] += 1.0;
     st = martello_eval_solve_mass(w->ev, c);
     if (st != MARTELLO_OK) return fail_eval(w, st, 0.0);
-    w->inert[j] = !(delassus(w, j, j) > 0.0);
   }
   /* the work integrals are outside the error control: an absolute scale that makes their
    * tolerance irrelevant */
@@ -868,18 +846,12 @@ static int ed_setup(ed_t *w) {
   return MARTELLO_OK;
 }
 
+/* What GSL's steppers need beyond the ranges martello_run_set_settings checked. */
 static int check_settings(ed_t *w) {
-  const char *bad = NULL;
   /* a relative tolerance near the rounding unit cannot be met: the steps would shrink to
    * where the error estimates are rounding noise and the run would crawl */
-  if (!(w->rtol >= 10.0 * DBL_EPSILON)) bad = "rtol must be >= 10 machine epsilons (2.2e-15)";
-  else if (!(w->atol > 0.0)) bad = "atol must be > 0";
-  else if (!(w->event_tol > 0.0)) bad = "event_tol must be > 0";
-  else if (!(w->h_max >= 0.0)) bad = "h_max must be >= 0 (0: no limit)";
-  else if (!(w->dt_out > 0.0 && w->t_end > 0.0)) bad = "dt (output interval) and t_end must be > 0";
-  else if (w->every < 1) bad = "every must be >= 1";
-  if (bad == NULL) return MARTELLO_OK;
-  snprintf(w->msg, sizeof w->msg, "event-driven: %s", bad);
+  if (w->rtol >= 10.0 * DBL_EPSILON) return MARTELLO_OK;
+  snprintf(w->msg, sizeof w->msg, "event-driven: rtol must be >= 10 machine epsilons (2.2e-15)");
   return martello_observer_fail(w->obs, MARTELLO_ERR_ARGUMENT, 0.0, w->msg);
 }
 
@@ -940,10 +912,10 @@ static int ed_integrate(ed_t *w) {
     memcpy(w->y0, w->y, w->dim * sizeof *w->y);
     kinematics(w, w->y0, w->fstart + n, w->pen0, w->rate0, w->acc0);
     st = gsl_odeiv2_evolve_apply(w->drv->e, w->drv->c, w->drv->s, &w->sys, &t, t_out, &hs, w->y);
-    w->cnt[C_REJECTED] += (long long)(w->drv->e->failed_steps - failed);
+    w->cnt[MARTELLO_COUNTER_REJECTED_STEPS] += (long long)(w->drv->e->failed_steps - failed);
     if (st != GSL_SUCCESS) return gsl_failure(w, st, t, hs);
     if (t < t_out) h = hs;   /* the last step onto an output time keeps the suggestion */
-    w->cnt[C_STEPS]++;
+    w->cnt[MARTELLO_COUNTER_STEPS]++;
     /* the step end (a non-finite state stops the RHS here: a divergence): gap kinematics
      * and multipliers, then the earliest event inside */
     st = eval_point(w, t, w->y, w->f1, w->lam1);
@@ -974,7 +946,7 @@ static int ed_integrate(ed_t *w) {
 
 int martello_event_driven_run(martello_model *model, martello_run *run) {
   ed_t w;
-  double par[MARTELLO_NPAR_INTEGRATOR];
+  martello_settings s;
   int st, nco;
   memset(&w, 0, sizeof w);
   w.model = model;
@@ -982,19 +954,20 @@ int martello_event_driven_run(martello_model *model, martello_run *run) {
   if (model == NULL || run == NULL) return MARTELLO_ERR_ARGUMENT;
   st = martello_run_observer(run, &w.obs);
   if (st != MARTELLO_OK) return st;
-  st = martello_run_settings(run, &w.kind, par);
+  st = martello_run_settings(run, &s);
   if (st != MARTELLO_OK) return st;
+  w.kind = s.kind;
   if (w.kind != MARTELLO_INT_RKF45 && w.kind != MARTELLO_INT_RK8PD &&
       w.kind != MARTELLO_INT_MSBDF)
     return martello_observer_fail(w.obs, MARTELLO_ERR_ARGUMENT, 0.0,
                                   "event-driven: the integrator must be rkf45, rk8pd or msbdf");
-  w.dt_out = par[MARTELLO_R_DT];
-  w.t_end = par[MARTELLO_R_T_END];
-  w.rtol = par[MARTELLO_R_RTOL];
-  w.atol = par[MARTELLO_R_ATOL];
-  w.event_tol = par[MARTELLO_R_EVENT_TOL];
-  w.h_max = par[MARTELLO_R_H_MAX];
-  w.every = (int)lround(par[MARTELLO_R_EVERY]);
+  w.dt_out = s.dt;
+  w.t_end = s.t_end;
+  w.rtol = s.rtol;
+  w.atol = s.atol;
+  w.event_tol = s.event_tol;
+  w.h_max = s.h_max;
+  w.every = s.every;
   st = check_settings(&w);
   if (st != MARTELLO_OK) return st;
   st = martello_model_topology(model, &w.n, &w.nc, NULL, NULL, NULL, NULL, NULL, NULL, NULL, &nco);

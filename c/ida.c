@@ -19,8 +19,8 @@
  * gives the exact peak penetration and catches a contact that opens and closes inside one
  * step), P_r for closed rigid contacts (release when it turns tensile). At an onset or a
  * separation of a penalty contact, an impact (Newton's law with restitution e, all contacts
- * at zero gap at once: an impulse-level LCP), a closing (e = 0, or a rebound too small to resolve: Zeno accumulation) or a
- * release, the state is made consistent and IDA restarts there (IDAReInit) instead of
+ * at zero gap at once: an impulse-level LCP), a closing (e = 0, or an accumulation of
+ * impacts: the policy of docs/impulse.md §4) or a release, the state is made consistent and IDA restarts there (IDAReInit) instead of
  * stepping across the kink. Steps are taken in IDA_ONE_STEP mode so that path-dependent
  * links commit at every accepted step; output times are stop times (IDASetStopTime), so
  * every history row is an accepted, committed state. Every accepted state is a sample of
@@ -44,17 +44,14 @@
 #include "martello.h"
 #include "martello_internal.h"
 
-/* Slots of the cost counters (fortran/observer.f90 C_*, 0-based here). */
-enum { CNT_STEPS, CNT_REJECTED, CNT_NEWTON, CNT_RESIDUALS, CNT_FACTORIZATIONS, CNT_EVENTS,
-       CNT_JACOBIANS, CNT_ROOT_EVALS, CNT_CHATTER };
-
 /* What happens to a contact at a restart. */
 enum { ACT_NONE, ACT_ONSET, ACT_SEPARATION, ACT_IMPACT, ACT_RELEASE };
 
-/* Position tolerance of a rigid contact, in units of IDA's own: a rebound whose flight
- * height v^2/(2 a_n) stays below it cannot be resolved by the integrator, so the contact
- * closes (Zeno accumulation). */
-#define ZENO_HEIGHT_FACTOR 10.0
+/* Position tolerance of a rigid contact, in units of IDA's own: a rigid contact within it
+ * of zero gap touches (it enters the impact LCP with the one whose root fired, and a rebound
+ * that would not leave it has accumulated). IDA's position error is a small multiple of its
+ * local tolerance rtol |u| + atol. */
+#define POSITION_TOL_FACTOR 10.0
 #define MAX_STEPS 100000000L
 
 typedef struct {
@@ -80,8 +77,12 @@ typedef struct {
   /* work */
   double *u, *v, *a, *x, *uq, *vq, *fint, *fext, *force, *lam;
   double *S, *rhs, *mb;
-  int *aset, *map;
-  double *S2, *q;
+  int *aset;
+  double *q, *w0;
+  /* the impulse problem (c/martello_internal.h): M^-1 B_r^T of every rigid contact (column r,
+   * B_r = e_b - e_a), built once; the door lists of the contacts in aset */
+  double *cols;
+  int cols_ready, *dc;
   /* settings */
   double rtol, atol, event_tol, t_end, h_max, out_dt;
   int every;     /* output intervals dt per stop time out_dt */
@@ -138,22 +139,14 @@ static void apply_B(const ida_problem *P, const double *lam, double *x) {
   }
 }
 
-/* mb <- M^-1 B_r (one contact). */
-static int mass_column(ida_problem *P, int j, double *mb) {
-  memset(mb, 0, sizeof(double) * (size_t)P->n);
-  if (P->con_a[j] >= 0) mb[P->con_a[j]] += 1.0;
-  if (P->con_b[j] >= 0) mb[P->con_b[j]] -= 1.0;
-  return martello_eval_solve_mass(P->ev, mb);
-}
-
 static double dot_B(const ida_problem *P, int j, const double *x) { return pen_rate(P, j, x); }
 
-/* Height below which a rigid contact's bounce is not resolved (see ZENO_HEIGHT_FACTOR). */
-static double height_tol(const ida_problem *P, int j, const double *u) {
+/* Gap within which a rigid contact touches (see POSITION_TOL_FACTOR). */
+static double position_tol(const ida_problem *P, int j, const double *u) {
   double s = fabs(P->gap[j]);
   s = fmax(s, fabs(node_u(P->con_a[j], u)));
   s = fmax(s, fabs(node_u(P->con_b[j], u)));
-  return ZENO_HEIGHT_FACTOR * (P->rtol * s + P->atol);
+  return POSITION_TOL_FACTOR * (P->rtol * s + P->atol);
 }
 
 static double speed_tol(const ida_problem *P, const double *v) {
@@ -180,46 +173,28 @@ static void nudge(ida_problem *P, int j, int sgn, double *u) {
   }
 }
 
-/* Dense LU with partial pivoting of the m x m row-major A, solving A x = b in place. */
-static int small_solve(int m, double *A, double *b) {
-  for (int k = 0; k < m; k++) {
-    int p = k;
-    for (int i = k + 1; i < m; i++)
-      if (fabs(A[i * m + k]) > fabs(A[p * m + k])) p = i;
-    if (!(fabs(A[p * m + k]) > 0.0)) return -1;
-    if (p != k) {
-      for (int c = 0; c < m; c++) {
-        double t = A[k * m + c];
-        A[k * m + c] = A[p * m + c];
-        A[p * m + c] = t;
-      }
-      double t = b[k];
-      b[k] = b[p];
-      b[p] = t;
-    }
-    for (int i = k + 1; i < m; i++) {
-      double f = A[i * m + k] / A[k * m + k];
-      for (int c = k; c < m; c++) A[i * m + c] -= f * A[k * m + c];
-      b[i] -= f * b[k];
-    }
+/* M^-1 B_r^T of every rigid contact, once (the mass matrix does not change). */
+static int impulse_columns(ida_problem *P) {
+  if (P->cols_ready) return MARTELLO_OK;
+  for (int r = 0; r < P->nr; r++) {
+    int j = P->rig_con[r], st;
+    double *c = P->cols + (size_t)r * (size_t)P->n;
+    memset(c, 0, sizeof(double) * (size_t)P->n);
+    if (P->con_a[j] >= 0) c[P->con_a[j]] -= 1.0;
+    if (P->con_b[j] >= 0) c[P->con_b[j]] += 1.0;
+    if ((st = martello_eval_solve_mass(P->ev, c)) != MARTELLO_OK) return st;
   }
-  for (int k = m - 1; k >= 0; k--) {
-    double s = b[k];
-    for (int c = k + 1; c < m; c++) s -= A[k * m + c] * b[c];
-    b[k] = s / A[k * m + k];
-  }
-  return 0;
-}
-
-/* The Delassus matrix S = B_A^T M^-1 B_A of the closed rigid contacts (aset[0..m)), row-major. */
-static int delassus(ida_problem *P, int m) {
-  for (int c = 0; c < m; c++) {
-    int st = mass_column(P, P->rig_con[P->aset[c]], P->mb);
-    if (st != MARTELLO_OK) return st;
-    for (int rr = 0; rr < m; rr++) P->S[rr * m + c] = dot_B(P, P->rig_con[P->aset[rr]], P->mb);
-  }
+  P->cols_ready = 1;
   return MARTELLO_OK;
 }
+
+/* The rigid contacts aset[0..m) as the impulse door's list (contact indices) into dc. */
+static void door_list(ida_problem *P, int m) {
+  for (int k = 0; k < m; k++) P->dc[k] = P->rig_con[P->aset[k]];
+}
+
+/* The impulse door's topology arguments (c/martello_internal.h): sides, columns in cols. */
+#define TOPOLOGY(P) (P)->con_a, (P)->con_b, (P)->rig, (P)->cols
 
 static int closed_set(ida_problem *P) {
   int m = 0;
@@ -307,26 +282,26 @@ static void error_handler(int code, const char *module, const char *function, ch
 static int flush_counts(ida_problem *P, void *mem) {
   long c[9] = {0}, cf = 0, nre_ls = 0;
   int st = 0;
-  st |= IDAGetNumSteps(mem, &c[CNT_STEPS]);
-  st |= IDAGetNumErrTestFails(mem, &c[CNT_REJECTED]);
+  st |= IDAGetNumSteps(mem, &c[MARTELLO_COUNTER_STEPS]);
+  st |= IDAGetNumErrTestFails(mem, &c[MARTELLO_COUNTER_REJECTED_STEPS]);
   st |= IDAGetNumNonlinSolvConvFails(mem, &cf);
-  st |= IDAGetNumNonlinSolvIters(mem, &c[CNT_NEWTON]);
-  st |= IDAGetNumResEvals(mem, &c[CNT_RESIDUALS]);
+  st |= IDAGetNumNonlinSolvIters(mem, &c[MARTELLO_COUNTER_NEWTON_ITERATIONS]);
+  st |= IDAGetNumResEvals(mem, &c[MARTELLO_COUNTER_RESIDUAL_EVALUATIONS]);
   st |= IDAGetNumLinResEvals(mem, &nre_ls);
-  st |= IDAGetNumLinSolvSetups(mem, &c[CNT_FACTORIZATIONS]);
-  st |= IDAGetNumJacEvals(mem, &c[CNT_JACOBIANS]);
-  st |= IDAGetNumGEvals(mem, &c[CNT_ROOT_EVALS]);
+  st |= IDAGetNumLinSolvSetups(mem, &c[MARTELLO_COUNTER_FACTORIZATIONS]);
+  st |= IDAGetNumJacEvals(mem, &c[MARTELLO_COUNTER_JACOBIAN_EVALUATIONS]);
+  st |= IDAGetNumGEvals(mem, &c[MARTELLO_COUNTER_ROOT_EVALUATIONS]);
   if (st != IDA_SUCCESS) return fail(P, MARTELLO_ERR_EXTERNAL, "IDA: could not read the counters");
-  c[CNT_REJECTED] += cf;
-  c[CNT_RESIDUALS] += nre_ls;
+  c[MARTELLO_COUNTER_REJECTED_STEPS] += cf;
+  c[MARTELLO_COUNTER_RESIDUAL_EVALUATIONS] += nre_ls;
   long long inc[MARTELLO_NCOUNTERS] = {0};
   for (int k = 0; k < 9; k++) {
-    if (k == CNT_EVENTS || k == CNT_CHATTER) continue;
+    if (k == MARTELLO_COUNTER_EVENTS || k == MARTELLO_COUNTER_CONTACT_CHATTER_RESOLUTIONS) continue;
     long d = c[k] >= P->cnt_last[k] ? c[k] - P->cnt_last[k] : c[k];
     inc[k] = d;
     P->cnt_last[k] = c[k];
   }
-  inc[CNT_EVENTS] = P->events;
+  inc[MARTELLO_COUNTER_EVENTS] = P->events;
   P->events = 0;
   return martello_observer_add_counts(P->obs, inc);
 }
@@ -387,98 +362,39 @@ static int work_quadrature(ida_problem *P, void *mem, double t0, double t1, N_Ve
 
 /* ---- contact events ------------------------------------------------------------------- */
 
-/* The impulse-level LCP of the contacts in aset[0..m): impulses p >= 0 with post-impact rates
- * delta'+ = delta'- - S p and complementarity  S p - q >= 0 (delta'+ <= -e delta'-)  ⊥  p >= 0,
- * q_k = (1 + e_k) delta'-_k for an approaching contact, delta'-_k otherwise. Solved by an
- * active-set (principal pivoting) iteration on the small dense Delassus matrix P->S. */
-static int impulse_lcp(ida_problem *P, int m, const double *q, double *p) {
-  int *in = P->cand + P->nr; /* second half of the work array */
-  double qmax = 0.0;
-  for (int k = 0; k < m; k++) {
-    in[k] = q[k] > 0.0;
-    qmax = fmax(qmax, fabs(q[k]));
-  }
-  double tol = 64.0 * DBL_EPSILON * qmax;
-  for (int it = 0; it < 4 * m + 16; it++) {
-    int mi = 0;
-    for (int k = 0; k < m; k++) {
-      p[k] = 0.0;
-      if (in[k]) P->map[mi++] = k;
-    }
-    for (int a = 0; a < mi; a++) {
-      P->rhs[a] = q[P->map[a]];
-      for (int c = 0; c < mi; c++) P->S2[a * mi + c] = P->S[P->map[a] * m + P->map[c]];
-    }
-    if (mi > 0 && small_solve(mi, P->S2, P->rhs) != 0) return -1;
-    int worst = -1;
-    double vmin = -tol;
-    for (int a = 0; a < mi; a++) {
-      p[P->map[a]] = P->rhs[a];
-      if (P->rhs[a] < vmin) {
-        vmin = P->rhs[a];
-        worst = P->map[a];
-      }
-    }
-    if (worst >= 0) {
-      in[worst] = 0;
-      continue;
-    }
-    for (int k = 0; k < m; k++) {
-      if (in[k]) continue;
-      double w = -q[k];
-      for (int c = 0; c < m; c++) w += P->S[k * m + c] * p[c];
-      if (w < vmin) {
-        vmin = w;
-        worst = k;
-      }
-    }
-    if (worst < 0) {
-      for (int k = 0; k < m; k++) p[k] = fmax(p[k], 0.0);
-      return 0;
-    }
-    in[worst] = 1;
-  }
-  return -1;
-}
-
 /* Newton's impact law on the rigid contacts that touch (closed, flagged ACT_IMPACT, or open
- * at zero gap within the position tolerance), all at once through impulse_lcp (simultaneous
- * impacts in a chain), restitution e (0 for a closed contact). P->hit and P->w_in say which
- * contacts took an impulse and their approach speed. Then the closing rule and, for the
- * closed set, zero rates and positions. */
+ * at zero gap within the position tolerance), all at once (martello_impulse_newton:
+ * simultaneous impacts in a chain), restitution e (0 for a closed contact). P->hit and
+ * P->w_in say which contacts took an impulse and their approach speed. Then the closing
+ * rule (the accumulation policy) and, for the closed set, zero rates and positions. */
 static int rigid_impacts(ida_problem *P, double t, double *u, double *v) {
-  int st, m = 0;
+  int st, m = 0, piv;
+  if ((st = impulse_columns(P)) != MARTELLO_OK) return fail(P, st, "IDA: singular mass at an impact");
   for (int r = 0; r < P->nr; r++) {
     int j = P->rig_con[r];
     P->hit[r] = 0;
-    P->cand[r] = P->closed[r] || P->act[j] == ACT_IMPACT || penetration(P, j, u) >= -height_tol(P, j, u);
+    P->cand[r] = P->closed[r] || P->act[j] == ACT_IMPACT || penetration(P, j, u) >= -position_tol(P, j, u);
     if (P->cand[r]) P->aset[m++] = r;
   }
   if (m > 0) {
-    if ((st = delassus(P, m)) != MARTELLO_OK) return fail(P, st, "IDA: singular mass at an impact");
+    door_list(P, m);
     for (int k = 0; k < m; k++) {
       int r = P->aset[k], j = P->rig_con[r];
-      double w = pen_rate(P, j, v), e = P->closed[r] ? 0.0 : (P->rest[j] >= 0.0 ? P->rest[j] : 0.0);
-      P->q[k] = w > 0.0 ? (1.0 + e) * w : w;
+      P->w0[k] = pen_rate(P, j, v);
+      P->q[k] = P->closed[r] ? 0.0 : (P->rest[j] >= 0.0 ? P->rest[j] : 0.0);
     }
-    if (impulse_lcp(P, m, P->q, P->lam) != 0)
-      return fail(P, MARTELLO_ERR_NOT_CONVERGED, "IDA: the impact LCP of %d contacts did not settle at t = %.9e s", m, t);
+    st = martello_impulse_newton(P->n, m, P->dc, TOPOLOGY(P), P->q, v, P->rhs, &piv);
+    if (st != MARTELLO_OK)
+      return fail(P, st, "IDA: the impact LCP of %d contacts failed at t = %.9e s (%s)", m, t,
+                  st == MARTELLO_ERR_SINGULAR ? "redundant contacts" : "pivot limit");
     for (int k = 0; k < m; k++) {
       int r = P->aset[k], j = P->rig_con[r];
-      if (P->lam[k] > 0.0 && !P->closed[r]) {
+      if (P->rhs[k] > 0.0 && !P->closed[r]) {
         P->hit[r] = 1;
-        P->w_in[j] = pen_rate(P, j, v);
+        P->w_in[j] = P->w0[k];
         if (P->act[j] != ACT_IMPACT) P->events++;
       }
     }
-    memset(P->x, 0, sizeof(double) * (size_t)P->n);
-    for (int k = 0; k < m; k++) {
-      int j = P->rig_con[P->aset[k]];
-      if (P->con_a[j] >= 0) P->x[P->con_a[j]] += P->lam[k];
-      if (P->con_b[j] >= 0) P->x[P->con_b[j]] -= P->lam[k];
-    }
-    if ((st = martello_eval_solve_mass(P->ev, P->x)) != MARTELLO_OK) return fail(P, st, "IDA: singular mass at an impact");
-    for (int i = 0; i < P->n; i++) v[i] -= P->x[i];
     /* a closed contact that the impact sets apart (p = 0, separating) opens */
     double vtol = speed_tol(P, v);
     for (int r = 0; r < P->nr; r++)
@@ -487,77 +403,77 @@ static int rigid_impacts(ida_problem *P, double t, double *u, double *v) {
         P->opened[r] = 1;
       }
   }
-  /* closing: e = 0, or a rebound whose flight height v^2/(2 a_n) is below the position
-   * tolerance (Zeno accumulation) */
-  int have_a = 0;
-  for (int r = 0; r < P->nr; r++) {
-    int j = P->rig_con[r];
-    if (P->closed[r] || !(P->hit[r] || P->act[j] == ACT_IMPACT)) continue;
-    if (!have_a) {
-      st = martello_eval_acceleration(P->ev, t, u, v, P->a);
-      if (st != MARTELLO_OK) return fail(P, st, "IDA: acceleration failed at t = %.9e s", t);
-      have_a = 1;
-    }
-    /* tentative: rigid_multipliers opens it again if its multiplier comes out tensile (the
-     * free normal acceleration a_n ignores the other closed contacts) */
-    double an = dot_B(P, j, P->a), rebound = -pen_rate(P, j, v);
+  /* closing: the accumulation policy (docs/impulse.md §4) with event_tol and the position
+   * tolerance as the resolution, and the normal acceleration a_n that presses each
+   * contact that took an impulse with the contacts already closed enforced (their forces from
+   * the persistent-contact rule): aset = [closed set, candidates] */
+  int mc = closed_set(P), ma = mc;
+  for (int r = 0; r < P->nr; r++)
+    if (!P->closed[r] && (P->hit[r] || P->act[P->rig_con[r]] == ACT_IMPACT)) P->aset[ma++] = r;
+  if (ma > mc) {
+    st = martello_eval_acceleration(P->ev, t, u, v, P->a);
+    if (st != MARTELLO_OK) return fail(P, st, "IDA: acceleration failed at t = %.9e s", t);
+    door_list(P, ma);
+    st = martello_impulse_delassus(P->n, ma, P->dc, TOPOLOGY(P), P->S);
+    if (st == MARTELLO_OK && mc > 0)
+      st = martello_impulse_contact_forces(P->n, mc, P->dc, TOPOLOGY(P), P->a, P->w0,
+                                           P->cand, &piv);
+    if (st != MARTELLO_OK)
+      return fail(P, st, "IDA: the contact forces of the closed contacts failed at t = %.9e s", t);
+  }
+  for (int k = mc; k < ma; k++) {
+    int r = P->aset[k], j = P->rig_con[r];
+    double t_inf, an = dot_B(P, j, P->a), rebound = fmax(-pen_rate(P, j, v), 0.0);
     double e = P->rest[j] >= 0.0 ? P->rest[j] : 0.0;
-    double thr = sqrt(2.0 * fabs(an) * height_tol(P, j, u));
-    if (e == 0.0 || rebound < thr) P->closed[r] = 1;
+    for (int l = 0; l < mc; l++) an -= P->S[k + ma * l] * P->w0[l];
+    /* tentative: rigid_multipliers opens it again if its multiplier is not compressive */
+    if (martello_impulse_accumulation(e, rebound, an, t, P->event_tol, position_tol(P, j, u),
+                                      &t_inf))
+      P->closed[r] = 1;
   }
   m = closed_set(P);
   if (m == 0) return MARTELLO_OK;
-  /* zero the rates of the closed set (for a closing rebound below the threshold this removes
-   * an unresolvable bounce: its energy goes to E_IMPACT), then put it on delta = 0 by the
-   * mass-weighted projection u -= M^-1 B S^-1 delta */
-  for (int pass = 0; pass < 2; pass++) {
-    if ((st = delassus(P, m)) != MARTELLO_OK) return fail(P, st, "IDA: singular mass in the constraint projection");
-    for (int k = 0; k < m; k++) {
-      int j = P->rig_con[P->aset[k]];
-      P->rhs[k] = pass == 0 ? pen_rate(P, j, v) : penetration(P, j, u);
-    }
-    if (small_solve(m, P->S, P->rhs) != 0)
-      return fail(P, MARTELLO_ERR_SINGULAR, "IDA: redundant closed contacts at t = %.9e s (B^T M^-1 B singular)", t);
-    for (int r = 0; r < P->nr; r++) P->lam[r] = 0.0;
-    for (int k = 0; k < m; k++) P->lam[P->aset[k]] = P->rhs[k];
-    apply_B(P, P->lam, P->x);
-    if ((st = martello_eval_solve_mass(P->ev, P->x)) != MARTELLO_OK) return fail(P, st, "IDA: singular mass");
-    double *z = pass == 0 ? v : u;
-    for (int i = 0; i < P->n; i++) z[i] -= P->x[i];
-  }
+  /* zero the rates of the closed set (for an accumulation this removes the rest of the
+   * bounces: their energy goes to E_IMPACT), then put it on delta = 0 (B u = -gap) by the
+   * mass-weighted projection */
+  door_list(P, m);
+  if ((st = martello_impulse_factor(P->n, m, P->dc, TOPOLOGY(P), P->S)) != MARTELLO_OK)
+    return fail(P, MARTELLO_ERR_SINGULAR, "IDA: redundant closed contacts at t = %.9e s (B^T M^-1 B singular)", t);
+  for (int k = 0; k < m; k++) P->q[k] = -P->gap[P->rig_con[P->aset[k]]];
+  st = martello_impulse_project(P->n, m, P->dc, TOPOLOGY(P), P->S, NULL, v, P->rhs);
+  if (st == MARTELLO_OK)
+    st = martello_impulse_project(P->n, m, P->dc, TOPOLOGY(P), P->S, P->q, u, P->rhs);
+  if (st != MARTELLO_OK) return fail(P, st, "IDA: the constraint projection failed at t = %.9e s", t);
   return MARTELLO_OK;
 }
 
-/* Multipliers of the closed set from the acceleration-level constraint S P = B^T a_free;
- * a contact whose P comes out tensile opens (active-set iteration on the small LCP). Leaves
+/* Multipliers of the closed set: the persistent-contact rule (martello_impulse_contact_forces
+ * on the free accelerations); a contact that the solution opens (lambda = 0, opening
+ * acceleration) opens. Leaves
  * a_free in P->a and the multipliers in P->lam. */
 static int rigid_multipliers(ida_problem *P, double t, double *u, double *v) {
-  int st = martello_eval_acceleration(P->ev, t, u, v, P->a);
+  int st = martello_eval_acceleration(P->ev, t, u, v, P->a), piv;
   if (st != MARTELLO_OK) return fail(P, st, "IDA: acceleration failed at t = %.9e s", t);
   for (int r = 0; r < P->nr; r++) P->lam[r] = 0.0;
-  for (int it = 0; it <= P->nr; it++) {
-    int m = closed_set(P);
-    if (m == 0) return MARTELLO_OK;
-    if ((st = delassus(P, m)) != MARTELLO_OK) return fail(P, st, "IDA: singular mass");
-    for (int k = 0; k < m; k++) P->rhs[k] = dot_B(P, P->rig_con[P->aset[k]], P->a);
-    if (small_solve(m, P->S, P->rhs) != 0)
-      return fail(P, MARTELLO_ERR_SINGULAR, "IDA: redundant closed contacts at t = %.9e s (B^T M^-1 B singular)", t);
-    int worst = -1;
-    double pmin = 0.0;
-    for (int k = 0; k < m; k++)
-      if (P->rhs[k] < pmin) {
-        pmin = P->rhs[k];
-        worst = P->aset[k];
-      }
-    if (worst < 0) {
-      for (int r = 0; r < P->nr; r++) P->lam[r] = 0.0;
-      for (int k = 0; k < m; k++) P->lam[P->aset[k]] = P->rhs[k];
-      return MARTELLO_OK;
+  int m = closed_set(P);
+  if (m == 0) return MARTELLO_OK;
+  if ((st = impulse_columns(P)) != MARTELLO_OK) return fail(P, st, "IDA: singular mass");
+  door_list(P, m);
+  st = martello_impulse_contact_forces(P->n, m, P->dc, TOPOLOGY(P), P->a, P->rhs,
+                                       P->cand, &piv);
+  if (st != MARTELLO_OK)
+    return fail(P, st, "IDA: the contact forces of %d closed contacts failed at t = %.9e s (%s)", m, t,
+                st == MARTELLO_ERR_SINGULAR ? "redundant closed contacts" : "pivot limit");
+  for (int k = 0; k < m; k++) {
+    int r = P->aset[k];
+    if (P->cand[k]) {
+      P->lam[r] = P->rhs[k];
+    } else {
+      P->closed[r] = 0;
+      P->opened[r] = 1;
     }
-    P->closed[worst] = 0;
-    P->opened[worst] = 1;
   }
-  return fail(P, MARTELLO_ERR_NOT_CONVERGED, "IDA: active set of the closed contacts did not settle at t = %.9e s", t);
+  return MARTELLO_OK;
 }
 
 /* Make the state at a restart consistent with the actions in P->act: penalty regimes,
@@ -805,8 +721,8 @@ static void *take(size_t count, size_t size, int *ok) {
 static void release(ida_problem *P) {
   void *all[] = {P->mass, P->gap, P->rest, P->fixed, P->con_a, P->con_b, P->scheme, P->rig,
                  P->rig_con, P->iu, P->iv, P->ip, P->im, P->closed, P->act,
-                 P->opened, P->was_closed, P->hit, P->cand, P->map, P->q, P->S2, P->w_in, P->u, P->v, P->a, P->x, P->uq, P->vq, P->fint, P->fext,
-                 P->force, P->lam, P->S, P->rhs, P->mb, P->aset};
+                 P->opened, P->was_closed, P->hit, P->cand, P->q, P->w0, P->w_in, P->u, P->v, P->a, P->x, P->uq, P->vq, P->fint, P->fext,
+                 P->force, P->lam, P->S, P->rhs, P->mb, P->cols, P->dc, P->aset};
   for (size_t k = 0; k < sizeof all / sizeof all[0]; k++) free(all[k]);
   if (P->ev) martello_eval_free(&P->ev);
 }
@@ -856,22 +772,18 @@ static int bandwidth(ida_problem *P, const double *u0, const double *v0, suninde
 }
 
 static int setup(ida_problem *P, martello_model *model, martello_run *run) {
-  int st, ok = 1, kind, n, nc, ncp;
-  double par[MARTELLO_NPAR_INTEGRATOR];
+  int st, ok = 1, n, nc, ncp;
+  martello_settings s;
   P->model = model;
   P->run = run;
-  if ((st = martello_run_settings(run, &kind, par)) != MARTELLO_OK) return st;
-  P->rtol = par[MARTELLO_R_RTOL];
-  P->atol = par[MARTELLO_R_ATOL];
-  P->event_tol = par[MARTELLO_R_EVENT_TOL] > 0.0 ? par[MARTELLO_R_EVENT_TOL] : 1e-12;
-  P->t_end = par[MARTELLO_R_T_END];
-  P->h_max = par[MARTELLO_R_H_MAX];
-  P->every = par[MARTELLO_R_EVERY] >= 1.0 ? (int)par[MARTELLO_R_EVERY] : 1;
-  P->out_dt = par[MARTELLO_R_DT] * (par[MARTELLO_R_EVERY] >= 1.0 ? par[MARTELLO_R_EVERY] : 1.0);
-  if (!(P->rtol >= 0.0 && P->atol >= 0.0 && P->rtol + P->atol > 0.0))
-    return fail(P, MARTELLO_ERR_ARGUMENT, "IDA needs rtol >= 0 and atol >= 0, not both 0");
-  if (!(P->t_end > 0.0 && P->out_dt > 0.0))
-    return fail(P, MARTELLO_ERR_ARGUMENT, "IDA needs t_end > 0 and an output interval dt > 0");
+  if ((st = martello_run_settings(run, &s)) != MARTELLO_OK) return st;
+  P->rtol = s.rtol;
+  P->atol = s.atol;
+  P->event_tol = s.event_tol;
+  P->t_end = s.t_end;
+  P->h_max = s.h_max;
+  P->every = s.every;
+  P->out_dt = s.dt * s.every;
   if ((st = martello_model_topology(model, &n, &nc, NULL, NULL, NULL, NULL, NULL, NULL, NULL,
                                     &ncp)) != MARTELLO_OK)
     return fail(P, st, "IDA: could not read the model");
@@ -912,10 +824,11 @@ static int setup(ida_problem *P, martello_model *model, martello_run *run) {
   P->opened = take(nr, sizeof(int), &ok);
   P->was_closed = take(nr, sizeof(int), &ok);
   P->hit = take(nr, sizeof(int), &ok);
-  P->cand = take(2 * nr, sizeof(int), &ok);
-  P->map = take(nr, sizeof(int), &ok);
+  P->cand = take(nr, sizeof(int), &ok);
   P->q = take(nr, sizeof(double), &ok);
-  P->S2 = take(nr * nr, sizeof(double), &ok);
+  P->w0 = take(nr, sizeof(double), &ok);
+  P->dc = take(nr, sizeof(int), &ok);
+  P->cols = take(nr * un, sizeof(double), &ok);
   P->aset = take(nr, sizeof(int), &ok);
   P->lam = take(nr, sizeof(double), &ok);
   P->rhs = take(nr, sizeof(double), &ok);
@@ -979,7 +892,7 @@ static int integrate(ida_problem *P, SUNContext sunctx, void **memp, N_Vector yy
     if (P->rig[j] < 0) {
       if (d == 0.0 && w > 0.0) P->act[j] = ACT_ONSET;
     } else {
-      double htol = height_tol(P, j, u0);
+      double htol = position_tol(P, j, u0);
       if (d > htol)
         return fail(P, MARTELLO_ERR_ARGUMENT, "contact %d starts penetrated by %.3e m (rigid contacts need delta <= 0 at t = 0)", j, d);
       if (d >= -htol && w >= -vtol) P->act[j] = ACT_IMPACT;

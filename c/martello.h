@@ -10,9 +10,12 @@
  * Return codes: 0 success, > 0 a non-error outcome, < 0 failure; martello_status_name()
  * names them and martello_model_message() explains the last one of a model.
  * Arrays are plain C arrays of double; parameter slots are given by the MARTELLO_P_* and
- * MARTELLO_L_* indices (0-based). */
+ * MARTELLO_L_* indices (0-based). The tables behind every enum (names, values, defaults,
+ * ranges, what reads what) are the library's registry: martello_registry_*. */
 #ifndef MARTELLO_H
 #define MARTELLO_H
+
+#include <stdbool.h>
 
 #ifdef __cplusplus
 extern "C" {
@@ -20,7 +23,11 @@ extern "C" {
 
 #define MARTELLO_GROUND (-1)
 
-/* Status codes (values fixed; fortran/status.f90 mirrors them). */
+/* Every constant below is a row of the library's registry (fortran/registry.f90), which
+ * the functions martello_registry_* read at run time: tests/test_registry.py checks each
+ * enum of this header against it, both ways. */
+
+/* Status codes (the registry's table "status"; fortran/status.f90 holds the values). */
 enum martello_status {
   MARTELLO_OK = 0,
   MARTELLO_ILL_CONDITIONED = 1,     /* solved, but digits were lost: read the message   */
@@ -38,17 +45,20 @@ enum martello_status {
   MARTELLO_ERR_STATE = -11          /* call out of order                                 */
 };
 
-/* Contact schemes, laws, link kinds and time functions (values are the kernels';
- * martello_constant() returns them by name). */
+/* Contact schemes, laws, link kinds and time functions (tables "schemes", "laws", "links",
+ * "time_functions"); parameter slots (0-based) of the contact and link arrays (tables
+ * "contact_parameters", "link_parameters"); sizes (table "constants"). */
 enum { MARTELLO_SCHEME_PENALTY = 1, MARTELLO_SCHEME_LAGRANGE = 2,
-       MARTELLO_SCHEME_AUGMENTED = 3, MARTELLO_SCHEME_RESTITUTION = 4 };
+       MARTELLO_SCHEME_AUGMENTED_LAGRANGE = 3, MARTELLO_SCHEME_RESTITUTION = 4 };
 enum { MARTELLO_LAW_LINEAR = 1, MARTELLO_LAW_HERTZ = 2, MARTELLO_LAW_KELVIN = 3,
        MARTELLO_LAW_HUNT_CROSSLEY = 4, MARTELLO_LAW_LANKARANI_NIKRAVESH = 5,
        MARTELLO_LAW_FLORES = 6, MARTELLO_LAW_GONTHIER = 7, MARTELLO_LAW_HERTZDAMP = 8,
        MARTELLO_LAW_JANKOWSKI = 9 };
+/* Slots 5 to 7 are reserved and must be 0: the effective mass m* that the kelvin conversion
+ * from a restitution and the jankowski law need is the library's, 1/(B M^-1 B^T) from the
+ * node masses and mass couplings (martello_model_effective_masses). */
 enum { MARTELLO_NPAR_CONTACT = 8, MARTELLO_P_STIFF = 0, MARTELLO_P_EXPONENT = 1,
-       MARTELLO_P_DAMPING = 2, MARTELLO_P_RESTITUTION = 3, MARTELLO_P_CLIP = 4,
-       MARTELLO_P_MSTAR = 5 };
+       MARTELLO_P_DAMPING = 2, MARTELLO_P_RESTITUTION = 3, MARTELLO_P_CLIP = 4 };
 enum { MARTELLO_LINK_SPRING = 1, MARTELLO_LINK_DASHPOT = 2, MARTELLO_LINK_BILINEAR = 3,
        MARTELLO_LINK_FLUID_DAMPER = 4, MARTELLO_LINK_BAR = 5 };
 enum { MARTELLO_NPAR_LINK = 6, MARTELLO_L_STIFF = 0, MARTELLO_L_DAMP = 1, MARTELLO_L_YIELD = 2,
@@ -61,7 +71,26 @@ const char *martello_version(void);
 /* Versions of the numerical libraries linked in (GSL, SUNDIALS, FFTW, LAPACK), as text. */
 int martello_library_versions(char *buf, int buflen);
 const char *martello_status_name(int status);
-int martello_constant(const char *name, int *value);
+
+/* ---- registry ---------------------------------------------------------------------- */
+/* The library's tables by name: "tables" lists them all (columns rows, cols; the text of a
+ * row is the prefix of that table's C constants, e.g. "MARTELLO_LAW_"). A table has rows
+ * (0-based), each with a name (at most 31 characters), a text (at most 159) and cols
+ * numbers named by martello_registry_column. Among them: "integrators" (value, family,
+ * adaptive), "settings" (default, min, max, min_open, max_open, type: the fields of
+ * martello_settings after kind, in order), "reads" (integrator x setting: 1 if read),
+ * "compatibility" (integrator x scheme: 1 if it runs), "laws" (value, exponent,
+ * exponent_fixed), "history" (per: the column groups of martello_run_history in order,
+ * repeated per "history_per"), "counters", "energy", "events" (0-based indices), "status"
+ * (text: meaning). Names and texts are copied NUL-terminated; a buffer too short, an
+ * unknown table or an index out of range return MARTELLO_ERR_ARGUMENT. NULL name, text or
+ * values are skipped. */
+int martello_registry_shape(const char *table, int *rows, int *cols);
+int martello_registry_column(const char *table, int col, char *name, int namelen);
+int martello_registry_entry(const char *table, int row, char *name, int namelen, double *values);
+int martello_registry_text(const char *table, int row, char *text, int textlen);
+/* The row named name (or MARTELLO_ERR_ARGUMENT and row = -1). */
+int martello_registry_find(const char *table, const char *name, int *row);
 
 /* ---- model ------------------------------------------------------------------------- */
 typedef struct martello_model martello_model;
@@ -86,6 +115,10 @@ int martello_model_set_ground_acceleration(martello_model *model, int kind,
                                            const double *par, int n_table, const double *t,
                                            const double *y);
 int martello_model_message(const martello_model *model, char *buf, int buflen);
+/* The effective mass m* = 1/(B M^-1 B^T) of every contact (mstar[n_contacts]): B the
+ * contact's row (+1 at a, -1 at b), M the node masses plus mass couplings on the free
+ * nodes; a ground or fixed side is infinitely heavy (+inf if neither side moves). */
+int martello_model_effective_masses(martello_model *model, double *mstar);
 
 /* ---- static analysis ---------------------------------------------------------------- */
 /* Outputs: u[n_nodes]; per contact force[] (P >= 0), penetration[], active[] (0/1);
@@ -99,47 +132,85 @@ int martello_static_solve(martello_model *model, double tol, int max_iter, doubl
                           double *conditioning);
 
 /* ---- dynamic analysis --------------------------------------------------------------- */
-/* Lifecycle: martello_run_create -> martello_run_set_integrator (-> _set_outputs)
- * -> martello_dynamic_run(model, run) -> martello_run_* getters -> martello_run_free.
- * A failed run (status < 0: diverged, unstable, Newton not converged ...) keeps what it
- * computed up to the failure for diagnosis; martello_run_message() says where and why. */
+/* Lifecycle: martello_run_create -> martello_settings_default + martello_run_set_settings
+ * (-> _set_outputs) -> martello_dynamic_run(model, run) -> martello_run_* getters ->
+ * martello_run_free. A failed run (status < 0: diverged, unstable, Newton not converged ...)
+ * keeps what it computed up to the failure for diagnosis; martello_run_message() says where
+ * and why. */
 typedef struct martello_run martello_run;
 
+/* Integrators (table "integrators") and their families (table "families"). */
 enum { MARTELLO_INT_NEWMARK = 1, MARTELLO_INT_HHT = 2, MARTELLO_INT_GENERALIZED_ALPHA = 3,
        MARTELLO_INT_CENTRAL_DIFFERENCE = 4, MARTELLO_INT_MOREAU_JEAN = 5,
        MARTELLO_INT_NEWMARK_LAGRANGE = 6, MARTELLO_INT_RKF45 = 7, MARTELLO_INT_RK8PD = 8,
        MARTELLO_INT_MSBDF = 9, MARTELLO_INT_IDA = 10 };
-/* Slots of the integrator parameter array (0-based). */
-enum { MARTELLO_NPAR_INTEGRATOR = 17, MARTELLO_R_DT = 0, MARTELLO_R_T_END = 1,
-       MARTELLO_R_BETA = 2, MARTELLO_R_GAMMA = 3, MARTELLO_R_ALPHA = 4, MARTELLO_R_RHO_INF = 5,
-       MARTELLO_R_TOL_RESIDUAL = 6, MARTELLO_R_TOL_INCREMENT = 7, MARTELLO_R_MAX_NEWTON = 8,
-       MARTELLO_R_CHECK_STABILITY = 9, MARTELLO_R_EVERY = 10, MARTELLO_R_DIVERGENCE_FACTOR = 11,
-       MARTELLO_R_RTOL = 12, MARTELLO_R_ATOL = 13, MARTELLO_R_THETA = 14, MARTELLO_R_EVENT_TOL = 15,
-       MARTELLO_R_H_MAX = 16 };
+enum { MARTELLO_FAMILY_NEWMARK = 1, MARTELLO_FAMILY_TIME_STEPPING = 2,
+       MARTELLO_FAMILY_CONSTRAINED_NEWMARK = 3, MARTELLO_FAMILY_EVENT_DRIVEN = 4,
+       MARTELLO_FAMILY_DAE = 5 };
+
+/* The settings of a run, field by field the Fortran type integrator_settings_t
+ * (fortran/integrator_settings.f90). martello_settings_default fills the registry's
+ * defaults (table "settings"); set dt and t_end, then martello_run_set_settings checks every
+ * field the integrator reads (table "reads") against its range and names the first one out
+ * of it. Fields an integrator does not read are ignored. */
+typedef struct martello_settings {
+  int kind;                 /* the integrator, MARTELLO_INT_* */
+  double dt;                /* fixed step [s]; adaptive integrators: the output interval */
+  double t_end;             /* end time [s] */
+  double beta;              /* Newmark beta > 0 */
+  double gamma;             /* Newmark gamma >= 1/2 */
+  double alpha;             /* HHT alpha in [-1/3, 0] */
+  double rho_inf;           /* generalized-alpha: spectral radius at infinity, in [0, 1] */
+  double tol_residual;      /* Newton: |r|inf <= tol_residual x force scale */
+  double tol_increment;     /* Newton: predicted |du|inf <= tol_increment x displacement scale */
+  int max_newton;           /* Newton iterations per step */
+  bool check_stability;     /* central difference: refuse dt > dt_crit */
+  int every;                /* record every n-th step (adaptive: every n-th output time) */
+  double divergence_factor; /* diverged when the mechanical energy > factor x (E0 + input) */
+  double rtol;              /* adaptive steppers: relative tolerance */
+  double atol;              /* adaptive steppers: absolute tolerance */
+  double theta;             /* Moreau-Jean theta in [1/2, 1] */
+  double event_tol;         /* event location, absolute in time [s] */
+  double h_max;             /* adaptive: the largest step [s] (0: no limit) */
+} martello_settings;
+
+/* Indices of martello_run_counters, martello_run_energy and the values of
+ * martello_run_events (tables "counters", "energy", "events"). */
 enum { MARTELLO_NCOUNTERS = 9, MARTELLO_NENERGY = 9, MARTELLO_NEVENT = 6 };
+enum { MARTELLO_COUNTER_STEPS = 0, MARTELLO_COUNTER_REJECTED_STEPS = 1,
+       MARTELLO_COUNTER_NEWTON_ITERATIONS = 2, MARTELLO_COUNTER_RESIDUAL_EVALUATIONS = 3,
+       MARTELLO_COUNTER_FACTORIZATIONS = 4, MARTELLO_COUNTER_EVENTS = 5,
+       MARTELLO_COUNTER_JACOBIAN_EVALUATIONS = 6, MARTELLO_COUNTER_ROOT_EVALUATIONS = 7,
+       MARTELLO_COUNTER_CONTACT_CHATTER_RESOLUTIONS = 8 };
+enum { MARTELLO_ENERGY_KINETIC = 0, MARTELLO_ENERGY_RECOVERABLE = 1, MARTELLO_ENERGY_INPUT = 2,
+       MARTELLO_ENERGY_DAMPING = 3, MARTELLO_ENERGY_PLASTIC = 4, MARTELLO_ENERGY_CONTACT = 5,
+       MARTELLO_ENERGY_BALANCE = 6, MARTELLO_ENERGY_INITIAL = 7, MARTELLO_ENERGY_IMPACT = 8 };
+enum { MARTELLO_EVENT_T_ON = 0, MARTELLO_EVENT_T_OFF = 1, MARTELLO_EVENT_V_IN = 2,
+       MARTELLO_EVENT_V_OUT = 3, MARTELLO_EVENT_MAX_PENETRATION = 4,
+       MARTELLO_EVENT_MAX_FORCE = 5 };
 
 int martello_run_create(martello_run **run);
 void martello_run_free(martello_run **run);
-int martello_run_set_integrator(martello_run *run, int kind,
-                                const double par[MARTELLO_NPAR_INTEGRATOR]);
+/* MARTELLO_ERR_ARGUMENT for an unknown kind. */
+int martello_settings_default(int kind, martello_settings *settings);
+int martello_run_set_settings(martello_run *run, const martello_settings *settings);
 int martello_run_set_outputs(martello_run *run, int n_nodes, const int *nodes, int n_contacts,
                              const int *contacts);
 /* Links whose force and elongation the history records (0-based; default none). */
 int martello_run_set_link_outputs(martello_run *run, int n_links, const int *links);
 int martello_dynamic_run(martello_model *model, martello_run *run);
 int martello_run_message(const martello_run *run, char *buf, int buflen);
-/* History: rows records of cols values, record after record: t, then u, v, a of each output
- * node (all u first, then all v, then all a), then penetration and force of each output
- * contact, then force and elongation of each output link (NaN where an integrator does not
- * report links), then the MARTELLO_NENERGY energy terms. */
+/* History: rows records of cols values, record after record, in the column groups of the
+ * table "history": t, then u, v, a of each output node (all u first, then all v, then all
+ * a), then penetration and force of each output contact, then force and elongation of each
+ * output link (NaN where an integrator does not report links), then the energy terms. */
 int martello_run_history_shape(const martello_run *run, int *rows, int *cols);
 int martello_run_history(const martello_run *run, double *buf);
 /* Contact phases: n on return; with non-NULL arrays also contact[n] and
- * values[n][6] = {t_on, t_off (-1: open at the end), v_in, v_out, max penetration, max force}. */
+ * values[n][MARTELLO_NEVENT], indexed by MARTELLO_EVENT_* (t_off = -1: open at the end). */
 int martello_run_events(const martello_run *run, int *n, int *contacts, double *values);
-/* counters = {steps, rejected steps, Newton iterations, residual evaluations,
- * factorizations, events, Jacobian evaluations, root-function evaluations, contact
- * chatter resolutions (steps where a contact was held open, see docs/integrators.md)} */
+/* counters indexed by MARTELLO_COUNTER_* (chatter resolutions: steps where a contact was
+ * held open, see docs/integrators.md) */
 int martello_run_counters(const martello_run *run, long long counters[MARTELLO_NCOUNTERS]);
 /* Per node: extremes over the steps, and the largest local maximum of u interpolated between
  * steps (u_peak at t_peak; t_peak = -1 if u never turned back); per contact: max
@@ -147,8 +218,8 @@ int martello_run_counters(const martello_run *run, long long counters[MARTELLO_N
 int martello_run_peaks(const martello_run *run, double *u_max, double *u_min, double *v_absmax,
                        double *a_absmax, double *pen_max, double *force_max, int *impacts,
                        double *u_peak, double *t_peak);
-/* energy = {kinetic, recoverable, input work, damping, plastic, contact dissipation, balance,
- * initial, impact}; extra = {max |balance|, omega_max, dt_crit (explicit), time reached} */
+/* energy indexed by MARTELLO_ENERGY_*; extra = {max |balance|, omega_max, dt_crit
+ * (explicit), time reached} */
 int martello_run_energy(const martello_run *run, double energy[MARTELLO_NENERGY], double extra[4]);
 /* Per link: max |force| and max |elongation| over the run (NaN if the integrator does not
  * report link states). */

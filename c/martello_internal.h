@@ -37,8 +37,9 @@ int martello_eval_power(martello_eval *ev, double power[5]);
 int martello_eval_energy(martello_eval *ev, const double *u, const double *v, double *kinetic,
                          double *recoverable);
 
-/* The run being filled: its settings, and its observer. */
-int martello_run_settings(const martello_run *run, int *kind, double par[MARTELLO_NPAR_INTEGRATOR]);
+/* The run being filled: its settings, as martello_run_set_settings validated them, and its
+ * observer. */
+int martello_run_settings(const martello_run *run, martello_settings *settings);
 int martello_run_observer(martello_run *run, martello_observer **obs);
 
 /* The observer's contract (docs/run-layer.md); MARTELLO_OK, or MARTELLO_ERR_ARGUMENT for a
@@ -74,6 +75,46 @@ int martello_observer_fail(martello_observer *obs, int status, double t_reached,
                            const char *message);
 /* The run reached t_reached: open phases become events with t_off = -1. */
 int martello_observer_finish(martello_observer *obs, double t_reached);
+
+/* ---- the impulse problem (fortran/impulse.f90 through fortran/api_impulse.f90;
+ * docs/impulse.md) ----------------------------------------------------------------------------
+ * The m contacts of a problem are list[0..m) of the caller's topology: contact j joins the
+ * 0-based nodes a[j] and b[j] (-1: the ground), its gap rate is gdot_j = B_j v = v_b - v_a
+ * (> 0 opening: the penetration rate with the opposite sign), a compressive impulse P >= 0 acts
+ * as B_j^T P, and its column C_j = M^-1 B_j^T (martello_eval_solve_mass of e_b - e_a) is column
+ * col[j] of the column-major n x (any) array cols. The Delassus matrix is W_kl = B_k C_l;
+ * matrices are m x m column-major; P, e, lambda, held are per problem contact. Status:
+ * MARTELLO_OK, MARTELLO_ERR_SINGULAR (redundant contacts: Newton's law has no solution, or the
+ * held set's W is not positive definite), MARTELLO_ERR_NOT_CONVERGED (LCP pivot or sweep
+ * limit), MARTELLO_ERR_ARGUMENT (n or m < 0). */
+int martello_impulse_delassus(int n, int m, const int *list, const int *a, const int *b,
+                              const int *col, const double *cols, double *W);
+/* Newton's impact law on the m contacts at once, 0 <= gdot+ + e min(gdot-, 0) _|_ P >= 0
+ * with gdot- = B v on entry: the impulses P and v <- v + sum_k P_k C_k. */
+int martello_impulse_newton(int n, int m, const int *list, const int *a, const int *b,
+                            const int *col, const double *cols, const double *e, double *v,
+                            double *P, int *iterations);
+/* The contact forces of contacts at zero gap and gap rate, 0 <= gddot _|_ lambda >= 0 with
+ * gddot = B acc + W lambda (acc: the accelerations without them), and the persistent-contact
+ * rule: held[k] = 0 iff the solution opens the contact (lambda_k = 0, gddot_k > 0). */
+int martello_impulse_contact_forces(int n, int m, const int *list, const int *a, const int *b,
+                                    const int *col, const double *cols, const double *acc,
+                                    double *lambda, int *held, int *iterations);
+/* W of contacts held together, Cholesky-factored into L (m x m). */
+int martello_impulse_factor(int n, int m, const int *list, const int *a, const int *b,
+                            const int *col, const double *cols, double *L);
+/* With L from martello_impulse_factor: P = W^-1 (target - B x), x <- x + sum_k P_k C_k, the
+ * mass-weighted projection onto B x = target (NULL: 0). */
+int martello_impulse_project(int n, int m, const int *list, const int *a, const int *b,
+                             const int *col, const double *cols, const double *L,
+                             const double *target, double *x, double *P);
+/* The accumulation policy (docs/impulse.md §4): 1 if the impacts of a contact leaving at t
+ * with separation speed s >= 0, pressed by the relative acceleration a, restitution e, have
+ * accumulated: no rebound, or a next flight 2 s/a shorter than tau_res or lower than
+ * height_res (the integrator's resolution). *t_inf = the accumulation point t + 2 s/(a (1 - e))
+ * (t without rebound, HUGE_VAL-like when there is none). */
+int martello_impulse_accumulation(double e, double s, double a, double t, double tau_res,
+                                  double height_res, double *t_inf);
 
 /* The C integrators, dispatched by martello_dynamic_run. */
 int martello_event_driven_run(martello_model *model, martello_run *run);

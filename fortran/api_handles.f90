@@ -9,7 +9,7 @@ module martello_api_handles
    use martello_observer, only: observer_t
    implicit none
    private
-   public :: get_model, get_run, get_eval, get_observer, copy_message
+   public :: get_model, get_run, get_eval, get_observer, copy_message, from_c_string
 
 contains
 
@@ -42,6 +42,20 @@ contains
       op => null()
       if (c_associated(handle)) call c_f_pointer(handle, op)
    end function get_observer
+   !> A NUL-terminated C string as Fortran text (at most maxlen characters).
+   function from_c_string(cstr, maxlen) result(s)
+      character(kind=c_char), intent(in) :: cstr(*)
+      integer, intent(in) :: maxlen
+      character(len=:), allocatable :: s
+      integer :: n
+      n = 0
+      do while (n < maxlen)
+         if (cstr(n + 1) == c_null_char) exit
+         n = n + 1
+      end do
+      allocate (character(len=n) :: s)
+      s = transfer(cstr(1:n), s)
+   end function from_c_string
 
    !> Copy msg into buf (NUL-terminated, truncated to buflen − 1 characters).
    subroutine copy_message(msg, buf, buflen)

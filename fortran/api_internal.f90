@@ -8,7 +8,7 @@ module martello_api_internal
    use martello_model
    use martello_evaluator
    use martello_contact_laws, only: P_RESTITUTION
-   use martello_integrator_settings
+   use martello_integrator_settings, only: integrator_settings_t
    use martello_observer
    use martello_run, only: run_t
    use martello_api_handles, only: get_model, get_run, get_eval, get_observer
@@ -164,25 +164,14 @@ contains
       c_eval_energy = MARTELLO_OK
    end function c_eval_energy
 
-   integer(c_int) function c_run_settings(handle, kind, par) bind(C, name='martello_run_settings')
+   integer(c_int) function c_run_settings(handle, s) bind(C, name='martello_run_settings')
       type(c_ptr), value :: handle
-      integer(c_int), intent(out) :: kind
-      real(c_double), intent(out) :: par(NPAR_INTEGRATOR)
+      type(integrator_settings_t), intent(out) :: s
       type(run_t), pointer :: rp
       rp => get_run(handle)
       c_run_settings = MARTELLO_ERR_ARGUMENT
       if (.not. associated(rp)) return
-      associate (st => rp%settings)
-         kind = st%kind
-         par = 0.0_c_double
-         par(R_DT) = st%dt; par(R_T_END) = st%t_end; par(R_BETA) = st%beta
-         par(R_GAMMA) = st%gamma; par(R_ALPHA) = st%alpha; par(R_RHO_INF) = st%rho_inf
-         par(R_TOL_RESIDUAL) = st%tol_residual; par(R_TOL_INCREMENT) = st%tol_increment
-         par(R_MAX_NEWTON) = st%max_newton; par(R_CHECK_STABILITY) = merge(1, 0, st%check_stability)
-         par(R_EVERY) = st%every; par(R_DIVERGENCE_FACTOR) = st%divergence_factor
-         par(R_RTOL) = st%rtol; par(R_ATOL) = st%atol; par(R_THETA) = st%theta
-         par(R_EVENT_TOL) = st%event_tol; par(R_H_MAX) = st%h_max
-      end associate
+      s = rp%settings
       c_run_settings = MARTELLO_OK
    end function c_run_settings
 

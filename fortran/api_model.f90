@@ -10,6 +10,7 @@ module martello_api_model
    use martello_contact_laws, only: NPAR_CONTACT
    use martello_links, only: NPAR_LINK
    use martello_statics, only: static_result_t, static_solve
+   use martello_effective_mass, only: contact_effective_masses
    use martello_api_handles, only: get_model, copy_message
    implicit none
    private
@@ -147,6 +148,24 @@ contains
       call model_set_ground_acceleration(mp, int(kind), par, t(1:ntab), y(1:ntab), stat)
       c_model_set_ground_acceleration = stat
    end function c_model_set_ground_acceleration
+
+   !> The effective mass m* = 1/(B M⁻¹ Bᵀ) of every contact (+inf if neither side moves).
+   integer(c_int) function c_model_effective_masses(handle, mstar) &
+      bind(C, name='martello_model_effective_masses')
+      type(c_ptr), value :: handle
+      real(c_double), intent(out) :: mstar(*)
+      type(model_t), pointer :: mp
+      integer :: stat
+      mp => get_model(handle)
+      c_model_effective_masses = MARTELLO_ERR_ARGUMENT
+      if (.not. associated(mp)) return
+      if (any(mp%mass(1:mp%n) < 0.0_dp)) then
+         mp%errmsg = 'effective_masses: every node must be set (set_node) first'
+         c_model_effective_masses = MARTELLO_ERR_STATE; return
+      end if
+      call contact_effective_masses(mp, mstar(1:mp%ncontact), mp%errmsg, stat)
+      c_model_effective_masses = stat
+   end function c_model_effective_masses
 
    !> Copy the model's last error or warning message into buf (NUL-terminated, truncated).
    integer(c_int) function c_model_message(handle, buf, buflen) bind(C, name='martello_model_message')

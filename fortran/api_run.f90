@@ -2,10 +2,9 @@
 !> converts arguments and calls martello_run, where validation and dispatch live.
 module martello_api_run
    use, intrinsic :: iso_c_binding
-   use martello_kinds, only: dp
    use martello_status
    use martello_model, only: model_t
-   use martello_integrator_settings
+   use martello_integrator_settings, only: integrator_settings_t, settings_default, settings_check
    use martello_run, only: run_t, run_dynamic
    use martello_api_handles, only: get_model, get_run, copy_message
    implicit none
@@ -35,54 +34,30 @@ contains
       handle = c_null_ptr
    end subroutine c_run_free
 
-   integer(c_int) function c_run_set_integrator(handle, kind, par) &
-      bind(C, name='martello_run_set_integrator')
-      type(c_ptr), value :: handle
+   !> The registry's default settings of integrator kind (MARTELLO_INT_*).
+   integer(c_int) function c_settings_default(kind, s) bind(C, name='martello_settings_default')
       integer(c_int), value :: kind
-      real(c_double), intent(in) :: par(NPAR_INTEGRATOR)
+      type(integrator_settings_t), intent(out) :: s
+      integer :: stat
+      call settings_default(int(kind), s, stat)
+      c_settings_default = stat
+   end function c_settings_default
+
+   !> Validate the settings (settings_check: the only place) and keep them for the run.
+   integer(c_int) function c_run_set_settings(handle, s) bind(C, name='martello_run_set_settings')
+      type(c_ptr), value :: handle
+      type(integrator_settings_t), intent(in) :: s
       type(run_t), pointer :: rp
+      integer :: stat
       rp => get_run(handle)
-      c_run_set_integrator = MARTELLO_ERR_ARGUMENT
+      c_run_set_settings = MARTELLO_ERR_ARGUMENT
       if (.not. associated(rp)) return
-      if (kind < INT_NEWMARK .or. kind > INT_LAST) then
-         rp%results%message = 'set_integrator: unknown integrator kind'; return
-      end if
-      if (.not. (par(R_DT) > 0.0_dp .and. par(R_T_END) > 0.0_dp .and. par(R_EVERY) >= 1.0_dp &
-                 .and. par(R_MAX_NEWTON) >= 1.0_dp .and. par(R_TOL_RESIDUAL) > 0.0_dp &
-                 .and. par(R_TOL_INCREMENT) > 0.0_dp .and. par(R_DIVERGENCE_FACTOR) > 1.0_dp)) then
-         rp%results%message = 'set_integrator: need dt, t_end, tolerances > 0, every and'// &
-            ' max_newton >= 1, divergence_factor > 1'
-         return
-      end if
-      if (kind == INT_NEWMARK .and. .not. (par(R_GAMMA) >= 0.0_dp .and. par(R_BETA) >= 0.0_dp)) then
-         rp%results%message = 'set_integrator: Newmark needs beta >= 0 and gamma >= 0'; return
-      end if
-      if (kind == INT_NEWMARK .and. par(R_BETA) == 0.0_dp) then
-         rp%results%message = 'set_integrator: Newmark with beta = 0 is explicit: use'// &
-            ' central-difference (lumped mass, lagged damping velocity)'
-         c_run_set_integrator = MARTELLO_ERR_UNSUPPORTED; return
-      end if
-      if (kind == INT_HHT .and. .not. (par(R_ALPHA) >= -1.0_dp/3.0_dp .and. par(R_ALPHA) <= 0.0_dp)) then
-         rp%results%message = 'set_integrator: HHT alpha must lie in [-1/3, 0]'; return
-      end if
-      if (kind == INT_GENERALIZED_ALPHA .and. .not. (par(R_RHO_INF) >= 0.0_dp .and. par(R_RHO_INF) <= 1.0_dp)) then
-         rp%results%message = 'set_integrator: generalized-alpha rho_inf must lie in [0, 1]'; return
-      end if
-      rp%settings%kind = kind
-      rp%settings%dt = par(R_DT); rp%settings%t_end = par(R_T_END)
-      rp%settings%beta = par(R_BETA); rp%settings%gamma = par(R_GAMMA)
-      rp%settings%alpha = par(R_ALPHA); rp%settings%rho_inf = par(R_RHO_INF)
-      rp%settings%tol_residual = par(R_TOL_RESIDUAL); rp%settings%tol_increment = par(R_TOL_INCREMENT)
-      rp%settings%max_newton = nint(par(R_MAX_NEWTON))
-      rp%settings%check_stability = par(R_CHECK_STABILITY) /= 0.0_dp
-      rp%settings%every = nint(par(R_EVERY))
-      rp%settings%divergence_factor = par(R_DIVERGENCE_FACTOR)
-      rp%settings%rtol = par(R_RTOL); rp%settings%atol = par(R_ATOL)
-      rp%settings%theta = par(R_THETA); rp%settings%event_tol = par(R_EVENT_TOL)
-      rp%settings%h_max = par(R_H_MAX)
+      call settings_check(s, rp%results%message, stat)
+      c_run_set_settings = stat
+      if (stat /= MARTELLO_OK) return
+      rp%settings = s
       rp%configured = .true.
-      c_run_set_integrator = MARTELLO_OK
-   end function c_run_set_integrator
+   end function c_run_set_settings
 
    !> Which nodes and contacts the history records (0-based); the peaks cover all of them.
    integer(c_int) function c_run_set_outputs(handle, nn, nodes, nc, contacts) &

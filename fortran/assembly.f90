@@ -124,7 +124,8 @@ contains
             if (m%con_law(j) == LAW_LINEAR) then
                dfd = m%con_par(P_STIFF, j); dfv = 0.0_dp; f = dfd*pen
             else
-               call contact_force(m%con_law(j), m%con_par(1, j), pen, rate, vin, f, dfd, dfv)
+               call contact_force(m%con_law(j), m%con_par(1, j), m%con_mstar(j), pen, rate, vin, &
+                                  f, dfd, dfv)
             end if
          else
             f = 0.0_dp; dfd = 0.0_dp; dfv = 0.0_dp

@@ -15,9 +15,9 @@ module martello_contact_laws
 
    public :: LAW_LINEAR, LAW_HERTZ, LAW_KELVIN, LAW_HUNT_CROSSLEY, LAW_LANKARANI_NIKRAVESH, &
              LAW_FLORES, LAW_GONTHIER, LAW_HERTZDAMP, LAW_JANKOWSKI
-   public :: NPAR_CONTACT, P_STIFF, P_EXPONENT, P_DAMPING, P_RESTITUTION, P_CLIP, P_MSTAR
+   public :: NPAR_CONTACT, P_STIFF, P_EXPONENT, P_DAMPING, P_RESTITUTION, P_CLIP, HERTZ_EXPONENT
    public :: contact_force, contact_elastic_energy, damping_from_restitution, exact_hc_factor
-   public :: law_name, law_is_known
+   public :: law_is_known, law_exponent
 
    ! Law identifiers: values are frozen, the C and Python layers use the same integers.
    integer, parameter :: LAW_LINEAR = 1
@@ -30,14 +30,17 @@ module martello_contact_laws
    integer, parameter :: LAW_HERTZDAMP = 8
    integer, parameter :: LAW_JANKOWSKI = 9
 
-   ! Layout of par(NPAR_CONTACT); slots 7 and 8 are reserved and must be zero.
+   ! Layout of par(NPAR_CONTACT); slots 6 to 8 are reserved and must be zero. The effective
+   ! mass m* the kelvin and jankowski laws need is the model's (martello_effective_mass).
    integer, parameter :: NPAR_CONTACT = 8
    integer, parameter :: P_STIFF = 1       ! k (linear, kelvin), K (hertz type), beta (Jankowski)
    integer, parameter :: P_EXPONENT = 2    ! n, read only by hertz and the HC family (see below)
    integer, parameter :: P_DAMPING = 3     ! kelvin: c [N s/m]; HC family: a = chi*v_in [-]; Jankowski: xi [-]
    integer, parameter :: P_RESTITUTION = 4 ! target e that produced P_DAMPING, or -1; never read here
    integer, parameter :: P_CLIP = 5        ! kelvin only: > 0.5 means F = max(0, k delta + c ddelta)
-   integer, parameter :: P_MSTAR = 6       ! m* = m1 m2/(m1 + m2), or the node mass against a wall
+   !> Hertz (1882): n = 3/2 for smooth bodies; the exponent of the laws that read P_EXPONENT
+   !> when the caller gives none.
+   real(dp), parameter :: HERTZ_EXPONENT = 1.5_dp
 
    real(dp), parameter :: PI = 3.14159265358979323846264338327950288_dp
    real(dp), parameter :: THREE_HALVES = 1.5_dp
@@ -53,11 +56,12 @@ contains
    !> (par(P_EXPONENT) is ignored for these four); hertz, Hunt-Crossley, Lankarani-Nikravesh,
    !> Flores and Gonthier use n = par(P_EXPONENT).
    !> v_in is the approach speed at the onset of the current contact phase, used only by
-   !> the HC family (chi = a/v_in); it must be > 0 there unless a = 0.
-   pure subroutine contact_force(law, par, delta, ddelta, v_in, f, df_ddelta, df_dddelta)
+   !> the HC family (chi = a/v_in); it must be > 0 there unless a = 0. mstar is the contact's
+   !> effective mass 1/(B M⁻¹ Bᵀ), read only by Jankowski.
+   pure subroutine contact_force(law, par, mstar, delta, ddelta, v_in, f, df_ddelta, df_dddelta)
       integer, intent(in) :: law
       real(dp), intent(in) :: par(NPAR_CONTACT)
-      real(dp), intent(in) :: delta, ddelta, v_in
+      real(dp), intent(in) :: mstar, delta, ddelta, v_in
       real(dp), intent(out) :: f, df_ddelta, df_dddelta
       real(dp) :: k, n, c, chi, fel, dfel, fac, root4, cj
 
@@ -128,7 +132,7 @@ contains
          df_ddelta = THREE_HALVES*k*sqrt(delta)
          if (ddelta > 0.0_dp) then
             root4 = sqrt(sqrt(delta))
-            cj = 2.0_dp*par(P_DAMPING)*sqrt(k*par(P_MSTAR))   ! c = cj * delta^(1/4)
+            cj = 2.0_dp*par(P_DAMPING)*sqrt(k*mstar)   ! c = cj * delta^(1/4)
             f = f + cj*root4*ddelta
             df_ddelta = df_ddelta + 0.25_dp*cj*ddelta/(root4*root4*root4)
             df_dddelta = cj*root4
@@ -159,16 +163,16 @@ contains
    !> in par(P_DAMPING). Only the Kelvin result is exact (for the unclipped law); for the HC
    !> family use exact_hc_factor to realise e exactly.
    !>  linear, hertz: 0 for any e (they cannot dissipate: they always realise e = 1);
-   !>  kelvin: c [N s/m], needs par(P_STIFF) and par(P_MSTAR); e in [0, 1]; e = 0 is taken as
-   !>          the limit xi -> 1 (critical damping, c = 2 sqrt(k m*)): the unclipped law
-   !>          then never separates, i.e. e = 0 is reached only asymptotically;
+   !>  kelvin: c [N s/m], needs par(P_STIFF) and the effective mass mstar; e in [0, 1];
+   !>          e = 0 is taken as the limit xi -> 1 (critical damping, c = 2 sqrt(k m*)): the
+   !>          unclipped law then never separates, i.e. e = 0 is reached only asymptotically;
    !>  HC family: the dimensionless a = chi*v_in; e in [0, 1] for HC, LN and hertzdamp,
    !>          e in (0, 1] for Flores and Gonthier (they divide by e);
    !>  Jankowski: xi [-]; e in (0, 1].
    !> Out-of-range e gives NaN.
-   pure function damping_from_restitution(law, e, par) result(d)
+   pure function damping_from_restitution(law, e, par, mstar) result(d)
       integer, intent(in) :: law
-      real(dp), intent(in) :: e
+      real(dp), intent(in) :: e, mstar
       real(dp), intent(in) :: par(NPAR_CONTACT)
       real(dp) :: d
       real(dp) :: lne, xi
@@ -187,7 +191,7 @@ contains
             lne = log(e)
             xi = -lne/sqrt(PI*PI + lne*lne)
          end if
-         d = 2.0_dp*xi*sqrt(par(P_STIFF)*par(P_MSTAR))
+         d = 2.0_dp*xi*sqrt(par(P_STIFF)*mstar)
       case (LAW_HUNT_CROSSLEY)
          d = 1.5_dp*(1.0_dp - e)                          ! Hunt & Crossley (1975)
       case (LAW_LANKARANI_NIKRAVESH, LAW_HERTZDAMP)
@@ -239,43 +243,13 @@ contains
       a = -expm1_dp(-0.5_dp*(lo + hi))/e
    end function exact_hc_factor
 
-   !> Short lower-case name, as used in reports and by the Python layer.
-   pure function law_name(law) result(name)
-      integer, intent(in) :: law
-      character(len=:), allocatable :: name
-
-      select case (law)
-      case (LAW_LINEAR)
-         name = 'linear'
-      case (LAW_HERTZ)
-         name = 'hertz'
-      case (LAW_KELVIN)
-         name = 'kelvin'
-      case (LAW_HUNT_CROSSLEY)
-         name = 'hunt_crossley'
-      case (LAW_LANKARANI_NIKRAVESH)
-         name = 'lankarani_nikravesh'
-      case (LAW_FLORES)
-         name = 'flores'
-      case (LAW_GONTHIER)
-         name = 'gonthier'
-      case (LAW_HERTZDAMP)
-         name = 'hertzdamp'
-      case (LAW_JANKOWSKI)
-         name = 'jankowski'
-      case default
-         name = 'unknown'
-      end select
-   end function law_name
-
    elemental logical function law_is_known(law)
       integer, intent(in) :: law
       law_is_known = law >= LAW_LINEAR .and. law <= LAW_JANKOWSKI
    end function law_is_known
 
-   ! ---------------------------------------------------------------- private helpers
-
-   !> Exponent of the elastic part, consistent with contact_force.
+   !> Exponent of the elastic part, consistent with contact_force: fixed by the law, or
+   !> par(P_EXPONENT) for the laws that read it.
    pure function law_exponent(law, par) result(n)
       integer, intent(in) :: law
       real(dp), intent(in) :: par(NPAR_CONTACT)
@@ -289,6 +263,8 @@ contains
          n = par(P_EXPONENT)
       end select
    end function law_exponent
+
+   ! ---------------------------------------------------------------- private helpers
 
    !> A quantity with the sign of (ln(1+a) - ln(1-e a) - (1+e) a), a = (1 - exp(-t))/e.
    !> Large a: the closed form with t = -ln(1 - e a) exactly. Small a: the series of the

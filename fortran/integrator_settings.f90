@@ -1,47 +1,47 @@
-!> Integrator kinds, their settings, and which contact schemes each can run (the
-!> compatibility table of docs/integrators.md; martello/scene.py holds the same table for
-!> scene-file errors, tests/test_compatibility.py checks that the two agree).
+!> The settings of a dynamic run: integrator_settings_t, interoperable field by field with
+!> martello_settings of c/martello.h (tests/test_registry.py checks the layout), its defaults
+!> and valid ranges (the registry's table "settings"), and settings_check, the one validation
+!> of a run's settings (martello_run_set_settings). The integrator names and the scheme ×
+!> integrator compatibility are the registry's too (docs/integrators.md).
 module martello_integrator_settings
+   use, intrinsic :: iso_c_binding, only: c_int, c_double, c_bool
    use martello_kinds, only: dp
-   use martello_model, only: SCHEME_PENALTY, SCHEME_LAGRANGE, SCHEME_AUGMENTED, SCHEME_RESTITUTION
+   use martello_status, only: MARTELLO_OK, MARTELLO_ERR_ARGUMENT
+   use martello_registry, only: INT_NEWMARK, INT_HHT, INT_GENERALIZED_ALPHA, &
+      INT_CENTRAL_DIFFERENCE, INT_MOREAU_JEAN, INT_NEWMARK_LAGRANGE, INT_RKF45, INT_RK8PD, &
+      INT_MSBDF, INT_IDA, INT_LAST, SETTINGS, INTEGRATORS, setting_t, NSETTINGS, S_DT, S_T_END, &
+      S_BETA, S_GAMMA, S_ALPHA, S_RHO_INF, S_TOL_RESIDUAL, S_TOL_INCREMENT, S_MAX_NEWTON, &
+      S_CHECK_STABILITY, S_EVERY, S_DIVERGENCE_FACTOR, S_RTOL, S_ATOL, S_THETA, S_EVENT_TOL, &
+      S_H_MAX, T_INT
    implicit none
    private
-   public :: integrator_settings_t, integrator_name, scheme_supported, &
-      INT_NEWMARK, INT_HHT, INT_GENERALIZED_ALPHA, INT_CENTRAL_DIFFERENCE, INT_MOREAU_JEAN, &
-      INT_NEWMARK_LAGRANGE, INT_RKF45, INT_RK8PD, INT_MSBDF, INT_IDA, INT_LAST, &
-      NPAR_INTEGRATOR, R_DT, R_T_END, R_BETA, R_GAMMA, R_ALPHA, R_RHO_INF, R_TOL_RESIDUAL, &
-      R_TOL_INCREMENT, R_MAX_NEWTON, R_CHECK_STABILITY, R_EVERY, R_DIVERGENCE_FACTOR, R_RTOL, &
-      R_ATOL, R_THETA, R_EVENT_TOL, R_H_MAX
+   public :: integrator_settings_t, integrator_name, scheme_supported, settings_default, &
+      settings_check, INT_NEWMARK, INT_HHT, INT_GENERALIZED_ALPHA, INT_CENTRAL_DIFFERENCE, &
+      INT_MOREAU_JEAN, INT_NEWMARK_LAGRANGE, INT_RKF45, INT_RK8PD, INT_MSBDF, INT_IDA, INT_LAST
 
-   integer, parameter :: INT_NEWMARK = 1, INT_HHT = 2, INT_GENERALIZED_ALPHA = 3, &
-                         INT_CENTRAL_DIFFERENCE = 4, INT_MOREAU_JEAN = 5, &
-                         INT_NEWMARK_LAGRANGE = 6, INT_RKF45 = 7, INT_RK8PD = 8, INT_MSBDF = 9, &
-                         INT_IDA = 10, INT_LAST = 10
-
-   !> Slots of the integrator parameter array of martello_run_set_integrator (0-based in C).
-   integer, parameter :: NPAR_INTEGRATOR = 17
-   integer, parameter :: R_DT = 1, R_T_END = 2, R_BETA = 3, R_GAMMA = 4, R_ALPHA = 5, &
-                         R_RHO_INF = 6, R_TOL_RESIDUAL = 7, R_TOL_INCREMENT = 8, &
-                         R_MAX_NEWTON = 9, R_CHECK_STABILITY = 10, R_EVERY = 11, &
-                         R_DIVERGENCE_FACTOR = 12, R_RTOL = 13, R_ATOL = 14, R_THETA = 15, &
-                         R_EVENT_TOL = 16, R_H_MAX = 17
-
-   type :: integrator_settings_t
-      integer :: kind = INT_NEWMARK
-      real(dp) :: dt = 0.0_dp, t_end = 0.0_dp       !< fixed step, or output interval (adaptive)
-      real(dp) :: beta = 0.25_dp, gamma = 0.5_dp     !< Newmark
-      real(dp) :: alpha = 0.0_dp                     !< HHT, in [−1/3, 0]
-      real(dp) :: rho_inf = 1.0_dp                   !< generalized-α, in [0, 1]
-      real(dp) :: tol_residual = 1.0e-9_dp           !< ‖r‖∞ ≤ tol·force scale
-      real(dp) :: tol_increment = 1.0e-11_dp         !< predicted ‖Δu‖∞ ≤ tol·displacement scale
-      integer :: max_newton = 30
-      logical :: check_stability = .true.           !< central difference: refuse Δt > Δt_crit
-      integer :: every = 1                           !< record every n-th step (fixed step)
-      real(dp) :: divergence_factor = 10.0_dp        !< mechanical energy > factor·(E0 + input)
-      real(dp) :: rtol = 1.0e-8_dp, atol = 1.0e-12_dp  !< adaptive steppers (GSL, IDA)
-      real(dp) :: theta = 0.5_dp                     !< Moreau–Jean θ
-      real(dp) :: event_tol = 1.0e-12_dp             !< event location, absolute in time [s]
-      real(dp) :: h_max = 0.0_dp                     !< adaptive: largest step (0: no limit)
+   !> martello_settings. Defaults are the registry's; which fields an integrator reads is its
+   !> row of the registry's table "reads".
+   type, bind(C) :: integrator_settings_t
+      integer(c_int) :: kind = INT_NEWMARK                               !< INT_*
+      real(c_double) :: dt = SETTINGS(S_DT)%default        !< fixed step, or output interval (adaptive)
+      real(c_double) :: t_end = SETTINGS(S_T_END)%default
+      real(c_double) :: beta = SETTINGS(S_BETA)%default                  !< Newmark
+      real(c_double) :: gamma = SETTINGS(S_GAMMA)%default                !< Newmark
+      real(c_double) :: alpha = SETTINGS(S_ALPHA)%default                !< HHT
+      real(c_double) :: rho_inf = SETTINGS(S_RHO_INF)%default            !< generalized-α
+      real(c_double) :: tol_residual = SETTINGS(S_TOL_RESIDUAL)%default  !< ‖r‖∞ ≤ tol·force scale
+      real(c_double) :: tol_increment = SETTINGS(S_TOL_INCREMENT)%default !< ‖Δu‖∞ ≤ tol·u scale
+      integer(c_int) :: max_newton = nint(SETTINGS(S_MAX_NEWTON)%default)
+      !> central difference: refuse Δt > Δt_crit
+      logical(c_bool) :: check_stability = SETTINGS(S_CHECK_STABILITY)%default /= 0.0_dp
+      integer(c_int) :: every = nint(SETTINGS(S_EVERY)%default)          !< record every n-th step
+      !> diverged when the mechanical energy > factor·(E0 + input)
+      real(c_double) :: divergence_factor = SETTINGS(S_DIVERGENCE_FACTOR)%default
+      real(c_double) :: rtol = SETTINGS(S_RTOL)%default                  !< adaptive steppers
+      real(c_double) :: atol = SETTINGS(S_ATOL)%default
+      real(c_double) :: theta = SETTINGS(S_THETA)%default                !< Moreau–Jean θ
+      real(c_double) :: event_tol = SETTINGS(S_EVENT_TOL)%default        !< absolute in time [s]
+      real(c_double) :: h_max = SETTINGS(S_H_MAX)%default                !< 0: no limit
    end type integrator_settings_t
 
 contains
@@ -49,34 +49,91 @@ contains
    pure function integrator_name(kind) result(name)
       integer, intent(in) :: kind
       character(len=:), allocatable :: name
-      select case (kind)
-      case (INT_NEWMARK); name = 'newmark'
-      case (INT_HHT); name = 'hht'
-      case (INT_GENERALIZED_ALPHA); name = 'generalized-alpha'
-      case (INT_CENTRAL_DIFFERENCE); name = 'central-difference'
-      case (INT_MOREAU_JEAN); name = 'moreau-jean'
-      case (INT_NEWMARK_LAGRANGE); name = 'newmark-lagrange'
-      case (INT_RKF45); name = 'rkf45'
-      case (INT_RK8PD); name = 'rk8pd'
-      case (INT_MSBDF); name = 'msbdf'
-      case (INT_IDA); name = 'ida'
-      case default; name = 'unknown'
-      end select
+      name = 'unknown'
+      if (kind >= 1 .and. kind <= INT_LAST) name = trim(INTEGRATORS(kind)%name)
    end function integrator_name
 
-   !> The compatibility table. Penalty contacts are smooth forces (every integrator but the
-   !> seed's Newmark–Lagrange, which is built for rigid impacts); Lagrange and restitution
-   !> contacts need event location or impulse-level time stepping.
+   !> Whether the integrator runs contacts of the scheme (the registry's table compatibility).
    pure logical function scheme_supported(kind, scheme) result(ok)
       integer, intent(in) :: kind, scheme
-      select case (scheme)
-      case (SCHEME_PENALTY)
-         ok = kind /= INT_NEWMARK_LAGRANGE
-      case (SCHEME_LAGRANGE, SCHEME_RESTITUTION)
-         ok = kind >= INT_MOREAU_JEAN
-      case default   ! augmented Lagrange is a static scheme
-         ok = .false.
-      end select
-      if (scheme == SCHEME_AUGMENTED) ok = .false.
+      ok = .false.
+      if (kind >= 1 .and. kind <= INT_LAST .and. scheme >= 0 .and. scheme < bit_size(scheme)) &
+         ok = btest(INTEGRATORS(kind)%schemes, scheme)
    end function scheme_supported
+
+   !> The registry's defaults for integrator kind; stat = MARTELLO_ERR_ARGUMENT if unknown.
+   pure subroutine settings_default(kind, s, stat)
+      integer, intent(in) :: kind
+      type(integrator_settings_t), intent(out) :: s
+      integer, intent(out) :: stat
+      stat = merge(MARTELLO_OK, MARTELLO_ERR_ARGUMENT, kind >= 1 .and. kind <= INT_LAST)
+      s%kind = kind
+   end subroutine settings_default
+
+   !> The one validation of a run's settings: a known integrator, and every setting it reads
+   !> within the registry's range. The message names the field, its value and what is valid.
+   subroutine settings_check(s, message, stat)
+      type(integrator_settings_t), intent(in) :: s
+      character(len=*), intent(inout) :: message
+      integer, intent(out) :: stat
+      integer :: i
+      character(len=32) :: num
+      stat = MARTELLO_ERR_ARGUMENT
+      if (s%kind < 1 .or. s%kind > INT_LAST) then
+         write (num, '(i0)') s%kind
+         message = 'settings.kind = '//trim(num)//' is no integrator: use a MARTELLO_INT_*'// &
+            ' value (the registry''s table integrators)'
+         return
+      end if
+      do i = 1, NSETTINGS
+         if (.not. btest(INTEGRATORS(s%kind)%reads, i)) cycle
+         if (in_range(SETTINGS(i), setting_value(s, i))) cycle
+         if (SETTINGS(i)%type == T_INT) then
+            write (num, '(i0)') nint(setting_value(s, i))
+         else
+            write (num, '(es11.4)') setting_value(s, i)
+         end if
+         message = 'settings.'//trim(SETTINGS(i)%name)//' = '//trim(adjustl(num))// &
+            ' is invalid for '//integrator_name(s%kind)//': set it to '//trim(SETTINGS(i)%text)
+         return
+      end do
+      stat = MARTELLO_OK
+   end subroutine settings_check
+
+   ! ---------------------------------------------------------------- private helpers
+
+   pure logical function in_range(st, x)
+      type(setting_t), intent(in) :: st
+      real(dp), intent(in) :: x
+      logical :: lo_ok, hi_ok
+      lo_ok = merge(x > st%lo, x >= st%lo, st%lo_open)     ! NaN fails both bounds
+      hi_ok = merge(x < st%hi, x <= st%hi, st%hi_open)
+      in_range = lo_ok .and. hi_ok
+   end function in_range
+
+   !> Setting i (a row of the registry's table settings) of s, as a number.
+   pure real(dp) function setting_value(s, i) result(x)
+      type(integrator_settings_t), intent(in) :: s
+      integer, intent(in) :: i
+      select case (i)
+      case (S_DT); x = s%dt
+      case (S_T_END); x = s%t_end
+      case (S_BETA); x = s%beta
+      case (S_GAMMA); x = s%gamma
+      case (S_ALPHA); x = s%alpha
+      case (S_RHO_INF); x = s%rho_inf
+      case (S_TOL_RESIDUAL); x = s%tol_residual
+      case (S_TOL_INCREMENT); x = s%tol_increment
+      case (S_MAX_NEWTON); x = s%max_newton
+      case (S_CHECK_STABILITY); x = merge(1.0_dp, 0.0_dp, logical(s%check_stability))
+      case (S_EVERY); x = s%every
+      case (S_DIVERGENCE_FACTOR); x = s%divergence_factor
+      case (S_RTOL); x = s%rtol
+      case (S_ATOL); x = s%atol
+      case (S_THETA); x = s%theta
+      case (S_EVENT_TOL); x = s%event_tol
+      case (S_H_MAX); x = s%h_max
+      case default; x = 0.0_dp
+      end select
+   end function setting_value
 end module martello_integrator_settings

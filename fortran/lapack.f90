@@ -4,7 +4,7 @@ module martello_lapack
    use martello_kinds, only: dp
    implicit none
    private
-   public :: dgbsv, dgbtrf, dgbtrs, dlansy, dpbtrf, dpocon, dpotrf, dpotrs, dsbgvx, dsycon, dsytrf, dsytrs
+   public :: dgbsv, dgbtrf, dgbtrs, dlansy, dpbtrf, dpbtrs, dpocon, dpotrf, dpotrs, dsbgvx, dsycon, dsytrf, dsytrs
 
    interface
       subroutine dgbsv(n, kl, ku, nrhs, ab, ldab, ipiv, b, ldb, info)
@@ -42,6 +42,14 @@ module martello_lapack
          real(dp), intent(inout) :: ab(ldab, *)
          integer, intent(out) :: info
       end subroutine dpbtrf
+      subroutine dpbtrs(uplo, n, kd, nrhs, ab, ldab, b, ldb, info)
+         import :: dp
+         character, intent(in) :: uplo
+         integer, intent(in) :: n, kd, nrhs, ldab, ldb
+         real(dp), intent(in) :: ab(ldab, *)
+         real(dp), intent(inout) :: b(ldb, *)
+         integer, intent(out) :: info
+      end subroutine dpbtrs
       subroutine dpocon(uplo, n, a, lda, anorm, rcond, work, iwork, info)
          import :: dp
          character, intent(in) :: uplo

@@ -14,7 +14,7 @@ module martello_links
    public :: LINK_SPRING, LINK_DASHPOT, LINK_BILINEAR, LINK_FLUID_DAMPER, LINK_BAR
    public :: NPAR_LINK, L_STIFF, L_DAMP, L_YIELD, L_HARDENING, L_ALPHA, L_VREG
    public :: bilinear_return_map, bilinear_energy, fluid_damper_force, link_force
-   public :: link_name, link_is_known
+   public :: link_is_known
 
    ! Link kinds: values are frozen, the C and Python layers use the same integers.
    integer, parameter :: LINK_SPRING = 1
@@ -174,27 +174,6 @@ contains
          f_committed_new = f
       end select
    end subroutine link_force
-
-   !> Short lower-case name, as used in reports and by the Python layer.
-   pure function link_name(kind) result(name)
-      integer, intent(in) :: kind
-      character(len=:), allocatable :: name
-
-      select case (kind)
-      case (LINK_SPRING)
-         name = 'spring'
-      case (LINK_DASHPOT)
-         name = 'dashpot'
-      case (LINK_BILINEAR)
-         name = 'bilinear'
-      case (LINK_FLUID_DAMPER)
-         name = 'fluid_damper'
-      case (LINK_BAR)
-         name = 'bar'
-      case default
-         name = 'unknown'
-      end select
-   end function link_name
 
    elemental logical function link_is_known(kind)
       integer, intent(in) :: kind

@@ -1,13 +1,15 @@
 !> The scene as native code sees it: a 1D network of lumped masses (nodes), two-node links,
 !> unilateral contacts and loads. Node numbers are 1-based here; 0 means ground. The C door
-!> (api.f90) converts from the 0-based numbering of the C API.
+!> (api_model.f90) converts from the 0-based numbering of the C API. What derives from the
+!> whole model (the contacts' effective masses) is martello_effective_mass's.
 module martello_model
    use martello_kinds, only: dp
    use martello_status, only: MARTELLO_OK, MARTELLO_ERR_ARGUMENT
    use martello_time_functions, only: time_function_t, tf_is_known, TF_TABLE, NPAR_TF
-   use martello_contact_laws, only: NPAR_CONTACT, law_is_known, damping_from_restitution, &
-      P_RESTITUTION, P_DAMPING
+   use martello_contact_laws, only: NPAR_CONTACT, law_is_known, P_RESTITUTION, P_CLIP
    use martello_links, only: NPAR_LINK, link_is_known
+   use martello_registry, only: SCHEME_PENALTY, SCHEME_LAGRANGE, SCHEME_AUGMENTED, &
+      SCHEME_RESTITUTION, registry_name
    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
    implicit none
    private
@@ -15,11 +17,6 @@ module martello_model
       model_add_mass_coupling, model_add_nodal_force, model_set_ground_acceleration, &
       model_bandwidth, rigid_contact_sides, SCHEME_PENALTY, SCHEME_LAGRANGE, SCHEME_AUGMENTED, &
       SCHEME_RESTITUTION, scheme_name
-
-   integer, parameter :: SCHEME_PENALTY = 1      !< force law on the penetration
-   integer, parameter :: SCHEME_LAGRANGE = 2     !< non-penetration constraint, multiplier = force
-   integer, parameter :: SCHEME_AUGMENTED = 3    !< augmented Lagrangian (Uzawa), static only
-   integer, parameter :: SCHEME_RESTITUTION = 4  !< instantaneous impacts, Newton's e
 
    type :: model_t
       integer :: n = 0
@@ -33,6 +30,9 @@ module martello_model
       integer :: ncontact = 0
       integer, allocatable :: con_a(:), con_b(:), con_scheme(:), con_law(:)
       real(dp), allocatable :: con_gap(:), con_par(:, :) !< (NPAR_CONTACT, ncontact)
+      !> effective mass 1/(B M⁻¹ Bᵀ) of each contact (+inf if neither side moves), and the
+      !> damping derived from a target restitution: set by effective_mass_prepare before a run
+      real(dp), allocatable :: con_mstar(:)
       ! off-diagonal mass (consistent bar mass): M(a,b) = M(b,a) += value
       integer :: ncoupling = 0
       integer, allocatable :: mc_a(:), mc_b(:)
@@ -48,16 +48,11 @@ module martello_model
 
 contains
 
+   !> The scheme's name in the registry (and in scene files).
    pure function scheme_name(scheme) result(name)
       integer, intent(in) :: scheme
       character(len=:), allocatable :: name
-      select case (scheme)
-      case (SCHEME_PENALTY); name = 'penalty'
-      case (SCHEME_LAGRANGE); name = 'lagrange'
-      case (SCHEME_AUGMENTED); name = 'augmented-lagrange'
-      case (SCHEME_RESTITUTION); name = 'restitution'
-      case default; name = 'unknown'
-      end select
+      name = registry_name('schemes', scheme)
    end function scheme_name
 
    subroutine fail(m, stat, msg)
@@ -85,7 +80,7 @@ contains
                 m%link_par(NPAR_LINK, max_links))
       allocate (m%con_a(max_contacts), m%con_b(max_contacts), m%con_scheme(max_contacts), &
                 m%con_law(max_contacts), m%con_gap(max_contacts), &
-                m%con_par(NPAR_CONTACT, max_contacts))
+                m%con_par(NPAR_CONTACT, max_contacts), m%con_mstar(max_contacts))
       allocate (m%force_node(max_forces), m%force_fn(max_forces))
       allocate (m%mc_a(max_couplings), m%mc_b(max_couplings), m%mc_value(max_couplings))
    end subroutine model_init
@@ -163,6 +158,10 @@ contains
       if (.not. (ieee_is_finite(gap) .and. all(ieee_is_finite(par)))) then
          call fail(m, stat, 'add_contact: gap and parameters must be finite'); return
       end if
+      if (any(par(P_CLIP + 1:) /= 0.0_dp)) then
+         call fail(m, stat, 'add_contact: par[5] and above are reserved and must be 0 (the'// &
+                   ' effective mass m* is computed by the library from the masses)'); return
+      end if
       if (scheme == SCHEME_PENALTY .and. par(P_RESTITUTION) >= 0.0_dp) then
          if (par(P_RESTITUTION) > 1.0_dp) then
             call fail(m, stat, 'add_contact: target restitution must lie in [0, 1]'); return
@@ -172,9 +171,7 @@ contains
       m%con_a(m%ncontact) = a; m%con_b(m%ncontact) = b; m%con_gap(m%ncontact) = gap
       m%con_scheme(m%ncontact) = scheme; m%con_law(m%ncontact) = law
       m%con_par(:, m%ncontact) = par
-      ! Damping from a target restitution, by the law's own published formula (contact_laws).
-      if (scheme == SCHEME_PENALTY .and. par(P_RESTITUTION) >= 0.0_dp) &
-         m%con_par(P_DAMPING, m%ncontact) = damping_from_restitution(law, par(P_RESTITUTION), par)
+      m%con_mstar(m%ncontact) = 0.0_dp
    end subroutine model_add_contact
 
    subroutine model_add_mass_coupling(m, a, b, value, stat)

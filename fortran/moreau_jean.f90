@@ -14,9 +14,10 @@
 !>
 !>   0 ≤ ġ_{k+1} + e ġ_k ⊥ p_{k+1} ≥ 0,   ġ = B v = v_b − v_a = −δ̇,
 !>
-!> an LCP on the Delassus operator W = B Ŵ⁻¹ Bᵀ (martello_lcp: Lemke for up to LEMKE_MAX
-!> active contacts, projected Gauss–Seidel beyond, on a tridiagonal W when Ŵ is diagonal).
-!> Lagrange contacts are the same law with e = their restitution (default 0).
+!> an LCP on the Delassus operator W = B Ŵ⁻¹ Bᵀ, the shared impulse problem (martello_impulse,
+!> docs/impulse.md: Lemke for up to LEMKE_MAX active contacts, projected Gauss–Seidel beyond,
+!> on a tridiagonal W when Ŵ is diagonal). Lagrange contacts are the same law with e = their
+!> restitution (default 0).
 !>
 !> Discrete energy identity (linear forces): E_{k+1} − E_k = −(θ − ½)(‖Δv‖²_M + ‖Δq‖²_K)
 !> + Δqᵀ f_ext,θ + ġ_θᵀ p_{k+1}; the impulse work ġ_θ p = (1 − θ(1+e)) ġ_k p is ≤ 0 iff
@@ -37,18 +38,12 @@ module martello_moreau_jean
       observer_close_phase, C_NEWTON, C_RESIDUALS, C_FACTORIZATIONS, C_EVENTS, C_JACOBIANS
    use martello_integrator_settings, only: integrator_settings_t
    use martello_fixed_step, only: stepper_t, stepper_start, contact_state
-   use martello_lcp, only: lcp_lemke, lcp_pgs, LCP_OK
+   use martello_impulse, only: contact_graph_t, contact_graph, delassus_columns, &
+      delassus_bandwidth, delassus_diagonal_band, newton_impulses, IMPULSE_OK
    use martello_linalg, only: lapack_status
    implicit none
    private
-   public :: moreau_jean_t, LEMKE_MAX
-
-   !> Up to this many active contacts the LCP is solved by Lemke on a dense W (exact, O(n³)
-   !> at worst); beyond, by projected Gauss–Seidel on the band of W.
-   integer, parameter :: LEMKE_MAX = 64
-   !> PGS: stop when a sweep changes no impulse by more than PGS_TOL·max impulse
-   real(dp), parameter :: PGS_TOL = 1.0e-14_dp
-   integer, parameter :: PGS_MAX_SWEEPS = 100000
+   public :: moreau_jean_t
 
    type, extends(stepper_t) :: moreau_jean_t
       integer :: kd = 0, na = 0, kw = 0, iters = 0
@@ -56,10 +51,11 @@ module martello_moreau_jean
       logical :: thomas = .false.
       real(dp), allocatable :: fint(:), fint_n(:), fext(:), fext_n(:), rhs(:), work(:)
       real(dp), allocatable :: e_con(:), p(:), p_prev(:), ph_last(:)
-      integer, allocatable :: sa(:), sb(:), act(:), pos(:), ipiv(:), node_ptr(:), node_con(:)
+      integer, allocatable :: sa(:), sb(:), act(:), pos(:), ipiv(:)
+      type(contact_graph_t) :: graph   !< which rigid contacts share a node (martello_impulse)
       logical, allocatable :: rigid(:), movable(:)
       ! Delassus operator: dense (Lemke) and band (PGS), the columns Ŵ⁻¹Bᵀ (kd > 0), LCP data
-      real(dp), allocatable :: wd_(:, :), wb(:, :), zcol(:, :), qlcp(:), zlcp(:)
+      real(dp), allocatable :: wd_(:, :), wb(:, :), zcol(:, :), qlcp(:), zlcp(:), gref(:), eact(:)
       type(band_t) :: kband, cband, what
    contains
       procedure :: init
@@ -77,11 +73,6 @@ contains
       integer, intent(out) :: stat
       integer :: n, nc
       stat = MARTELLO_OK
-      if (.not. (s%theta >= 0.5_dp .and. s%theta <= 1.0_dp)) then
-         call observer_fail(o, MARTELLO_ERR_ARGUMENT, 0.0_dp, &
-                            'Moreau-Jean: theta must lie in [0.5, 1] (theta < 1/2 is unstable)', stat)
-         return
-      end if
       call stepper_start(self, m, s)
       n = m%n; nc = m%ncontact
       self%advice = 'the linearised smooth forces need a smaller step'
@@ -98,7 +89,7 @@ contains
       call band_init(self%cband, n, self%kd)
       call band_init(self%what, n, self%kd)
       call rigid_contact_sides(m, self%rigid, self%e_con, self%sa, self%sb, self%movable)
-      call node_adjacency()
+      call contact_graph(n, self%sa, self%sb, self%movable, self%graph)
       self%kband%ab = 0.0_dp; self%cband%ab = 0.0_dp
       call internal_forces(m, self%ms, self%u, self%v, self%fint, self%kband%ab, 1.0_dp, 0.0_dp, &
                            self%cband%ab)
@@ -108,35 +99,6 @@ contains
       o%counters(C_JACOBIANS) = o%counters(C_JACOBIANS) + 1_i8
       call contact_state(self, m, self%p, self%h)
 
-   contains
-
-      !> Contacts touching each node (rigid ones only): node_con(node_ptr(i):node_ptr(i+1)−1).
-      subroutine node_adjacency()
-         integer :: cnt(0:n), k
-         associate (sa => self%sa, sb => self%sb)
-            cnt = 0
-            do k = 1, nc
-               if (.not. self%movable(k)) cycle
-               if (sa(k) > 0) cnt(sa(k)) = cnt(sa(k)) + 1
-               if (sb(k) > 0) cnt(sb(k)) = cnt(sb(k)) + 1
-            end do
-            allocate (self%node_ptr(n + 2), self%node_con(max(1, sum(cnt(1:n)))))
-            self%node_ptr(1) = 1
-            do k = 1, n
-               self%node_ptr(k + 1) = self%node_ptr(k) + cnt(k)
-            end do
-            cnt = 0
-            do k = 1, nc
-               if (.not. self%movable(k)) cycle
-               if (sa(k) > 0) then
-                  self%node_con(self%node_ptr(sa(k)) + cnt(sa(k))) = k; cnt(sa(k)) = cnt(sa(k)) + 1
-               end if
-               if (sb(k) > 0) then
-                  self%node_con(self%node_ptr(sb(k)) + cnt(sb(k))) = k; cnt(sb(k)) = cnt(sb(k)) + 1
-               end if
-            end do
-         end associate
-      end subroutine node_adjacency
    end subroutine init
 
    !> One step: free velocity, index set, impulses, positions; the smooth forces and their
@@ -314,63 +276,35 @@ contains
          end associate
       end subroutine active_set
 
-      !> W, q of the LCP on the active contacts, solved; p(act) the impulses.
+      !> W of the active contacts (martello_impulse) and Newton's law on them; p(act) the
+      !> impulses. ġ_free = B v_free, ġ_ref = B v_k.
       subroutine impulses(inf)
          integer, intent(out) :: inf
-         integer :: ii, jj, k, node, side, cj
-         real(dp) :: si
+         integer :: ii, jj, k
          associate (na => self%na, kw => self%kw, kd => self%kd, act => self%act, &
                     pos => self%pos, sa => self%sa, sb => self%sb, v => self%v, vn => self%vn, &
-                    e_con => self%e_con, node_ptr => self%node_ptr, node_con => self%node_con, &
-                    what => self%what, iters => self%iters, p => self%p, p_prev => self%p_prev)
+                    e_con => self%e_con, what => self%what, iters => self%iters, p => self%p, &
+                    p_prev => self%p_prev)
             inf = 0
-            if (.not. allocated(self%qlcp)) allocate (self%qlcp(nc), self%zlcp(nc))
-            ! q = B v_free + e B v_k
+            if (allocated(self%qlcp)) then
+               if (size(self%qlcp) < na) deallocate (self%qlcp, self%zlcp, self%gref, self%eact)
+            end if
+            if (.not. allocated(self%qlcp)) allocate (self%qlcp(nc), self%zlcp(nc), self%gref(nc), &
+                                                      self%eact(nc))
             do ii = 1, na
                k = act(ii)
-               self%qlcp(ii) = (v(sb(k)) - v(sa(k))) + e_con(k)*(vn(sb(k)) - vn(sa(k)))
+               self%qlcp(ii) = v(sb(k)) - v(sa(k))
+               self%gref(ii) = vn(sb(k)) - vn(sa(k))
+               self%eact(ii) = e_con(k)
+               self%zlcp(ii) = p_prev(k)                ! warm start from the last step (PGS)
             end do
             if (kd == 0) then
-               ! Ŵ diagonal: W_ij = Σ over the nodes the two contacts share of s_i s_j / Ŵ_nn.
-               ! Its bandwidth in the active ordering is kw (1 for a chain).
-               kw = 0
-               do ii = 1, na
-                  k = act(ii)
-                  do side = 1, 2
-                     node = merge(sa(k), sb(k), side == 1)
-                     if (node == 0) cycle
-                     do jj = node_ptr(node), node_ptr(node + 1) - 1
-                        cj = node_con(jj)
-                        if (pos(cj) > 0) kw = max(kw, abs(pos(cj) - ii))
-                     end do
-                  end do
-               end do
+               ! Ŵ diagonal: W banded in the active ordering (tridiagonal for a chain)
+               kw = delassus_bandwidth(self%graph, sa, sb, act(1:na), pos)
                call ensure_band(kw)
-               self%wb(:, 1:na) = 0.0_dp
-               do ii = 1, na
-                  k = act(ii)
-                  do side = 1, 2
-                     node = merge(sa(k), sb(k), side == 1)
-                     if (node == 0) cycle
-                     si = merge(-1.0_dp, 1.0_dp, side == 1)
-                     do jj = node_ptr(node), node_ptr(node + 1) - 1
-                        cj = node_con(jj)
-                        if (pos(cj) == 0) cycle
-                        ! s_j at this node: −1 if it is cj's a side, +1 if its b side
-                        self%wb(kw + 1 + ii - pos(cj), pos(cj)) = self%wb(kw + 1 + ii - pos(cj), pos(cj)) + &
-                           si*merge(-1.0_dp, 1.0_dp, sa(cj) == node)/what%ab(1, node)
-                     end do
-                  end do
-               end do
-               if (na <= LEMKE_MAX) then
-                  call ensure_dense()
-                  self%wd_(1:na, 1:na) = 0.0_dp
-                  do jj = 1, na
-                     do ii = max(1, jj - kw), min(na, jj + kw)
-                        self%wd_(ii, jj) = self%wb(kw + 1 + ii - jj, jj)
-                     end do
-                  end do
-               end if
+               call delassus_diagonal_band(self%graph, sa, sb, act(1:na), pos, what%ab(1, :), kw, self%wb)
+               call newton_impulses(self%qlcp(1:na), self%gref(1:na), self%eact(1:na), &
+                                    self%zlcp(1:na), inf, iters, wb=self%wb, kw=kw)
             else
                ! W = B Ŵ⁻¹ Bᵀ from the columns Ŵ⁻¹ B_jᵀ (one multi-right-hand-side solve)
                if (allocated(self%zcol)) then
@@ -391,35 +325,13 @@ contains
                   call dgbtrs('N', n, kd, kd, na, what%ab, size(what%ab, 1), self%ipiv, self%zcol, n, inf)
                end if
                call ensure_dense()
-               do jj = 1, na
-                  do ii = 1, na
-                     k = act(ii)
-                     self%wd_(ii, jj) = 0.0_dp
-                     if (sb(k) > 0) self%wd_(ii, jj) = self%wd_(ii, jj) + self%zcol(sb(k), jj)
-                     if (sa(k) > 0) self%wd_(ii, jj) = self%wd_(ii, jj) - self%zcol(sa(k), jj)
-                  end do
-               end do
-               if (na > LEMKE_MAX) then
-                  kw = na - 1
-                  call ensure_band(kw)
-                  do jj = 1, na
-                     do ii = 1, na
-                        self%wb(kw + 1 + ii - jj, jj) = self%wd_(ii, jj)
-                     end do
-                  end do
-               end if
-            end if
-            if (na <= LEMKE_MAX) then
-               call lcp_lemke(self%wd_(1:na, 1:na), self%qlcp(1:na), self%zlcp(1:na), iters, inf)
-            else
-               do ii = 1, na
-                  self%zlcp(ii) = p_prev(act(ii))          ! warm start from the last step
-               end do
-               call lcp_pgs(self%wb(:, 1:na), kw, self%qlcp(1:na), self%zlcp(1:na), PGS_TOL, &
-                            PGS_MAX_SWEEPS, iters, inf)
+               call delassus_columns(sa(act(1:na)), sb(act(1:na)), self%zcol(:, 1:na), &
+                                     self%wd_(1:na, 1:na))
+               call newton_impulses(self%qlcp(1:na), self%gref(1:na), self%eact(1:na), &
+                                    self%zlcp(1:na), inf, iters, w=self%wd_(1:na, 1:na))
             end if
             o%counters(C_NEWTON) = o%counters(C_NEWTON) + int(iters, i8)
-            if (inf /= LCP_OK) then
+            if (inf /= IMPULSE_OK) then
                write (msg, '(a,i0,a,es12.5,a,i0,a)') 'Moreau-Jean: the impulse LCP on ', na, &
                   ' active contacts failed at t = ', t, ' s (', iters, &
                   ' iterations; redundant constraints or a contact between immobile sides?)'

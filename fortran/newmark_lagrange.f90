@@ -23,8 +23,10 @@
 !> acceleration is reset from equilibrium (the impulsive a_{n+1} must not enter the next
 !> Newmark predictor). Steps without impacts use β = ¼, γ = ½ with the persistent contacts
 !> (plastic impacts, Zeno) held by the multiplier, released when it turns tensile.
-!> Zeno: an impact whose rebound flight, at the pressing relative acceleration, would last
-!> less than one step (2 e v_imp < h δ̈) is made plastic and the contact persistent.
+!> Zeno: an impact whose next rebound flight, at the pressing relative acceleration, would be
+!> shorter than one step (the accumulation policy of docs/impulse.md §4 with the step as time
+!> resolution, martello_impulse's impulse_accumulation) is made plastic and the contact
+!> persistent.
 !> Dense KKT solves (LAPACK dsytrf): a scheme for the small problems P2 and P5.
 !>
 !> A stepper of the fixed-step strategy (martello_fixed_step, docs/run-layer.md).
@@ -41,6 +43,7 @@ module martello_newmark_lagrange
    use martello_integrator_settings, only: integrator_settings_t
    use martello_fixed_step, only: stepper_t, stepper_start, newmark_kinematics, contact_state
    use martello_linalg, only: solve_symmetric_indefinite
+   use martello_impulse, only: impulse_accumulation
    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
    implicit none
    private
@@ -219,8 +222,8 @@ contains
       integer, intent(out) :: stat
       integer :: n, nc, c, ci, attempt, imp_c
       real(dp) :: h, t_prev, beta, gamma, wdl, wll, wcl, alpha_imp, v_imp, e_eff, rr, d0, dd0, &
-                  ddd0, tau, best_alpha, lam_tol
-      logical :: converged, impact, released
+                  ddd0, tau, best_alpha, lam_tol, t_inf
+      logical :: converged, impact, released, zeno
       character(len=256) :: msg
       character(len=320) :: why
 
@@ -277,8 +280,11 @@ contains
             ddd0 = an(m%con_a(c)) - an(m%con_b(c))
             v_imp = dd0 + alpha_imp*h*ddd0
             e_eff = e_con(c)
-            ! Zeno: the rebound flight under the pressing acceleration would be < one step
-            if (ddd0 > 0.0_dp .and. 2.0_dp*e_eff*v_imp < h*ddd0) e_eff = 0.0_dp
+            ! Zeno: the next rebound flight under the pressing acceleration δ̈_n is shorter than
+            ! a step (one impact a step is what the tuned (β, γ) resolve)
+            call impulse_accumulation(e_eff, e_eff*max(v_imp, 0.0_dp), ddd0, t_prev + alpha_imp*h, &
+                                      h, 0.0_dp, zeno, t_inf)
+            if (zeno) e_eff = 0.0_dp
             rr = h*(dd0 + h*ddd0 + e_eff*v_imp)/(d0 + h*dd0 + 0.5_dp*h*h*ddd0)
             if (.not. (rr > 0.0_dp .and. ieee_is_finite(rr)) .or. v_imp <= 0.0_dp) then
                ! a graze (no approach speed): hold it as a persistent contact

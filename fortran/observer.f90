@@ -10,6 +10,7 @@ module martello_observer
    use martello_model, only: model_t
    use martello_assembly, only: mech_state_t, kinetic_energy, recoverable_energy, mass_times
    use martello_integrator_settings, only: integrator_settings_t, integrator_name
+   use martello_run_quantities
    use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan, ieee_is_finite
    implicit none
    private
@@ -21,20 +22,6 @@ module martello_observer
       C_JACOBIANS, C_ROOT_EVALS, C_CHATTER, NENERGY, E_KINETIC, E_RECOVERABLE, E_INPUT, E_DAMPING, &
       E_PLASTIC, E_CONTACT, E_BALANCE, E_INITIAL, E_IMPACT, NEVENT, EV_T_ON, EV_T_OFF, &
       EV_V_IN, EV_V_OUT, EV_MAX_PEN, EV_MAX_FORCE
-
-   ! cost counters
-   integer, parameter :: NCOUNTERS = 9
-   integer, parameter :: C_STEPS = 1, C_REJECTED = 2, C_NEWTON = 3, C_RESIDUALS = 4, &
-                         C_FACTORIZATIONS = 5, C_EVENTS = 6, C_JACOBIANS = 7, C_ROOT_EVALS = 8, &
-                         C_CHATTER = 9
-   ! energy terms [J]: balance = initial + input − kinetic − recoverable − dissipated (≈ 0)
-   integer, parameter :: NENERGY = 9
-   integer, parameter :: E_KINETIC = 1, E_RECOVERABLE = 2, E_INPUT = 3, E_DAMPING = 4, &
-                         E_PLASTIC = 5, E_CONTACT = 6, E_BALANCE = 7, E_INITIAL = 8, E_IMPACT = 9
-   ! one contact phase
-   integer, parameter :: NEVENT = 6
-   integer, parameter :: EV_T_ON = 1, EV_T_OFF = 2, EV_V_IN = 3, EV_V_OUT = 4, &
-                         EV_MAX_PEN = 5, EV_MAX_FORCE = 6
 
    type :: results_t
       ! history: hist(:, k) = [t, (u, v, a of each output node), (δ, P of each output

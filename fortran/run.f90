@@ -7,7 +7,7 @@ module martello_run
    use martello_status
    use martello_model, only: model_t
    use martello_integrator_settings
-   use martello_stability, only: mass_positive_definite
+   use martello_effective_mass, only: effective_mass_prepare
    use martello_run_checks, only: check_schemes
    use martello_observer, only: observer_t, observer_init
    use martello_fixed_step, only: run_fixed_step, stepper_t
@@ -41,8 +41,9 @@ module martello_run
 contains
 
    !> Validate the run against the model (outputs in range, schemes runnable by the
-   !> integrator, a positive definite mass matrix), size the results and run the integrator:
-   !> a one-step method on the fixed-step strategy, or a C integrator (docs/run-layer.md).
+   !> integrator, a positive definite mass matrix), derive the contacts' effective masses,
+   !> size the results and run the integrator: a one-step method on the fixed-step strategy,
+   !> or a C integrator (docs/run-layer.md).
    subroutine run_dynamic(mp, rp, stat)
       type(model_t), pointer, intent(in) :: mp
       type(run_t), pointer, intent(in) :: rp
@@ -51,7 +52,7 @@ contains
       class(stepper_t), allocatable :: stepper
       stat = MARTELLO_ERR_ARGUMENT
       if (.not. rp%configured) then
-         rp%results%message = 'dynamic_run: call martello_run_set_integrator first'
+         rp%results%message = 'dynamic_run: call martello_run_set_settings first'
          stat = MARTELLO_ERR_STATE; return
       end if
       if (any(rp%out_nodes < 1 .or. rp%out_nodes > mp%n) .or. &
@@ -65,13 +66,7 @@ contains
       call observer_init(rp%results, rp%settings, mp%n, mp%ncontact, rp%out_nodes, &
                          rp%out_contacts, cap, mp%nlink, rp%out_links)
       call check_schemes(mp, rp%settings%kind, rp%results%message, stat)
-      if (stat == MARTELLO_OK .and. mp%ncoupling > 0) then
-         if (.not. mass_positive_definite(mp)) then
-            stat = MARTELLO_ERR_ARGUMENT
-            rp%results%message = 'the mass matrix (node masses plus mass couplings) is not'// &
-               ' positive definite: a coupling is larger than the masses it joins allow'
-         end if
-      end if
+      if (stat == MARTELLO_OK) call effective_mass_prepare(mp, rp%results%message, stat)
       if (stat == MARTELLO_OK) then
          select case (rp%settings%kind)
          case (INT_NEWMARK, INT_HHT, INT_GENERALIZED_ALPHA)

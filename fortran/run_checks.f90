@@ -11,19 +11,13 @@ module martello_run_checks
 
 contains
 
-   !> dt, t_end and every positive; every contact's scheme runnable by the integrator; every
-   !> node set. stat /= MARTELLO_OK with message saying which.
+   !> Every contact's scheme runnable by the integrator; every node set (the settings were
+   !> validated by settings_check). stat /= MARTELLO_OK with message saying which.
    subroutine check_run_settings(m, s, message, stat)
       type(model_t), intent(in) :: m
       type(integrator_settings_t), intent(in) :: s
       character(len=*), intent(inout) :: message
       integer, intent(out) :: stat
-      stat = MARTELLO_OK
-      if (.not. (s%dt > 0.0_dp .and. s%t_end > 0.0_dp .and. s%every >= 1)) then
-         stat = MARTELLO_ERR_ARGUMENT
-         message = 'dynamic run: need dt > 0, t_end > 0 and every >= 1'
-         return
-      end if
       call check_schemes(m, s%kind, message, stat)
       if (stat /= MARTELLO_OK) return
       if (any(m%mass < 0.0_dp)) then

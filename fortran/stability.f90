@@ -6,13 +6,13 @@
 !> on the penetration, so only the run-time divergence detector guards them.
 module martello_stability
    use martello_kinds, only: dp
-   use martello_lapack, only: dpbtrf, dsbgvx
+   use martello_lapack, only: dsbgvx
    use martello_model, only: model_t, model_bandwidth, SCHEME_PENALTY
    use martello_links, only: LINK_SPRING, LINK_BAR, LINK_BILINEAR, L_STIFF
    use martello_contact_laws, only: LAW_LINEAR, LAW_KELVIN, P_STIFF
    implicit none
    private
-   public :: omega_max, mass_positive_definite
+   public :: omega_max, free_dofs, mass_band
 
 
 contains
@@ -22,7 +22,7 @@ contains
       type(model_t), intent(in) :: m
       real(dp), intent(out) :: w_max
       integer, intent(out) :: info
-      integer :: kd, nf, i, j, nfound
+      integer :: kd, nf, j, nfound
       integer, allocatable :: dof(:), iwork(:), ifail(:)
       real(dp), allocatable :: ka(:, :), mb(:, :), w(:), work(:)
       real(dp) :: q(1, 1), z(1, 1)
@@ -32,14 +32,9 @@ contains
       w_max = 0.0_dp; info = 0
       if (nf == 0) return
       ! upper band storage: A(i,j), i <= j, in ab(kd+1+i−j, j)
-      allocate (ka(kd + 1, nf), mb(kd + 1, nf), w(nf), work(7*nf), iwork(5*nf), ifail(nf))
-      ka = 0.0_dp; mb = 0.0_dp
-      do i = 1, m%n
-         if (dof(i) > 0) mb(kd + 1, dof(i)) = m%mass(i)
-      end do
-      do j = 1, m%ncoupling
-         call put(mb, dof(m%mc_a(j)), dof(m%mc_b(j)), m%mc_value(j), .false.)
-      end do
+      allocate (ka(kd + 1, nf), w(nf), work(7*nf), iwork(5*nf), ifail(nf))
+      ka = 0.0_dp
+      call mass_band(m, dof, nf, kd, mb)
       do j = 1, m%nlink
          select case (m%link_kind(j))
          case (LINK_SPRING, LINK_BAR, LINK_BILINEAR)
@@ -61,31 +56,20 @@ contains
          real(dp), intent(in) :: k
          if (ia > 0) ka(kd + 1, ia) = ka(kd + 1, ia) + k
          if (ib > 0) ka(kd + 1, ib) = ka(kd + 1, ib) + k
-         if (ia > 0 .and. ib > 0) call put(ka, ia, ib, -k, .false.)
+         if (ia > 0 .and. ib > 0) &
+            ka(kd + 1 + min(ia, ib) - max(ia, ib), max(ia, ib)) = &
+            ka(kd + 1 + min(ia, ib) - max(ia, ib), max(ia, ib)) - k
       end subroutine pair
-      subroutine put(band, ia, ib, val, diag)
-         real(dp), intent(inout) :: band(:, :)
-         integer, intent(in) :: ia, ib
-         real(dp), intent(in) :: val
-         logical, intent(in) :: diag
-         integer :: r, c
-         if (ia == 0 .or. ib == 0) return
-         if (diag) return
-         r = min(ia, ib); c = max(ia, ib)
-         band(kd + 1 + r - c, c) = band(kd + 1 + r - c, c) + val
-      end subroutine put
    end subroutine omega_max
-   !> Whether M (lumped diagonal plus consistent couplings) is positive definite on the free
-   !> nodes: banded Cholesky (dpbtrf) succeeds. Couplings from a scene can make it indefinite.
-   logical function mass_positive_definite(m) result(ok)
+
+   !> M (lumped diagonal plus consistent couplings) on the free nodes, dof-numbered, in
+   !> LAPACK's upper band storage: M(i,j), i <= j, in mb(kd+1+i−j, j). A coupling to a fixed
+   !> node drops out with that node's row and column.
+   pure subroutine mass_band(m, dof, nf, kd, mb)
       type(model_t), intent(in) :: m
-      integer :: kd, nf, i, j, info, ia, ib
-      integer, allocatable :: dof(:)
-      real(dp), allocatable :: mb(:, :)
-      kd = max(model_bandwidth(m), 0)
-      call free_dofs(m, dof, nf)
-      ok = .true.
-      if (nf == 0) return
+      integer, intent(in) :: dof(0:), nf, kd
+      real(dp), allocatable, intent(out) :: mb(:, :)
+      integer :: i, j, ia, ib
       allocate (mb(kd + 1, nf)); mb = 0.0_dp
       do i = 1, m%n
          if (dof(i) > 0) mb(kd + 1, dof(i)) = m%mass(i)
@@ -96,9 +80,8 @@ contains
          mb(kd + 1 + min(ia, ib) - max(ia, ib), max(ia, ib)) = &
             mb(kd + 1 + min(ia, ib) - max(ia, ib), max(ia, ib)) + m%mc_value(j)
       end do
-      call dpbtrf('U', nf, kd, mb, kd + 1, info)
-      ok = info == 0
-   end function mass_positive_definite
+   end subroutine mass_band
+
    !> Numbering of the free nodes: dof(i) in 1..nf, 0 for fixed nodes and ground (dof(0)).
    pure subroutine free_dofs(m, dof, nf)
       type(model_t), intent(in) :: m

@@ -1,6 +1,6 @@
-!> Status codes returned through the C door. The values must match the enum in c/martello.h
-!> (the C example `status_codes` checks that they do): 0 success, > 0 a result with a
-!> non-error outcome, < 0 failure.
+!> Status codes returned through the C door: 0 success, > 0 a result with a non-error
+!> outcome, < 0 failure. Their names and meanings are the registry's table "status"
+!> (fortran/registry.f90); tests/test_registry.py checks the enum of c/martello.h against it.
 module martello_status
    implicit none
    private

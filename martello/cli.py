@@ -1,14 +1,14 @@
 """The `martello` command line (git-like subcommands; exit code non-zero on any failure)."""
 
 import argparse
-import csv
 import json
 import sys
 from pathlib import Path
 
-from . import catalogue, native
-from . import scene as scene_mod
+from .binding import native
 from .errors import MartelloError
+from .scene import catalogue
+from .scene.loader import load
 
 DESCRIPTION = """\
 martello: verification and benchmark suite for contact and impact in structural dynamics.
@@ -33,7 +33,7 @@ def cmd_list(args):
         return 0
     width = max(len(str(f.relative_to(catalogue.ROOT.parent))) for f in files)
     for f in files:
-        s = scene_mod.load(f)
+        s = load(f)
         schemes = ",".join(sorted({c["scheme"] for c in s.contacts})) or "-"
         print(f"{str(f.relative_to(catalogue.ROOT.parent)):<{width}}  {s.problem or '-':<4} "
               f"{s.analysis['type']:<8} {schemes:<22} {s.title}")
@@ -41,9 +41,10 @@ def cmd_list(args):
 
 
 def cmd_run(args):
-    from .run import run_full, write_results
-    s = scene_mod.load(args.scene)
-    summary, history = run_full(s)
+    from .checks.measures import run_measured
+    from .run import write_results
+    s = load(args.scene)
+    summary, history = run_measured(s)     # with the problem's measures (P4), as check does
     out = Path(args.output) if args.output else Path("out") / Path(args.scene).stem
     path = write_results(summary, out, history)
     for w in summary.get("warnings", []):
@@ -53,6 +54,16 @@ def cmd_run(args):
     if args.print:
         print(json.dumps(summary, indent=2, default=float))
     return 0
+
+
+def cmd_study(args):
+    from .study import atlas, study_file, sweep
+    return (atlas if study_file.file_kind(args.study) == "atlas" else sweep).main(args)
+
+
+def cmd_compare(args):
+    from . import compare
+    return compare.main(args)
 
 
 def cmd_check(args):
@@ -104,7 +115,7 @@ def main(argv=None):
     p.add_argument("study", help="study file (TOML)")
     p.add_argument("-o", "--output", help="output folder (default: out/studies/<name>)")
     p.add_argument("-j", "--jobs", type=int, default=0, help="parallel runs (default: all cores)")
-    p.set_defaults(func=lambda a: __import__("martello.study", fromlist=["main"]).main(a))
+    p.set_defaults(func=cmd_study)
 
     p = sub.add_parser("compare", help="score another code's time history against a scene",
                        description="Score a foreign time history (CSV, columns documented in "
@@ -114,7 +125,7 @@ def main(argv=None):
     p.add_argument("history", help="the other code's history (CSV)")
     p.add_argument("--against", required=True, help="scene file (TOML) it claims to solve")
     p.add_argument("-o", "--output", help="write the scores as JSON here")
-    p.set_defaults(func=lambda a: __import__("martello.compare", fromlist=["main"]).main(a))
+    p.set_defaults(func=cmd_compare)
 
     p = sub.add_parser("version", help="versions of martello and the libraries it links")
     p.set_defaults(func=_print_version)

@@ -16,9 +16,13 @@ from pathlib import Path
 
 import numpy as np
 
-from . import check, metrics
-from . import scene as scene_mod
+from .checks.verify import digits, lookup, oracle_values
 from .errors import MartelloError
+from .history import history_dict
+from .metrics.from_history import summary_from_history
+from .metrics.score import COST_KEYS, history_errors, score
+from .reference.selection import reference_for_scene
+from .scene.loader import load
 
 NODE_KINDS = ("u", "v", "a")
 CONTACT_KINDS = ("penetration", "force")
@@ -111,12 +115,12 @@ def comparable(columns, ref):
 
 def compare(history_path, scene_path):
     """Score a history CSV against a scene's reference; returns the report dict."""
-    sc = scene_mod.load(scene_path)
+    sc = load(scene_path)
     if sc.analysis.get("type") != "dynamic":
         raise MartelloError(f"{scene_path}: a static scene has no time history to compare with "
                             "(compare its nodal values with `martello check`)")
     columns, data = read_history(history_path, sc)
-    ref = metrics.reference_for_scene(sc)
+    ref = reference_for_scene(sc)
     if ref is None:
         raise MartelloError(f"{scene_path}: no reference to compare with: no closed-form history "
                             "and no stored reference data (reference/references.toml; "
@@ -125,43 +129,43 @@ def compare(history_path, scene_path):
     if not cols:
         raise HistoryError(history_path, "no column can be compared with the reference",
                            "the reference has " + ", ".join(c for c in ref.columns))
-    h = metrics.history_dict((columns, data))
+    h = history_dict((columns, data))
     t = h["t"]
     if t[0] > ref.t_end or t[-1] < 0:
         raise HistoryError(history_path, f"its times [{t[0]}, {t[-1]}] s miss the reference's "
                            f"[0, {ref.t_end}] s")
     # a closed form is exact anywhere: compare at their times; stored data at its samples
     times = t[t <= ref.t_end * (1 + 1e-12)] if ref.kind == "closed-form" else None
-    summary = metrics.summary_from_history(sc, (columns, data))
+    summary = summary_from_history(sc, (columns, data))
     u_cols = [c for c in cols if c.startswith("u:")] or cols[:1]
-    m = metrics.score(summary, (columns, data), ref, columns=u_cols, times=times)
+    m = score(summary, (columns, data), ref, columns=u_cols, times=times)
     per_column = {}
     for c in cols:
-        e = metrics.history_errors((columns, data), ref, [c], times)
+        e = history_errors((columns, data), ref, [c], times)
         per_column[c] = {"max_abs_error": e.get(f"max_abs_error:{c}"), "max_rel_error": e["max_rel_error"],
                          "scd": e["scd"], "mescd": e["mescd"]}
     checks = []
     if sc.check:
         try:
-            oracle = check.oracle_values(sc.check, sc.source)
+            oracle = oracle_values(sc.check, sc.source)
         except MartelloError:
             oracle = {}
         for item in sc.check["compare"]:
             try:
-                value = float(check.lookup(summary, item["result"]))
+                value = float(lookup(summary, item["result"]))
             except (KeyError, TypeError, ValueError):
                 checks.append({"quantity": item["result"], "note": "not derivable from a history"})
                 continue
             refv = float(oracle[item["oracle"]])
             tol = (item.get("atol") or 0.0) + (item.get("rtol") or 0.0) * abs(refv)
             checks.append({"quantity": item["result"], "value": value, "reference": refv,
-                           "digits": check.digits(value, refv), "tolerance": tol,
+                           "digits": digits(value, refv), "tolerance": tol,
                            "within_catalogue_tolerance": abs(value - refv) <= tol})
     span = [float(t[0]), float(min(t[-1], ref.t_end))]
     return {"history": str(history_path), "scene": str(scene_path), "reference": ref.name,
             "reference_kind": ref.kind, "reference_digits": ref.trusted_digits(u_cols),
             "compared_columns": cols, "time_span": span, "rows": int(len(t)),
-            "score_scd": m.get("scd"), "metrics": {k: v for k, v in m.items() if k not in metrics.COST_KEYS},
+            "score_scd": m.get("scd"), "metrics": {k: v for k, v in m.items() if k not in COST_KEYS},
             "per_column": per_column, "checks": checks,
             "derived_events": {k: {kk: v[kk] for kk in ("impact_times", "restitution",
                                                         "phase_max_penetration")}

@@ -16,6 +16,15 @@ class SceneError(MartelloError):
         super().__init__(msg)
 
 
+class StudyError(MartelloError):
+    """A study or atlas file is invalid: the message names the file, the field and what is
+    valid."""
+
+    def __init__(self, file, field, problem, fix=None):
+        msg = f"{file}: {field}: {problem}" + (f" ({fix})" if fix else "")
+        super().__init__(msg)
+
+
 class RecordError(MartelloError):
     """A ground-motion record (CSV or PEER AT2) is unreadable or inconsistent."""
 

@@ -7,12 +7,13 @@ import sys
 import time
 from pathlib import Path
 
-from . import native
-from . import scene as scene_mod
-from .check import verify
-from .metrics import verify_reference_data
+from .binding import native
+from .checks.measures import run_measured
+from .checks.reference_data import verify_reference_data
+from .checks.verify import verify
 from .errors import MartelloError
-from .run import run_full, write_results
+from .run import write_results
+from .scene.loader import load
 
 
 def _fmt(x):
@@ -28,8 +29,8 @@ def check_catalogue(files, outdir, plots=True, stream=sys.stdout):
     print("-" * len(header), file=stream)
     for k, path in enumerate(files, 1):
         try:
-            s = scene_mod.load(path)
-            summary, history = run_full(s)
+            s = load(path)
+            summary, history = run_measured(s)     # with the problem's measures (P4)
             write_results(summary, outdir / "runs" / Path(path).stem, history)
             schemes = ",".join(sorted({c["scheme"] for c in s.contacts})) or "-"
             # closed form where the scene names one, else the stored reference data (reference/)
@@ -144,7 +145,7 @@ def _write_markdown(rows, failures, pngs, path, elapsed):
              f"martello {native.version()}; {native.library_versions()}; "
              f"{time.strftime('%Y-%m-%d %H:%M UTC', time.gmtime())}; {elapsed:.1f} s.", "",
              "Each row compares one quantity of one run with the closed form named in the "
-             "scene's `[check]` table (martello.closed_forms, coded independently of the "
+             "scene's `[check]` table (martello.oracles, coded independently of the "
              "solvers) or, for scenes without one, with the stored reference data in "
              "`reference/` (event-located, tight tolerance; such a row passes when the error is "
              "within twice what this scene's own settings showed when the reference was made: "

@@ -7,38 +7,12 @@ from pathlib import Path
 
 import numpy as np
 
-from . import native
-from .native import constant
-from .records import read_record
+from .binding import native
+from .binding.native import constant
+from .ground_motion.records import read_record
 
-LAW_CONST = {"linear": "LAW_LINEAR", "hertz": "LAW_HERTZ", "kelvin": "LAW_KELVIN",
-             "hunt-crossley": "LAW_HUNT_CROSSLEY", "lankarani-nikravesh": "LAW_LANKARANI_NIKRAVESH",
-             "flores": "LAW_FLORES", "gonthier": "LAW_GONTHIER", "hertzdamp": "LAW_HERTZDAMP",
-             "jankowski": "LAW_JANKOWSKI"}
-# Default exponent n of each law's elastic part F ~ δ^n.
-LAW_EXPONENT = {"linear": 1.0, "kelvin": 1.0, "hertz": 1.5, "hunt-crossley": 1.5,
-                "lankarani-nikravesh": 1.5, "flores": 1.5, "gonthier": 1.5, "hertzdamp": 1.5,
-                "jankowski": 1.5}
-SCHEME_CONST = {"penalty": "SCHEME_PENALTY", "lagrange": "SCHEME_LAGRANGE",
-                "augmented-lagrange": "SCHEME_AUGMENTED", "restitution": "SCHEME_RESTITUTION"}
-LINK_CONST = {"spring": "LINK_SPRING", "dashpot": "LINK_DASHPOT", "bilinear": "LINK_BILINEAR",
-              "fluid_damper": "LINK_FLUID_DAMPER", "bar": "LINK_BAR"}
-
-
-def effective_mass(scene, a, b):
-    """m* = m_a m_b/(m_a + m_b); a ground (or fixed) side is infinitely heavy."""
-    def m(i):
-        if i < 0 or scene.nodes[i]["fixed"]:
-            return np.inf
-        return scene.nodes[i]["mass"]
-    ma, mb = m(a), m(b)
-    if np.isinf(ma) and np.isinf(mb):
-        return np.inf
-    if np.isinf(ma):
-        return mb
-    if np.isinf(mb):
-        return ma
-    return ma * mb / (ma + mb)
+# Default exponent n of each law's elastic part F ~ δ^n (fixed, or Hertz's when the law reads it).
+LAW_EXPONENT = {r.name: r.values["exponent"] for r in native.registry("laws")}
 
 
 def _link_par(lk):
@@ -63,11 +37,9 @@ def _link_par(lk):
 def _contact_par(scene, c):
     par = np.zeros(constant("NPAR_CONTACT"))
     par[constant("P_RESTITUTION")] = -1.0
-    mstar = effective_mass(scene, c["a"], c["b"])
-    par[constant("P_MSTAR")] = mstar if np.isfinite(mstar) else 0.0
     law = 0
     if c["scheme"] == "penalty":
-        law = constant(LAW_CONST[c["law"]])
+        law = native.value("laws", c["law"])
         par[constant("P_STIFF")] = c["stiffness"]
         par[constant("P_EXPONENT")] = c["exponent"] or LAW_EXPONENT[c["law"]]
         if c["damping"] is not None:
@@ -112,10 +84,10 @@ def build_model(scene):
     for i, n in enumerate(scene.nodes):
         m.set_node(i, n["mass"], n["u0"], n["v0"], n["fixed"])
     for lk in scene.links:
-        m.add_link(constant(LINK_CONST[lk["type"]]), lk["a"], lk["b"], _link_par(lk))
+        m.add_link(native.value("links", lk["type"]), lk["a"], lk["b"], _link_par(lk))
     for c in scene.contacts:
         law, par = _contact_par(scene, c)
-        m.add_contact(c["a"], c["b"], c["gap"], constant(SCHEME_CONST[c["scheme"]]), law, par)
+        m.add_contact(c["a"], c["b"], c["gap"], native.value("schemes", c["scheme"]), law, par)
     for mc in scene.couplings:
         m.add_mass_coupling(mc["a"], mc["b"], mc["value"])
     m.set_gravity(scene.gravity)
@@ -149,28 +121,11 @@ def run_full(scene, raise_on_failure=True):
         return _dynamic(scene, model, raise_on_failure)
 
 
-INTEGRATOR_CONST = {"newmark": "INT_NEWMARK", "hht": "INT_HHT",
-                    "generalized-alpha": "INT_GENERALIZED_ALPHA",
-                    "central-difference": "INT_CENTRAL_DIFFERENCE", "moreau-jean": "INT_MOREAU_JEAN",
-                    "newmark-lagrange": "INT_NEWMARK_LAGRANGE", "rkf45": "INT_RKF45",
-                    "rk8pd": "INT_RK8PD", "msbdf": "INT_MSBDF", "ida": "INT_IDA"}
-
-
-def integrator_par(an):
-    """The analysis table -> the native integrator parameter array."""
-    par = np.zeros(constant("NPAR_INTEGRATOR"))
-    def put(slot, value):
-        par[constant(slot)] = value
-    put("R_DT", an["dt"]); put("R_T_END", an["t_end"])
-    put("R_BETA", an["beta"] or 0.0); put("R_GAMMA", an["gamma"] or 0.0)
-    put("R_ALPHA", an["alpha"] or 0.0)
-    put("R_RHO_INF", an["rho_inf"] if an["rho_inf"] is not None else 1.0)
-    put("R_TOL_RESIDUAL", an["tol_residual"]); put("R_TOL_INCREMENT", an["tol_increment"])
-    put("R_MAX_NEWTON", an["max_newton"]); put("R_CHECK_STABILITY", 1.0 if an["check_stability"] else 0.0)
-    put("R_EVERY", an["output"]["every"]); put("R_DIVERGENCE_FACTOR", an["divergence_factor"])
-    put("R_RTOL", an["rtol"]); put("R_ATOL", an["atol"]); put("R_THETA", an["theta"])
-    put("R_EVENT_TOL", an["event_tol"]); put("R_H_MAX", an["h_max"])
-    return par
+def integrator_settings(an):
+    """The analysis table -> the native settings: the library's defaults, overridden by every
+    setting the table gives (output.every is the setting every)."""
+    given = {k: an[k] for k in native.settings_defaults() if an.get(k) is not None}
+    return native.settings(an["integrator"], **given, every=an["output"]["every"])
 
 
 def integrator_description(an):
@@ -197,7 +152,7 @@ def _dynamic(scene, model, raise_on_failure=True):
     cnames = [c["name"] for c in scene.contacts]
     out_contacts = [cnames.index(c) for c in an["output"]["contacts"]]
     with native.Run() as r:
-        r.set_integrator(constant(INTEGRATOR_CONST[an["integrator"]]), integrator_par(an))
+        r.set_settings(integrator_settings(an))
         r.set_outputs(out_nodes, out_contacts)
         lnames = [l["name"] for l in scene.links]
         out_links = [lnames.index(n) for n in an["output"]["links"]]
@@ -213,6 +168,9 @@ def _dynamic(scene, model, raise_on_failure=True):
         counters = r.counters()
         message = r.message()
 
+    columns = native.history_columns(an["output"]["nodes"], an["output"]["contacts"],
+                                     an["output"]["links"])
+    col = {name: i for i, name in enumerate(columns)}
     nodes = {}
     for i, n in enumerate(scene.nodes):
         nodes[n["name"]] = {"u_max": float(peaks["u_max"][i]), "u_min": float(peaks["u_min"][i]),
@@ -220,10 +178,9 @@ def _dynamic(scene, model, raise_on_failure=True):
                             "a_absmax": float(peaks["a_absmax"][i])}
         if peaks["t_peak"][i] >= 0:
             nodes[n["name"]].update(u_peak=float(peaks["u_peak"][i]), t_peak=float(peaks["t_peak"][i]))
-        if an["output"]["nodes"] and n["name"] in an["output"]["nodes"] and len(hist):
-            k = an["output"]["nodes"].index(n["name"])
-            nodes[n["name"]].update(u_final=float(hist[-1, 1 + k]),
-                                    v_final=float(hist[-1, 1 + len(an["output"]["nodes"]) + k]))
+        if f"u:{n['name']}" in col and len(hist):
+            nodes[n["name"]].update(u_final=float(hist[-1, col[f"u:{n['name']}"]]),
+                                    v_final=float(hist[-1, col[f"v:{n['name']}"]]))
     contacts = {}
     # events grouped by contact once (a long chain has one or more per contact)
     order = np.argsort(ev_contacts, kind="stable")
@@ -248,9 +205,8 @@ def _dynamic(scene, model, raise_on_failure=True):
             contacts[c["name"]]["contact_time"] = float(closed[0, 1] - closed[0, 0])  # first phase
         if c["name"] in an["output"]["contacts"] and len(hist):
             # the state at t_end: a persistent contact's multiplier (e.g. k h − m g after Zeno)
-            k = 1 + 3 * len(an["output"]["nodes"]) + an["output"]["contacts"].index(c["name"])
-            contacts[c["name"]]["penetration_final"] = float(hist[-1, k])
-            contacts[c["name"]]["force_final"] = float(hist[-1, k + len(an["output"]["contacts"])])
+            contacts[c["name"]]["penetration_final"] = float(hist[-1, col[f"penetration:{c['name']}"]])
+            contacts[c["name"]]["force_final"] = float(hist[-1, col[f"force:{c['name']}"]])
             contacts[c["name"]]["lambda_final"] = 0.0 - contacts[c["name"]]["force_final"]  # seed sign
         if c["scheme"] in ("restitution", "lagrange"):
             # the start of the first lasting contact phase: the accumulation (Zeno) time of
@@ -281,15 +237,6 @@ def _dynamic(scene, model, raise_on_failure=True):
         "cost": counters | {"wall_time_s": wall},
         "provenance": provenance(scene),
     }
-    columns = ["t"] + [f"u:{n}" for n in an["output"]["nodes"]] + \
-              [f"v:{n}" for n in an["output"]["nodes"]] + [f"a:{n}" for n in an["output"]["nodes"]] + \
-              [f"penetration:{c}" for c in an["output"]["contacts"]] + \
-              [f"force:{c}" for c in an["output"]["contacts"]] + \
-              [f"link_force:{l}" for l in an["output"]["links"]] + \
-              [f"elongation:{l}" for l in an["output"]["links"]] + \
-              [f"energy:{e}" for e in native.ENERGY_NAMES]
-    from .measures import attach     # problem-specific measures (e.g. rod impact, P4)
-    attach(scene, summary, (columns, hist))
     return summary, (columns, hist)
 
 

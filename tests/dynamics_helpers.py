@@ -2,8 +2,8 @@
 
 import numpy as np
 
-from martello import scene
 from martello.run import run_full
+from martello.scene.loader import from_dict
 
 
 def dynamic(integrator="newmark", dt=1e-3, t_end=1.0, every=1, **extra):
@@ -29,7 +29,7 @@ def sdof(m=1.0, k=100.0, analysis=None, links=(), **node):
 
 
 def execute(d):
-    summary, (columns, data) = run_full(scene.from_dict(d))
+    summary, (columns, data) = run_full(from_dict(d))
     return summary, {c: data[:, i] for i, c in enumerate(columns)}
 
 

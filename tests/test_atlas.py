@@ -1,5 +1,5 @@
-"""The stability atlas (martello.atlas): classification of runs, and the central-difference
-boundary, which must fall at Δt_crit = 2/ω_max (PROBLEMS.md "Integrators": h_crit = 2/ω for
+"""The stability atlas (martello.study.atlas): classification of runs, and the central-difference
+boundary, which must fall at Δt_crit = 2/ω_max (docs/problems.md "Integrators": h_crit = 2/ω for
 an undamped oscillator). Tiny sweeps; the committed atlas is run by `martello study`."""
 
 import csv
@@ -11,8 +11,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from martello import atlas
-from martello.study import execute
+from martello.batch import execute
+from martello.study import atlas
 
 ROOT = Path(__file__).resolve().parent.parent
 CD = {"label": "central difference", "integrator": "central-difference",

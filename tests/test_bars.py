@@ -1,20 +1,22 @@
-"""Two bars in dynamic contact (issue 5, PROBLEMS.md P4): the [[bar]] mesher, the wave-theory
-oracles of martello.wave_theory, the rod-impact measures, and the issue's "What must show":
-exactness at Courant number 1, convergence rates under refinement, penetration ~ 1/ε.
-Oracles: martello.closed_forms.rod_impact and martello.wave_theory (d'Alembert only).
-docs/p4-bars.md derives every rate and tolerance used here."""
+"""Two bars in dynamic contact (docs/problems.md P4): the [[bar]] mesher, the wave-theory
+oracles of martello.oracles.p4_wave_theory, the rod-impact measures, and what P4 must show
+(docs/p4-bars.md): exactness at Courant number 1, convergence rates under refinement,
+penetration ~ 1/ε. Oracles: martello.oracles.p4_rod_impact.rod_impact and
+martello.oracles.p4_wave_theory (d'Alembert only). docs/p4-bars.md derives every rate and
+tolerance used here."""
 
 import math
 
 import numpy as np
 import pytest
 
-from martello import closed_forms as cf
-from martello import scene
-from martello.bars import rod_impact_scene
+from martello.checks.measures import attach, rod_impact_measures, run_measured
 from martello.errors import DivergenceError, SceneError
+from martello.oracles.p4_rod_impact import rod_impact_interface_displacement
+from martello.oracles.p4_wave_theory import X_STAR, penalty_rod_impact, rod_point_displacement
 from martello.run import run_full
-from martello.wave_theory import X_STAR, penalty_rod_impact, rod_point_displacement
+from martello.scene.bars import rod_impact_scene
+from martello.scene.loader import from_dict
 from tests.dynamics_helpers import slope
 
 E, RHO, A, L, V0 = 2.0e11, 7850.0, 1.0e-4, 1.0, 1.0
@@ -35,9 +37,14 @@ def bar_scene(*bars, analysis=None, **top):
     return d
 
 
-def measures(**kw):
-    summary, _ = run_full(scene.from_dict(rod_impact_scene(**kw)))
+def measures_of(d):
+    """The rod-impact measures of a run of the scene dict d, as `martello run` reports them."""
+    summary, _ = run_measured(from_dict(d))
     return summary["measures"]["rod_impact"]
+
+
+def measures(**kw):
+    return measures_of(rod_impact_scene(**kw))
 
 
 # --- the mesher --------------------------------------------------------------------------------
@@ -47,14 +54,14 @@ def measures(**kw):
 def test_mass_matrix_sums_to_rho_A_L(mass, ends, N):
     # 1ᵀM1 = ρAL for every mass matrix (rigid translation carries the whole mass): an identity,
     # so the tolerance is a few ulps of the sum.
-    s = scene.from_dict(bar_scene(rod(elements=N, mass=mass, ends=ends)))
+    s = from_dict(bar_scene(rod(elements=N, mass=mass, ends=ends)))
     total = sum(n["mass"] for n in s.nodes) + 2.0 * sum(c["value"] for c in s.couplings)
     assert total == pytest.approx(5.0 * 2.0, rel=8 * N * np.finfo(float).eps)
 
 
 def test_one_element_rod():
     # the degenerate size: two end nodes, one element, half the mass each (lumped)
-    s = scene.from_dict(bar_scene(rod(elements=1)))
+    s = from_dict(bar_scene(rod(elements=1)))
     assert [n["name"] for n in s.nodes] == ["A.left", "A.right"]
     assert [n["mass"] for n in s.nodes] == [5.0, 5.0]
     assert len(s.links) == 1 and s.links[0]["L"] == 2.0
@@ -62,7 +69,7 @@ def test_one_element_rod():
 
 def test_consistent_mass_entries():
     # ρA L_e/6 [[2, 1], [1, 2]] per element: ends ρAL_e/3, interior 2ρAL_e/3, neighbours ρAL_e/6
-    s = scene.from_dict(bar_scene(rod(mass="consistent")))
+    s = from_dict(bar_scene(rod(mass="consistent")))
     me = 5.0 * 0.5
     assert [n["mass"] for n in s.nodes] == pytest.approx([me / 3, 2 * me / 3, 2 * me / 3, 2 * me / 3, me / 3],
                                                          rel=1e-15)
@@ -74,7 +81,7 @@ def test_consistent_mass_entries():
 
 
 def test_names_links_and_info():
-    s = scene.from_dict(bar_scene(rod(x0=3.0, v0=2.0)))
+    s = from_dict(bar_scene(rod(x0=3.0, v0=2.0)))
     assert [n["name"] for n in s.nodes] == ["A.left", "A.1", "A.2", "A.3", "A.right"]
     assert all(n["v0"] == 2.0 for n in s.nodes)
     assert [(s.nodes[l["a"]]["name"], s.nodes[l["b"]]["name"]) for l in s.links] == \
@@ -89,8 +96,8 @@ def test_names_links_and_info():
 
 def test_E_A_rho_equal_EA_rhoA():
     b = {k: v for k, v in rod().items() if k not in ("EA", "rhoA")}
-    a = scene.from_dict(bar_scene(dict(b, E=3.0e10, A=1.0e-4, rho=5.0e4)))
-    b = scene.from_dict(bar_scene(rod()))
+    a = from_dict(bar_scene(dict(b, E=3.0e10, A=1.0e-4, rho=5.0e4)))
+    b = from_dict(bar_scene(rod()))
     assert [n["mass"] for n in a.nodes] == pytest.approx([n["mass"] for n in b.nodes], rel=1e-15)
     assert [l["EA"] for l in a.links] == pytest.approx([l["EA"] for l in b.links], rel=1e-15)
 
@@ -98,7 +105,7 @@ def test_E_A_rho_equal_EA_rhoA():
 def test_half_cell_layout_and_supports():
     # N cells, a node of mass ρA L_e at each centre, N−1 elements; a held end is tied to
     # ground by the half cell (a bar of L_e/2)
-    s = scene.from_dict(bar_scene(rod(ends="half-cell", fixed="both")))
+    s = from_dict(bar_scene(rod(ends="half-cell", fixed="both")))
     assert [n["mass"] for n in s.nodes] == [2.5] * 4
     assert s.extras["bars"][0]["x"] == [0.25, 0.75, 1.25, 1.75]
     supports = [l for l in s.links if -1 in (l["a"], l["b"])]
@@ -107,7 +114,7 @@ def test_half_cell_layout_and_supports():
 
 
 def test_fixed_end_nodes():
-    s = scene.from_dict(bar_scene(rod(fixed="left", v0=1.0)))
+    s = from_dict(bar_scene(rod(fixed="left", v0=1.0)))
     assert [n["fixed"] for n in s.nodes] == [True, False, False, False, False]
     assert s.nodes[0]["v0"] == 0.0 and s.nodes[1]["v0"] == 1.0
 
@@ -117,9 +124,9 @@ def test_fixed_end_nodes():
 def test_output_nodes(output, expected):
     an = {"type": "dynamic", "integrator": "newmark", "dt": 1e-3, "t_end": 1e-2}
     d = bar_scene(rod(output=output), analysis=an, node=[{"name": "m", "mass": 1.0}])
-    assert scene.from_dict(d).analysis["output"]["nodes"] == expected
+    assert from_dict(d).analysis["output"]["nodes"] == expected
     an["output"] = {"nodes": ["A.2"]}
-    kept = scene.from_dict(bar_scene(rod(output=output), analysis=an)).analysis["output"]["nodes"]
+    kept = from_dict(bar_scene(rod(output=output), analysis=an)).analysis["output"]["nodes"]
     assert kept[0] == "A.2" and len(kept) == len(set(kept))
 
 
@@ -153,25 +160,25 @@ def test_bar_error_paths(change, field):
         else:
             b[k] = v
     with pytest.raises(SceneError, match=field):
-        scene.from_dict(bar_scene(b))
+        from_dict(bar_scene(b))
 
 
 def test_name_clashes():
     with pytest.raises(SceneError, match=r"bar\[1\]\.name: duplicate name 'A'"):
-        scene.from_dict(bar_scene(rod(), rod()))
+        from_dict(bar_scene(rod(), rod()))
     with pytest.raises(SceneError, match=r"bar\[0\]\.name: generates the node 'A.left'"):
-        scene.from_dict(bar_scene(rod(), node=[{"name": "A.left", "mass": 1.0}]))
+        from_dict(bar_scene(rod(), node=[{"name": "A.left", "mass": 1.0}]))
     with pytest.raises(SceneError, match=r"bar: must be a non-empty array"):
-        scene.from_dict(bar_scene())
+        from_dict(bar_scene())
 
 
 # --- wave theory (independent oracles) -----------------------------------------------------------
 
 @pytest.mark.parametrize("LB,wall", [(1.0, False), (2.0, False), (1.0, True)])
 def test_point_displacement_agrees_with_closed_forms_at_the_face(LB, wall):
-    # two independent codings of d'Alembert: images at depth 0 vs closed_forms' pulse integral
+    # two independent codings of d'Alembert: images at depth 0 vs p4_rod_impact's pulse integral
     t = np.linspace(0.0, 5.0 * 2 * LB / C, 997)
-    uA, uB = cf.rod_impact_interface_displacement(t, E, RHO, L, LB, V0, wall=wall)
+    uA, uB = rod_impact_interface_displacement(t, E, RHO, L, LB, V0, wall=wall)
     a = V0 * t + rod_point_displacement(0.0, t, C, L, LB, V0, "a", wall=wall)
     assert np.max(np.abs(a - uA)) <= 1e-13 * V0 * L / C
     if not wall:
@@ -306,13 +313,22 @@ def test_penalty_penetration_scales_like_one_over_eps(integrator, courant):
 def test_measures_need_one_contact_between_free_rod_ends():
     d = rod_impact_scene(N=4)
     d["contact"].append(dict(d["contact"][0], name="other"))
-    summary, _ = run_full(scene.from_dict(d))
-    m = summary["measures"]["rod_impact"]
+    m = measures_of(d)
     assert m["applicable"] is False and "2 contacts" in m["notes"][0]
     d = rod_impact_scene(N=4)
     d["bar"][1]["fixed"] = "right"
-    summary, _ = run_full(scene.from_dict(d))
-    assert "fixed end" in summary["measures"]["rod_impact"]["notes"][0]
+    assert "fixed end" in measures_of(d)["notes"][0]
+
+
+def test_measures_are_attached_by_the_reporting_layer_not_by_the_run():
+    # the run layer knows no oracle: run_full leaves the summary without measures, attach
+    # (called by `martello run` and `martello check` through run_measured) adds them
+    s = from_dict(rod_impact_scene(N=4))
+    summary, history = run_full(s)
+    assert "measures" not in summary
+    attach(s, summary, history)
+    assert summary["measures"]["rod_impact"] == rod_impact_measures(s, summary, history)
+    assert list(summary)[-1] == "measures"
 
 
 def test_measures_say_what_is_missing_from_the_output():

@@ -52,7 +52,7 @@ def test_list_shows_one_line_per_scene():
     r = martello("list")
     assert r.returncode == 0
     lines = [l for l in r.stdout.splitlines() if l.strip()]
-    from martello import catalogue
+    from martello.scene import catalogue
     assert len(lines) == len(catalogue.scene_files()) >= 30
     assert any("P1" in l and "lagrange" in l for l in lines)
 

@@ -10,8 +10,10 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from martello import compare, metrics, scene
+from martello import compare
 from martello.errors import MartelloError
+from martello.reference.closed_form import kelvin_bounce_reference
+from martello.scene.loader import load
 
 ROOT = Path(__file__).resolve().parent.parent
 KELVIN = ROOT / "benchmarks" / "p2" / "p2_penalty_kelvin.toml"
@@ -26,7 +28,7 @@ def write_csv(path, columns, data):
 @pytest.fixture(scope="module")
 def exact_kelvin(tmp_path_factory):
     """The exact P2 Kelvin history sampled every 0.1 ms, as another code would write it."""
-    ref = metrics.kelvin_bounce_reference(0.7, 1.0, 100.0, 0.05, 9.81, 1e6, restitution=0.8)
+    ref = kelvin_bounce_reference(0.7, 1.0, 100.0, 0.05, 9.81, 1e6, restitution=0.8)
     t = np.linspace(0.0, 0.7, 7001)
     r = ref.at(t, ["u:mass", "v:mass", "penetration:plane", "force:plane"])
     cols = ["t"] + list(r)
@@ -65,7 +67,7 @@ def test_a_perturbed_history_scores_lower(tmp_path, exact_kelvin):
 def test_a_martello_run_against_stored_reference_data(tmp_path):
     # P7 two oscillators has no closed form: the reference is reference/p7_two_oscillators
     from martello.run import run_full, write_results
-    s = scene.load(TWO)
+    s = load(TWO)
     summary, hist = run_full(s)
     write_results(summary, tmp_path / "run", hist)
     rep = compare.compare(tmp_path / "run" / "history.csv", TWO)

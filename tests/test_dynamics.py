@@ -1,14 +1,18 @@
-"""Dynamics core (issue 3): penalty impacts against P5, the elasto-plastic SDOF against P6,
-a damped SDOF under ground motion against its exact solution, energy balance, stability of
-central difference, and the error paths of dynamic runs. Oracles: martello.closed_forms."""
+"""Dynamics core (docs/integrators.md): penalty impacts against P5, the elasto-plastic SDOF
+against P6, a damped SDOF under ground motion against its exact solution, energy balance,
+stability of central difference, and the error paths of dynamic runs. Oracles:
+martello.oracles."""
 
 import math
 
 import numpy as np
 import pytest
 
-from martello import closed_forms as cf
+from martello.checks.dispatchers import two_body_impact
 from martello.errors import DivergenceError, SceneError, SolverError
+from martello.oracles.linear_sdof import sdof_sine_ground_response
+from martello.oracles.p5_contact_laws import hertz_impact, kelvin_xi_from_e, linear_contact_time
+from martello.oracles.p6_hysteresis import elastoplastic_impulse
 from tests.dynamics_helpers import dynamic, execute, interpolated_peak, sdof, slope, two_bodies
 
 
@@ -21,7 +25,7 @@ def test_kelvin_unclipped_realises_target_restitution(e):
     k, mstar = 1e4, 0.5
     w = math.sqrt(k / mstar)
     dt = 1e-6 / w
-    tc = math.pi / (w * math.sqrt(1 - cf.kelvin_xi_from_e(e) ** 2))
+    tc = math.pi / (w * math.sqrt(1 - kelvin_xi_from_e(e) ** 2))
     s, _ = execute(two_bodies("kelvin", k, restitution=e,
                               analysis=dynamic(dt=dt, t_end=1.05 * tc, every=10 ** 7)))
     c = s["contacts"]["impact"]
@@ -39,16 +43,16 @@ def test_linear_contact_time_and_penetration():
     s, _ = execute(two_bodies("linear", k, m1, m2, v0, gap=1e-4,
                               analysis=dynamic(dt=3e-4 / w, t_end=5e-5 + 1.2 * math.pi / w, every=10 ** 6)))
     c = s["contacts"]["impact"]
-    assert c["contact_time"] == pytest.approx(cf.linear_contact_time(mstar, k), rel=1e-6)
+    assert c["contact_time"] == pytest.approx(linear_contact_time(mstar, k), rel=1e-6)
     assert c["max_penetration"] == pytest.approx(v0 * math.sqrt(mstar / k), rel=1e-6)
     assert c["restitution"][0] == pytest.approx(1.0, abs=1e-6)
 
 
 def test_hertz_penetration_and_contact_time():
-    # δ_max and t_c = 2.94327518 δ_max/v0 (PROBLEMS.md P5): O(h²) errors, 1e-5 is the issue's bar.
+    # δ_max and t_c = 2.94327518 δ_max/v0 (docs/problems.md P5): O(h²) errors, 1e-5 is the bar.
     kh, m1, m2, v0 = 1e9, 2.0, 2.0, 0.5
     mstar = 1.0
-    ref = cf.hertz_impact(mstar, kh, v0)
+    ref = hertz_impact(mstar, kh, v0)
     dt = ref.t_c / 2e4
     s, _ = execute(two_bodies("hertz", kh, m1, m2, v0, gap=1e-6,
                               analysis=dynamic(dt=dt, t_end=2e-6 + 1.2 * ref.t_c, every=10 ** 6)))
@@ -61,10 +65,10 @@ def test_hertz_penetration_and_contact_time():
                                    ("flores", 0.4), ("gonthier", 0.7), ("hertzdamp", 0.85),
                                    ("jankowski", 0.65)])
 def test_viscoelastic_laws_realise_their_published_restitution(law, e):
-    # The realised e of each law is a closed form of its damping factor (PROBLEMS.md P5), not
+    # The realised e of each law is a closed form of its damping factor (docs/problems.md P5), not
     # the target: e.g. Lankarani–Nikravesh undershoots damping. Measured errors ≤ 1e-8 for the
     # HC family at this step (force continuous), ~5e-6 for Jankowski (δ^{1/4} damping, low order).
-    ref = cf.two_body_impact(law, 1.0, 1.0, 1.0, 1e8, restitution=e)
+    ref = two_body_impact(law, 1.0, 1.0, 1.0, 1e8, restitution=e)
     s, _ = execute(two_bodies(law, 1e8, restitution=e, gap=1e-4,
                               analysis=dynamic(dt=2e-8, t_end=4e-3, every=10 ** 6)))
     tol = 1e-4 if law == "jankowski" else 1e-6
@@ -77,7 +81,7 @@ def test_viscoelastic_laws_realise_their_published_restitution(law, e):
 @pytest.mark.parametrize("rho", [0.0, 0.05])
 def test_elastoplastic_peak_converges_at_second_order(integrator, rho):
     m, k, uy, v0 = 1.0, 100.0, 0.01, 0.5
-    ref = cf.elastoplastic_impulse(m, k, uy, rho, v0)
+    ref = elastoplastic_impulse(m, k, uy, rho, v0)
     hs, eu, et = [], [], []
     for n in (400, 800, 1600, 3200):
         dt = 0.6 / n
@@ -89,7 +93,7 @@ def test_elastoplastic_peak_converges_at_second_order(integrator, rho):
         umax, tmax = interpolated_peak(h["t"], h["u:m"], h["v:m"], h["a:m"])
         hs.append(dt); eu.append(abs(umax - ref.u_max)); et.append(abs(tmax - ref.t_max))
     # Both integrators are second order; the yield kink inside a step keeps O(h²) globally.
-    # ±0.1 is the issue's bar; the fit is over an 8× range of h.
+    # ±0.1 is the bar for a measured order; the fit is over an 8× range of h.
     assert slope(hs, eu) == pytest.approx(2.0, abs=0.1), eu
     assert slope(hs, et) == pytest.approx(2.0, abs=0.1), et
     assert eu[-1] < 1e-5 * ref.u_max   # sub-micrometre at the finest step (measured 7.7e-7 relative)
@@ -117,17 +121,17 @@ def test_sdof_sine_ground_motion_converges_at_the_integrator_order(integrator, p
                  links=[{"type": "dashpot", "a": "m", "b": "ground", "c": c}])
         d["loads"] = {"ground_acceleration": {"type": "sine", "amplitude": A, "omega": Om}}
         _, h = execute(d)
-        ref = cf.sdof_sine_ground_response(m, k, zeta, A, Om, h["t"])
+        ref = sdof_sine_ground_response(m, k, zeta, A, Om, h["t"])
         hs.append(dt); errs.append(np.max(np.abs(h["u:m"] - ref.u)))
-    # measured slopes are within 0.02 of the theory; ±0.1 as in the issue
+    # measured slopes are within 0.02 of the theory; ±0.1 as for every measured order
     assert slope(hs, errs) == pytest.approx(order, abs=0.1), errs
 
 
 # --- energy balance -------------------------------------------------------------------------
 
 def test_energy_balance_closes_on_every_dynamic_catalogue_scene():
-    from martello import catalogue
     from martello.run import run
+    from martello.scene import catalogue
     checked = 0
     for s in catalogue.scenes():
         if s.analysis["type"] != "dynamic":
@@ -242,17 +246,17 @@ def test_lagrange_on_a_structural_integrator_is_refused():
 def test_dynamic_analysis_errors_name_the_field(change, field):
     an = dynamic(dt=1e-3, t_end=1.0)
     an.update(change)
-    from martello import scene
+    from martello.scene.loader import from_dict
     with pytest.raises(SceneError) as info:
-        scene.from_dict(two_bodies("linear", 1e6, analysis=an), source="dyn.toml")
+        from_dict(two_bodies("linear", 1e6, analysis=an), source="dyn.toml")
     assert info.value.field == field, str(info.value)
 
 
 def test_history_columns_and_decimation(tmp_path):
-    from martello import scene
     from martello.run import run_full, write_results
+    from martello.scene.loader import from_dict
     d = two_bodies("linear", 1e6, gap=1e-4, analysis=dynamic(dt=1e-6, t_end=1e-3, every=10))
-    summary, hist = run_full(scene.from_dict(d))
+    summary, hist = run_full(from_dict(d))
     write_results(summary, tmp_path, hist)
     header = (tmp_path / "history.csv").read_text().splitlines()[0].split(",")
     assert header[:3] == ["t", "u:m1", "u:m2"] and "force:impact" in header
@@ -266,9 +270,10 @@ def test_history_columns_and_decimation(tmp_path):
 def test_record_ground_motion_equals_the_same_table(name):
     # A record drives the scene exactly as the table of its samples (in m/s², scaled) does:
     # same native table function, so the two runs agree to round-off; the units of the file
-    # (g here) are converted by martello.records, checked independently in test_records.py.
+    # (g here) are converted by martello.ground_motion.records, checked independently in
+    # test_records.py.
     from pathlib import Path
-    from martello.records import read_record
+    from martello.ground_motion.records import read_record
     f = Path(__file__).parent / "data" / "records" / name
     rec = read_record(f, scale=1.25)
     base = sdof(1.0, 400.0, links=[{"type": "dashpot", "a": "m", "b": "ground", "zeta": 0.05}],

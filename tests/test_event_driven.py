@@ -1,24 +1,27 @@
-"""Event-driven integration on GSL odeiv2 (issue 4, items 1, 2 and 6; c/event_driven.c,
-docs/event-driven.md): P2 restitution against its closed form (impact times and speeds, the
-Zeno time, the resting force), P5 Newton velocities to round-off over mass ratios 1e-6…1e6,
+"""Event-driven integration on GSL odeiv2 (c/event_driven.c, docs/event-driven.md): P2
+restitution against its closed form (impact times and speeds, the Zeno time, the resting
+force), P5 Newton velocities to round-off over mass ratios 1e-6…1e6,
 the three steppers against each other, penalty runs converging to the event-driven
 restitution reference at the rate ε^(-1/2) (P2 and a two-oscillator P7 chain), grazing
 contacts inside one step, release of a persistent contact, simultaneous impacts, and every
-error path. Oracles: martello.closed_forms, or closed forms written out here."""
+error path. Oracles: martello.oracles, or closed forms written out here."""
 
 import math
 
 import numpy as np
 import pytest
 
-from martello import closed_forms as cf
-from martello import scene
+from martello.binding.native import Model, Run, constant
+from martello.checks.dispatchers import bouncing_kelvin_events
 from martello.errors import DivergenceError, SolverError
-from martello.native import Model, Run, constant
-from martello.run import INTEGRATOR_CONST, integrator_par
+from martello.oracles.p2_bouncing import (bouncing_oscillator_restitution,
+                                          bouncing_oscillator_restitution_no_gravity)
+from martello.oracles.p5_contact_laws import newton_impact
+from martello.run import integrator_settings
+from martello.scene.loader import from_dict
 from tests.dynamics_helpers import execute, slope
 
-M, K, H, G = 1.0, 100.0, 0.05, 9.81          # PROBLEMS.md P2 example
+M, K, H, G = 1.0, 100.0, 0.05, 9.81          # docs/problems.md P2 example
 STEPPERS = ("rkf45", "rk8pd", "msbdf")
 TIGHT = {"rtol": 1e-12, "atol": 1e-14}
 EPS = float(np.finfo(float).eps)
@@ -67,9 +70,9 @@ P2_T_END = {0.0: 0.5, 0.5: 1.0, 0.8: 2.0, 1.0: 2.2}
 def test_p2_impact_times_and_speeds(e):
     # rk8pd at rtol 1e-12: the flights are smooth and the roots are located to event_tol =
     # 1e-12 s, so the impact times carry the integration error only (measured ≤ 2.7e-12 s,
-    # speeds ≤ 4e-12 m/s); 1e-9 (absolute, times ~1 s and speeds ~1 m/s) is the issue's bar.
+    # speeds ≤ 4e-12 m/s); 1e-9 (absolute, times ~1 s and speeds ~1 m/s) is the bar.
     s, hist = execute(p2(restitution(e), adaptive(t_end=P2_T_END[e], **TIGHT)))
-    ref = cf.bouncing_oscillator_restitution(M, K, H, G, e, 10)
+    ref = bouncing_oscillator_restitution(M, K, H, G, e, 10)
     t, vin, _ = impacts_of(s["contacts"]["plane"])
     assert len(t) >= len(ref.t)
     n = len(ref.t)                    # 10, or 1 for e = 0 (a plastic impact sticks)
@@ -88,7 +91,7 @@ def test_p2_zeno_time_and_resting_force(e):
     # multiplier is the P1 Lagrange force k h − m g, exact to rounding once u = h (measured 0
     # relative, 1e-9 bar).
     s, hist = execute(p2(restitution(e), adaptive(t_end=2.0, **TIGHT)))
-    ref = cf.bouncing_oscillator_restitution(M, K, H, G, e, 10)
+    ref = bouncing_oscillator_restitution(M, K, H, G, e, 10)
     _, _, persistent = impacts_of(s["contacts"]["plane"])
     assert len(persistent) == 1
     assert abs(persistent[0] - ref.zeno_time) <= 1e-6
@@ -112,7 +115,7 @@ def test_the_three_steppers_agree(stepper):
     # from the step start. Measured worst impact-time errors: rkf45 2.5e-12 s, rk8pd 1.5e-12 s,
     # msbdf 2.9e-10 s; Zeno time within 2.5e-7 s for msbdf (fifth order at most).
     s, _ = execute(p2(restitution(0.8), adaptive(stepper, t_end=1.5, **TIGHT)))
-    ref = cf.bouncing_oscillator_restitution(M, K, H, G, 0.8, 10)
+    ref = bouncing_oscillator_restitution(M, K, H, G, 0.8, 10)
     t, vin, persistent = impacts_of(s["contacts"]["plane"])
     assert np.abs(t[:10] - ref.t).max() <= 1e-8
     assert np.abs(vin[:10] - ref.v).max() <= 1e-8
@@ -145,7 +148,7 @@ def test_p5_newton_velocities_to_round_off(ratio, e, stepper):
                       "restitution": e}],
          "analysis": adaptive(stepper, dt=1e-3, t_end=2e-3)}
     s, _ = execute(d)
-    ref = cf.newton_impact(m1, m2, v1, v2, e)
+    ref = newton_impact(m1, m2, v1, v2, e)
     w1, w2 = s["nodes"]["m1"]["v_final"], s["nodes"]["m2"]["v_final"]
     assert abs(w1 - ref.v1) <= 8 * EPS * abs(ref.v1)
     assert abs(w2 - ref.v2) <= 8 * EPS * abs(ref.v2)
@@ -193,7 +196,7 @@ def test_persistent_contact_released_when_the_multiplier_changes_sign():
                                                          "omega": 2.0, "t_start": 0.2}}]
     s, hist = execute(d)
     c = s["contacts"]["plane"]
-    t1 = cf.bouncing_oscillator_restitution(M, K, H, G, 0.0, 1).t[0]
+    t1 = bouncing_oscillator_restitution(M, K, H, G, 0.0, 1).t[0]
     t_release = 0.2 + math.asin((M * G - K * H) / 10.0) / 2.0
     assert c["impact_times"][:2] == pytest.approx([t1, t1], abs=1e-9)
     assert c["separation_times"][1] == pytest.approx(t_release, abs=1e-9)
@@ -218,7 +221,7 @@ def test_grazing_contact_inside_one_step_is_not_missed(stepper):
     d = p2(restitution(1.0), adaptive(stepper, dt=2.0, t_end=2.0, rtol=1e-8, atol=1e-16),
            h=h, g=0.0, v0=A * w)
     s, _ = execute(d)
-    ref = cf.bouncing_oscillator_restitution_no_gravity(M, K, h, A * w, 1.0, 3)
+    ref = bouncing_oscillator_restitution_no_gravity(M, K, h, A * w, 1.0, 3)
     c = s["contacts"]["plane"]
     window = 2.0 * math.acos(h / A) / w
     assert 2.0 / s["cost"]["steps"] > 20 * window        # mean step ≫ the contact window
@@ -247,11 +250,11 @@ def test_grazing_penalty_contact_inside_one_step_is_not_missed():
 def test_penalty_events_on_gsl_match_the_semi_analytic_solution():
     # A linear penalty plane (ε = 1e6 N/m) on rk8pd: onset, peak and separation are located
     # events, so no step straddles the kink of the force and the event times carry only the
-    # integration error against closed_forms.bouncing_kelvin_events (measured ≤ 3e-13 s,
+    # integration error against checks.dispatchers.bouncing_kelvin_events (measured ≤ 3e-13 s,
     # peaks ≤ 1.3e-13 relative; bars 1e-9 s and 1e-10, a thousand rtol).
     eps = 1e6
     s, _ = execute(p2(linear_penalty(eps), adaptive(t_end=0.7, **TIGHT)))
-    ref = cf.bouncing_kelvin_events(M, K, H, G, eps, 3)
+    ref = bouncing_kelvin_events(M, K, H, G, eps, 3)
     c = s["contacts"]["plane"]
     for i in range(3):
         assert c["impact_times"][i] == pytest.approx(ref[f"t_impact_{i}"], abs=1e-9)
@@ -273,7 +276,7 @@ def test_penalty_on_gsl_converges_to_restitution_p2():
     # Measured slope −0.502 over ε/k = 1e2…1e8.
     s, _ = execute(p2(restitution(1.0), adaptive(t_end=0.4, **TIGHT)))
     t2 = s["contacts"]["plane"]["impact_times"][1]
-    assert t2 == pytest.approx(cf.bouncing_oscillator_restitution(M, K, H, G, 1.0, 2).t[1], abs=1e-9)
+    assert t2 == pytest.approx(bouncing_oscillator_restitution(M, K, H, G, 1.0, 2).t[1], abs=1e-9)
     ratios = 10.0 ** np.arange(2, 9)
     errors = [_second_impact_error(linear_penalty(K * r), "rk8pd", t2, **TIGHT) for r in ratios]
     assert slope(K * ratios, errors) == pytest.approx(-0.5, abs=0.03)
@@ -369,14 +372,16 @@ def test_rtol_at_rounding_level_is_refused():
         execute(p2(restitution(0.5), adaptive(t_end=0.1, rtol=1e-16)))
 
 
-@pytest.mark.parametrize("slot,value,what", [("R_EVENT_TOL", 0.0, "event_tol must be > 0"),
-                                             ("R_ATOL", -1.0, "atol must be > 0"),
-                                             ("R_H_MAX", -1.0, "h_max must be >= 0")])
-def test_bad_settings_through_the_c_api(slot, value, what):
-    # The scene loader refuses these already; the library checks them again for C callers.
-    sc = scene.from_dict(p2(restitution(0.5), adaptive(t_end=0.1)))
-    par = integrator_par(sc.analysis)
-    par[constant(slot)] = value
+@pytest.mark.parametrize("field,value,what", [
+    ("event_tol", 0.0, "settings.event_tol = 0.0000E+00 is invalid for rk8pd: set it to a number > 0"),
+    ("atol", -1.0, "settings.atol = -1.0000E+00 is invalid for rk8pd: set it to a number > 0"),
+    ("h_max", -1.0, "settings.h_max = -1.0000E+00 is invalid for rk8pd: set it to a number >= 0")])
+def test_bad_settings_through_the_c_api(field, value, what):
+    # The scene loader refuses these already (from the same registry ranges); the library
+    # checks them once, in martello_run_set_settings, for C callers.
+    sc = from_dict(p2(restitution(0.5), adaptive(t_end=0.1)))
+    s = integrator_settings(sc.analysis)
+    setattr(s, field, value)
     m = Model(1, 1, 1, 0)
     m.set_node(0, M)
     lpar = np.zeros(constant("NPAR_LINK"))
@@ -386,6 +391,8 @@ def test_bad_settings_through_the_c_api(slot, value, what):
     cpar[constant("P_RESTITUTION")] = 0.5
     m.add_contact(0, -1, H, constant("SCHEME_RESTITUTION"), 0, cpar)
     r = Run()
-    r.set_integrator(constant(INTEGRATOR_CONST["rk8pd"]), par)
-    assert r.status_of(m) == constant("MARTELLO_ERR_ARGUMENT")
+    with pytest.raises(SolverError, match="settings") as info:
+        r.set_settings(s)
+    assert info.value.status == constant("MARTELLO_ERR_ARGUMENT")
     assert what in r.message()
+    assert r.status_of(m) == constant("MARTELLO_ERR_STATE")   # refused settings are not kept

@@ -1,7 +1,7 @@
-"""SUNDIALS IDA (issue 4, item 3): penalty scenes as implicit ODEs restarted at every contact
+"""SUNDIALS IDA (docs/ida.md): penalty scenes as implicit ODEs restarted at every contact
 onset and separation, Lagrange/restitution scenes as a stabilised index-2 DAE (GGL) with
-IDA's root finding for impacts, closings and releases (docs/ida.md). Oracles:
-martello.closed_forms, coded independently of the solvers.
+IDA's root finding for impacts, closings and releases. Oracles: martello.oracles, coded
+independently of the solvers.
 
 Tolerances: IDA controls the local error to rtol·|y| + atol per step; what reaches an event
 time is the global error of the flight before it, which accumulates over the steps and the
@@ -13,11 +13,13 @@ import math
 import numpy as np
 import pytest
 
-from martello import closed_forms as cf
+from martello.checks.dispatchers import bouncing_kelvin_events, two_body_impact
 from martello.errors import SolverError
+from martello.oracles.p2_bouncing import bouncing_oscillator_restitution
+from martello.oracles.p5_contact_laws import linear_contact_time, newton_impact
 from tests.dynamics_helpers import dynamic, execute, two_bodies
 
-M, K, H, G = 1.0, 100.0, 0.05, 9.81          # P2 of PROBLEMS.md
+M, K, H, G = 1.0, 100.0, 0.05, 9.81          # P2 of docs/problems.md
 
 
 def ida(rtol=1e-10, atol=1e-14, dt=1e-3, t_end=0.7, **extra):
@@ -50,7 +52,7 @@ def test_p2_penalty_linear_event_times():
     s, _ = execute(p2({"scheme": "penalty", "law": "linear", "stiffness": eps}, ida()))
     assert s["status"] == "MARTELLO_OK"
     c = s["contacts"]["plane"]
-    ref = cf.bouncing_kelvin_events(M, K, H, G, eps, 3)
+    ref = bouncing_kelvin_events(M, K, H, G, eps, 3)
     for i in range(3):
         assert rel(c["impact_times"][i], ref[f"t_impact_{i}"]) < 3e-8
         assert rel(c["separation_times"][i], ref[f"t_separation_{i}"]) < 3e-8
@@ -64,7 +66,7 @@ def test_p2_penalty_kelvin_force_jump_is_not_stepped_across():
     eps = 1e6
     s, _ = execute(p2({"scheme": "penalty", "law": "kelvin", "stiffness": eps, "restitution": 0.8}, ida()))
     c = s["contacts"]["plane"]
-    ref = cf.bouncing_kelvin_events(M, K, H, G, eps, 3, restitution=0.8)
+    ref = bouncing_kelvin_events(M, K, H, G, eps, 3, restitution=0.8)
     for i in range(3):
         assert rel(c["impact_times"][i], ref[f"t_impact_{i}"]) < 2e-8
         assert rel(c["separation_times"][i], ref[f"t_separation_{i}"]) < 2e-8
@@ -73,7 +75,7 @@ def test_p2_penalty_kelvin_force_jump_is_not_stepped_across():
 def test_p2_penalty_error_follows_the_tolerance():
     # The event-time error scales with rtol (the flights are smooth and the kinks are
     # restarts): measured 9.1e-8, 2.3e-9, 2.3e-11 at rtol 1e-8, 1e-10, 1e-12.
-    ref = cf.bouncing_kelvin_events(M, K, H, G, 1e6, 3)
+    ref = bouncing_kelvin_events(M, K, H, G, 1e6, 3)
     errs = []
     for rtol in (1e-8, 1e-12):
         s, _ = execute(p2({"scheme": "penalty", "law": "linear", "stiffness": 1e6},
@@ -95,7 +97,7 @@ def test_p2_restitution_impacts_zeno_and_resting_force():
     e, rtol, atol = 0.8, 1e-12, 1e-16
     s, hist = execute(p2({"scheme": "restitution", "restitution": e}, ida(rtol, atol, t_end=1.6)))
     c = s["contacts"]["plane"]
-    ref = cf.bouncing_oscillator_restitution(M, K, H, G, e, 5)
+    ref = bouncing_oscillator_restitution(M, K, H, G, e, 5)
     for i in range(5):
         assert rel(c["impact_times"][i], ref.t[i]) < 1e-10
         assert rel(c["approach_speeds"][i], ref.v[i]) < 1e-10
@@ -119,7 +121,7 @@ def test_p2_lagrange_sticks_at_first_impact():
     # linear in P: the Newton solve is exact, measured error 0 (bar 1e-12 relative).
     s, hist = execute(p2({"scheme": "lagrange"}, ida(t_end=1.0)))
     c = s["contacts"]["plane"]
-    ref = cf.bouncing_oscillator_restitution(M, K, H, G, 0.0, 1)
+    ref = bouncing_oscillator_restitution(M, K, H, G, 0.0, 1)
     assert c["impacts"] == 1
     assert rel(c["impact_times"][0], ref.t[0]) < 3e-9            # measured 2.3e-10
     after = hist["t"] > ref.t[0] + 1e-9
@@ -155,7 +157,7 @@ def test_p5_penalty_laws(law, k, e):
     s, _ = execute(two_bodies(law, k, 1.0, 2.0, 1.0, gap=1e-3,
                               analysis=ida(rtol=1e-10, atol=1e-15, dt=1e-4, t_end=5e-3), **extra))
     c = s["contacts"]["impact"]
-    ref = cf.two_body_impact(law, 1.0, 2.0, 1.0, k, restitution=e)
+    ref = two_body_impact(law, 1.0, 2.0, 1.0, k, restitution=e)
     assert c["impacts"] == 1
     assert c["restitution"][0] == pytest.approx(ref["restitution"], rel=2e-8)
     if "contact_time" in ref:
@@ -165,11 +167,12 @@ def test_p5_penalty_laws(law, k, e):
 
 
 def test_p5_linear_contact_time():
-    # The issue's P5 check: pi sqrt(m*/k), m* = 2/3, k = 1e6. Measured 1.5e-11 at rtol 1e-10.
+    # The P5 check (docs/problems.md): pi sqrt(m*/k), m* = 2/3, k = 1e6. Measured 1.5e-11 at
+    # rtol 1e-10.
     s, _ = execute(two_bodies("linear", 1e6, 1.0, 2.0, 1.0, gap=1e-3,
                               analysis=ida(rtol=1e-10, atol=1e-15, dt=1e-4, t_end=5e-3)))
     assert s["contacts"]["impact"]["contact_time"] == pytest.approx(
-        cf.linear_contact_time(2.0 / 3.0, 1e6), rel=1e-9)
+        linear_contact_time(2.0 / 3.0, 1e6), rel=1e-9)
 
 
 @pytest.mark.parametrize("e", [0.0, 0.3, 1.0])
@@ -182,7 +185,7 @@ def test_p5_newton_velocities(e, m2):
          "contact": [{"name": "impact", "a": "m1", "b": "m2", "gap": 1e-3, **scheme}],
          "analysis": ida(rtol=1e-12, atol=1e-15, dt=1e-4, t_end=2e-3)}
     s, _ = execute(d)
-    ref = cf.newton_impact(1.0, m2, 1.0, -0.5, e)
+    ref = newton_impact(1.0, m2, 1.0, -0.5, e)
     assert s["contacts"]["impact"]["impacts"] == 1
     assert s["nodes"]["m1"]["v_final"] == pytest.approx(ref.v1, rel=1e-12, abs=1e-15)
     assert s["nodes"]["m2"]["v_final"] == pytest.approx(ref.v2, rel=1e-12, abs=1e-15)
@@ -324,7 +327,7 @@ def test_grazing_contact_inside_a_step_is_found():
     # A free oscillation of amplitude 0.1 m grazes a plane 0.1 um deep: each contact lasts
     # 0.28 ms, while IDA's steps average 0.8 ms. The root on the gap rate stops at the apex,
     # where the gap is positive, and the onset is located on the step's interpolant
-    # (PROBLEMS.md P7: never step over a contact). Peak penetration measured 7.6e-5 low at
+    # (docs/problems.md P7: never step over a contact). Peak penetration measured 7.6e-5 low at
     # rtol = 1e-12 (the global error of u ~ 1e-13 m against a 1e-7 m depth).
     depth = 1e-7
     d = {"node": [{"name": "m", "mass": 1.0, "v0": 1.0}],

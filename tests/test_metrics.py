@@ -1,6 +1,7 @@
-"""Metrics of a run against a reference (martello.metrics; PROBLEMS.md "Metrics"): history
-errors, impacts matched before comparing, peaks, restitution, energy, the closed-form
-references and the scene digest that keys reference data. Oracles: martello.closed_forms."""
+"""Metrics of a run against a reference (martello.metrics; docs/problems.md "Metrics"):
+history errors, impacts matched before comparing, peaks, restitution, energy, the
+closed-form references and the scene digest that keys reference data (martello.reference).
+Oracles: martello.oracles."""
 
 import copy
 import math
@@ -9,8 +10,18 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from martello import closed_forms as cf
-from martello import metrics, scene
+from martello.checks.dispatchers import bouncing_kelvin_events, bouncing_restitution_events
+from martello.history import interpolate
+from martello.metrics.from_history import summary_from_history
+from martello.metrics.score import event_errors, history_errors, score
+from martello.oracles.p5_contact_laws import kelvin_damping, kelvin_xi_from_e
+from martello.reference.base import Reference, ReferenceError
+from martello.reference.closed_form import (closed_form_reference, kelvin_bounce_reference,
+                                            restitution_bounce_reference,
+                                            two_body_kelvin_reference)
+from martello.reference.selection import reference_for_scene
+from martello.reference.store import physics_digest
+from martello.scene.loader import from_dict, load
 from tests.dynamics_helpers import dynamic, two_bodies
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -19,9 +30,9 @@ P2 = ROOT / "benchmarks" / "p2"
 
 def ref_of(columns, t, **events):
     """A data Reference with given samples and events."""
-    return metrics.Reference(name="test", kind="data", t_end=float(t[-1]), columns=tuple(columns),
-                             times=np.asarray(t, float), samples={k: np.asarray(v, float) for k, v in columns.items()},
-                             events=events)
+    return Reference(name="test", kind="data", t_end=float(t[-1]), columns=tuple(columns),
+                     times=np.asarray(t, float), samples={k: np.asarray(v, float) for k, v in columns.items()},
+                     events=events)
 
 
 # --- interpolation and history errors --------------------------------------------------------
@@ -35,22 +46,22 @@ def test_hermite_interpolation_is_exact_for_its_degree():
     du = lambda s: -2 + 6 * s - 3 * s**2 + 2 * s**3 - 3.5 * s**4
     ddu = lambda s: 6 - 6 * s + 6 * s**2 - 14 * s**3
     samples = {"u:n": u(t), "v:n": du(t), "a:n": ddu(t)}
-    assert np.max(np.abs(metrics.interpolate(t, samples, "u:n", tt) - u(tt))) < 100 * np.finfo(float).eps
+    assert np.max(np.abs(interpolate(t, samples, "u:n", tt) - u(tt))) < 100 * np.finfo(float).eps
     v3 = lambda s: 2 - s + 4 * s**3
     samples = {"v:n": v3(t), "a:n": -1 + 12 * t**2}
-    assert np.max(np.abs(metrics.interpolate(t, samples, "v:n", tt) - v3(tt))) < 100 * np.finfo(float).eps
+    assert np.max(np.abs(interpolate(t, samples, "v:n", tt) - v3(tt))) < 100 * np.finfo(float).eps
     # samples that fall on requested times are returned bit for bit
-    assert np.array_equal(metrics.interpolate(t, {"x:n": t**2}, "x:n", t), t**2)
+    assert np.array_equal(interpolate(t, {"x:n": t**2}, "x:n", t), t**2)
 
 
 def test_history_errors_measure_a_known_perturbation():
     t = np.linspace(0.0, 2.0, 401)
     u = np.sin(3 * t)
     ref = ref_of({"u:n": u}, t)
-    same = metrics.history_errors((["t", "u:n"], np.column_stack([t, u])), ref)
+    same = history_errors((["t", "u:n"], np.column_stack([t, u])), ref)
     assert same["max_rel_error"] == 0.0 and same["scd"] == math.inf
     bump = 1e-4 * np.exp(-((t - 1.0) / 0.1) ** 2)
-    e = metrics.history_errors((["t", "u:n"], np.column_stack([t, u + bump])), ref)
+    e = history_errors((["t", "u:n"], np.column_stack([t, u + bump])), ref)
     # normwise: the bump's peak over the peak of |u| (= 1 to 1e-5 on this grid)
     assert e["max_abs_error:u:n"] == pytest.approx(1e-4, rel=1e-12)
     assert e["max_rel_error"] == pytest.approx(1e-4 / np.max(np.abs(u)), rel=1e-12)
@@ -63,7 +74,7 @@ def test_history_errors_compare_only_at_the_runs_own_times_when_they_fall_on_the
     t = np.linspace(0.0, 1.0, 101)
     ref = ref_of({"u:n": np.cos(t)}, t)
     run = (["t", "u:n"], np.column_stack([t[::2], np.cos(t[::2])]))
-    e = metrics.history_errors(run, ref)
+    e = history_errors(run, ref)
     assert e["compare_points"] == len(t[::2]) and e["max_rel_error"] == 0.0
 
 
@@ -74,13 +85,13 @@ def test_a_shifted_impact_is_a_time_error_not_a_missing_and_an_extra_one():
                                               "approach_speeds": [1, 1, 1], "restitution": [0.8, 0.8, 0.8]})
     run = {"c": {"impact_times": [1.0, 2.001, 3.0, 3.4], "approach_speeds": [1, 1, 1, 0.5],
                  "restitution": [0.8, 0.79, 0.8, 0.8]}}
-    e = metrics.event_errors(run, ref)
+    e = event_errors(run, ref)
     assert e["impact_time_error"] == pytest.approx(0.001)
     assert (e["impacts_missing"], e["impacts_extra"], e["impact_count_error"]) == (0, 1, 1)
     assert e["restitution_error"] == pytest.approx(0.01)
     # beyond the reference's event horizon nothing is counted
     ref.event_horizon = 2.5
-    e = metrics.event_errors(run, ref)
+    e = event_errors(run, ref)
     assert (e["impact_count"], e["impact_count_ref"], e["impacts_extra"]) == (2, 2, 0)
 
 
@@ -88,15 +99,15 @@ def test_grazing_phases_do_not_score_restitution():
     ref = ref_of({"u:n": [0, 1]}, [0, 10], c={"impact_times": [1.0, 2.0], "approach_speeds": [1.0, 1e-4],
                                               "restitution": [0.8, 0.8]})
     run = {"c": {"impact_times": [1.0, 2.0], "approach_speeds": [1.0, 1e-4], "restitution": [0.8, 0.2]}}
-    e = metrics.event_errors(run, ref)
+    e = event_errors(run, ref)
     assert e["restitution_error"] == 0.0 and e["restitution"] == 0.8
 
 
 # --- closed-form references -------------------------------------------------------------------
 
 def test_kelvin_reference_events_are_the_closed_forms():
-    ref = metrics.kelvin_bounce_reference(0.7, 1.0, 100.0, 0.05, 9.81, 1e6, restitution=0.8)
-    oracle = cf.bouncing_kelvin_events(1.0, 100.0, 0.05, 9.81, 1e6, 4, restitution=0.8)
+    ref = kelvin_bounce_reference(0.7, 1.0, 100.0, 0.05, 9.81, 1e6, restitution=0.8)
+    oracle = bouncing_kelvin_events(1.0, 100.0, 0.05, 9.81, 1e6, 4, restitution=0.8)
     ev = ref.events["plane"]
     for i in range(4):
         assert ev["impact_times"][i] == oracle[f"t_impact_{i}"]
@@ -105,7 +116,7 @@ def test_kelvin_reference_events_are_the_closed_forms():
     t1, t2 = ev["impact_times"][0], ev["separation_times"][0]
     r = ref.at(np.array([t1, 0.5 * (t1 + t2)]), ["penetration:plane", "force:plane", "v:mass"])
     assert abs(r["penetration:plane"][0]) < 1e-15
-    c = cf.kelvin_damping(1e6, 1.0, cf.kelvin_xi_from_e(0.8))
+    c = kelvin_damping(1e6, 1.0, kelvin_xi_from_e(0.8))
     assert r["force:plane"][1] == pytest.approx(1e6 * r["penetration:plane"][1] + c * r["v:mass"][1], rel=1e-14)
     # the phase peak force is the maximum of the exact force (sampled and refined)
     s = np.linspace(t1, t2, 200001)
@@ -115,8 +126,8 @@ def test_kelvin_reference_events_are_the_closed_forms():
 
 def test_restitution_reference_flights_and_zeno_point():
     m, k, h, g, e = 1.0, 100.0, 0.05, 9.81, 0.8
-    ref = metrics.restitution_bounce_reference(1.5, m, k, h, g, e)
-    oracle = cf.bouncing_restitution_events(m, k, h, g, e, 3)
+    ref = restitution_bounce_reference(1.5, m, k, h, g, e)
+    oracle = bouncing_restitution_events(m, k, h, g, e, 3)
     ti = ref.events["plane"]["impact_times"]
     assert ti[:3] == [oracle["t_impact_0"], oracle["t_impact_1"], oracle["t_impact_2"]]
     r = ref.at(np.array([ti[0], ti[1] - 1e-12, ti[1] + 1e-12, 1.4]), ["u:mass", "v:mass", "force:plane"])
@@ -128,7 +139,7 @@ def test_restitution_reference_flights_and_zeno_point():
 
 def test_two_body_reference_conserves_momentum_and_realises_e():
     m1, m2, eps, e = 1.0, 3.0, 1e6, 0.65
-    ref = metrics.two_body_kelvin_reference(0.01, m1, m2, 1e-3, eps, restitution=e, v1=1.0)
+    ref = two_body_kelvin_reference(0.01, m1, m2, 1e-3, eps, restitution=e, v1=1.0)
     t = np.linspace(0.0, 0.01, 5001)
     r = ref.at(t, ref.columns)
     p = m1 * r["v:m1"] + m2 * r["v:m2"]
@@ -138,12 +149,12 @@ def test_two_body_reference_conserves_momentum_and_realises_e():
 
 
 def test_summary_from_a_sampled_exact_history_finds_the_impacts():
-    ref = metrics.kelvin_bounce_reference(0.7, 1.0, 100.0, 0.05, 9.81, 1e6, restitution=0.8)
+    ref = kelvin_bounce_reference(0.7, 1.0, 100.0, 0.05, 9.81, 1e6, restitution=0.8)
     t = np.linspace(0.0, 0.7, 70001)
     r = ref.at(t, ref.columns)
     cols = ["t"] + list(r)
-    sc = scene.load(P2 / "p2_penalty_kelvin.toml")
-    s = metrics.summary_from_history(sc, (cols, np.column_stack([t] + [r[c] for c in r])))
+    sc = load(P2 / "p2_penalty_kelvin.toml")
+    s = summary_from_history(sc, (cols, np.column_stack([t] + [r[c] for c in r])))
     ev = ref.events["plane"]
     got = s["contacts"]["plane"]
     assert len(got["impact_times"]) == len(ev["impact_times"]) == 4
@@ -158,11 +169,11 @@ def test_score_of_a_run_against_its_closed_form():
     # P2 linear penalty with Newmark at Δt = 1e-5 (ω_c Δt = 0.01): second order, the onset is
     # not located by the integrator: the error is measured ≈ 3e-5 of the peak |u|
     from martello.run import run_full
-    d = scene.load(P2 / "p2_penalty_linear.toml")
+    d = load(P2 / "p2_penalty_linear.toml")
     summary, hist = run_full(d)
-    ref = metrics.reference_for_scene(d)
+    ref = reference_for_scene(d)
     assert ref.kind == "closed-form"
-    m = metrics.score(summary, hist, ref)
+    m = score(summary, hist, ref)
     assert 1e-6 < m["max_rel_error"] < 1e-4
     assert m["impact_count_error"] == 0 and m["impacts_missing"] == 0
     assert m["impact_time_error"] < 1e-5
@@ -172,26 +183,26 @@ def test_score_of_a_run_against_its_closed_form():
 
 
 def test_physics_digest_ignores_the_analysis_and_sees_the_contacts():
-    base = scene.load(P2 / "p2_penalty_hertz.toml")
+    base = load(P2 / "p2_penalty_hertz.toml")
     import tomllib
     d = tomllib.loads((P2 / "p2_penalty_hertz.toml").read_text())
     d2 = copy.deepcopy(d)
     d2["analysis"].update(dt=1e-4, integrator="central-difference")
     d2["analysis"].pop("preset")
-    assert metrics.physics_digest(scene.from_dict(d2)) == metrics.physics_digest(base)
+    assert physics_digest(from_dict(d2)) == physics_digest(base)
     d3 = copy.deepcopy(d)
     d3["contact"][0]["stiffness"] = 2e6
-    assert metrics.physics_digest(scene.from_dict(d3)) != metrics.physics_digest(base)
+    assert physics_digest(from_dict(d3)) != physics_digest(base)
 
 
 def test_reference_for_scene_chooses_data_closed_form_or_nothing():
-    hertz = metrics.reference_for_scene(scene.load(P2 / "p2_penalty_hertz.toml"))
+    hertz = reference_for_scene(load(P2 / "p2_penalty_hertz.toml"))
     assert hertz.kind == "data" and hertz.name == "reference/p2_penalty_hertz"
-    kelvin = metrics.reference_for_scene(scene.load(P2 / "p2_penalty_kelvin.toml"))
+    kelvin = reference_for_scene(load(P2 / "p2_penalty_kelvin.toml"))
     assert kelvin.kind == "closed-form"
-    sdof = metrics.reference_for_scene(scene.load(ROOT / "benchmarks" / "sdof" / "sdof_sine_newmark.toml"))
+    sdof = reference_for_scene(load(ROOT / "benchmarks" / "sdof" / "sdof_sine_newmark.toml"))
     assert sdof.kind == "closed-form" and "u:m" in sdof.columns
     d = two_bodies("kelvin", 1e4, restitution=0.5, analysis=dynamic(t_end=0.1))
-    assert metrics.reference_for_scene(scene.from_dict(d)) is None     # no [check], no data
-    with pytest.raises(metrics.ReferenceError, match="no closed-form history named"):
-        metrics.closed_form_reference("nope", {}, 1.0)
+    assert reference_for_scene(from_dict(d)) is None     # no [check], no data
+    with pytest.raises(ReferenceError, match="no closed-form history named"):
+        closed_form_reference("nope", {}, 1.0)

@@ -1,6 +1,6 @@
-"""Moreau–Jean time stepping (PROBLEMS.md P2, P5 and "Integrators"; issue 4 item 4).
+"""Moreau–Jean time stepping (docs/problems.md P2, P5 and "Integrators"; docs/moreau-jean.md).
 
-Oracles: martello.closed_forms (bouncing_oscillator_restitution, newton_impact) and the
+Oracles: martello.oracles (bouncing_oscillator_restitution, newton_impact) and the
 reference rows of Siconos' bouncing-ball example (reference/siconos_bouncing_ball/). Every
 tolerance says where it comes from; "measured" values are from this implementation."""
 
@@ -10,13 +10,14 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from martello import closed_forms as cf
+from martello.oracles.p2_bouncing import bouncing_oscillator_restitution
+from martello.oracles.p5_contact_laws import newton_impact
 from dynamics_helpers import execute, slope
 
 EPS = np.finfo(float).eps
 REF = Path(__file__).resolve().parent.parent / "reference" / "siconos_bouncing_ball" / "BouncingBallTS_ref_rows.csv"
 
-# P2 of PROBLEMS.md: m = 1, k = 100, plane at h = 0.05, g = 9.81 (u_s = 0.0981 > h: Zeno)
+# P2 of docs/problems.md: m = 1, k = 100, plane at h = 0.05, g = 9.81 (u_s = 0.0981 > h: Zeno)
 M, K, GAP, G = 1.0, 100.0, 0.05, 9.81
 G_EFF = (M * G - K * GAP) / M      # acceleration pressing the mass onto the plane there
 
@@ -89,7 +90,7 @@ def test_p2_impact_times_first_order(theta):
     impact s after t_k, uniform over the phase), so at one h the error is erratic between 0
     and ~h; averaged over 8 equally spaced phases of the start (the exact state at s·h/8 is
     the initial state) the mean error is C·h + o(h). Measured slopes 1.007 (θ = ½) and
-    0.992 (θ = 1) over 5 halvings; the issue asks for 1 ± 0.15."""
+    0.992 (θ = 1) over 5 halvings; the bar is 1 ± 0.15."""
     w, us, n_imp, n_phase = math.sqrt(K / M), M * G / K, 6, 8
     hs = [1e-3 / 2 ** j for j in range(6)]
     mean_err = []
@@ -98,7 +99,7 @@ def test_p2_impact_times_first_order(theta):
         for i in range(n_phase):
             s0 = i / n_phase * dt
             u0, v0 = us * (1 - math.cos(w * s0)), us * w * math.sin(w * s0)
-            ref = cf.bouncing_oscillator_restitution(M, K, GAP, G, 0.8, n_imp, u0=u0, v0=v0)
+            ref = bouncing_oscillator_restitution(M, K, GAP, G, 0.8, n_imp, u0=u0, v0=v0)
             s, _ = p2(dt, 0.9, theta=theta, u0=u0, v0=v0, every=10 ** 6)
             errs.append(np.abs(np.array(s["contacts"]["plane"]["impact_times"][:n_imp]) - ref.t))
         mean_err.append(np.mean(errs))
@@ -148,7 +149,7 @@ def test_p2_zeno_comes_to_rest(p2_zeno):
     delta_res = h["penetration:plane"][-1]
     assert 0 <= delta_res <= G_EFF * dt ** 2
     np.testing.assert_allclose(f, M * G - K * u, rtol=64 * EPS)
-    ref = cf.bouncing_oscillator_restitution(M, K, GAP, G, 0.8, 1)
+    ref = bouncing_oscillator_restitution(M, K, GAP, G, 0.8, 1)
     assert f == pytest.approx(-ref.resting_force, rel=K * G_EFF * dt ** 2 / (M * G - K * GAP))
     assert np.abs(v).max() <= 1e-15
     # the energy that the impacts took out is the whole mechanical energy lost: m g h − ½ k h²
@@ -214,7 +215,7 @@ def test_p5_newton_velocities_in_one_step(e, m2):
         "contact": [{"name": "impact", "a": "m1", "b": "m2", "gap": 1e-3, "scheme": "restitution",
                      "restitution": e}],
         "analysis": {"type": "dynamic", "integrator": "moreau-jean", "dt": 3e-4, "t_end": 0.003}})
-    ref = cf.newton_impact(m1, m2, v0, 0.0, e)
+    ref = newton_impact(m1, m2, v0, 0.0, e)
     assert h["v:m1"][-1] == pytest.approx(ref.v1, abs=8 * EPS * v0)
     assert h["v:m2"][-1] == pytest.approx(ref.v2, abs=8 * EPS * v0)
     assert m1 * h["v:m1"][-1] + m2 * h["v:m2"][-1] == pytest.approx(m1 * v0, abs=8 * EPS * m1 * v0)
@@ -243,7 +244,7 @@ def test_chain_of_touching_bodies_simultaneous_impact(n, e):
                                  "t_end": 0.003,
                                  "output": {"every": 1, "nodes": [x["name"] for x in nodes]}}})
     v = np.array([h[f"v:b{i}"][-1] for i in range(n)])
-    ref = cf.newton_impact(1.0, n - 1.0, 1.0, 0.0, e)
+    ref = newton_impact(1.0, n - 1.0, 1.0, 0.0, e)
     assert v[0] == pytest.approx(ref.v1, abs=64 * EPS)
     np.testing.assert_allclose(v[1:], ref.v2, rtol=0, atol=64 * EPS)
     assert v.sum() == pytest.approx(1.0, abs=64 * EPS)
@@ -278,6 +279,6 @@ def test_lagrange_contact_defaults_to_plastic():
         "node": [{"name": "m1", "mass": 1.0, "v0": 1.0}, {"name": "m2", "mass": 3.0}],
         "contact": [{"name": "c", "a": "m1", "b": "m2", "gap": 1e-3, "scheme": "lagrange"}],
         "analysis": {"type": "dynamic", "integrator": "moreau-jean", "dt": 3e-4, "t_end": 0.01}})
-    ref = cf.newton_impact(1.0, 3.0, 1.0, 0.0, 0.0)
+    ref = newton_impact(1.0, 3.0, 1.0, 0.0, 0.0)
     assert h["v:m1"][-1] == pytest.approx(ref.v1, abs=8 * EPS)
     assert h["v:m2"][-1] == pytest.approx(ref.v2, abs=8 * EPS)

@@ -1,5 +1,5 @@
 """P8 (seed §5-6): the adjacent-buildings scenes, their gap stiffness rule, the case study's
-aggregation and the committed records (issue 7 items 4-5)."""
+aggregation and the committed records (docs/p8-case-study.md)."""
 
 import importlib.util
 import math
@@ -15,9 +15,9 @@ if str(ROOT) not in sys.path:
     sys.path.insert(0, str(ROOT))
 
 from martello import ground_motion as gm  # noqa: E402
-from martello import scene as scene_mod  # noqa: E402
-from martello.records import read_csv_record  # noqa: E402
+from martello.ground_motion.records import read_csv_record  # noqa: E402
 from martello.run import run_full  # noqa: E402
+from martello.scene.loader import from_dict, load  # noqa: E402
 
 P8 = ROOT / "benchmarks" / "p8"
 SCENES = {c: P8 / f"p8_{c}.toml" for c in ("bare", "A", "B")}
@@ -42,7 +42,7 @@ def cs():
 
 @pytest.mark.parametrize("config, damper_floors", [("bare", ()), ("A", (1, 2)), ("B", (2,))])
 def test_scenes_load_with_the_seed_layout(config, damper_floors):
-    s = scene_mod.load(SCENES[config])
+    s = load(SCENES[config])
     assert s.problem == "P8" and s.analysis["type"] == "dynamic"
     names = [n["name"] for n in s.nodes]
     assert names == ["b1.f1", "b1.f2", "b2.f1", "b2.f2", "b2.f3", "b2.f4", "b2.f5"]
@@ -77,13 +77,13 @@ def test_beam_axial_stiffness_rule_gives_the_scene_stiffness(cs):
     assert k_rule == pytest.approx(9.5e8, rel=1e-15)
     assert cs.beam_axial_stiffness() == pytest.approx(k_rule, rel=1e-15)
     for path in SCENES.values():
-        for c in scene_mod.load(path).contacts:
+        for c in load(path).contacts:
             assert c["stiffness"] == pytest.approx(k_rule, rel=1e-15)
 
 
 def test_first_periods_follow_the_stated_rule():
     """T1 = sqrt(2) 0.075 H^(3/4), recomputed from the scene's masses and storey stiffnesses."""
-    s = scene_mod.load(SCENES["bare"])
+    s = load(SCENES["bare"])
     for prefix, n in (("b1", 2), ("b2", 5)):
         m = np.array([s.nodes[s.index[f"{prefix}.f{i}"]]["mass"] for i in range(1, n + 1)])
         k = [next(l["k"] for l in s.links if l["name"] == f"{prefix}.s{i}") for i in range(1, n + 1)]
@@ -100,7 +100,7 @@ def test_first_periods_follow_the_stated_rule():
 def test_short_run_pounds_by_millimetres_and_balances_energy():
     d = tomllib.loads(SCENES["bare"].read_text())
     d["analysis"]["t_end"] = 6.0
-    s = scene_mod.from_dict(d, source=str(SCENES["bare"]), base_dir=P8)
+    s = from_dict(d, source=str(SCENES["bare"]), base_dir=P8)
     summary, (cols, hist) = run_full(s)
     assert summary["status"] == "MARTELLO_OK"
     pen = max(c["max_penetration"] for c in summary["contacts"].values())
@@ -115,7 +115,7 @@ def test_a_damper_run_uses_the_fluid_law():
     d = tomllib.loads(SCENES["B"].read_text())
     d["analysis"]["t_end"] = 4.0
     d["analysis"]["output"]["every"] = 1
-    s = scene_mod.from_dict(d, source=str(SCENES["B"]), base_dir=P8)
+    s = from_dict(d, source=str(SCENES["B"]), base_dir=P8)
     summary, (cols, hist) = run_full(s)
     F = hist[:, cols.index("link_force:f2.fvd1")]
     v = hist[:, cols.index("v:b1.f2")] - hist[:, cols.index("v:b2.f2")]
@@ -156,7 +156,7 @@ def test_mean_over_records_and_reductions_on_synthetic_numbers(cs):
 def test_measure_reads_the_summary(cs):
     d = tomllib.loads(SCENES["A"].read_text())
     d["analysis"]["t_end"] = 3.0
-    summary, _ = run_full(scene_mod.from_dict(d, source=str(SCENES["A"]), base_dir=P8))
+    summary, _ = run_full(from_dict(d, source=str(SCENES["A"]), base_dir=P8))
     m = cs.measure(summary)
     assert m["drift"][(2, 3)] == summary["links"]["b2.s3"]["max_abs_elongation"]
     assert m["shear"][(1, 2)] == summary["links"]["b1.s2"]["max_abs_force"]

@@ -1,4 +1,4 @@
-"""Tests of martello.records: ground-motion record readers (CSV and PEER AT2)."""
+"""Tests of martello.ground_motion.records: ground-motion record readers (CSV and PEER AT2)."""
 
 import math
 import re
@@ -13,7 +13,7 @@ if str(_ROOT) not in sys.path:  # the package is not installed in the venv
     sys.path.insert(0, str(_ROOT))
 
 from martello.errors import RecordError  # noqa: E402
-from martello.records import (  # noqa: E402
+from martello.ground_motion.records import (  # noqa: E402
     Record,
     arias_intensity,
     pga,

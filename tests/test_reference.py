@@ -1,4 +1,4 @@
-"""Reference data in reference/ (issue 6, item 3): each stored history still matches a fresh
+"""Reference data in reference/ (docs/studies.md): each stored history still matches a fresh
 computation to the digits it claims, carries its provenance, and is tied to the physics of
 its scene; the independent event-located reference engine reproduces a closed form."""
 
@@ -12,24 +12,33 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from martello import metrics, scene, study
+from martello.batch import execute
+from martello.checks.reference_data import verify_reference_data
+from martello.history import history_dict, interpolate
+from martello.metrics.score import score
+from martello.reference.base import ReferenceError
+from martello.reference.build import _method_runs, reference_scene
+from martello.reference.event_located import event_located_run
+from martello.reference.selection import reference_for_scene
+from martello.reference.store import find_reference_data, load_reference, manifest, physics_digest
+from martello.scene.loader import from_dict, load
 
 ROOT = Path(__file__).resolve().parent.parent
-ENTRIES = metrics.manifest()
+ENTRIES = manifest()
 PROVENANCE = ("scene", "scene_sha256", "physics_sha256", "method", "digits", "refinement",
               "martello_version", "libraries", "date", "events", "t_end")
 
 
 @pytest.mark.parametrize("entry", ENTRIES, ids=[e["name"] for e in ENTRIES])
 def test_stored_reference_has_provenance_and_matches_its_scene(entry):
-    ref = metrics.load_reference(entry["folder"])
+    ref = load_reference(entry["folder"])
     meta = ref.provenance
     for key in PROVENANCE:
         assert key in meta, key
-    sc, _, _ = study.reference_scene(entry)
+    sc, _, _ = reference_scene(entry)
     # the data are for this scene's physics as it is now (else: regenerate)
-    assert meta["physics_sha256"] == metrics.physics_digest(sc)
-    assert metrics.reference_for_scene(sc).name == ref.name
+    assert meta["physics_sha256"] == physics_digest(sc)
+    assert reference_for_scene(sc).name == ref.name
     u_digits = [d for c, d in meta["digits"].items() if c.startswith("u:")]
     assert min(u_digits) >= 4.0
     assert ref.times[0] == 0.0 and ref.times[-1] == pytest.approx(sc.analysis["t_end"])
@@ -44,14 +53,14 @@ def _fresh(entry):
     cheapest run whose difference from the stored data was recorded)."""
     meta = json.loads((entry["folder"] / "reference.json").read_text())
     method = meta["method"]
-    ref = metrics.load_reference(entry["folder"])
+    ref = load_reference(entry["folder"])
     level = meta["refinement"][-1]
-    sc, d, path = study.reference_scene(entry)
+    sc, d, path = reference_scene(entry)
     if method["integrator"] == "scipy-dop853":
-        out = study.event_located_run(sc, level["rtol"], ref.times)
+        out = event_located_run(sc, level["rtol"], ref.times)
     else:
-        spec = study._method_runs(entry, method, d, path, level["dt"], level["rtol"])
-        out = study.execute(spec)
+        spec = _method_runs(entry, method, d, path, level["dt"], level["rtol"])
+        out = execute(spec)
     assert out["status"] == "MARTELLO_OK", out.get("message")
     return ref, level, out
 
@@ -63,11 +72,11 @@ def test_fresh_computation_matches_the_stored_data(entry):
     # the stored data by the same amount (the computation is deterministic), to the trusted
     # digits of the stored data: |d_fresh − d_stored| ≤ 10^-digits.
     ref, level, out = _fresh(entry)
-    h = metrics.history_dict(out["history"])
+    h = history_dict(out["history"])
     diffs = []
     for c in ref.columns:
         if c.startswith("u:"):
-            y = metrics.interpolate(h["t"], h, c, ref.times)
+            y = interpolate(h["t"], h, c, ref.times)
             diffs.append(np.max(np.abs(y - ref.samples[c])) / np.max(np.abs(ref.samples[c])))
     trusted = 10.0 ** -min(d for c, d in ref.digits.items() if c.startswith("u:"))
     assert abs(max(diffs) - level["max_rel_diff_u"]) <= trusted
@@ -77,12 +86,13 @@ def test_fresh_computation_matches_the_stored_data(entry):
 
 
 def test_event_located_engine_reproduces_the_closed_form():
-    # P2 with a Kelvin plane: exact piecewise solution (closed_forms.bouncing_oscillator_kelvin)
-    sc = scene.load(ROOT / "benchmarks" / "p2" / "p2_penalty_kelvin.toml")
+    # P2 with a Kelvin plane: exact piecewise solution
+    # (martello.oracles.p2_bouncing.bouncing_oscillator_kelvin)
+    sc = load(ROOT / "benchmarks" / "p2" / "p2_penalty_kelvin.toml")
     grid = np.linspace(0.0, 0.7, 1401)
-    out = study.event_located_run(sc, 1e-12, grid)
-    ref = metrics.reference_for_scene(sc)
-    m = metrics.score(out["summary"], out["history"], ref, times=grid)
+    out = event_located_run(sc, 1e-12, grid)
+    ref = reference_for_scene(sc)
+    m = score(out["summary"], out["history"], ref, times=grid)
     assert m["max_rel_error"] < 1e-10
     assert m["impact_time_error"] < 1e-11 and m["impact_count_error"] == 0
     assert m["phase_penetration_error"] < 1e-9 and m["restitution_error"] < 1e-10
@@ -90,13 +100,13 @@ def test_event_located_engine_reproduces_the_closed_form():
 
 def test_event_located_engine_finds_a_contact_inside_one_step():
     # Two free masses whose gap closes for a moment: the gap's maximum is checked, so a
-    # contact shallower than one step's sign test is still found (PROBLEMS.md P7).
+    # contact shallower than one step's sign test is still found (docs/problems.md P7).
     d = {"node": [{"name": "m1", "mass": 1.0, "v0": 1e-3}, {"name": "m2", "mass": 1.0}],
          "link": [{"type": "spring", "a": "m1", "b": "ground", "k": 1.0}],
          "contact": [{"name": "c", "a": "m1", "b": "m2", "gap": 9.9999e-4, "scheme": "penalty",
                       "law": "linear", "stiffness": 1e6}],
          "analysis": {"type": "dynamic", "integrator": "newmark", "dt": 1e-3, "t_end": 3.0}}
-    out = study.event_located_run(scene.from_dict(d), 1e-10, np.linspace(0, 3.0, 301))
+    out = event_located_run(from_dict(d), 1e-10, np.linspace(0, 3.0, 301))
     assert len(out["summary"]["contacts"]["c"]["impact_times"]) == 1
 
 
@@ -112,17 +122,17 @@ def test_stale_reference_data_are_refused(tmp_path):
                           .replace("gap = 0.02", "gap = 0.021").replace("gap = 0.05", "gap = 0.051"))
     (root / "references.toml").write_text(
         f'[[reference]]\nname = "{src["name"]}"\nscene = "{scene_copy}"\nstore_every = 1.0\n')
-    with pytest.raises(metrics.ReferenceError, match="regenerate_reference"):
-        metrics.find_reference_data(scene.load(scene_copy), root)
+    with pytest.raises(ReferenceError, match="regenerate_reference"):
+        find_reference_data(load(scene_copy), root)
     # the unchanged scene still finds its data through the physics digest
-    assert metrics.find_reference_data(scene.load(ROOT / src["scene"]), root) is not None
+    assert find_reference_data(load(ROOT / src["scene"]), root) is not None
 
 
 def test_check_rows_for_scenes_without_closed_form():
     # `martello check` extension: a scene with reference data gets verification rows
     from martello.run import run_full
-    sc = scene.load(ROOT / "benchmarks" / "p7" / "p7_two_oscillators.toml")
+    sc = load(ROOT / "benchmarks" / "p7" / "p7_two_oscillators.toml")
     summary, hist = run_full(sc)
-    rows = metrics.verify_reference_data(sc, summary, hist)
+    rows = verify_reference_data(sc, summary, hist)
     assert rows and all(r["passed"] for r in rows), rows
     assert {"scene", "quantity", "value", "digits", "passed", "why"} <= set(rows[0])

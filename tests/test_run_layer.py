@@ -12,7 +12,9 @@ import math
 import numpy as np
 import pytest
 
-from martello import closed_forms as cf
+from martello.oracles.linear_sdof import sdof_free_response
+from martello.oracles.p5_contact_laws import hc_factor_hunt_crossley, hunt_crossley_realised_e
+from martello.oracles.p6_hysteresis import elastoplastic_impulse
 from tests.dynamics_helpers import execute
 
 FIXED = ("newmark", "hht", "generalized-alpha", "central-difference", "moreau-jean")
@@ -38,11 +40,11 @@ def analysis(integrator, t_end, h=1e-4, every=10 ** 7, **extra):
 M, K, FY, RHO, V0 = 1.0, 100.0, 1.0, 0.1, 1.0      # P6: a bilinear SDOF given v0
 KH, NH, E, GAP = 1e5, 1.5, 0.6, 0.05               # P5: a mass hitting a wall (Hunt–Crossley)
 KD, CD = 100.0, 0.5                                # a damped SDOF in free vibration
-P6 = cf.elastoplastic_impulse(M, K, FY / K, RHO, V0)
+P6 = elastoplastic_impulse(M, K, FY / K, RHO, V0)
 # just past the P6 peak, before the spring yields again in reverse (the elastic swing back
 # reaches the reverse yield after 2u_y·k/F_max = 60 % of its amplitude; 0.3 rad is 4.5 %)
 T_END = P6.t_max + 0.3 / math.sqrt(K / M)
-E_REALISED = cf.hunt_crossley_realised_e(cf.hc_factor_hunt_crossley(E))
+E_REALISED = hunt_crossley_realised_e(hc_factor_hunt_crossley(E))
 
 
 def dissipation_scene(integrator):
@@ -65,7 +67,7 @@ def expected_dissipation():
     u_y to u_max at its yield force (1 − ρ)F_y (the ρk part stays elastic); contact: the
     kinetic energy the realised restitution takes, ½ m v0² (1 − e²) (after the separation
     δ < 0 stores nothing); damping: the energy the free damped response has lost by T_END."""
-    r = cf.sdof_free_response(M, KD, CD / (2 * math.sqrt(KD * M)), np.array([T_END]), 0.0, V0)
+    r = sdof_free_response(M, KD, CD / (2 * math.sqrt(KD * M)), np.array([T_END]), 0.0, V0)
     return {"plastic": (1 - RHO) * FY * (P6.u_max - FY / K),
             "contact": 0.5 * M * V0 ** 2 * (1 - E_REALISED ** 2),
             "damping": 0.5 * M * V0 ** 2 - 0.5 * M * r.v[0] ** 2 - 0.5 * KD * r.u[0] ** 2}

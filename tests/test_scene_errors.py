@@ -6,8 +6,8 @@ import math
 
 import pytest
 
-from martello import scene
 from martello.errors import SceneError
+from martello.scene.loader import from_dict, load
 from tests.conftest import p1_dict
 
 
@@ -92,7 +92,7 @@ CASES = [
 @pytest.mark.parametrize("mutate,field,fix", [c[1:] for c in CASES], ids=[c[0] for c in CASES])
 def test_scene_error_names_file_field_and_fix(mutate, field, fix):
     with pytest.raises(SceneError) as info:
-        scene.from_dict(bad(mutate), source="bad.toml")
+        from_dict(bad(mutate), source="bad.toml")
     msg = str(info.value)
     assert msg.startswith("bad.toml: "), msg
     assert info.value.field == field, msg
@@ -100,35 +100,35 @@ def test_scene_error_names_file_field_and_fix(mutate, field, fix):
 
 
 def test_valid_p1_loads():
-    s = scene.from_dict(p1_dict(), source="ok.toml")
+    s = from_dict(p1_dict(), source="ok.toml")
     assert s.nodes[0]["u0"] == 0.0 and s.contacts[0]["a"] == 0 and s.contacts[0]["b"] == -1
 
 
 def test_fixed_node_may_be_massless():
     d = p1_dict()
     d["node"].append({"name": "support", "mass": 0.0, "fixed": True})
-    assert scene.from_dict(d).nodes[1]["fixed"]
+    assert from_dict(d).nodes[1]["fixed"]
 
 
 def test_file_errors_name_the_file(tmp_path):
     with pytest.raises(SceneError, match="does not exist"):
-        scene.load(tmp_path / "missing.toml")
+        load(tmp_path / "missing.toml")
     broken = tmp_path / "broken.toml"
     broken.write_text("[[node]\nname = 'x'\n")
     with pytest.raises(SceneError, match=r"broken\.toml: \(syntax\): not valid TOML"):
-        scene.load(broken)
+        load(broken)
     nan_file = tmp_path / "nan.toml"
     nan_file.write_text("[[node]]\nname = 'x'\nmass = nan\n[analysis]\ntype = 'static'\n")
     with pytest.raises(SceneError, match=r"nan\.toml: node\[0\]\.mass: is nan"):
-        scene.load(nan_file)
+        load(nan_file)
 
 
 def test_every_catalogue_scene_is_valid():
-    from martello import catalogue
+    from martello.scene import catalogue
     files = catalogue.scene_files()
     assert files, "the catalogue must not be empty"
     for f in files:
-        scene.load(f)
+        load(f)
 
 
 @pytest.mark.parametrize("check,field,words", [
@@ -148,11 +148,11 @@ def test_every_catalogue_scene_is_valid():
      "check.compare[0].result", "dotted path"),
 ])
 def test_check_table_errors_name_the_field(check, field, words):
-    from martello.check import verify
+    from martello.checks.verify import verify
     from martello.run import run
     d = p1_dict()
     d["check"] = check
-    s = scene.from_dict(d, source="chk.toml")
+    s = from_dict(d, source="chk.toml")
     with pytest.raises(SceneError) as info:
         verify(s, run(s))
     assert info.value.field == field and words in str(info.value), str(info.value)
@@ -163,5 +163,5 @@ def test_static_run_names_what_it_ignores():
     d = p1_dict()
     d["node"][0]["v0"] = 1.0
     d["link"].append({"type": "dashpot", "a": "mass", "b": "ground", "c": 1.0})
-    w = run(scene.from_dict(d))["warnings"]
+    w = run(from_dict(d))["warnings"]
     assert any("static analysis ignores: dashpots and fluid dampers, initial velocities" in x for x in w), w

@@ -1,4 +1,4 @@
-"""Static contact (PROBLEMS.md P1, P3): every scheme against the closed forms, the penalty
+"""Static contact (docs/problems.md P1, P3): every scheme against the closed forms, the penalty
 convergence rate, mesh refinement, and the extremes (ε/k to 1e16, grazing, h = 0)."""
 
 import copy
@@ -7,10 +7,10 @@ import json
 import numpy as np
 import pytest
 
-from martello import closed_forms as cf
-from martello import scene
 from martello.errors import SolverError
+from martello.oracles.p1_p3_static import mass_on_plane_static, two_bars_static
 from martello.run import run
+from martello.scene.loader import from_dict
 from tests.conftest import p1_dict
 
 M, K, H, G = 1.0, 100.0, 0.05, 9.81
@@ -20,7 +20,7 @@ R, D, F = 2.1e7, 1.0e-3, 5.0e4
 def p1(scheme="lagrange", h=H, **contact):
     d = p1_dict(scheme, **contact)
     d["contact"][0]["gap"] = h
-    return run(scene.from_dict(d))
+    return run(from_dict(d))
 
 
 def two_bars(scheme, ne=1, F=F, **contact):
@@ -36,18 +36,19 @@ def two_bars(scheme, ne=1, F=F, **contact):
     c.update(contact)
     d = {"node": nodes, "link": links, "contact": [c],
          "loads": {"force": [{"node": f"L{ne}", "value": F}]}, "analysis": {"type": "static"}}
-    s = run(scene.from_dict(d))
+    s = run(from_dict(d))
     u = s["nodes"]
     return np.array([u[f"L{ne}"]["u"], u[f"L{2 * ne}"]["u"], u["R0"]["u"],
                      s["contacts"]["ends"]["force"]]), s
 
 
-# Lagrange and augmented Lagrange: ≤ 1e-12 relative (issue bar). The solves are 2×2 (P1) and
-# 4×4 (P3) with condition ≲ 10 after scaling: errors are a few ulps, far inside 1e-12.
+# Lagrange and augmented Lagrange: ≤ 1e-12 relative (the bar set for P1 and P3). The solves are
+# 2×2 (P1) and 4×4 (P3) with condition ≲ 10 after scaling: errors are a few ulps, far inside
+# 1e-12.
 @pytest.mark.parametrize("scheme,extra", [("lagrange", {}), ("augmented-lagrange", {"stiffness": 1e4}),
                                           ("restitution", {"restitution": 0.5})])
 def test_p1_lagrange_family_matches_closed_form(scheme, extra):
-    ref = cf.mass_on_plane_static(M, K, H, G, scheme="lagrange")
+    ref = mass_on_plane_static(M, K, H, G, scheme="lagrange")
     s = p1(scheme, **extra)
     assert s["nodes"]["mass"]["u"] == pytest.approx(ref.u, rel=1e-12, abs=0)
     assert s["contacts"]["plane"]["lambda"] == pytest.approx(ref.lam, rel=1e-12, abs=0)
@@ -56,9 +57,9 @@ def test_p1_lagrange_family_matches_closed_form(scheme, extra):
 
 
 def test_p1_penalty_matches_its_closed_form():
-    ref = cf.mass_on_plane_static(M, K, H, G, scheme="penalty", eps=1e4)
+    ref = mass_on_plane_static(M, K, H, G, scheme="penalty", eps=1e4)
     s = p1("penalty", stiffness=1e4)
-    assert s["nodes"]["mass"]["u"] == pytest.approx(0.0504762376237623762, rel=1e-13)  # PROBLEMS.md digits
+    assert s["nodes"]["mass"]["u"] == pytest.approx(0.0504762376237623762, rel=1e-13)  # problems.md digits
     assert s["nodes"]["mass"]["u"] == pytest.approx(ref.u, rel=1e-13)
     # λ = −εδ: δ = u − h cancels log10(h/δ) ≈ 2 digits of u, so 1e-11 rather than 1e-13
     assert s["contacts"]["plane"]["lambda"] == pytest.approx(ref.lam, rel=1e-11)
@@ -69,8 +70,8 @@ def test_p1_penalty_matches_its_closed_form():
     # penalty: P = εδ with δ/d ≈ 1e-2 → two digits cancel
     ("penalty", {"stiffness": 100 * R}, 1e-10)])
 def test_p3_matches_closed_form(scheme, extra, rtol):
-    ref = cf.two_bars_static(F, R, D, scheme="penalty" if scheme == "penalty" else "lagrange",
-                             eps=extra.get("stiffness"))
+    ref = two_bars_static(F, R, D, scheme="penalty" if scheme == "penalty" else "lagrange",
+                          eps=extra.get("stiffness"))
     got, _ = two_bars(scheme, **extra)
     want = np.array([ref.u1, ref.u2, ref.u3, ref.P])
     np.testing.assert_allclose(got, want, rtol=rtol, atol=0)
@@ -80,7 +81,7 @@ def test_p3_matches_closed_form(scheme, extra, rtol):
                                           ("augmented-lagrange", {"stiffness": 100 * R})])
 def test_p3_refinement_leaves_coarse_nodes_unchanged(scheme, extra):
     # Linear FE is nodally exact for point loads: any refinement gives the same nodal values.
-    # Dense solves up to 195 unknowns with condition ~1e4·(ne)²: 1e-12 is the issue's bar.
+    # Dense solves up to 195 unknowns with condition ~1e4·(ne)²: 1e-12 is the bar set for P3.
     coarse, _ = two_bars(scheme, 1, **extra)
     for ne in (2, 8, 64):
         fine, _ = two_bars(scheme, ne, **extra)
@@ -102,7 +103,7 @@ def test_p1_penalty_error_is_first_order_in_one_over_eps():
     ratios = 10.0 ** np.arange(2, 9)
     err = np.array([abs(p1("penalty", stiffness=K * q)["contacts"]["plane"]["lambda"] - lam_exact)
                     / abs(lam_exact) for q in ratios])
-    # predicted relative error k/(k+ε) (PROBLEMS.md P1); δ keeps ≥ 6 digits at ε/k = 1e8
+    # predicted relative error k/(k+ε) (docs/problems.md P1); δ keeps ≥ 6 digits at ε/k = 1e8
     np.testing.assert_allclose(err, 1.0 / (1.0 + ratios), rtol=1e-3)
     assert log_slope(ratios, err) == pytest.approx(-1.0, abs=0.02)
 
@@ -112,7 +113,7 @@ def test_p3_penalty_error_is_first_order_in_one_over_eps():
     ratios = 10.0 ** np.arange(2, 9)
     err = np.array([abs(two_bars("penalty", stiffness=R * q)[0][3] - p_exact) / p_exact
                     for q in ratios])
-    np.testing.assert_allclose(err, 1.0 / (1.0 + 3 * ratios), rtol=1e-3)   # PROBLEMS.md P3
+    np.testing.assert_allclose(err, 1.0 / (1.0 + 3 * ratios), rtol=1e-3)   # docs/problems.md P3
     assert log_slope(ratios, err) == pytest.approx(-1.0, abs=0.02)
 
 
@@ -162,7 +163,7 @@ def test_mass_held_only_by_contact():
     # No spring: without the contact K is singular; the solver must start from the active set.
     d = p1_dict("lagrange")
     d.pop("link")
-    s = run(scene.from_dict(d))
+    s = run(from_dict(d))
     assert s["nodes"]["mass"]["u"] == pytest.approx(H, rel=1e-15)
     assert s["contacts"]["plane"]["force"] == pytest.approx(M * G, rel=1e-14)
 
@@ -172,17 +173,17 @@ def test_unheld_mass_is_reported_singular():
     d.pop("link")
     d["loads"]["gravity"] = -9.81        # pulled away from the plane: nothing holds it
     with pytest.raises(SolverError, match="not held"):
-        run(scene.from_dict(d))
+        run(from_dict(d))
 
 
 def test_static_rejects_elastoplastic_spring_and_nonlinear_penalty():
     d = p1_dict("lagrange")
     d["link"][0].update(type="bilinear", fy=1.0)
     with pytest.raises(SolverError, match="elasto-plastic spring needs a dynamic analysis"):
-        run(scene.from_dict(d))
+        run(from_dict(d))
     d = p1_dict("penalty", law="hertz", stiffness=1e4)
     with pytest.raises(SolverError, match="static penalty supports law linear only"):
-        run(scene.from_dict(d))
+        run(from_dict(d))
 
 
 def test_uzawa_iterations_are_reported_and_bounded():

@@ -12,8 +12,11 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from martello import study
 from martello.errors import MartelloError
+from martello.study.outcome import status_class
+from martello.study.output import Progress
+from martello.study.study_file import _sweep, load_study
+from martello.study.sweep import fit_order, snap_step
 
 ROOT = Path(__file__).resolve().parent.parent
 P2 = ROOT / "benchmarks" / "p2"
@@ -103,47 +106,47 @@ def test_tiny_study_end_to_end(tmp_path):
 ])
 def test_study_file_errors_name_the_field(tmp_path, text, match):
     with pytest.raises(MartelloError, match=match):
-        study.load_study(write(tmp_path, text))
+        load_study(write(tmp_path, text))
 
 
 def test_scheme_override_replaces_the_laws_keys(tmp_path):
-    s = study.load_study(write(tmp_path, TINY))
+    s = load_study(write(tmp_path, TINY))
     assert [c.scheme_label for c in s.cases] == ["penalty linear", "restitution e=0.8"]
     c = s.cases[1].scene_dict["contact"][0]
     assert c["scheme"] == "restitution" and "stiffness" not in c and "law" not in c
     assert s.cases[1].reference["closed_form"] == "bouncing_oscillator_restitution"
     # geometric sweeps: from, to, per_decade
-    assert study._sweep("f", "dt", {"from": 1e-2, "to": 1e-4, "per_decade": 2}) == \
+    assert _sweep("f", "dt", {"from": 1e-2, "to": 1e-4, "per_decade": 2}) == \
         pytest.approx([1e-2, 10 ** -2.5, 1e-3, 10 ** -3.5, 1e-4])
 
 
 def test_steps_are_snapped_to_the_comparison_times():
-    assert study.snap_step(3e-5, 1e-4) == (1e-4 / 3, 3)
-    assert study.snap_step(2.6e-4, 1e-4) == (pytest.approx(3e-4, rel=1e-15), 1)
-    assert study.snap_step(1e-6, 5e-4, adaptive=True) == (5e-4, 1)
+    assert snap_step(3e-5, 1e-4) == (1e-4 / 3, 3)
+    assert snap_step(2.6e-4, 1e-4) == (pytest.approx(3e-4, rel=1e-15), 1)
+    assert snap_step(1e-6, 5e-4, adaptive=True) == (5e-4, 1)
 
 
 def test_status_classes():
-    assert study.status_class("MARTELLO_OK") == "ok"
-    assert study.status_class("MARTELLO_ERR_DIVERGED", "diverged at t = 1: non-finite state") == "diverged: NaN"
-    assert study.status_class("MARTELLO_ERR_DIVERGED", "mechanical energy exceeds") == "diverged: energy growth"
-    assert study.status_class("MARTELLO_ERR_NOT_CONVERGED") == "failed: no Newton convergence"
-    assert study.status_class("MARTELLO_ERR_STEP_UNDERFLOW") == "failed: step-size underflow"
-    assert study.status_class("MARTELLO_ERR_UNSUPPORTED") == "unsupported"
+    assert status_class("MARTELLO_OK") == "ok"
+    assert status_class("MARTELLO_ERR_DIVERGED", "diverged at t = 1: non-finite state") == "diverged: NaN"
+    assert status_class("MARTELLO_ERR_DIVERGED", "mechanical energy exceeds") == "diverged: energy growth"
+    assert status_class("MARTELLO_ERR_NOT_CONVERGED") == "failed: no Newton convergence"
+    assert status_class("MARTELLO_ERR_STEP_UNDERFLOW") == "failed: step-size underflow"
+    assert status_class("MARTELLO_ERR_UNSUPPORTED") == "unsupported"
 
 
 def test_fit_order_uses_the_asymptotic_range_only():
     h = np.array([1e-1, 5e-2, 2.5e-2, 1.25e-2, 6.25e-3])
     err = 3.0 * h**2
     err[0] = 0.9                         # pre-asymptotic: excluded by hi = 0.5
-    p, n = study.fit_order(h, err, 0.0, 0.5)
+    p, n = fit_order(h, err, 0.0, 0.5)
     assert p == pytest.approx(2.0, abs=1e-12) and n == 4
-    assert math.isnan(study.fit_order(h[:2], err[:2])[0])
+    assert math.isnan(fit_order(h[:2], err[:2])[0])
 
 
 def test_progress_bar_plain_text():
     buf = io.StringIO()
-    p = study.Progress(20, stream=buf)
+    p = Progress(20, stream=buf)
     for i in range(20):
         p.update(ok=i != 3)
     lines = buf.getvalue().splitlines()

@@ -1,4 +1,4 @@
-"""P8 case study (seed §5-6, Table 1; PROBLEMS.md P8; issue 7 items 4-5).
+"""P8 case study (seed §5-6, Table 1; docs/problems.md P8; docs/p8-case-study.md).
 
     .venv/bin/python benchmarks/p8/case_study.py                 # all runs, report, plots
     .venv/bin/python benchmarks/p8/case_study.py --write-scenes  # rewrite benchmarks/p8/*.toml
@@ -41,8 +41,8 @@ if str(ROOT) not in sys.path:
     sys.path.insert(0, str(ROOT))
 
 from martello import ground_motion as gm  # noqa: E402
-from martello import scene as scene_mod  # noqa: E402
-from martello.records import STANDARD_GRAVITY, read_csv_record  # noqa: E402
+from martello.ground_motion.records import STANDARD_GRAVITY, read_csv_record  # noqa: E402
+from martello.scene.loader import from_dict  # noqa: E402
 
 G = STANDARD_GRAVITY
 RECORD_DIR = HERE / "records"
@@ -350,7 +350,7 @@ def variant(config, record=1, *, alpha=None, elastic=False, stiffness_factor=1.0
     else:
         out["every"] = every or out.get("every", 1)
         out["links"] = [lk["name"] for lk in d["link"] if lk["type"] in ("bilinear", "spring", "fluid_damper")]
-    return scene_mod.from_dict(d, source=f"{SCENE_FILES[config].name}[record {record}]", base_dir=HERE)
+    return from_dict(d, source=f"{SCENE_FILES[config].name}[record {record}]", base_dir=HERE)
 
 
 # ============================================================================= one run
@@ -985,7 +985,7 @@ def main(argv=None):
         print("out of date with the parameters in case_study.py: "
               + ", ".join(p.name for p in stale) + " (run with --write-scenes)")
         return 1
-    from martello import native
+    from martello.binding import native
     from martello.run import run_full
     t_start = time.perf_counter()
     n_cfg = len(CONFIGS) * N_RECORDS
@@ -1050,7 +1050,7 @@ def main(argv=None):
         if lk["type"] == "fluid_damper":
             lk["v_reg"] = DAMPER_V_REG / 10
     d["analysis"]["output"] = {"nodes": [], "contacts": [], "links": [], "every": 1000000}
-    m_vreg = measure(run_full(scene_mod.from_dict(d, source="p8_A.toml[v_reg/10]", base_dir=HERE))[0])
+    m_vreg = measure(run_full(from_dict(d, source="p8_A.toml[v_reg/10]", base_dir=HERE))[0])
     all_runs.append(m_vreg)
     prog(f"v_reg {DAMPER_V_REG / 10:g} m/s: A, record 1", m_vreg)
     m_ref = runs["A"][0]

@@ -1,4 +1,4 @@
-"""Generate the five P8 input accelerograms (seed §5; PROBLEMS.md P8; issue 7 item 4).
+"""Generate the five P8 input accelerograms (seed §5; docs/problems.md P8; docs/p8-case-study.md).
 
     .venv/bin/python benchmarks/p8/make_records.py            # (re)write records/*.csv
     .venv/bin/python benchmarks/p8/make_records.py --check    # regenerate in memory and

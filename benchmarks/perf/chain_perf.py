@@ -38,9 +38,9 @@ def chain_scene(n, t_end=8.0, dt=1e-3):
 
 def one(n):
     """Run one size in this process; print a JSON line."""
-    from martello import scene
     from martello.run import run
-    s = scene.from_dict(chain_scene(n))
+    from martello.scene.loader import from_dict
+    s = from_dict(chain_scene(n))
     t0 = time.perf_counter()
     r = run(s)
     wall = time.perf_counter() - t0
@@ -66,7 +66,7 @@ def main():
     if args.one:
         one(args.one)
         return
-    from martello import native
+    from martello.binding import native
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
     rows = []

@@ -14,7 +14,7 @@ Families (docs/p4-bars.md explains each rate):
              dispersion of a second-order scheme on a wave with jumps.
   node       FE mesh with the ends at nodes (lumped or consistent mass) and a penalty spring
              ε = 0.1·EA/L_e: the spring's compliance dominates, an O(h) error predicted by
-             martello.wave_theory.penalty_rod_impact.
+             martello.oracles.p4_wave_theory.penalty_rod_impact.
   fixed ε    the same meshes with ε = 10·EA/L held fixed, compared with the continuum rods
              joined by that spring (wave_theory.penalty_rod_impact; equal and L_B = 2 L_A):
              the penalty problem is smooth, and the FE converges to it at high order.
@@ -35,10 +35,10 @@ import numpy as np
 ROOT = Path(__file__).resolve().parents[2]
 sys.path.insert(0, str(ROOT))
 
-from martello import scene                      # noqa: E402
-from martello.bars import rod_impact_scene      # noqa: E402
-from martello.run import run_full               # noqa: E402
-from martello.wave_theory import penalty_rod_impact  # noqa: E402
+from martello.checks.measures import run_measured            # noqa: E402
+from martello.oracles.p4_wave_theory import penalty_rod_impact  # noqa: E402
+from martello.scene.bars import rod_impact_scene               # noqa: E402
+from martello.scene.loader import from_dict                    # noqa: E402
 
 INTEGRATORS = {   # name -> extra [analysis] keys
     "central-difference": {},
@@ -59,7 +59,7 @@ def errors(N, integrator, ends, mass, eps_factor, courant):
     """The P4 measures of one run, as absolute errors (a dict)."""
     d = rod_impact_scene(N=N, integrator=integrator, ends=ends, mass=mass, eps_factor=eps_factor,
                          courant=courant, **INTEGRATORS[integrator])
-    summary, _ = run_full(scene.from_dict(d))
+    summary, _ = run_measured(from_dict(d))
     m = summary["measures"]["rod_impact"]
     return {"duration": abs(m.get("duration_relative_error", math.nan)),
             "pulse_l1": m.get("pulse_l1_error", math.nan),
@@ -77,7 +77,7 @@ def penalty_errors(N, integrator, mass, L_B, eps_over_rod=10.0):
     E, rho, A, L = 2.0e11, 7850.0, 1.0e-4, 1.0
     Z, c = math.sqrt(E * rho) * A, math.sqrt(E / rho)
     ref = penalty_rod_impact(Z, 1.0, d["contact"][0]["stiffness"], 2 * L / c, 2 * L_B / c)
-    summary, _ = run_full(scene.from_dict(d))
+    summary, _ = run_measured(from_dict(d))
     m = summary["measures"]["rod_impact"]
     out = {"penetration": abs(m["max_penetration"] / ref["max_penetration"] - 1.0),
            # rod A's mean velocity is v0 − impulse/m_A = −v0·impulse_relative_error

@@ -1,0 +1,162 @@
+!> The door of the impulse problem (fortran/impulse.f90, docs/impulse.md) for the C
+!> integrators (c/martello_internal.h, "the impulse problem"). The m contacts of a problem are
+!> list[0..m) of the integrator's own topology: contact j joins the 0-based nodes a[j] and
+!> b[j] (−1: the ground) and its column C_j = M⁻¹ B_jᵀ (length n) is column col[j] of the
+!> column-major array cols; the gap rate is ġ_j = B_j v = v_b − v_a. Matrices are m × m,
+!> column-major.
+module martello_api_impulse
+   use, intrinsic :: iso_c_binding
+   use martello_kinds, only: dp
+   use martello_status
+   use martello_impulse
+   implicit none
+   private
+
+   !> The problem's contacts in the module's terms: 1-based sides (0: ground) and columns.
+   type :: problem_t
+      integer, allocatable :: sa(:), sb(:), ic(:)
+   end type problem_t
+
+contains
+
+   integer(c_int) function c_impulse_delassus(n, m, list, a, b, col, cols, w) &
+      bind(C, name='martello_impulse_delassus')
+      integer(c_int), value :: n, m
+      integer(c_int), intent(in) :: list(*), a(*), b(*), col(*)
+      real(c_double), intent(in) :: cols(n, *)
+      real(c_double), intent(out) :: w(m, *)
+      type(problem_t) :: pb
+      c_impulse_delassus = status_of_sizes(n, m)
+      if (c_impulse_delassus /= MARTELLO_OK .or. m == 0) return
+      pb = problem(m, list, a, b, col)
+      call delassus_columns(pb%sa, pb%sb, cols(:, pb%ic), w(:, 1:m))
+   end function c_impulse_delassus
+
+   integer(c_int) function c_impulse_newton(n, m, list, a, b, col, cols, e, v, p, iterations) &
+      bind(C, name='martello_impulse_newton')
+      integer(c_int), value :: n, m
+      integer(c_int), intent(in) :: list(*), a(*), b(*), col(*)
+      real(c_double), intent(in) :: cols(n, *), e(*)
+      real(c_double), intent(inout) :: v(*)
+      real(c_double), intent(out) :: p(*)
+      integer(c_int), intent(out) :: iterations
+      type(problem_t) :: pb
+      real(dp) :: w(m, m), g(m)
+      integer :: info, its
+      iterations = 0
+      c_impulse_newton = status_of_sizes(n, m)
+      if (c_impulse_newton /= MARTELLO_OK .or. m == 0) return
+      pb = problem(m, list, a, b, col)
+      call delassus_columns(pb%sa, pb%sb, cols(:, pb%ic), w)
+      g = rates(pb, v(1:n))
+      p(1:m) = 0.0_dp
+      call newton_impulses(g, min(g, 0.0_dp), e(1:m), p(1:m), info, its, w=w)   ! an impact
+      iterations = its
+      c_impulse_newton = martello_status_of(info)
+      if (info == IMPULSE_OK) call apply_impulses(cols(:, pb%ic), p(1:m), v(1:n))
+   end function c_impulse_newton
+
+   integer(c_int) function c_impulse_contact_forces(n, m, list, a, b, col, cols, acc, lam, held, &
+                                                    iterations) bind(C, name='martello_impulse_contact_forces')
+      integer(c_int), value :: n, m
+      integer(c_int), intent(in) :: list(*), a(*), b(*), col(*)
+      real(c_double), intent(in) :: cols(n, *), acc(*)
+      real(c_double), intent(out) :: lam(*)
+      integer(c_int), intent(out) :: held(*), iterations
+      type(problem_t) :: pb
+      real(dp) :: w(m, m)
+      logical :: keep(m)
+      integer :: info, its
+      iterations = 0
+      c_impulse_contact_forces = status_of_sizes(n, m)
+      if (c_impulse_contact_forces /= MARTELLO_OK .or. m == 0) return
+      pb = problem(m, list, a, b, col)
+      call delassus_columns(pb%sa, pb%sb, cols(:, pb%ic), w)
+      call contact_forces(w, rates(pb, acc(1:n)), lam(1:m), keep, info, its)
+      held(1:m) = merge(1, 0, keep)
+      iterations = its
+      c_impulse_contact_forces = martello_status_of(info)
+   end function c_impulse_contact_forces
+
+   integer(c_int) function c_impulse_factor(n, m, list, a, b, col, cols, l) &
+      bind(C, name='martello_impulse_factor')
+      integer(c_int), value :: n, m
+      integer(c_int), intent(in) :: list(*), a(*), b(*), col(*)
+      real(c_double), intent(in) :: cols(n, *)
+      real(c_double), intent(out) :: l(m, *)
+      type(problem_t) :: pb
+      integer :: info
+      c_impulse_factor = status_of_sizes(n, m)
+      if (c_impulse_factor /= MARTELLO_OK .or. m == 0) return
+      pb = problem(m, list, a, b, col)
+      call delassus_columns(pb%sa, pb%sb, cols(:, pb%ic), l(:, 1:m))
+      call delassus_factor(l(:, 1:m), info)
+      c_impulse_factor = martello_status_of(info)
+   end function c_impulse_factor
+
+   integer(c_int) function c_impulse_project(n, m, list, a, b, col, cols, l, target, x, p) &
+      bind(C, name='martello_impulse_project')
+      integer(c_int), value :: n, m
+      integer(c_int), intent(in) :: list(*), a(*), b(*), col(*)
+      real(c_double), intent(in) :: cols(n, *), l(m, *)
+      type(c_ptr), value :: target
+      real(c_double), intent(inout) :: x(*)
+      real(c_double), intent(out) :: p(*)
+      type(problem_t) :: pb
+      real(c_double), pointer :: tg(:)
+      real(dp) :: goal(m)
+      c_impulse_project = status_of_sizes(n, m)
+      if (c_impulse_project /= MARTELLO_OK .or. m == 0) return
+      pb = problem(m, list, a, b, col)
+      goal = 0.0_dp
+      if (c_associated(target)) then
+         call c_f_pointer(target, tg, [m])
+         goal = tg
+      end if
+      call project_factored(pb%sa, pb%sb, cols(:, pb%ic), l(:, 1:m), goal, x(1:n), p(1:m))
+   end function c_impulse_project
+
+   integer(c_int) function c_impulse_accumulation(e, s, a, t, tau_res, height_res, t_inf) &
+      bind(C, name='martello_impulse_accumulation')
+      real(c_double), value :: e, s, a, t, tau_res, height_res
+      real(c_double), intent(out) :: t_inf
+      logical :: acc
+      call impulse_accumulation(e, s, a, t, tau_res, height_res, acc, t_inf)
+      c_impulse_accumulation = merge(1, 0, acc)
+   end function c_impulse_accumulation
+
+   !> Contacts list[0..m) of the topology (a, b, col) in the module's terms.
+   pure function problem(m, list, a, b, col) result(pb)
+      integer, intent(in) :: m
+      integer(c_int), intent(in) :: list(*), a(*), b(*), col(*)
+      type(problem_t) :: pb
+      allocate (pb%sa(m), pb%sb(m), pb%ic(m))
+      pb%sa = max(a(list(1:m) + 1), -1) + 1
+      pb%sb = max(b(list(1:m) + 1), -1) + 1
+      pb%ic = col(list(1:m) + 1) + 1
+   end function problem
+
+   !> ġ_k = x_b − x_a of the problem's contacts.
+   pure function rates(pb, x) result(g)
+      type(problem_t), intent(in) :: pb
+      real(dp), intent(in) :: x(:)
+      real(dp) :: g(size(pb%sa)), xg(0:size(x))
+      xg(0) = 0.0_dp
+      xg(1:) = x
+      g = xg(pb%sb) - xg(pb%sa)
+   end function rates
+
+   pure integer function status_of_sizes(n, m)
+      integer(c_int), intent(in) :: n, m
+      status_of_sizes = merge(MARTELLO_OK, MARTELLO_ERR_ARGUMENT, n >= 0 .and. m >= 0)
+   end function status_of_sizes
+
+   elemental integer function martello_status_of(info)
+      integer, intent(in) :: info
+      select case (info)
+      case (IMPULSE_OK); martello_status_of = MARTELLO_OK
+      case (IMPULSE_INFEASIBLE, IMPULSE_SINGULAR); martello_status_of = MARTELLO_ERR_SINGULAR
+      case default; martello_status_of = MARTELLO_ERR_NOT_CONVERGED
+      end select
+   end function martello_status_of
+end module martello_api_impulse

@@ -1,0 +1,108 @@
+!> The effective mass of every contact and what derives from it. For contact c with row B of
+!> the constraint matrix (δ = B u − gap: +1 at node a, −1 at node b, nothing for ground or a
+!> fixed node), the relative motion obeys δ̈ = −(B M⁻¹ Bᵀ) P + …, so the contact sees
+!>
+!>   m* = 1/(B M⁻¹ Bᵀ)
+!>
+!> (the inverse of the contact's Delassus operator, docs/moreau-jean.md; = m_a m_b/(m_a + m_b)
+!> for a diagonal M, m_a against a wall, infinite if neither side moves). M is the lumped
+!> diagonal plus the consistent couplings (docs/p4-bars.md), restricted to the free nodes.
+!> m* sets the damping of a penalty contact given a target restitution (contact_laws'
+!> damping_from_restitution, PROBLEMS.md P5) and the Jankowski damping coefficient.
+module martello_effective_mass
+   use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_positive_inf, ieee_is_finite
+   use martello_kinds, only: dp
+   use martello_status
+   use martello_model, only: model_t, model_bandwidth, SCHEME_PENALTY
+   use martello_contact_laws, only: P_RESTITUTION, P_DAMPING, damping_from_restitution
+   use martello_stability, only: free_dofs, mass_band
+   use martello_lapack, only: dpbtrf, dpbtrs
+   implicit none
+   private
+   public :: contact_effective_masses, effective_mass_prepare
+
+contains
+
+   !> m* of every contact. A contact whose moving nodes carry no coupling sees a diagonal M,
+   !> m* = m_a m_b/(m_a + m_b) (or the moving side's mass); otherwise M is factored once
+   !> (banded Cholesky, dpbtrf) and B M⁻¹ Bᵀ solved per contact. stat = MARTELLO_ERR_ARGUMENT
+   !> (message says why) if M is not positive definite on the free nodes.
+   subroutine contact_effective_masses(m, mstar, message, stat)
+      type(model_t), intent(in) :: m
+      real(dp), intent(out) :: mstar(:)
+      character(len=*), intent(inout) :: message
+      integer, intent(out) :: stat
+      integer, allocatable :: dof(:)
+      logical, allocatable :: coupled(:)
+      real(dp), allocatable :: mb(:, :), x(:)
+      integer :: nf, kd, c, j, ia, ib, info
+      stat = MARTELLO_OK
+      call free_dofs(m, dof, nf)
+      allocate (coupled(0:m%n)); coupled = .false.
+      do j = 1, m%ncoupling
+         if (dof(m%mc_a(j)) > 0 .and. dof(m%mc_b(j)) > 0) then
+            coupled(m%mc_a(j)) = .true.; coupled(m%mc_b(j)) = .true.
+         end if
+      end do
+      kd = max(model_bandwidth(m), 0)
+      if (any(coupled)) then
+         call mass_band(m, dof, nf, kd, mb)
+         call dpbtrf('U', nf, kd, mb, kd + 1, info)
+         if (info /= 0) then
+            stat = MARTELLO_ERR_ARGUMENT
+            message = 'the mass matrix (node masses plus mass couplings) is not positive'// &
+               ' definite: a coupling is larger than the masses it joins allow'
+            return
+         end if
+         allocate (x(nf))
+      end if
+      do c = 1, m%ncontact
+         ia = dof(m%con_a(c)); ib = dof(m%con_b(c))   ! 0: ground or a fixed node
+         if (ia == 0 .and. ib == 0) then
+            mstar(c) = ieee_value(1.0_dp, ieee_positive_inf)
+         else if (.not. (coupled(m%con_a(c)) .or. coupled(m%con_b(c)))) then
+            if (ia == 0) then
+               mstar(c) = m%mass(m%con_b(c))
+            else if (ib == 0) then
+               mstar(c) = m%mass(m%con_a(c))
+            else
+               associate (ma => m%mass(m%con_a(c)), mbb => m%mass(m%con_b(c)))
+                  mstar(c) = ma*mbb/(ma + mbb)
+               end associate
+            end if
+         else
+            x = 0.0_dp
+            if (ia > 0) x(ia) = 1.0_dp
+            if (ib > 0) x(ib) = -1.0_dp
+            call dpbtrs('U', nf, kd, 1, mb, kd + 1, x, nf, info)
+            mstar(c) = 0.0_dp            ! B M⁻¹ Bᵀ = x_a − x_b over the moving sides
+            if (ia > 0) mstar(c) = x(ia)
+            if (ib > 0) mstar(c) = mstar(c) - x(ib)
+            mstar(c) = 1.0_dp/mstar(c)
+         end if
+      end do
+   end subroutine contact_effective_masses
+
+   !> What a run needs from the whole model: m%con_mstar, and the damping of every penalty
+   !> contact given a target restitution, by its law's published formula. Called once the
+   !> model is complete (masses and couplings are known), before the integrator starts.
+   subroutine effective_mass_prepare(m, message, stat)
+      type(model_t), intent(inout) :: m
+      character(len=*), intent(inout) :: message
+      integer, intent(out) :: stat
+      integer :: c
+      if (any(m%mass < 0.0_dp)) then
+         stat = MARTELLO_ERR_STATE; message = 'every node must be set before a run'; return
+      end if
+      call contact_effective_masses(m, m%con_mstar(1:m%ncontact), message, stat)
+      if (stat /= MARTELLO_OK) return
+      do c = 1, m%ncontact
+         if (m%con_scheme(c) /= SCHEME_PENALTY .or. m%con_par(P_RESTITUTION, c) < 0.0_dp) cycle
+         ! neither side moves: the contact never acts, its damping is moot (and c·0 must stay 0)
+         m%con_par(P_DAMPING, c) = 0.0_dp
+         if (ieee_is_finite(m%con_mstar(c))) m%con_par(P_DAMPING, c) = &
+            damping_from_restitution(m%con_law(c), m%con_par(P_RESTITUTION, c), m%con_par(:, c), &
+                                     m%con_mstar(c))
+      end do
+   end subroutine effective_mass_prepare
+end module martello_effective_mass

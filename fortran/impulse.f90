@@ -1,0 +1,509 @@
+!> The contact/impulse problem shared by every integrator with rigid contacts (docs/impulse.md):
+!> the Delassus matrix, Newton's impact law and the contact forces of persistent contacts as
+!> LCPs w = W z + q, 0 ≤ w ⊥ z ≥ 0, their solvers, the projection onto held contacts, and the
+!> accumulation (Zeno) policy.
+!>
+!> Conventions (docs/impulse.md §1; Acary & Brogliato 2008, §3.1): contact k joins the sides
+!> sa_k, sb_k (nodes; 0 for the ground or an immobile node), its gap rate is ġ_k = B_k v =
+!> v_b − v_a (> 0 opening), a compressive impulse P_k ≥ 0 acts as B_kᵀ P_k. With the columns
+!> C_k = A B_kᵀ of an inverse-mass action A (M⁻¹, or Moreau–Jean's Ŵ⁻¹), W = B A Bᵀ, W_kl =
+!> B_k C_l, and Δv = Σ_k P_k C_k. Matrices are column-major; band storage as LAPACK's general
+!> band with kl = ku = kw: W(i, j) lives in wb(kw + 1 + i − j, j).
+module martello_impulse
+   use martello_kinds, only: dp
+   use martello_lapack, only: dgbsv, dpotrf, dpotrs
+   implicit none
+   private
+   public :: contact_graph_t, contact_graph, delassus_columns, delassus_bandwidth, &
+      delassus_diagonal_band, newton_impulses, contact_forces, apply_impulses, delassus_factor, &
+      project_factored, impulse_accumulation, LEMKE_MAX, IMPULSE_OK, IMPULSE_INFEASIBLE, &
+      IMPULSE_NOT_CONVERGED, IMPULSE_SINGULAR
+
+   !> Up to this many contacts an LCP is solved by Lemke on a dense W (finite, exact to
+   !> round-off); beyond, by projected Gauss–Seidel with its direct finish on the band of W
+   !> (O(m) a sweep on a chain). docs/impulse.md §2.
+   integer, parameter :: LEMKE_MAX = 64
+   !> PGS: stop when a sweep changes no impulse by more than PGS_TOL·max impulse (the direct
+   !> finish makes the solution exact to round-off before that)
+   real(dp), parameter :: PGS_TOL = 1.0e-14_dp
+   integer, parameter :: PGS_MAX_SWEEPS = 100000
+
+   integer, parameter :: IMPULSE_OK = 0
+   !> no solution (Lemke's secondary ray): redundant contacts that Newton's law cannot all
+   !> satisfy, e.g. a node that reaches two walls at once
+   integer, parameter :: IMPULSE_INFEASIBLE = 1
+   integer, parameter :: IMPULSE_NOT_CONVERGED = 2    !< pivot or sweep limit reached
+   integer, parameter :: IMPULSE_SINGULAR = 3         !< W of the held set not positive definite
+
+   !> Which contacts touch each node: con(ptr(i):ptr(i+1)−1). Built once a run; it makes the
+   !> band Delassus matrix of a diagonal A cost O(m) instead of O(m²).
+   type :: contact_graph_t
+      integer, allocatable :: ptr(:), con(:)
+   end type contact_graph_t
+
+contains
+   !> The node → contact adjacency of the contacts with use(k) true (sides 0 are left out).
+   pure subroutine contact_graph(n, sa, sb, use, g)
+      integer, intent(in) :: n, sa(:), sb(:)
+      logical, intent(in) :: use(:)
+      type(contact_graph_t), intent(out) :: g
+      integer :: cnt(0:n), k
+      cnt = 0
+      do k = 1, size(sa)
+         if (.not. use(k)) cycle
+         cnt(sa(k)) = cnt(sa(k)) + 1
+         cnt(sb(k)) = cnt(sb(k)) + 1
+      end do
+      allocate (g%ptr(n + 2), g%con(max(1, sum(cnt(1:n)))))
+      g%ptr(1) = 1
+      do k = 1, n
+         g%ptr(k + 1) = g%ptr(k) + cnt(k)
+      end do
+      cnt = 0
+      do k = 1, size(sa)
+         if (.not. use(k)) cycle
+         if (sa(k) > 0) then
+            g%con(g%ptr(sa(k)) + cnt(sa(k))) = k; cnt(sa(k)) = cnt(sa(k)) + 1
+         end if
+         if (sb(k) > 0) then
+            g%con(g%ptr(sb(k)) + cnt(sb(k))) = k; cnt(sb(k)) = cnt(sb(k)) + 1
+         end if
+      end do
+   end subroutine contact_graph
+
+   !> W_kl = B_k C_l for the contacts k, l = 1..m with sides sa, sb and columns c(:, l) =
+   !> A B_lᵀ (any inverse-mass action: M⁻¹, consistent mass included, or Ŵ⁻¹).
+   pure subroutine delassus_columns(sa, sb, c, w)
+      integer, intent(in) :: sa(:), sb(:)
+      real(dp), intent(in) :: c(:, :)
+      real(dp), intent(out) :: w(:, :)
+      integer :: k, l
+      do l = 1, size(sa)
+         do k = 1, size(sa)
+            w(k, l) = side(c(:, l), sb(k)) - side(c(:, l), sa(k))
+         end do
+      end do
+   end subroutine delassus_columns
+
+   !> The bandwidth kw of W in the ordering act(1..m) of the contacts in an LCP (pos(c) = the
+   !> position of contact c in act, 0 if absent): 1 for a chain of neighbours.
+   pure integer function delassus_bandwidth(g, sa, sb, act, pos) result(kw)
+      type(contact_graph_t), intent(in) :: g
+      integer, intent(in) :: sa(:), sb(:), act(:), pos(:)
+      integer :: i, k, side_, node, jj
+      kw = 0
+      do i = 1, size(act)
+         k = act(i)
+         do side_ = 1, 2
+            node = merge(sa(k), sb(k), side_ == 1)
+            if (node == 0) cycle
+            do jj = g%ptr(node), g%ptr(node + 1) - 1
+               if (pos(g%con(jj)) > 0) kw = max(kw, abs(pos(g%con(jj)) - i))
+            end do
+         end do
+      end do
+   end function delassus_bandwidth
+
+   !> W in band storage (bandwidth kw from delassus_bandwidth; wb at least (2kw + 1, m)) for
+   !> a diagonal A = diag(1/d) (Moreau–Jean's Ŵ of a lumped-mass chain without links): W_kl =
+   !> Σ over the nodes i that contacts k and l share of s_k(i) s_l(i)/d_i (s = −1 on the a
+   !> side, +1 on the b side): O(m) for a chain instead of the O(m²) of delassus_columns.
+   pure subroutine delassus_diagonal_band(g, sa, sb, act, pos, d, kw, wb)
+      type(contact_graph_t), intent(in) :: g
+      integer, intent(in) :: sa(:), sb(:), act(:), pos(:), kw
+      real(dp), intent(in) :: d(:)
+      real(dp), intent(inout) :: wb(:, :)
+      integer :: i, k, side_, node, jj, cj
+      real(dp) :: si
+      wb(:, 1:size(act)) = 0.0_dp
+      do i = 1, size(act)
+         k = act(i)
+         do side_ = 1, 2
+            node = merge(sa(k), sb(k), side_ == 1)
+            if (node == 0) cycle
+            si = merge(-1.0_dp, 1.0_dp, side_ == 1)
+            do jj = g%ptr(node), g%ptr(node + 1) - 1
+               cj = g%con(jj)
+               if (pos(cj) == 0) cycle
+               wb(kw + 1 + i - pos(cj), pos(cj)) = wb(kw + 1 + i - pos(cj), pos(cj)) + &
+                  si*merge(-1.0_dp, 1.0_dp, sa(cj) == node)/d(node)
+            end do
+         end do
+      end do
+   end subroutine delassus_diagonal_band
+
+   !> Newton's impact law at the velocity level (docs/impulse.md §2; Moreau 1988; Pfeiffer &
+   !> Glocker 1996, §6.2), 0 ≤ ġ⁺ + e ġ_ref ⊥ P ≥ 0 with ġ⁺ = ġ_free + W P: the LCP with
+   !> q = ġ_free + e ġ_ref. ġ_ref is what the restitution acts on: the approach min(ġ⁻, 0) of
+   !> an impact (ġ_free = ġ⁻), or Moreau–Jean's start-of-step ġ_k (Acary & Brogliato 2008,
+   !> eq. 10.12). W dense (w) or in band storage (wb, kw); p on entry: PGS's warm start.
+   subroutine newton_impulses(g_free, g_ref, e, p, info, iterations, w, wb, kw)
+      real(dp), intent(in) :: g_free(:), g_ref(:), e(:)
+      real(dp), intent(inout) :: p(:)
+      integer, intent(out) :: info, iterations
+      real(dp), intent(in), optional :: w(:, :), wb(:, :)
+      integer, intent(in), optional :: kw
+      call solve_lcp(g_free + e*g_ref, p, info, iterations, w, wb, kw)
+   end subroutine newton_impulses
+
+   !> The contact forces λ of contacts at zero gap and zero gap rate: Signorini's law at the
+   !> acceleration level, 0 ≤ g̈ ⊥ λ ≥ 0 with g̈ = g̈_free + W λ (Pfeiffer & Glocker 1996, §5.3).
+   !> The persistent-contact rule (docs/impulse.md §3): held = the solution does not open the
+   !> contact (λ > 0, or g̈ ≤ 0); a multiplier that would turn tensile opens it, one that only
+   !> reaches 0 with nothing pulling (g̈ = 0) does not.
+   subroutine contact_forces(w, a_free, lam, held, info, iterations)
+      real(dp), intent(in) :: w(:, :), a_free(:)
+      real(dp), intent(out) :: lam(:)
+      logical, intent(out) :: held(:)
+      integer, intent(out) :: info, iterations
+      lam = 0.0_dp
+      call solve_lcp(a_free, lam, info, iterations, w=w)
+      held = lam > 0.0_dp .or. .not. (matmul(w, lam) + a_free > 0.0_dp)
+   end subroutine contact_forces
+
+   !> x ← x + Σ_k p_k c(:, k): the velocity jump of impulses p (or the displacement of a
+   !> projection), through the columns c(:, k) = A B_kᵀ.
+   pure subroutine apply_impulses(c, p, x)
+      real(dp), intent(in) :: c(:, :), p(:)
+      real(dp), intent(inout) :: x(:)
+      integer :: k
+      do k = 1, size(p)
+         if (p(k) /= 0.0_dp) x = x + p(k)*c(:, k)
+      end do
+   end subroutine apply_impulses
+
+   !> Cholesky factorisation in place (LAPACK dpotrf, L in the lower triangle) of the Delassus
+   !> matrix of contacts held together. IMPULSE_SINGULAR when a pivot falls to the rounding of
+   !> the largest diagonal, L_jj² ≤ 64 ε m max W_ii (the Cholesky backward error bound, Higham
+   !> 2002 Thm 10.3, with a margin): the contacts are redundant, W only semi-definite. One
+   !> contact keeps W itself: its solve is then one division, exact to one rounding.
+   subroutine delassus_factor(w, info)
+      real(dp), intent(inout) :: w(:, :)
+      integer, intent(out) :: info
+      real(dp) :: dmax
+      integer :: j, m, lapack_info
+      m = size(w, 1)
+      info = IMPULSE_OK
+      if (m == 0) return
+      dmax = maxval([(abs(w(j, j)), j = 1, m)])
+      if (m == 1) then
+         if (.not. (w(1, 1) > 0.0_dp)) info = IMPULSE_SINGULAR
+         return
+      end if
+      call dpotrf('L', m, w, m, lapack_info)
+      if (lapack_info /= 0) then
+         info = IMPULSE_SINGULAR
+      else if (.not. all([(w(j, j)**2 > 64.0_dp*epsilon(1.0_dp)*m*dmax, j = 1, m)])) then
+         info = IMPULSE_SINGULAR
+      end if
+   end subroutine delassus_factor
+
+   !> The mass-weighted projection of x onto B x = target for contacts held together
+   !> (Acary & Brogliato 2008, §4.2: the closest point in the metric A⁻¹): with W factored
+   !> by delassus_factor, P = W⁻¹ (target − B x) and x ← x + Σ P_k c(:, k). On the velocities
+   !> with target 0 it is the plastic impulse of the held set; on the accelerations, the
+   !> bilateral contact forces; on the displacements with target −gap, the return onto δ = 0.
+   subroutine project_factored(sa, sb, c, l, target, x, p)
+      integer, intent(in) :: sa(:), sb(:)
+      real(dp), intent(in) :: c(:, :), l(:, :), target(:)
+      real(dp), intent(inout) :: x(:)
+      real(dp), intent(out) :: p(:)
+      integer :: k, m, info
+      m = size(sa)
+      do k = 1, m
+         p(k) = target(k) - (side(x, sb(k)) - side(x, sa(k)))
+      end do
+      if (m == 1) then
+         p(1) = p(1)/l(1, 1)
+      else
+         call dpotrs('L', m, 1, l, m, p, m, info)
+      end if
+      call apply_impulses(c, p, x)
+   end subroutine project_factored
+
+   !> The accumulation (Zeno) policy, the one rule of every integrator (docs/impulse.md §4).
+   !> A contact leaving at t with separation speed s ≥ 0, pressed by its relative acceleration
+   !> a > 0, makes the geometric series of flights τ, eτ, e²τ, … (τ = 2s/a; Moreau 1988, §9)
+   !> that ends at the accumulation point t∞ = t + 2s/(a(1 − e)), returned in t_inf (huge when
+   !> there is none): the contact is persistent from there. The flights are no longer resolved
+   !> one by one when there is no rebound (s = 0 or e = 0: t∞ = t, and the persistent-contact
+   !> rule decides whether the contact stays closed), or when the next flight is below the
+   !> integrator's resolution: shorter than tau_res (the step of a time-stepping scheme,
+   !> event_tol for the event-driven ones) or with its apex s²/(2a) lower than height_res (0
+   !> for time stepping; the heights an event-driven integrator resolves). Deciding on "t∞
+   !> inside the current interval" was measured and rejected: docs/impulse.md §4 says why.
+   !> No accumulation without pressing (a ≤ 0) or dissipation (e ≥ 1).
+   pure subroutine impulse_accumulation(e, s, a, t, tau_res, height_res, accumulates, t_inf)
+      real(dp), intent(in) :: e, s, a, t, tau_res, height_res
+      logical, intent(out) :: accumulates
+      real(dp), intent(out) :: t_inf
+      accumulates = .true.
+      t_inf = t
+      if (s <= 0.0_dp .or. e <= 0.0_dp) return
+      accumulates = .false.
+      t_inf = huge(1.0_dp)
+      if (.not. (a > 0.0_dp) .or. e >= 1.0_dp) return
+      t_inf = t + 2.0_dp*s/(a*(1.0_dp - e))
+      accumulates = 2.0_dp*s/a <= tau_res .or. s*s/(2.0_dp*a) <= height_res
+   end subroutine impulse_accumulation
+
+   ! ---- the LCP solvers (docs/impulse.md §2) -----------------------------------------------
+
+   !> W z + q ≥ 0 ⊥ z ≥ 0 with W dense (w) or in band storage (wb, kw): Lemke on the dense W up
+   !> to LEMKE_MAX contacts, PGS on the band beyond (a dense W is copied into a band of full
+   !> width, a band W into a dense one for Lemke); z on entry is PGS's warm start.
+   subroutine solve_lcp(q, z, info, iterations, w, wb, kw)
+      real(dp), intent(in) :: q(:)
+      real(dp), intent(inout) :: z(:)
+      integer, intent(out) :: info, iterations
+      real(dp), intent(in), optional :: w(:, :), wb(:, :)
+      integer, intent(in), optional :: kw
+      real(dp), allocatable :: wd(:, :), wbd(:, :)
+      integer :: m, i, j
+      m = size(q)
+      if (present(w)) then
+         if (m <= LEMKE_MAX) then
+            call lemke(w(1:m, 1:m), q, z, iterations, info)
+            return
+         end if
+         allocate (wbd(2*m - 1, m))
+         forall (i = 1:m, j = 1:m) wbd(m + i - j, j) = w(i, j)
+         call pgs(wbd, m - 1, q, z, PGS_TOL, PGS_MAX_SWEEPS, iterations, info)
+      else if (m <= LEMKE_MAX) then
+         allocate (wd(m, m))
+         wd = 0.0_dp
+         forall (j = 1:m, i = 1:m, abs(i - j) <= kw) wd(i, j) = wb(kw + 1 + i - j, j)
+         call lemke(wd, q, z, iterations, info)
+      else
+         call pgs(wb(:, 1:m), kw, q, z, PGS_TOL, PGS_MAX_SWEEPS, iterations, info)
+      end if
+   end subroutine solve_lcp
+
+   !> Lemke's method with the covering vector (1, …, 1). On return z solves the LCP and
+   !> pivots is the number of pivots made (0 when q ≥ 0, z = 0). The ratio test breaks ties
+   !> in favour of the artificial variable z0 (it ends the algorithm), then of the smallest
+   !> row. info = IMPULSE_INFEASIBLE when the entering column has no positive entry (W not copositive-
+   !> plus on a feasible problem: impossible for a positive semi-definite Delassus operator
+   !> with a feasible LCP); IMPULSE_NOT_CONVERGED after max_pivots.
+   pure subroutine lemke(w, q, z, pivots, info, max_pivots)
+      real(dp), intent(in) :: w(:, :), q(:)
+      real(dp), intent(out) :: z(:)
+      integer, intent(out) :: pivots, info
+      integer, intent(in), optional :: max_pivots
+      ! tableau: binv(n, n) = B⁻¹, x(n) = B⁻¹ q; basis(i) = variable basic in row i:
+      ! 1..n are w, n+1..2n are z, 2n+1 is z0
+      real(dp) :: binv(size(q), size(q)), x(size(q)), col(size(q)), piv_tol, ratio, best
+      integer :: basis(size(q)), n, r, i, entering, leaving, maxp
+      logical :: solved
+      n = size(q)
+      z = 0.0_dp
+      pivots = 0
+      info = IMPULSE_OK
+      if (n == 0) return
+      if (minval(q) >= 0.0_dp) return
+      maxp = 50*n + 10
+      if (present(max_pivots)) maxp = max_pivots
+      binv = 0.0_dp
+      do i = 1, n
+         binv(i, i) = 1.0_dp
+         basis(i) = i
+      end do
+      x = q
+      ! z0 enters; the most negative q leaves
+      r = minloc(q, 1)
+      col = -1.0_dp
+      call lemke_pivot(binv, x, r, col, pivots)
+      leaving = basis(r)
+      basis(r) = 2*n + 1
+      entering = complement(leaving)
+      solved = .false.
+      do while (pivots < maxp)
+         ! column of the entering variable in the current basis: B⁻¹ A_j
+         if (entering <= n) then
+            col = binv(:, entering)                       ! A_j = e_j
+         else
+            col = -matmul(binv, w(:, entering - n))       ! A_j = −W(:, j)
+         end if
+         piv_tol = 1.0e3_dp*epsilon(1.0_dp)*max(maxval(abs(col)), tiny(1.0_dp))
+         r = 0
+         best = huge(1.0_dp)
+         do i = 1, n
+            if (col(i) > piv_tol) then
+               ratio = max(x(i), 0.0_dp)/col(i)
+               if (ratio < best .or. (ratio == best .and. basis(i) == 2*n + 1)) then
+                  best = ratio; r = i
+               end if
+            end if
+         end do
+         if (r == 0) then
+            info = IMPULSE_INFEASIBLE
+            exit
+         end if
+         call lemke_pivot(binv, x, r, col, pivots)
+         leaving = basis(r)
+         basis(r) = entering
+         if (leaving == 2*n + 1) then                     ! z0 left the basis: solved
+            solved = .true.
+            exit
+         end if
+         entering = complement(leaving)
+      end do
+      if (.not. solved .and. info == IMPULSE_OK) info = IMPULSE_NOT_CONVERGED
+      do i = 1, n
+         if (basis(i) > n .and. basis(i) <= 2*n) z(basis(i) - n) = max(x(i), 0.0_dp)
+      end do
+   contains
+      pure integer function complement(var)
+         integer, intent(in) :: var
+         if (var <= n) then
+            complement = var + n
+         else
+            complement = var - n
+         end if
+      end function complement
+
+   end subroutine lemke
+
+   !> Gauss–Jordan pivot of Lemke's tableau (B⁻¹ and x = B⁻¹q) on row rr, column cc = B⁻¹A_j.
+   pure subroutine lemke_pivot(binv, x, rr, cc, pivots)
+      real(dp), intent(inout) :: binv(:, :), x(:)
+      integer, intent(in) :: rr
+      real(dp), intent(in) :: cc(:)
+      integer, intent(inout) :: pivots
+      integer :: k
+      real(dp) :: p
+      p = cc(rr)
+      binv(rr, :) = binv(rr, :)/p
+      x(rr) = x(rr)/p
+      do k = 1, size(x)
+         if (k == rr .or. cc(k) == 0.0_dp) cycle
+         binv(k, :) = binv(k, :) - cc(k)*binv(rr, :)
+         x(k) = x(k) - cc(k)*x(rr)
+      end do
+      pivots = pivots + 1
+   end subroutine lemke_pivot
+
+   !> Projected Gauss–Seidel, z_i ← max(0, z_i − (q + W z)_i / W_ii) for i = 1..n, from the
+   !> given z (a warm start), with an exact finish: after 8 sweeps, every POLISH_EVERY, and once the
+   !> sweeps change z by less than √tol, the support J = {z_i > 0} is taken as the active set
+   !> and W_JJ z_J = −q_J solved directly (a band solve: W_JJ keeps W's bandwidth). If that z
+   !> is feasible (z_J ≥ 0, (Wz + q)_i ≥ −tol·scale off J) it is the solution to round-off;
+   !> plain PGS converges only linearly, at a rate 1 − O(1/n²) on a chain of n contacts
+   !> pressed together (Newton's cradle), so without the finish it would stop far from it.
+   !> Otherwise PGS stops when a sweep changes no z_i by more than tol·max z.
+   !> Rows with W_ii ≤ 0 (a contact between immobile sides) are left at z_i = 0.
+   subroutine pgs(wb, kw, q, z, tol, max_sweeps, sweeps, info)
+      real(dp), intent(in) :: wb(:, :)    !< (2kw + 1, n) band
+      integer, intent(in) :: kw
+      real(dp), intent(in) :: q(:), tol
+      real(dp), intent(inout) :: z(:)
+      integer, intent(in) :: max_sweeps
+      integer, intent(out) :: sweeps, info
+      integer, parameter :: POLISH_EVERY = 64
+      integer :: i, j, n
+      real(dp) :: s, znew, change, zmax
+      logical :: done
+      n = size(q)
+      info = IMPULSE_OK
+      sweeps = 0
+      if (n == 0) return
+      z = max(z, 0.0_dp)
+      do sweeps = 1, max_sweeps
+         change = 0.0_dp; zmax = 0.0_dp
+         do i = 1, n
+            if (wb(kw + 1, i) <= 0.0_dp) then
+               z(i) = 0.0_dp; cycle
+            end if
+            s = q(i)
+            do j = max(1, i - kw), min(n, i + kw)
+               s = s + wb(kw + 1 + i - j, j)*z(j)
+            end do
+            znew = max(0.0_dp, z(i) - s/wb(kw + 1, i))
+            change = max(change, abs(znew - z(i)))
+            z(i) = znew
+            zmax = max(zmax, znew)
+         end do
+         if (change <= tol*max(zmax, tiny(1.0_dp))) return
+         if (sweeps == 8 .or. mod(sweeps, POLISH_EVERY) == 0 .or. change <= sqrt(tol)*zmax) then
+            call polish(wb, kw, q, z, tol, done)
+            if (done) return
+         end if
+      end do
+      sweeps = max_sweeps
+      info = IMPULSE_NOT_CONVERGED
+   end subroutine pgs
+
+   !> Block principal pivoting from the support of z (Júdice & Pires 1994, without their
+   !> safeguard): solve W_JJ z_J = −q_J (dgbsv on the compressed band), drop from J the
+   !> indices with z_j < 0, add those off J with (Wz + q)_i < 0, repeat. Accepted when both
+   !> sets are empty within tol (z is then the LCP solution to round-off); after MAX_ROUNDS
+   !> rounds z is left unchanged and PGS carries on.
+   subroutine polish(wb, kw, q, z, tol, done)
+      real(dp), intent(in) :: wb(:, :), q(:), tol
+      integer, intent(in) :: kw
+      real(dp), intent(inout) :: z(:)
+      logical, intent(out) :: done
+      integer, parameter :: MAX_ROUNDS = 8
+      integer :: idx(size(q)), ipiv(size(q)), nj, i, j, k, l, n, info, round
+      logical :: inj(size(q)), changed
+      real(dp), allocatable :: ab(:, :)
+      real(dp) :: zj(size(q)), zfull(size(q)), w, qscale, zscale
+      n = size(q)
+      done = .false.
+      inj = z > 0.0_dp
+      qscale = maxval(abs(q))
+      allocate (ab(3*kw + 1, n))
+      do round = 1, MAX_ROUNDS
+         nj = 0
+         do i = 1, n
+            if (inj(i)) then
+               nj = nj + 1; idx(nj) = i
+            end if
+         end do
+         zfull = 0.0_dp
+         if (nj > 0) then
+            ! compressed band of W_JJ: J's rows and columns k, l with |idx(k) − idx(l)| ≤ kw
+            ab(:, 1:nj) = 0.0_dp
+            do l = 1, nj
+               do k = max(1, l - kw), min(nj, l + kw)
+                  if (abs(idx(k) - idx(l)) <= kw) &
+                     ab(2*kw + 1 + k - l, l) = wb(kw + 1 + idx(k) - idx(l), idx(l))
+               end do
+               zj(l) = -q(idx(l))
+            end do
+            call dgbsv(nj, kw, kw, 1, ab, 3*kw + 1, ipiv, zj, nj, info)
+            if (info /= 0) return
+            zfull(idx(1:nj)) = zj(1:nj)
+         end if
+         zscale = max(maxval(abs(zfull)), tiny(1.0_dp))
+         changed = .false.
+         do i = 1, n
+            if (inj(i)) then
+               if (zfull(i) < -tol*zscale) then
+                  inj(i) = .false.; changed = .true.
+               end if
+            else
+               w = q(i)
+               do j = max(1, i - kw), min(n, i + kw)
+                  w = w + wb(kw + 1 + i - j, j)*zfull(j)
+               end do
+               if (w < -tol*qscale) then
+                  inj(i) = .true.; changed = .true.
+               end if
+            end if
+         end do
+         if (.not. changed) then
+            z = max(zfull, 0.0_dp)
+            done = .true.
+            return
+         end if
+      end do
+   end subroutine polish
+   !> x at a contact side (0: the ground or an immobile node, which does not move).
+   pure real(dp) function side(x, node)
+      real(dp), intent(in) :: x(:)
+      integer, intent(in) :: node
+      side = 0.0_dp
+      if (node > 0) side = x(node)
+   end function side
+end module martello_impulse

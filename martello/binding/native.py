@@ -1,0 +1,448 @@
+"""The ctypes binding to libmartello: the only place Python touches the C API.
+
+Status codes become exceptions here (as dftd4 raises RuntimeError from its error handle):
+negative codes raise, positive ones are returned to the caller as outcomes. Every table the
+front end shares with the library (integrators, compatibility, settings and their defaults,
+counters, energy terms, constants) is read from the library's registry (registry(), and the
+functions built on it), never copied here."""
+
+import ctypes
+import os
+from collections import namedtuple
+from functools import lru_cache
+from pathlib import Path
+
+import numpy as np
+
+from ..errors import MartelloError, SolverError, DivergenceError
+
+_REPO = Path(__file__).resolve().parents[2]
+_DOUBLE_P = np.ctypeslib.ndpointer(dtype=np.float64, flags="C_CONTIGUOUS")
+_INT_P = np.ctypeslib.ndpointer(dtype=np.int32, flags="C_CONTIGUOUS")
+_VOID_P = ctypes.c_void_p
+
+
+def library_path():
+    """MARTELLO_LIB if set, else the CMake build tree of this checkout."""
+    env = os.environ.get("MARTELLO_LIB")
+    if env:
+        return Path(env)
+    return _REPO / "build" / "libmartello.so"
+
+
+@lru_cache(maxsize=None)
+def lib():
+    path = library_path()
+    if not path.exists():
+        raise MartelloError(
+            f"native library not found at {path}: build it with ./scripts/build "
+            "(or point MARTELLO_LIB at libmartello.so)")
+    L = ctypes.CDLL(str(path))
+    c_int, c_double, c_char_p = ctypes.c_int, ctypes.c_double, ctypes.c_char_p
+    protos = {
+        "martello_version": (c_char_p, []),
+        "martello_library_versions": (c_int, [c_char_p, c_int]),
+        "martello_status_name": (c_char_p, [c_int]),
+        "martello_registry_shape": (c_int, [c_char_p, ctypes.POINTER(c_int), ctypes.POINTER(c_int)]),
+        "martello_registry_column": (c_int, [c_char_p, c_int, c_char_p, c_int]),
+        "martello_registry_entry": (c_int, [c_char_p, c_int, c_char_p, c_int, _VOID_P]),
+        "martello_registry_text": (c_int, [c_char_p, c_int, c_char_p, c_int]),
+        "martello_registry_find": (c_int, [c_char_p, c_char_p, ctypes.POINTER(c_int)]),
+        "martello_model_effective_masses": (c_int, [_VOID_P, _DOUBLE_P]),
+        "martello_model_create": (c_int, [c_int] * 5 + [ctypes.POINTER(_VOID_P)]),
+        "martello_model_free": (None, [ctypes.POINTER(_VOID_P)]),
+        "martello_model_set_node": (c_int, [_VOID_P, c_int, c_double, c_double, c_double, c_int]),
+        "martello_model_add_link": (c_int, [_VOID_P, c_int, c_int, c_int, _DOUBLE_P]),
+        "martello_model_add_contact": (c_int, [_VOID_P, c_int, c_int, c_double, c_int, c_int,
+                                               _DOUBLE_P]),
+        "martello_model_add_mass_coupling": (c_int, [_VOID_P, c_int, c_int, c_double]),
+        "martello_model_set_gravity": (c_int, [_VOID_P, c_double]),
+        "martello_model_add_nodal_force": (c_int, [_VOID_P, c_int, c_int, _DOUBLE_P, c_int,
+                                                   _DOUBLE_P, _DOUBLE_P]),
+        "martello_model_set_ground_acceleration": (c_int, [_VOID_P, c_int, _DOUBLE_P, c_int,
+                                                           _DOUBLE_P, _DOUBLE_P]),
+        "martello_model_message": (c_int, [_VOID_P, c_char_p, c_int]),
+        "martello_static_solve": (c_int, [_VOID_P, c_double, c_int, _DOUBLE_P, _DOUBLE_P,
+                                          _DOUBLE_P, _INT_P, _INT_P, _DOUBLE_P]),
+        "martello_run_create": (c_int, [ctypes.POINTER(_VOID_P)]),
+        "martello_run_free": (None, [ctypes.POINTER(_VOID_P)]),
+        "martello_settings_default": (c_int, [c_int, _VOID_P]),
+        "martello_run_set_settings": (c_int, [_VOID_P, _VOID_P]),
+        "martello_run_settings": (c_int, [_VOID_P, _VOID_P]),
+        "martello_run_set_outputs": (c_int, [_VOID_P, c_int, _INT_P, c_int, _INT_P]),
+        "martello_dynamic_run": (c_int, [_VOID_P, _VOID_P]),
+        "martello_run_message": (c_int, [_VOID_P, c_char_p, c_int]),
+        "martello_run_history_shape": (c_int, [_VOID_P, ctypes.POINTER(c_int), ctypes.POINTER(c_int)]),
+        "martello_run_history": (c_int, [_VOID_P, _DOUBLE_P]),
+        "martello_run_events": (c_int, [_VOID_P, ctypes.POINTER(c_int), _VOID_P, _VOID_P]),
+        "martello_run_counters": (c_int, [_VOID_P, np.ctypeslib.ndpointer(dtype=np.int64, flags="C_CONTIGUOUS")]),
+        "martello_run_peaks": (c_int, [_VOID_P] + [_DOUBLE_P] * 6 + [_INT_P] + [_DOUBLE_P] * 2),
+        "martello_run_energy": (c_int, [_VOID_P, _DOUBLE_P, _DOUBLE_P]),
+        "martello_run_set_link_outputs": (c_int, [_VOID_P, c_int, _INT_P]),
+        "martello_run_link_peaks": (c_int, [_VOID_P, _DOUBLE_P, _DOUBLE_P]),
+    }
+    for name, (res, args) in protos.items():
+        fn = getattr(L, name)
+        fn.restype, fn.argtypes = res, args
+    return L
+
+
+# --- the registry --------------------------------------------------------------------
+
+Row = namedtuple("Row", "name values text")   # values: column name -> number
+
+
+@lru_cache(maxsize=None)
+def registry(table):
+    """One of the library's tables (fortran/registry.f90, martello_registry_* of
+    c/martello.h) as a tuple of Rows in order; "tables" lists them all."""
+    L, buf = lib(), ctypes.create_string_buffer(256)
+    rows, cols = ctypes.c_int(), ctypes.c_int()
+    if L.martello_registry_shape(table.encode(), ctypes.byref(rows), ctypes.byref(cols)) != 0:
+        raise KeyError(f"the native library has no table {table!r}")
+    columns = []
+    for j in range(cols.value):
+        L.martello_registry_column(table.encode(), j, buf, len(buf))
+        columns.append(buf.value.decode())
+    out, values = [], np.zeros(max(cols.value, 1))
+    for i in range(rows.value):
+        L.martello_registry_entry(table.encode(), i, buf, len(buf), values.ctypes.data_as(_VOID_P))
+        name = buf.value.decode()
+        L.martello_registry_text(table.encode(), i, buf, len(buf))
+        out.append(Row(name, dict(zip(columns, map(float, values[:cols.value]))), buf.value.decode()))
+    return tuple(out)
+
+
+def value(table, name):
+    """The (first) value of the row named name, as an int: a kind, slot or index."""
+    for row in registry(table):
+        if row.name == name:
+            return int(next(iter(row.values.values())))
+    raise KeyError(f"the native table {table!r} has no row {name!r}; "
+                   f"valid: {', '.join(r.name for r in registry(table))}")
+
+
+def names(table):
+    """The row names of a table ordered by their value (indices of counters, energy, ...)."""
+    return tuple(r.name for r in sorted(registry(table), key=lambda r: next(iter(r.values.values()))))
+
+
+@lru_cache(maxsize=None)
+def constants():
+    """Every named constant of c/martello.h without its MARTELLO_ prefix ("LAW_KELVIN",
+    "NPAR_LINK", "MARTELLO_ERR_ARGUMENT" for status codes), from the registry."""
+    out = {r.name: int(r.values["value"]) for r in registry("status")}
+    for t in registry("tables"):
+        if t.text:
+            prefix = t.text.removeprefix("MARTELLO_")
+            for r in registry(t.name):
+                out[prefix + r.name.upper().replace("-", "_")] = int(r.values["value"])
+    return out
+
+
+def constant(name):
+    """A named integer constant of the kernels (law, link kind, scheme, slot, status)."""
+    try:
+        return constants()[name]
+    except KeyError:
+        raise KeyError(f"the native library has no constant {name!r}") from None
+
+
+def integrators():
+    return names("integrators")
+
+
+def adaptive_integrators():
+    return tuple(r.name for r in registry("integrators") if r.values["adaptive"])
+
+
+def compatibility():
+    """scheme -> the integrators that run its contacts (the registry's table compatibility)."""
+    rows = registry("compatibility")
+    return {s: tuple(r.name for r in rows if r.values[s]) for s in names("schemes")}
+
+
+def settings_read(integrator):
+    """The settings the integrator reads (the registry's table reads)."""
+    row = next((r for r in registry("reads") if r.name == integrator), None)
+    if row is None:
+        raise KeyError(f"no integrator {integrator!r}; valid: {', '.join(integrators())}")
+    return {k for k, v in row.values.items() if v}
+
+
+Range = namedtuple("Range", "lo hi lo_open hi_open text")
+
+
+def settings_ranges():
+    """setting -> its valid Range (text: the range in words, as error messages state it)."""
+    return {r.name: Range(r.values["min"], r.values["max"], bool(r.values["min_open"]),
+                          bool(r.values["max_open"]), r.text) for r in registry("settings")}
+
+
+def in_range(rng, x):
+    return ((x > rng.lo) if rng.lo_open else (x >= rng.lo)) and \
+           ((x < rng.hi) if rng.hi_open else (x <= rng.hi))
+
+
+@lru_cache(maxsize=None)
+def settings_type():
+    """The ctypes mirror of martello_settings, built from the registry's table settings."""
+    ctype = {"double": ctypes.c_double, "int": ctypes.c_int, "bool": ctypes.c_bool}
+    types = {int(r.values["value"]): r.name for r in registry("setting_types")}
+    fields = [("kind", ctypes.c_int)] + [(r.name, ctype[types[int(r.values["type"])]])
+                                         for r in registry("settings")]
+    return type("Settings", (ctypes.Structure,), {"_fields_": fields})
+
+
+def settings(integrator, **values):
+    """martello_settings for the integrator: the library's defaults (martello_settings_default)
+    with the given fields set."""
+    s = settings_type()()
+    if lib().martello_settings_default(value("integrators", integrator), ctypes.byref(s)) != 0:
+        raise KeyError(integrator)
+    for k, v in values.items():
+        if k == "kind" or not hasattr(s, k):
+            raise KeyError(f"martello_settings has no field {k!r}")
+        setattr(s, k, v)
+    return s
+
+
+def settings_defaults(integrator="newmark"):
+    """The library's default settings of an integrator, as a dict (kind left out)."""
+    s = settings(integrator)
+    return {k: getattr(s, k) for k, _ in s._fields_ if k != "kind"}
+
+
+def counter_names():
+    return names("counters")
+
+
+def energy_names():
+    return names("energy")
+
+
+def event_names():
+    return names("events")
+
+
+def history_columns(nodes, contacts, links):
+    """Column names of martello_run_history for these output nodes, contacts and links
+    (the registry's table history): "t", "u:<node>", ..., "energy:<term>"."""
+    per = {r.name: int(r.values["value"]) for r in registry("history_per")}
+    items = {per["once"]: None, per["node"]: nodes, per["contact"]: contacts,
+             per["link"]: links, per["energy_term"]: energy_names()}
+    cols = []
+    for g in registry("history"):
+        each = items[int(g.values["per"])]
+        cols += [g.name] if each is None else [f"{g.name}:{x}" for x in each]
+    return cols
+
+
+def version():
+    return lib().martello_version().decode()
+
+
+def library_versions():
+    buf = ctypes.create_string_buffer(256)
+    lib().martello_library_versions(buf, len(buf))
+    return buf.value.decode()
+
+
+def status_name(status):
+    return lib().martello_status_name(status).decode()
+
+
+def _f64(values, n=None):
+    a = np.ascontiguousarray(values, dtype=np.float64)
+    if n is not None and a.size != n:
+        raise ValueError(f"expected {n} values, got {a.size}")
+    return a
+
+
+class _Handle:
+    """A native handle with a lifecycle (create ... free) and a last message; the base of
+    Model and Run. free() (or a with-block) releases it."""
+
+    _kind = ""   # "model" or "run": names the C functions martello_<kind>_free/_message
+
+    def _create(self, create, *args):
+        self._h = _VOID_P()
+        st = create(*args, ctypes.byref(self._h))
+        if st < 0:
+            raise SolverError(st, status_name(st), f"could not create the {self._kind}")
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        self.free()
+
+    def __del__(self):
+        self.free()
+
+    def free(self):
+        if getattr(self, "_h", None) and self._h.value:
+            getattr(lib(), f"martello_{self._kind}_free")(ctypes.byref(self._h))
+
+    @property
+    def handle(self):
+        return self._h
+
+    def message(self):
+        buf = ctypes.create_string_buffer(1024)
+        getattr(lib(), f"martello_{self._kind}_message")(self._h, buf, len(buf))
+        return buf.value.decode(errors="replace")
+
+    def check(self, status, what):
+        """Raise on a negative status (DivergenceError for diverged or unstable runs);
+        return the status (0 or a positive outcome)."""
+        if status < 0:
+            cls = DivergenceError if status in (constant("MARTELLO_ERR_DIVERGED"),
+                                                constant("MARTELLO_ERR_UNSTABLE")) else SolverError
+            raise cls(status, status_name(status), f"{what}: {self.message()}")
+        return status
+
+
+class Model(_Handle):
+    """Owns one native model."""
+
+    _kind = "model"
+
+    def __init__(self, n_nodes, max_links, max_contacts, max_forces, max_couplings=0):
+        self._create(lib().martello_model_create, n_nodes, max_links, max_contacts, max_forces,
+                     max_couplings)
+        self.n_nodes, self.n_contacts = n_nodes, 0
+
+    def set_node(self, i, mass, u0=0.0, v0=0.0, fixed=False):
+        self.check(lib().martello_model_set_node(self._h, i, mass, u0, v0, int(fixed)),
+                   f"node {i}")
+
+    def add_link(self, kind, a, b, par):
+        self.check(lib().martello_model_add_link(self._h, kind, a, b,
+                                                 _f64(par, constant("NPAR_LINK"))), "link")
+
+    def add_contact(self, a, b, gap, scheme, law, par):
+        self.check(lib().martello_model_add_contact(self._h, a, b, gap, scheme, law,
+                                                    _f64(par, constant("NPAR_CONTACT"))),
+                   "contact")
+        self.n_contacts += 1
+
+    def add_mass_coupling(self, a, b, value):
+        self.check(lib().martello_model_add_mass_coupling(self._h, a, b, value), "mass coupling")
+
+    def effective_masses(self):
+        """m* = 1/(B M⁻¹ Bᵀ) of every contact, as the library computes it (inf: immovable)."""
+        out = np.zeros(max(self.n_contacts, 1))
+        self.check(lib().martello_model_effective_masses(self._h, out), "effective masses")
+        return out[: self.n_contacts]
+
+    def set_gravity(self, g):
+        self.check(lib().martello_model_set_gravity(self._h, g), "gravity")
+
+    def add_nodal_force(self, node, kind, par, t=(), y=()):
+        t, y = _f64(t), _f64(y)
+        self.check(lib().martello_model_add_nodal_force(
+            self._h, node, kind, _f64(par, constant("NPAR_TF")), t.size, t, y), "nodal force")
+
+    def set_ground_acceleration(self, kind, par, t=(), y=()):
+        t, y = _f64(t), _f64(y)
+        self.check(lib().martello_model_set_ground_acceleration(
+            self._h, kind, _f64(par, constant("NPAR_TF")), t.size, t, y), "ground acceleration")
+
+    def static_solve(self, tol, max_iter):
+        """Static equilibrium with unilateral contacts; returns a dict of arrays and counters."""
+        nc = self.n_contacts
+        u = np.zeros(self.n_nodes)
+        force, pen = np.zeros(max(nc, 1)), np.zeros(max(nc, 1))
+        active = np.zeros(max(nc, 1), dtype=np.int32)
+        counters = np.zeros(3, dtype=np.int32)
+        cond = np.zeros(4)
+        st = lib().martello_static_solve(self._h, tol, max_iter, u, force, pen, active,
+                                         counters, cond)
+        self.check(st, "static analysis")
+        return {
+            "status": status_name(st),
+            "warning": self.message() if st > 0 else "",
+            "u": u, "force": force[:nc], "penetration": pen[:nc], "active": active[:nc] != 0,
+            "active_set_iterations": int(counters[0]), "uzawa_iterations": int(counters[1]),
+            "linear_solves": int(counters[2]),
+            "rcond": float(cond[0]), "digits_lost": float(cond[1]),
+            "penalty_ratio": float(cond[2]), "penalised_rcond": float(cond[3]),
+        }
+
+
+class Run(_Handle):
+    """One dynamic run: its integrator settings and, after execute(), its results."""
+
+    _kind = "run"
+
+    def __init__(self):
+        self._create(lib().martello_run_create)
+
+    _check = _Handle.check
+
+    def set_settings(self, settings):
+        """Hand the run its settings (a Settings from settings()); the library validates them."""
+        self._check(lib().martello_run_set_settings(self._h, ctypes.byref(settings)), "settings")
+
+    def set_outputs(self, nodes, contacts):
+        n = np.ascontiguousarray(nodes, dtype=np.int32)
+        c = np.ascontiguousarray(contacts, dtype=np.int32)
+        self._check(lib().martello_run_set_outputs(self._h, n.size, n, c.size, c), "outputs")
+
+    def set_link_outputs(self, links):
+        l = np.ascontiguousarray(links, dtype=np.int32)
+        self._check(lib().martello_run_set_link_outputs(self._h, l.size, l), "link outputs")
+
+    def link_peaks(self, n_links):
+        f, du = np.zeros(max(n_links, 1)), np.zeros(max(n_links, 1))
+        lib().martello_run_link_peaks(self._h, f, du)
+        return f[:n_links], du[:n_links]
+
+    def execute(self, model):
+        """Run; raises on failure (DivergenceError for diverged/unstable runs)."""
+        return self._check(lib().martello_dynamic_run(model.handle, self._h), "dynamic run")
+
+    def status_of(self, model):
+        """Run without raising; returns the status code (for studies that classify failures)."""
+        return lib().martello_dynamic_run(model.handle, self._h)
+
+    def history(self):
+        rows, cols = ctypes.c_int(), ctypes.c_int()
+        lib().martello_run_history_shape(self._h, ctypes.byref(rows), ctypes.byref(cols))
+        buf = np.zeros(max(rows.value * cols.value, 1))
+        lib().martello_run_history(self._h, buf)
+        return buf[: rows.value * cols.value].reshape(rows.value, cols.value)
+
+    def events(self):
+        n = ctypes.c_int()
+        lib().martello_run_events(self._h, ctypes.byref(n), None, None)
+        contacts = np.zeros(max(n.value, 1), dtype=np.int32)
+        values = np.zeros((max(n.value, 1), constant("NEVENT")))
+        lib().martello_run_events(self._h, ctypes.byref(n), contacts.ctypes.data_as(_VOID_P),
+                                  values.ctypes.data_as(_VOID_P))
+        return contacts[: n.value], values[: n.value]
+
+    def counters(self):
+        c = np.zeros(constant("NCOUNTERS"), dtype=np.int64)
+        lib().martello_run_counters(self._h, c)
+        return dict(zip(counter_names(), map(int, c)))
+
+    def peaks(self, n_nodes, n_contacts):
+        arrays = [np.zeros(max(n_nodes, 1)) for _ in range(4)] + \
+                 [np.zeros(max(n_contacts, 1)) for _ in range(2)]
+        impacts = np.zeros(max(n_contacts, 1), dtype=np.int32)
+        peak = [np.zeros(max(n_nodes, 1)) for _ in range(2)]
+        lib().martello_run_peaks(self._h, *arrays, impacts, *peak)
+        names = ("u_max", "u_min", "v_absmax", "a_absmax", "pen_max", "force_max")
+        out = {k: a[: (n_nodes if i < 4 else n_contacts)] for i, (k, a) in enumerate(zip(names, arrays))}
+        out["impacts"] = impacts[:n_contacts]
+        out["u_peak"], out["t_peak"] = peak[0][:n_nodes], peak[1][:n_nodes]
+        return out
+
+    def energy(self):
+        e, extra = np.zeros(constant("NENERGY")), np.zeros(4)
+        lib().martello_run_energy(self._h, e, extra)
+        d = dict(zip(energy_names(), map(float, e)))
+        return d, {"balance_max": float(extra[0]), "omega_max": float(extra[1]),
+                   "dt_critical": float(extra[2]), "t_reached": float(extra[3])}

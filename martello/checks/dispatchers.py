@@ -1,0 +1,91 @@
+"""Catalogue dispatchers: one call per scene kind, returning a dict of named oracle values, so
+that a scene's [check] table can name them (martello.checks.verify). They only combine the
+closed forms of martello.oracles."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from ..oracles.linear_sdof import sdof_sine_ground_response
+from ..oracles.p2_bouncing import bouncing_oscillator_kelvin, bouncing_oscillator_restitution
+from ..oracles.p5_contact_laws import (HC_FACTORS, hc_max_penetration, hertz_impact,
+                                       hunt_crossley_realised_e, jankowski_realised_e,
+                                       jankowski_xi, kelvin_clipped_restitution, kelvin_damping,
+                                       kelvin_xi_from_e, linear_contact_time)
+from ..oracles.p6_hysteresis import elastoplastic_impulse
+
+
+def two_body_impact(law, m1, m2, v0, stiffness, restitution=None, exponent=None, clipped=False):
+    """P5: a free two-body impact (approach speed v0 > 0) under one penalty law.
+
+    Returns restitution (realised e), contact_time where a closed form exists, and
+    max_penetration where one exists. For kelvin the damping is the Anagnostopoulos one
+    derived from the target e; the HC family uses its own published factor a(e)."""
+    mstar = m1 * m2 / (m1 + m2)
+    out = {}
+    if law == "linear":
+        out.update(restitution=1.0, contact_time=linear_contact_time(mstar, stiffness),
+                   max_penetration=v0 * math.sqrt(mstar / stiffness))
+    elif law == "hertz":
+        h = hertz_impact(mstar, stiffness, v0)
+        out.update(restitution=1.0, contact_time=h.t_c, max_penetration=h.delta_max)
+    elif law == "kelvin":
+        xi = kelvin_xi_from_e(restitution)
+        out["restitution"] = kelvin_clipped_restitution(xi) if clipped else restitution
+        if not clipped:
+            # the unclipped phase is exactly half a damped period
+            out["contact_time"] = math.pi / (math.sqrt(stiffness / mstar) * math.sqrt(1 - xi * xi))
+    elif law in ("hunt-crossley", "lankarani-nikravesh", "flores", "gonthier", "hertzdamp"):
+        key = "lankarani_nikravesh" if law == "hertzdamp" else law.replace("-", "_")
+        a = HC_FACTORS[key](restitution)
+        n = 1.5 if (law == "hertzdamp" or exponent is None) else exponent
+        out.update(restitution=hunt_crossley_realised_e(a),
+                   max_penetration=hc_max_penetration(n, stiffness, mstar, a / v0, v0))
+    elif law == "jankowski":
+        out["restitution"] = jankowski_realised_e(jankowski_xi(restitution))
+    else:
+        raise ValueError(f"no closed form for law {law!r}")
+    return out
+
+
+def elastoplastic_peak(m, k, uy, rho, v0):
+    """P6 as a dict (u_max, t_max) for scene checks."""
+    r = elastoplastic_impulse(m, k, uy, rho, v0)
+    return {"u_max": r.u_max, "t_max": r.t_max}
+
+
+def sdof_sine_ground_final(m, k, zeta, ag_amp, omega_g, t_end):
+    """Exact relative displacement and velocity of a damped SDOF under A sin(Ωt) ground
+    acceleration at t_end, from rest."""
+    r = sdof_sine_ground_response(m, k, zeta, ag_amp, omega_g, np.array([t_end]))
+    return {"u": float(r.u[0]), "v": float(r.v[0])}
+
+
+def bouncing_kelvin_events(m, k, h, g, eps, n_impacts, restitution=None, damping=0.0,
+                           clipped=False):
+    """P2 with a Kelvin (or, damping = 0, linear) penalty plane, as named values for scene
+    checks: t_impact_i, t_separation_i, max_penetration_i (i from 0). The dashpot c comes from
+    the target e by Anagnostopoulos' formula with m* = m, as the scene's law does."""
+    c = damping
+    if restitution is not None:
+        c = kelvin_damping(eps, m, kelvin_xi_from_e(restitution))
+    r = bouncing_oscillator_kelvin(m, k, h, g, eps, c, n_impacts, clipped=clipped)
+    out = {}
+    for i in range(min(n_impacts, len(r.t_impact))):
+        out[f"t_impact_{i}"] = r.t_impact[i]
+        if i < len(r.t_separation) and r.t_separation[i] is not None:
+            out[f"t_separation_{i}"] = r.t_separation[i]
+        out[f"max_penetration_{i}"] = r.max_penetration[i]
+    return out
+
+
+def bouncing_restitution_events(m, k, h, g, e, n_impacts):
+    """P2 with Newton restitution, as named values: t_impact_i, v_impact_i, zeno_time,
+    resting_force."""
+    r = bouncing_oscillator_restitution(m, k, h, g, e, n_impacts)
+    out = {f"t_impact_{i}": float(t) for i, t in enumerate(r.t)}
+    out.update({f"v_impact_{i}": float(v) for i, v in enumerate(r.v)})
+    out.update(zeno_time=r.zeno_time, resting_force=r.resting_force)
+    return out

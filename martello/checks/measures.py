@@ -1,0 +1,302 @@
+"""Problem-specific measures added to a dynamic run's summary: the errors of the run
+against its problem's oracles. The run itself knows no oracle; the callers that report a run
+(`martello run`, `martello check`) run a scene with :func:`run_measured`, which calls
+:func:`attach` on its summary and history.
+
+Rod impact (docs/problems.md P4, docs/p4-bars.md). When the scene was built from `[[bar]]`
+tables (scene.extras["bars"]) and has exactly one contact, between the end nodes of two
+rods or between a rod's end node and ground (a rigid wall), `summary["measures"]
+["rod_impact"]` receives the errors of the run against elementary wave theory
+(martello.oracles.p4_rod_impact.rod_impact for the plateau force, the duration and the final
+velocities; martello.oracles.p4_wave_theory for the displacement field):
+
+* contact duration: first onset to the last separation of the first *episode* (phases
+  whose open intervals are shorter than the shortest element transit time L_e/c, or one
+  output interval if that is longer, are one impact: a contact that only touches zero
+  between two steps has not separated);
+* the force pulse against the rectangle P0 = Z v0/2 (Z v0 on a wall) on
+  [t_on, t_on + 2 L_min/c): L1 error (the recorded force held constant over each output
+  interval, centred on its sample: the impulse a step of central difference applies),
+  peak error, total variation (the rectangle has 2 P0; the excess is spurious
+  oscillation) and impulse;
+* energy error: max |E_kin + E_recoverable − E0| / E0 over the history, and its final value;
+* penetration: the maximum, and the maximum over the interface displacement scale v_p τ;
+* final mean velocities of the rods (momentum / mass, consistent couplings included) at
+  the last recorded step, their errors over v0, and the share of energy left as vibration;
+* displacement error: max over samples and recorded rod nodes of |u − u_exact|, over v_p τ
+  (all nodes, and the two contact nodes alone).
+
+What the measures need from `[analysis.output]`: the contact in `contacts` (default) for
+the pulse, the energy and the duration's episode; every node of both rods in `nodes` for
+the final velocities and the displacement field (`[[bar]] output = "all"`, the default,
+puts them there); `every = 1` for the L1, peak and total-variation figures to mean what
+they say (with every > 1 they are computed on the recorded samples and a note says so).
+Errors are signed value − reference unless called relative. Quantities that cannot be
+formed are left out and `notes` says why; nothing here raises for a scene that does not fit.
+"""
+
+import numpy as np
+
+from ..oracles.p4_rod_impact import rod_impact
+from ..oracles.p4_wave_theory import rod_point_displacement, vibration_energy_fraction
+from ..run import run_full
+
+REL_SAME = 1e-12     # two rods with c and Z equal to this relative tolerance are "the same bar"
+# A held force below this share of P0 is no pulse: rounding-level forces while two faces
+# rest against each other after the pulse (unequal rods: from 2 L_A/c to 2 L_B/c) are not.
+PULSE_THRESHOLD = 1e-6
+
+
+def run_measured(scene):
+    """(summary, history) of run_full(scene) with the problem's measures attached: what
+    `martello run` writes and `martello check` verifies."""
+    summary, history = run_full(scene)
+    attach(scene, summary, history)
+    return summary, history
+
+
+def attach(scene, summary, history):
+    """Add measures that the scene's generators ask for (scene.extras) to the summary of a
+    dynamic run (a static run, whose history is None, has none)."""
+    rods = scene.extras.get("bars") if scene.extras else None
+    if rods and scene.contacts and history is not None:
+        m = rod_impact_measures(scene, summary, history)
+        summary.setdefault("measures", {})["rod_impact"] = m
+    return summary
+
+
+def _rod_of_end(rods, name):
+    for r in rods:
+        if name in (r["left"], r["right"]):
+            return r
+    return None
+
+
+def _applicability(scene, rods):
+    """(contact, side_a, side_b) or a reason string; a side is (rod info, end node name)
+    or None for ground."""
+    if len(scene.contacts) != 1:
+        return f"the scene has {len(scene.contacts)} contacts; the rod-impact measures need exactly one"
+    c = scene.contacts[0]
+    names = [n["name"] for n in scene.nodes]
+    sides = []
+    for key in ("a", "b"):
+        if c[key] < 0:
+            sides.append(None)
+            continue
+        node = names[c[key]]
+        r = _rod_of_end(rods, node)
+        if r is None:
+            return f"contact side {key} ({node}) is not the end node of a [[bar]] rod"
+        if r["fixed"] != "none":
+            return f"rod {r['name']} has a fixed end; wave theory here is for free rods"
+        sides.append((r, node))
+    if sides[0] is None and sides[1] is None:
+        return "the contact joins ground to ground"
+    if scene.forces or scene.gravity != 0.0 or scene.ground is not None:
+        return "the scene has loads (forces, gravity or ground motion): not a free rod impact"
+    rod_nodes = {}
+    for r in rods:
+        for nm in r["nodes"]:
+            rod_nodes[scene.index[nm]] = r["name"]
+    for lk in scene.links:
+        ra, rb = rod_nodes.get(lk["a"]), rod_nodes.get(lk["b"])
+        if (ra is not None or rb is not None) and (lk["type"] != "bar" or ra != rb):
+            return f"link {lk['name']} attaches something else to a rod"
+    if all(s is not None for s in sides):
+        ra, rb = sides[0][0], sides[1][0]
+        if ra is rb:
+            return "the contact joins two ends of the same rod"
+        if (abs(ra["c"] - rb["c"]) > REL_SAME * ra["c"]
+                or abs(ra["impedance"] - rb["impedance"]) > REL_SAME * ra["impedance"]):
+            return ("the rods differ in wave speed or impedance: only equal bars have the "
+                    "closed forms used here (oracles.p4_rod_impact.impedance_plateau_force gives "
+                    "the plateau)")
+    if c["gap"] < 0:
+        return "negative gap (initial overlap)"
+    return c, sides[0], sides[1]
+
+
+def _episode(summary_contact, t_merge):
+    """(t_on, t_off or None, phases in the episode, phases after it)."""
+    on = summary_contact["impact_times"]
+    off = summary_contact["separation_times"]
+    if not on:
+        return None, None, 0, 0
+    k = 0
+    while k + 1 < len(on) and off[k] is not None and on[k + 1] - off[k] <= t_merge:
+        k += 1
+    return on[0], off[k], k + 1, len(on) - (k + 1)
+
+
+def _cells(t):
+    """Edges (lo, hi) of the cells centred on the samples: midpoints between samples, the
+    end cells stopping at the first and last sample."""
+    if len(t) == 1:
+        return t.copy(), t.copy()
+    mid = 0.5 * (t[1:] + t[:-1])
+    return np.concatenate(([t[0]], mid)), np.concatenate((mid, [t[-1]]))
+
+
+def _hold_l1(t, p, t0, t1, level):
+    """∫ |P_h − level·1[t0, t1)| dt with P_h the samples held over their cells."""
+    lo, hi = _cells(t)
+    overlap = np.clip(np.minimum(hi, t1) - np.maximum(lo, t0), 0.0, None)
+    return float(np.sum(np.abs(p - level) * overlap + np.abs(p) * (hi - lo - overlap)))
+
+
+def rod_impact_measures(scene, summary, history):
+    rods = scene.extras["bars"]
+    got = _applicability(scene, rods)
+    if isinstance(got, str):
+        return {"applicable": False, "notes": [got]}
+    c, side_a, side_b = got
+    notes = []
+    wall = side_a is None or side_b is None
+    rod_a = side_a[0] if side_a else None
+    rod_b = side_b[0] if side_b else None
+    va0 = rod_a["v0"] if rod_a else 0.0
+    vb0 = rod_b["v0"] if rod_b else 0.0
+    v_rel = va0 - vb0
+    if not v_rel > 0:
+        return {"applicable": False, "notes": [f"the rods do not approach (v_a − v_b = {v_rel:g})"]}
+    some = rod_a or rod_b
+    EA, rhoA = some["EA"], some["rhoA"]
+    if wall:
+        rod = rod_a or rod_b
+        ref = rod_impact(EA, rhoA, 1.0, rod["L"], rod["L"], v_rel, wall=True)
+        v_ref = {rod["name"]: -(va0 if rod_a else vb0)}
+    else:
+        ref = rod_impact(EA, rhoA, 1.0, rod_a["L"], rod_b["L"], v_rel)
+        v_ref = {rod_a["name"]: vb0 + ref.vA, rod_b["name"]: vb0 + ref.vB}
+    t_on_ref = c["gap"] / v_rel
+    P0, T = ref.force, ref.duration
+    vp = P0 / ref.impedance
+    an = scene.analysis
+    dt_out = an["dt"] * an["output"]["every"]
+    involved = [r for r in (rod_a, rod_b) if r is not None]
+    t_merge = max(min(r["transit_time"] for r in involved), dt_out) * (1.0 + 1e-9)
+
+    m = {"applicable": True, "contact": c["name"],
+         "rods": {"a": rod_a["name"] if rod_a else "ground", "b": rod_b["name"] if rod_b else "ground"},
+         "approach_speed": v_rel,
+         "reference": {"onset_time": t_on_ref, "duration": T, "force": P0,
+                       "v_final": v_ref, "impedance": ref.impedance, "c": ref.c}}
+
+    # contact phases (from the summary: every integrator reports them)
+    sc = summary["contacts"][c["name"]]
+    t_on, t_off, n_in, n_after = _episode(sc, t_merge)
+    m.update(phases=n_in, later_phases=n_after)
+    if t_on is None:
+        notes.append("no contact occurred")
+    else:
+        m.update(onset_time=t_on, onset_error=t_on - t_on_ref)
+        if t_off is None:
+            notes.append("the contact is still closed at the end of the run: no duration")
+        else:
+            m.update(duration=t_off - t_on, duration_error=(t_off - t_on) - T,
+                     duration_relative_error=((t_off - t_on) - T) / T)
+    m["max_penetration"] = sc["max_penetration"]
+    m["penetration_relative"] = sc["max_penetration"] / (vp * T)
+
+    columns, data = history if history is not None else ([], np.zeros((0, 0)))
+    col = {name: i for i, name in enumerate(columns)}
+    if len(data) == 0:
+        notes.append("empty history: no pulse, energy or velocity measures")
+        m["notes"] = notes
+        return m
+    t = data[:, col["t"]]
+    if an["output"]["every"] > 1:
+        notes.append(f"output every {an['output']['every']} steps: L1, peak and total variation "
+                     "are computed on the recorded samples only")
+
+    fkey = f"force:{c['name']}"
+    if fkey in col:
+        p = data[:, col[fkey]]
+        l1 = _hold_l1(t, p, t_on_ref, t_on_ref + T, P0)
+        m["pulse_l1_error"] = l1 / (P0 * T)
+        m["force_peak"] = float(np.max(p))
+        m["peak_error"] = (float(np.max(p)) - P0) / P0
+        # impulse of the held samples (the rectangle's is P0 T)
+        lo, hi = _cells(t)
+        w = hi - lo
+        m["impulse_error"] = (float(np.dot(w, p)) - P0 * T) / (P0 * T)
+        if t_on is not None:
+            end = t_off if t_off is not None else t[-1]
+            i0 = max(int(np.searchsorted(t, t_on, side="right")) - 1, 0)
+            i1 = min(int(np.searchsorted(t, end, side="left")), len(t) - 1)
+            tv = float(np.sum(np.abs(np.diff(p[i0:i1 + 1])))) if i1 > i0 else 0.0
+            m["force_total_variation"] = tv / P0
+            m["spurious_variation"] = tv / P0 - 2.0
+            # width of the held pulse: cells with P > PULSE_THRESHOLD·P0 in the episode
+            lo, hi = _cells(t)
+            inside = (hi > t_on) & (lo < end + t_merge) & (p > PULSE_THRESHOLD * P0)
+            if np.any(inside):
+                k = np.nonzero(inside)[0]
+                width = float(hi[k[-1]] - lo[k[0]])
+                m.update(pulse_duration=width, pulse_duration_error=width - T,
+                         pulse_duration_relative_error=(width - T) / T)
+    else:
+        notes.append(f"contact {c['name']} is not in analysis.output.contacts: no pulse measures")
+
+    ekeys = ("energy:kinetic", "energy:recoverable", "energy:initial")
+    if all(k in col for k in ekeys):
+        e = data[:, col["energy:kinetic"]] + data[:, col["energy:recoverable"]]
+        e0 = data[0, col["energy:initial"]]
+        if e0 > 0:
+            m["energy_error"] = float(np.max(np.abs(e - e0)) / e0)
+            m["energy_final_error"] = float((e[-1] - e0) / e0)
+
+    # final mean velocities and the displacement field need every node of the rods
+    missing = [r["name"] for r in involved
+               if any(f"v:{nm}" not in col for nm in r["nodes"])]
+    if missing:
+        notes.append("rod(s) " + ", ".join(missing) + " not fully in analysis.output.nodes "
+                     "([[bar]] output = \"all\"): no final velocities or displacement field")
+    else:
+        last = data[-1]
+        v_fin, v_err = {}, {}
+        for r in involved:
+            v = np.array([last[col[f"v:{nm}"]] for nm in r["nodes"]])
+            mom = float(np.dot(r["node_mass"], v))
+            pos = {nm: i for i, nm in enumerate(r["nodes"])}
+            for na, nb, val in r["couplings"]:
+                mom += val * (v[pos[na]] + v[pos[nb]])
+            v_fin[r["name"]] = mom / r["mass_total"]
+            v_err[r["name"]] = (v_fin[r["name"]] - v_ref[r["name"]]) / v_rel
+        m["v_final"], m["v_error"] = v_fin, v_err
+        if t_off is None or t[-1] < t_off:
+            notes.append("the run ends before the contact opens: final velocities are not post-impact")
+        ma = rod_a["mass_total"] if rod_a else None
+        mb = rod_b["mass_total"] if rod_b else None
+        if wall:
+            r = involved[0]
+            frac = vibration_energy_fraction(r["mass_total"], None, r["v0"], 0.0, v_fin[r["name"]], 0.0)
+            frac_ref = vibration_energy_fraction(r["mass_total"], None, r["v0"], 0.0, v_ref[r["name"]], 0.0)
+        else:
+            frac = vibration_energy_fraction(ma, mb, va0, vb0, v_fin[rod_a["name"]], v_fin[rod_b["name"]])
+            frac_ref = vibration_energy_fraction(ma, mb, va0, vb0, v_ref[rod_a["name"]], v_ref[rod_b["name"]])
+        m["vibration_energy_fraction"] = frac
+        m["vibration_energy_reference"] = frac_ref
+
+        # displacement field against d'Alembert (free rods of equal bars)
+        err_all, err_end = 0.0, 0.0
+        scale = vp * T
+        for side, r, end_node in (("a", rod_a, side_a and side_a[1]), ("b", rod_b, side_b and side_b[1])):
+            if r is None:
+                continue
+            face = r["x0"] + r["L"] if end_node == r["right"] else r["x0"]
+            other = (rod_b if side == "a" else rod_a)
+            L_other = other["L"] if other is not None else r["L"]
+            for nm, x in zip(r["nodes"], r["x"]):
+                s = min(max(abs(face - x), 0.0), r["L"])
+                u_ex = r["v0"] * t + rod_point_displacement(s, t - t_on_ref, ref.c, r["L"], L_other,
+                                                            v_rel, side, wall=wall)
+                e_node = float(np.max(np.abs(data[:, col[f"u:{nm}"]] - u_ex))) / scale
+                err_all = max(err_all, e_node)
+                if nm == end_node:
+                    err_end = max(err_end, e_node)
+        m["displacement_error"] = err_all
+        m["end_displacement_error"] = err_end
+    m["notes"] = notes
+    return m

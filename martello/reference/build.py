@@ -1,0 +1,243 @@
+"""Building the stored reference data (reference/, scripts/regenerate_reference): each entry
+of reference/references.toml is run by the first method of its list that the library (or the
+independent event-located engine) runs, checked by refinement and by a second method, and
+written with its provenance."""
+
+from __future__ import annotations
+
+import copy
+import json
+import math
+import sys
+import time
+import tomllib
+from pathlib import Path
+
+import numpy as np
+
+from ..batch import execute, run_specs
+from ..binding import native
+from ..errors import MartelloError
+from ..history import history_dict, interpolate
+from ..metrics.event_matching import match_events
+from ..metrics.score import score
+from ..paths import REFERENCE_ROOT, REPO
+from ..scene.loader import load
+from ..scene.spec import ADAPTIVE
+from ..scene.variants import analysis_for, override_contacts, runnable_scene
+from .event_located import Unsupported, event_located_run
+from .store import load_reference, manifest, physics_digest
+
+
+def _method_runs(entry, method, scene_dict, scene_path, dt, rtol=None):
+    params = {k: v for k, v in method.items() if k not in ("integrator", "dt", "refine", "rtol")}
+    store = float(entry["store_every"])
+    every = 1 if method["integrator"] in ADAPTIVE else max(1, int(round(store / dt)))
+    d = copy.deepcopy(scene_dict)
+    d["analysis"] = analysis_for(d.get("analysis", {}), method["integrator"], params, dt,
+                                 d["analysis"]["t_end"], every, rtol)
+    d["analysis"]["output"].pop("nodes", None)
+    d["analysis"]["output"].pop("contacts", None)
+    return {"id": 0, "scene_dict": d, "scene_file": str(scene_path), "base_dir": str(scene_path.parent),
+            "repeat": 1}
+
+
+def _sampled(result, grid):
+    h = history_dict(result["history"])
+    return {c: interpolate(h["t"], h, c, grid) for c in h if c != "t"}
+
+
+def reference_scene(entry):
+    """(Scene, scene dict without [check], path) of a reference entry, with its contact
+    override applied (a variant of the scene: same file, other physics)."""
+    scene_path = (REPO / entry["scene"]).resolve()
+    with open(scene_path, "rb") as fh:
+        sdict = tomllib.load(fh)
+    sdict.pop("check", None)
+    if entry.get("contact"):
+        sdict = override_contacts(sdict, entry["contact"], scene_path, f"reference {entry['name']}")
+        # validated with an integrator the new contacts run on (the analysis does not enter
+        # the physics digest)
+        return runnable_scene(sdict, scene_path, sdict["analysis"]["t_end"]), sdict, scene_path
+    return load(scene_path), sdict, scene_path
+
+
+def build_reference(entry, root=REFERENCE_ROOT, stream=sys.stderr, jobs=0):
+    """Compute one reference (an entry of reference/references.toml) and write
+    reference/<name>/history.csv and reference.json. The first method the library runs is
+    used; it is checked by refinement (Δt, Δt·2, Δt·4 for fixed steps; rtol, rtol·100 for
+    adaptive ones): the digits trusted in each column are −log10 of max |y_h − y_2h| over the
+    column's peak (the finest run's error for a first-order method, a 3× overestimate for a
+    second-order one)."""
+    scene, sdict, scene_path = reference_scene(entry)
+    t_end = scene.analysis["t_end"]
+    chosen, results = None, None
+    store = float(entry["store_every"])
+    grid = np.linspace(0.0, t_end, int(round(t_end / store)) + 1)
+    for method in entry["method"]:
+        if method["integrator"] == "scipy-dop853":
+            rt = float(method["rtol"])
+            levels = [(None, rt), (None, rt * 100.0)]
+            print(f"{entry['name']}: scipy DOP853 with event location at rtol={rt:g}, {rt * 100:g}",
+                  file=stream)
+            try:
+                res = [event_located_run(scene, r_, grid) for _, r_ in levels]
+            except Unsupported as exc:
+                print(f"  scipy-dop853: the scene has {exc}, which it does not model; next method",
+                      file=stream)
+                continue
+            if any(r["status"] != "MARTELLO_OK" for r in res):
+                raise MartelloError(f"{entry['name']}: reference run failed: {res[0].get('message')}")
+            chosen, results = (method, levels), res
+            break
+        dt = float(method["dt"])
+        if method["integrator"] in ADAPTIVE:
+            rt = float(method["rtol"])
+            levels = [(dt, rt), (dt, rt * 100.0)]
+        else:
+            levels = [(dt, None), (2 * dt, None), (4 * dt, None)]
+        specs = [dict(_method_runs(entry, method, sdict, scene_path, d_, r_), id=i)
+                 for i, (d_, r_) in enumerate(levels)]
+        print(f"{entry['name']}: {method['integrator']} at "
+              + ", ".join(f"dt={d_:g}" + (f" rtol={r_:g}" if r_ else "") for d_, r_ in levels), file=stream)
+        res = sorted(run_specs(specs, jobs), key=lambda r: r["id"])
+        if any(r["status"] == "MARTELLO_ERR_UNSUPPORTED" for r in res):
+            print(f"  {method['integrator']}: not available ({res[0].get('message', '')[:80]}); next method",
+                  file=stream)
+            continue
+        bad = [r for r in res if r["status"] != "MARTELLO_OK"]
+        if bad:
+            raise MartelloError(f"{entry['name']}: reference run failed: {bad[0]['status']}: "
+                                f"{bad[0].get('message', '')}")
+        chosen, results = (method, levels), res
+        break
+    if chosen is None:
+        raise MartelloError(f"{entry['name']}: none of the reference methods runs")
+    method, levels = chosen
+    fine = _sampled(results[0], grid)
+    coarse = [_sampled(r, grid) for r in results[1:]]
+    digits, refinement = {}, []
+    for c, y in fine.items():
+        scale = float(np.max(np.abs(y)))
+        if c.startswith("energy:") and c not in ("energy:kinetic", "energy:recoverable", "energy:input"):
+            continue
+        # |y_h − y_2h|, or |y_h − y_4h|/3 if larger: equal to the error of y_h for a
+        # first-order method, an overestimate for higher orders, and still a bound when the
+        # differences do not shrink (steps that fall differently on contact onsets)
+        d1 = max([float(np.max(np.abs(coarse[0][c] - y)))]
+                 + [float(np.max(np.abs(cz[c] - y))) / (2 ** (k + 2) - 1) * 1.0
+                    for k, cz in enumerate(coarse[1:])])
+        digits[c] = min(15.0, -math.log10(d1 / scale)) if scale > 0 and d1 > 0 else 15.0
+    for k, cz in enumerate(coarse):
+        refinement.append({"level": k + 1, "dt": levels[k + 1][0], "rtol": levels[k + 1][1],
+                           "max_rel_diff_u": max(float(np.max(np.abs(cz[c] - fine[c])) / max(np.max(np.abs(fine[c])), 1e-300))
+                                                 for c in fine if c.startswith("u:"))})
+    if len(refinement) >= 2 and refinement[0]["max_rel_diff_u"] > 0:
+        # |y_4h − y_h| / |y_2h − y_h| = (4^p − 1)/(2^p − 1) = 2^p + 1 for a method of order p
+        ratio = refinement[1]["max_rel_diff_u"] / refinement[0]["max_rel_diff_u"]
+        observed = math.log2(ratio - 1.0) if ratio > 2.0 else math.nan   # nan: not asymptotic
+    else:
+        observed = math.nan
+    # events: the finest run's, with their refinement differences
+    fs, cs = results[0]["summary"], results[1]["summary"]
+    events, peaks, ev_diff = {}, {}, {}
+    for name, c in fs["contacts"].items():
+        keys = ("impact_times", "separation_times", "approach_speeds", "restitution",
+                "phase_max_penetration", "phase_max_force")
+        events[name] = {k: c.get(k, []) for k in keys}
+        peaks[name] = {"max_penetration": c["max_penetration"], "max_force": c["max_force"]}
+        tc = np.asarray(cs["contacts"][name]["impact_times"], float)
+        tf = np.asarray(c["impact_times"], float)
+        m = match_events(tc, tf, 0.5 * (np.min(np.diff(tf)) if len(tf) > 1 else t_end))
+        ev_diff[name] = {"count_fine": len(tf), "count_coarse": len(tc),
+                         "max_time_diff": m.max_abs_dt}
+    # columns stored: t, then the kinds the entry keeps (default u, v, a, penetration, force,
+    # and the kinetic, recoverable and input energy)
+    kinds = entry.get("columns", ["u", "v", "penetration", "force", "energy"])
+    cols = ["t"] + [c for c in results[0]["history"][0] if c != "t" and c in fine
+                    and c.partition(":")[0] in kinds
+                    and (not c.startswith("energy:") or c in ("energy:kinetic", "energy:recoverable",
+                                                              "energy:input"))]
+    digits = {c: v for c, v in digits.items() if c in cols}
+    # a second method of the list, when it runs, as an independent cross-check
+    cross = None
+    for other in entry["method"]:
+        if other is method or not entry.get("cross_check", True) or other.get("cross_check") is False:
+            continue
+        if other["integrator"] == "scipy-dop853":
+            try:
+                r = event_located_run(scene, float(other["rtol"]), grid)
+            except Unsupported:
+                continue
+        else:
+            spec = _method_runs(entry, other, sdict, scene_path, float(other["dt"]), other.get("rtol"))
+            r = execute(spec)
+        if r["status"] != "MARTELLO_OK":
+            continue
+        oy = _sampled(r, grid)
+        cross = {"method": dict(other),
+                 "max_rel_diff_u": max(float(np.max(np.abs(oy[c] - fine[c])) / max(np.max(np.abs(fine[c])), 1e-300))
+                                       for c in fine if c.startswith("u:"))}
+        print(f"  cross-check with {other['integrator']}: max rel. difference of u "
+              f"{cross['max_rel_diff_u']:.2e}", file=stream)
+        break
+    if cross is not None and cross["max_rel_diff_u"] > 0:
+        # an independent method bounds the error too: trust the smaller of the two statements
+        # (refinement cannot see an error both levels share; two methods rarely share one)
+        cap = -math.log10(cross["max_rel_diff_u"])
+        cross["digits"] = cap
+        for c in digits:
+            if c.startswith("u:") and digits[c] > cap:
+                digits[c] = cap
+    # two digits beyond the trusted ones: rounding adds < 1 % to the reference's error
+    prec = int(min(17, max(8, math.ceil(max(digits.values(), default=12.0)) + 2)))
+    folder = Path(root) / entry["name"]
+    folder.mkdir(parents=True, exist_ok=True)
+    data = np.column_stack([grid] + [fine[c] for c in cols[1:]])
+    np.savetxt(folder / "history.csv", data, delimiter=",", header=",".join(cols), comments="",
+               fmt=f"%.{prec - 1}e")
+    meta = {"name": entry["name"], "scene": entry["scene"], "contact_override": entry.get("contact"),
+            "scene_sha256": scene.digest,
+            "physics_sha256": physics_digest(scene), "t_end": t_end,
+            "method": {k: v for k, v in method.items()}, "refinement": refinement,
+            "observed_order": observed, "digits": digits,
+            "digits_note": "−log10(max(|y_h − y_2h|, |y_h − y_4h|/3) / max |y_h|) per column "
+                           "(adaptive: |y_rtol − y_100rtol|): the error of the stored (finest) "
+                           "history for a first-order method, an overestimate for a higher "
+                           "order, still a bound when the differences do not shrink; for u, "
+                           "capped by the difference from the cross-check method",
+            "stored": {"every_s": store, "significant_digits": prec, "rows": len(grid)},
+            "events": events, "peaks": peaks, "event_refinement": ev_diff,
+            "event_horizon": t_end, "cross_check": cross,
+            "masses": {n["name"]: n["mass"] for n in scene.nodes},
+            "cost": fs["cost"],
+            "martello_version": native.version(), "libraries": native.library_versions(),
+            "python_numpy": np.__version__,
+            "date": time.strftime("%Y-%m-%dT%H:%M:%SZ", time.gmtime()),
+            "command": "scripts/regenerate_reference " + entry["name"]}
+    (folder / "reference.json").write_text(json.dumps(meta, indent=1, default=float) + "\n")
+    # the catalogue's own settings against the new reference: what `martello check` expects
+    ref = load_reference(folder)
+    own = {"status": "skipped"} if entry.get("contact") else execute({"id": 0, "scene_dict": sdict,
+                   "scene_file": str(scene_path), "base_dir": str(scene_path.parent), "repeat": 1})
+    if own["status"] == "MARTELLO_OK":
+        sc = score(own["summary"], own["history"], ref)
+        meta["catalogue_error"] = {k: sc.get(k) for k in ("max_rel_error", "impact_time_error",
+                                                          "peak_penetration_error", "impact_count_error")}
+        meta["catalogue_settings"] = {k: v for k, v in sdict["analysis"].items() if k != "output"}
+        (folder / "reference.json").write_text(json.dumps(meta, indent=1, default=float) + "\n")
+    print(f"  -> {folder}: {len(grid)} rows, digits trusted (min over u) "
+          f"{min(v for k, v in digits.items() if k.startswith('u:')):.1f}, observed order {observed:.2f}",
+          file=stream)
+    return folder
+
+
+def regenerate_references(names=None, root=REFERENCE_ROOT, stream=sys.stderr, jobs=0):
+    entries = manifest(root)
+    if names:
+        unknown = set(names) - {e["name"] for e in entries}
+        if unknown:
+            raise MartelloError(f"unknown reference(s) {', '.join(sorted(unknown))}; known: "
+                                + ", ".join(e["name"] for e in entries))
+        entries = [e for e in entries if e["name"] in names]
+    return [build_reference(e, root, stream, jobs) for e in entries]

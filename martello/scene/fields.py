@@ -1,0 +1,92 @@
+"""The field checker of scene tables: every table of a scene (and of its generators,
+[[chain]] and [[bar]]) is validated against a spec of its keys, so every error names the
+file, the field and what would be valid, in the same words everywhere.
+
+A spec maps each key to (kind, required, check, default). kind is "float", "int", "str",
+"bool", "list", "table", "function" or "any". check is (predicate, "what is valid")."""
+
+import math
+
+from ..errors import SceneError
+
+POSITIVE = (lambda x: x > 0, "a number > 0")
+NONNEG = (lambda x: x >= 0, "a number >= 0")
+ANY = (lambda x: True, "a number")
+
+
+def unit_interval(lo_open=False, hi_open=False):
+    def ok(x):
+        return (x > 0 if lo_open else x >= 0) and (x < 1 if hi_open else x <= 1)
+    lo, hi = ("(" if lo_open else "["), (")" if hi_open else "]")
+    return (ok, f"a number in {lo}0, 1{hi}")
+
+
+def kind_ok(kind, v):
+    if kind == "any":
+        return True
+    if kind == "float":
+        return isinstance(v, (int, float)) and not isinstance(v, bool)
+    if kind == "int":
+        return isinstance(v, int) and not isinstance(v, bool)
+    return isinstance(v, {"str": str, "bool": bool, "list": list, "table": dict}[kind])
+
+
+def check_fields(src, table, where, spec, extra_ok=()):
+    """Validate one table against its spec; return a dict with defaults filled in."""
+    if not isinstance(table, dict):
+        raise SceneError(src, where, "must be a table", "write it as [name] or { ... }")
+    for key in table:
+        if key not in spec and key not in extra_ok:
+            valid = ", ".join(sorted(set(spec) | set(extra_ok)))
+            raise SceneError(src, f"{where}.{key}", "unknown key", f"valid keys here: {valid}")
+    out = {}
+    for key, (kind, required, check, default) in spec.items():
+        path = f"{where}.{key}"
+        if key not in table:
+            if required:
+                raise SceneError(src, path, "missing", f"this field is required ({kind})")
+            out[key] = default
+            continue
+        v = table[key]
+        if not kind_ok(kind, v):
+            raise SceneError(src, path, f"has the wrong type ({type(v).__name__})",
+                             f"expected {kind}")
+        if kind == "float":
+            v = float(v)
+        if check is not None and kind in ("float", "int"):
+            ok, what = check
+            if not ok(v):
+                raise SceneError(src, path, f"invalid value {v!r}", f"must be {what}")
+        out[key] = v
+    return out
+
+
+def finite_everywhere(src, obj, where):
+    """TOML admits nan and inf literals; a scene never may."""
+    if isinstance(obj, float) and not math.isfinite(obj):
+        raise SceneError(src, where, f"is {obj}", "every number in a scene must be finite")
+    if isinstance(obj, dict):
+        for k, v in obj.items():
+            finite_everywhere(src, v, f"{where}.{k}" if where else k)
+    elif isinstance(obj, list):
+        for i, v in enumerate(obj):
+            finite_everywhere(src, v, f"{where}[{i}]")
+
+
+def choice(src, path, value, choices):
+    if value not in choices:
+        raise SceneError(src, path, f"unknown value {value!r}", "valid: " + ", ".join(choices))
+    return value
+
+def per_item(src, where, value, count, check=None):
+    """A scalar for all, or a list of exactly `count` numbers."""
+    values = value if isinstance(value, list) else [value] * count
+    if len(values) != count:
+        raise SceneError(src, where, f"has {len(values)} values", f"give one number or a list of {count}")
+    for i, v in enumerate(values):
+        path = f"{where}[{i}]" if isinstance(value, list) else where
+        if not kind_ok("float", v):
+            raise SceneError(src, path, f"has the wrong type ({type(v).__name__})", "expected float")
+        if check is not None and not check[0](float(v)):
+            raise SceneError(src, path, f"invalid value {v!r}", f"must be {check[1]}")
+    return [float(v) for v in values]

@@ -1,0 +1,361 @@
+"""Scene files: read, validate, and describe a 1D mechanical network.
+
+A scene is TOML with tables `[[node]]`, `[[link]]`, `[[contact]]`, `[loads]`, `[analysis]`
+and an optional `[check]` (the closed form it is verified against). The format is documented
+in docs/scene-format.md. Every error names the file, the field and what would be valid."""
+
+import hashlib
+import json
+import tomllib
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from ..errors import SceneError
+from .bars import expand_bars
+from .chain import expand_chains
+from .compatibility import COMPATIBLE
+from .fields import ANY, NONNEG, POSITIVE, check_fields, choice, finite_everywhere, kind_ok
+from .spec import (ALL_SPECIFIC, ANALYSIS_TYPES, CONTACT_COMMON, CONTACT_SCHEMES,
+                   FIXED_EXPONENT, FUNCTION_TYPES, GROUND, INTEGRATOR_KEYS,
+                   INTEGRATORS, LAWS, LINK_COMMON, LINK_TYPES, NEWMARK_PRESETS, NODE_KEYS,
+                   OUTPUT_KEYS, SCHEMES, TOP_KEYS)
+
+
+@dataclass
+class Scene:
+    source: str
+    title: str
+    problem: str
+    description: str
+    nodes: list          # dicts: name, mass, u0, v0, fixed
+    links: list          # dicts: name, type, a, b (indices, -1 ground) + parameters
+    contacts: list       # dicts: name, a, b, gap, scheme + parameters
+    gravity: float
+    forces: list         # dicts: node (index), function (dict)
+    ground: dict | None  # function dict, or None
+    analysis: dict
+    check: dict | None
+    digest: str          # sha256 of the file (or of the canonical JSON of a dict scene)
+    index: dict = field(default_factory=dict)   # node name -> index
+    couplings: list = field(default_factory=list)  # dicts: a, b (indices), value
+    extras: dict = field(default_factory=dict)     # what generators ([[bar]]) know of the scene
+
+    def node_index(self, name):
+        return -1 if name == GROUND else self.index[name]
+
+
+# --- helpers ---------------------------------------------------------------------------------
+
+def _function(src, tab, where, base_dir, allow_record):
+    if not isinstance(tab, dict):
+        raise SceneError(src, where, "must be a table", "e.g. { type = \"sine\", ... }")
+    if "type" not in tab:
+        raise SceneError(src, f"{where}.type", "missing",
+                         "valid: " + ", ".join(FUNCTION_TYPES))
+    kinds = list(FUNCTION_TYPES) if allow_record else [k for k in FUNCTION_TYPES if k != "record"]
+    kind = choice(src, f"{where}.type", tab["type"], kinds)
+    f = check_fields(src, tab, where, FUNCTION_TYPES[kind], extra_ok=("type",))
+    f["type"] = kind
+    if kind in ("rectangular", "half_sine", "sine") and f["t_end"] <= f["t_start"]:
+        raise SceneError(src, f"{where}.t_end", "must be later than t_start")
+    if kind == "table":
+        t, y = f["t"], f["values"]
+        for name, arr in (("t", t), ("values", y)):
+            if not all(kind_ok("float", x) for x in arr):
+                raise SceneError(src, f"{where}.{name}", "must be a list of numbers")
+        if len(t) < 2 or len(t) != len(y):
+            raise SceneError(src, where, f"t has {len(t)} and values {len(y)} entries",
+                             "a table needs >= 2 pairs of equal length")
+        for i in range(1, len(t)):
+            if not t[i] > t[i - 1]:
+                raise SceneError(src, f"{where}.t[{i}]", f"{t[i]} does not follow {t[i - 1]}",
+                                 "times must increase strictly")
+    if kind == "record":
+        p = Path(f["file"])
+        f["file"] = str(p if p.is_absolute() else (base_dir / p))
+        if not Path(f["file"]).exists():
+            raise SceneError(src, f"{where}.file", f"{f['file']} does not exist",
+                             "paths are relative to the scene file's folder")
+    return f
+
+
+# --- the loader ----------------------------------------------------------------------------
+
+def load(path):
+    """Read and validate a scene file."""
+    path = Path(path)
+    if not path.exists():
+        raise SceneError(path, "(file)", "does not exist")
+    raw = path.read_bytes()
+    try:
+        data = tomllib.loads(raw.decode("utf-8"))
+    except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
+        raise SceneError(path, "(syntax)", f"not valid TOML: {exc}") from None
+    return from_dict(data, source=str(path), base_dir=path.parent,
+                     digest=hashlib.sha256(raw).hexdigest())
+
+
+def from_dict(data, source="<scene>", base_dir=Path("."), digest=None):
+    """Validate a scene given as a dict (the parsed TOML)."""
+    src = source
+    if digest is None:
+        digest = hashlib.sha256(json.dumps(data, sort_keys=True, default=str).encode()).hexdigest()
+    finite_everywhere(src, data, "")
+    for key in data:
+        if key not in TOP_KEYS:
+            raise SceneError(src, key, "unknown key", "valid top-level keys: " + ", ".join(sorted(TOP_KEYS)))
+    extras = {}
+    if "chain" in data:
+        data = expand_chains(src, data)
+    if "bar" in data:
+        data, extras["bars"] = expand_bars(src, data)   # [[bar]]: rods meshed into elements (P4)
+
+    # nodes
+    raw_nodes = data.get("node")
+    if not isinstance(raw_nodes, list) or not raw_nodes:
+        raise SceneError(src, "node", "missing", "a scene needs at least one [[node]]")
+    nodes, index = [], {}
+    for i, tab in enumerate(raw_nodes):
+        where = f"node[{i}]"
+        n = check_fields(src, tab, where, NODE_KEYS)
+        if n["name"] == GROUND:
+            raise SceneError(src, f"{where}.name", "'ground' is reserved", "choose another name")
+        if n["name"] in index:
+            raise SceneError(src, f"{where}.name", f"duplicate name {n['name']!r}", "names must be unique")
+        if n["fixed"]:
+            if n["mass"] < 0:
+                raise SceneError(src, f"{where}.mass", f"invalid value {n['mass']!r}", "must be >= 0 for a fixed node")
+        elif not n["mass"] > 0:
+            raise SceneError(src, f"{where}.mass", f"invalid value {n['mass']!r}", "must be > 0 (or set fixed = true)")
+        index[n["name"]] = i
+        nodes.append(n)
+
+    def node_ref(path, name, ground_ok=True):
+        if name == GROUND and ground_ok:
+            return -1
+        if name not in index:
+            known = ", ".join(list(index)[:8]) + (", ..." if len(index) > 8 else "")
+            raise SceneError(src, path, f"names no node {name!r}",
+                             f"use one of: {known}" + (", ground" if ground_ok else ""))
+        return index[name]
+
+    for key in ("link", "contact", "mass_coupling"):
+        if key in data and not isinstance(data[key], list):
+            raise SceneError(src, key, "must be an array of tables", f"write [[{key}]]")
+    if "force" in data.get("loads", {}) and not isinstance(data["loads"]["force"], list):
+        raise SceneError(src, "loads.force", "must be an array of tables", "write [[loads.force]]")
+    # links
+    links, lnames = [], set()
+    for i, tab in enumerate(data.get("link", [])):
+        where = f"link[{i}]"
+        if not isinstance(tab, dict) or "type" not in tab:
+            raise SceneError(src, f"{where}.type", "missing", "valid: " + ", ".join(LINK_TYPES))
+        kind = choice(src, f"{where}.type", tab["type"], list(LINK_TYPES))
+        spec = dict(LINK_COMMON, **LINK_TYPES[kind])
+        lk = check_fields(src, tab, where, spec)
+        lk["a"], lk["b"] = node_ref(f"{where}.a", lk["a"]), node_ref(f"{where}.b", lk["b"])
+        if lk["a"] == lk["b"]:
+            raise SceneError(src, f"{where}.b", "connects a node to itself", "name two different nodes")
+        lk["name"] = lk["name"] or f"link{i}"
+        if lk["name"] in lnames:
+            raise SceneError(src, f"{where}.name", f"duplicate name {lk['name']!r}", "names must be unique")
+        lnames.add(lk["name"])
+        if kind == "dashpot" and (lk["c"] is None) == (lk["zeta"] is None):
+            raise SceneError(src, where, "needs exactly one of c or zeta",
+                             "c = damping [N s/m], or zeta = damping ratio of a node-to-ground oscillator")
+        links.append(lk)
+
+    # contacts
+    contacts, cnames = [], set()
+    for i, tab in enumerate(data.get("contact", [])):
+        where = f"contact[{i}]"
+        if not isinstance(tab, dict) or "scheme" not in tab:
+            raise SceneError(src, f"{where}.scheme", "missing", "valid: " + ", ".join(SCHEMES))
+        scheme = choice(src, f"{where}.scheme", tab["scheme"], SCHEMES)
+        c = check_fields(src, tab, where, dict(CONTACT_COMMON, **CONTACT_SCHEMES[scheme]))
+        if c["name"] in cnames:
+            raise SceneError(src, f"{where}.name", f"duplicate name {c['name']!r}", "names must be unique")
+        cnames.add(c["name"])
+        c["a"], c["b"] = node_ref(f"{where}.a", c["a"]), node_ref(f"{where}.b", c["b"])
+        if c["a"] == c["b"]:
+            raise SceneError(src, f"{where}.b", "pairs a node with itself", "name two different nodes or ground")
+        if scheme == "penalty":
+            choice(src, f"{where}.law", c["law"], LAWS)
+            if c["clipped"] and c["law"] != "kelvin":
+                raise SceneError(src, f"{where}.clipped", "applies to law kelvin only", "remove it")
+            if c["exponent"] is not None and c["law"] in FIXED_EXPONENT:
+                raise SceneError(src, f"{where}.exponent", f"does not apply to law {c['law']}",
+                                 f"its exponent is fixed at {FIXED_EXPONENT[c['law']]:g}; remove it")
+            if c["law"] in ("linear", "hertz") and (c["damping"] is not None or c["restitution"] is not None):
+                key = "damping" if c["damping"] is not None else "restitution"
+                raise SceneError(src, f"{where}.{key}", f"law {c['law']} is elastic (e = 1)",
+                                 "remove it, or choose a damped law (kelvin, hunt-crossley, ...)")
+            if c["law"] in ("flores", "gonthier", "jankowski") and c["restitution"] == 0:
+                raise SceneError(src, f"{where}.restitution", f"law {c['law']} divides by e",
+                                 "give e > 0 (e = 0 is a plastic impact: use scheme restitution)")
+            if c["damping"] is not None and c["restitution"] is not None:
+                raise SceneError(src, f"{where}.damping", "given together with restitution",
+                                 "give one: damping directly, or restitution to derive it")
+        contacts.append(c)
+
+    # loads
+    loads = data.get("loads", {})
+    lt = check_fields(src, loads, "loads", {"gravity": ("float", False, ANY, 0.0),
+                                            "force": ("list", False, None, []),
+                                            "ground_acceleration": ("table", False, None, None)})
+    forces = []
+    for i, tab in enumerate(lt["force"]):
+        where = f"loads.force[{i}]"
+        if not isinstance(tab, dict):
+            raise SceneError(src, where, "must be a table", "write [[loads.force]]")
+        f = check_fields(src, tab, where, {"node": ("str", True, None, None),
+                                            "value": ("float", False, ANY, None),
+                                            "function": ("table", False, None, None)})
+        if (f["value"] is None) == (f["function"] is None):
+            raise SceneError(src, where, "needs exactly one of value or function",
+                             "value = 10.0 for a constant force, or function = { type = ... }")
+        fn = ({"type": "constant", "value": f["value"]} if f["function"] is None
+              else _function(src, f["function"], f"{where}.function", base_dir, False))
+        forces.append({"node": node_ref(f"{where}.node", f["node"], ground_ok=False), "function": fn})
+    ground = None
+    if lt["ground_acceleration"] is not None:
+        ground = _function(src, lt["ground_acceleration"], "loads.ground_acceleration", base_dir, True)
+
+    # analysis
+    an = data.get("analysis")
+    if not isinstance(an, dict) or "type" not in an:
+        raise SceneError(src, "analysis.type", "missing", "valid: " + ", ".join(ANALYSIS_TYPES))
+    atype = choice(src, "analysis.type", an["type"], list(ANALYSIS_TYPES))
+    analysis = check_fields(src, an, "analysis", ANALYSIS_TYPES[atype], extra_ok=("type",))
+    analysis["type"] = atype
+    if atype == "dynamic":
+        _dynamic_analysis(src, an, analysis, index, contacts, links)
+    ground_k = _ground_stiffness(links)
+    for i, lk in enumerate(links):
+        if lk["type"] == "dashpot" and lk["zeta"] is not None:
+            lk["c"] = _dashpot_from_zeta(src, i, lk, ground_k, nodes)
+
+    check = data.get("check")
+    if check is not None:
+        check = _check_table(src, check)
+
+    # off-diagonal (consistent) mass terms: M(a,b) = M(b,a) += value
+    couplings = []
+    for i, tab in enumerate(data.get("mass_coupling", [])):
+        where = f"mass_coupling[{i}]"
+        mc = check_fields(src, tab, where, {"a": ("str", True, None, None),
+                                            "b": ("str", True, None, None),
+                                            "value": ("float", True, POSITIVE, None)})
+        mc["a"] = node_ref(f"{where}.a", mc["a"], ground_ok=False)
+        mc["b"] = node_ref(f"{where}.b", mc["b"], ground_ok=False)
+        if mc["a"] == mc["b"]:
+            raise SceneError(src, f"{where}.b", "couples a node with itself", "name two different nodes")
+        couplings.append(mc)
+
+    meta = {k: data.get(k, "") for k in ("title", "problem", "description")}
+    for k, v in meta.items():
+        if not isinstance(v, str):
+            raise SceneError(src, k, "must be a string")
+    return Scene(source=src, title=meta["title"] or Path(src).stem, problem=meta["problem"],
+                 description=meta["description"], nodes=nodes, links=links, contacts=contacts,
+                 gravity=lt["gravity"], forces=forces, ground=ground, analysis=analysis,
+                 check=check, digest=digest, index=index, couplings=couplings, extras=extras)
+
+
+
+def _dynamic_analysis(src, raw, an, index, contacts, links):
+    integ = choice(src, "analysis.integrator", an["integrator"], INTEGRATORS)
+    allowed = INTEGRATOR_KEYS[integ]
+    for key in ALL_SPECIFIC:
+        if key in raw and key not in allowed:
+            raise SceneError(src, f"analysis.{key}", f"does not apply to integrator {integ}",
+                             "valid here: " + ", ".join(sorted(allowed)))
+    if integ == "newmark":
+        if an["preset"] is not None:
+            choice(src, "analysis.preset", an["preset"], list(NEWMARK_PRESETS))
+            if an["beta"] is not None or an["gamma"] is not None:
+                raise SceneError(src, "analysis.preset", "given together with beta/gamma",
+                                 "give a preset or beta and gamma")
+            an["beta"], an["gamma"] = NEWMARK_PRESETS[an["preset"]]
+        else:
+            if an["beta"] is None and an["gamma"] is None:
+                an["preset"] = "average-acceleration"
+                an["beta"], an["gamma"] = NEWMARK_PRESETS["average-acceleration"]
+            elif an["beta"] is None or an["gamma"] is None:
+                raise SceneError(src, "analysis.beta" if an["beta"] is None else "analysis.gamma",
+                                 "missing", "Newmark needs both beta and gamma (or a preset)")
+    if integ == "hht" and an["alpha"] is None:
+        raise SceneError(src, "analysis.alpha", "missing", "HHT needs alpha in [-1/3, 0]")
+    if integ == "generalized-alpha" and an["rho_inf"] is None:
+        raise SceneError(src, "analysis.rho_inf", "missing", "generalized-alpha needs rho_inf in [0, 1]")
+    for i, c in enumerate(contacts):
+        if integ not in COMPATIBLE[c["scheme"]]:
+            works = ", ".join(COMPATIBLE[c["scheme"]]) or "none (a static scheme: use analysis type static)"
+            raise SceneError(src, f"contact[{i}].scheme",
+                             f"scheme {c['scheme']} cannot run on integrator {integ}",
+                             f"integrators that can: {works}")
+    if an["dt"] > an["t_end"]:
+        raise SceneError(src, "analysis.dt", f"{an['dt']} is longer than t_end = {an['t_end']}",
+                         "choose dt <= t_end")
+    out = check_fields(src, an["output"] or {}, "analysis.output", OUTPUT_KEYS)
+    names = list(index)
+    # default: every node and contact of a small scene; none of a large one (peaks are always there)
+    out["nodes"] = out["nodes"] if out["nodes"] is not None else (names if len(names) <= 50 else [])
+    contact_names = [c["name"] for c in contacts]
+    out["contacts"] = (out["contacts"] if out["contacts"] is not None
+                       else (contact_names if len(contact_names) <= 50 else []))
+    for i, nm in enumerate(out["nodes"]):
+        if nm not in index:
+            raise SceneError(src, f"analysis.output.nodes[{i}]", f"names no node {nm!r}",
+                             "use node names of this scene")
+    for i, nm in enumerate(out["contacts"]):
+        if nm not in contact_names:
+            raise SceneError(src, f"analysis.output.contacts[{i}]", f"names no contact {nm!r}",
+                             "use contact names of this scene")
+    link_names = [l["name"] for l in links]
+    for i, nm in enumerate(out["links"]):
+        if nm not in link_names:
+            raise SceneError(src, f"analysis.output.links[{i}]", f"names no link {nm!r}",
+                             "use link names of this scene (links without a name are link<i>)")
+    an["output"] = out
+
+
+def _ground_stiffness(links):
+    """Sum of the stiffnesses of springs, bilinear springs and bars from each node to ground."""
+    k = {}
+    for l in links:
+        if l["type"] in ("spring", "bilinear", "bar") and -1 in (l["a"], l["b"]):
+            node = l["a"] if l["b"] == -1 else l["b"]
+            k[node] = k.get(node, 0.0) + (l["EA"] / l["L"] if l["type"] == "bar" else l["k"])
+    return k
+
+
+def _dashpot_from_zeta(src, i, lk, ground_k, nodes):
+    """c = 2ζ√(k m) for a dashpot from a node to ground, k the node's springs to ground."""
+    where = f"link[{i}].zeta"
+    if lk["b"] != -1 and lk["a"] != -1:
+        raise SceneError(src, where, "applies to a dashpot between a node and ground",
+                         "give c for a dashpot between two nodes")
+    node = lk["a"] if lk["b"] == -1 else lk["b"]
+    if nodes[node]["fixed"]:
+        raise SceneError(src, where, "the node is fixed", "a damping ratio needs a free node")
+    k = ground_k.get(node, 0.0)
+    if k <= 0:
+        raise SceneError(src, where, "the node has no spring to ground to define a frequency",
+                         "give c directly")
+    return 2.0 * lk["zeta"] * (k * nodes[node]["mass"]) ** 0.5
+
+
+def _check_table(src, check):
+    c = check_fields(src, check, "check", {"closed_form": ("str", True, None, None),
+                                           "params": ("table", True, None, None),
+                                           "compare": ("list", True, None, None)})
+    for i, item in enumerate(c["compare"]):
+        check_fields(src, item, f"check.compare[{i}]", {
+            "result": ("str", True, None, None), "oracle": ("str", True, None, None),
+            "rtol": ("float", False, NONNEG, None), "atol": ("float", False, NONNEG, None),
+            "why": ("str", True, None, None)})
+        if "rtol" not in item and "atol" not in item:
+            raise SceneError(src, f"check.compare[{i}]", "needs rtol or atol",
+                             "state the tolerance and why (rtol = 0 and atol = 0 ask for exact equality)")
+    return c

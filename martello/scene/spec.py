@@ -1,0 +1,115 @@
+"""The scene format's vocabulary: the keys of every table with their kinds, checks and
+defaults, the contact schemes and laws, the time functions, the integrators and their
+parameters (docs/scene-format.md). Which integrators run which contact scheme is in
+martello.scene.compatibility."""
+
+from ..binding import native
+from .fields import ANY, NONNEG, POSITIVE, unit_interval
+
+GROUND = "ground"
+
+NODE_KEYS = {
+    "name": ("str", True, None, None),
+    "mass": ("float", True, None, None),        # > 0 unless fixed: the loader checks it
+    "u0": ("float", False, ANY, 0.0),
+    "v0": ("float", False, ANY, 0.0),
+    "fixed": ("bool", False, None, False),
+}
+
+LINK_COMMON = {"name": ("str", False, None, None), "type": ("str", True, None, None),
+               "a": ("str", True, None, None), "b": ("str", True, None, None)}
+LINK_TYPES = {
+    "spring": {"k": ("float", True, POSITIVE, None)},
+    "dashpot": {"c": ("float", False, POSITIVE, None),
+                "zeta": ("float", False, (lambda x: 0 < x < 10, "a number in (0, 10)"), None)},
+    "bilinear": {"k": ("float", True, POSITIVE, None), "fy": ("float", True, POSITIVE, None),
+                 "hardening": ("float", False, unit_interval(hi_open=True), 0.0)},
+    "fluid_damper": {"c": ("float", True, POSITIVE, None),
+                     "alpha": ("float", False, (lambda x: 0 < x <= 2, "a number in (0, 2]"), 1.0),
+                     "v_reg": ("float", False, NONNEG, 1e-6)},
+    "bar": {"EA": ("float", True, POSITIVE, None), "L": ("float", True, POSITIVE, None)},
+}
+
+SCHEMES = native.names("schemes")
+LAWS = native.names("laws")
+FIXED_EXPONENT = {r.name: r.values["exponent"] for r in native.registry("laws")
+                  if r.values["exponent_fixed"]}
+CONTACT_COMMON = {"name": ("str", True, None, None), "a": ("str", True, None, None),
+                  "b": ("str", True, None, None), "gap": ("float", False, ANY, 0.0),
+                  "scheme": ("str", True, None, None)}
+CONTACT_SCHEMES = {
+    "penalty": {"law": ("str", False, None, "linear"),
+                "stiffness": ("float", True, POSITIVE, None),
+                "exponent": ("float", False, POSITIVE, None),
+                "damping": ("float", False, NONNEG, None),
+                "restitution": ("float", False, unit_interval(), None),
+                "clipped": ("bool", False, None, False)},
+    "lagrange": {"restitution": ("float", False, unit_interval(), None)},
+    "augmented-lagrange": {"stiffness": ("float", True, POSITIVE, None)},
+    "restitution": {"restitution": ("float", True, unit_interval(), None)},
+}
+
+FUNCTION_TYPES = {
+    "constant": {"value": ("float", True, ANY, None)},
+    "sine": {"amplitude": ("float", True, ANY, None), "omega": ("float", True, POSITIVE, None),
+             "phase": ("float", False, ANY, 0.0), "t_start": ("float", False, NONNEG, 0.0),
+             "t_end": ("float", False, POSITIVE, 1e300)},
+    "rectangular": {"amplitude": ("float", True, ANY, None),
+                    "t_start": ("float", False, NONNEG, 0.0), "t_end": ("float", True, POSITIVE, None)},
+    "half_sine": {"amplitude": ("float", True, ANY, None),
+                  "t_start": ("float", False, NONNEG, 0.0), "t_end": ("float", True, POSITIVE, None)},
+    "table": {"t": ("list", True, None, None), "values": ("list", True, None, None),
+              "scale": ("float", False, ANY, 1.0)},
+    "record": {"file": ("str", True, None, None), "format": ("str", False, None, None),
+               "units": ("str", False, None, None), "scale": ("float", False, ANY, 1.0)},
+}
+
+# The integrators are the library's (its registry; tests/test_registry.py).
+INTEGRATORS = native.integrators()
+ADAPTIVE = native.adaptive_integrators()
+
+
+def _setting(kind, name, required=False, default=True):
+    """A key that is a native setting: the library's valid range and, unless required or
+    default=False, its default (the registry's table settings)."""
+    rng = native.settings_ranges()[name]
+    return (kind, required, (lambda x: native.in_range(rng, x), rng.text),
+            native.settings_defaults()[name] if default and not required else None)
+
+
+NEWMARK_PRESETS = {"average-acceleration": (0.25, 0.5), "linear-acceleration": (1.0 / 6.0, 0.5)}
+ANALYSIS_TYPES = {
+    "static": {"tol": ("float", False, POSITIVE, 1e-14),
+               "max_iter": ("int", False, POSITIVE, 500)},
+    "dynamic": {"integrator": ("str", True, None, None),
+                "dt": _setting("float", "dt", required=True),
+                "t_end": _setting("float", "t_end", required=True),
+                "preset": ("str", False, None, None),
+                "beta": _setting("float", "beta", default=False),
+                "gamma": _setting("float", "gamma", default=False),
+                "alpha": _setting("float", "alpha", default=False),
+                "rho_inf": _setting("float", "rho_inf", default=False),
+                "tol_residual": _setting("float", "tol_residual"),
+                "tol_increment": _setting("float", "tol_increment"),
+                "max_newton": _setting("int", "max_newton"),
+                "check_stability": _setting("bool", "check_stability"),
+                "divergence_factor": _setting("float", "divergence_factor"),
+                "rtol": _setting("float", "rtol"),
+                "atol": _setting("float", "atol"),
+                "theta": _setting("float", "theta"),
+                "event_tol": _setting("float", "event_tol"),
+                "h_max": _setting("float", "h_max"),
+                "output": ("table", False, None, None)},
+}
+OUTPUT_KEYS = {"every": _setting("int", "every"), "nodes": ("list", False, None, None),
+               "contacts": ("list", False, None, None), "links": ("list", False, None, [])}
+# The analysis keys of one integrator or a group: the settings it reads beyond those every
+# integrator reads (the library's table "reads"); Newmark also takes a preset.
+_READ_BY_ALL = set.intersection(*(native.settings_read(i) for i in INTEGRATORS))
+INTEGRATOR_KEYS = {i: native.settings_read(i) - _READ_BY_ALL | ({"preset"} if i == "newmark" else set())
+                   for i in INTEGRATORS}
+ALL_SPECIFIC = set().union(*INTEGRATOR_KEYS.values())
+
+TOP_KEYS = {"title", "problem", "description", "node", "link", "contact", "loads", "analysis",
+            "check", "chain", "bar", "mass_coupling"}
+

@@ -1,0 +1,187 @@
+"""The study file (docs/studies.md): scenes, contact schemes, integrators and the steps or
+tolerances to sweep, read and validated into a Study."""
+
+from __future__ import annotations
+
+import math
+import tomllib
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from ..errors import StudyError
+from ..scene.spec import ADAPTIVE, INTEGRATORS
+from ..scene.variants import override_contacts
+
+STUDY_KEYS = {"title", "description", "output", "t_end", "repeat", "compare", "scene", "scheme",
+              "integrator", "atlas", "kind"}
+SCENE_KEYS = {"file", "label", "reference", "t_end", "scheme"}
+SCHEME_KEYS = {"label", "contact", "reference", "scenes"}
+INTEGRATOR_KEYS = {"name", "label", "params", "dt", "rtol", "order", "scenes", "schemes"}
+COMPARE_KEYS = {"histories", "atol", "rtol", "points", "plot_metrics", "fit", "window"}
+# Integrator parameters that fix a member of a family; the label says them.
+FAMILY_KEYS = ("preset", "beta", "gamma", "alpha", "rho_inf", "theta")
+
+
+@dataclass
+class Case:
+    """One scene with one contact scheme: the unit that has one reference."""
+    label: str
+    scene_label: str
+    scheme_label: str
+    scene_file: Path
+    scene_dict: dict
+    reference: object          # spec: None/"auto", {closed_form...} or {data...}
+    t_end: float
+
+
+@dataclass
+class Method:
+    label: str
+    name: str
+    params: dict
+    dts: list
+    rtols: list
+    order: float | None
+    scenes: list | None
+    schemes: list | None
+
+
+@dataclass
+class Study:
+    path: Path
+    title: str
+    description: str
+    output: str | None
+    repeat: int
+    compare: dict
+    cases: list
+    methods: list
+    raw: dict = field(default_factory=dict)
+
+
+def _sweep(src, where, value):
+    """A list of numbers, or {from, to, per_decade} for a geometric sweep (from > to)."""
+    if value is None:
+        return []
+    if isinstance(value, (int, float)) and not isinstance(value, bool):
+        return [float(value)]
+    if isinstance(value, list):
+        if not value or not all(isinstance(x, (int, float)) and x > 0 for x in value):
+            raise StudyError(src, where, "must be a non-empty list of numbers > 0")
+        return [float(x) for x in value]
+    if isinstance(value, dict) and {"from", "to"} <= set(value):
+        a, b, n = float(value["from"]), float(value["to"]), int(value.get("per_decade", 4))
+        if not (a > 0 and b > 0 and n > 0):
+            raise StudyError(src, where, "from, to and per_decade must be > 0")
+        count = int(round(abs(math.log10(b / a)) * n)) + 1
+        return [float(x) for x in np.geomspace(a, b, count)]
+    raise StudyError(src, where, f"invalid sweep {value!r}",
+                     "give a list of numbers or { from = 1e-3, to = 1e-6, per_decade = 4 }")
+
+
+def _check_keys(src, where, table, valid):
+    if not isinstance(table, dict):
+        raise StudyError(src, where, "must be a table")
+    for k in table:
+        if k not in valid:
+            raise StudyError(src, f"{where}.{k}", "unknown key", "valid: " + ", ".join(sorted(valid)))
+
+
+def method_label(name, params):
+    fam = [f"{k}={params[k]}" for k in FAMILY_KEYS if k in params]
+    return name + (f" ({', '.join(fam)})" if fam else "")
+
+
+def read_toml(path):
+    """The parsed TOML of a study or atlas file; StudyError if it is missing or invalid."""
+    path = Path(path)
+    if not path.exists():
+        raise StudyError(path, "(file)", "does not exist")
+    try:
+        return tomllib.loads(path.read_text())
+    except tomllib.TOMLDecodeError as exc:
+        raise StudyError(path, "(syntax)", f"not valid TOML: {exc}") from None
+
+
+def load_study(path):
+    path = Path(path)
+    raw = read_toml(path)
+    _check_keys(path, "(top level)", raw, STUDY_KEYS)
+    compare = raw.get("compare", {})
+    _check_keys(path, "compare", compare, COMPARE_KEYS)
+    compare = {"histories": compare.get("histories"), "atol": float(compare.get("atol", 1e-12)),
+               "rtol": float(compare.get("rtol", 1e-6)), "points": int(compare.get("points", 2001)),
+               "plot_metrics": list(compare.get("plot_metrics", ["max_rel_error"])),
+               "fit": [float(x) for x in compare.get("fit", [0.0, 0.1])],
+               "window": compare.get("window")}
+    top_schemes = raw.get("scheme", [])
+    for i, sc in enumerate(top_schemes):
+        _check_keys(path, f"scheme[{i}]", sc, SCHEME_KEYS)
+    cases = []
+    if not raw.get("scene"):
+        raise StudyError(path, "scene", "missing", "name at least one [[scene]] with file = \"...\"")
+    for i, st in enumerate(raw["scene"]):
+        where = f"scene[{i}]"
+        _check_keys(path, where, st, SCENE_KEYS)
+        if "file" not in st:
+            raise StudyError(path, f"{where}.file", "missing", "the scene file, relative to the study")
+        f = Path(st["file"])
+        f = f if f.is_absolute() else (path.parent / f).resolve()
+        if not f.exists():
+            raise StudyError(path, f"{where}.file", f"{f} does not exist")
+        with open(f, "rb") as fh:
+            try:
+                sdict = tomllib.load(fh)
+            except tomllib.TOMLDecodeError as exc:
+                raise StudyError(f, "(syntax)", f"not valid TOML: {exc}") from None
+        sdict.pop("check", None)     # the study's reference decides what is compared
+        slabel = st.get("label", f.stem)
+        t_end = float(st.get("t_end", raw.get("t_end", sdict.get("analysis", {}).get("t_end", 0.0))))
+        schemes = list(st.get("scheme", [])) + [s for s in top_schemes
+                                                 if not s.get("scenes") or slabel in s["scenes"]]
+        for j, sc in enumerate(st.get("scheme", [])):
+            _check_keys(path, f"{where}.scheme[{j}]", sc, SCHEME_KEYS)
+        if not schemes:
+            schemes = [{"label": "as in the scene"}]
+        for sc in schemes:
+            d = override_contacts(sdict, sc.get("contact"), path, f"{where} scheme {sc.get('label')}")
+            # the scene's reference is for its own contacts: an override brings its own
+            ref = sc.get("reference", "auto") if sc.get("contact") else \
+                sc.get("reference", st.get("reference", "auto"))
+            cases.append(Case(label=f"{slabel} | {sc.get('label', 'scheme')}" if len(schemes) > 1 else slabel,
+                              scene_label=slabel, scheme_label=sc.get("label", "as in the scene"),
+                              scene_file=f, scene_dict=d, reference=ref, t_end=t_end))
+    methods = []
+    if not raw.get("integrator"):
+        raise StudyError(path, "integrator", "missing", "name at least one [[integrator]]")
+    for i, it in enumerate(raw["integrator"]):
+        where = f"integrator[{i}]"
+        _check_keys(path, where, it, INTEGRATOR_KEYS)
+        name = it.get("name")
+        if name not in INTEGRATORS:
+            raise StudyError(path, f"{where}.name", f"unknown integrator {name!r}",
+                             "valid: " + ", ".join(INTEGRATORS))
+        params = dict(it.get("params", {}))
+        dts = _sweep(path, f"{where}.dt", it.get("dt"))
+        rtols = _sweep(path, f"{where}.rtol", it.get("rtol"))
+        if not dts:
+            raise StudyError(path, f"{where}.dt", "missing",
+                             "a list of steps (adaptive integrators: one output step)")
+        if rtols and name not in ADAPTIVE:
+            raise StudyError(path, f"{where}.rtol", f"applies to adaptive integrators, not {name}",
+                             "sweep dt instead")
+        methods.append(Method(label=it.get("label", method_label(name, params)), name=name,
+                              params=params, dts=dts, rtols=rtols,
+                              order=it.get("order"), scenes=it.get("scenes"), schemes=it.get("schemes")))
+    return Study(path=path, title=raw.get("title", path.stem), description=raw.get("description", ""),
+                 output=raw.get("output"), repeat=int(raw.get("repeat", 1)), compare=compare,
+                 cases=cases, methods=methods, raw=raw)
+
+
+def file_kind(path):
+    """"atlas" for a stability-atlas file (martello.study.atlas), else "study": both are run
+    by `martello study`."""
+    raw = read_toml(path)
+    return "atlas" if raw.get("kind") == "atlas" or "atlas" in raw else "study"
