@@ -75,7 +75,7 @@ contains
       type(integrator_settings_t), intent(in) :: s
       type(observer_t), intent(inout) :: o
       integer, intent(out) :: stat
-      integer :: n, nc, i, c
+      integer :: n, nc, i
       logical :: converged
       character(len=16) :: num
       stat = MARTELLO_OK
@@ -107,11 +107,9 @@ contains
          self%mdense(:, i) = self%ma(1:n)
       end do
       call rigid_contact_sides(m, self%rigid, self%e_con, self%sa, self%sb, self%movable)
-      do c = 1, nc
-         ! effective mass of the contact, 1/(B M⁻¹ Bᵀ), for the impact energy loss
-         self%mstar(c) = 0.0_dp
-         if (self%movable(c)) self%mstar(c) = effective_mass(self, c)
-      end do
+      ! the model's effective mass of each contact, 1/(B M⁻¹ Bᵀ) (martello_effective_mass),
+      ! for the impact energy loss; 0 where neither side moves
+      self%mstar = merge(m%con_mstar(1:nc), 0.0_dp, self%movable)
 
       call internal_forces(m, self%ms, self%u, self%v, self%fint)
       call mech_commit(m, self%ms, self%u)
@@ -120,27 +118,6 @@ contains
       if (.not. converged) return
       call contact_state(self, m, self%lam)
    end subroutine init
-
-   !> 1/(B M⁻¹ Bᵀ) of contact cc (M restricted to the free nodes).
-   real(dp) function effective_mass(self, cc)
-      class(newmark_lagrange_t), intent(in) :: self
-      integer, intent(in) :: cc
-      real(dp) :: mm(self%n, self%n), x(self%n), rc
-      integer :: st
-      character(len=256) :: msg
-      mm = self%mdense
-      x = 0.0_dp
-      if (self%sa(cc) > 0) x(self%sa(cc)) = -1.0_dp
-      if (self%sb(cc) > 0) x(self%sb(cc)) = 1.0_dp
-      call kkt_constraints(self, mm, [0], 0)      ! the fixed nodes pinned
-      call solve_symmetric_indefinite(mm, x, rc, st, msg)
-      effective_mass = 0.0_dp
-      if (st /= MARTELLO_OK) return
-      rc = 0.0_dp
-      if (self%sb(cc) > 0) rc = rc + x(self%sb(cc))
-      if (self%sa(cc) > 0) rc = rc - x(self%sa(cc))
-      if (rc > 0.0_dp) effective_mass = 1.0_dp/rc
-   end function effective_mass
 
    !> a from M a = f_ext − fint + Bᵀλ with B a = 0 on the persistent contacts (their λ the
    !> contact forces of the state).
