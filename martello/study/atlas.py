@@ -50,7 +50,7 @@ from ..binding import native
 from ..errors import StudyError
 from ..history import history_dict
 from ..oracles.p2_bouncing import bouncing_oscillator_restitution
-from ..paths import REPO
+from ..paths import OUTPUT_ROOT, REPO
 from ..reference.closed_form import kelvin_bounce_reference, two_body_kelvin_reference
 from ..scene.spec import ADAPTIVE, INTEGRATORS
 from .outcome import status_class
@@ -452,7 +452,7 @@ def _markdown(atlas, rows, bounds, pngs, elapsed, path):
 
 def main(args):
     atlas = load_atlas(args.study)
-    out = Path(args.output) if args.output else (REPO / atlas["output"] if atlas["output"]
+    out = Path(args.output) if args.output else (OUTPUT_ROOT / atlas["output"] if atlas["output"]
                                                  else Path("out") / "studies" / Path(args.study).stem)
     rows, bounds = run_atlas(atlas, out, jobs=getattr(args, "jobs", 0) or 0)
     counts = {}

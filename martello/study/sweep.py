@@ -25,7 +25,7 @@ from ..batch import run_specs
 from ..binding import native
 from ..errors import MartelloError, SceneError
 from ..metrics.score import COST_KEYS, cost, score
-from ..paths import REPO
+from ..paths import OUTPUT_ROOT, REPO
 from ..reference.selection import reference_for_scene
 from ..scene.loader import from_dict
 from ..scene.spec import ADAPTIVE
@@ -367,7 +367,7 @@ def run_study(study, outdir, jobs=0, plots=True, stream=sys.stderr):
 def main(args):
     path = Path(args.study)
     study = load_study(path)
-    out = Path(args.output) if args.output else (REPO / study.output if study.output
+    out = Path(args.output) if args.output else (OUTPUT_ROOT / study.output if study.output
                                                  else Path("out") / "studies" / path.stem)
     rows, order_rows = run_study(study, out, jobs=getattr(args, "jobs", 0) or 0)
     counts = {}
