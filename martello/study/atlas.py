@@ -54,7 +54,7 @@ from ..paths import OUTPUT_ROOT, REPO
 from ..reference.closed_form import kelvin_bounce_reference, two_body_kelvin_reference
 from ..scene.spec import ADAPTIVE, INTEGRATORS
 from .outcome import status_class
-from .output import Progress, csv_cell, palette_png, slug
+from .output import Progress, csv_cell, md_cell, palette_png, slug
 from .study_file import read_toml
 CLASSES = ("accurate", "inaccurate", "unstable", "failed", "unavailable", "no reference")
 CLASS_COLORS = {"accurate": "#2ca02c", "inaccurate": "#ffd92f", "unstable": "#d62728",
@@ -440,11 +440,11 @@ def _markdown(atlas, rows, bounds, pngs, elapsed, path):
              "| map | method | y | largest stable Δt/Δt_crit | smallest unstable | largest accurate |",
              "|---|---|---|---|---|---|"]
     for b in bounds:
-        lines.append(f"| {b['map']} | {b['method']} | {b['y']:g} | {b['largest_stable_ratio']:g} | "
+        lines.append(f"| {md_cell(b['map'])} | {md_cell(b['method'])} | {b['y']:g} | {b['largest_stable_ratio']:g} | "
                      f"{b['smallest_unstable_ratio']:g} | {b['largest_accurate_ratio']:g} |")
     lines += ["", "| method | " + " | ".join(CLASSES) + " |", "|---|" + "---|" * len(CLASSES)]
     for m in atlas["methods"]:
-        lines.append(f"| {m['label']} | " + " | ".join(str(counts.get((m["label"], c), 0)) for c in CLASSES) + " |")
+        lines.append(f"| {md_cell(m['label'])} | " + " | ".join(str(counts.get((m["label"], c), 0)) for c in CLASSES) + " |")
     for p in pngs:
         lines += ["", f"![{p.stem}]({p.name})"]
     path.write_text("\n".join(lines) + "\n")

@@ -31,7 +31,7 @@ from ..scene.loader import from_dict
 from ..scene.spec import ADAPTIVE
 from ..scene.variants import analysis_for, runnable_scene
 from .outcome import status_class
-from .output import Progress, csv_cell, palette_png, slug
+from .output import Progress, csv_cell, md_cell, palette_png, slug
 from .study_file import load_study
 
 
@@ -313,7 +313,8 @@ def _markdown(study, rows, order_rows, refs, notes, pngs, elapsed, path):
     lines += ["| case | method | metric | measured order | theory | points fitted | runs ok/all | smallest error | not ok |",
               "|---|---|---|---|---|---|---|---|---|"]
     for o in order_rows:
-        lines.append(f"| {o['case']} | {o['method']} | {o['metric']} ({o['against']}) | "
+        lines.append(f"| {md_cell(o['case'])} | {md_cell(o['method'])} | "
+                     f"{md_cell(o['metric'])} ({md_cell(o['against'])}) | "
                      f"{o['order']:.2f} | {o['theoretical']:g} | {o['points_fitted']} | "
                      f"{o['runs_ok']}/{o['runs']} | {o['min_error']:.2e} | {o['not_ok']} |"
                      .replace("nan", "–"))
