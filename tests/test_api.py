@@ -58,13 +58,6 @@ def test_unknown_attribute_is_an_attribute_error():
         martello.nope
 
 
-def test_version_is_the_packages_and_the_librarys():
-    from importlib.metadata import version
-    from martello.binding import native
-    assert martello.__version__ == version("martello") == native.version()
-    assert re.fullmatch(r"\d+\.\d+\.\d+", martello.__version__)
-
-
 def test_load_a_file_or_a_catalogue_path(tmp_path, monkeypatch):
     s = martello.load(P2)
     assert isinstance(s, martello.Scene) and s.title.startswith("P2")
