@@ -52,11 +52,8 @@ def load(path):
     ``path`` is a file, or a path inside the catalogue such as ``"p2/p2_restitution_e08.toml"``
     (found in benchmarks/ of the checkout or of the installed package) when no such file
     exists where you are. Errors (SceneError) name the file, the field and the fix."""
-    p = Path(path)
-    if not p.exists() and not p.is_absolute():
-        for base in (_catalogue.ROOT, _catalogue.ROOT.parent):
-            if (base / p).is_file():
-                return Scene.load(base / p)
+    p = _catalogue.find(path)
+    if not p.exists():
         raise SceneError(p, "(file)", "does not exist here nor in the catalogue",
                          "give a scene file, or a catalogue path such as "
                          "p2/p2_restitution_e08.toml (martello.catalogue() lists them)")

@@ -44,7 +44,7 @@ def cmd_list(args):
 def cmd_run(args):
     from .checks.measures import run_measured
     from .run import write_results
-    s = load(args.scene)
+    s = load(catalogue.find(args.scene))   # a file, or a path in the catalogue
     summary, history = run_measured(s)     # with the problem's measures (P4), as check does
     out = Path(args.output) if args.output else Path("out") / Path(args.scene).stem
     path = write_results(summary, out, history)
@@ -69,7 +69,7 @@ def cmd_compare(args):
 
 def cmd_check(args):
     from .report import check_catalogue
-    files = [Path(p) for p in args.scenes] if args.scenes else catalogue.scene_files()
+    files = [catalogue.find(p) for p in args.scenes] if args.scenes else catalogue.scene_files()
     # a scene named on the command line must have something to verify
     ok = check_catalogue(files, Path(args.output), plots=not args.no_plots,
                          require_checks=bool(args.scenes))

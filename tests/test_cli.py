@@ -94,6 +94,16 @@ def test_list_into_a_closed_pipe_stops_quietly(unbuffered):
     assert r.returncode == 141                # 128 + SIGPIPE, as a tool killed by it
 
 
+def test_run_and_check_take_the_paths_list_prints_from_any_folder(tmp_path):
+    r = martello("run", "benchmarks/p1/p1_static_lagrange.toml", "-o", tmp_path / "p1", cwd=tmp_path)
+    assert r.returncode == 0, r.stderr
+    assert json.loads((tmp_path / "p1" / "summary.json").read_text())["status"] == "MARTELLO_OK"
+    r = martello("check", "p1/p1_static_lagrange.toml", "-o", tmp_path / "c", "--no-plots", cwd=tmp_path)
+    assert r.returncode == 0 and "0 failure(s)" in r.stdout, r.stdout
+    r = martello("run", "p1/nope.toml", cwd=tmp_path)
+    assert r.returncode == 1 and "p1/nope.toml: (file): does not exist" in r.stderr
+
+
 def test_check_a_scene_with_nothing_to_verify_fails(tmp_path):
     bare = tmp_path / "bare.toml"
     bare.write_text(P1.read_text().split("[check]")[0])

@@ -11,6 +11,7 @@ test's environment through a .pth line, while pip installs the wheel alone (--no
 --no-index): no network, and nothing of the checkout on its path."""
 
 import csv
+import json
 import os
 import subprocess
 import sys
@@ -94,6 +95,12 @@ def test_the_installed_package_uses_its_own_library_and_data(venv, tmp_path):
     assert Path(lib) == site / "martello" / "_native" / "lib" / "libmartello.so"
     assert Path(data) == site / "martello" / "data"
     assert version == native.version() and status == "MARTELLO_OK"
+    # the paths `martello list` prints name the installed catalogue from any folder
+    listed = sh(venv / "bin" / "martello", "list", cwd=tmp_path, env=clean_env()).split()
+    assert "benchmarks/p2/p2_restitution_e08.toml" in listed
+    sh(venv / "bin" / "martello", "run", "benchmarks/p2/p2_restitution_e08.toml", "-o", "p2",
+       cwd=tmp_path, env=clean_env())
+    assert json.loads((tmp_path / "p2" / "summary.json").read_text())["status"] == "MARTELLO_OK"
 
 
 def test_the_installed_check_verifies_every_reference(venv, tmp_path):
