@@ -28,14 +28,12 @@ from pathlib import Path
 
 import numpy as np
 
-from .checks.measures import run_measured
-from .compare import compare as _compare_history
 from .errors import MartelloError, SceneError
-from .reference.base import ReferenceError
-from .reference.selection import reference_for_scene
-from .run import write_results
 from .scene import catalogue as _catalogue
 from .scene.loader import Scene
+
+# The run layer (the native library), the checks, the references and compare (scipy) are
+# imported by the functions that need them: martello.load and martello.Scene stay light.
 
 __all__ = ["Result", "Scene", "catalogue", "compare", "load", "reference", "run"]
 
@@ -114,6 +112,7 @@ class Result:
     def write(self, folder):
         """Write summary.json (and history.csv) into folder, as ``martello run -o folder``;
         returns the path of summary.json."""
+        from .run import write_results
         history = (list(self.columns), self.data) if self.columns else None
         return write_results(self.summary, Path(folder), history)
 
@@ -130,6 +129,7 @@ def run(scene):
     the problem's measures (P4) included. A failed run (diverged, unstable, not converged)
     raises SolverError, with the library's message; nothing is returned as if it were a
     result."""
+    from .checks.measures import run_measured
     s = _scene(scene)
     summary, history = run_measured(s)
     return Result(s, summary, history)
@@ -143,6 +143,8 @@ def reference(scene, spec=None):
 
     ``ref.at(t, columns)`` evaluates it at times t; ``ref.trusted_digits()`` says how far it
     can be trusted. Raises ReferenceError if the scene has none."""
+    from .reference.base import ReferenceError
+    from .reference.selection import reference_for_scene
     s = _scene(scene)
     ref = reference_for_scene(s, spec=spec)
     if ref is None:
@@ -159,6 +161,7 @@ def compare(history, against):
     ``history`` is a CSV file in the documented format, or a ``Result`` (written to a
     temporary CSV first, so it is read exactly as a file would be); ``against`` is a scene
     file or catalogue path, or a Scene loaded from a file."""
+    from .compare import compare as _compare_history
     if isinstance(against, Scene):
         against = against.source
     if not isinstance(against, (str, Path)) or not Path(against).is_file():
