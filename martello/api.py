@@ -2,8 +2,8 @@
 notebook, on scenes given as files, catalogue names or dicts.
 
 ``import martello`` stays cheap: martello/__init__.py makes these names attributes of the
-package lazily, and this module (which loads numpy, scipy and the native library) is imported
-the first time one of them is used.
+package lazily; this module is imported the first time one of them is used, and each function
+imports what it needs (the run layer, the checks, scipy) when it is first called.
 
 * ``load(path)``, ``Scene.from_dict(d)``: a validated Scene;
 * ``run(scene) -> Result``: the summary (a dict, what summary.json holds) and the history
