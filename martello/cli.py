@@ -2,6 +2,7 @@
 
 import argparse
 import json
+import os
 import sys
 from pathlib import Path
 
@@ -43,7 +44,7 @@ def cmd_list(args):
 def cmd_run(args):
     from .checks.measures import run_measured
     from .run import write_results
-    s = load(args.scene)
+    s = load(catalogue.find(args.scene))   # a file, or a path in the catalogue
     summary, history = run_measured(s)     # with the problem's measures (P4), as check does
     out = Path(args.output) if args.output else Path("out") / Path(args.scene).stem
     path = write_results(summary, out, history)
@@ -68,8 +69,10 @@ def cmd_compare(args):
 
 def cmd_check(args):
     from .report import check_catalogue
-    files = [Path(p) for p in args.scenes] if args.scenes else catalogue.scene_files()
-    ok = check_catalogue(files, Path(args.output), plots=not args.no_plots)
+    files = [catalogue.find(p) for p in args.scenes] if args.scenes else catalogue.scene_files()
+    # a scene named on the command line must have something to verify
+    ok = check_catalogue(files, Path(args.output), plots=not args.no_plots,
+                         require_checks=bool(args.scenes))
     return 0 if ok else 1
 
 
@@ -137,10 +140,18 @@ def main(argv=None):
         parser.print_help()
         return 2
     try:
-        return args.func(args)
+        code = args.func(args)
+        sys.stdout.flush()       # here, not at exit: a reader that went away shows below
+        return code
     except MartelloError as exc:
         print(f"martello: error: {exc}", file=sys.stderr)
         return 1
+    except BrokenPipeError:
+        # the reader went away (`martello list | head`): stop quietly, as a tool killed by
+        # SIGPIPE does (exit 128 + 13); stdout goes to devnull so that the flush at exit
+        # cannot fail again (Python docs, signal module, "Note on SIGPIPE")
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        return 141
 
 
 if __name__ == "__main__":

@@ -12,6 +12,8 @@ from .checks.measures import run_measured
 from .checks.reference_data import verify_reference_data
 from .checks.verify import verify
 from .errors import MartelloError
+from .paths import REPO
+from .reference.store import manifest
 from .run import write_results
 from .scene.loader import load
 
@@ -20,7 +22,12 @@ def _fmt(x):
     return f"{x:.10g}" if isinstance(x, float) else str(x)
 
 
-def check_catalogue(files, outdir, plots=True, stream=sys.stdout):
+def check_catalogue(files, outdir, plots=True, stream=sys.stdout, require_checks=False):
+    """Run and verify the scene files; print the table, write the report; True if nothing
+    failed. A scene with nothing to verify (no [check] table, no stored reference data) is
+    listed as "ran, not verified"; it is a failure if require_checks (scenes named on the
+    command line) or if reference/references.toml lists reference data for it that are
+    missing (an installation without its data must not pass as verified)."""
     outdir.mkdir(parents=True, exist_ok=True)
     rows, failures, t_start = [], [], time.perf_counter()
     print(f"martello {native.version()} ({native.library_versions()})", file=stream)
@@ -38,6 +45,15 @@ def check_catalogue(files, outdir, plots=True, stream=sys.stdout):
             if history is not None:
                 rows_here += verify_reference_data(s, summary, history)
             if not rows_here:
+                missing = _missing_reference_data(path)
+                if missing:
+                    failures.append(f"{path}: its reference data {missing} are missing "
+                                    "(reinstall martello, or rebuild them with "
+                                    "scripts/regenerate_reference)")
+                elif require_checks:
+                    failures.append(f"{path}: nothing to verify: no [check] table "
+                                    "(docs/scene-format.md) and no stored reference data for its "
+                                    "physics; `martello run` runs a scene without verifying it")
                 print(f"{s.title[:44]:<44} (no closed form or reference data: ran, not verified)",
                       file=stream)
                 continue
@@ -69,6 +85,16 @@ def check_catalogue(files, outdir, plots=True, stream=sys.stdout):
     for f in failures:
         print(f"  FAILED {f}", file=stream)
     return not failures
+
+
+def _missing_reference_data(path):
+    """The folder of the reference data references.toml lists for this scene file as is
+    (no contact override), if they are not there; else None."""
+    for e in manifest():
+        if not e.get("contact") and (REPO / e["scene"]).resolve() == Path(path).resolve() \
+                and not (e["folder"] / "reference.json").is_file():
+            return e["folder"]
+    return None
 
 
 def _write_csv(rows, path):

@@ -1,9 +1,12 @@
 """The command line: run, list, check, help, and non-zero exit codes on every error."""
 
 import json
+import os
 import subprocess
 import sys
 from pathlib import Path
+
+import pytest
 
 ROOT = Path(__file__).resolve().parent.parent
 P1 = ROOT / "benchmarks" / "p1" / "p1_static_lagrange.toml"
@@ -71,3 +74,61 @@ def test_check_fails_on_a_wrong_reference(tmp_path):
     r = martello("check", wrong, "-o", tmp_path / "report", "--no-plots")
     assert r.returncode == 1
     assert "FAIL" in r.stdout
+
+
+@pytest.mark.parametrize("unbuffered", ["1", None])
+def test_list_into_a_closed_pipe_stops_quietly(unbuffered):
+    # `martello list | head`: the reader is gone before the first line; with stdout
+    # unbuffered the first print fails, buffered the flush does: neither is a traceback
+    read, write = os.pipe()
+    os.close(read)
+    env = {k: v for k, v in os.environ.items() if k != "PYTHONUNBUFFERED"}
+    if unbuffered:
+        env["PYTHONUNBUFFERED"] = unbuffered
+    try:
+        r = subprocess.run([sys.executable, "-m", "martello", "list"], stdout=write,
+                           stderr=subprocess.PIPE, text=True, cwd=ROOT, env=env, timeout=120)
+    finally:
+        os.close(write)
+    assert r.stderr == ""
+    assert r.returncode == 141                # 128 + SIGPIPE, as a tool killed by it
+
+
+def test_run_and_check_take_the_paths_list_prints_from_any_folder(tmp_path):
+    r = martello("run", "benchmarks/p1/p1_static_lagrange.toml", "-o", tmp_path / "p1", cwd=tmp_path)
+    assert r.returncode == 0, r.stderr
+    assert json.loads((tmp_path / "p1" / "summary.json").read_text())["status"] == "MARTELLO_OK"
+    r = martello("check", "p1/p1_static_lagrange.toml", "-o", tmp_path / "c", "--no-plots", cwd=tmp_path)
+    assert r.returncode == 0 and "0 failure(s)" in r.stdout, r.stdout
+    r = martello("run", "p1/nope.toml", cwd=tmp_path)
+    assert r.returncode == 1 and "p1/nope.toml: (file): does not exist" in r.stderr
+
+
+def test_check_a_scene_with_nothing_to_verify_fails(tmp_path):
+    bare = tmp_path / "bare.toml"
+    bare.write_text(P1.read_text().split("[check]")[0])
+    r = martello("check", bare, "-o", tmp_path / "report", "--no-plots")
+    assert r.returncode == 1
+    assert "ran, not verified" in r.stdout
+    assert f"FAILED {bare}: nothing to verify: no [check] table" in r.stdout
+
+
+def test_check_fails_when_listed_reference_data_are_missing(tmp_path, monkeypatch):
+    # an installation without its reference data must not pass as verified
+    import io
+    import shutil
+    from martello import report
+    from martello.reference import store
+    shutil.copytree(ROOT / "reference", tmp_path / "reference")
+    (tmp_path / "reference" / "p7_two_oscillators" / "reference.json").unlink()
+    real = store.manifest
+    for module in (store, report):
+        monkeypatch.setattr(module, "manifest", lambda root=None: real(tmp_path / "reference"))
+    out = io.StringIO()
+    p7 = ROOT / "benchmarks" / "p7" / "p7_two_oscillators.toml"
+    assert report.check_catalogue([p7], tmp_path / "out", plots=False, stream=out) is False
+    assert "p7_two_oscillators are missing (reinstall martello" in out.getvalue()
+    # with the data there, the same call verifies the scene
+    for module in (store, report):
+        monkeypatch.setattr(module, "manifest", real)
+    assert report.check_catalogue([p7], tmp_path / "out2", plots=False, stream=io.StringIO())

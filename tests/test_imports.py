@@ -99,14 +99,16 @@ def test_the_cycle_finder_finds_a_cycle():
 
 # The layers of the package (martello/__init__.py), bottom up: a module imports modules of
 # its own unit (subpackage or top-level module) or of a lower layer, never of a higher one.
-LAYERS = [("martello", "martello.errors", "martello.paths", "martello.history"),
-          ("martello.binding", "martello.oracles"),
+# The package's own __init__ ("martello") is its face: it gives the API's names lazily
+# (PEP 562), so it sits on top; test_import_martello_loads_nothing_else keeps it cheap.
+LAYERS = [("martello.errors", "martello.paths", "martello.history"),
+          ("martello.binding", "martello.oracles"), ("martello.closed_forms",),
           ("martello.scene", "martello.ground_motion"),
           ("martello.run",), ("martello.batch",),
           ("martello.metrics",), ("martello.reference",),
           ("martello.checks",),
           ("martello.study", "martello.compare", "martello.report"),
-          ("martello.cli",), ("martello.__main__",)]
+          ("martello.api",), ("martello.cli",), ("martello.__main__", "martello")]
 
 
 def unit(module):
@@ -133,6 +135,14 @@ def loaded_after(module):
                         "print(' '.join(m for m in sys.modules if m.startswith('martello')))"],
                        cwd=ROOT, capture_output=True, text=True, check=True)
     return set(r.stdout.split())
+
+
+def test_import_martello_loads_nothing_else():
+    # `import martello` is cheap: the API's names load on first use (martello/__init__.py)
+    r = subprocess.run([sys.executable, "-c", "import sys, martello; print(' '.join(sorted("
+                        "m for m in sys.modules if m.startswith(('martello', 'numpy', 'scipy', "
+                        "'ctypes')))))"], cwd=ROOT, capture_output=True, text=True, check=True)
+    assert r.stdout.split() == ["martello"]
 
 
 def test_oracles_know_no_solver():

@@ -5,6 +5,7 @@ studies (benchmarks/studies/) are run by the CLI, not here."""
 import csv
 import io
 import math
+import re
 import subprocess
 import sys
 from pathlib import Path
@@ -14,7 +15,7 @@ import pytest
 
 from martello.errors import MartelloError
 from martello.study.outcome import status_class
-from martello.study.output import Progress
+from martello.study.output import Progress, md_cell
 from martello.study.study_file import _sweep, load_study
 from martello.study.sweep import fit_order, snap_step
 
@@ -63,6 +64,16 @@ def martello(*args):
                           capture_output=True, text=True, timeout=300)
 
 
+def table_cells(line):
+    """The cells of a Markdown table row: split at every | that is not escaped as \\|."""
+    return [c.strip() for c in re.split(r"(?<!\\)\|", line.strip())[1:-1]]
+
+
+def test_md_cell_keeps_a_table_row_one_row():
+    row = f"| {md_cell('a | b')} | {md_cell('two' + chr(10) + 'lines')} |"
+    assert table_cells(row) == [r"a \| b", "two lines"]
+
+
 def test_tiny_study_end_to_end(tmp_path):
     r = martello("study", write(tmp_path, TINY), "-o", tmp_path / "out", "-j", "2")
     assert r.returncode == 0, r.stderr
@@ -91,7 +102,12 @@ def test_tiny_study_end_to_end(tmp_path):
                for o in orders)
     pngs = list((tmp_path / "out").glob("*.png"))
     assert len(pngs) == 2 and all(p.stat().st_size > 10000 for p in pngs)
-    assert "measured order" in (tmp_path / "out" / "study.md").read_text()
+    md = (tmp_path / "out" / "study.md").read_text()
+    assert "measured order" in md
+    # the case labels are "linear | penalty linear": each table row keeps the header's cells
+    table = [ln for ln in md.splitlines() if ln.startswith("|")]
+    assert len(table) >= 4 and all(len(table_cells(ln)) == 9 for ln in table), table
+    assert any(table_cells(ln)[0] == r"linear \| penalty linear" for ln in table)
     assert "/10 runs" in r.stderr            # the progress bar
     assert "p = " in r.stdout
 

@@ -1,15 +1,10 @@
-!> P3 (two bars, static contact) through the Fortran modules, checked against the closed form
-!> of PROBLEMS.md P3 coded here independently, for Lagrange, penalty and augmented Lagrange,
-!> and with every segment refined into 1, 2, 8 and 64 elements (linear FE is nodally exact
-!> for point loads, so the coarse nodes must not move). Stops with a non-zero code on failure.
+!> P3 (two bars, static contact) through the Fortran module `martello` (fortran/martello.f90),
+!> checked against the closed form of docs/problems.md P3 coded here independently, for Lagrange,
+!> penalty and augmented Lagrange, and with every segment refined into 1, 2, 8 and 64
+!> elements (linear FE is nodally exact for point loads, so the coarse nodes must not move).
+!> Stops with a non-zero code on failure.
 program p3_static
-   use martello_kinds, only: dp
-   use martello_status, only: MARTELLO_OK
-   use martello_model
-   use martello_statics, only: static_result_t, static_solve
-   use martello_links, only: LINK_BAR, NPAR_LINK, L_STIFF
-   use martello_contact_laws, only: NPAR_CONTACT, P_STIFF, LAW_LINEAR
-   use martello_time_functions, only: TF_CONSTANT, NPAR_TF
+   use martello
    implicit none
    real(dp), parameter :: r = 2.1e7_dp, d = 1.0e-3_dp, f = 5.0e4_dp, eps = 100.0_dp*r
    integer :: ne, refinements(4) = [1, 2, 8, 64], i, failures = 0, checks = 0

@@ -15,19 +15,19 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import MartelloError, SolverError, DivergenceError
-
-_REPO = Path(__file__).resolve().parents[2]
+from ..paths import LIBRARIES
 _DOUBLE_P = np.ctypeslib.ndpointer(dtype=np.float64, flags="C_CONTIGUOUS")
 _INT_P = np.ctypeslib.ndpointer(dtype=np.int32, flags="C_CONTIGUOUS")
 _VOID_P = ctypes.c_void_p
 
 
 def library_path():
-    """MARTELLO_LIB if set, else the CMake build tree of this checkout."""
+    """MARTELLO_LIB if set, else the installed package's library, else the CMake build tree
+    of this checkout (martello.paths.LIBRARIES)."""
     env = os.environ.get("MARTELLO_LIB")
     if env:
         return Path(env)
-    return _REPO / "build" / "libmartello.so"
+    return next((p for p in LIBRARIES if p.exists()), LIBRARIES[-1])
 
 
 @lru_cache(maxsize=None)

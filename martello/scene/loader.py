@@ -43,6 +43,22 @@ class Scene:
     def node_index(self, name):
         return -1 if name == GROUND else self.index[name]
 
+    @classmethod
+    def from_dict(cls, data, base_dir=".", source="<scene>"):
+        """A validated scene from a dict shaped like the scene file's tables
+        (docs/scene-format.md), e.g. the parsed TOML; record files named in it are relative
+        to base_dir. The dict is not modified."""
+        if not isinstance(data, dict):
+            raise SceneError(source, "(scene)", f"is a {type(data).__name__}",
+                             "give a dict of the scene file's tables: node, link, contact, "
+                             "loads, analysis (docs/scene-format.md)")
+        return from_dict(data, source=source, base_dir=Path(base_dir))
+
+    @classmethod
+    def load(cls, path):
+        """A validated scene from its TOML file (the same as martello.load)."""
+        return load(path)
+
 
 # --- helpers ---------------------------------------------------------------------------------
 

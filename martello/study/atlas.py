@@ -50,11 +50,11 @@ from ..binding import native
 from ..errors import StudyError
 from ..history import history_dict
 from ..oracles.p2_bouncing import bouncing_oscillator_restitution
-from ..paths import REPO
+from ..paths import OUTPUT_ROOT, REPO
 from ..reference.closed_form import kelvin_bounce_reference, two_body_kelvin_reference
 from ..scene.spec import ADAPTIVE, INTEGRATORS
 from .outcome import status_class
-from .output import Progress, csv_cell, palette_png, slug
+from .output import Progress, csv_cell, md_cell, palette_png, slug
 from .study_file import read_toml
 CLASSES = ("accurate", "inaccurate", "unstable", "failed", "unavailable", "no reference")
 CLASS_COLORS = {"accurate": "#2ca02c", "inaccurate": "#ffd92f", "unstable": "#d62728",
@@ -440,11 +440,11 @@ def _markdown(atlas, rows, bounds, pngs, elapsed, path):
              "| map | method | y | largest stable Δt/Δt_crit | smallest unstable | largest accurate |",
              "|---|---|---|---|---|---|"]
     for b in bounds:
-        lines.append(f"| {b['map']} | {b['method']} | {b['y']:g} | {b['largest_stable_ratio']:g} | "
+        lines.append(f"| {md_cell(b['map'])} | {md_cell(b['method'])} | {b['y']:g} | {b['largest_stable_ratio']:g} | "
                      f"{b['smallest_unstable_ratio']:g} | {b['largest_accurate_ratio']:g} |")
     lines += ["", "| method | " + " | ".join(CLASSES) + " |", "|---|" + "---|" * len(CLASSES)]
     for m in atlas["methods"]:
-        lines.append(f"| {m['label']} | " + " | ".join(str(counts.get((m["label"], c), 0)) for c in CLASSES) + " |")
+        lines.append(f"| {md_cell(m['label'])} | " + " | ".join(str(counts.get((m["label"], c), 0)) for c in CLASSES) + " |")
     for p in pngs:
         lines += ["", f"![{p.stem}]({p.name})"]
     path.write_text("\n".join(lines) + "\n")
@@ -452,7 +452,7 @@ def _markdown(atlas, rows, bounds, pngs, elapsed, path):
 
 def main(args):
     atlas = load_atlas(args.study)
-    out = Path(args.output) if args.output else (REPO / atlas["output"] if atlas["output"]
+    out = Path(args.output) if args.output else (OUTPUT_ROOT / atlas["output"] if atlas["output"]
                                                  else Path("out") / "studies" / Path(args.study).stem)
     rows, bounds = run_atlas(atlas, out, jobs=getattr(args, "jobs", 0) or 0)
     counts = {}

@@ -44,6 +44,13 @@ def csv_cell(v):
     return v
 
 
+def md_cell(text):
+    """Text for one cell of a Markdown table: a | would end the cell (a case label is
+    "scene | scheme"), so it is escaped as \\|, which GitHub-flavoured Markdown shows as |
+    (GFM spec, "Tables"); a line break would end the row, so it becomes a space."""
+    return str(text).replace("|", "\\|").replace("\r", " ").replace("\n", " ")
+
+
 def slug(text):
     keep = "".join(ch if ch.isalnum() else "_" for ch in text.lower())
     while "__" in keep:

@@ -25,13 +25,13 @@ from ..batch import run_specs
 from ..binding import native
 from ..errors import MartelloError, SceneError
 from ..metrics.score import COST_KEYS, cost, score
-from ..paths import REPO
+from ..paths import OUTPUT_ROOT, REPO
 from ..reference.selection import reference_for_scene
 from ..scene.loader import from_dict
 from ..scene.spec import ADAPTIVE
 from ..scene.variants import analysis_for, runnable_scene
 from .outcome import status_class
-from .output import Progress, csv_cell, palette_png, slug
+from .output import Progress, csv_cell, md_cell, palette_png, slug
 from .study_file import load_study
 
 
@@ -313,7 +313,8 @@ def _markdown(study, rows, order_rows, refs, notes, pngs, elapsed, path):
     lines += ["| case | method | metric | measured order | theory | points fitted | runs ok/all | smallest error | not ok |",
               "|---|---|---|---|---|---|---|---|---|"]
     for o in order_rows:
-        lines.append(f"| {o['case']} | {o['method']} | {o['metric']} ({o['against']}) | "
+        lines.append(f"| {md_cell(o['case'])} | {md_cell(o['method'])} | "
+                     f"{md_cell(o['metric'])} ({md_cell(o['against'])}) | "
                      f"{o['order']:.2f} | {o['theoretical']:g} | {o['points_fitted']} | "
                      f"{o['runs_ok']}/{o['runs']} | {o['min_error']:.2e} | {o['not_ok']} |"
                      .replace("nan", "–"))
@@ -367,7 +368,7 @@ def run_study(study, outdir, jobs=0, plots=True, stream=sys.stderr):
 def main(args):
     path = Path(args.study)
     study = load_study(path)
-    out = Path(args.output) if args.output else (REPO / study.output if study.output
+    out = Path(args.output) if args.output else (OUTPUT_ROOT / study.output if study.output
                                                  else Path("out") / "studies" / path.stem)
     rows, order_rows = run_study(study, out, jobs=getattr(args, "jobs", 0) or 0)
     counts = {}

@@ -1,0 +1,182 @@
+"""The Python API (docs/python-api.md): what the command line does, from a script or a
+notebook, on scenes given as files, catalogue names or dicts.
+
+``import martello`` stays cheap: martello/__init__.py makes these names attributes of the
+package lazily; this module is imported the first time one of them is used, and each function
+imports what it needs (the run layer, the checks, scipy) when it is first called.
+
+* ``load(path)``, ``Scene.from_dict(d)``: a validated Scene;
+* ``run(scene) -> Result``: the summary (a dict, what summary.json holds) and the history
+  (numpy arrays, ``Result.dataframe()`` with pandas);
+* ``reference(scene)``: the Reference the scene is scored against;
+* ``compare(history, against)``: another code's history scored against a scene's reference,
+  as ``martello compare`` does;
+* ``catalogue()``: the catalogue's scene files.
+
+(``martello.closed_forms``, the oracles by name, is a module of its own: martello/closed_forms.py.)
+
+``martello.run``, ``martello.reference`` and ``martello.compare`` are also the names of the
+package's modules (martello/run.py, martello/reference/, martello/compare.py): the package
+gives back those modules made callable (martello/__init__.py), and a call goes to the
+function of the same name here, so ``martello.run(scene)`` runs a scene and
+``from martello.run import run_full`` keeps working."""
+
+from __future__ import annotations
+
+import tempfile
+from pathlib import Path
+
+import numpy as np
+
+from .errors import MartelloError, SceneError
+from .scene import catalogue as _catalogue
+from .scene.loader import Scene
+
+# The run layer (the native library), the checks, the references and compare (scipy) are
+# imported by the functions that need them: martello.load and martello.Scene stay light.
+
+__all__ = ["Result", "Scene", "catalogue", "compare", "load", "reference", "run"]
+
+
+def catalogue():
+    """The catalogue's scene files (benchmarks/, one problem variant each), sorted: the
+    paths ``martello list`` prints, absolute."""
+    return list(_catalogue.scene_files())
+
+
+def load(path):
+    """A validated Scene from a scene file (TOML, docs/scene-format.md).
+
+    ``path`` is a file, or a path inside the catalogue such as ``"p2/p2_restitution_e08.toml"``
+    (found in benchmarks/ of the checkout or of the installed package) when no such file
+    exists where you are. Errors (SceneError) name the file, the field and the fix."""
+    p = _catalogue.find(path)
+    if not p.exists():
+        raise SceneError(p, "(file)", "does not exist here nor in the catalogue",
+                         "give a scene file, or a catalogue path such as "
+                         "p2/p2_restitution_e08.toml (martello.catalogue() lists them)")
+    return Scene.load(p)
+
+
+def _scene(scene, what="scene"):
+    if isinstance(scene, Scene):
+        return scene
+    if isinstance(scene, dict):
+        return Scene.from_dict(scene)
+    if isinstance(scene, (str, Path)):
+        return load(scene)
+    raise MartelloError(f"{what}: a {type(scene).__name__} is not a scene (give a Scene, a scene "
+                        "file or catalogue path, or a dict of the scene's tables)")
+
+
+class Result:
+    """What ``martello.run`` gives back: the scene, its summary and its history.
+
+    ``summary`` is the dict ``martello run`` writes as summary.json (docs/results.md):
+    ``status``, ``nodes``, ``contacts``, ``energy``, ``cost``, ``provenance``, ...
+    For a dynamic run, ``columns`` names the history's columns (``t``, ``u:<node>``,
+    ``force:<contact>``, ... as in history.csv), ``data`` is the 2D array (one row per
+    sample) and ``history`` the same as {column: 1D array}; a static run has none."""
+
+    def __init__(self, scene, summary, history=None):
+        self.scene = scene
+        self.summary = summary
+        if history is None:
+            self.columns, self.data = (), np.empty((0, 0))
+        else:
+            self.columns, self.data = tuple(history[0]), np.asarray(history[1], float)
+
+    @property
+    def status(self):
+        """The run's status, e.g. ``MARTELLO_OK``."""
+        return self.summary["status"]
+
+    @property
+    def history(self):
+        """{column: 1D array} (views of ``data``); empty for a static run."""
+        return {c: self.data[:, i] for i, c in enumerate(self.columns)}
+
+    def dataframe(self):
+        """The history as a pandas DataFrame, one column per history column (``t``
+        included). Needs pandas (``pip install martello[pandas]``)."""
+        if not self.columns:
+            raise MartelloError(f"{self.scene.source}: a static run has no history (its values "
+                                "are in Result.summary['nodes'] and ['contacts'])")
+        try:
+            import pandas
+        except ImportError:
+            raise MartelloError("Result.dataframe() needs pandas: pip install pandas (the "
+                                "history is also in Result.history as numpy arrays)") from None
+        return pandas.DataFrame(self.data, columns=list(self.columns))
+
+    def write(self, folder):
+        """Write summary.json (and history.csv) into folder, as ``martello run -o folder``;
+        returns the path of summary.json."""
+        from .run import write_results
+        history = (list(self.columns), self.data) if self.columns else None
+        return write_results(self.summary, Path(folder), history)
+
+    def __repr__(self):
+        shape = f", {len(self.data)} samples x {len(self.columns)} columns" if self.columns else ""
+        return f"<martello.Result {self.scene.title!r}: {self.status}{shape}>"
+
+
+def run(scene):
+    """Run a scene's analysis; a ``Result``.
+
+    ``scene`` is a Scene, a scene file or catalogue path (see ``load``) or a dict of the
+    scene's tables (see ``Scene.from_dict``). The run is the one ``martello run`` makes,
+    the problem's measures (P4) included. A failed run (diverged, unstable, not converged)
+    raises SolverError, with the library's message; nothing is returned as if it were a
+    result."""
+    from .checks.measures import run_measured
+    s = _scene(scene)
+    summary, history = run_measured(s)
+    return Result(s, summary, history)
+
+
+def reference(scene, spec=None):
+    """The Reference a scene is scored against (martello.reference.base.Reference):
+    stored reference data for its physics (reference/references.toml), else the closed-form
+    history its ``[check]`` implies. ``spec`` names another, as a study's ``reference``
+    entry does: ``{"closed_form": NAME, "params": {...}}`` or ``{"data": "reference/<name>"}``.
+
+    ``ref.at(t, columns)`` evaluates it at times t; ``ref.trusted_digits()`` says how far it
+    can be trusted. Raises ReferenceError if the scene has none."""
+    from .reference.base import ReferenceError
+    from .reference.selection import reference_for_scene
+    s = _scene(scene)
+    ref = reference_for_scene(s, spec=spec)
+    if ref is None:
+        raise ReferenceError(f"{s.source}: no reference: no closed-form history ([check]) and no "
+                             "stored reference data for its physics (reference/references.toml)")
+    return ref
+
+
+def compare(history, against):
+    """Score a time history against a scene's reference, as ``martello compare HISTORY
+    --against SCENE`` does (docs/compare.md); the report dict that command writes with -o
+    (``score_scd``, ``metrics``, ``per_column``, ``checks``, ...).
+
+    ``history`` is a CSV file in the documented format, or a ``Result`` (written to a
+    temporary CSV first, so it is read exactly as a file would be); ``against`` is a scene
+    file or catalogue path, or a Scene loaded from a file."""
+    from .compare import compare as _compare_history
+    if isinstance(against, Scene):
+        against = against.source
+    if not isinstance(against, (str, Path)) or not Path(against).is_file():
+        try:
+            against = load(against).source
+        except (SceneError, TypeError):
+            raise MartelloError(f"compare: against = {against!r} is not a scene file (give the "
+                                "path of a scene file or a catalogue path; a scene made from a "
+                                "dict has none: write it as TOML)") from None
+    if isinstance(history, Result):
+        if not history.columns:
+            raise MartelloError("compare: a static run has no history to compare")
+        with tempfile.TemporaryDirectory() as tmp:
+            path = Path(tmp) / "history.csv"
+            np.savetxt(path, history.data, delimiter=",", header=",".join(history.columns),
+                       comments="", fmt="%.17g")
+            return _compare_history(path, against)
+    return _compare_history(history, against)
