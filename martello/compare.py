@@ -250,11 +250,12 @@ def comparable(columns, ref):
     return sorted(cols, key=lambda c: (order.get(c.partition(":")[0], 9), c))
 
 
-def compare(history_path, scene_path, columns=None, compute=True, stream=sys.stderr):
+def compare(history_path, scene_path, columns=None, compute=True, stream=None):
     """Score a history (a CSV, an OpenSees recorder file, or several of them: read_histories)
     against a scene's reference; returns the report dict. A scene with no closed form and no
     stored reference data gets one computed (or taken from the cache) unless compute is
     False (martello.reference.cache)."""
+    stream = stream or sys.stderr
     sc = load(scene_path)
     if sc.analysis.get("type") != "dynamic":
         raise MartelloError(f"{scene_path}: a static scene has no time history to compare with "

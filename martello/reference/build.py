@@ -121,15 +121,22 @@ def _run_levels(method, sdict, scene_path, scene, grid, store, label, jobs, stre
             raise MartelloError(f"{label}: reference run failed: {res[0].get('message')}")
         return levels, res
     dt = float(method["dt"])
-    if method["integrator"] in ADAPTIVE:
+    if method.get("refine") == "h_max":
+        # an adaptive method whose error is set by its largest step (kinks it does not
+        # locate, such as yield: docs/event-driven.md): refined in h_max, like a fixed step
+        h, rt = float(method["h_max"]), float(method["rtol"])
+        levels = [(dt, rt, h), (dt, rt, 2 * h), (dt, rt, 4 * h)]
+    elif method["integrator"] in ADAPTIVE:
         rt = float(method["rtol"])
         levels = [(dt, rt), (dt, rt * 100.0)]
     else:
         levels = [(dt, None), (2 * dt, None), (4 * dt, None)]
-    specs = [dict(_spec(method, sdict, scene_path, d_, r_, store, keep_output), id=i)
-             for i, (d_, r_) in enumerate(levels)]
+    specs = [dict(_spec(dict(method, h_max=lv[2]) if len(lv) > 2 else method, sdict, scene_path,
+                        lv[0], lv[1], store, keep_output), id=i)
+             for i, lv in enumerate(levels)]
     print(f"{label}: {method['integrator']} at "
-          + ", ".join(f"dt={d_:g}" + (f" rtol={r_:g}" if r_ else "") for d_, r_ in levels), file=stream)
+          + ", ".join(f"dt={lv[0]:g}" + (f" rtol={lv[1]:g}" if lv[1] else "")
+                      + (f" h_max={lv[2]:g}" if len(lv) > 2 else "") for lv in levels), file=stream)
     res = sorted(run_specs(specs, jobs), key=lambda r: r["id"])
     if any(r["status"] in ("MARTELLO_ERR_UNSUPPORTED", "incompatible") for r in res):
         print(f"  {method['integrator']}: not available ({res[0].get('message', '')[:80]}); next method",
@@ -187,6 +194,7 @@ def compute_reference(scene, sdict, scene_path, methods, store_every, label="ref
         digits[c] = min(15.0, -math.log10(d1 / scale)) if scale > 0 and d1 > 0 else 15.0
     for k, cz in enumerate(coarse):
         refinement.append({"level": k + 1, "dt": levels[k + 1][0], "rtol": levels[k + 1][1],
+                           **({"h_max": levels[k + 1][2]} if len(levels[k + 1]) > 2 else {}),
                            "max_rel_diff_u": max(float(np.max(np.abs(cz[c] - fine[c])) / max(np.max(np.abs(fine[c])), 1e-300))
                                                  for c in fine if c.startswith("u:"))})
     if len(refinement) >= 2 and refinement[0]["max_rel_diff_u"] > 0:
