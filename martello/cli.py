@@ -66,6 +66,11 @@ def cmd_compare(args):
     return compare.main(args)
 
 
+def cmd_plot(args):
+    from . import plot
+    return plot.main(args)
+
+
 def cmd_reference(args):
     from .reference import cache
     return cache.main(args)
@@ -120,6 +125,9 @@ def main(argv=None):
     p.add_argument("study", help="study file (TOML)")
     p.add_argument("-o", "--output", help="output folder (default: out/studies/<name>)")
     p.add_argument("-j", "--jobs", type=int, default=0, help="parallel runs (default: all cores)")
+    p.add_argument("--scheduler", metavar="ADDRESS", help="run on the Dask cluster whose scheduler "
+                   "is at ADDRESS (tcp://host:8786, or a scheduler file .json) instead of local "
+                   "processes (docs/studies.md)")
     p.set_defaults(func=cmd_study)
 
     p = sub.add_parser("compare", help="score another code's time history against a scene",
@@ -136,6 +144,19 @@ def main(argv=None):
                    "the sign); once per recorder file, in order (default: u of the scene's free nodes)")
     p.add_argument("-o", "--output", help="write the scores as JSON here")
     p.set_defaults(func=cmd_compare)
+
+    p = sub.add_parser("plot", help="pictures of a run or a study folder (PNG and SVG)",
+                       description="Plot a run folder (martello run: displacement and contact-force "
+                       "histories, phase portraits, force against penetration, hysteresis loops of "
+                       "the links it wrote, energy terms) or a study folder (martello study: error "
+                       "against the step and work-precision, per case). See docs/plot.md.")
+    p.add_argument("folder", help="a folder written by martello run or martello study")
+    p.add_argument("-o", "--output", help="folder for the pictures (default: FOLDER/plots)")
+    p.add_argument("--format", default="png,svg", help="png, svg or png,svg (default)")
+    p.add_argument("--nodes", help="nodes to plot, e.g. s1,s2 (default: the first six)")
+    p.add_argument("--contacts", help="contacts to plot (default: the first six)")
+    p.add_argument("--metric", help="study error to plot (default: max_rel_error)")
+    p.set_defaults(func=cmd_plot)
 
     p = sub.add_parser("reference", help="compute (or take from the cache) a scene's reference history",
                        description="Compute a reference history for any dynamic scene with the most "
