@@ -39,6 +39,9 @@ def _pyplot():
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
+    # SVG text stays text (searchable, editable, small); a fixed salt for its ids: the same
+    # history gives the same file
+    plt.rcParams.update({"svg.fonttype": "none", "svg.hashsalt": "martello"})
     return plt
 
 

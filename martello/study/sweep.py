@@ -329,10 +329,11 @@ def _markdown(study, rows, order_rows, refs, notes, pngs, elapsed, path):
     path.write_text("\n".join(lines) + "\n")
 
 
-def run_study(study, outdir, jobs=0, plots=True, stream=sys.stderr, executor=None, where=None):
+def run_study(study, outdir, jobs=0, plots=True, stream=None, executor=None, where=None):
     """Run a loaded study; write runs.csv, orders.csv, study.md and the plots in outdir.
     The runs go to local processes, or to `executor` (a Dask cluster's: study.cluster),
     described by `where`. Returns (rows, order_rows)."""
+    stream = stream or sys.stderr
     outdir = Path(outdir)
     outdir.mkdir(parents=True, exist_ok=True)
     t0 = time.perf_counter()
