@@ -106,7 +106,7 @@ LAYERS = [("martello", "martello.errors", "martello.paths", "martello.history"),
           ("martello.metrics",), ("martello.reference",),
           ("martello.checks",),
           ("martello.study", "martello.compare", "martello.report"),
-          ("martello.cli", "martello.plot"), ("martello.__main__",)]
+          ("martello.plot",), ("martello.cli",), ("martello.__main__",)]
 
 
 def unit(module):
