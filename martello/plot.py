@@ -56,6 +56,23 @@ def _save(fig, outdir, stem, formats):
     return paths
 
 
+def _panels(plt, n, width, height):
+    """A grid of n panels, three to a row: (figure, the n axes); unused cells are hidden."""
+    ncol = min(3, n)
+    nrow = math.ceil(n / ncol)
+    fig, axes = plt.subplots(nrow, ncol, figsize=(width * ncol, height * nrow + 0.8), squeeze=False)
+    flat = list(axes.ravel())
+    for ax in flat[n:]:
+        ax.axis("off")
+    return fig, flat[:n]
+
+
+def _finish(fig, title, outdir, stem, formats):
+    fig.suptitle(title, fontsize=10)
+    fig.tight_layout()
+    return _save(fig, outdir, stem, formats)
+
+
 def read_run_history(path):
     """history.csv of a run as (columns, {column: values}); NaN is allowed (link columns of
     an integrator that does not report links)."""
@@ -122,18 +139,13 @@ def plot_run(folder, outdir, formats=FORMATS, nodes=None, contacts=None, limit=6
     for ax in axes[:, 0]:
         ax.grid(True, alpha=0.3)
         ax.legend(fontsize=7, loc="best", ncol=2)
-    fig.suptitle(title, fontsize=10)
-    fig.tight_layout()
-    files += _save(fig, outdir, "histories", formats)
+    files += _finish(fig, title, outdir, "histories", formats)
 
     # phase portraits
     with_v = [n for n in node_sel if f"v:{n}" in h]
     if with_v:
-        ncol = min(3, len(with_v))
-        nrow = math.ceil(len(with_v) / ncol)
-        fig, axes = plt.subplots(nrow, ncol, figsize=(4.2 * ncol, 3.6 * nrow + 0.8), squeeze=False)
-        for k, n in enumerate(with_v):
-            ax = axes[k // ncol, k % ncol]
+        fig, axes = _panels(plt, len(with_v), 4.2, 3.6)
+        for ax, n in zip(axes, with_v):
             ax.plot(h[f"u:{n}"], h[f"v:{n}"], lw=0.9)
             ax.plot(h[f"u:{n}"][0], h[f"v:{n}"][0], "o", ms=4, color="k", label="t = 0")
             ax.ticklabel_format(style="sci", scilimits=(-2, 4), useMathText=True)
@@ -142,11 +154,7 @@ def plot_run(folder, outdir, formats=FORMATS, nodes=None, contacts=None, limit=6
             ax.set_title(f"phase portrait of {n}", fontsize=9)
             ax.grid(True, alpha=0.3)
             ax.legend(fontsize=7)
-        for k in range(len(with_v), nrow * ncol):
-            axes[k // ncol, k % ncol].axis("off")
-        fig.suptitle(title, fontsize=10)
-        fig.tight_layout()
-        files += _save(fig, outdir, "phase", formats)
+        files += _finish(fig, title, outdir, "phase", formats)
 
     # force against penetration, one line per contact phase (no line across the open gap)
     loops = [c for c in contact_sel if f"penetration:{c}" in h]
@@ -168,19 +176,14 @@ def plot_run(folder, outdir, formats=FORMATS, nodes=None, contacts=None, limit=6
             ax.set_title(f"{c}: {law.get('scheme', '')} {law.get('law') or ''}, "
                          f"{len(edges) // 2} contact phase(s)", fontsize=9)
             ax.grid(True, alpha=0.3)
-        fig.suptitle(title, fontsize=10)
-        fig.tight_layout()
-        files += _save(fig, outdir, "force_penetration", formats)
+        files += _finish(fig, title, outdir, "force_penetration", formats)
 
     # link force against elongation (hysteresis loops)
     links = [ln for ln in _names(columns, "link_force")
              if f"elongation:{ln}" in h and np.all(np.isfinite(h[f"link_force:{ln}"]))][:limit]
     if links:
-        ncol = min(3, len(links))
-        nrow = math.ceil(len(links) / ncol)
-        fig, axes = plt.subplots(nrow, ncol, figsize=(4.4 * ncol, 3.8 * nrow + 0.8), squeeze=False)
-        for k, ln in enumerate(links):
-            ax = axes[k // ncol, k % ncol]
+        fig, axes = _panels(plt, len(links), 4.4, 3.8)
+        for ax, ln in zip(axes, links):
             ax.plot(h[f"elongation:{ln}"], h[f"link_force:{ln}"], lw=0.9)
             ax.ticklabel_format(style="sci", scilimits=(-2, 4), useMathText=True)
             kind = summary.get("links", {}).get(ln, {}).get("type", "")
@@ -188,11 +191,7 @@ def plot_run(folder, outdir, formats=FORMATS, nodes=None, contacts=None, limit=6
             ax.set_ylabel("link force f [N]")
             ax.set_title(f"{ln} ({kind})", fontsize=9)
             ax.grid(True, alpha=0.3)
-        for k in range(len(links), nrow * ncol):
-            axes[k // ncol, k % ncol].axis("off")
-        fig.suptitle(title, fontsize=10)
-        fig.tight_layout()
-        files += _save(fig, outdir, "hysteresis", formats)
+        files += _finish(fig, title, outdir, "hysteresis", formats)
 
     # energy terms and their balance
     present = [k for k in ENERGY_TERMS if f"energy:{k}" in h]
@@ -213,9 +212,7 @@ def plot_run(folder, outdir, formats=FORMATS, nodes=None, contacts=None, limit=6
         axes[1].set_xlabel("time t [s]")
         for ax in axes:
             ax.grid(True, alpha=0.3)
-        fig.suptitle(title, fontsize=10)
-        fig.tight_layout()
-        files += _save(fig, outdir, "energy", formats)
+        files += _finish(fig, title, outdir, "energy", formats)
     return files
 
 

@@ -13,38 +13,17 @@ import pytest
 from martello.cli import main
 from martello.errors import MartelloError
 from martello.study.cluster import dask_executor
+from tests.test_study import TINY
 
 ROOT = Path(__file__).resolve().parent.parent
-P2 = ROOT / "benchmarks" / "p2"
 
-# P2 with two contact schemes, a fixed-step and an adaptive integrator, and a run that
-# fails (central difference beyond its stability limit): every kind of row.
-STUDY = f"""
-title = "P2 on a cluster"
-[compare]
-histories = ["u:mass"]
-points = 701
-[[scene]]
-file = "{P2 / 'p2_penalty_linear.toml'}"
-label = "linear"
-reference = {{ closed_form = "bouncing_oscillator_kelvin", params = {{ m = 1.0, k = 100.0, h = 0.05, g = 9.81, eps = 1.0e6 }} }}
-[[scene.scheme]]
-label = "penalty linear"
-[[scene.scheme]]
-label = "restitution e=0.8"
-contact = {{ scheme = "restitution", restitution = 0.8 }}
-reference = {{ closed_form = "bouncing_oscillator_restitution", params = {{ m = 1.0, k = 100.0, h = 0.05, g = 9.81, e = 0.8 }} }}
-[[integrator]]
-name = "newmark"
-params = {{ preset = "average-acceleration" }}
-dt = [2e-4, 1e-4, 5e-5]
+# tests/test_study.py's P2 study (two contact schemes, Newmark, and central difference with
+# a run beyond its stability limit) plus an adaptive integrator: every kind of row.
+STUDY = TINY + """
 [[integrator]]
 name = "rk8pd"
 dt = 1e-3
 rtol = [1e-6, 1e-8, 1e-10]
-[[integrator]]
-name = "central-difference"
-dt = [5e-3, 1e-4]
 """
 
 # Starts a LocalCluster of two worker processes (one thread each, as docs/studies.md asks of
