@@ -162,9 +162,13 @@ def _publish(tmp, folder):
     try:
         tmp.rename(folder)
     except OSError:
-        if not folder.exists() and old.exists():
+        if folder.exists():             # another process published the same reference first
+            shutil.rmtree(tmp, ignore_errors=True)
+        elif old.exists():
             old.rename(folder)
-        raise
+            raise
+        else:
+            raise
     shutil.rmtree(old, ignore_errors=True)
 
 
@@ -174,13 +178,20 @@ def reference_for_file(scene_path, refresh=False, every=None, jobs=0, stream=Non
     Returns (Reference, folder, cached) where folder holds history.csv and reference.json
     and cached says whether it was reused. Raises ReferenceError (a static scene, a scene no
     method runs) with one line naming the fix."""
+    scene_path = Path(scene_path)
+    return computed_reference(load(scene_path), _scene_dict(scene_path), scene_path, refresh,
+                              every, jobs, stream)
+
+
+def computed_reference(scene, sdict, scene_path, refresh=False, every=None, jobs=0, stream=None):
+    """reference_for_file for a loaded scene: its Scene, the scene dict it was loaded from
+    (without [check]) and the path its relative files are read from (a dict scene: any file
+    in the folder they are relative to)."""
     stream = stream or sys.stderr
     scene_path = Path(scene_path)
-    scene = load(scene_path)
     if scene.analysis.get("type") != "dynamic":
         raise ReferenceError(f"{scene_path}: a static scene has no time history: its reference is "
                              "the static solution (martello run, martello check)")
-    sdict = _scene_dict(scene_path)
     root = cache_root() / "references"
     key = cache_key(scene)
     folder = root / key
@@ -228,14 +239,16 @@ def _named(ref, folder):
     return ref
 
 
-def describe(ref, folder, cached, stream=None):
+def describe(ref, folder, cached, scene_path=None, stream=None):
     """What a computed reference is and how far it is trusted, for a person."""
     stream = stream or sys.stdout
     meta = ref.provenance
     m = meta["method"]
     how = f"rtol {m['rtol']:g}" if "rtol" in m else f"Δt {m['dt']:g} s"
-    when = f"cached {meta['date']}" if cached else f"computed in {meta.get('compute_time_s', 0.0):.1f} s"
-    print(f"{meta['scene']}: reference by {m['integrator']} ({how}), {when}", file=stream)
+    how += f", h_max {m['h_max']:g} s" if m.get("h_max") else ""
+    when = (f"from the cache (computed {meta['date']} for {meta['scene']})" if cached
+            else f"computed in {meta.get('compute_time_s', 0.0):.1f} s")
+    print(f"{scene_path or meta['scene']}: reference by {m['integrator']} ({how}), {when}", file=stream)
     print(f"  trusted digits from {meta['digits_basis']}", file=stream)
     width = max(len(c) for c in meta["digits"])
     for c, d in meta["digits"].items():
@@ -256,6 +269,10 @@ def main(args):
     out.mkdir(parents=True, exist_ok=True)
     for name in ("history.csv", "reference.json"):
         shutil.copyfile(folder / name, out / name)
-    describe(ref, folder, cached)
+    describe(ref, folder, cached, args.scene)
     print(f"-> {out / 'history.csv'} and {out / 'reference.json'} (cache: {folder})")
+    from .selection import reference_for_scene
+    own = reference_for_scene(load(args.scene))
+    if own is not None:
+        print(f"note: the scene also has {own.name}, which martello compare and check use for it")
     return 0
