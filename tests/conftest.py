@@ -1,8 +1,10 @@
 """Shared fixtures. The package is installed in .venv (editable) by scripts/setup; the path
 line below also lets `python -m pytest` work from a checkout without that install."""
 
+import atexit
 import copy
 import os
+import shutil
 import sys
 import tempfile
 from pathlib import Path
@@ -15,6 +17,7 @@ if str(ROOT) not in sys.path:
 # References computed on demand (docs/reference.md) go to a cache of the test session, never
 # to the user's (subprocesses inherit it)
 os.environ["MARTELLO_CACHE_DIR"] = tempfile.mkdtemp(prefix="martello-test-cache-")
+atexit.register(shutil.rmtree, os.environ["MARTELLO_CACHE_DIR"], True)
 
 
 def p1_dict(scheme="lagrange", **contact):
