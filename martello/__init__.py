@@ -26,8 +26,9 @@ The package by concern, from the bottom up; each layer imports only the layers b
 3. ``run`` (one scene), then ``batch`` (many, on the local cores);
 4. ``metrics`` (scores), then ``reference`` (what a run is scored against);
 5. ``checks``: runs verified against closed forms and reference data, the P4 measures;
-6. ``study``, ``compare``, ``report``, then ``api`` (the Python API), then ``cli``: the front
-   ends; this file, the package's face, sits on top of them all and imports them lazily.
+6. ``study``, ``compare``, ``report``, then ``plot``, then ``api`` (the Python API), then
+   ``cli``: the front ends; this file, the package's face, sits on top of them all and
+   imports them lazily.
 """
 
 import sys

@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import os
 from concurrent.futures import ProcessPoolExecutor, as_completed
+from contextlib import nullcontext
 from pathlib import Path
 
 import numpy as np
@@ -38,9 +39,11 @@ def execute(spec):
                   "summary": keep, "history": (history[0], np.asarray(history[1]))}
 
 
-def run_specs(specs, jobs=0, progress=None):
-    """Run specs in worker processes (ProcessPoolExecutor); yield results as they finish.
-    Specs with a precomputed status (incompatible combinations) are not run."""
+def run_specs(specs, jobs=0, progress=None, executor=None):
+    """Run specs in worker processes (ProcessPoolExecutor), or on `executor` (any
+    concurrent.futures executor, e.g. a Dask cluster's: martello.study.cluster); yield
+    results as they finish. Specs with a precomputed status (incompatible combinations) are
+    not run."""
     todo = [s for s in specs if "status" not in s]
     for s in specs:
         if "status" in s:
@@ -48,14 +51,14 @@ def run_specs(specs, jobs=0, progress=None):
                 progress.update(False)
             yield dict(s)
     jobs = jobs or os.cpu_count() or 1
-    if jobs == 1 or len(todo) <= 1:
+    if executor is None and (jobs == 1 or len(todo) <= 1):
         for s in todo:
             r = execute(s)
             if progress:
                 progress.update(r["status"] == "MARTELLO_OK")
             yield r
         return
-    with ProcessPoolExecutor(max_workers=jobs) as pool:
+    with (ProcessPoolExecutor(max_workers=jobs) if executor is None else nullcontext(executor)) as pool:
         futs = [pool.submit(execute, s) for s in todo]
         for f in as_completed(futs):
             try:

@@ -67,6 +67,16 @@ def cmd_compare(args):
     return compare.main(args)
 
 
+def cmd_plot(args):
+    from . import plot
+    return plot.main(args)
+
+
+def cmd_reference(args):
+    from .reference import cache
+    return cache.main(args)
+
+
 def cmd_check(args):
     from .report import check_catalogue
     files = [catalogue.find(p) for p in args.scenes] if args.scenes else catalogue.scene_files()
@@ -118,17 +128,54 @@ def main(argv=None):
     p.add_argument("study", help="study file (TOML)")
     p.add_argument("-o", "--output", help="output folder (default: out/studies/<name>)")
     p.add_argument("-j", "--jobs", type=int, default=0, help="parallel runs (default: all cores)")
+    p.add_argument("--scheduler", metavar="ADDRESS", help="run on the Dask cluster whose scheduler "
+                   "is at ADDRESS (tcp://host:8786, or a scheduler file .json) instead of local "
+                   "processes (docs/studies.md)")
     p.set_defaults(func=cmd_study)
 
     p = sub.add_parser("compare", help="score another code's time history against a scene",
                        description="Score a foreign time history (CSV, columns documented in "
-                       "docs/compare.md) against martello's reference for a scene, with the same "
+                       "docs/compare.md, or OpenSees recorder output) against martello's reference for a scene, with the same "
                        "metrics as the studies (max error, significant digits, peak and impact "
                        "errors).")
-    p.add_argument("history", help="the other code's history (CSV)")
-    p.add_argument("--against", required=True, help="scene file (TOML) it claims to solve")
+    p.add_argument("history", nargs="+", help="the other code's history: a CSV (docs/compare.md), "
+                   "or OpenSees recorder files (whitespace-separated, time first), one or more")
+    p.add_argument("--against", required=True, help="scene file (TOML) it claims to solve; without a "
+                   "closed form or stored data its reference is computed and cached (martello reference)")
+    p.add_argument("--columns", action="append", metavar="NAMES",
+                   help="names of a recorder file's value columns, e.g. u:s1,-u:s2 (a leading - flips "
+                   "the sign); once per recorder file, in order (default: u of the scene's free nodes)")
     p.add_argument("-o", "--output", help="write the scores as JSON here")
     p.set_defaults(func=cmd_compare)
+
+    p = sub.add_parser("plot", help="pictures of a run or a study folder (PNG and SVG)",
+                       description="Plot a run folder (martello run: displacement and contact-force "
+                       "histories, phase portraits, force against penetration, hysteresis loops of "
+                       "the links it wrote, energy terms) or a study folder (martello study: error "
+                       "against the step and work-precision, per case). See docs/plot.md.")
+    p.add_argument("folder", help="a folder written by martello run or martello study")
+    p.add_argument("-o", "--output", help="folder for the pictures (default: FOLDER/plots)")
+    p.add_argument("--format", default="png,svg", help="png, svg or png,svg (default)")
+    p.add_argument("--nodes", help="nodes to plot, e.g. s1,s2 (default: the first six)")
+    p.add_argument("--contacts", help="contacts to plot (default: the first six)")
+    p.add_argument("--metric", help="study error to plot (default: max_rel_error)")
+    p.set_defaults(func=cmd_plot)
+
+    p = sub.add_parser("reference", help="compute (or take from the cache) a scene's reference history",
+                       description="Compute a reference history for any dynamic scene with the most "
+                       "accurate methods that run it (rk8pd with event location, the independent "
+                       "scipy engine, Newmark at a small step), state the digits it can be trusted "
+                       "to (refinement and a second method) and its provenance, and cache it per "
+                       "scene physics in $MARTELLO_CACHE_DIR (default $XDG_CACHE_HOME/martello or "
+                       "~/.cache/martello). See docs/reference.md.")
+    p.add_argument("scene", help="scene file (TOML)")
+    p.add_argument("-o", "--output", help="folder for history.csv and reference.json "
+                   "(default: out/reference/<scene name>)")
+    p.add_argument("--every", type=float, help="spacing of the stored samples in s "
+                   "(default: the scene's output interval, 1000 to 20000 samples)")
+    p.add_argument("--refresh", action="store_true", help="recompute even if the cache has it")
+    p.add_argument("-j", "--jobs", type=int, default=0, help="parallel runs (default: all cores)")
+    p.set_defaults(func=cmd_reference)
 
     p = sub.add_parser("version", help="versions of martello and the libraries it links")
     p.set_defaults(func=_print_version)

@@ -4,7 +4,10 @@ against martello's closed forms and reference data. The CSV format is documented
 docs/compare.md: a header row, then one row per time; column t (s) and any of u:<node>,
 v:<node>, a:<node> (m, m/s, m/s²), penetration:<contact> (m, > 0 in contact), force:<contact>
 (N, compressive > 0) and energy:kinetic, energy:recoverable (J) — exactly as in martello's own
-history.csv, so a martello run can be fed back as a self-check."""
+history.csv, so a martello run can be fed back as a self-check. OpenSees node recorder files
+(whitespace-separated, a time column, no header) are read too, their columns named on the
+command line (read_recorder). A scene with neither a closed form nor stored reference data
+gets a reference computed on demand and cached (martello.reference.cache)."""
 
 from __future__ import annotations
 
@@ -40,6 +43,29 @@ class HistoryError(MartelloError):
         super().__init__(f"{where}: {problem}" + (f" ({fix})" if fix else ""))
 
 
+def _check_names(path, header, scene, hline):
+    """Every column names a node or contact of the scene, with a known kind."""
+    if scene is None:
+        return
+    nodes = {n["name"] for n in scene.nodes}
+    contacts = {c["name"] for c in scene.contacts}
+    for c in header:
+        kind, sep, name = c.partition(":")
+        if c == "t" or c in ENERGY_COLUMNS:
+            continue
+        if not sep or kind not in NODE_KINDS + CONTACT_KINDS:
+            raise HistoryError(path, f"unknown column {c!r}",
+                               "valid: t, u:<node>, v:<node>, a:<node>, penetration:<contact>, "
+                               "force:<contact>, energy:kinetic, energy:recoverable, ...", row=hline)
+        if kind in NODE_KINDS and name not in nodes:
+            raise HistoryError(path, f"column {c!r} names no node of {scene.source}",
+                               "nodes: " + ", ".join(sorted(nodes)), row=hline)
+        if kind in CONTACT_KINDS and name not in contacts:
+            raise HistoryError(path, f"column {c!r} names no contact of {scene.source}",
+                               "contacts: " + ", ".join(sorted(contacts)) if contacts else "it has none",
+                               row=hline)
+
+
 def read_history(path, scene=None):
     """Read and validate a history CSV; returns (columns, 2D array). Lines starting with #
     are comments. Errors name the line: a missing t column, a column that names no node or
@@ -59,24 +85,7 @@ def read_history(path, scene=None):
     if len(set(header)) != len(header):
         dup = sorted({c for c in header if header.count(c) > 1})
         raise HistoryError(path, f"duplicate column(s) {', '.join(dup)}", row=hline)
-    if scene is not None:
-        nodes = {n["name"] for n in scene.nodes}
-        contacts = {c["name"] for c in scene.contacts}
-        for c in header:
-            kind, sep, name = c.partition(":")
-            if c == "t" or c in ENERGY_COLUMNS:
-                continue
-            if not sep or kind not in NODE_KINDS + CONTACT_KINDS:
-                raise HistoryError(path, f"unknown column {c!r}",
-                                   "valid: t, u:<node>, v:<node>, a:<node>, penetration:<contact>, "
-                                   "force:<contact>, energy:kinetic, energy:recoverable, ...", row=hline)
-            if kind in NODE_KINDS and name not in nodes:
-                raise HistoryError(path, f"column {c!r} names no node of {scene.source}",
-                                   "nodes: " + ", ".join(sorted(nodes)), row=hline)
-            if kind in CONTACT_KINDS and name not in contacts:
-                raise HistoryError(path, f"column {c!r} names no contact of {scene.source}",
-                                   "contacts: " + ", ".join(sorted(contacts)) if contacts else "it has none",
-                                   row=hline)
+    _check_names(path, header, scene, hline)
     rows = []
     for lineno, ln in lines[1:]:
         cells = next(csv.reader([ln]))
@@ -106,6 +115,134 @@ def read_history(path, scene=None):
     return header, data
 
 
+def is_recorder_file(path):
+    """True for a whitespace-separated numeric file without a header (an OpenSees recorder's
+    output), False for a CSV with a header row."""
+    try:
+        with open(path) as fh:
+            for ln in fh:
+                if ln.strip() and not ln.lstrip().startswith("#"):
+                    cells = ln.split()
+                    if "," in ln or len(cells) < 2:
+                        return False
+                    try:
+                        [float(c) for c in cells]
+                    except ValueError:
+                        return False
+                    return True
+    except (OSError, UnicodeDecodeError):
+        return False
+    return False
+
+
+def _recorder_names(path, spec, count, scene):
+    """The column names of a recorder file's value columns: `spec` ("u:a,-u:b": a leading −
+    flips the sign) or, without one, u of every free node of the scene in its order when
+    the file has that many value columns. Returns [(name, sign)]."""
+    if spec:
+        names = [c.strip() for c in spec.split(",") if c.strip()]
+    elif scene is not None and count == sum(1 for n in scene.nodes if not n["fixed"]):
+        names = [f"u:{n['name']}" for n in scene.nodes if not n["fixed"]]
+        print(f"note: {path}: reading its {count} value column(s) as "
+              + ", ".join(names) + " (the scene's free nodes in order; name them with --columns)",
+              file=sys.stderr)
+    else:
+        free = [n["name"] for n in scene.nodes if not n["fixed"]] if scene is not None else []
+        raise HistoryError(path, f"{count} value column(s) after the time column and no --columns "
+                           "naming them", "e.g. --columns " + ",".join(f"u:{n}" for n in free[:count] or ["NODE"])
+                           + " (docs/compare.md#opensees-recorder-files)")
+    if len(names) != count:
+        raise HistoryError(path, f"--columns names {len(names)} column(s), the file has {count} after "
+                           "the time column", "one name per recorded value, in the recorder's order")
+    return [(n[1:], -1.0) if n.startswith("-") else (n, 1.0) for n in names]
+
+
+def read_recorder(path, spec=None, scene=None):
+    """Read an OpenSees node recorder file (`recorder Node -file F -time -node ... -dof 1
+    disp`): whitespace-separated rows, the time first, then one value per node and dof. The
+    value columns are named by spec (see _recorder_names); returns (columns, 2D array) as a
+    history CSV would give, validated the same way."""
+    path = Path(path)
+    if not path.exists():
+        raise HistoryError(path, "does not exist")
+    rows, width = [], None
+    with open(path) as fh:
+        for i, ln in enumerate(fh, 1):
+            if not ln.strip() or ln.lstrip().startswith("#"):
+                continue
+            cells = ln.split()
+            if width is None:
+                width = len(cells)
+            if len(cells) != width:
+                raise HistoryError(path, f"{len(cells)} values, the first row has {width}", row=i)
+            try:
+                vals = [float(c) for c in cells]
+            except ValueError:
+                bad = next(c for c in cells if not _is_float(c))
+                raise HistoryError(path, f"{bad!r} is not a number", row=i) from None
+            if not all(math.isfinite(x) for x in vals):
+                raise HistoryError(path, "NaN or inf", "a history must be finite; cut it before the "
+                                   "solver failed", row=i)
+            rows.append(vals)
+    if not rows:
+        raise HistoryError(path, "is empty", "rows of time and values (an OpenSees recorder with -time)")
+    names = _recorder_names(path, spec, width - 1, scene)
+    columns = ["t"] + [n for n, _ in names]
+    data = np.array(rows, float)
+    data[:, 1:] *= np.array([sg for _, sg in names])
+    if len(data) < 2:
+        raise HistoryError(path, f"{len(data)} data row(s)", "a history needs at least two times")
+    bad = np.nonzero(np.diff(data[:, 0]) <= 0)[0]
+    if len(bad):
+        i = int(bad[0]) + 1
+        raise HistoryError(path, f"time {data[i, 0]!r} (row {i + 1}) does not follow {data[i - 1, 0]!r}",
+                           "the first column must be the time, increasing: give the recorder -time")
+    _check_names(path, columns, scene, None)
+    return columns, data
+
+
+def _is_float(x):
+    try:
+        float(x)
+        return True
+    except ValueError:
+        return False
+
+
+def read_histories(paths, columns=None, scene=None):
+    """One history from several files (CSV with a header, or OpenSees recorder files whose
+    value columns `columns[i]` names): the first file's times; each further file must have
+    the same times, its columns are added. Returns (columns, 2D array)."""
+    paths = [paths] if isinstance(paths, (str, Path)) else list(paths)
+    columns = list(columns or [])
+    if len(columns) > len(paths):
+        raise MartelloError(f"--columns given {len(columns)} times for {len(paths)} history file(s): "
+                            "give it once per recorder file, in the files' order")
+    merged = None
+    for i, p in enumerate(paths):
+        spec = columns[i] if i < len(columns) else None
+        if is_recorder_file(p):
+            h = read_recorder(p, spec, scene)
+        else:
+            if spec:
+                raise HistoryError(p, "--columns names the columns of a recorder file; this is a CSV "
+                                   "with a header row", "drop --columns for it (or give it last)")
+            h = read_history(p, scene)
+        if merged is None:
+            merged = (list(h[0]), h[1])
+            continue
+        t0, t1 = merged[1][:, merged[0].index("t")], h[1][:, h[0].index("t")]
+        if len(t0) != len(t1) or not np.allclose(t0, t1, rtol=1e-12, atol=0.0):
+            raise HistoryError(p, f"its {len(t1)} times differ from those of {paths[0]} ({len(t0)})",
+                               "record every file at the same times (OpenSees: the same -dT or none)")
+        dup = sorted(set(merged[0]) & set(h[0]) - {"t"})
+        if dup:
+            raise HistoryError(p, f"column(s) {', '.join(dup)} also in an earlier file")
+        keep = [j for j, c in enumerate(h[0]) if c != "t"]
+        merged = (merged[0] + [h[0][j] for j in keep], np.column_stack([merged[1], h[1][:, keep]]))
+    return merged
+
+
 def comparable(columns, ref):
     """The columns of a history that the reference also has, u first."""
     order = {"u": 0, "v": 1, "a": 2, "penetration": 3, "force": 4, "energy": 5}
@@ -113,18 +250,33 @@ def comparable(columns, ref):
     return sorted(cols, key=lambda c: (order.get(c.partition(":")[0], 9), c))
 
 
-def compare(history_path, scene_path):
-    """Score a history CSV against a scene's reference; returns the report dict."""
+def compare(history_path, scene_path, columns=None, compute=True, stream=None):
+    """Score a history (a CSV, an OpenSees recorder file, or several of them: read_histories)
+    against a scene's reference; returns the report dict. A scene with no closed form and no
+    stored reference data gets one computed (or taken from the cache) unless compute is
+    False (martello.reference.cache)."""
+    stream = stream or sys.stderr
     sc = load(scene_path)
     if sc.analysis.get("type") != "dynamic":
         raise MartelloError(f"{scene_path}: a static scene has no time history to compare with "
                             "(compare its nodal values with `martello check`)")
-    columns, data = read_history(history_path, sc)
+    columns, data = read_histories(history_path, columns, sc)
+    history_path = ", ".join(map(str, history_path)) if isinstance(history_path, (list, tuple)) \
+        else history_path
     ref = reference_for_scene(sc)
+    computed = None
+    if ref is None and compute:
+        from .reference.cache import reference_for_file
+        ref, folder, cached = reference_for_file(scene_path, stream=stream)
+        computed = {"folder": str(folder), "cached": cached,
+                    "method": ref.provenance["method"], "digits_basis": ref.provenance["digits_basis"]}
+        print(f"reference: no closed form and no stored data for {scene_path}: "
+              + ("taken from the cache" if cached else "computed and cached") + f" in {folder}",
+              file=stream)
     if ref is None:
         raise MartelloError(f"{scene_path}: no reference to compare with: no closed-form history "
                             "and no stored reference data (reference/references.toml; "
-                            "scripts/regenerate_reference)")
+                            "scripts/regenerate_reference; or `martello reference` to compute one)")
     cols = comparable(columns, ref)
     if not cols:
         raise HistoryError(history_path, "no column can be compared with the reference",
@@ -166,7 +318,7 @@ def compare(history_path, scene_path):
             "reference_kind": ref.kind, "reference_digits": ref.trusted_digits(u_cols),
             "compared_columns": cols, "time_span": span, "rows": int(len(t)),
             "score_scd": m.get("scd"), "metrics": {k: v for k, v in m.items() if k not in COST_KEYS},
-            "per_column": per_column, "checks": checks,
+            "per_column": per_column, "checks": checks, "computed_reference": computed,
             "derived_events": {k: {kk: v[kk] for kk in ("impact_times", "restitution",
                                                         "phase_max_penetration")}
                                for k, v in summary["contacts"].items()}}
@@ -229,7 +381,7 @@ def print_report(rep, stream=sys.stdout):
 
 
 def main(args):
-    rep = compare(args.history, args.against)
+    rep = compare(args.history, args.against, columns=getattr(args, "columns", None))
     print_report(rep)
     if args.output:
         Path(args.output).parent.mkdir(parents=True, exist_ok=True)

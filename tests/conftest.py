@@ -1,8 +1,12 @@
 """Shared fixtures. The package is installed in .venv (editable) by scripts/setup; the path
 line below also lets `python -m pytest` work from a checkout without that install."""
 
+import atexit
 import copy
+import os
+import shutil
 import sys
+import tempfile
 from pathlib import Path
 
 import pytest
@@ -10,6 +14,10 @@ import pytest
 ROOT = Path(__file__).resolve().parent.parent
 if str(ROOT) not in sys.path:
     sys.path.insert(0, str(ROOT))
+# References computed on demand (docs/reference.md) go to a cache of the test session, never
+# to the user's (subprocesses inherit it)
+os.environ["MARTELLO_CACHE_DIR"] = tempfile.mkdtemp(prefix="martello-test-cache-")
+atexit.register(shutil.rmtree, os.environ["MARTELLO_CACHE_DIR"], True)
 
 
 def p1_dict(scheme="lagrange", **contact):

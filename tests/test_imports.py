@@ -108,7 +108,7 @@ LAYERS = [("martello.errors", "martello.paths", "martello.history"),
           ("martello.metrics",), ("martello.reference",),
           ("martello.checks",),
           ("martello.study", "martello.compare", "martello.report"),
-          ("martello.api",), ("martello.cli",), ("martello.__main__", "martello")]
+          ("martello.plot",), ("martello.api",), ("martello.cli",), ("martello.__main__", "martello")]
 
 
 def unit(module):

@@ -29,17 +29,24 @@ from .event_located import Unsupported, event_located_run
 from .store import load_reference, manifest, physics_digest
 
 
-def _method_runs(entry, method, scene_dict, scene_path, dt, rtol=None):
-    params = {k: v for k, v in method.items() if k not in ("integrator", "dt", "refine", "rtol")}
-    store = float(entry["store_every"])
+def _spec(method, scene_dict, scene_path, dt, rtol, store, keep_output=False):
+    """The run spec of one method at one step (or tolerance), output every `store` s: every
+    node and contact (the loader's default), or the scene's own selection if keep_output."""
+    params = {k: v for k, v in method.items() if k not in ("integrator", "dt", "refine", "rtol", "cross_check")}
     every = 1 if method["integrator"] in ADAPTIVE else max(1, int(round(store / dt)))
     d = copy.deepcopy(scene_dict)
     d["analysis"] = analysis_for(d.get("analysis", {}), method["integrator"], params, dt,
                                  d["analysis"]["t_end"], every, rtol)
-    d["analysis"]["output"].pop("nodes", None)
-    d["analysis"]["output"].pop("contacts", None)
+    if not keep_output:
+        d["analysis"]["output"].pop("nodes", None)
+        d["analysis"]["output"].pop("contacts", None)
     return {"id": 0, "scene_dict": d, "scene_file": str(scene_path), "base_dir": str(scene_path.parent),
             "repeat": 1}
+
+
+def _method_runs(entry, method, scene_dict, scene_path, dt, rtol=None):
+    """The run spec of a reference entry's method (tests recompute stored data with it)."""
+    return _spec(method, scene_dict, scene_path, dt, rtol, float(entry["store_every"]))
 
 
 def _sampled(result, grid):
@@ -64,56 +71,113 @@ def reference_scene(entry):
 
 def build_reference(entry, root=REFERENCE_ROOT, stream=sys.stderr, jobs=0):
     """Compute one reference (an entry of reference/references.toml) and write
-    reference/<name>/history.csv and reference.json. The first method the library runs is
-    used; it is checked by refinement (Δt, Δt·2, Δt·4 for fixed steps; rtol, rtol·100 for
+    reference/<name>/history.csv and reference.json (compute_reference says how), then score
+    the catalogue's own settings against it."""
+    scene, sdict, scene_path = reference_scene(entry)
+    out = compute_reference(scene, sdict, scene_path, entry["method"], float(entry["store_every"]),
+                            label=entry["name"], kinds=entry.get("columns"),
+                            cross_check=entry.get("cross_check", True), jobs=jobs, stream=stream)
+    meta = {"name": entry["name"], "scene": entry["scene"], "contact_override": entry.get("contact")}
+    meta.update(out["meta"])
+    meta["command"] = "scripts/regenerate_reference " + entry["name"]
+    folder = Path(root) / entry["name"]
+    write_reference(folder, out, meta)
+    # the catalogue's own settings against the new reference: what `martello check` expects
+    ref = load_reference(folder)
+    own = {"status": "skipped"} if entry.get("contact") else execute({"id": 0, "scene_dict": sdict,
+                   "scene_file": str(scene_path), "base_dir": str(scene_path.parent), "repeat": 1})
+    if own["status"] == "MARTELLO_OK":
+        sc = score(own["summary"], own["history"], ref)
+        meta["catalogue_error"] = {k: sc.get(k) for k in ("max_rel_error", "impact_time_error",
+                                                          "peak_penetration_error", "impact_count_error")}
+        meta["catalogue_settings"] = {k: v for k, v in sdict["analysis"].items() if k != "output"}
+        (folder / "reference.json").write_text(json.dumps(meta, indent=1, default=float) + "\n")
+    print(f"  -> {folder}: {len(out['grid'])} rows, digits trusted (min over u) "
+          f"{min(v for k, v in out['digits'].items() if k.startswith('u:')):.1f}, "
+          f"observed order {out['meta']['observed_order']:.2f}", file=stream)
+    return folder
+
+
+# Columns whose definition is the same in every engine: the cross-check bounds their digits
+# too (energy terms are bookkept differently by the engines, e.g. the input of a ground
+# motion, so a difference there need not be an error).
+CROSS_CHECKED_KINDS = ("u", "v", "penetration", "force")
+
+
+def _run_levels(method, sdict, scene_path, scene, grid, store, label, jobs, stream, keep_output):
+    """The refinement levels of one method, run: (levels, results), or None when the method
+    cannot run the scene (not built, or a part the independent engine does not model)."""
+    if method["integrator"] == "scipy-dop853":
+        rt = float(method["rtol"])
+        levels = [(None, rt), (None, rt * 100.0)]
+        print(f"{label}: scipy DOP853 with event location at rtol={rt:g}, {rt * 100:g}", file=stream)
+        try:
+            res = [event_located_run(scene, r_, grid) for _, r_ in levels]
+        except Unsupported as exc:
+            print(f"  scipy-dop853: the scene has {exc}, which it does not model; next method",
+                  file=stream)
+            return None
+        if any(r["status"] != "MARTELLO_OK" for r in res):
+            raise MartelloError(f"{label}: reference run failed: {res[0].get('message')}")
+        return levels, res
+    dt = float(method["dt"])
+    if method.get("refine") == "h_max":
+        # an adaptive method whose error is set by its largest step (kinks it does not
+        # locate, such as yield: docs/event-driven.md): refined in h_max, like a fixed step
+        h, rt = float(method["h_max"]), float(method["rtol"])
+        levels = [(dt, rt, h), (dt, rt, 2 * h), (dt, rt, 4 * h)]
+    elif method["integrator"] in ADAPTIVE:
+        rt = float(method["rtol"])
+        levels = [(dt, rt), (dt, rt * 100.0)]
+    else:
+        levels = [(dt, None), (2 * dt, None), (4 * dt, None)]
+    specs = [dict(_spec(dict(method, h_max=lv[2]) if len(lv) > 2 else method, sdict, scene_path,
+                        lv[0], lv[1], store, keep_output), id=i)
+             for i, lv in enumerate(levels)]
+    print(f"{label}: {method['integrator']} at "
+          + ", ".join(f"dt={lv[0]:g}" + (f" rtol={lv[1]:g}" if lv[1] else "")
+                      + (f" h_max={lv[2]:g}" if len(lv) > 2 else "") for lv in levels), file=stream)
+    res = sorted(run_specs(specs, jobs), key=lambda r: r["id"])
+    if any(r["status"] in ("MARTELLO_ERR_UNSUPPORTED", "incompatible") for r in res):
+        print(f"  {method['integrator']}: not available ({res[0].get('message', '')[:80]}); next method",
+              file=stream)
+        return None
+    bad = [r for r in res if r["status"] != "MARTELLO_OK"]
+    if bad:
+        raise MartelloError(f"{label}: reference run failed: {bad[0]['status']}: "
+                            f"{bad[0].get('message', '')}")
+    return levels, res
+
+
+def compute_reference(scene, sdict, scene_path, methods, store_every, label="reference",
+                      kinds=None, cross_check=True, jobs=0, stream=sys.stderr, keep_output=False):
+    """A reference history of a scene, with the digits it can be trusted to.
+
+    methods are tried in order (integrator + its analysis keys + dt, rtol for adaptive
+    ones; "scipy-dop853" is the independent event-located engine): the first that runs the
+    scene is used, checked by refinement (Δt, Δt·2, Δt·4 for fixed steps; rtol, rtol·100 for
     adaptive ones): the digits trusted in each column are −log10 of max |y_h − y_2h| over the
     column's peak (the finest run's error for a first-order method, a 3× overestimate for a
-    second-order one)."""
-    scene, sdict, scene_path = reference_scene(entry)
+    second-order one). The next method of the list that runs is a cross-check: the digits of
+    u, v, penetration and force are capped by −log10 of its difference from the reference
+    (refinement cannot see an error both levels share; two methods rarely share one).
+
+    Returns {"grid", "columns", "fine" ({column: samples}), "digits", "meta"} (meta: the
+    provenance reference.json records)."""
     t_end = scene.analysis["t_end"]
-    chosen, results = None, None
-    store = float(entry["store_every"])
+    store = float(store_every)
     grid = np.linspace(0.0, t_end, int(round(t_end / store)) + 1)
-    for method in entry["method"]:
-        if method["integrator"] == "scipy-dop853":
-            rt = float(method["rtol"])
-            levels = [(None, rt), (None, rt * 100.0)]
-            print(f"{entry['name']}: scipy DOP853 with event location at rtol={rt:g}, {rt * 100:g}",
-                  file=stream)
-            try:
-                res = [event_located_run(scene, r_, grid) for _, r_ in levels]
-            except Unsupported as exc:
-                print(f"  scipy-dop853: the scene has {exc}, which it does not model; next method",
-                      file=stream)
-                continue
-            if any(r["status"] != "MARTELLO_OK" for r in res):
-                raise MartelloError(f"{entry['name']}: reference run failed: {res[0].get('message')}")
-            chosen, results = (method, levels), res
+    chosen = None
+    for method in methods:
+        ran = _run_levels(method, sdict, scene_path, scene, grid, store, label, jobs, stream,
+                          keep_output)
+        if ran is not None:
+            chosen = (method, *ran)
             break
-        dt = float(method["dt"])
-        if method["integrator"] in ADAPTIVE:
-            rt = float(method["rtol"])
-            levels = [(dt, rt), (dt, rt * 100.0)]
-        else:
-            levels = [(dt, None), (2 * dt, None), (4 * dt, None)]
-        specs = [dict(_method_runs(entry, method, sdict, scene_path, d_, r_), id=i)
-                 for i, (d_, r_) in enumerate(levels)]
-        print(f"{entry['name']}: {method['integrator']} at "
-              + ", ".join(f"dt={d_:g}" + (f" rtol={r_:g}" if r_ else "") for d_, r_ in levels), file=stream)
-        res = sorted(run_specs(specs, jobs), key=lambda r: r["id"])
-        if any(r["status"] == "MARTELLO_ERR_UNSUPPORTED" for r in res):
-            print(f"  {method['integrator']}: not available ({res[0].get('message', '')[:80]}); next method",
-                  file=stream)
-            continue
-        bad = [r for r in res if r["status"] != "MARTELLO_OK"]
-        if bad:
-            raise MartelloError(f"{entry['name']}: reference run failed: {bad[0]['status']}: "
-                                f"{bad[0].get('message', '')}")
-        chosen, results = (method, levels), res
-        break
     if chosen is None:
-        raise MartelloError(f"{entry['name']}: none of the reference methods runs")
-    method, levels = chosen
+        raise MartelloError(f"{label}: none of the reference methods runs ("
+                            + ", ".join(m["integrator"] for m in methods) + ")")
+    method, levels, results = chosen
     fine = _sampled(results[0], grid)
     coarse = [_sampled(r, grid) for r in results[1:]]
     digits, refinement = {}, []
@@ -130,6 +194,7 @@ def build_reference(entry, root=REFERENCE_ROOT, stream=sys.stderr, jobs=0):
         digits[c] = min(15.0, -math.log10(d1 / scale)) if scale > 0 and d1 > 0 else 15.0
     for k, cz in enumerate(coarse):
         refinement.append({"level": k + 1, "dt": levels[k + 1][0], "rtol": levels[k + 1][1],
+                           **({"h_max": levels[k + 1][2]} if len(levels[k + 1]) > 2 else {}),
                            "max_rel_diff_u": max(float(np.max(np.abs(cz[c] - fine[c])) / max(np.max(np.abs(fine[c])), 1e-300))
                                                  for c in fine if c.startswith("u:"))})
     if len(refinement) >= 2 and refinement[0]["max_rel_diff_u"] > 0:
@@ -151,18 +216,49 @@ def build_reference(entry, root=REFERENCE_ROOT, stream=sys.stderr, jobs=0):
         m = match_events(tc, tf, 0.5 * (np.min(np.diff(tf)) if len(tf) > 1 else t_end))
         ev_diff[name] = {"count_fine": len(tf), "count_coarse": len(tc),
                          "max_time_diff": m.max_abs_dt}
-    # columns stored: t, then the kinds the entry keeps (default u, v, a, penetration, force,
-    # and the kinetic, recoverable and input energy)
-    kinds = entry.get("columns", ["u", "v", "penetration", "force", "energy"])
+    # columns stored: t, then the kinds asked for (default u, v, penetration, force, and the
+    # kinetic, recoverable and input energy)
+    kinds = kinds or ["u", "v", "penetration", "force", "energy"]
     cols = ["t"] + [c for c in results[0]["history"][0] if c != "t" and c in fine
                     and c.partition(":")[0] in kinds
                     and (not c.startswith("energy:") or c in ("energy:kinetic", "energy:recoverable",
                                                               "energy:input"))]
     digits = {c: v for c, v in digits.items() if c in cols}
-    # a second method of the list, when it runs, as an independent cross-check
-    cross = None
-    for other in entry["method"]:
-        if other is method or not entry.get("cross_check", True) or other.get("cross_check") is False:
+    cross = _cross_check(methods, method, scene, sdict, scene_path, grid, store, fine,
+                         stream, keep_output) if cross_check else None
+    if cross is not None:
+        for c, cap in cross["digits"].items():
+            if c in digits and c.partition(":")[0] in CROSS_CHECKED_KINDS and digits[c] > cap:
+                digits[c] = cap
+    meta = {"scene_sha256": scene.digest, "physics_sha256": physics_digest(scene), "t_end": t_end,
+            "method": {k: v for k, v in method.items()}, "refinement": refinement,
+            "observed_order": observed, "digits": digits,
+            "digits_note": "−log10(max(|y_h − y_2h|, |y_h − y_4h|/3) / max |y_h|) per column "
+                           "(adaptive: |y_rtol − y_100rtol|): the error of the stored (finest) "
+                           "history for a first-order method, an overestimate for a higher "
+                           "order, still a bound when the differences do not shrink; for u, v, "
+                           "penetration and force, capped by the difference from the "
+                           "cross-check method",
+            "stored": {"every_s": store, "rows": len(grid)},
+            "events": events, "peaks": peaks, "event_refinement": ev_diff,
+            "event_horizon": t_end, "cross_check": cross,
+            "masses": {n["name"]: n["mass"] for n in scene.nodes},
+            "cost": fs["cost"],
+            "martello_version": native.version(), "libraries": native.library_versions(),
+            "python_numpy": np.__version__,
+            "date": time.strftime("%Y-%m-%dT%H:%M:%SZ", time.gmtime())}
+    return {"grid": grid, "columns": cols, "fine": fine, "digits": digits, "meta": meta}
+
+
+def _cross_check(methods, chosen, scene, sdict, scene_path, grid, store, fine, stream, keep_output):
+    """The next method of the list that runs the scene, as an independent check of the
+    chosen one: its method, max relative difference of u and per-column digits
+    (−log10 of the difference over the column's peak), or None."""
+    for other in methods:
+        if other is chosen or other.get("cross_check") is False:
+            continue
+        # only the methods after the chosen one: those before it did not run the scene
+        if methods.index(other) < methods.index(chosen):
             continue
         if other["integrator"] == "scipy-dop853":
             try:
@@ -170,65 +266,41 @@ def build_reference(entry, root=REFERENCE_ROOT, stream=sys.stderr, jobs=0):
             except Unsupported:
                 continue
         else:
-            spec = _method_runs(entry, other, sdict, scene_path, float(other["dt"]), other.get("rtol"))
+            spec = _spec(other, sdict, scene_path, float(other["dt"]), other.get("rtol"), store,
+                         keep_output)
             r = execute(spec)
         if r["status"] != "MARTELLO_OK":
             continue
         oy = _sampled(r, grid)
-        cross = {"method": dict(other),
-                 "max_rel_diff_u": max(float(np.max(np.abs(oy[c] - fine[c])) / max(np.max(np.abs(fine[c])), 1e-300))
-                                       for c in fine if c.startswith("u:"))}
-        print(f"  cross-check with {other['integrator']}: max rel. difference of u "
-              f"{cross['max_rel_diff_u']:.2e}", file=stream)
-        break
-    if cross is not None and cross["max_rel_diff_u"] > 0:
-        # an independent method bounds the error too: trust the smaller of the two statements
-        # (refinement cannot see an error both levels share; two methods rarely share one)
-        cap = -math.log10(cross["max_rel_diff_u"])
-        cross["digits"] = cap
-        for c in digits:
-            if c.startswith("u:") and digits[c] > cap:
-                digits[c] = cap
+        per = {}
+        for c in fine:
+            if c in oy and c in fine:
+                scale = float(np.max(np.abs(fine[c])))
+                diff = float(np.max(np.abs(oy[c] - fine[c])))
+                per[c] = min(15.0, -math.log10(diff / scale)) if scale > 0 and diff > 0 else 15.0
+        rel_u = max(float(np.max(np.abs(oy[c] - fine[c])) / max(np.max(np.abs(fine[c])), 1e-300))
+                    for c in fine if c.startswith("u:"))
+        cross = {"method": dict(other), "max_rel_diff_u": rel_u, "digits": per}
+        print(f"  cross-check with {other['integrator']}: max rel. difference of u {rel_u:.2e}",
+              file=stream)
+        return cross
+    return None
+
+
+def write_reference(folder, out, meta):
+    """Write a computed reference: folder/history.csv (the samples) and reference.json (its
+    provenance)."""
+    folder = Path(folder)
+    folder.mkdir(parents=True, exist_ok=True)
+    digits, cols, grid, fine = out["digits"], out["columns"], out["grid"], out["fine"]
     # two digits beyond the trusted ones: rounding adds < 1 % to the reference's error
     prec = int(min(17, max(8, math.ceil(max(digits.values(), default=12.0)) + 2)))
-    folder = Path(root) / entry["name"]
-    folder.mkdir(parents=True, exist_ok=True)
     data = np.column_stack([grid] + [fine[c] for c in cols[1:]])
     np.savetxt(folder / "history.csv", data, delimiter=",", header=",".join(cols), comments="",
                fmt=f"%.{prec - 1}e")
-    meta = {"name": entry["name"], "scene": entry["scene"], "contact_override": entry.get("contact"),
-            "scene_sha256": scene.digest,
-            "physics_sha256": physics_digest(scene), "t_end": t_end,
-            "method": {k: v for k, v in method.items()}, "refinement": refinement,
-            "observed_order": observed, "digits": digits,
-            "digits_note": "−log10(max(|y_h − y_2h|, |y_h − y_4h|/3) / max |y_h|) per column "
-                           "(adaptive: |y_rtol − y_100rtol|): the error of the stored (finest) "
-                           "history for a first-order method, an overestimate for a higher "
-                           "order, still a bound when the differences do not shrink; for u, "
-                           "capped by the difference from the cross-check method",
-            "stored": {"every_s": store, "significant_digits": prec, "rows": len(grid)},
-            "events": events, "peaks": peaks, "event_refinement": ev_diff,
-            "event_horizon": t_end, "cross_check": cross,
-            "masses": {n["name"]: n["mass"] for n in scene.nodes},
-            "cost": fs["cost"],
-            "martello_version": native.version(), "libraries": native.library_versions(),
-            "python_numpy": np.__version__,
-            "date": time.strftime("%Y-%m-%dT%H:%M:%SZ", time.gmtime()),
-            "command": "scripts/regenerate_reference " + entry["name"]}
+    meta = dict(meta)
+    meta["stored"] = dict(meta.get("stored", {}), significant_digits=prec)
     (folder / "reference.json").write_text(json.dumps(meta, indent=1, default=float) + "\n")
-    # the catalogue's own settings against the new reference: what `martello check` expects
-    ref = load_reference(folder)
-    own = {"status": "skipped"} if entry.get("contact") else execute({"id": 0, "scene_dict": sdict,
-                   "scene_file": str(scene_path), "base_dir": str(scene_path.parent), "repeat": 1})
-    if own["status"] == "MARTELLO_OK":
-        sc = score(own["summary"], own["history"], ref)
-        meta["catalogue_error"] = {k: sc.get(k) for k in ("max_rel_error", "impact_time_error",
-                                                          "peak_penetration_error", "impact_count_error")}
-        meta["catalogue_settings"] = {k: v for k, v in sdict["analysis"].items() if k != "output"}
-        (folder / "reference.json").write_text(json.dumps(meta, indent=1, default=float) + "\n")
-    print(f"  -> {folder}: {len(grid)} rows, digits trusted (min over u) "
-          f"{min(v for k, v in digits.items() if k.startswith('u:')):.1f}, observed order {observed:.2f}",
-          file=stream)
     return folder
 
 

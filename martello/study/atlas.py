@@ -451,6 +451,9 @@ def _markdown(atlas, rows, bounds, pngs, elapsed, path):
 
 
 def main(args):
+    if getattr(args, "scheduler", None):
+        raise StudyError(args.study, "--scheduler", "a stability atlas runs on the local cores; "
+                         "only sweep studies run on a Dask cluster", "drop --scheduler (use -j)")
     atlas = load_atlas(args.study)
     out = Path(args.output) if args.output else (OUTPUT_ROOT / atlas["output"] if atlas["output"]
                                                  else Path("out") / "studies" / Path(args.study).stem)

@@ -330,19 +330,21 @@ def _markdown(study, rows, order_rows, refs, notes, pngs, elapsed, path):
     path.write_text("\n".join(lines) + "\n")
 
 
-def run_study(study, outdir, jobs=0, plots=True, stream=sys.stderr):
+def run_study(study, outdir, jobs=0, plots=True, stream=None, executor=None, where=None):
     """Run a loaded study; write runs.csv, orders.csv, study.md and the plots in outdir.
-    Returns (rows, order_rows)."""
+    The runs go to local processes, or to `executor` (a Dask cluster's: study.cluster),
+    described by `where`. Returns (rows, order_rows)."""
+    stream = stream or sys.stderr
     outdir = Path(outdir)
     outdir.mkdir(parents=True, exist_ok=True)
     t0 = time.perf_counter()
     specs, refs, notes = build_specs(study)
     print(f"{study.title}: {len(study.cases)} case(s) x {len(study.methods)} method(s): "
-          f"{len(specs)} runs on {jobs or os.cpu_count()} worker(s)", file=stream)
+          f"{len(specs)} runs on {where or f'{jobs or os.cpu_count()} worker(s)'}", file=stream)
     progress = Progress(len(specs), stream=stream)
     by_id = {s["id"]: s for s in specs}
     rows = []
-    for res in run_specs(specs, jobs, progress):
+    for res in run_specs(specs, jobs, progress, executor):
         spec = by_id[res["id"]]
         rows.append(make_row(study, spec, res, refs.get(spec["case"])))
     rows.sort(key=lambda r: r["run"])
@@ -370,7 +372,14 @@ def main(args):
     study = load_study(path)
     out = Path(args.output) if args.output else (OUTPUT_ROOT / study.output if study.output
                                                  else Path("out") / "studies" / path.stem)
-    rows, order_rows = run_study(study, out, jobs=getattr(args, "jobs", 0) or 0)
+    scheduler = getattr(args, "scheduler", None)
+    if scheduler:
+        from .cluster import dask_executor
+        with dask_executor(scheduler) as (executor, workers):
+            rows, order_rows = run_study(study, out, executor=executor,
+                                         where=f"the Dask cluster at {scheduler} ({workers} worker(s))")
+    else:
+        rows, order_rows = run_study(study, out, jobs=getattr(args, "jobs", 0) or 0)
     counts = {}
     for r in rows:
         counts[r["classification"]] = counts.get(r["classification"], 0) + 1
