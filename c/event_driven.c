@@ -15,7 +15,7 @@
  *    a penalty contact crossing 0 either way (no step straddles the kink of the law), and the
  *    multiplier of a persistent contact turning tensile (release). A quintic Hermite
  *    interpolant of the gap on the step (u, v, a at both ends) screens for an extremum that
- *    crosses 0 inside one step (PROBLEMS.md P7, grazing contacts); the crossing is then
+ *    crosses 0 inside one step (docs/problems.md P7, grazing contacts); the crossing is then
  *    confirmed on re-integrated states.
  *  - At an event the unilateral contacts touching within tolerance are resolved together by
  *    Newton's law at the velocity level, 0 <= g'+ + e g'- _|_ P >= 0: an impulse LCP on the

@@ -1,4 +1,4 @@
-/* DAE integration on SUNDIALS IDA (issue 4, item 3; docs/ida.md).
+/* DAE integration on SUNDIALS IDA (docs/ida.md).
  *
  * State y, node by node: [u_i, v_i] followed, after the first node of each rigid contact r
  * (scheme lagrange or restitution), by its multiplier P_r and its GGL multiplier mu_r, so that
@@ -645,7 +645,7 @@ static int classify_roots(ida_problem *P, void *mem, double t_last, double tret,
 }
 
 /* A reported root whose function is exactly 0 at the return stays 0 when two nodes move
- * identically (identical neighbours never touch, PROBLEMS.md P7; rigid clusters of a chain):
+ * identically (identical neighbours never touch, docs/problems.md P7; rigid clusters of a chain):
  * IDA would stop on it again at once and fail with "root found at and very near t". A
  * restart with no event lets IDA treat it as inactive until it moves away from 0. */
 static int root_stays_zero(ida_problem *P, const double *y, const int *found) {

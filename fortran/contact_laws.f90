@@ -1,5 +1,5 @@
 !> Penalty contact laws for one contact pair: force, tangents, elastic energy and the
-!> published damping-from-restitution formulas (PROBLEMS.md P5).
+!> published damping-from-restitution formulas (docs/problems.md P5).
 !>
 !> Conventions (shared with the C and Python layers):
 !>   delta  = (u_a - u_b) - gap, penetration; contact when delta > 0,
@@ -89,7 +89,7 @@ contains
 
       case (LAW_KELVIN)
          ! Anagnostopoulos (1988): linear spring + dashpot; the clipped variant removes the
-         ! tension that the unclipped law develops just before separation (PROBLEMS.md P5).
+         ! tension that the unclipped law develops just before separation (docs/problems.md P5).
          c = par(P_DAMPING)
          f = k*delta + c*ddelta
          df_ddelta = k
@@ -209,7 +209,7 @@ contains
 
    !> The factor a = chi*v0 for which the Hunt-Crossley form F = K delta^n (1 + chi ddelta)
    !> realises restitution e exactly: the root in (0, 1/e) of (1 + e) a = ln[(1 + a)/(1 - e a)]
-   !> (PROBLEMS.md P5; independent of n, K and m*). e = 1 gives 0; e must be in (0, 1]
+   !> (docs/problems.md P5; independent of n, K and m*). e = 1 gives 0; e must be in (0, 1]
    !> (a -> infinity as e -> 0); otherwise NaN.
    !> Solved by bisection to round-off in t = -ln(1 - e a) in (0, (1+e)/e + 1): a(t) stays
    !> below 1/e even when 1 - e a is below round-off (small e, a = 1/e to working precision).

@@ -8,7 +8,7 @@
 !> for a diagonal M, m_a against a wall, infinite if neither side moves). M is the lumped
 !> diagonal plus the consistent couplings (docs/p4-bars.md), restricted to the free nodes.
 !> m* sets the damping of a penalty contact given a target restitution (contact_laws'
-!> damping_from_restitution, PROBLEMS.md P5) and the Jankowski damping coefficient.
+!> damping_from_restitution, docs/problems.md P5) and the Jankowski damping coefficient.
 module martello_effective_mass
    use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_positive_inf, ieee_is_finite
    use martello_kinds, only: dp

@@ -1,5 +1,5 @@
 !> Two-node connectors (node b may be ground): springs, dashpots, bilinear hysteretic springs,
-!> fluid-viscous dampers and axial bars (PROBLEMS.md P6, P7, P8).
+!> fluid-viscous dampers and axial bars (docs/problems.md P6, P7, P8).
 !>
 !> Conventions: du = u_a - u_b (elongation), dv = its rate. f = f(du, dv) is positive when
 !> the link is stretched; node a receives -f and node b receives +f. k_tan = df/d(du),
@@ -33,7 +33,7 @@ module martello_links
 
 contains
 
-   !> Bilinear spring with kinematic hardening (PROBLEMS.md P6): a trial step from the
+   !> Bilinear spring with kinematic hardening (docs/problems.md P6): a trial step from the
    !> committed state (f_n, u_n) to the elongation u_new. The force is bounded by the lines
    !> rho k u +- (1 - rho) F_y, so the return map is a clamp of the elastic predictor;
    !> the consistent tangent is k if the clamp was inactive, rho k otherwise.
@@ -96,7 +96,7 @@ contains
       e_recoverable = e_recoverable + 0.5_dp*fp*fp/((1.0_dp - rho)*k)
    end subroutine bilinear_energy
 
-   !> Fluid-viscous damper F = c sign(v) |v|^alpha (seed §5, PROBLEMS.md P8).
+   !> Fluid-viscous damper F = c sign(v) |v|^alpha (seed §5, docs/problems.md P8).
    !> For alpha < 1 the tangent c alpha |v|^(alpha-1) is infinite at v = 0 and Newton
    !> iterations break down, so for |v| < v_reg the law is replaced by the secant line
    !> F = c v_reg^(alpha-1) v: continuous at |v| = v_reg, the slope jumps by the factor alpha.

@@ -1,4 +1,4 @@
-!> The seed's Newmark–Lagrange scheme (Papadrakakis et al. 1991; seed eq. 48; PROBLEMS.md
+!> The seed's Newmark–Lagrange scheme (Papadrakakis et al. 1991; seed eq. 48; docs/problems.md
 !> "Lagrange + Newmark"): Newmark time stepping with the contact constraint δ = 0 enforced at
 !> the displacement level by a Lagrange multiplier, and (β, γ) re-chosen in every step that
 !> contains an impact so that the relative velocity at the end of that step is −e times the
@@ -14,7 +14,7 @@
 !> fixes only the ratio
 !>
 !>   γ/β = R = h (δ̇_n + hδ̈_n + e v_imp)/D₀     (= (1 + e)/(1 − α) when δ̈_n = 0, which is
-!>                                               PROBLEMS.md's "γ(1 − α)/β − 1 = e").
+!>                                               docs/problems.md's "γ(1 − α)/β − 1 = e").
 !>
 !> We keep γ = ½ (no numerical damping) and take β = 1/(2R). The pair is unconditionally
 !> stable (2β ≥ γ ≥ ½) iff R ≤ 2, i.e. α ≤ (1 − e)/2 without other forces; otherwise the

@@ -1,4 +1,4 @@
-!> Static equilibrium of any scene with unilateral contacts (PROBLEMS.md P1, P3; seed §3).
+!> Static equilibrium of any scene with unilateral contacts (docs/problems.md P1, P3; seed §3).
 !> Elastic links only (springs, bars). Contacts are solved by a primal–dual active set:
 !>  - lagrange: KKT system [K B; Bᵀ 0][u; P] = [f; d] (symmetric indefinite, dsytrf);
 !>  - penalty (linear law, stiffness ε): the SPD penalised stiffness K + ε B Bᵀ is formed for

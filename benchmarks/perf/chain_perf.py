@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Chain performance benchmark (issue 3): time per DOF per step of average-acceleration Newmark
+"""Chain performance benchmark: time per DOF per step of average-acceleration Newmark
 on chains of n elasto-plastic oscillators whose contacts are all active, and peak memory.
 
 Each n runs in its own process so that peak memory (ru_maxrss) belongs to that n alone.

@@ -1,5 +1,5 @@
 /* P1 (mass on a rigid plane, static) through the C API, checked against the closed form of
- * PROBLEMS.md P1, coded here independently. Also the error exits: one bad argument at a
+ * docs/problems.md P1, coded here independently. Also the error exits: one bad argument at a
  * time, each must return its documented code (as LAPACK's error-exit tests do).
  * Returns non-zero on any failure, so ctest reports it. */
 #include <math.h>
@@ -91,7 +91,7 @@ int main(void) {
     printf("FAIL registry: %d status codes (14 expected), or an unknown table accepted\n", rows);
   }
 
-  /* Lagrange: u = h, P = m g − k h (PROBLEMS.md P1). A 2×2 KKT solve: a few ulps, 1e-14. */
+  /* Lagrange: u = h, P = m g − k h (docs/problems.md P1). A 2×2 KKT solve: a few ulps, 1e-14. */
   martello_model *m = p1(MARTELLO_SCHEME_LAGRANGE, 0.0);
   st = martello_static_solve(m, 1e-14, 100, &u, &force, &pen, &active, counters, cond);
   expect_status("lagrange solve", st, MARTELLO_OK);

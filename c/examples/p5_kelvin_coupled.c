@@ -1,4 +1,4 @@
-/* P5 (two-body impact through a Kelvin contact, PROBLEMS.md) through the C API, with a mass
+/* P5 (two-body impact through a Kelvin contact, docs/problems.md) through the C API, with a mass
  * coupling between the bodies: the caller gives only the target restitution e; the library
  * derives the damping 2 xi sqrt(k m*) from its own effective mass m* = 1/(B M^-1 B^T). The
  * unclipped Kelvin law realises e exactly (Anagnostopoulos 1988), so the event of the run must

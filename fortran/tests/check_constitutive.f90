@@ -1,5 +1,5 @@
 !> Self-check of martello_contact_laws and martello_links against oracles coded here,
-!> independently of the modules (PROBLEMS.md P5, P6, P8). Prints one line per check and
+!> independently of the modules (docs/problems.md P5, P6, P8). Prints one line per check and
 !> "N passed, M failed"; stops with status 1 if anything failed.
 program check_constitutive
    use, intrinsic :: iso_fortran_env, only: real128, output_unit
@@ -459,7 +459,7 @@ contains
                     //trim(fmt_f(targets(i))), abs(e1 - efo(i)), 6.0e-11_dp)
       end do
 
-      ! Hertz, no damping: e = 1 and t_c = 2.9432751843 delta_max/v0 (PROBLEMS.md P5)
+      ! Hertz, no damping: e = 1 and t_c = 2.9432751843 delta_max/v0 (docs/problems.md P5)
       call law_params(LAW_HERTZ, 1.0_dp, par)
       dmax = (5.0_dp*mstar*v0**2/(4.0_dp*par(P_STIFF)))**0.4_dp
       th = 2.9432751843_dp*dmax/v0
@@ -532,7 +532,7 @@ contains
 
    ! ------------------------------------------------------------------------ links
 
-   !> Exact bilinear monotonic loading curve (PROBLEMS.md P6).
+   !> Exact bilinear monotonic loading curve (docs/problems.md P6).
    pure function bilinear_curve(k, fy, rho, u) result(f)
       real(dp), intent(in) :: k, fy, rho, u
       real(dp) :: f
