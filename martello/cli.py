@@ -5,6 +5,7 @@ import json
 import sys
 from pathlib import Path
 
+from . import errors
 from .binding import native
 from .errors import MartelloError
 from .scene import catalogue
@@ -43,7 +44,10 @@ def cmd_list(args):
 def cmd_run(args):
     from .checks.measures import run_measured
     from .run import write_results
+    from .run import check_budget
     s = load(args.scene)
+    for w in check_budget(s, force=args.force):     # steps and output size, before running
+        print(f"warning: {w}", file=sys.stderr)
     summary, history = run_measured(s)     # with the problem's measures (P4), as check does
     out = Path(args.output) if args.output else Path("out") / Path(args.scene).stem
     path = write_results(summary, out, history)
@@ -78,12 +82,73 @@ def _print_version(args):
     return 0
 
 
+REPORT = ("this is a bug in martello: please report it with the command and its input files; "
+          "--debug shows the traceback")
+MAX_JOBS = 256
+
+
+class _Parser(argparse.ArgumentParser):
+    """Usage errors in one line, exit code 1, like every other error."""
+
+    def error(self, message):
+        self.exit(1, f"{self.prog}: error: {_one_line(message)} (see {self.prog} --help)\n")
+
+
+def _one_line(text):
+    return " ".join(str(text).split())
+
+
+def _jobs(text):
+    """-j/--jobs: 0 (all cores) to MAX_JOBS."""
+    try:
+        n = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r} is not a whole number") from None
+    if not 0 <= n <= MAX_JOBS:
+        raise argparse.ArgumentTypeError(f"{n} is not in 0 to {MAX_JOBS} (0: all cores)")
+    return n
+
+
 def main(argv=None):
-    parser = argparse.ArgumentParser(prog="martello", description=DESCRIPTION,
-                                     formatter_class=argparse.RawDescriptionHelpFormatter)
+    """The command line. Every failure ends as one line on stderr and exit code 1: the
+    message of a MartelloError (input the user can fix, a failed run), a system error (a
+    file that cannot be read or written, out of memory), or, for anything else, the
+    exception with a request to report it (a bug); --debug raises it with its traceback."""
+    argv = sys.argv[1:] if argv is None else list(argv)
+    debug = errors.debug = "--debug" in argv
+    try:
+        return _main(argv)
+    except MartelloError as exc:
+        print(f"martello: error: {_one_line(exc)}", file=sys.stderr)
+    except KeyboardInterrupt:
+        print("martello: interrupted", file=sys.stderr)
+        return 130
+    except BrokenPipeError:        # the reader of stdout went away (martello list | head)
+        sys.stderr.close()
+        return 1
+    except Exception as exc:
+        if debug:
+            raise
+        if isinstance(exc, MemoryError):
+            print("martello: error: out of memory (the scene asks for more than this machine "
+                  "has: record less, or use fewer nodes)", file=sys.stderr)
+        elif isinstance(exc, OSError) and exc.strerror:
+            where = f": {exc.filename}" if exc.filename else ""
+            print(f"martello: error: {exc.strerror}{where}", file=sys.stderr)
+        else:
+            print(f"martello: internal error: {type(exc).__name__}: {_one_line(exc)} ({REPORT})",
+                  file=sys.stderr)
+    return 1
+
+
+def _main(argv):
+    parser = _Parser(prog="martello", description=DESCRIPTION,
+                     formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--version", action="store_true",
                         help="print the versions of martello and the libraries it links")
-    sub = parser.add_subparsers(dest="command", metavar="COMMAND")
+    parser.add_argument("--debug", action="store_true",
+                        help="show the traceback of an internal error (a bug to report)")
+    sub = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=_Parser)
 
     p = sub.add_parser("list", help="list the benchmark catalogue, one line per scene")
     p.set_defaults(func=cmd_list)
@@ -95,6 +160,8 @@ def main(argv=None):
     p.add_argument("scene", help="scene file (TOML)")
     p.add_argument("-o", "--output", help="output folder (default: out/<scene name>)")
     p.add_argument("--print", action="store_true", help="also print the summary")
+    p.add_argument("--force", action="store_true",
+                   help="run even if it needs more than 1e9 steps or writes more than 1 GB")
     p.set_defaults(func=cmd_run)
 
     p = sub.add_parser("check", help="verify scenes against their closed forms",
@@ -114,7 +181,8 @@ def main(argv=None):
                        "error-vs-step plots with the measured orders.")
     p.add_argument("study", help="study file (TOML)")
     p.add_argument("-o", "--output", help="output folder (default: out/studies/<name>)")
-    p.add_argument("-j", "--jobs", type=int, default=0, help="parallel runs (default: all cores)")
+    p.add_argument("-j", "--jobs", type=_jobs, default=0,
+                   help=f"parallel runs, 0 to {MAX_JOBS} (default 0: all cores)")
     p.set_defaults(func=cmd_study)
 
     p = sub.add_parser("compare", help="score another code's time history against a scene",
@@ -130,17 +198,16 @@ def main(argv=None):
     p = sub.add_parser("version", help="versions of martello and the libraries it links")
     p.set_defaults(func=_print_version)
 
+    for p in sub.choices.values():      # --debug after the command too
+        p.add_argument("--debug", action="store_true", default=argparse.SUPPRESS,
+                       help=argparse.SUPPRESS)
     args = parser.parse_args(argv)
     if args.version:
         args.command, args.func = "version", _print_version
     if not args.command:
         parser.print_help()
         return 2
-    try:
-        return args.func(args)
-    except MartelloError as exc:
-        print(f"martello: error: {exc}", file=sys.stderr)
-        return 1
+    return args.func(args)
 
 
 if __name__ == "__main__":
