@@ -48,6 +48,8 @@ def check_regular(path):
         raise UnreadableFile("does not exist (a part of the path is a file, not a folder)") from None
     except OSError as exc:
         raise UnreadableFile(f"cannot be examined: {exc.strerror or exc}") from None
+    except ValueError:               # a NUL byte, which no path may hold
+        raise UnreadableFile("is no valid path (it holds a NUL character)") from None
     kind = _not_regular(st.st_mode)
     if kind:
         raise UnreadableFile(f"is {kind}, not a regular file", "give the path of a file")

@@ -46,7 +46,7 @@ velocity history without the native model.
 import math
 
 from ..errors import SceneError
-from .fields import MAX_GENERATED, check_fields
+from .fields import MAX_GENERATED, TINY, check_fields
 
 BAR_KEYS = {
     "name": ("str", True, None, None),
@@ -108,7 +108,7 @@ def _derived_ok(src, where, b, EA, rhoA, Le):
     """The rod's derived numbers must be normal doubles: E·A and ρ·A can underflow to zero
     or a subnormal (ρ = 1e-310), overflow to inf (E = 1e300, A = 1e10), and then c = √(EA/ρA),
     Z = √(EA ρA) and the element masses ρA·L_e are no numbers to integrate with."""
-    tiny = 2.2250738585072014e-308       # the smallest normal double (IEEE 754 binary64)
+    tiny = TINY
     for key, value in (("EA", EA), ("rhoA", rhoA), ("element mass rhoA·L/elements", rhoA * Le),
                        ("element stiffness EA·elements/L", EA / Le)):
         if not (math.isfinite(value) and value >= tiny):
@@ -265,8 +265,8 @@ def _with_output_nodes(analysis, explicit_nodes, rod_nodes):
     listed = out.get("nodes")
     if listed is None:
         listed = [n for n in explicit_nodes if isinstance(n, str)]
-    elif not isinstance(listed, list):
-        return analysis
+    elif not isinstance(listed, list) or not all(isinstance(n, str) for n in listed):
+        return analysis            # the loader reports the malformed list
     seen = set(listed)
     out["nodes"] = list(listed) + [n for n in rod_nodes if n not in seen]
     analysis["output"] = out
