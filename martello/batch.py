@@ -56,8 +56,14 @@ def _processes(pool):
 
 
 def _death(processes):
-    """Why a worker died, from the exit codes of a pool's processes (best effort)."""
+    """Why a worker died, from the exit codes of a pool's processes (best effort). The pool
+    fails its futures before it reaps its processes, and it ends the survivors with SIGTERM:
+    wait for the exit codes a moment, and name another signal first."""
+    for p in processes:
+        if p.exitcode is None:
+            p.join(1.0)
     codes = [p.exitcode for p in processes if p.exitcode not in (None, 0)]
+    codes.sort(key=lambda c: c == -signal.SIGTERM)
     for c in codes:
         if c < 0:
             try:

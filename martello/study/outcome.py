@@ -22,7 +22,7 @@ def status_class(status, message=""):
     return f"failed: {status}"
 
 
-def failed_rows(rows, key, table, stream=sys.stderr):
+def failed_rows(rows, key, table, stream=None):
     """Exit code of a study: 1 when a row has no outcome (status "error": the run raised, or
     its worker died however often it was run), saying how many; diverged, unstable or
     unconverged runs are outcomes of the sweep, not failures of the study."""
@@ -31,5 +31,5 @@ def failed_rows(rows, key, table, stream=sys.stderr):
         return 0
     first = (bad[0].get("message") or "").strip()
     print(f"martello: error: {len(bad)} of {len(rows)} runs failed without a result "
-          f"(status error; the first: {first}); see {table}", file=stream)
+          f"(status error; the first: {first}); see {table}", file=stream or sys.stderr)
     return 1
