@@ -341,3 +341,20 @@ def test_output_budget_warns_refuses_and_yields_to_force(tmp_path):
     r = martello("run", f, "-o", tmp_path / "out")
     one_line_error(r, "analysis.dt: needs at least 5e9 steps")
     assert not (tmp_path / "out").exists()
+
+
+def test_a_bug_in_one_scene_does_not_stop_martello_check(tmp_path, monkeypatch):
+    import io
+    from martello import report
+    real = report.run_measured
+
+    def flaky(scene):
+        if scene.problem == "P5":
+            raise KeyError("a bug")
+        return real(scene)
+    monkeypatch.setattr(report, "run_measured", flaky)
+    out = io.StringIO()
+    ok = report.check_catalogue([P5, P1], tmp_path, plots=False, stream=out)
+    text = out.getvalue()
+    assert not ok and "internal error: KeyError: 'a bug'" in text
+    assert "P1 mass on plane" in text and "1 failure(s); 2 scenes" in text

@@ -59,9 +59,10 @@ def _key(k):
     return k if _BARE.fullmatch(k) else json.dumps(k)
 
 
-def _value(v):
+def toml_value(v):
+    """A value as TOML text; tables inline (also tests/test_behaviour.py's writer)."""
     if isinstance(v, Deep):
-        return "[" * v.depth + _value(v.leaf) + "]" * v.depth
+        return "[" * v.depth + toml_value(v.leaf) + "]" * v.depth
     if isinstance(v, bool):
         return "true" if v else "false"
     if isinstance(v, int):
@@ -75,16 +76,16 @@ def _value(v):
     if isinstance(v, str):
         return json.dumps(v)
     if isinstance(v, list):
-        return "[" + ", ".join(_value(x) for x in v) + "]"
+        return "[" + ", ".join(toml_value(x) for x in v) + "]"
     if isinstance(v, dict):
-        return "{" + ", ".join(f"{_key(str(k))} = {_value(x)}" for k, x in v.items()) + "}"
+        return "{" + ", ".join(f"{_key(str(k))} = {toml_value(x)}" for k, x in v.items()) + "}"
     return json.dumps(str(v))
 
 
 def to_toml(d):
     if not isinstance(d, dict):
-        return f"x = {_value(d)}\n"
-    return "".join(f"{_key(str(k))} = {_value(v)}\n" for k, v in d.items())
+        return f"x = {toml_value(d)}\n"
+    return "".join(f"{_key(str(k))} = {toml_value(v)}\n" for k, v in d.items())
 
 
 # --- values ---------------------------------------------------------------------------------
