@@ -109,15 +109,14 @@ def _jobs(text):
     return n
 
 
-def main(argv=None):
-    """The command line. Every failure ends as one line on stderr and exit code 1: the
+def run_command(args):
+    """Run the parsed command. Every failure ends as one line on stderr and exit code 1: the
     message of a MartelloError (input the user can fix, a failed run), a system error (a
     file that cannot be read or written, out of memory), or, for anything else, the
     exception with a request to report it (a bug); --debug raises it with its traceback."""
-    argv = sys.argv[1:] if argv is None else list(argv)
-    debug = errors.debug = "--debug" in argv
+    errors.debug = args.debug
     try:
-        return _main(argv)
+        return args.func(args)
     except MartelloError as exc:
         print(f"martello: error: {_one_line(exc)}", file=sys.stderr)
     except KeyboardInterrupt:
@@ -127,7 +126,7 @@ def main(argv=None):
         sys.stderr.close()
         return 1
     except Exception as exc:
-        if debug:
+        if args.debug:
             raise
         if isinstance(exc, MemoryError):
             print("martello: error: out of memory (the scene asks for more than this machine "
@@ -141,7 +140,7 @@ def main(argv=None):
     return 1
 
 
-def _main(argv):
+def main(argv=None):
     parser = _Parser(prog="martello", description=DESCRIPTION,
                      formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--version", action="store_true",
@@ -207,7 +206,7 @@ def _main(argv):
     if not args.command:
         parser.print_help()
         return 2
-    return args.func(args)
+    return run_command(args)
 
 
 if __name__ == "__main__":
