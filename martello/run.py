@@ -277,10 +277,10 @@ def _static(scene, model):
         "nodes": {n["name"]: {"u": float(r["u"][i])} for i, n in enumerate(scene.nodes)},
         "contacts": contacts,
         "conditioning": {"rcond": r["rcond"],
-                         "condition_estimate": (1.0 / r["rcond"]) if r["rcond"] > 0 else None,
+                         "condition_estimate": _finite_or_none(1.0 / r["rcond"]) if r["rcond"] > 0 else None,
                          "digits_lost": r["digits_lost"],
                          "penalty_ratio": r["penalty_ratio"],
-                         "penalised_stiffness_condition": (1.0 / r["penalised_rcond"])
+                         "penalised_stiffness_condition": _finite_or_none(1.0 / r["penalised_rcond"])
                          if r["penalised_rcond"] > 0 else None},
         "cost": {"active_set_iterations": r["active_set_iterations"],
                  "uzawa_iterations": r["uzawa_iterations"], "linear_solves": r["linear_solves"],
