@@ -5,8 +5,10 @@ reference builder run their sweeps through here."""
 from __future__ import annotations
 
 import os
-from concurrent.futures import ProcessPoolExecutor, as_completed
-from contextlib import nullcontext
+import signal
+from collections import deque
+from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, as_completed, wait
+from concurrent.futures.process import BrokenProcessPool
 from pathlib import Path
 
 import numpy as np
@@ -39,11 +41,53 @@ def execute(spec):
                   "summary": keep, "history": (history[0], np.asarray(history[1]))}
 
 
-def run_specs(specs, jobs=0, progress=None, executor=None):
+# How many times a spec whose worker died is run again, each time alone in a process of its
+# own, before its row is marked failed with the reason.
+RETRIES = 2
+
+
+def _pool(workers):
+    return ProcessPoolExecutor(max_workers=workers)
+
+
+def _processes(pool):
+    """The worker processes a pool has started (private to concurrent.futures: best effort)."""
+    return list((getattr(pool, "_processes", None) or {}).values())
+
+
+def _death(processes):
+    """Why a worker died, from the exit codes of a pool's processes (best effort). The pool
+    fails its futures before it reaps its processes, and it ends the survivors with SIGTERM:
+    wait for the exit codes a moment, and name another signal first."""
+    for p in processes:
+        if p.exitcode is None:
+            p.join(1.0)
+    codes = [p.exitcode for p in processes if p.exitcode not in (None, 0)]
+    codes.sort(key=lambda c: c == -signal.SIGTERM)
+    for c in codes:
+        if c < 0:
+            try:
+                name = signal.Signals(-c).name
+            except ValueError:
+                name = f"signal {-c}"
+            hint = " (kill -9, or the out-of-memory killer)" if -c == signal.SIGKILL else ""
+            return f"killed by {name}{hint}"
+    return f"exit code {codes[0]}" if codes else "ended abruptly"
+
+
+def run_specs(specs, jobs=0, progress=None, *, fn=None, retries=RETRIES, executor=None):
     """Run specs in worker processes (ProcessPoolExecutor), or on `executor` (any
-    concurrent.futures executor, e.g. a Dask cluster's: martello.study.cluster); yield
-    results as they finish. Specs with a precomputed status (incompatible combinations) are
-    not run."""
+    concurrent.futures executor, e.g. a Dask cluster's: martello.study.cluster, which
+    reschedules the work of a lost worker itself); yield results as they finish. Specs with
+    a precomputed status (incompatible combinations) are not run.
+
+    A worker that dies (killed, out of memory, a crash in the native library) breaks its
+    pool and fails every spec running in it. Those specs are run again, each alone in a
+    process of its own, so the one that kills its worker is found and the others finish;
+    one whose worker still dies after `retries` further runs gives a row with status
+    "error" and the reason. Specs not yet started go to a fresh pool. Every spec gives a
+    row. `fn` runs one spec (default: execute)."""
+    fn = fn or execute
     todo = [s for s in specs if "status" not in s]
     for s in specs:
         if "status" in s:
@@ -51,21 +95,76 @@ def run_specs(specs, jobs=0, progress=None, executor=None):
                 progress.update(False)
             yield dict(s)
     jobs = jobs or os.cpu_count() or 1
-    if executor is None and (jobs == 1 or len(todo) <= 1):
-        for s in todo:
-            r = execute(s)
-            if progress:
-                progress.update(r["status"] == "MARTELLO_OK")
-            yield r
-        return
-    with (ProcessPoolExecutor(max_workers=jobs) if executor is None else nullcontext(executor)) as pool:
-        futs = [pool.submit(execute, s) for s in todo]
+
+    def done(r):
+        if progress:
+            progress.update(r["status"] == "MARTELLO_OK")
+        return r
+
+    if executor is not None:
+        futs = {executor.submit(fn, s): s for s in todo}
         for f in as_completed(futs):
             try:
                 r = f.result()
-            except Exception as exc:             # a worker died: keep the row
-                r = {"id": todo[futs.index(f)]["id"], "status": "error",
-                     "message": f"worker failed: {exc!r}"}
-            if progress:
-                progress.update(r["status"] == "MARTELLO_OK")
-            yield r
+            except Exception as exc:      # the cluster gave up on the case: keep the row
+                r = {"id": futs[f]["id"], "status": "error", "message": f"worker failed: {exc!r}"}
+            yield done(r)
+        return
+    if jobs == 1 or len(todo) <= 1:
+        # in this process: no worker to lose (a crash here ends the caller too)
+        for s in todo:
+            yield done(fn(s))
+        return
+    waiting = deque(todo)          # not started
+    alone = deque()                # to run again, each in a process of its own
+    deaths = {}                    # spec id -> worker deaths while it ran
+    running = {}                   # future -> (spec, pool, alone?)
+    workers = {}                   # pool -> its processes, for the exit codes
+    shared = None
+    try:
+        while waiting or alone or running:
+            while alone and len(running) < jobs:
+                s = alone.popleft()
+                pool = _pool(1)
+                running[pool.submit(fn, s)] = (s, pool, True)
+                workers[pool] = _processes(pool)
+            while waiting and len(running) < jobs:
+                shared = shared or _pool(jobs)
+                s = waiting.popleft()
+                try:
+                    running[shared.submit(fn, s)] = (s, shared, False)
+                    known = workers.setdefault(shared, [])
+                    known += [p for p in _processes(shared) if p not in known]
+                except BrokenProcessPool:     # broke since its last result: a fresh one
+                    waiting.appendleft(s)
+                    shared.shutdown(wait=False, cancel_futures=True)
+                    shared = None
+            finished, _ = wait(running, return_when=FIRST_COMPLETED)
+            for f in finished:
+                s, pool, isolated = running.pop(f)
+                try:
+                    r = f.result()
+                except BrokenProcessPool:
+                    deaths[s["id"]] = deaths.get(s["id"], 0) + 1
+                    why = _death(workers.get(pool, []))
+                    pool.shutdown(wait=False)
+                    if pool is shared:
+                        shared = None         # the specs not started go to a fresh pool
+                    if deaths[s["id"]] <= retries:
+                        alone.append(s)
+                        continue
+                    r = {"id": s["id"], "status": "error",
+                         "message": f"worker process died running this case, "
+                                    f"{deaths[s['id']]} times ({why})"}
+                except Exception as exc:      # e.g. a result that cannot be pickled
+                    r = {"id": s["id"], "status": "error", "message": f"worker failed: {exc!r}"}
+                if isolated:
+                    pool.shutdown(wait=False)
+                    workers.pop(pool, None)
+                yield done(r)
+    finally:
+        pools = {id(p): p for _, p, _ in running.values()}
+        if shared is not None:
+            pools[id(shared)] = shared
+        for pool in pools.values():
+            pool.shutdown(wait=True, cancel_futures=True)

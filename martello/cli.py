@@ -6,6 +6,7 @@ import os
 import sys
 from pathlib import Path
 
+from . import errors
 from .binding import native
 from .errors import MartelloError
 from .scene import catalogue
@@ -44,7 +45,10 @@ def cmd_list(args):
 def cmd_run(args):
     from .checks.measures import run_measured
     from .run import write_results
+    from .run import check_budget
     s = load(catalogue.find(args.scene))   # a file, or a path in the catalogue
+    for w in check_budget(s, force=args.force):     # steps and output size, before running
+        print(f"warning: {w}", file=sys.stderr)
     summary, history = run_measured(s)     # with the problem's measures (P4), as check does
     out = Path(args.output) if args.output else Path("out") / Path(args.scene).stem
     path = write_results(summary, out, history)
@@ -91,12 +95,77 @@ def _print_version(args):
     return 0
 
 
+REPORT = ("this is a bug in martello: please report it with the command and its input files; "
+          "--debug shows the traceback")
+MAX_JOBS = 256
+
+
+class _Parser(argparse.ArgumentParser):
+    """Usage errors in one line, exit code 1, like every other error."""
+
+    def error(self, message):
+        self.exit(1, f"{self.prog}: error: {_one_line(message)} (see {self.prog} --help)\n")
+
+
+def _one_line(text):
+    return " ".join(str(text).split())
+
+
+def _jobs(text):
+    """-j/--jobs: 0 (all cores) to MAX_JOBS."""
+    try:
+        n = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r} is not a whole number") from None
+    if not 0 <= n <= MAX_JOBS:
+        raise argparse.ArgumentTypeError(f"{n} is not in 0 to {MAX_JOBS} (0: all cores)")
+    return n
+
+
+def run_command(args):
+    """Run the parsed command. Every failure ends as one line on stderr and exit code 1: the
+    message of a MartelloError (input the user can fix, a failed run), a system error (a
+    file that cannot be read or written, out of memory), or, for anything else, the
+    exception with a request to report it (a bug); --debug raises it with its traceback."""
+    errors.debug = args.debug
+    try:
+        code = args.func(args)
+        sys.stdout.flush()       # here, not at exit: a reader that went away shows below
+        return code
+    except MartelloError as exc:
+        print(f"martello: error: {_one_line(exc)}", file=sys.stderr)
+    except KeyboardInterrupt:
+        print("martello: interrupted", file=sys.stderr)
+        return 130
+    except BrokenPipeError:
+        # the reader went away (`martello list | head`): stop quietly, as a tool killed by
+        # SIGPIPE does (exit 128 + 13); stdout goes to devnull so that the flush at exit
+        # cannot fail again (Python docs, signal module, "Note on SIGPIPE")
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        return 141
+    except Exception as exc:
+        if args.debug:
+            raise
+        if isinstance(exc, MemoryError):
+            print("martello: error: out of memory (the scene asks for more than this machine "
+                  "has: record less, or use fewer nodes)", file=sys.stderr)
+        elif isinstance(exc, OSError) and exc.strerror:
+            where = f": {exc.filename}" if exc.filename else ""
+            print(f"martello: error: {exc.strerror}{where}", file=sys.stderr)
+        else:
+            print(f"martello: internal error: {type(exc).__name__}: {_one_line(exc)} ({REPORT})",
+                  file=sys.stderr)
+    return 1
+
+
 def main(argv=None):
-    parser = argparse.ArgumentParser(prog="martello", description=DESCRIPTION,
-                                     formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser = _Parser(prog="martello", description=DESCRIPTION,
+                     formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--version", action="store_true",
                         help="print the versions of martello and the libraries it links")
-    sub = parser.add_subparsers(dest="command", metavar="COMMAND")
+    parser.add_argument("--debug", action="store_true",
+                        help="show the traceback of an internal error (a bug to report)")
+    sub = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=_Parser)
 
     p = sub.add_parser("list", help="list the benchmark catalogue, one line per scene")
     p.set_defaults(func=cmd_list)
@@ -108,6 +177,8 @@ def main(argv=None):
     p.add_argument("scene", help="scene file (TOML)")
     p.add_argument("-o", "--output", help="output folder (default: out/<scene name>)")
     p.add_argument("--print", action="store_true", help="also print the summary")
+    p.add_argument("--force", action="store_true",
+                   help="run even if it needs more than 1e9 steps or writes more than 1 GB")
     p.set_defaults(func=cmd_run)
 
     p = sub.add_parser("check", help="verify scenes against their closed forms",
@@ -127,7 +198,8 @@ def main(argv=None):
                        "error-vs-step plots with the measured orders.")
     p.add_argument("study", help="study file (TOML)")
     p.add_argument("-o", "--output", help="output folder (default: out/studies/<name>)")
-    p.add_argument("-j", "--jobs", type=int, default=0, help="parallel runs (default: all cores)")
+    p.add_argument("-j", "--jobs", type=_jobs, default=0,
+                   help=f"parallel runs, 0 to {MAX_JOBS} (default 0: all cores)")
     p.add_argument("--scheduler", metavar="ADDRESS", help="run on the Dask cluster whose scheduler "
                    "is at ADDRESS (tcp://host:8786, or a scheduler file .json) instead of local "
                    "processes (docs/studies.md)")
@@ -180,25 +252,16 @@ def main(argv=None):
     p = sub.add_parser("version", help="versions of martello and the libraries it links")
     p.set_defaults(func=_print_version)
 
+    for p in sub.choices.values():      # --debug after the command too
+        p.add_argument("--debug", action="store_true", default=argparse.SUPPRESS,
+                       help=argparse.SUPPRESS)
     args = parser.parse_args(argv)
     if args.version:
         args.command, args.func = "version", _print_version
     if not args.command:
         parser.print_help()
         return 2
-    try:
-        code = args.func(args)
-        sys.stdout.flush()       # here, not at exit: a reader that went away shows below
-        return code
-    except MartelloError as exc:
-        print(f"martello: error: {exc}", file=sys.stderr)
-        return 1
-    except BrokenPipeError:
-        # the reader went away (`martello list | head`): stop quietly, as a tool killed by
-        # SIGPIPE does (exit 128 + 13); stdout goes to devnull so that the flush at exit
-        # cannot fail again (Python docs, signal module, "Note on SIGPIPE")
-        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
-        return 141
+    return run_command(args)
 
 
 if __name__ == "__main__":

@@ -22,6 +22,7 @@ import numpy as np
 from .checks.verify import digits, lookup, oracle_values
 from .errors import MartelloError
 from .history import history_dict
+from .paths import MiB, UnreadableFile, read_input, write_text_atomic
 from .metrics.from_history import summary_from_history
 from .metrics.score import COST_KEYS, history_errors, score
 from .reference.selection import reference_for_scene
@@ -29,6 +30,8 @@ from .scene.loader import load
 
 NODE_KINDS = ("u", "v", "a")
 CONTACT_KINDS = ("penetration", "force")
+# A history to compare is at most this large (a million rows of 50 columns).
+HISTORY_LIMIT = 1024 * MiB
 ENERGY_COLUMNS = ("energy:kinetic", "energy:recoverable", "energy:input", "energy:damping",
                   "energy:plastic", "energy:contact", "energy:balance", "energy:initial",
                   "energy:impact")
@@ -71,11 +74,18 @@ def read_history(path, scene=None):
     are comments. Errors name the line: a missing t column, a column that names no node or
     contact of the scene, a non-numeric or non-finite value, times that do not increase."""
     path = Path(path)
-    if not path.exists():
-        raise HistoryError(path, "does not exist")
-    with open(path, newline="") as fh:
-        lines = [(i + 1, ln) for i, ln in enumerate(fh.read().splitlines())
-                 if ln.strip() and not ln.lstrip().startswith("#")]
+    try:
+        raw = read_input(path, HISTORY_LIMIT)
+    except UnreadableFile as exc:
+        raise HistoryError(path, exc.problem, exc.fix) from None
+    try:
+        text = raw.decode("utf-8-sig")
+    except UnicodeDecodeError as exc:
+        line = raw.count(b"\n", 0, exc.start) + 1
+        raise HistoryError(path, f"byte {exc.start + 1} is not UTF-8 text",
+                           "a history is a UTF-8 (or ASCII) CSV file", row=line) from None
+    lines = [(i + 1, ln) for i, ln in enumerate(text.splitlines())
+             if ln.strip() and not ln.lstrip().startswith("#")]
     if not lines:
         raise HistoryError(path, "is empty", "a header row (t,u:<node>,...) and data rows")
     hline, header = lines[0][0], [c.strip() for c in next(csv.reader([lines[0][1]]))]
@@ -308,7 +318,11 @@ def compare(history_path, scene_path, columns=None, compute=True, stream=None):
             except (KeyError, TypeError, ValueError):
                 checks.append({"quantity": item["result"], "note": "not derivable from a history"})
                 continue
-            refv = float(oracle[item["oracle"]])
+            try:
+                refv = float(oracle[item["oracle"]])
+            except (KeyError, TypeError, ValueError):
+                checks.append({"quantity": item["result"], "note": "the closed form gives no such value"})
+                continue
             tol = (item.get("atol") or 0.0) + (item.get("rtol") or 0.0) * abs(refv)
             checks.append({"quantity": item["result"], "value": value, "reference": refv,
                            "digits": digits(value, refv), "tolerance": tol,
@@ -384,8 +398,12 @@ def main(args):
     rep = compare(args.history, args.against, columns=getattr(args, "columns", None))
     print_report(rep)
     if args.output:
-        Path(args.output).parent.mkdir(parents=True, exist_ok=True)
-        Path(args.output).write_text(json.dumps(_finite(rep), indent=1, default=_json_default) + "\n")
+        out = Path(args.output)
+        try:
+            out.parent.mkdir(parents=True, exist_ok=True)
+            write_text_atomic(out, json.dumps(_finite(rep), indent=1, default=_json_default) + "\n")
+        except OSError as exc:
+            raise MartelloError(f"{out}: cannot write the scores: {exc.strerror or exc}") from None
     return 0
 
 

@@ -1,4 +1,10 @@
-"""Exceptions the command line reports as one clear message, without a traceback."""
+"""Exceptions the command line reports as one clear message, without a traceback.
+
+Anything else that reaches the command line is a bug; it is reported in one line too, with a
+request to report it (martello.cli.main; the traceback with --debug). `debug` is set by
+--debug, for the layers that catch errors of their own (martello check, per scene)."""
+
+debug = False
 
 
 class MartelloError(Exception):
@@ -35,6 +41,16 @@ class RecordError(MartelloError):
         if fix:
             msg += f" ({fix})"
         super().__init__(msg)
+
+    def within(self, scene, field, given):
+        """The same error, naming the scene, its field and the record's path as the scene
+        gives it (relative to the scene's folder) instead of the path as resolved."""
+        return RecordError(f"{scene}: {field}: {given}", self.problem, self.line, self.fix)
+
+
+class ResultError(MartelloError):
+    """A run's results cannot be written: a number that is not finite, or an output folder
+    that cannot take them. Nothing is written."""
 
 
 class SolverError(MartelloError):

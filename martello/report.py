@@ -11,6 +11,7 @@ from .binding import native
 from .checks.measures import run_measured
 from .checks.reference_data import verify_reference_data
 from .checks.verify import verify
+from . import errors
 from .errors import MartelloError
 from .paths import REPO
 from .reference.store import manifest
@@ -75,6 +76,12 @@ def check_catalogue(files, outdir, plots=True, stream=sys.stdout, require_checks
         except MartelloError as exc:
             failures.append(f"{path}: {exc}")
             print(f"{Path(path).stem[:44]:<44} ERROR: {exc}", file=stream)
+        except Exception as exc:        # a bug: this scene fails, the others are still checked
+            if errors.debug:
+                raise
+            msg = f"internal error: {type(exc).__name__}: {exc} (a bug in martello: please report it)"
+            failures.append(f"{path}: {msg}")
+            print(f"{Path(path).stem[:44]:<44} ERROR: {msg}", file=stream)
     elapsed = time.perf_counter() - t_start
     _write_csv(rows, outdir / "verification.csv")
     pngs = _plots(rows, outdir) if plots and rows else []

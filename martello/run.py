@@ -2,6 +2,9 @@
 the results as a summary dict (and, for dynamic runs, a history) ready to be written."""
 
 import json
+import os
+import shutil
+import tempfile
 import time
 from pathlib import Path
 
@@ -9,6 +12,7 @@ import numpy as np
 
 from .binding import native
 from .binding.native import constant
+from .errors import RecordError, ResultError, SceneError
 from .ground_motion.records import read_record
 
 # Default exponent n of each law's elastic part F ~ δ^n (fixed, or Hertz's when the law reads it).
@@ -54,7 +58,7 @@ def _contact_par(scene, c):
     return law, par
 
 
-def _function_args(fn):
+def _function_args(fn, source="<scene>"):
     """A validated function table -> (kind, par[NPAR_TF], t, y) for the native library."""
     par = np.zeros(constant("NPAR_TF"))
     kind = fn["type"]
@@ -71,7 +75,12 @@ def _function_args(fn):
         par[0] = fn["scale"]
         return constant("TF_TABLE"), par, fn["t"], fn["values"]
     if kind == "record":
-        rec = read_record(fn["file"], fmt=fn["format"], units=fn["units"], scale=fn["scale"])
+        try:
+            rec = read_record(fn["file"], fmt=fn["format"], units=fn["units"], scale=fn["scale"])
+        except RecordError as exc:
+            if "given" not in fn:
+                raise
+            raise exc.within(source, fn["where"], fn["given"]) from None
         par[0] = 1.0
         return constant("TF_TABLE"), par, rec.t, rec.accel
     raise AssertionError(kind)
@@ -92,9 +101,9 @@ def build_model(scene):
         m.add_mass_coupling(mc["a"], mc["b"], mc["value"])
     m.set_gravity(scene.gravity)
     for f in scene.forces:
-        m.add_nodal_force(f["node"], *_function_args(f["function"]))
+        m.add_nodal_force(f["node"], *_function_args(f["function"], scene.source))
     if scene.ground is not None:
-        m.set_ground_acceleration(*_function_args(scene.ground))
+        m.set_ground_acceleration(*_function_args(scene.ground, scene.source))
     return m
 
 
@@ -268,10 +277,10 @@ def _static(scene, model):
         "nodes": {n["name"]: {"u": float(r["u"][i])} for i, n in enumerate(scene.nodes)},
         "contacts": contacts,
         "conditioning": {"rcond": r["rcond"],
-                         "condition_estimate": (1.0 / r["rcond"]) if r["rcond"] > 0 else None,
+                         "condition_estimate": _finite_or_none(1.0 / r["rcond"]) if r["rcond"] > 0 else None,
                          "digits_lost": r["digits_lost"],
                          "penalty_ratio": r["penalty_ratio"],
-                         "penalised_stiffness_condition": (1.0 / r["penalised_rcond"])
+                         "penalised_stiffness_condition": _finite_or_none(1.0 / r["penalised_rcond"])
                          if r["penalised_rcond"] > 0 else None},
         "cost": {"active_set_iterations": r["active_set_iterations"],
                  "uzawa_iterations": r["uzawa_iterations"], "linear_solves": r["linear_solves"],
@@ -284,14 +293,186 @@ def _finite_or_none(x):
     return float(x) if np.isfinite(x) else None
 
 
-def write_results(summary, outdir, history=None):
-    outdir = Path(outdir)
-    outdir.mkdir(parents=True, exist_ok=True)
+# --- what a run may cost and write ------------------------------------------------------------
+
+# Without force (`martello run --force`), a run is refused when it needs more steps than this
+# (the integrators count steps in 32 bits up to 2.1e9, and at ~1e7 steps/s a billion is
+# minutes) or would write more than OUTPUT_LIMIT; above OUTPUT_WARN it is run with a warning
+# (docs/behaviour.md, "Failures and limits").
+MAX_STEPS = 1e9
+OUTPUT_WARN = 100e6
+OUTPUT_LIMIT = 1e9
+# Bytes per value of history.csv (%.17g and a comma; 23 on average) and, in summary.json, per
+# node, contact (without its events), event and link: measured on the catalogue, rounded up.
+_CSV_VALUE, _NODE, _CONTACT, _EVENT, _LINK, _BASE = 24, 200, 600, 200, 150, 6000
+
+
+def output_estimate(scene):
+    """What a run of the scene will take and write, estimated before it starts: steps (a
+    lower bound for the adaptive integrators: t_end/h_max, or t_end/dt), history rows and
+    columns, and the sizes of history.csv and summary.json in bytes (one impact per contact
+    assumed). Static runs take no steps and write a summary only."""
+    an = scene.analysis
+    n_nodes, n_contacts, n_links = len(scene.nodes), len(scene.contacts), len(scene.links)
+    est = {"steps": 0.0, "rows": 0.0, "columns": 0,
+           "summary_bytes": float(_BASE + _NODE * n_nodes + _LINK * n_links
+                                  + (_CONTACT + _EVENT) * n_contacts)}
+    if an["type"] == "dynamic":
+        out = an["output"]
+        intervals = an["t_end"] / an["dt"]
+        if an["integrator"] in native.adaptive_integrators():
+            # dt is the output interval; h_max (when > 0) caps every step
+            steps = an["t_end"] / an["h_max"] if an.get("h_max") else intervals
+            rows = intervals + 2
+        else:
+            steps = float(np.ceil(intervals))
+            rows = steps / out["every"] + 2
+        est.update(steps=steps, rows=rows, columns=len(native.history_columns(
+            out["nodes"], out["contacts"], out["links"])))
+    est["history_bytes"] = est["rows"] * est["columns"] * _CSV_VALUE
+    est["bytes"] = est["history_bytes"] + est["summary_bytes"]
+    return est
+
+
+def _size(b):
+    return next(f"{b / d:.3g} {u}" for d, u in ((1e9, "GB"), (1e6, "MB"), (1e3, "kB"), (0, ""))
+                if b >= d or not d).strip()
+
+
+def _g(x):
+    """3 digits, exponents without + and leading zeros: 7e11, 1e9, 2.5e5, 18."""
+    return f"{x:.3g}".replace("e+0", "e").replace("e+", "e").replace("e-0", "e-")
+
+
+def check_budget(scene, force=False):
+    """Refuse (SceneError naming the field) a run that needs more than MAX_STEPS steps or
+    would write more than OUTPUT_LIMIT, unless force; return the warnings to print (output
+    above OUTPUT_WARN, or above the limits when forced)."""
+    est, an, warnings = output_estimate(scene), scene.analysis, []
+    if est["steps"] > MAX_STEPS:
+        adaptive = an["type"] == "dynamic" and an["integrator"] in native.adaptive_integrators()
+        key = "h_max" if adaptive and an.get("h_max") else "dt"
+        what = f"at least {_g(est['steps'])} steps (t_end/{key} = {an['t_end']!r}/{an[key]!r})"
+        if not force:
+            raise SceneError(scene.source, f"analysis.{key}", f"needs {what}, more than the "
+                             f"{_g(MAX_STEPS)} steps a run may take",
+                             f"raise {key} or shorten t_end; --force runs it anyway")
+        warnings.append(f"the run needs {what}: it may take very long")
+    if est["bytes"] > OUTPUT_WARN:
+        what = (f"up to about {_size(est['bytes'])} (history.csv: {_g(est['rows'])} rows x "
+                f"{est['columns']} columns, {_size(est['history_bytes'])}; summary.json: "
+                f"{_size(est['summary_bytes'])})")
+        if est["bytes"] > OUTPUT_LIMIT and not force:
+            key = ("analysis.output.every" if est["history_bytes"] > est["summary_bytes"]
+                   else "(size)")
+            raise SceneError(scene.source, key, f"the run would write {what}, more than the "
+                             f"{_size(OUTPUT_LIMIT)} written without --force",
+                             "record less (output.every, output.nodes, output.contacts) "
+                             "or pass --force")
+        warnings.append(f"the run will write {what}")
+    return warnings
+
+
+def _first_nonfinite(obj, path=""):
+    """The dotted path of the first number in a summary that is not finite, or None."""
+    if isinstance(obj, (float, np.floating)):
+        return None if np.isfinite(obj) else path
+    if isinstance(obj, dict):
+        items = obj.items()
+    elif isinstance(obj, (list, tuple)):
+        items = enumerate(obj)
+    else:
+        return None
+    for k, v in items:
+        bad = _first_nonfinite(v, f"{path}.{k}" if path else str(k))
+        if bad is not None:
+            return bad
+    return None
+
+
+def check_finite(summary, history=None):
+    """ResultError unless every number of the summary and the history is finite. A history
+    column of link states that is NaN throughout is a state the integrator does not report
+    (the adaptive integrators; docs/behaviour.md), not a result."""
+    bad = _first_nonfinite(summary)
+    if bad is not None:
+        value = summary
+        for part in bad.split("."):
+            value = value[int(part)] if isinstance(value, list) else value[part]
+        raise ResultError(f"the run's result {bad} is {value}: a result must be finite "
+                          "(nothing written)")
     if history is not None:
         columns, data = history
-        np.savetxt(outdir / "history.csv", data, delimiter=",", header=",".join(columns),
-                   comments="", fmt="%.17g")
-    with open(outdir / "summary.json", "w") as fh:
-        json.dump(summary, fh, indent=2, allow_nan=False, default=float)
-        fh.write("\n")
-    return outdir / "summary.json"
+        data = np.asarray(data, float)
+        if data.size and not np.isfinite(data).all():
+            for j, c in enumerate(columns):
+                col = data[:, j]
+                unreported = c.startswith(("link_force:", "elongation:")) and np.isnan(col).all()
+                if not unreported and not np.isfinite(col).all():
+                    i = int(np.flatnonzero(~np.isfinite(col))[0])
+                    raise ResultError(f"the run's history column {c} is {col[i]} at row {i} "
+                                      f"(t = {data[i, 0]!r}): a result must be finite "
+                                      "(nothing written)")
+
+
+RESULT_FILES = ("summary.json", "history.csv")
+
+
+def write_results(summary, outdir, history=None):
+    """Write summary.json (and history.csv) as the folder outdir, atomically: they are written
+    to a temporary folder beside it, which is renamed into place, so outdir holds one complete
+    run or none, never a part of one nor files of an earlier run. An existing outdir is
+    replaced only if it is empty or an earlier run's (it holds a summary.json); every result
+    must be finite (check_finite). ResultError for anything that stops it; nothing is
+    written then."""
+    check_finite(summary, history)
+    text = json.dumps(summary, indent=2, allow_nan=False, default=float) + "\n"
+    given = Path(outdir)
+    outdir = Path(os.path.abspath(outdir))
+    if not outdir.name:
+        raise ResultError(f"{outdir}: cannot be an output folder (give a folder to create)")
+    if outdir.exists() or outdir.is_symlink():
+        if not outdir.is_dir() or outdir.is_symlink():
+            raise ResultError(f"{outdir}: is not a folder (-o names the folder the results "
+                              "go to: give a new folder, or an earlier run's)")
+        held = sorted(p.name for p in outdir.iterdir())
+        if held and "summary.json" not in held:
+            shown = ", ".join(held[:3]) + (", ..." if len(held) > 3 else "")
+            raise ResultError(f"{outdir}: holds files of something else ({shown}): a run "
+                              "replaces its whole output folder (give a new or empty folder, "
+                              "or an earlier run's)")
+    try:
+        outdir.parent.mkdir(parents=True, exist_ok=True)
+        tmp = Path(tempfile.mkdtemp(prefix=f".{outdir.name}.", suffix=".tmp", dir=outdir.parent))
+    except OSError as exc:
+        raise ResultError(f"{outdir}: cannot create the output folder: "
+                          f"{exc.strerror or exc}") from None
+    old = None
+    try:
+        if history is not None:
+            columns, data = history
+            np.savetxt(tmp / "history.csv", data, delimiter=",", header=",".join(columns),
+                       comments="", fmt="%.17g")
+        (tmp / "summary.json").write_text(text)
+        os.chmod(tmp, 0o777 & ~_umask())
+        if outdir.is_dir():
+            old = Path(tempfile.mkdtemp(prefix=f".{outdir.name}.", suffix=".old",
+                                        dir=outdir.parent))
+            os.replace(outdir, old)      # onto the empty folder just made: atomic
+        os.replace(tmp, outdir)
+    except OSError as exc:
+        shutil.rmtree(tmp, ignore_errors=True)
+        if old is not None and not outdir.exists():
+            os.replace(old, outdir)      # put the earlier run back
+            old = None
+        raise ResultError(f"{outdir}: cannot write the results: {exc.strerror or exc}") from None
+    finally:
+        if old is not None:
+            shutil.rmtree(old, ignore_errors=True)
+    return given / "summary.json"
+
+
+def _umask():
+    mask = os.umask(0)
+    os.umask(mask)
+    return mask

@@ -12,25 +12,13 @@ from pathlib import Path
 
 import pytest
 
+from benchmarks.fuzz.mutations import toml_value as _value
+
 ROOT = Path(__file__).resolve().parent.parent
 EPS = 2.0 ** -52          # double-precision machine epsilon
 
 
 # --- a scene as a dict -> TOML text -> the CLI -----------------------------------------------
-
-def _value(v):
-    if isinstance(v, bool):
-        return "true" if v else "false"
-    if isinstance(v, (int, float)):
-        return repr(v)
-    if isinstance(v, str):
-        return json.dumps(v)
-    if isinstance(v, list):
-        return "[" + ", ".join(_value(x) for x in v) + "]"
-    if isinstance(v, dict):
-        return "{ " + ", ".join(f"{k} = {_value(x)}" for k, x in v.items()) + " }"
-    raise TypeError(v)
-
 
 def _is_table_array(v):
     return isinstance(v, list) and v and all(isinstance(x, dict) for x in v)

@@ -54,6 +54,16 @@ def oracle_values(check, source="<scene>"):
                      "use a closed form that returns a dataclass or dict (e.g. two_body_impact)")
 
 
+def _number(x):
+    """float(x) for a number (a bool counts as 0 or 1), else None."""
+    if isinstance(x, (str, bytes)) or not hasattr(x, "__float__"):
+        return None
+    try:
+        return float(x)
+    except (TypeError, ValueError, OverflowError):
+        return None
+
+
 def digits(value, reference):
     """Significant correct digits −log10 |rel. error| (absolute error when the reference is 0)."""
     err = abs(value - reference)
@@ -73,11 +83,20 @@ def verify(scene, summary):
             raise SceneError(scene.source, f"check.compare[{i}].oracle", f"{item['oracle']!r} is not an output of "
                              f"{check['closed_form']}", "valid: " + ", ".join(ref))
         try:
-            value = float(lookup(summary, item["result"]))
+            found = lookup(summary, item["result"])
         except KeyError:
             raise SceneError(scene.source, f"check.compare[{i}].result", f"{item['result']!r} is not in the summary",
                              "use a dotted path such as nodes.<name>.u or contacts.<name>.force") from None
-        reference = float(ref[item["oracle"]])
+        value = _number(found)
+        if value is None:
+            raise SceneError(scene.source, f"check.compare[{i}].result",
+                             f"{item['result']!r} is a {type(found).__name__} in the summary, not a number",
+                             "name a number, e.g. contacts.<name>.restitution.0 for a list's first entry")
+        reference = _number(ref[item["oracle"]])
+        if reference is None or not math.isfinite(reference):
+            raise SceneError(scene.source, f"check.compare[{i}].oracle",
+                             f"{check['closed_form']} gives {item['oracle']} = {ref[item['oracle']]!r}, "
+                             "not a finite number", "compare a quantity the closed form defines here")
         rtol, atol = item.get("rtol") or 0.0, item.get("atol") or 0.0
         err = abs(value - reference)
         rows.append({

@@ -26,6 +26,7 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import RecordError
+from ..paths import MiB, UnreadableFile, read_input
 
 __all__ = [
     "Record",
@@ -46,6 +47,18 @@ _VALID_UNITS_TEXT = '"g", "m/s2" or "cm/s2"'
 
 # Relative tolerance under which the time steps of a record count as uniform.
 _UNIFORM_RTOL = 1e-9
+# A record file is at most this large: a PEER NGA record is under 1 MB, a million samples of
+# CSV about 40 MB.
+RECORD_LIMIT = 256 * MiB
+# Messages quote at most this many characters of a file: enough for any number, too few to
+# copy out a file that is not a record (a scene may name any path; docs/behaviour.md).
+_QUOTE = 20
+
+
+def _quote(text):
+    """repr of a piece of a file, cut to _QUOTE characters."""
+    text = str(text)
+    return repr(text) if len(text) <= _QUOTE else repr(text[:_QUOTE]) + "…"
 
 
 @dataclass(frozen=True)
@@ -125,18 +138,16 @@ def _check_g(g, path):
 
 def _read_lines(path):
     """Lines of a text file, numbered from 1 as an editor shows them."""
-    p = Path(path)
     try:
-        raw = p.read_bytes()
-    except FileNotFoundError:
-        raise RecordError(path, "file not found",
-                          fix="check the path; relative paths start at the working directory") from None
-    except IsADirectoryError:
-        raise RecordError(path, "is a directory, not a record file",
-                          fix="give the path of a .AT2, .csv or .txt file") from None
-    except OSError as exc:
-        raise RecordError(path, f"cannot read file: {exc.strerror or exc}",
-                          fix="check the file permissions") from None
+        raw = read_input(path, RECORD_LIMIT)
+    except UnreadableFile as exc:
+        if exc.problem == "does not exist":
+            raise RecordError(path, "file not found",
+                              fix="check the path; relative paths start at the working directory") from None
+        if exc.problem.startswith("is a directory"):
+            raise RecordError(path, "is a directory, not a record file",
+                              fix="give the path of a .AT2, .csv or .txt file") from None
+        raise RecordError(path, exc.problem, fix=exc.fix) from None
     try:
         text = raw.decode("utf-8-sig")
     except UnicodeDecodeError:
@@ -155,7 +166,8 @@ def _parse_number(token):
     """float for a plain or scientific number (Fortran D exponent allowed), 'nonfinite' for
     nan/inf spellings, None for anything else."""
     if _NUMBER_RE.fullmatch(token):
-        return float(token.replace("d", "e").replace("D", "E"))
+        x = float(token.replace("d", "e").replace("D", "E"))
+        return x if math.isfinite(x) else "nonfinite"       # 1e999 overflows to inf
     if _NONFINITE_RE.fullmatch(token):
         return "nonfinite"
     return None
@@ -222,7 +234,7 @@ def read_csv_record(path, *, units=None, g=STANDARD_GRAVITY) -> Record:
             if m:
                 canon = _units_from_text(m.group(1))
                 if canon is None:
-                    raise RecordError(path, f"unknown units {m.group(1)!r} in the units comment",
+                    raise RecordError(path, f"unknown units {_quote(m.group(1))} in the units comment",
                                       line=num,
                                       fix=f"write '# units: g', '# units: m/s2' or '# units: cm/s2'")
                 if file_units is not None and file_units[0] != canon:
@@ -238,13 +250,13 @@ def read_csv_record(path, *, units=None, g=STANDARD_GRAVITY) -> Record:
             header_seen = True  # the one optional header line
             continue
         if len(fields) != 2:
-            raise RecordError(path, f"expected 2 columns (time, acceleration), found {len(fields)}: {line!r}",
+            raise RecordError(path, f"expected 2 columns (time, acceleration), found {len(fields)}",
                               line=num,
                               fix="keep exactly two columns separated by a comma or whitespace")
         for col, (field, value) in enumerate(zip(fields, values)):
             name = ("time", "acceleration")[col]
             if value is None:
-                problem = f"{name} value {field!r} is not a number"
+                problem = f"{name} value {_quote(field)} is not a number"
                 fix = "fix the value"
                 if not times and header_seen:
                     fix += "; only one header line is allowed, make other text lines '#' comments"
@@ -252,12 +264,13 @@ def read_csv_record(path, *, units=None, g=STANDARD_GRAVITY) -> Record:
                     fix += "; a header line must be all text"
                 raise RecordError(path, problem, line=num, fix=fix)
             if value == "nonfinite":
-                raise RecordError(path, f"{name} value {field!r} is not finite", line=num,
+                raise RecordError(path, f"{name} value {_quote(field)} is not finite", line=num,
                                   fix="replace the NaN/inf by a measured value or trim the record")
         t, a = values
         if times and not t > times[-1]:
             kind = "repeated" if t == times[-1] else "decreasing"
-            raise RecordError(path, f"{kind} time: t={fields[0]} on line {num} after t={prev_text} "
+            raise RecordError(path, f"{kind} time: t={_quote(fields[0])[1:-1]} on line {num} "
+                                    f"after t={_quote(prev_text)[1:-1]} "
                                     f"on line {where[-1]}",
                               line=num, fix="times must be strictly increasing; remove or reorder samples")
         prev_text = fields[0]
@@ -303,17 +316,17 @@ def _parse_npts_dt(path, line):
         mn, md = _NPTS_KEYED_RE.search(line), _DT_KEYED_RE.search(line)
         if not mn or not md:
             missing = " and ".join(k for k, mm in (("NPTS", mn), ("DT", md)) if not mm)
-            raise RecordError(path, f"header line has no {missing}: {line.strip()!r}", line=4,
+            raise RecordError(path, f"header line has no {missing}: {_quote(line.strip())}", line=4,
                               fix=f"the 4th line of a PEER AT2 file reads like {_AT2_FORMS}")
         npts_txt, dt_txt = mn.group(1), md.group(1)
 
     npts = _parse_number(npts_txt)
-    if not isinstance(npts, float) or npts != int(npts) or npts < 0:
-        raise RecordError(path, f"NPTS {npts_txt!r} is not a non-negative whole number", line=4,
+    if not isinstance(npts, float) or npts != int(npts) or npts < 0:   # "nonfinite": 1e400
+        raise RecordError(path, f"NPTS {_quote(npts_txt)} is not a non-negative whole number", line=4,
                           fix="NPTS is the number of samples, e.g. 'NPTS=  5590'")
     dt = _parse_number(dt_txt)
     if not isinstance(dt, float):
-        raise RecordError(path, f"DT {dt_txt!r} is not a number", line=4,
+        raise RecordError(path, f"DT {_quote(dt_txt)} is not a finite number", line=4,
                           fix="DT is the time step in seconds, e.g. 'DT=   .0050 SEC'")
     if not dt > 0:
         raise RecordError(path, f"DT={dt_txt} is not positive", line=4,
@@ -329,11 +342,11 @@ def _parse_at2_units(path, line):
                               line=3, fix="use the .AT2 (acceleration) file of the record")
     m = _UNITS_LINE_RE.search(line)
     if not m:
-        raise RecordError(path, f"no units on the units line: {line.strip()!r}", line=3,
+        raise RecordError(path, "no units on the units line", line=3,
                           fix="the 3rd line of a PEER AT2 file reads 'ACCELERATION TIME SERIES IN UNITS OF G'")
     canon = _units_from_text(m.group(1))
     if canon is None:
-        raise RecordError(path, f"unknown units {m.group(1)!r}", line=3,
+        raise RecordError(path, f"unknown units {_quote(m.group(1))}", line=3,
                           fix="known units are G, M/S2 (M/S/S) and CM/S2 (CM/S/S, GAL)")
     return canon
 
@@ -371,10 +384,10 @@ def read_at2(path, *, g=STANDARD_GRAVITY) -> Record:
         for tok in tokens:
             v = _parse_number(tok)
             if v is None:
-                raise RecordError(path, f"value {tok!r} is not a number", line=num,
+                raise RecordError(path, f"value {_quote(tok)} is not a number", line=num,
                                   fix="values are plain or scientific numbers separated by whitespace")
             if v == "nonfinite":
-                raise RecordError(path, f"value {tok!r} is not finite", line=num,
+                raise RecordError(path, f"value {_quote(tok)} is not finite", line=num,
                                   fix="replace the NaN/inf by a measured value or re-download the record")
             values.append(v)
         first_line = first_line or num
@@ -392,6 +405,9 @@ def read_at2(path, *, g=STANDARD_GRAVITY) -> Record:
                           fix="check the file is complete")
 
     t = np.arange(npts) * dt
+    if not math.isfinite(t[-1]):
+        raise RecordError(path, f"NPTS x DT = {npts} x {dt!r} s is no finite duration", line=4,
+                          fix="DT is the time step in seconds, e.g. 'DT=   .0050 SEC'")
     accel = np.asarray(values, dtype=float) * _to_si_factor(units, g)
     return Record(t=t, accel=accel, dt=dt, source=str(path), units_in_file=units,
                   description=description)

@@ -46,7 +46,7 @@ velocity history without the native model.
 import math
 
 from ..errors import SceneError
-from .fields import check_fields
+from .fields import MAX_GENERATED, TINY, check_fields
 
 BAR_KEYS = {
     "name": ("str", True, None, None),
@@ -102,6 +102,26 @@ def _section(src, where, b):
     if b["A"] is not None and b["EA"] is not None and b["rhoA"] is not None:
         raise SceneError(src, f"{where}.A", "is not used with both EA and rhoA", "remove it")
     return EA, rhoA
+
+
+def _derived_ok(src, where, b, EA, rhoA, Le):
+    """The rod's derived numbers must be normal doubles: E·A and ρ·A can underflow to zero
+    or a subnormal (ρ = 1e-310), overflow to inf (E = 1e300, A = 1e10), and then c = √(EA/ρA),
+    Z = √(EA ρA) and the element masses ρA·L_e are no numbers to integrate with."""
+    tiny = TINY
+    for key, value in (("EA", EA), ("rhoA", rhoA), ("element mass rhoA·L/elements", rhoA * Le),
+                       ("element stiffness EA·elements/L", EA / Le)):
+        if not (math.isfinite(value) and value >= tiny):
+            field = key if key in ("EA", "rhoA") and b[key] is not None else (
+                "elements" if key.startswith("element") else ("E" if key == "EA" else "rho"))
+            raise SceneError(src, f"{where}.{field}", f"gives {key} = {value!r}",
+                             "the rod's derived values must be finite numbers >= 2.2e-308: "
+                             "check the units")
+    c2, z2 = EA / rhoA, EA * rhoA
+    if not (math.isfinite(c2) and c2 >= tiny and math.isfinite(z2) and z2 >= tiny):
+        raise SceneError(src, f"{where}.{'rhoA' if b['rhoA'] is not None else 'rho'}",
+                         f"gives a wave speed sqrt(EA/rhoA) = {math.sqrt(c2)!r} and impedance "
+                         f"sqrt(EA rhoA) = {math.sqrt(z2)!r}", "both must be finite and > 0: check the units")
 
 
 def mesh_rod(name, L, N, rhoA, mass="lumped", ends="node", x0=0.0):
@@ -164,6 +184,10 @@ def expand_bars(src, data):
         fixed = _choice(src, f"{where}.fixed", b["fixed"], FIXED_KINDS)
         output = _choice(src, f"{where}.output", b["output"], OUTPUT_KINDS)
         N = b["elements"]
+        made = len(nodes) + N + 1
+        if made > MAX_GENERATED:
+            raise SceneError(src, f"{where}.elements", f"invalid value {N!r}",
+                             f"the generators of a scene make at most {MAX_GENERATED} nodes in all")
         if ends == "half-cell":
             if mass != "lumped":
                 raise SceneError(src, f"{where}.mass", "a half-cell rod has lumped mass only",
@@ -173,6 +197,7 @@ def expand_bars(src, data):
                                  "a half-cell rod needs >= 2 cells (its two end nodes are distinct)")
         EA, rhoA = _section(src, where, b)
         L = b["L"]
+        _derived_ok(src, where, b, EA, rhoA, L / N)
         mesh = mesh_rod(name, L, N, rhoA, mass, ends, b["x0"])
         names, Le = mesh["names"], mesh["element_length"]
         for nm in names:
@@ -240,8 +265,8 @@ def _with_output_nodes(analysis, explicit_nodes, rod_nodes):
     listed = out.get("nodes")
     if listed is None:
         listed = [n for n in explicit_nodes if isinstance(n, str)]
-    elif not isinstance(listed, list):
-        return analysis
+    elif not isinstance(listed, list) or not all(isinstance(n, str) for n in listed):
+        return analysis            # the loader reports the malformed list
     seen = set(listed)
     out["nodes"] = list(listed) + [n for n in rod_nodes if n not in seen]
     analysis["output"] = out

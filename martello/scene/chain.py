@@ -2,7 +2,7 @@
 links and contacts they stand for before the loader validates those."""
 
 from ..errors import SceneError
-from .fields import POSITIVE, check_fields, per_item, unit_interval
+from .fields import MAX_GENERATED, POSITIVE, check_fields, per_item, unit_interval
 
 # [[chain]]: n oscillators in a row (docs/problems.md P7), each a mass on a spring to ground
 # (bilinear if fy is given) with an optional dashpot (zeta), and contacts between
@@ -23,10 +23,15 @@ def expand_chains(src, data):
     if not isinstance(chains, list):
         raise SceneError(src, "chain", "must be an array of tables", "write [[chain]]")
     nodes, links, contacts = list(data.get("node", [])), list(data.get("link", [])), list(data.get("contact", []))
+    made = 0
     for ci, tab in enumerate(chains):
         w = f"chain[{ci}]"
         ch = check_fields(src, tab, w, CHAIN_KEYS)
         n, p = ch["n"], ch["prefix"]
+        made += n
+        if made > MAX_GENERATED:
+            raise SceneError(src, f"{w}.n", f"invalid value {n!r}",
+                             f"the generators of a scene make at most {MAX_GENERATED} nodes in all")
         mass = per_item(src, f"{w}.mass", ch["mass"], n, POSITIVE)
         k = per_item(src, f"{w}.k", ch["k"], n, POSITIVE)
         fy = per_item(src, f"{w}.fy", ch["fy"], n, POSITIVE) if ch["fy"] is not None else None

@@ -9,6 +9,23 @@ import math
 
 from ..errors import SceneError
 
+# The range of an integer field: the library's int (C int, 32 bits; c/martello.h). A larger
+# value would wrap when handed over, and `every = 2**40` would read as 0.
+INT_MAX = 2**31 - 1
+# TOML integers are 64-bit (TOML v1.0.0, "Integer"): a longer one is not a TOML integer,
+# whatever the parser makes of it.
+TOML_INT_MAX = 2**63 - 1
+# How deep a scene's tables and arrays may nest: a scene needs 4 levels
+# (check.compare[i].why); a deeper one is a mistake, or an attack on the parser.
+MAX_DEPTH = 16
+# The smallest normal double (IEEE 754 binary64): below it, a number has lost precision and
+# its reciprocal overflows (1/1e-310 = inf). No physical input of a scene is that small.
+TINY = 2.2250738585072014e-308
+# How many nodes the generators ([[chain]], [[bar]]) may make in one scene, all tables
+# together: a million oscillators already write a summary of about 1 GB
+# (docs/behaviour.md, "Failures and limits"); more is a typing mistake, not a model.
+MAX_GENERATED = 1_000_000
+
 POSITIVE = (lambda x: x > 0, "a number > 0")
 NONNEG = (lambda x: x >= 0, "a number >= 0")
 ANY = (lambda x: True, "a number")
@@ -51,6 +68,9 @@ def check_fields(src, table, where, spec, extra_ok=()):
         if not kind_ok(kind, v):
             raise SceneError(src, path, f"has the wrong type ({type(v).__name__})",
                              f"expected {kind}")
+        if kind == "int" and abs(v) > INT_MAX:
+            raise SceneError(src, path, f"invalid value {v!r}",
+                             f"must be an integer of at most {INT_MAX} in magnitude")
         if kind == "float":
             v = float(v)
         if check is not None and kind in ("float", "int"):
@@ -61,16 +81,31 @@ def check_fields(src, table, where, spec, extra_ok=()):
     return out
 
 
-def finite_everywhere(src, obj, where):
-    """TOML admits nan and inf literals; a scene never may."""
-    if isinstance(obj, float) and not math.isfinite(obj):
-        raise SceneError(src, where, f"is {obj}", "every number in a scene must be finite")
-    if isinstance(obj, dict):
-        for k, v in obj.items():
-            finite_everywhere(src, v, f"{where}.{k}" if where else k)
-    elif isinstance(obj, list):
-        for i, v in enumerate(obj):
-            finite_everywhere(src, v, f"{where}[{i}]")
+def finite_everywhere(src, obj, where, what="a scene", error=SceneError):
+    """TOML admits nan and inf literals; a scene never may. Nor integers beyond 64 bits, nor
+    tables and arrays nested deeper than MAX_DEPTH (walked without recursion). `what` and
+    `error` serve the other TOML files (study files: StudyError)."""
+    SceneError = error            # noqa: N806 (the messages below are the same for all)
+    todo = [(obj, where, 0)]
+    while todo:
+        obj, where, depth = todo.pop()
+        if isinstance(obj, float) and not math.isfinite(obj):
+            raise SceneError(src, where, f"is {obj}", f"every number in {what} must be finite")
+        if isinstance(obj, float) and obj != 0 and abs(obj) < TINY:
+            raise SceneError(src, where, f"is {obj!r}, a subnormal number",
+                             f"every number in {what} is 0 or at least {TINY:.4g} in magnitude")
+        if isinstance(obj, int) and not isinstance(obj, bool) and abs(obj) > TOML_INT_MAX:
+            raise SceneError(src, where, f"is an integer of {obj.bit_length()} bits",
+                             "TOML integers are 64-bit; write a large number as a float, e.g. 1e30")
+        if isinstance(obj, (dict, list)) and depth >= MAX_DEPTH:
+            raise SceneError(src, where, f"nests tables or arrays deeper than {MAX_DEPTH} levels",
+                             f"{what} needs at most 4")
+        if isinstance(obj, dict):
+            # pushed in reverse: the first offender in the file's order is the one reported
+            todo += reversed([(v, f"{where}.{k}" if where else str(k), depth + 1)
+                              for k, v in obj.items()])
+        elif isinstance(obj, list):
+            todo += reversed([(v, f"{where}[{i}]", depth + 1) for i, v in enumerate(obj)])
 
 
 def choice(src, path, value, choices):

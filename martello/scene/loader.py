@@ -14,7 +14,9 @@ from ..errors import SceneError
 from .bars import expand_bars
 from .chain import expand_chains
 from .compatibility import COMPATIBLE
-from .fields import ANY, NONNEG, POSITIVE, check_fields, choice, finite_everywhere, kind_ok
+from ..paths import MiB, UnreadableFile, check_regular, read_input
+from .fields import (ANY, MAX_DEPTH, NONNEG, POSITIVE, check_fields, choice, finite_everywhere,
+                     kind_ok)
 from .spec import (ALL_SPECIFIC, ANALYSIS_TYPES, CONTACT_COMMON, CONTACT_SCHEMES,
                    FIXED_EXPONENT, FUNCTION_TYPES, GROUND, INTEGRATOR_KEYS,
                    INTEGRATORS, LAWS, LINK_COMMON, LINK_TYPES, NEWMARK_PRESETS, NODE_KEYS,
@@ -87,25 +89,42 @@ def _function(src, tab, where, base_dir, allow_record):
                 raise SceneError(src, f"{where}.t[{i}]", f"{t[i]} does not follow {t[i - 1]}",
                                  "times must increase strictly")
     if kind == "record":
-        p = Path(f["file"])
+        # read from the path resolved against the scene's folder; named in messages as the
+        # scene gives it (relative to the scene). A FIFO or a device is refused from its
+        # stat mode, without being opened.
+        given = f["file"]
+        p = Path(given)
         f["file"] = str(p if p.is_absolute() else (base_dir / p))
-        if not Path(f["file"]).exists():
-            raise SceneError(src, f"{where}.file", f"{f['file']} does not exist",
-                             "paths are relative to the scene file's folder")
+        f["given"], f["where"] = given, f"{where}.file"
+        try:
+            check_regular(f["file"])
+        except UnreadableFile as exc:
+            raise SceneError(src, f"{where}.file", f"{given} {exc.problem}",
+                             "paths are relative to the scene file's folder") from None
     return f
 
 
 # --- the loader ----------------------------------------------------------------------------
 
+# A scene file is text of at most this size (the largest catalogue scene is 20 kB).
+SCENE_LIMIT = 64 * MiB
+
+
 def load(path):
     """Read and validate a scene file."""
     path = Path(path)
-    if not path.exists():
-        raise SceneError(path, "(file)", "does not exist")
-    raw = path.read_bytes()
+    try:
+        raw = read_input(path, SCENE_LIMIT)
+    except UnreadableFile as exc:
+        raise SceneError(path, "(file)", exc.problem, exc.fix) from None
     try:
         data = tomllib.loads(raw.decode("utf-8"))
     except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
+        raise SceneError(path, "(syntax)", f"not valid TOML: {exc}") from None
+    except RecursionError:
+        raise SceneError(path, "(syntax)", "tables or arrays nested too deeply to parse",
+                         f"a scene needs at most 4 levels, and may have {MAX_DEPTH}") from None
+    except ValueError as exc:        # e.g. an integer of more digits than int() takes
         raise SceneError(path, "(syntax)", f"not valid TOML: {exc}") from None
     return from_dict(data, source=str(path), base_dir=path.parent,
                      digest=hashlib.sha256(raw).hexdigest())
@@ -158,6 +177,8 @@ def from_dict(data, source="<scene>", base_dir=Path("."), digest=None):
     for key in ("link", "contact", "mass_coupling"):
         if key in data and not isinstance(data[key], list):
             raise SceneError(src, key, "must be an array of tables", f"write [[{key}]]")
+    if "loads" in data and not isinstance(data["loads"], dict):
+        raise SceneError(src, "loads", "must be a table", "write [loads]")
     if "force" in data.get("loads", {}) and not isinstance(data["loads"]["force"], list):
         raise SceneError(src, "loads.force", "must be an array of tables", "write [[loads.force]]")
     # links
@@ -320,6 +341,11 @@ def _dynamic_analysis(src, raw, an, index, contacts, links):
     contact_names = [c["name"] for c in contacts]
     out["contacts"] = (out["contacts"] if out["contacts"] is not None
                        else (contact_names if len(contact_names) <= 50 else []))
+    for key in ("nodes", "contacts", "links"):
+        for i, nm in enumerate(out[key]):
+            if not isinstance(nm, str):
+                raise SceneError(src, f"analysis.output.{key}[{i}]",
+                                 f"has the wrong type ({type(nm).__name__})", "expected a name (str)")
     for i, nm in enumerate(out["nodes"]):
         if nm not in index:
             raise SceneError(src, f"analysis.output.nodes[{i}]", f"names no node {nm!r}",

@@ -53,7 +53,7 @@ from ..oracles.p2_bouncing import bouncing_oscillator_restitution
 from ..paths import OUTPUT_ROOT, REPO
 from ..reference.closed_form import kelvin_bounce_reference, two_body_kelvin_reference
 from ..scene.spec import ADAPTIVE, INTEGRATORS
-from .outcome import status_class
+from .outcome import failed_rows, status_class
 from .output import Progress, csv_cell, md_cell, palette_png, slug
 from .study_file import read_toml
 CLASSES = ("accurate", "inaccurate", "unstable", "failed", "unavailable", "no reference")
@@ -463,4 +463,4 @@ def main(args):
         counts[r["class"]] = counts.get(r["class"], 0) + 1
     print(f"{atlas['title']}: {len(rows)} runs (" + ", ".join(f"{v} {k}" for k, v in sorted(counts.items()))
           + f") -> {out / 'atlas.csv'}")
-    return 0
+    return failed_rows(rows, "status", out / "atlas.csv")

@@ -1,5 +1,7 @@
 """A run's outcome in words, from its status: the classification every row of a study or an
-atlas carries."""
+atlas carries; and the exit code of a study from its rows."""
+
+import sys
 
 
 def status_class(status, message=""):
@@ -18,3 +20,16 @@ def status_class(status, message=""):
     if status in ("incompatible", "error"):
         return status
     return f"failed: {status}"
+
+
+def failed_rows(rows, key, table, stream=None):
+    """Exit code of a study: 1 when a row has no outcome (status "error": the run raised, or
+    its worker died however often it was run), saying how many; diverged, unstable or
+    unconverged runs are outcomes of the sweep, not failures of the study."""
+    bad = [r for r in rows if r.get(key) == "error"]
+    if not bad:
+        return 0
+    first = (bad[0].get("message") or "").strip()
+    print(f"martello: error: {len(bad)} of {len(rows)} runs failed without a result "
+          f"(status error; the first: {first}); see {table}", file=stream or sys.stderr)
+    return 1

@@ -11,6 +11,8 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import StudyError
+from ..paths import MiB, UnreadableFile, read_input
+from ..scene.fields import finite_everywhere
 from ..scene.spec import ADAPTIVE, INTEGRATORS
 from ..scene.variants import override_contacts
 
@@ -61,23 +63,42 @@ class Study:
     raw: dict = field(default_factory=dict)
 
 
+MAX_LEVELS = 10_000     # steps or tolerances one integrator sweeps
+
+
+def _number(src, where, value, kind=float, positive=False):
+    """A number of a study file: int or float, finite (read_toml checks that), > 0 if asked."""
+    ok = isinstance(value, (int, float)) and not isinstance(value, bool)
+    if kind is int:
+        ok = ok and float(value).is_integer()
+    if not ok or (positive and not value > 0):
+        raise StudyError(src, where, f"invalid value {value!r}",
+                         ("a whole number" if kind is int else "a number") + (" > 0" if positive else ""))
+    return kind(value)
+
+
 def _sweep(src, where, value):
     """A list of numbers, or {from, to, per_decade} for a geometric sweep (from > to)."""
     if value is None:
         return []
     if isinstance(value, (int, float)) and not isinstance(value, bool):
-        return [float(value)]
+        return [_number(src, where, value, positive=True)]
     if isinstance(value, list):
-        if not value or not all(isinstance(x, (int, float)) and x > 0 for x in value):
+        if not value or not all(isinstance(x, (int, float)) and not isinstance(x, bool) and x > 0
+                                for x in value):
             raise StudyError(src, where, "must be a non-empty list of numbers > 0")
+        if len(value) > MAX_LEVELS:
+            raise StudyError(src, where, f"has {len(value)} values", f"at most {MAX_LEVELS}")
         return [float(x) for x in value]
     if isinstance(value, dict) and {"from", "to"} <= set(value):
-        a, b, n = float(value["from"]), float(value["to"]), int(value.get("per_decade", 4))
-        if not (a > 0 and b > 0 and n > 0):
-            raise StudyError(src, where, "from, to and per_decade must be > 0")
+        a = _number(src, f"{where}.from", value["from"], positive=True)
+        b = _number(src, f"{where}.to", value["to"], positive=True)
+        n = _number(src, f"{where}.per_decade", value.get("per_decade", 4), int, positive=True)
         count = int(round(abs(math.log10(b / a)) * n)) + 1
+        if count > MAX_LEVELS:
+            raise StudyError(src, where, f"asks for {count} values", f"at most {MAX_LEVELS}")
         return [float(x) for x in np.geomspace(a, b, count)]
-    raise StudyError(src, where, f"invalid sweep {value!r}",
+    raise StudyError(src, where, f"invalid sweep {value!r}"[:200],
                      "give a list of numbers or { from = 1e-3, to = 1e-6, per_decade = 4 }")
 
 
@@ -97,12 +118,18 @@ def method_label(name, params):
 def read_toml(path):
     """The parsed TOML of a study or atlas file; StudyError if it is missing or invalid."""
     path = Path(path)
-    if not path.exists():
-        raise StudyError(path, "(file)", "does not exist")
     try:
-        return tomllib.loads(path.read_text())
-    except tomllib.TOMLDecodeError as exc:
+        raw = read_input(path, 64 * MiB)
+    except UnreadableFile as exc:
+        raise StudyError(path, "(file)", exc.problem, exc.fix) from None
+    try:
+        data = tomllib.loads(raw.decode("utf-8"))
+    except (tomllib.TOMLDecodeError, UnicodeDecodeError, ValueError) as exc:
         raise StudyError(path, "(syntax)", f"not valid TOML: {exc}") from None
+    except RecursionError:
+        raise StudyError(path, "(syntax)", "tables or arrays nested too deeply to parse") from None
+    finite_everywhere(path, data, "", "a study file", StudyError)
+    return data
 
 
 def load_study(path):
@@ -111,14 +138,25 @@ def load_study(path):
     _check_keys(path, "(top level)", raw, STUDY_KEYS)
     compare = raw.get("compare", {})
     _check_keys(path, "compare", compare, COMPARE_KEYS)
-    compare = {"histories": compare.get("histories"), "atol": float(compare.get("atol", 1e-12)),
-               "rtol": float(compare.get("rtol", 1e-6)), "points": int(compare.get("points", 2001)),
-               "plot_metrics": list(compare.get("plot_metrics", ["max_rel_error"])),
-               "fit": [float(x) for x in compare.get("fit", [0.0, 0.1])],
+    fit = compare.get("fit", [0.0, 0.1])
+    if not isinstance(fit, list) or len(fit) != 2:
+        raise StudyError(path, "compare.fit", f"invalid value {fit!r}"[:100], "two numbers [lo, hi]")
+    metrics = compare.get("plot_metrics", ["max_rel_error"])
+    if not isinstance(metrics, list) or not metrics or not all(isinstance(m, str) for m in metrics):
+        raise StudyError(path, "compare.plot_metrics", "must be a non-empty list of metric names")
+    compare = {"histories": compare.get("histories"),
+               "atol": _number(path, "compare.atol", compare.get("atol", 1e-12)),
+               "rtol": _number(path, "compare.rtol", compare.get("rtol", 1e-6)),
+               "points": _number(path, "compare.points", compare.get("points", 2001), int, True),
+               "plot_metrics": list(metrics),
+               "fit": [_number(path, f"compare.fit[{i}]", x) for i, x in enumerate(fit)],
                "window": compare.get("window")}
     top_schemes = raw.get("scheme", [])
     for i, sc in enumerate(top_schemes):
         _check_keys(path, f"scheme[{i}]", sc, SCHEME_KEYS)
+    for key in ("scene", "integrator", "scheme"):
+        if key in raw and not isinstance(raw[key], list):
+            raise StudyError(path, key, "must be an array of tables", f"write [[{key}]]")
     cases = []
     if not raw.get("scene"):
         raise StudyError(path, "scene", "missing", "name at least one [[scene]] with file = \"...\"")
@@ -127,18 +165,17 @@ def load_study(path):
         _check_keys(path, where, st, SCENE_KEYS)
         if "file" not in st:
             raise StudyError(path, f"{where}.file", "missing", "the scene file, relative to the study")
+        if not isinstance(st["file"], str):
+            raise StudyError(path, f"{where}.file", "must be a string", "the scene file's path")
         f = Path(st["file"])
         f = f if f.is_absolute() else (path.parent / f).resolve()
         if not f.exists():
             raise StudyError(path, f"{where}.file", f"{f} does not exist")
-        with open(f, "rb") as fh:
-            try:
-                sdict = tomllib.load(fh)
-            except tomllib.TOMLDecodeError as exc:
-                raise StudyError(f, "(syntax)", f"not valid TOML: {exc}") from None
+        sdict = read_toml(f)
         sdict.pop("check", None)     # the study's reference decides what is compared
         slabel = st.get("label", f.stem)
-        t_end = float(st.get("t_end", raw.get("t_end", sdict.get("analysis", {}).get("t_end", 0.0))))
+        t_end = _number(path, f"{where}.t_end", st.get("t_end", raw.get("t_end", (
+            sdict.get("analysis") if isinstance(sdict.get("analysis"), dict) else {}).get("t_end", 0.0))))
         schemes = list(st.get("scheme", [])) + [s for s in top_schemes
                                                  if not s.get("scenes") or slabel in s["scenes"]]
         for j, sc in enumerate(st.get("scheme", [])):
@@ -176,7 +213,8 @@ def load_study(path):
                               params=params, dts=dts, rtols=rtols,
                               order=it.get("order"), scenes=it.get("scenes"), schemes=it.get("schemes")))
     return Study(path=path, title=raw.get("title", path.stem), description=raw.get("description", ""),
-                 output=raw.get("output"), repeat=int(raw.get("repeat", 1)), compare=compare,
+                 output=raw.get("output"), compare=compare,
+                 repeat=_number(path, "repeat", raw.get("repeat", 1), int, True),
                  cases=cases, methods=methods, raw=raw)
 
 

@@ -30,7 +30,7 @@ from ..reference.selection import reference_for_scene
 from ..scene.loader import from_dict
 from ..scene.spec import ADAPTIVE
 from ..scene.variants import analysis_for, runnable_scene
-from .outcome import status_class
+from .outcome import failed_rows, status_class
 from .output import Progress, csv_cell, md_cell, palette_png, slug
 from .study_file import load_study
 
@@ -344,7 +344,7 @@ def run_study(study, outdir, jobs=0, plots=True, stream=None, executor=None, whe
     progress = Progress(len(specs), stream=stream)
     by_id = {s["id"]: s for s in specs}
     rows = []
-    for res in run_specs(specs, jobs, progress, executor):
+    for res in run_specs(specs, jobs, progress, executor=executor):
         spec = by_id[res["id"]]
         rows.append(make_row(study, spec, res, refs.get(spec["case"])))
     rows.sort(key=lambda r: r["run"])
@@ -389,4 +389,5 @@ def main(args):
         if o["metric"] == study.compare["plot_metrics"][0]:
             print(f"  {o['case'][:40]:<40} {o['method'][:44]:<44} p = {o['order']:5.2f}"
                   + (f" (theory {o['theoretical']:g})" if o["theoretical"] == o["theoretical"] else ""))
-    return 0
+    return failed_rows(rows, "status", out / "runs.csv")
+

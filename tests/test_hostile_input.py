@@ -1,0 +1,360 @@
+"""Hostile input, through the command line: every input of the fuzz campaign's findings gets
+one line on stderr (`martello: error: ...` naming the file and field), exit code 1, no
+traceback, and nothing written; a FIFO or a device is refused without being opened. Also the
+guarantees behind that: the catch-all for bugs (--debug shows the traceback), results
+checked finite and written atomically, the output budget, the range caps."""
+
+import json
+import os
+import subprocess
+import sys
+import threading
+from pathlib import Path
+
+import pytest
+
+from benchmarks.fuzz.mutations import scene_dict, to_toml
+from martello import cli
+from martello.errors import ResultError, SceneError
+from martello.run import check_budget, write_results
+from martello.scene.loader import from_dict, load
+
+ROOT = Path(__file__).resolve().parent.parent
+P1 = ROOT / "benchmarks" / "p1" / "p1_static_lagrange.toml"
+P5 = ROOT / "benchmarks" / "p5" / "p5_linear.toml"
+PEER = ROOT / "tests" / "data" / "records" / "peer_fixed.AT2"
+
+
+def martello(*args, cwd=ROOT, timeout=120):
+    return subprocess.run([sys.executable, "-m", "martello", *map(str, args)], cwd=cwd,
+                          capture_output=True, text=True, timeout=timeout,
+                          stdin=subprocess.DEVNULL)
+
+
+def one_line_error(r, *words):
+    """The run failed cleanly: exit 1, one line on stderr, no traceback, naming `words`."""
+    lines = [ln for ln in r.stderr.splitlines() if ln.strip()]
+    assert r.returncode == 1, (r.returncode, r.stderr)
+    assert len(lines) == 1 and "error:" in lines[0], r.stderr
+    assert "Traceback" not in r.stderr and "internal error" not in r.stderr, r.stderr
+    for w in words:
+        assert w in lines[0], (w, lines[0])
+    return lines[0]
+
+
+def write(path, d):
+    path.parent.mkdir(parents=True, exist_ok=True)
+    path.write_text(d if isinstance(d, str) else to_toml(d))
+    return path
+
+
+def sdof_record(file, **fn):
+    """A mass on a spring shaken by a record (the record path as the scene gives it)."""
+    return {"node": [{"name": "m", "mass": 1.0}],
+            "link": [{"type": "spring", "a": "m", "b": "ground", "k": 100.0}],
+            "loads": {"ground_acceleration": dict({"type": "record", "file": file}, **fn)},
+            "analysis": {"type": "dynamic", "integrator": "newmark", "dt": 0.01, "t_end": 0.04}}
+
+
+def run_fails(tmp_path, scene, *words, out="out"):
+    f = write(tmp_path / "s.toml", scene)
+    r = martello("run", f, "-o", tmp_path / out, cwd=tmp_path)
+    line = one_line_error(r, *words)
+    assert not (tmp_path / out).exists(), "a failed run wrote its folder"
+    return line
+
+
+# --- the causes the fuzz campaign found, one test each --------------------------------------
+
+def test_scalar_loads_is_refused(tmp_path):
+    d = scene_dict("p5/p5_linear")
+    d["loads"] = 5
+    run_fails(tmp_path, d, "s.toml: loads: must be a table")
+
+
+def test_nested_lists_in_output_nodes_are_refused(tmp_path):
+    d = scene_dict("p5/p5_linear")
+    d["analysis"]["output"]["nodes"] = [["m1"]]
+    run_fails(tmp_path, d, "analysis.output.nodes[0]: has the wrong type (list)")
+    # a rod scene merges its nodes into the list first: the same error
+    d = scene_dict("p4/p4_wall_cd_half_cell_courant1")
+    d["analysis"]["output"] = {"nodes": [{"a": 1}]}
+    run_fails(tmp_path, d, "analysis.output.nodes[0]: has the wrong type (dict)")
+
+
+def test_denormal_bar_density_is_refused(tmp_path):
+    d = scene_dict("p4/p4_wall_cd_half_cell_courant1")
+    d["bar"][0]["rho"] = 1e-310                         # subnormal itself
+    run_fails(tmp_path, d, "bar[0].rho: is 1e-310, a subnormal number")
+    d["bar"][0].update(rho=1e-200, A=1e-200)            # normal, but rho·A underflows to 0
+    d["bar"][0].pop("E", None)
+    d["bar"][0]["EA"] = 1.0
+    run_fails(tmp_path, d, "bar[0].rho: gives rhoA = 0.0")
+
+
+def test_huge_integers_in_float_fields_are_refused(tmp_path):
+    text = P5.read_text().replace("mass = 1.0", "mass = 1" + "0" * 400, 1)
+    run_fails(tmp_path, text, "node[0].mass: is an integer of 1329 bits", "64-bit")
+
+
+def test_every_beyond_the_library_int_is_refused(tmp_path):
+    # 2**40 used to reach the library as 0 ("need every >= 1")
+    text = P5.read_text().replace("every = 100", f"every = {2 ** 40}")
+    run_fails(tmp_path, text, "analysis.output.every: invalid value 1099511627776",
+              "at most 2147483647")
+
+
+def test_generators_are_capped(tmp_path):
+    d = {"chain": [{"prefix": "p", "n": 10 ** 9, "mass": 1.0, "k": 1.0}],
+         "analysis": {"type": "static"}}
+    run_fails(tmp_path, d, "chain[0].n: invalid value 1000000000", "at most 1000000 nodes")
+    d = scene_dict("p4/p4_wall_cd_half_cell_courant1")
+    d["bar"][0]["elements"] = 10 ** 7
+    run_fails(tmp_path, d, "bar[0].elements: invalid value 10000000", "at most 1000000 nodes")
+    # all tables together: two chains of 600 000
+    d = {"chain": [{"prefix": "p", "n": 600_000, "mass": 1.0, "k": 1.0},
+                   {"prefix": "q", "n": 600_000, "mass": 1.0, "k": 1.0}],
+         "analysis": {"type": "static"}}
+    with pytest.raises(SceneError, match=r"chain\[1\]\.n: .*at most 1000000 nodes in all"):
+        from_dict(d)
+
+
+def test_deep_toml_nesting_is_refused(tmp_path):
+    run_fails(tmp_path, "x = " + "[" * 5000 + "]" * 5000 + "\n", "(syntax)", "nested too deeply")
+    d = scene_dict("p1/p1_static_lagrange")
+    d["description"] = [[[[[[[[[[[[[[[[[["x"]]]]]]]]]]]]]]]]]]        # parses, too deep
+    run_fails(tmp_path, d, "description", "deeper than 16 levels")
+
+
+def test_scene_path_that_is_a_directory_or_a_device(tmp_path):
+    for path, kind in ((tmp_path, "a directory"), ("/dev/zero", "a character device")):
+        r = martello("run", path, "-o", tmp_path / "out", cwd=tmp_path, timeout=30)
+        one_line_error(r, f"{path}: (file): is {kind}, not a regular file")
+        assert not (tmp_path / "out").exists()
+
+
+def test_scene_path_that_is_a_fifo_is_not_opened(tmp_path):
+    fifo = tmp_path / "scene.toml"
+    os.mkfifo(fifo)
+    r = martello("run", fifo, "-o", tmp_path / "out", timeout=30)   # would block in open()
+    one_line_error(r, "scene.toml: (file): is a FIFO (named pipe), not a regular file")
+
+
+def test_output_naming_a_file_is_refused(tmp_path):
+    (tmp_path / "afile").write_text("mine\n")
+    for out in ("afile", "afile/sub"):
+        r = martello("run", P1, "-o", tmp_path / out)
+        one_line_error(r, "afile")
+        assert (tmp_path / "afile").read_text() == "mine\n"
+
+
+def test_output_folder_of_something_else_is_not_replaced(tmp_path):
+    (tmp_path / "notes").mkdir()
+    (tmp_path / "notes" / "mine.txt").write_text("keep\n")
+    r = martello("run", P1, "-o", tmp_path / "notes")
+    one_line_error(r, "holds files of something else (mine.txt)")
+    assert sorted(p.name for p in (tmp_path / "notes").iterdir()) == ["mine.txt"]
+
+
+def test_at2_header_npts_1e400(tmp_path):
+    rec = PEER.read_text().splitlines()
+    rec[3] = "NPTS=1e400, DT= .0200 SEC"
+    (tmp_path / "r.AT2").write_text("\n".join(rec) + "\n")
+    run_fails(tmp_path, sdof_record("r.AT2"), "s.toml: loads.ground_acceleration.file: r.AT2:4:",
+              "NPTS '1e400' is not a non-negative whole number")
+
+
+def test_record_value_1e999_names_the_file_and_line(tmp_path):
+    (tmp_path / "r.csv").write_text("0.0, 0.0\n0.01, 0.5\n0.02, 1e999\n0.03, 0.0\n")
+    run_fails(tmp_path, sdof_record("r.csv"), "loads.ground_acceleration.file: r.csv:3:",
+              "acceleration value '1e999' is not finite")
+
+
+def test_record_at_dev_zero_or_a_fifo_is_refused_unopened(tmp_path):
+    run_fails(tmp_path, sdof_record("/dev/zero", format="csv"),
+              "loads.ground_acceleration.file: /dev/zero is a character device")
+    os.mkfifo(tmp_path / "pipe.csv")
+    opened = []
+    # a writer that would be released if the run opened the FIFO for reading
+    t = threading.Thread(target=lambda: opened.append(os.open(tmp_path / "pipe.csv", os.O_WRONLY)),
+                         daemon=True)
+    t.start()
+    run_fails(tmp_path, sdof_record("pipe.csv"), "pipe.csv is a FIFO (named pipe), not a regular file")
+    t.join(0.5)
+    assert not opened, "the run opened the FIFO"
+    fd = os.open(tmp_path / "pipe.csv", os.O_RDONLY | os.O_NONBLOCK)    # release the writer
+    t.join(5)
+    os.close(fd)
+    for w in opened:
+        os.close(w)
+
+
+def test_record_path_out_of_the_scene_folder_is_shown_as_given_and_not_echoed(tmp_path):
+    # the scene two folders down names ../../etc/passwd: a file that is no record
+    secret = ["root:x:0:0:root:/root:/bin/bash",
+              "admin:x:1000:1000:The Secret Admin Line:/home/admin:/bin/bash"]
+    (tmp_path / "etc").mkdir()
+    (tmp_path / "etc" / "passwd").write_text("\n".join(secret) + "\n")
+    for fmt in ("csv", "at2"):
+        f = write(tmp_path / "a" / "b" / "s.toml", sdof_record("../../etc/passwd", format=fmt))
+        r = martello("run", f, "-o", tmp_path / "out", cwd=tmp_path)
+        line = one_line_error(r, "a/b/s.toml: loads.ground_acceleration.file: ../../etc/passwd:")
+        assert not any(part in line for s in secret for part in s.split(":") if len(part) > 4), line
+        assert "Secret" not in line and not (tmp_path / "out").exists()
+
+
+def test_check_path_to_a_non_number_fails_that_scene_only(tmp_path):
+    text = P5.read_text().replace('result = "contacts.impact.restitution.0"',
+                                  'result = "contacts.impact"')
+    f = write(tmp_path / "s.toml", text)
+    r = martello("check", f, P1, "-o", tmp_path / "report", "--no-plots")
+    assert r.returncode == 1 and "Traceback" not in r.stderr + r.stdout
+    assert "'contacts.impact' is a dict in the summary, not a number" in r.stdout
+    assert "P1 mass on plane" in r.stdout and "1 failure(s); 2 scenes" in r.stdout
+
+
+def test_infinite_reference_fails_its_check(monkeypatch):
+    """A reference of inf used to pass any check with 16 digits; now it is an error."""
+    from martello.checks import verify as v
+    s = load(P5)
+    monkeypatch.setattr(v, "oracle_values", lambda check, source: {
+        "restitution": float("inf"), "contact_time": 1.0, "max_penetration": 1.0})
+    summary = {"contacts": {"impact": {"restitution": [1.0], "contact_time": 1.0,
+                                       "max_penetration": 1.0}}}
+    with pytest.raises(SceneError, match=r"check\.compare\[0\]\.oracle: two_body_impact gives "
+                                         r"restitution = inf, not a finite number"):
+        v.verify(s, summary)
+
+
+def test_compare_of_non_utf8_history(tmp_path):
+    (tmp_path / "h.csv").write_bytes(b"t,u:m1\n0,0\n0.001,\xff\xfe\n")
+    r = martello("compare", tmp_path / "h.csv", "--against", P5, "-o", tmp_path / "sc.json")
+    one_line_error(r, "h.csv:3: byte", "is not UTF-8 text")
+    assert not (tmp_path / "sc.json").exists()
+
+
+def test_study_with_negative_jobs(tmp_path):
+    r = martello("study", ROOT / "benchmarks" / "studies" / "atlas.toml", "-j", "-3",
+                 "-o", tmp_path / "out")
+    one_line_error(r, "martello study: error: argument -j/--jobs: -3 is not in 0 to 256")
+    assert not (tmp_path / "out").exists()
+
+
+def test_h_max_that_would_run_for_ever_is_refused(tmp_path):
+    text = (ROOT / "benchmarks" / "p2" / "p2_ida_penalty_linear.toml").read_text().replace(
+        'integrator = "ida"', 'integrator = "ida"\nh_max = 1e-12')
+    line = run_fails(tmp_path, text, "s.toml: analysis.h_max: needs at least 7e11 steps",
+                     "--force runs it anyway")
+    assert "1e9 steps" in line
+
+
+def test_usage_errors_are_one_line(tmp_path):
+    for args in (["run"], ["frobnicate"], ["run", P1, "--nope"]):
+        one_line_error(martello(*args), "(see martello")
+
+
+# --- the guarantees behind them ---------------------------------------------------------------
+
+def test_an_unexpected_exception_is_one_line_with_a_report_hint(monkeypatch, capsys):
+    def boom(args):
+        raise ZeroDivisionError("float division by zero\nsecond line")
+    monkeypatch.setattr(cli, "cmd_list", boom)
+    assert cli.main(["list"]) == 1
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "Traceback" not in err
+    assert err.startswith("martello: internal error: ZeroDivisionError: float division by zero second line")
+    assert "please report" in err and "--debug" in err
+    with pytest.raises(ZeroDivisionError):          # --debug: the exception, traceback and all
+        cli.main(["--debug", "list"])
+    with pytest.raises(ZeroDivisionError):
+        cli.main(["list", "--debug"])
+
+
+def test_out_of_memory_and_system_errors_are_one_line(monkeypatch, capsys):
+    def oom(args):
+        raise MemoryError()
+    monkeypatch.setattr(cli, "cmd_list", oom)
+    assert cli.main(["list"]) == 1
+    err = capsys.readouterr().err
+    assert err.startswith("martello: error: out of memory") and err.count("\n") == 1
+
+
+def _summary():
+    return {"status": "MARTELLO_OK", "nodes": {"m": {"u": 1.0, "list": [0.5, 2.0]}}}
+
+
+def test_results_must_be_finite_to_be_written(tmp_path):
+    s = _summary()
+    s["nodes"]["m"]["list"][1] = float("inf")
+    with pytest.raises(ResultError, match=r"nodes\.m\.list\.1 is inf"):
+        write_results(s, tmp_path / "out")
+    with pytest.raises(ResultError, match=r"history column u:m is nan at row 1"):
+        write_results(_summary(), tmp_path / "out",
+                      (["t", "u:m"], [[0.0, 0.0], [1.0, float("nan")]]))
+    assert not (tmp_path / "out").exists() and not list(tmp_path.iterdir())
+    # link states that are NaN throughout are unreported (adaptive integrators), not results
+    write_results(_summary(), tmp_path / "out",
+                  (["t", "u:m", "link_force:s"], [[0.0, 0.0, float("nan")], [1.0, 1.0, float("nan")]]))
+    assert (tmp_path / "out" / "history.csv").exists()
+
+
+def test_results_replace_an_earlier_run_whole(tmp_path):
+    out = tmp_path / "run"
+    write_results(_summary(), out, (["t", "u:m"], [[0.0, 0.0], [1.0, 1.0]]))
+    (out / "plot.png").write_bytes(b"stale")
+    write_results(_summary() | {"status": "MARTELLO_ILL_CONDITIONED"}, out)   # a static run
+    assert sorted(p.name for p in out.iterdir()) == ["summary.json"]      # stale files gone
+    assert json.loads((out / "summary.json").read_text())["status"] == "MARTELLO_ILL_CONDITIONED"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["run"]          # no temporary left
+    # a failed write leaves the earlier run as it was
+    bad = _summary()
+    bad["nodes"]["m"]["u"] = float("nan")
+    with pytest.raises(ResultError):
+        write_results(bad, out)
+    assert json.loads((out / "summary.json").read_text())["status"] == "MARTELLO_ILL_CONDITIONED"
+
+
+def test_a_failed_run_keeps_the_earlier_results(tmp_path):
+    out = tmp_path / "out"
+    assert martello("run", P1, "-o", out).returncode == 0
+    before = (out / "summary.json").read_text()
+    bad = write(tmp_path / "bad.toml", P1.read_text().replace("mass = 1.0 ", "mass = -1.0 "))
+    one_line_error(martello("run", bad, "-o", out), "node[0].mass")
+    assert (out / "summary.json").read_text() == before
+
+
+def test_output_budget_warns_refuses_and_yields_to_force(tmp_path):
+    d = scene_dict("p5/p5_linear")
+    d["analysis"]["output"]["every"] = 1
+    d["analysis"]["dt"] = 2e-8                      # 2.5e5 rows x 18 columns: ~100 MB
+    assert "up to about 108 MB" in check_budget(from_dict(d))[0]
+    d["analysis"]["dt"] = 1e-9                      # 5e6 rows: > 1 GB
+    with pytest.raises(SceneError, match=r"analysis\.output\.every: the run would write up to "
+                                         r"about 2\.16 GB .*more than the 1 GB"):
+        check_budget(from_dict(d))
+    assert "2.16 GB" in check_budget(from_dict(d), force=True)[0]
+    d["analysis"]["dt"] = 1e-12                     # 5e9 steps
+    with pytest.raises(SceneError, match=r"analysis\.dt: needs at least 5e9 steps"):
+        check_budget(from_dict(d))
+    # and on the command line: refused in one line, nothing written
+    f = write(tmp_path / "big.toml", d)
+    r = martello("run", f, "-o", tmp_path / "out")
+    one_line_error(r, "analysis.dt: needs at least 5e9 steps")
+    assert not (tmp_path / "out").exists()
+
+
+def test_a_bug_in_one_scene_does_not_stop_martello_check(tmp_path, monkeypatch):
+    import io
+    from martello import report
+    real = report.run_measured
+
+    def flaky(scene):
+        if scene.problem == "P5":
+            raise KeyError("a bug")
+        return real(scene)
+    monkeypatch.setattr(report, "run_measured", flaky)
+    out = io.StringIO()
+    ok = report.check_catalogue([P5, P1], tmp_path, plots=False, stream=out)
+    text = out.getvalue()
+    assert not ok and "internal error: KeyError: 'a bug'" in text
+    assert "P1 mass on plane" in text and "1 failure(s); 2 scenes" in text
