@@ -178,7 +178,7 @@ def main(argv=None):
     p.add_argument("-o", "--output", help="output folder (default: out/<scene name>)")
     p.add_argument("--print", action="store_true", help="also print the summary")
     p.add_argument("--force", action="store_true",
-                   help="run even if it needs more than 1e9 steps or writes more than 1 GB")
+                   help="run even if it needs more than 1e9 node-steps or writes more than 1 GB")
     p.set_defaults(func=cmd_run)
 
     p = sub.add_parser("check", help="verify scenes against their closed forms",

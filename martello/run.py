@@ -295,11 +295,12 @@ def _finite_or_none(x):
 
 # --- what a run may cost and write ------------------------------------------------------------
 
-# Without force (`martello run --force`), a run is refused when it needs more steps than this
-# (the integrators count steps in 32 bits up to 2.1e9, and at ~1e7 steps/s a billion is
-# minutes) or would write more than OUTPUT_LIMIT; above OUTPUT_WARN it is run with a warning
-# (docs/behaviour.md, "Failures and limits").
-MAX_STEPS = 1e9
+# Without force (`martello run --force`), a run is refused when it needs more work than this,
+# in node-steps (steps x nodes: a step costs about its nodes' worth; the integrators count
+# steps in 32 bits up to 2.1e9, and a billion node-steps is minutes), or would write more
+# than OUTPUT_LIMIT; above OUTPUT_WARN it is run with a warning (docs/behaviour.md,
+# "Failures and limits").
+MAX_WORK = 1e9
 OUTPUT_WARN = 100e6
 OUTPUT_LIMIT = 1e9
 # Bytes per value of history.csv (%.17g and a comma; 23 on average) and, in summary.json, per
@@ -345,17 +346,20 @@ def _g(x):
 
 
 def check_budget(scene, force=False):
-    """Refuse (SceneError naming the field) a run that needs more than MAX_STEPS steps or
+    """Refuse (SceneError naming the field) a run that needs more than MAX_WORK node-steps or
     would write more than OUTPUT_LIMIT, unless force; return the warnings to print (output
     above OUTPUT_WARN, or above the limits when forced)."""
     est, an, warnings = output_estimate(scene), scene.analysis, []
-    if est["steps"] > MAX_STEPS:
+    nodes = max(1, len(scene.nodes))
+    if est["steps"] * nodes > MAX_WORK:
         adaptive = an["type"] == "dynamic" and an["integrator"] in native.adaptive_integrators()
         key = "h_max" if adaptive and an.get("h_max") else "dt"
         what = f"at least {_g(est['steps'])} steps (t_end/{key} = {an['t_end']!r}/{an[key]!r})"
+        if nodes > 1:
+            what += f" of {nodes} nodes"
         if not force:
             raise SceneError(scene.source, f"analysis.{key}", f"needs {what}, more than the "
-                             f"{_g(MAX_STEPS)} steps a run may take",
+                             f"{_g(MAX_WORK)} node-steps a run may take",
                              f"raise {key} or shorten t_end; --force runs it anyway")
         warnings.append(f"the run needs {what}: it may take very long")
     if est["bytes"] > OUTPUT_WARN:

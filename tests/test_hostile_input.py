@@ -245,7 +245,11 @@ def test_h_max_that_would_run_for_ever_is_refused(tmp_path):
         'integrator = "ida"', 'integrator = "ida"\nh_max = 1e-12')
     line = run_fails(tmp_path, text, "s.toml: analysis.h_max: needs at least 7e11 steps",
                      "--force runs it anyway")
-    assert "1e9 steps" in line
+    assert "more than the 1e9 node-steps a run may take" in line
+    # two rods of 202 nodes: 6e8 steps are 1.2e11 node-steps (it used to pass: 6e8 < 1e9 steps)
+    d = scene_dict("p4/p4_equal_rods_rk8pd_restitution_e0")
+    d["analysis"]["h_max"] = 1e-12
+    run_fails(tmp_path, d, "analysis.h_max: needs at least 5.95e8 steps", "of 202 nodes")
 
 
 def test_usage_errors_are_one_line(tmp_path):
