@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import os
 import signal
+import time
 from collections import deque
 from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, as_completed, wait
 from concurrent.futures.process import BrokenProcessPool
@@ -59,9 +60,11 @@ def _death(processes):
     """Why a worker died, from the exit codes of a pool's processes (best effort). The pool
     fails its futures before it reaps its processes, and it ends the survivors with SIGTERM:
     wait for the exit codes a moment, and name another signal first."""
+    deadline = time.monotonic() + 2.0
     for p in processes:
-        if p.exitcode is None:
-            p.join(1.0)
+        # the pool's own thread may be reaping it: its exit code appears when it is done
+        while p.exitcode is None and time.monotonic() < deadline:
+            time.sleep(0.01)
     codes = [p.exitcode for p in processes if p.exitcode not in (None, 0)]
     codes.sort(key=lambda c: c == -signal.SIGTERM)
     for c in codes:
