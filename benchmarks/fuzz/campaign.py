@@ -37,8 +37,11 @@ from collections import Counter, defaultdict
 from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 
-sys.path.insert(0, str(Path(__file__).resolve().parent))
-import mutations  # noqa: E402
+if __package__:                           # imported as benchmarks.fuzz.campaign (the tests)
+    from . import mutations
+else:                                     # run as a script
+    sys.path.insert(0, str(Path(__file__).resolve().parent))
+    import mutations  # noqa: E402
 
 ROOT = mutations.ROOT
 CLASSES = ("ok", "clean error", "unclean error", "traceback", "crash", "hang", "suspicious ok")
