@@ -161,6 +161,16 @@ static double switch_value(const ed_t *w, int s, const double *y) {
   return w->sw_al[s] * du + w->sw_be[s] * dv + w->sw_ga[s];
 }
 
+/* The rounding of switch s on y: a value within it is on the surface, not past it (a branch
+ * just entered starts there). */
+static double switch_rounding(const ed_t *w, int s, const double *y) {
+  const int a = w->sw_a[s], b = w->sw_b[s];
+  double su = 0.0, sv = 0.0;
+  if (a >= 0) { su += fabs(y[a]); sv += fabs(y[w->n + a]); }
+  if (b >= 0) { su += fabs(y[b]); sv += fabs(y[w->n + b]); }
+  return 16.0 * DBL_EPSILON * (fabs(w->sw_al[s]) * su + fabs(w->sw_be[s]) * sv + fabs(w->sw_ga[s]));
+}
+
 static int switch_active(const ed_t *w, int s) {
   return w->sw_al[s] != 0.0 || w->sw_be[s] != 0.0;
 }
@@ -660,8 +670,10 @@ static int bracket_switch(ed_t *w, int s, double t0, double t1, double *ga, doub
   int i, st;
   *ga = switch_value(w, s, w->y0);
   *gb = switch_value(w, s, w->y);
-  if (*ga > 0.0) return 0;   /* left at the commit already: nothing to locate */
-  if (*gb > 0.0) {
+  /* the commit chose the branch at the step start (a value past 0 there is the rounding of
+   * a switch just crossed, or a branch chosen from a state past its surface): the start is
+   * on the branch's side */
+  if (*gb > switch_rounding(w, s, w->y)) {
     memcpy(w->yb, w->y, w->dim * sizeof *w->yb);
     return 1;
   }
@@ -690,7 +702,7 @@ static int bracket_switch(ed_t *w, int s, double t0, double t1, double *ga, doub
   if (st != MARTELLO_OK) return st;
   *gb = switch_value(w, s, w->yb);
   w->cnt[MARTELLO_COUNTER_ROOT_EVALUATIONS]++;
-  return *gb > 0.0;
+  return *gb > switch_rounding(w, s, w->yb);
 }
 
 /* The bracket of contact j's next event in the step [t0, t1], if there is one: before at

@@ -31,8 +31,8 @@ contains
    end function switch_count
 
    !> After a commit at the state (u, v) (0:n, 0 = ground): every branch whose switch is past
-   !> (g > 0) moves to the next branch; CONTACT_FREE and BRANCH_FREE are chosen from the
-   !> state. A bilinear force left outside its band by the located crossing (by at most
+   !> (g > 0) moves to the next branch (a bilinear one only while loading outward);
+   !> CONTACT_FREE and BRANCH_FREE are chosen from the state. A bilinear force left outside its band by the located crossing (by at most
    !> k |dv| event_tol) is put back on the band's edge.
    subroutine switching_choose(m, s, u, v)
       type(model_t), intent(in) :: m
@@ -61,8 +61,10 @@ contains
                g = al*du + be*dv + ga
                select case (s%link_branch(j))
                case (BRANCH_ELASTIC)
-                  if (g(1) > 0.0_dp) s%link_branch(j) = BRANCH_UPPER
-                  if (g(2) > 0.0_dp) s%link_branch(j) = BRANCH_LOWER
+                  ! yielding needs loading: a surface reached at the turning point (dv = 0,
+                  ! grazing) leaves the link elastic on the band's edge
+                  if (g(1) > 0.0_dp .and. dv > 0.0_dp) s%link_branch(j) = BRANCH_UPPER
+                  if (g(2) > 0.0_dp .and. dv < 0.0_dp) s%link_branch(j) = BRANCH_LOWER
                case (BRANCH_UPPER, BRANCH_LOWER)
                   if (g(1) > 0.0_dp) s%link_branch(j) = BRANCH_ELASTIC
                end select

@@ -56,7 +56,7 @@ class Scene:
             if law == "kelvin" and "restitution" in c:
                 damp = kelvin_damping(c["restitution"], k, self.m, idx[c["a"]], idx[c["b"]])
             self.contacts.append((idx[c["a"]], idx[c["b"]], c["gap"], k, damp,
-                                  law == "kelvin" and c.get("clip", True)))
+                                  law == "kelvin" and c.get("clipped", False)))
         g = d["loads"]["ground_acceleration"]
         assert g["type"] == "sine" and g.get("t_start", 0.0) == 0.0
         self.amp, self.omega, self.phase = g["amplitude"], g["omega"], g.get("phase", 0.0)
