@@ -928,7 +928,7 @@ static int ed_setup(ed_t *w) {
   w->sys.params = w;
   T = w->kind == MARTELLO_INT_RKF45 ? gsl_odeiv2_step_rkf45
       : w->kind == MARTELLO_INT_RK8PD ? gsl_odeiv2_step_rk8pd : gsl_odeiv2_step_msbdf;
-  h0 = 1e-3 * fmin(w->dt_out, w->t_end);
+  h0 = 1e-3 * fmin(w->dt_out * w->every, w->t_end);
   if (w->h_max > 0.0) h0 = fmin(h0, w->h_max);
   w->drv = gsl_odeiv2_driver_alloc_scaled_new(&w->sys, T, h0, w->atol, w->rtol, 1.0, 0.0,
                                               w->scale_abs);
@@ -999,9 +999,12 @@ static int ed_integrate(ed_t *w) {
   if (st == MARTELLO_OK) st = observe(w, 0.0, 0);
   if (st != MARTELLO_OK) return st;
 
-  h = 1e-3 * fmin(w->dt_out, w->t_end);
+  h = 1e-3 * fmin(w->dt_out * w->every, w->t_end);
   while (t < w->t_end) {
-    const double t_out = k_out >= n_out ? w->t_end : (double)k_out * w->dt_out;
+    /* the stops: the recorded grid points t = k dt, k a multiple of every, and t_end (the
+     * one meaning of the output interval dt x every, docs/run-layer.md, as on IDA) */
+    const long k_grid = k_out * (long)w->every;
+    const double t_out = k_grid >= n_out ? w->t_end : (double)k_grid * w->dt_out;
     const double t0 = t;
     unsigned long failed = w->drv->e->failed_steps;
     double hs = (w->h_max > 0.0) ? fmin(h, w->h_max) : h, te, t_stop;
@@ -1041,7 +1044,10 @@ static int ed_integrate(ed_t *w) {
     }
     st = commit(w, t, w->y0 + 2 * n);
     if (st != MARTELLO_OK) return st;
-    if (t >= t_out) k = (int)k_out++;   /* on the output grid: the observer may record it */
+    if (t >= t_out) {   /* on the output grid: the observer records it */
+      k = (int)(k_grid < n_out ? k_grid : n_out);
+      k_out++;
+    }
     st = observe(w, t, k);
     if (st != MARTELLO_OK) return st;
   }

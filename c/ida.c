@@ -88,7 +88,7 @@ typedef struct {
   int nsw, *sw_a, *sw_b;
   double *sw_al, *sw_be, *sw_ga;
   /* settings */
-  double rtol, atol, event_tol, t_end, h_max, out_dt;
+  double rtol, atol, event_tol, t_end, h_max, out_dt, dt;
   int every;     /* output intervals dt per stop time out_dt */
   /* works since the last hand-over to the observer: external, internal, of the links other
    * than dampers and of the penalty contacts (quadrature), kinetic energy taken out at
@@ -811,6 +811,7 @@ static int setup(ida_problem *P, martello_model *model, martello_run *run) {
   P->h_max = s.h_max;
   P->every = s.every;
   P->out_dt = s.dt * s.every;
+  P->dt = s.dt;
   if ((st = martello_model_topology(model, &n, &nc, NULL, NULL, NULL, NULL, NULL, NULL, NULL,
                                     &ncp)) != MARTELLO_OK)
     return fail(P, st, "IDA: could not read the model");
@@ -901,6 +902,34 @@ static int setup(ida_problem *P, martello_model *model, martello_run *run) {
 
 /* ---- the run ------------------------------------------------------------------------------ */
 
+/* IDA's first step (docs/ida.md, initial step): IDA guesses it from the first stop time,
+ * which from rest with a far output makes its first-order error test fail down to h_min; so
+ * at the start and at every restart: the first step h of order 1 errs by h^2 |y''|/2 per
+ * component; y'' = (a, a') at the restart (a' by a
+ * forward difference along the motion) and h0 = SAFETY min_i sqrt(2 w_i / |y''_i|), w_i =
+ * rtol |y_i| + atol, capped at 1e-3 of the output interval, as on the GSL path. */
+#define SAFETY 0.1   /* IDA's first-order error estimate is crude: a margin below it */
+static int initial_step(ida_problem *P, double t, const double *u, const double *v, double *h0) {
+  const int n = P->n;
+  const double cap = 1e-3 * fmin(P->out_dt, P->t_end), d = 1e-6 * cap;
+  int st = martello_eval_acceleration(P->ev, t, u, v, P->a);
+  if (st != MARTELLO_OK) return fail(P, st, "IDA: acceleration failed at t = %.9e s", t);
+  for (int i = 0; i < n; i++) {
+    P->uq[i] = u[i] + d * v[i];
+    P->vq[i] = v[i] + d * P->a[i];
+  }
+  st = martello_eval_acceleration(P->ev, t + d, P->uq, P->vq, P->x);
+  if (st != MARTELLO_OK) return fail(P, st, "IDA: acceleration failed at t = %.9e s", t + d);
+  *h0 = cap;
+  for (int i = 0; i < n; i++) {
+    double ju = fabs(P->a[i]), jv = fabs(P->x[i] - P->a[i]) / d;
+    double wu = P->rtol * fabs(u[i]) + P->atol, wv = P->rtol * fabs(v[i]) + P->atol;
+    if (ju > 0.0) *h0 = fmin(*h0, SAFETY * sqrt(2.0 * wu / ju));
+    if (jv > 0.0) *h0 = fmin(*h0, SAFETY * sqrt(2.0 * wv / jv));
+  }
+  return MARTELLO_OK;
+}
+
 /* The next stop after t: the output time t_out, or a kink of the load before it. */
 static double next_stop(ida_problem *P, double t, double t_out) {
   double tb = DBL_MAX;
@@ -970,6 +999,9 @@ static int integrate(ida_problem *P, SUNContext sunctx, void **memp, N_Vector yy
   if (!*LSp) return fail(P, MARTELLO_ERR_MEMORY, "IDA: could not create the linear solver");
   if ((st = check(P, IDASetLinearSolver(mem, *LSp, *Jp), "IDASetLinearSolver"))) return st;
   if (P->h_max > 0.0 && (st = check(P, IDASetMaxStep(mem, P->h_max), "IDASetMaxStep"))) return st;
+  double h0;
+  if ((st = initial_step(P, 0.0, u0, v0, &h0)) != MARTELLO_OK) return st;
+  if ((st = check(P, IDASetInitStep(mem, h0), "IDASetInitStep"))) return st;
   double *idv = N_VGetArrayPointer(id);
   for (sunindextype k = 0; k < P->N; k++) idv[k] = 1.0;
   for (int r = 0; r < P->nr; r++) idv[P->ip[r]] = idv[P->im[r]] = 0.0;
@@ -981,7 +1013,7 @@ static int integrate(ida_problem *P, SUNContext sunctx, void **memp, N_Vector yy
   }
 
   int k_out = 1;
-  double t_out = fmin(P->out_dt, P->t_end), t_last = 0.0;
+  double t_out = fmin((double)P->every * P->dt, P->t_end), t_last = 0.0;
   if ((st = observe(P, 0.0, N_VGetArrayPointer(yy), N_VGetArrayPointer(yp), 0)) != MARTELLO_OK) return st;
   double t_stop = next_stop(P, 0.0, t_out);
   if ((st = check(P, IDASetStopTime(mem, t_stop), "IDASetStopTime"))) return st;
@@ -1069,10 +1101,14 @@ static int integrate(ida_problem *P, SUNContext sunctx, void **memp, N_Vector yy
         break;
       }
       k_out++;
-      t_out = fmin(k_out * P->out_dt, P->t_end);
+      t_out = fmin((double)(k_out * P->every) * P->dt, P->t_end);   /* t = k dt, as on GSL */
       if (P->t_end - t_out <= 1e-9 * P->out_dt) t_out = P->t_end;
     }
     if (restart) {
+      double h0;
+      gather(P, N_VGetArrayPointer(yy), P->u, P->v);
+      if ((st = initial_step(P, t_r, P->u, P->v, &h0)) != MARTELLO_OK) break;
+      if ((st = check(P, IDASetInitStep(mem, h0), "IDASetInitStep"))) break;
       if ((st = check(P, IDAReInit(mem, t_r, yy, yp), "IDAReInit"))) break;
       reset_count_baseline(P);
     }
