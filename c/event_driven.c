@@ -42,7 +42,8 @@ enum { ROOT_IMPACT,      /* unilateral gap closing: delta >= 0                  
        ROOT_PEAK,        /* penalty contact at its deepest: delta' <= 0 (no change of
                             state; the step ends there so the peak force and
                             penetration are observed, not interpolated)             */
-       ROOT_RELEASE };   /* persistent contact: multiplier P below -tolerance       */
+       ROOT_RELEASE,     /* persistent contact: multiplier P below -tolerance       */
+       ROOT_SWITCH };    /* a law's branch left: switch g > 0 (index nc + slot)     */
 
 /* events without time advancing before the run is declared stuck */
 #define MAX_EVENTS_AT_ONCE 1000
@@ -79,6 +80,9 @@ typedef struct {
   int *ilist, *hk;
   double *Wl, *ql, *pl, *wl, *sl, *el, *tg;
   double *t_hold;                 /* predicted accumulation time of a contact being held */
+  /* the switches of the laws' branches (martello_eval_switches), refreshed at every commit */
+  int nsw, *sw_a, *sw_b;
+  double *sw_al, *sw_be, *sw_ga;
   /* cost counters; kinetic energy taken out by impulses since the last commit */
   long long cnt[MARTELLO_NCOUNTERS];
   double e_impact;
@@ -146,6 +150,29 @@ static double gap_tol(const ed_t *w, int j, const double *u) {
 #define RESOLUTION_MARGIN 1.0e3
 static double position_res(const ed_t *w, int j, const double *u) {
   return RESOLUTION_MARGIN * (w->atol + w->rtol * gap_scale(w, j, u));
+}
+
+/* The value of switch slot s on the state y: g > 0 once its branch is left. */
+static double switch_value(const ed_t *w, int s, const double *y) {
+  const int a = w->sw_a[s], b = w->sw_b[s];
+  double du = 0.0, dv = 0.0;
+  if (a >= 0) { du += y[a]; dv += y[w->n + a]; }
+  if (b >= 0) { du -= y[b]; dv -= y[w->n + b]; }
+  return w->sw_al[s] * du + w->sw_be[s] * dv + w->sw_ga[s];
+}
+
+/* The rounding of switch s on y: a value within it is on the surface, not past it (a branch
+ * just entered starts there). */
+static double switch_rounding(const ed_t *w, int s, const double *y) {
+  const int a = w->sw_a[s], b = w->sw_b[s];
+  double su = 0.0, sv = 0.0;
+  if (a >= 0) { su += fabs(y[a]); sv += fabs(y[w->n + a]); }
+  if (b >= 0) { su += fabs(y[b]); sv += fabs(y[w->n + b]); }
+  return 16.0 * DBL_EPSILON * (fabs(w->sw_al[s]) * su + fabs(w->sw_be[s]) * sv + fabs(w->sw_ga[s]));
+}
+
+static int switch_active(const ed_t *w, int s) {
+  return w->sw_al[s] != 0.0 || w->sw_be[s] != 0.0;
 }
 
 /* ---- the right-hand side --------------------------------------------------------------- */
@@ -491,6 +518,11 @@ static int root_value(ed_t *w, int j, int type, double t, const double *y, doubl
                       double *rate) {
   const double sgn = type == ROOT_SEPARATION ? -1.0 : 1.0;
   w->cnt[MARTELLO_COUNTER_ROOT_EVALUATIONS]++;
+  if (type == ROOT_SWITCH) {
+    *g = switch_value(w, j - w->nc, y);
+    if (rate) *rate = 0.0;
+    return MARTELLO_OK;
+  }
   if (type == ROOT_RELEASE) {
     int st = eval_point(w, t, y, w->f1, NULL);
     if (st != MARTELLO_OK) return fail_eval(w, st, t);
@@ -509,7 +541,7 @@ static int root_value(ed_t *w, int j, int type, double t, const double *y, doubl
 }
 
 static int after(int type, double g) {
-  return (type == ROOT_ONSET || type == ROOT_RELEASE) ? g > 0.0 : g >= 0.0;
+  return (type == ROOT_ONSET || type == ROOT_RELEASE || type == ROOT_SWITCH) ? g > 0.0 : g >= 0.0;
 }
 
 /* Shrink the bracket [ta, tb] (before/after the event) to event_tol by Illinois iterations,
@@ -622,6 +654,57 @@ static int search_extremum(ed_t *w, int j, int type, double t0, double t1, doubl
   return 0;
 }
 
+/* Samples of the step's interpolant screened for a switch crossed and re-crossed inside it
+ * (grazing): the switches are affine in the relative motion of two nodes, whose quintic
+ * Hermite interpolant (u, v, a at both ends) gives the switch along the step. */
+#define GRAZING_SAMPLES 32
+
+/* The bracket of switch slot s in the step [t0, t1]: 1 with the value before at t0 (*ga)
+ * and past at *tb (*gb, state in w->yb), 0 if it is not crossed, < 0 on failure. */
+static int bracket_switch(ed_t *w, int s, double t0, double t1, double *ga, double *tb,
+                          double *gb) {
+  const int n = w->n, a = w->sw_a[s], b = w->sw_b[s];
+  const double h = t1 - t0;
+  double x[2][3] = {{0.0, 0.0, 0.0}, {0.0, 0.0, 0.0}}, best = -HUGE_VAL, xbest = 0.0, tol;
+  hermite_t p;
+  int i, st;
+  *ga = switch_value(w, s, w->y0);
+  *gb = switch_value(w, s, w->y);
+  /* the commit chose the branch at the step start (a value past 0 there is the rounding of
+   * a switch just crossed, or a branch chosen from a state past its surface): the start is
+   * on the branch's side */
+  if (*gb > switch_rounding(w, s, w->y)) {
+    memcpy(w->yb, w->y, w->dim * sizeof *w->yb);
+    return 1;
+  }
+  /* du, dv, da at both ends */
+  if (a >= 0) {
+    x[0][0] += w->y0[a]; x[0][1] += w->y0[n + a]; x[0][2] += w->fstart[n + a];
+    x[1][0] += w->y[a]; x[1][1] += w->y[n + a]; x[1][2] += w->f1[n + a];
+  }
+  if (b >= 0) {
+    x[0][0] -= w->y0[b]; x[0][1] -= w->y0[n + b]; x[0][2] -= w->fstart[n + b];
+    x[1][0] -= w->y[b]; x[1][1] -= w->y[n + b]; x[1][2] -= w->f1[n + b];
+  }
+  hermite_build(&p, h, x[0][0], x[0][1], x[0][2], x[1][0], x[1][1], x[1][2]);
+  for (i = 1; i < GRAZING_SAMPLES; i++) {
+    const double th = (double)i / GRAZING_SAMPLES;
+    const double g = w->sw_al[s] * hermite_value(&p, th) +
+                     w->sw_be[s] * hermite_rate(&p, th) / h + w->sw_ga[s];
+    if (g > best) { best = g; xbest = th; }
+  }
+  /* the interpolant's own error: the position tolerance on both terms */
+  tol = (fabs(w->sw_al[s]) + fabs(w->sw_be[s]) / h) *
+        (w->atol + w->rtol * (fabs(x[0][0]) + fabs(x[1][0]) + h * (fabs(x[0][1]) + fabs(x[1][1]))));
+  if (best + tol < 0.0) return 0;
+  *tb = t0 + xbest * h;
+  st = reintegrate(w, t0, *tb - t0, w->yb);
+  if (st != MARTELLO_OK) return st;
+  *gb = switch_value(w, s, w->yb);
+  w->cnt[MARTELLO_COUNTER_ROOT_EVALUATIONS]++;
+  return *gb > switch_rounding(w, s, w->yb);
+}
+
 /* The bracket of contact j's next event in the step [t0, t1], if there is one: before at
  * *ta (value *ga), past at *tb (value *gb, state in w->yb). Returns 1, 0 (none) or < 0. */
 static int bracket(ed_t *w, int j, int type, double t0, double t1, double *ta, double *ga,
@@ -630,6 +713,7 @@ static int bracket(ed_t *w, int j, int type, double t0, double t1, double *ta, d
   double r0, r1;
   int st;
   *ta = t0; *tb = t1;
+  if (type == ROOT_SWITCH) return bracket_switch(w, j - w->nc, t0, t1, ga, tb, gb);
   if (type == ROOT_RELEASE || type == ROOT_PEAK) {
     *ga = type == ROOT_PEAK ? -w->rate0[j] : -(w->lam0[j] + w->lamtol[j]);
     *gb = type == ROOT_PEAK ? -w->rate1[j] : -(w->lam1[j] + w->lamtol[j]);
@@ -708,6 +792,8 @@ static int locate(ed_t *w, double t0, double t1, double *te) {
                     t0, t1, &found, &best);
     }
   }
+  for (j = 0; j < w->nsw && st >= 0; j++)
+    if (switch_active(w, j)) st = consider(w, w->nc + j, ROOT_SWITCH, t0, t1, &found, &best);
   if (st < 0) return st;
   if (!found) return 0;
   memcpy(w->y, w->ybest, w->dim * sizeof *w->y);
@@ -722,6 +808,8 @@ static int locate(ed_t *w, double t0, double t1, double *te) {
 static int commit(ed_t *w, double t, const double *w_start) {
   const double *wk = w->y + 2 * w->n;
   int st = martello_eval_commit(w->ev, w->y, w->y + w->n);
+  if (st == MARTELLO_OK && w->nsw > 0)   /* the branches may have changed */
+    st = martello_eval_switches(w->ev, w->sw_a, w->sw_b, w->sw_al, w->sw_be, w->sw_ga);
   if (st == MARTELLO_OK)
     st = martello_observer_work(w->obs, wk[0] - w_start[0], wk[1] - w_start[1],
                                 wk[2] - w_start[2], wk[3] - w_start[3], w->e_impact);
@@ -749,7 +837,8 @@ static void ed_free(ed_t *w) {
                   w->yerr, w->fstart, w->f, w->f1, w->fj, w->yj, w->fint, w->fext,
                   w->pen0, w->rate0, w->acc0, w->pen1, w->rate1, w->acc1, w->pen, w->rate,
                   w->force, w->lam, w->lam0, w->lam1, w->lamtol, w->hlist, w->held, w->Wh,
-                  w->rh, w->ilist, w->hk, w->Wl, w->ql, w->pl, w->wl, w->sl, w->el, w->tg, w->t_hold};
+                  w->rh, w->ilist, w->hk, w->Wl, w->ql, w->pl, w->wl, w->sl, w->el, w->tg, w->t_hold,
+                  w->sw_a, w->sw_b, w->sw_al, w->sw_be, w->sw_ga};
   size_t i;
   for (i = 0; i < sizeof bufs / sizeof bufs[0]; i++) free(bufs[i]);
   if (w->drv) gsl_odeiv2_driver_free(w->drv);
@@ -806,6 +895,15 @@ static int ed_setup(ed_t *w) {
     return MARTELLO_ERR_MEMORY;
   st = martello_eval_create(w->model, &w->ev);
   if (st != MARTELLO_OK) return fail(w, st, 0.0, "event-driven: martello_eval_create failed");
+  /* every switching surface of the laws is an event: hold them on smooth branches */
+  st = martello_eval_use_branches(w->ev, &w->nsw);
+  if (st != MARTELLO_OK) return fail(w, st, 0.0, "event-driven: martello_eval_use_branches failed");
+  if (!(ALLOC(w->sw_a, w->nsw) && ALLOC(w->sw_b, w->nsw) && ALLOC(w->sw_al, w->nsw) &&
+        ALLOC(w->sw_be, w->nsw) && ALLOC(w->sw_ga, w->nsw)))
+    return MARTELLO_ERR_MEMORY;
+  if (w->nsw > 0 &&
+      martello_eval_switches(w->ev, w->sw_a, w->sw_b, w->sw_al, w->sw_be, w->sw_ga) != MARTELLO_OK)
+    return fail(w, MARTELLO_ERR_ARGUMENT, 0.0, "event-driven: martello_eval_switches failed");
   /* M^-1 B_j^T of every unilateral contact; a contact between two immovable sides is inert */
   for (j = 0; j < nc; j++) {
     double *c;
@@ -830,7 +928,7 @@ static int ed_setup(ed_t *w) {
   w->sys.params = w;
   T = w->kind == MARTELLO_INT_RKF45 ? gsl_odeiv2_step_rkf45
       : w->kind == MARTELLO_INT_RK8PD ? gsl_odeiv2_step_rk8pd : gsl_odeiv2_step_msbdf;
-  h0 = 1e-3 * fmin(w->dt_out, w->t_end);
+  h0 = 1e-3 * fmin(w->dt_out * w->every, w->t_end);
   if (w->h_max > 0.0) h0 = fmin(h0, w->h_max);
   w->drv = gsl_odeiv2_driver_alloc_scaled_new(&w->sys, T, h0, w->atol, w->rtol, 1.0, 0.0,
                                               w->scale_abs);
@@ -901,20 +999,26 @@ static int ed_integrate(ed_t *w) {
   if (st == MARTELLO_OK) st = observe(w, 0.0, 0);
   if (st != MARTELLO_OK) return st;
 
-  h = 1e-3 * fmin(w->dt_out, w->t_end);
+  h = 1e-3 * fmin(w->dt_out * w->every, w->t_end);
   while (t < w->t_end) {
-    const double t_out = k_out >= n_out ? w->t_end : (double)k_out * w->dt_out;
+    /* the stops: the recorded grid points t = k dt, k a multiple of every, and t_end (the
+     * one meaning of the output interval dt x every, docs/run-layer.md, as on IDA) */
+    const long k_grid = k_out * (long)w->every;
+    const double t_out = k_grid >= n_out ? w->t_end : (double)k_grid * w->dt_out;
     const double t0 = t;
     unsigned long failed = w->drv->e->failed_steps;
-    double hs = (w->h_max > 0.0) ? fmin(h, w->h_max) : h, te;
+    double hs = (w->h_max > 0.0) ? fmin(h, w->h_max) : h, te, t_stop;
     int ev, k = -1;
+    /* a kink of the load is a stop (docs/event-driven.md, time events) */
+    martello_eval_next_breakpoint(w->ev, t, &t_stop);
+    t_stop = fmin(t_stop, t_out);
     /* the step start: state, RHS (from observe), gap kinematics */
     memcpy(w->y0, w->y, w->dim * sizeof *w->y);
     kinematics(w, w->y0, w->fstart + n, w->pen0, w->rate0, w->acc0);
-    st = gsl_odeiv2_evolve_apply(w->drv->e, w->drv->c, w->drv->s, &w->sys, &t, t_out, &hs, w->y);
+    st = gsl_odeiv2_evolve_apply(w->drv->e, w->drv->c, w->drv->s, &w->sys, &t, t_stop, &hs, w->y);
     w->cnt[MARTELLO_COUNTER_REJECTED_STEPS] += (long long)(w->drv->e->failed_steps - failed);
     if (st != GSL_SUCCESS) return gsl_failure(w, st, t, hs);
-    if (t < t_out) h = hs;   /* the last step onto an output time keeps the suggestion */
+    if (t < t_stop) h = hs;   /* the last step onto a stop keeps the suggestion */
     w->cnt[MARTELLO_COUNTER_STEPS]++;
     /* the step end (a non-finite state stops the RHS here: a divergence): gap kinematics
      * and multipliers, then the earliest event inside */
@@ -935,9 +1039,15 @@ static int ed_integrate(ed_t *w) {
                     "event-driven: events accumulate without time advancing (an unresolved "
                     "Zeno point or chattering contact)");
     }
+    else if (t >= t_stop && t_stop < t_out) {
+      gsl_odeiv2_driver_reset(w->drv);   /* across a kink of the load: start afresh */
+    }
     st = commit(w, t, w->y0 + 2 * n);
     if (st != MARTELLO_OK) return st;
-    if (t >= t_out) k = (int)k_out++;   /* on the output grid: the observer may record it */
+    if (t >= t_out) {   /* on the output grid: the observer records it */
+      k = (int)(k_grid < n_out ? k_grid : n_out);
+      k_out++;
+    }
     st = observe(w, t, k);
     if (st != MARTELLO_OK) return st;
   }

@@ -83,8 +83,12 @@ typedef struct {
    * B_r = e_b - e_a), built once; the door lists of the contacts in aset */
   double *cols;
   int cols_ready, *dc;
+  /* the switches of the laws' branches (martello_eval_switches), refreshed at every commit:
+   * roots 2 nc .. 2 nc + nsw - 1 */
+  int nsw, *sw_a, *sw_b;
+  double *sw_al, *sw_be, *sw_ga;
   /* settings */
-  double rtol, atol, event_tol, t_end, h_max, out_dt;
+  double rtol, atol, event_tol, t_end, h_max, out_dt, dt;
   int every;     /* output intervals dt per stop time out_dt */
   /* works since the last hand-over to the observer: external, internal, of the links other
    * than dampers and of the penalty contacts (quadrature), kinetic energy taken out at
@@ -247,8 +251,18 @@ static int residual(realtype t, N_Vector yy, N_Vector yp, N_Vector rr, void *dat
   return 0;
 }
 
+/* Commit (u, v) in the evaluator; the laws' branches may change there, so the switches are
+ * read again. */
+static int commit(ida_problem *P, const double *u, const double *v) {
+  int st = martello_eval_commit(P->ev, u, v);
+  if (st == MARTELLO_OK && P->nsw > 0)
+    st = martello_eval_switches(P->ev, P->sw_a, P->sw_b, P->sw_al, P->sw_be, P->sw_ga);
+  return st;
+}
+
 /* Two root functions per contact: (delta, delta') while open or penalty, (P, 1) while a rigid
- * contact is closed. */
+ * contact is closed; then one per switch slot of the laws' branches (g > 0: the branch is
+ * left; an unused slot stays at -1). */
 static int roots(realtype t, N_Vector yy, N_Vector yp, realtype *g, void *data) {
   ida_problem *P = data;
   const double *y = N_VGetArrayPointer(yy);
@@ -264,6 +278,11 @@ static int roots(realtype t, N_Vector yy, N_Vector yp, realtype *g, void *data) 
       g[2 * j] = penetration(P, j, P->uq);
       g[2 * j + 1] = pen_rate(P, j, P->vq);
     }
+  }
+  for (int s = 0; s < P->nsw; s++) {
+    const int a = P->sw_a[s], b = P->sw_b[s];
+    g[2 * P->nc + s] = P->sw_al[s] * (node_u(a, P->uq) - node_u(b, P->uq)) +
+                       P->sw_be[s] * (node_u(a, P->vq) - node_u(b, P->vq)) + P->sw_ga[s];
   }
   return 0;
 }
@@ -367,6 +386,8 @@ static int work_quadrature(ida_problem *P, void *mem, double t0, double t1, N_Ve
  * simultaneous impacts in a chain), restitution e (0 for a closed contact). P->hit and
  * P->w_in say which contacts took an impulse and their approach speed. Then the closing
  * rule (the accumulation policy) and, for the closed set, zero rates and positions. */
+static int project_closed(ida_problem *P, double t, double *u, double *v);
+
 static int rigid_impacts(ida_problem *P, double t, double *u, double *v) {
   int st, m = 0, piv;
   if ((st = impulse_columns(P)) != MARTELLO_OK) return fail(P, st, "IDA: singular mass at an impact");
@@ -431,11 +452,15 @@ static int rigid_impacts(ida_problem *P, double t, double *u, double *v) {
                                       &t_inf))
       P->closed[r] = 1;
   }
-  m = closed_set(P);
+  return project_closed(P, t, u, v);
+}
+
+/* Zero the rates of the closed set (for an accumulation this removes the rest of the
+ * bounces: their energy goes to E_IMPACT), then put it on delta = 0 (B u = -gap) by the
+ * mass-weighted projection: at every restart, so that IDA starts on the constraints. */
+static int project_closed(ida_problem *P, double t, double *u, double *v) {
+  int st, m = closed_set(P);
   if (m == 0) return MARTELLO_OK;
-  /* zero the rates of the closed set (for an accumulation this removes the rest of the
-   * bounces: their energy goes to E_IMPACT), then put it on delta = 0 (B u = -gap) by the
-   * mass-weighted projection */
   door_list(P, m);
   if ((st = martello_impulse_factor(P->n, m, P->dc, TOPOLOGY(P), P->S)) != MARTELLO_OK)
     return fail(P, MARTELLO_ERR_SINGULAR, "IDA: redundant closed contacts at t = %.9e s (B^T M^-1 B singular)", t);
@@ -520,13 +545,14 @@ static int prepare_restart(ida_problem *P, double t, double *u, double *v, N_Vec
     P->hit[r] = 0;
   }
   if (any_rigid && (st = rigid_impacts(P, t, u, v)) != MARTELLO_OK) return st;
+  if (!any_rigid && P->nr > 0 && (st = project_closed(P, t, u, v)) != MARTELLO_OK) return st;
   /* rebounding (not closed) contacts leave from delta < 0 so that the gap root sees the
    * next approach as a sign change */
   for (int r = 0; r < P->nr; r++) {
     int j = P->rig_con[r];
     if ((P->hit[r] || P->act[j] == ACT_IMPACT) && !P->closed[r]) nudge(P, j, -1, u);
   }
-  if ((st = martello_eval_commit(P->ev, u, v)) != MARTELLO_OK) return fail(P, st, "IDA: commit failed");
+  if ((st = commit(P, u, v)) != MARTELLO_OK) return fail(P, st, "IDA: commit failed");
   if (P->nr > 0 && (st = rigid_multipliers(P, t, u, v)) != MARTELLO_OK) return st;
   if (P->nr == 0 && (st = martello_eval_acceleration(P->ev, t, u, v, P->a)) != MARTELLO_OK)
     return fail(P, st, "IDA: acceleration failed at t = %.9e s", t);
@@ -722,7 +748,8 @@ static void release(ida_problem *P) {
   void *all[] = {P->mass, P->gap, P->rest, P->fixed, P->con_a, P->con_b, P->scheme, P->rig,
                  P->rig_con, P->iu, P->iv, P->ip, P->im, P->closed, P->act,
                  P->opened, P->was_closed, P->hit, P->cand, P->q, P->w0, P->w_in, P->u, P->v, P->a, P->x, P->uq, P->vq, P->fint, P->fext,
-                 P->force, P->lam, P->S, P->rhs, P->mb, P->cols, P->dc, P->aset};
+                 P->force, P->lam, P->S, P->rhs, P->mb, P->cols, P->dc, P->aset,
+                 P->sw_a, P->sw_b, P->sw_al, P->sw_be, P->sw_ga};
   for (size_t k = 0; k < sizeof all / sizeof all[0]; k++) free(all[k]);
   if (P->ev) martello_eval_free(&P->ev);
 }
@@ -784,6 +811,7 @@ static int setup(ida_problem *P, martello_model *model, martello_run *run) {
   P->h_max = s.h_max;
   P->every = s.every;
   P->out_dt = s.dt * s.every;
+  P->dt = s.dt;
   if ((st = martello_model_topology(model, &n, &nc, NULL, NULL, NULL, NULL, NULL, NULL, NULL,
                                     &ncp)) != MARTELLO_OK)
     return fail(P, st, "IDA: could not read the model");
@@ -857,10 +885,57 @@ static int setup(ida_problem *P, martello_model *model, martello_run *run) {
   P->N = pos;
   if ((st = martello_eval_create(model, &P->ev)) != MARTELLO_OK)
     return fail(P, st, "IDA: could not create the force evaluator");
+  /* every switching surface of the laws is a root: hold them on smooth branches */
+  if ((st = martello_eval_use_branches(P->ev, &P->nsw)) != MARTELLO_OK)
+    return fail(P, st, "IDA: martello_eval_use_branches failed");
+  P->sw_a = take((size_t)P->nsw, sizeof(int), &ok);
+  P->sw_b = take((size_t)P->nsw, sizeof(int), &ok);
+  P->sw_al = take((size_t)P->nsw, sizeof(double), &ok);
+  P->sw_be = take((size_t)P->nsw, sizeof(double), &ok);
+  P->sw_ga = take((size_t)P->nsw, sizeof(double), &ok);
+  if (!ok) return fail(P, MARTELLO_ERR_MEMORY, "IDA: out of memory");
+  if (P->nsw > 0 &&
+      (st = martello_eval_switches(P->ev, P->sw_a, P->sw_b, P->sw_al, P->sw_be, P->sw_ga)) != MARTELLO_OK)
+    return fail(P, st, "IDA: martello_eval_switches failed");
   return MARTELLO_OK;
 }
 
 /* ---- the run ------------------------------------------------------------------------------ */
+
+/* IDA's first step (docs/ida.md, initial step): IDA guesses it from the first stop time,
+ * which from rest with a far output makes its first-order error test fail down to h_min; so
+ * at the start and at every restart: the first step h of order 1 errs by h^2 |y''|/2 per
+ * component; y'' = (a, a') at the restart (a' by a
+ * forward difference along the motion) and h0 = SAFETY min_i sqrt(2 w_i / |y''_i|), w_i =
+ * rtol |y_i| + atol, capped at 1e-3 of the output interval, as on the GSL path. */
+#define SAFETY 0.1   /* IDA's first-order error estimate is crude: a margin below it */
+static int initial_step(ida_problem *P, double t, const double *u, const double *v, double *h0) {
+  const int n = P->n;
+  const double cap = 1e-3 * fmin(P->out_dt, P->t_end), d = 1e-6 * cap;
+  int st = martello_eval_acceleration(P->ev, t, u, v, P->a);
+  if (st != MARTELLO_OK) return fail(P, st, "IDA: acceleration failed at t = %.9e s", t);
+  for (int i = 0; i < n; i++) {
+    P->uq[i] = u[i] + d * v[i];
+    P->vq[i] = v[i] + d * P->a[i];
+  }
+  st = martello_eval_acceleration(P->ev, t + d, P->uq, P->vq, P->x);
+  if (st != MARTELLO_OK) return fail(P, st, "IDA: acceleration failed at t = %.9e s", t + d);
+  *h0 = cap;
+  for (int i = 0; i < n; i++) {
+    double ju = fabs(P->a[i]), jv = fabs(P->x[i] - P->a[i]) / d;
+    double wu = P->rtol * fabs(u[i]) + P->atol, wv = P->rtol * fabs(v[i]) + P->atol;
+    if (ju > 0.0) *h0 = fmin(*h0, SAFETY * sqrt(2.0 * wu / ju));
+    if (jv > 0.0) *h0 = fmin(*h0, SAFETY * sqrt(2.0 * wv / jv));
+  }
+  return MARTELLO_OK;
+}
+
+/* The next stop after t: the output time t_out, or a kink of the load before it. */
+static double next_stop(ida_problem *P, double t, double t_out) {
+  double tb = DBL_MAX;
+  if (martello_eval_next_breakpoint(P->ev, t, &tb) != MARTELLO_OK) tb = DBL_MAX;
+  return fmin(tb, t_out);
+}
 
 static int check(ida_problem *P, int flag, const char *call) {
   if (flag >= 0) return MARTELLO_OK;
@@ -924,21 +999,25 @@ static int integrate(ida_problem *P, SUNContext sunctx, void **memp, N_Vector yy
   if (!*LSp) return fail(P, MARTELLO_ERR_MEMORY, "IDA: could not create the linear solver");
   if ((st = check(P, IDASetLinearSolver(mem, *LSp, *Jp), "IDASetLinearSolver"))) return st;
   if (P->h_max > 0.0 && (st = check(P, IDASetMaxStep(mem, P->h_max), "IDASetMaxStep"))) return st;
+  double h0;
+  if ((st = initial_step(P, 0.0, u0, v0, &h0)) != MARTELLO_OK) return st;
+  if ((st = check(P, IDASetInitStep(mem, h0), "IDASetInitStep"))) return st;
   double *idv = N_VGetArrayPointer(id);
   for (sunindextype k = 0; k < P->N; k++) idv[k] = 1.0;
   for (int r = 0; r < P->nr; r++) idv[P->ip[r]] = idv[P->im[r]] = 0.0;
   if ((st = check(P, IDASetId(mem, id), "IDASetId"))) return st;
   if (P->nr > 0 && (st = check(P, IDASetSuppressAlg(mem, SUNTRUE), "IDASetSuppressAlg"))) return st;
-  if (P->nc > 0) {
-    if ((st = check(P, IDARootInit(mem, 2 * P->nc, roots), "IDARootInit"))) return st;
+  if (P->nc + P->nsw > 0) {
+    if ((st = check(P, IDARootInit(mem, 2 * P->nc + P->nsw, roots), "IDARootInit"))) return st;
     if ((st = check(P, IDASetNoInactiveRootWarn(mem), "IDASetNoInactiveRootWarn"))) return st;
   }
 
   int k_out = 1;
-  double t_out = fmin(P->out_dt, P->t_end), t_last = 0.0;
+  double t_out = fmin((double)P->every * P->dt, P->t_end), t_last = 0.0;
   if ((st = observe(P, 0.0, N_VGetArrayPointer(yy), N_VGetArrayPointer(yp), 0)) != MARTELLO_OK) return st;
-  if ((st = check(P, IDASetStopTime(mem, t_out), "IDASetStopTime"))) return st;
-  int *found = calloc((size_t)(2 * P->nc + 1), sizeof(int));
+  double t_stop = next_stop(P, 0.0, t_out);
+  if ((st = check(P, IDASetStopTime(mem, t_stop), "IDASetStopTime"))) return st;
+  int *found = calloc((size_t)(2 * P->nc + P->nsw + 1), sizeof(int));
   if (!found) return fail(P, MARTELLO_ERR_MEMORY, "IDA: out of memory");
   long steps = 0;
   int same_time = 0;
@@ -972,7 +1051,12 @@ static int integrate(ida_problem *P, SUNContext sunctx, void **memp, N_Vector yy
         break;
       }
       if (!restart) restart = root_stays_zero(P, N_VGetArrayPointer(yy), found);
+      /* a branch of a law left: the commit at the root changes it, IDA restarts there */
+      for (int s = 0; s < P->nsw && !restart; s++)
+        if (found[2 * P->nc + s]) restart = 1;
     }
+    /* a kink of the load (docs/ida.md, time events): IDA restarts across it */
+    if (!restart && flag == IDA_TSTOP_RETURN && tret == t_stop && t_stop < t_out) restart = 1;
     if (!restart) {
       restart = boundary_events(P, mem, t_last, tret, N_VGetArrayPointer(yy), ytmp, &t_r);
       if (restart < 0) {
@@ -999,7 +1083,7 @@ static int integrate(ida_problem *P, SUNContext sunctx, void **memp, N_Vector yy
       if ((st = flush_counts(P, mem)) != MARTELLO_OK) break;
       if ((st = prepare_restart(P, t_r, P->u, P->v, yy, yp)) != MARTELLO_OK) break;
     } else {
-      if ((st = martello_eval_commit(P->ev, P->u, P->v)) != MARTELLO_OK) {
+      if ((st = commit(P, P->u, P->v)) != MARTELLO_OK) {
         st = fail(P, st, "IDA: commit failed");
         break;
       }
@@ -1007,7 +1091,7 @@ static int integrate(ida_problem *P, SUNContext sunctx, void **memp, N_Vector yy
     }
     /* an output time reached (tstop), or passed within round-off by a restart: grid point
      * k_out·every of the output interval dt (the observer records it) */
-    int at_output = (flag == IDA_TSTOP_RETURN && t_r == tret) || t_out - t_r <= 1e-9 * P->out_dt;
+    int at_output = t_r == t_out || (restart && t_out - t_r <= 16.0 * DBL_EPSILON * t_out);
     if ((st = observe(P, t_r, N_VGetArrayPointer(yy), N_VGetArrayPointer(yp),
                       at_output ? k_out * P->every : -1)) != MARTELLO_OK)
       break;
@@ -1017,15 +1101,21 @@ static int integrate(ida_problem *P, SUNContext sunctx, void **memp, N_Vector yy
         break;
       }
       k_out++;
-      t_out = fmin(k_out * P->out_dt, P->t_end);
+      t_out = fmin((double)(k_out * P->every) * P->dt, P->t_end);   /* t = k dt, as on GSL */
       if (P->t_end - t_out <= 1e-9 * P->out_dt) t_out = P->t_end;
     }
     if (restart) {
+      double h0;
+      gather(P, N_VGetArrayPointer(yy), P->u, P->v);
+      if ((st = initial_step(P, t_r, P->u, P->v, &h0)) != MARTELLO_OK) break;
+      if ((st = check(P, IDASetInitStep(mem, h0), "IDASetInitStep"))) break;
       if ((st = check(P, IDAReInit(mem, t_r, yy, yp), "IDAReInit"))) break;
       reset_count_baseline(P);
     }
-    if (restart || at_output)
-      if ((st = check(P, IDASetStopTime(mem, t_out), "IDASetStopTime"))) break;
+    if (restart || at_output || tret >= t_stop) {
+      t_stop = next_stop(P, t_r, t_out);
+      if ((st = check(P, IDASetStopTime(mem, t_stop), "IDASetStopTime"))) break;
+    }
   }
   free(found);
   int st2 = flush_counts(P, mem);

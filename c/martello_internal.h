@@ -30,6 +30,17 @@ int martello_eval_forces(martello_eval *ev, double t, const double *u, const dou
 int martello_eval_solve_mass(martello_eval *ev, double *x);
 /* Accept (u, v) at the end of a step: path-dependent links (hysteresis) commit. */
 int martello_eval_commit(martello_eval *ev, const double *u, const double *v);
+/* Event-driven integrators: from now on every piecewise-smooth law is held on one smooth
+ * branch between located switches (fortran/switching.f90, docs/event-driven.md); branches
+ * change at commits past their switches. *nsw: the number of switch slots. */
+int martello_eval_use_branches(martello_eval *ev, int *nsw);
+/* The switches of the branches held, g = alpha (u_a - u_b) + beta (v_a - v_b) + gamma with
+ * 0-based nodes a, b (-1: ground); g > 0: the branch is left. Constant between commits. */
+int martello_eval_switches(martello_eval *ev, int *a, int *b, double *alpha, double *beta,
+                           double *gamma);
+/* The first time after t where a load has a kink (a window's start or end, a table sample),
+ * or DBL_MAX. */
+int martello_eval_next_breakpoint(martello_eval *ev, double t, double *tb);
 /* power[5] at the last force evaluation: of the external and the internal forces on the free
  * nodes (f . v), and of the dampers, the other links and the penalty contacts (f (v_a - v_b)):
  * the integrands of martello_observer_work's works. */

@@ -7,6 +7,7 @@ module martello_api_internal
    use martello_status
    use martello_model
    use martello_evaluator
+   use martello_switching, only: switch_count
    use martello_contact_laws, only: P_RESTITUTION
    use martello_integrator_settings, only: integrator_settings_t
    use martello_observer
@@ -140,6 +141,48 @@ contains
       call evaluator_commit(ep, u(1:ep%m%n), v(1:ep%m%n))
       c_eval_commit = MARTELLO_OK
    end function c_eval_commit
+
+   !> Event-driven integrators: hold the laws on smooth branches (evaluator_use_branches).
+   integer(c_int) function c_eval_use_branches(handle, nsw) bind(C, name='martello_eval_use_branches')
+      type(c_ptr), value :: handle
+      integer(c_int), intent(out) :: nsw
+      type(evaluator_t), pointer :: ep
+      ep => get_eval(handle)
+      nsw = 0
+      c_eval_use_branches = MARTELLO_ERR_ARGUMENT
+      if (.not. associated(ep)) return
+      call evaluator_use_branches(ep)
+      nsw = switch_count(ep%m)
+      c_eval_use_branches = MARTELLO_OK
+   end function c_eval_use_branches
+
+   integer(c_int) function c_eval_switches(handle, na, nb, alpha, beta, gamma) &
+      bind(C, name='martello_eval_switches')
+      type(c_ptr), value :: handle
+      integer(c_int), intent(out) :: na(*), nb(*)
+      real(c_double), intent(out) :: alpha(*), beta(*), gamma(*)
+      type(evaluator_t), pointer :: ep
+      integer :: ns
+      ep => get_eval(handle)
+      c_eval_switches = MARTELLO_ERR_ARGUMENT
+      if (.not. associated(ep)) return
+      ns = switch_count(ep%m)
+      if (ns > 0) call evaluator_switches(ep, na(1:ns), nb(1:ns), alpha(1:ns), beta(1:ns), gamma(1:ns))
+      c_eval_switches = MARTELLO_OK
+   end function c_eval_switches
+
+   integer(c_int) function c_eval_next_breakpoint(handle, t, tb) bind(C, name='martello_eval_next_breakpoint')
+      type(c_ptr), value :: handle
+      real(c_double), value :: t
+      real(c_double), intent(out) :: tb
+      type(evaluator_t), pointer :: ep
+      ep => get_eval(handle)
+      tb = huge(1.0_dp)
+      c_eval_next_breakpoint = MARTELLO_ERR_ARGUMENT
+      if (.not. associated(ep)) return
+      tb = evaluator_next_breakpoint(ep, t)
+      c_eval_next_breakpoint = MARTELLO_OK
+   end function c_eval_next_breakpoint
 
    integer(c_int) function c_eval_power(handle, power) bind(C, name='martello_eval_power')
       type(c_ptr), value :: handle

@@ -5,9 +5,10 @@
 module martello_assembly
    use martello_kinds, only: dp
    use martello_model, only: model_t, SCHEME_PENALTY
-   use martello_links, only: link_force, bilinear_energy, LINK_SPRING, LINK_BAR, LINK_BILINEAR, &
+   use martello_links, only: link_force, link_force_on_branch, BRANCH_FREE, bilinear_energy, LINK_SPRING, LINK_BAR, LINK_BILINEAR, &
       LINK_DASHPOT, LINK_FLUID_DAMPER, L_STIFF, L_DAMP, L_YIELD, L_HARDENING
-   use martello_contact_laws, only: contact_force, contact_elastic_energy, LAW_LINEAR, P_STIFF
+   use martello_contact_laws, only: contact_force, contact_elastic_energy, LAW_LINEAR, LAW_KELVIN, &
+      P_STIFF, P_DAMPING
    use martello_band_matrix, only: band_t, band_add
    use martello_time_functions, only: tf_value, TF_NONE
    implicit none
@@ -19,6 +20,12 @@ module martello_assembly
    !> Hunt–Crossley-type laws scale damping by 1/v_in; a contact first seen while δ̇ ≤ 0
    !> (grazing, or a step that lands inside) uses this floor [m/s] instead of a division by 0.
    real(dp), parameter :: ONSET_SPEED_FLOOR = 1.0e-12_dp
+
+   !> Branches of a penalty contact (con_branch): the whole law; open (no force whatever
+   !> the gap); in contact (the law extended smoothly past delta = 0, Kelvin unclipped);
+   !> Kelvin past its tension cut-off (no force while delta > 0).
+   integer, parameter, public :: CONTACT_FREE = 0, CONTACT_OPEN = 1, CONTACT_ON = 2, &
+      CONTACT_CUT = 3
 
    type :: mech_state_t
       ! committed link state (rate-independent force and elongation), and its trial
@@ -32,6 +39,10 @@ module martello_assembly
       logical, allocatable :: is_penalty(:)
       !> contacts held open for the current step (see the chatter rule of the integrators)
       logical, allocatable :: forced_off(:)
+      !> the smooth piece of each law an event-driven integrator holds between located
+      !> switches (martello_switching, docs/event-driven.md); BRANCH_FREE and CONTACT_FREE:
+      !> the whole law, as the fixed-step methods use it
+      integer, allocatable :: link_branch(:), con_branch(:)
    end type mech_state_t
 
 contains
@@ -50,6 +61,8 @@ contains
                 s%is_penalty(m%ncontact))
       s%is_penalty = m%con_scheme(1:m%ncontact) == SCHEME_PENALTY
       allocate (s%forced_off(m%ncontact)); s%forced_off = .false.
+      allocate (s%link_branch(m%nlink), s%con_branch(m%ncontact))
+      s%link_branch = BRANCH_FREE; s%con_branch = CONTACT_FREE
       ! The initial state is elastic and unloaded history: the committed force of a bilinear
       ! spring starts on its elastic line k·u0 (clamped into the band by the first step).
       do j = 1, m%nlink
@@ -99,7 +112,12 @@ contains
                kt = 0.0_dp; ct = par(L_DAMP, j)
                f = ct*dv; fnew = 0.0_dp
             case default
-               call link_force(kind(j), par(1, j), du, dv, fc(j), lu(j), f, kt, ct, fnew)
+               if (s%link_branch(j) == BRANCH_FREE) then
+                  call link_force(kind(j), par(1, j), du, dv, fc(j), lu(j), f, kt, ct, fnew)
+               else
+                  call link_force_on_branch(kind(j), par(1, j), s%link_branch(j), du, dv, &
+                                            fc(j), lu(j), f, kt, ct, fnew)
+               end if
             end select
             fc_trial(j) = fnew
             f_trial(j) = f
@@ -115,7 +133,19 @@ contains
          pen = u(a) - u(b) - m%con_gap(j)
          rate = v(a) - v(b)
          s%con_pen_trial(j) = pen; s%con_rate_trial(j) = rate
-         if (pen > 0.0_dp .and. .not. s%forced_off(j)) then
+         if (s%con_branch(j) == CONTACT_ON .and. m%con_law(j) == LAW_LINEAR) then
+            ! held in contact: the linear law extended past delta = 0 (smooth)
+            dfd = m%con_par(P_STIFF, j); dfv = 0.0_dp; f = dfd*pen
+            s%con_vin_trial(j) = 0.0_dp
+         else if (s%con_branch(j) == CONTACT_ON .and. m%con_law(j) == LAW_KELVIN) then
+            dfd = m%con_par(P_STIFF, j); dfv = m%con_par(P_DAMPING, j); f = dfd*pen + dfv*rate
+            s%con_vin_trial(j) = 0.0_dp
+         else if (s%con_branch(j) == CONTACT_OPEN .or. s%con_branch(j) == CONTACT_CUT) then
+            f = 0.0_dp; dfd = 0.0_dp; dfv = 0.0_dp
+            ! the onset speed a commit past the located onset keeps (as the whole law would)
+            s%con_vin_trial(j) = s%con_vin(j)
+            if (.not. s%con_on(j)) s%con_vin_trial(j) = max(s%con_rate(j), rate, ONSET_SPEED_FLOOR)
+         else if (pen > 0.0_dp .and. .not. s%forced_off(j)) then
             ! onset speed: the committed (start-of-step, free-side) rate, not the in-contact
             ! one — exact for a free impact, so the 1/v_in laws keep their order
             vin = s%con_vin(j)

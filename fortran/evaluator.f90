@@ -7,11 +7,14 @@ module martello_evaluator
    use martello_model, only: model_t, model_bandwidth
    use martello_assembly
    use martello_band_matrix
+   use martello_switching, only: switch_count, switching_choose, switching_functions
+   use martello_time_functions, only: tf_next_breakpoint, TF_NONE
    implicit none
    private
    public :: evaluator_t, evaluator_init, evaluator_load, evaluator_acceleration, &
       evaluator_forces, evaluator_solve_mass, evaluator_commit, &
-      evaluator_energy, evaluator_power
+      evaluator_energy, evaluator_power, evaluator_use_branches, evaluator_switches, &
+      evaluator_next_breakpoint
 
    type :: evaluator_t
       type(model_t), pointer :: m => null()
@@ -19,6 +22,8 @@ module martello_evaluator
       type(band_t) :: mband
       real(dp), allocatable :: mrow(:), u(:), v(:), f(:), fext(:), work(:)
       integer, allocatable :: fixed_nodes(:)
+      !> laws held on smooth branches between located switches (martello_switching)
+      logical :: branches = .false.
    end type evaluator_t
 
 contains
@@ -100,7 +105,38 @@ contains
       call evaluator_load(ev, u, v)
       call internal_forces(ev%m, ev%ms, ev%u, ev%v, ev%f)
       call mech_commit(ev%m, ev%ms, ev%u)
+      if (ev%branches) call switching_choose(ev%m, ev%ms, ev%u, ev%v)
    end subroutine evaluator_commit
+
+   !> From now on the laws are held on smooth branches, chosen at the committed state and
+   !> changed at commits past their switches (docs/event-driven.md, switching surfaces).
+   subroutine evaluator_use_branches(ev)
+      type(evaluator_t), intent(inout) :: ev
+      ev%branches = .true.
+      call switching_choose(ev%m, ev%ms, ev%u, ev%v)
+   end subroutine evaluator_use_branches
+
+   !> The switches of the branches held (martello_switching): switch_count slots.
+   subroutine evaluator_switches(ev, na, nb, alpha, beta, gamma)
+      type(evaluator_t), intent(in) :: ev
+      integer, intent(out) :: na(:), nb(:)
+      real(dp), intent(out) :: alpha(:), beta(:), gamma(:)
+      call switching_functions(ev%m, ev%ms, na, nb, alpha, beta, gamma)
+   end subroutine evaluator_switches
+
+   !> The first time after t where a load of the scene has a kink (tf_next_breakpoint), or
+   !> huge().
+   pure function evaluator_next_breakpoint(ev, t) result(tb)
+      type(evaluator_t), intent(in) :: ev
+      real(dp), intent(in) :: t
+      real(dp) :: tb
+      integer :: j
+      tb = huge(1.0_dp)
+      if (ev%m%ground_accel%kind /= TF_NONE) tb = tf_next_breakpoint(ev%m%ground_accel, t)
+      do j = 1, ev%m%nforce
+         tb = min(tb, tf_next_breakpoint(ev%m%force_fn(j), t))
+      end do
+   end function evaluator_next_breakpoint
 
    !> The powers at the state of the last force evaluation: of the external and the internal
    !> forces on the free nodes, f·v, and of the dampers, the other links and the penalty

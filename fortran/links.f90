@@ -14,7 +14,9 @@ module martello_links
    public :: LINK_SPRING, LINK_DASHPOT, LINK_BILINEAR, LINK_FLUID_DAMPER, LINK_BAR
    public :: NPAR_LINK, L_STIFF, L_DAMP, L_YIELD, L_HARDENING, L_ALPHA, L_VREG
    public :: bilinear_return_map, bilinear_energy, fluid_damper_force, link_force
-   public :: link_is_known
+   public :: link_is_known, link_force_on_branch
+   public :: BRANCH_FREE, BRANCH_ELASTIC, BRANCH_UPPER, BRANCH_LOWER, BRANCH_LINEAR, &
+      BRANCH_POWER_POS, BRANCH_POWER_NEG
 
    ! Link kinds: values are frozen, the C and Python layers use the same integers.
    integer, parameter :: LINK_SPRING = 1
@@ -31,7 +33,56 @@ module martello_links
    integer, parameter :: L_ALPHA = 5      ! damper exponent alpha in (0, 2]
    integer, parameter :: L_VREG = 6       ! damper regularisation speed >= 0
 
+   ! Branches of a link's law (docs/event-driven.md, switching surfaces): an event-driven
+   ! integrator fixes the smooth piece of the law between two located switches, so no
+   ! Runge–Kutta stage evaluates a kink. BRANCH_FREE: the law as a whole (fixed-step methods).
+   integer, parameter :: BRANCH_FREE = 0
+   integer, parameter :: BRANCH_ELASTIC = 1     ! bilinear inside the band: f_n + k (du - u_n)
+   integer, parameter :: BRANCH_UPPER = 2       ! bilinear on rho k du + (1 - rho) F_y
+   integer, parameter :: BRANCH_LOWER = 3       ! bilinear on rho k du - (1 - rho) F_y
+   integer, parameter :: BRANCH_LINEAR = 4      ! fluid damper below v_reg: the secant line
+   integer, parameter :: BRANCH_POWER_POS = 5   ! fluid damper c dv^alpha, dv > 0
+   integer, parameter :: BRANCH_POWER_NEG = 6   ! fluid damper -c (-dv)^alpha, dv < 0
+
 contains
+
+   !> link_force on a fixed branch of a bilinear spring or a fluid damper: the smooth
+   !> extension of that piece of the law beyond its switching surface (where a stage of a
+   !> one-step method may land before the switch is located). Other kinds and BRANCH_FREE:
+   !> link_force.
+   pure subroutine link_force_on_branch(kind, par, branch, du, dv, state_f, state_u, f, k_tan, &
+                                        c_tan, f_committed_new)
+      integer, intent(in) :: kind, branch
+      real(dp), intent(in) :: par(NPAR_LINK)
+      real(dp), intent(in) :: du, dv, state_f, state_u
+      real(dp), intent(out) :: f, k_tan, c_tan, f_committed_new
+      real(dp) :: k, rho, r, s
+      k_tan = 0.0_dp
+      c_tan = 0.0_dp
+      select case (branch)
+      case (BRANCH_ELASTIC, BRANCH_UPPER, BRANCH_LOWER)
+         k = par(L_STIFF); rho = par(L_HARDENING); r = (1.0_dp - rho)*par(L_YIELD)
+         if (branch == BRANCH_ELASTIC) then
+            f = state_f + k*(du - state_u)
+            k_tan = k
+         else
+            f = rho*k*du + merge(r, -r, branch == BRANCH_UPPER)
+            k_tan = rho*k
+         end if
+         f_committed_new = f
+      case (BRANCH_LINEAR)
+         c_tan = par(L_DAMP)*par(L_VREG)**(par(L_ALPHA) - 1.0_dp)
+         f = c_tan*dv
+         f_committed_new = 0.0_dp
+      case (BRANCH_POWER_POS, BRANCH_POWER_NEG)
+         s = merge(1.0_dp, -1.0_dp, branch == BRANCH_POWER_POS)
+         f = s*par(L_DAMP)*max(s*dv, 0.0_dp)**par(L_ALPHA)
+         c_tan = par(L_DAMP)*par(L_ALPHA)*max(s*dv, tiny(1.0_dp))**(par(L_ALPHA) - 1.0_dp)
+         f_committed_new = 0.0_dp
+      case default
+         call link_force(kind, par, du, dv, state_f, state_u, f, k_tan, c_tan, f_committed_new)
+      end select
+   end subroutine link_force_on_branch
 
    !> Bilinear spring with kinematic hardening (docs/problems.md P6): a trial step from the
    !> committed state (f_n, u_n) to the elongation u_new. The force is bounded by the lines

@@ -5,7 +5,7 @@ module martello_time_functions
    use martello_kinds, only: dp
    implicit none
    private
-   public :: time_function_t, tf_value, tf_is_known, NPAR_TF, &
+   public :: time_function_t, tf_value, tf_is_known, tf_next_breakpoint, NPAR_TF, &
       TF_NONE, TF_CONSTANT, TF_TABLE, TF_SINE, TF_RECTANGULAR, TF_HALF_SINE
 
    integer, parameter :: TF_NONE = 0
@@ -68,4 +68,42 @@ contains
          y = tf%par(1)*((1.0_dp - w)*tf%y(lo) + w*tf%y(hi))
       end select
    end function tf_value
+
+   !> The first time after t where the function is not smooth (docs/event-driven.md, time
+   !> events): the start and end of a window, every sample of a table; huge() if none. An
+   !> integrator that stops there never steps across a kink of the load.
+   pure function tf_next_breakpoint(tf, t) result(tb)
+      type(time_function_t), intent(in) :: tf
+      real(dp), intent(in) :: t
+      real(dp) :: tb
+      integer :: lo, hi, mid, n
+
+      tb = huge(1.0_dp)
+      select case (tf%kind)
+      case (TF_SINE, TF_RECTANGULAR, TF_HALF_SINE)
+         if (tf%par(4) > t) then
+            tb = tf%par(4)
+         else if (tf%par(5) > t) then
+            tb = tf%par(5)
+         end if
+      case (TF_TABLE)
+         n = size(tf%t)
+         if (n < 1) return
+         if (tf%t(n) <= t) return
+         if (tf%t(1) > t) then
+            tb = tf%t(1)
+            return
+         end if
+         lo = 1; hi = n          ! invariant: t(lo) <= t < t(hi)
+         do while (hi - lo > 1)
+            mid = (lo + hi)/2
+            if (tf%t(mid) <= t) then
+               lo = mid
+            else
+               hi = mid
+            end if
+         end do
+         tb = tf%t(hi)
+      end select
+   end function tf_next_breakpoint
 end module martello_time_functions

