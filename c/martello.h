@@ -105,6 +105,13 @@ int martello_model_add_link(martello_model *model, int kind, int a, int b,
 int martello_model_add_contact(martello_model *model, int a, int b, double gap, int scheme,
                                int law, const double par[MARTELLO_NPAR_CONTACT]);
 int martello_model_add_mass_coupling(martello_model *model, int a, int b, double value);
+/* A symmetric stiffness block between n distinct nodes (0-based, no ground): internal force
+ * f[nodes[i]] += sum_j (k[i + n*j] u[nodes[j]] + c[i + n*j] v[nodes[j]]) (k, c column-major
+ * n x n, exactly symmetric, diag k > 0, diag c >= 0; c may be NULL: undamped) -- a
+ * statically condensed structure such as a planar frame on its lateral DOFs
+ * (docs/problems.md P10). Every integrator runs it; blocks need no capacity. */
+int martello_model_add_stiffness_block(martello_model *model, int n, const int *nodes,
+                                       const double *k, const double *c);
 int martello_model_set_gravity(martello_model *model, double g);
 /* A time function: kind MARTELLO_TF_*, par[MARTELLO_NPAR_TF], and for a table n_table
  * samples (t[i], y[i]) with t strictly increasing (y scaled by par[0]). */
