@@ -217,3 +217,37 @@ def natural_frequencies(K, M):
     s = 1 / np.sqrt(np.asarray(M, float))
     lam = np.linalg.eigvalsh(s[:, None] * K * s[None, :])
     return np.sqrt(np.maximum(lam, 0.0))
+
+
+# --- interface links across a joint (seed §4, after Muthukumar & DesRoches 2006) ----------
+
+def beam_axial_stiffness(frame, floor, bay):
+    """EA/L of the beam of `bay` (1-based, 1 at the left) at `floor` (1-based)."""
+    E, A, _ = frame.beams[floor - 1][bay - 1]
+    return E * A / frame.widths[bay - 1]
+
+
+def gap_stiffness_aligned(frame_a, frame_b, floor, combine="mean"):
+    """The seed's rule for a gap element between floors at the same level: the axial
+    stiffness of the two beams it connects — the last bay of frame_a (on the left of the
+    joint) and the first bay of frame_b (on the right) at `floor`. combine: "mean" (their
+    harmonic mean 2/(1/k_a + 1/k_b), which is their common EA/L when the beams are equal, as
+    docs/p8-case-study.md reads the rule), "series" (1/(1/k_a + 1/k_b): the two beams
+    compressed one after the other) or "sum" (k_a + k_b)."""
+    ka = beam_axial_stiffness(frame_a, floor, frame_a.bays)
+    kb = beam_axial_stiffness(frame_b, floor, 1)
+    rules = {"mean": 2 / (1 / ka + 1 / kb), "series": 1 / (1 / ka + 1 / kb), "sum": ka + kb}
+    if combine not in rules:
+        raise ValueError(f"combine: unknown value {combine!r} (valid: mean, series, sum)")
+    return rules[combine]
+
+
+def gap_stiffness_offset(frame, storey, line, factor=2.0):
+    """The seed's rule for floors at different levels, where a slab strikes a column
+    mid-height: factor (1.5–2) times the lateral stiffness of the struck column, taken as
+    fixed–fixed 12EI/h³ (the column between two floors of its frame)."""
+    if not 1.5 <= factor <= 2.0:
+        raise ValueError(f"factor: {factor!r} is outside the seed's 1.5–2 "
+                         "(the rule is 1.5–2 times the column's lateral stiffness)")
+    E, _, I = frame.columns[storey - 1][line]
+    return factor * 12 * E * I / frame.heights[storey - 1] ** 3
