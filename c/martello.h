@@ -105,6 +105,13 @@ int martello_model_add_link(martello_model *model, int kind, int a, int b,
 int martello_model_add_contact(martello_model *model, int a, int b, double gap, int scheme,
                                int law, const double par[MARTELLO_NPAR_CONTACT]);
 int martello_model_add_mass_coupling(martello_model *model, int a, int b, double value);
+/* A symmetric stiffness block between n distinct nodes (0-based, no ground): internal force
+ * f[nodes[i]] += sum_j (k[i + n*j] u[nodes[j]] + c[i + n*j] v[nodes[j]]) (k, c column-major
+ * n x n, exactly symmetric, diag k > 0, diag c >= 0; c may be NULL: undamped) -- a
+ * statically condensed structure such as a planar frame on its lateral DOFs
+ * (docs/problems.md P10). Every integrator runs it; blocks need no capacity. */
+int martello_model_add_stiffness_block(martello_model *model, int n, const int *nodes,
+                                       const double *k, const double *c);
 int martello_model_set_gravity(martello_model *model, double g);
 /* A time function: kind MARTELLO_TF_*, par[MARTELLO_NPAR_TF], and for a table n_table
  * samples (t[i], y[i]) with t strictly increasing (y scaled by par[0]). */
@@ -143,10 +150,10 @@ typedef struct martello_run martello_run;
 enum { MARTELLO_INT_NEWMARK = 1, MARTELLO_INT_HHT = 2, MARTELLO_INT_GENERALIZED_ALPHA = 3,
        MARTELLO_INT_CENTRAL_DIFFERENCE = 4, MARTELLO_INT_MOREAU_JEAN = 5,
        MARTELLO_INT_NEWMARK_LAGRANGE = 6, MARTELLO_INT_RKF45 = 7, MARTELLO_INT_RK8PD = 8,
-       MARTELLO_INT_MSBDF = 9, MARTELLO_INT_IDA = 10 };
+       MARTELLO_INT_MSBDF = 9, MARTELLO_INT_IDA = 10, MARTELLO_INT_FAST_NONLINEAR = 11 };
 enum { MARTELLO_FAMILY_NEWMARK = 1, MARTELLO_FAMILY_TIME_STEPPING = 2,
        MARTELLO_FAMILY_CONSTRAINED_NEWMARK = 3, MARTELLO_FAMILY_EVENT_DRIVEN = 4,
-       MARTELLO_FAMILY_DAE = 5 };
+       MARTELLO_FAMILY_DAE = 5, MARTELLO_FAMILY_MODAL = 6 };
 
 /* The settings of a run, field by field the Fortran type integrator_settings_t
  * (fortran/integrator_settings.f90). martello_settings_default fills the registry's
@@ -176,12 +183,12 @@ typedef struct martello_settings {
 
 /* Indices of martello_run_counters, martello_run_energy and the values of
  * martello_run_events (tables "counters", "energy", "events"). */
-enum { MARTELLO_NCOUNTERS = 9, MARTELLO_NENERGY = 9, MARTELLO_NEVENT = 6 };
+enum { MARTELLO_NCOUNTERS = 10, MARTELLO_NENERGY = 9, MARTELLO_NEVENT = 6 };
 enum { MARTELLO_COUNTER_STEPS = 0, MARTELLO_COUNTER_REJECTED_STEPS = 1,
        MARTELLO_COUNTER_NEWTON_ITERATIONS = 2, MARTELLO_COUNTER_RESIDUAL_EVALUATIONS = 3,
        MARTELLO_COUNTER_FACTORIZATIONS = 4, MARTELLO_COUNTER_EVENTS = 5,
        MARTELLO_COUNTER_JACOBIAN_EVALUATIONS = 6, MARTELLO_COUNTER_ROOT_EVALUATIONS = 7,
-       MARTELLO_COUNTER_CONTACT_CHATTER_RESOLUTIONS = 8 };
+       MARTELLO_COUNTER_CONTACT_CHATTER_RESOLUTIONS = 8, MARTELLO_COUNTER_MODES = 9 };
 enum { MARTELLO_ENERGY_KINETIC = 0, MARTELLO_ENERGY_RECOVERABLE = 1, MARTELLO_ENERGY_INPUT = 2,
        MARTELLO_ENERGY_DAMPING = 3, MARTELLO_ENERGY_PLASTIC = 4, MARTELLO_ENERGY_CONTACT = 5,
        MARTELLO_ENERGY_BALANCE = 6, MARTELLO_ENERGY_INITIAL = 7, MARTELLO_ENERGY_IMPACT = 8 };

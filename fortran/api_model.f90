@@ -105,6 +105,33 @@ contains
       c_model_add_mass_coupling = stat
    end function c_model_add_mass_coupling
 
+   !> c may be NULL (no damping).
+   integer(c_int) function c_model_add_stiffness_block(handle, n, nodes, k, c) &
+      bind(C, name='martello_model_add_stiffness_block')
+      type(c_ptr), value :: handle, c
+      integer(c_int), value :: n
+      integer(c_int), intent(in) :: nodes(*)
+      real(c_double), intent(in) :: k(*)
+      type(model_t), pointer :: mp
+      real(c_double), pointer :: cp(:)
+      real(dp), allocatable :: cm(:, :)
+      integer :: stat
+      mp => get_model(handle)
+      if (.not. associated(mp) .or. n < 1) then
+         c_model_add_stiffness_block = MARTELLO_ERR_ARGUMENT
+         if (associated(mp)) mp%errmsg = 'add_stiffness_block: need n >= 1'
+         return
+      end if
+      allocate (cm(n, n)); cm = 0.0_dp
+      if (c_associated(c)) then
+         call c_f_pointer(c, cp, [n*n])
+         cm = reshape(cp, [int(n), int(n)])
+      end if
+      call model_add_stiffness_block(mp, int(nodes(1:n)) + 1, &
+                                     reshape(k(1:n*n), [int(n), int(n)]), cm, stat)
+      c_model_add_stiffness_block = stat
+   end function c_model_add_stiffness_block
+
    integer(c_int) function c_model_set_gravity(handle, g) bind(C, name='martello_model_set_gravity')
       type(c_ptr), value :: handle
       real(c_double), value :: g

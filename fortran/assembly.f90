@@ -43,7 +43,17 @@ module martello_assembly
       !> switches (martello_switching, docs/event-driven.md); BRANCH_FREE and CONTACT_FREE:
       !> the whole law, as the fixed-step methods use it
       integer, allocatable :: link_branch(:), con_branch(:)
+      !> stiffness blocks: the recoverable energy ½uᵀku at the committed state, and their
+      !> forces (for the works and powers)
+      real(dp), allocatable :: blk_e(:)
+      type(block_state_t), allocatable :: blk(:)
    end type mech_state_t
+
+   !> One block's elastic force k·u and damping force c·v at the last evaluation (trial),
+   !> and the damping force and u at the committed state (trapezoidal damping work).
+   type :: block_state_t
+      real(dp), allocatable :: f(:), fc(:), fc_n(:), u_n(:)
+   end type block_state_t
 
 contains
 
@@ -72,6 +82,16 @@ contains
              m%link_kind(j) == LINK_BILINEAR) s%link_fc(j) = m%link_par(L_STIFF, j)*s%link_u(j)
       end do
       s%con_on = .false.; s%con_vin = 0.0_dp; s%con_rate = 0.0_dp
+      allocate (s%blk_e(m%nblock), s%blk(m%nblock))
+      do j = 1, m%nblock
+         associate (nd => m%block(j)%node)
+            s%blk(j)%f = matmul(m%block(j)%k, u(nd))
+            s%blk(j)%fc = matmul(m%block(j)%c, v(nd))
+            s%blk(j)%fc_n = s%blk(j)%fc
+            s%blk(j)%u_n = u(nd)
+         end associate
+         s%blk_e(j) = block_energy(m, j, u)
+      end do
       allocate (f(0:m%n))
       call internal_forces(m, s, u, v, f)
       call mech_commit(m, s, u)
@@ -167,6 +187,34 @@ contains
          if (tangent .and. (dfd /= 0.0_dp .or. dfv /= 0.0_dp)) call stencil(jac, a, b, ck*dfd + cc*dfv)
          if (present(cmat) .and. dfv /= 0.0_dp) call stencil(cmat, a, b, dfv)
       end do
+      do j = 1, m%nblock
+         associate (nd => m%block(j)%node, kb => m%block(j)%k, cb => m%block(j)%c, &
+                    fb => s%blk(j)%f, fcb => s%blk(j)%fc, damped => m%block(j)%damped)
+            fb = matmul(kb, u(nd))
+            fint(nd) = fint(nd) + fb
+            if (damped) then
+               fcb = matmul(cb, v(nd))
+               fint(nd) = fint(nd) + fcb
+            end if
+            ! band layout A(i,j) in ab(r+i−j, j); model_bandwidth covers the block's span
+            if (tangent) then
+               do b = 1, size(nd)
+                  do a = 1, size(nd)
+                     jac(r + nd(a) - nd(b), nd(b)) = jac(r + nd(a) - nd(b), nd(b)) + ck*kb(a, b)
+                     if (damped) jac(r + nd(a) - nd(b), nd(b)) = &
+                        jac(r + nd(a) - nd(b), nd(b)) + cc*cb(a, b)
+                  end do
+               end do
+            end if
+            if (present(cmat) .and. damped) then
+               do b = 1, size(nd)
+                  do a = 1, size(nd)
+                     cmat(r + nd(a) - nd(b), nd(b)) = cmat(r + nd(a) - nd(b), nd(b)) + cb(a, b)
+                  end do
+               end do
+            end if
+         end associate
+      end do
       fint(0) = 0.0_dp
    contains
       !> The two-node stencil of band_add_pair, in line (this loop runs n times a step).
@@ -209,6 +257,21 @@ contains
          s%link_fc(j) = s%link_fc_trial(j)
          s%link_u(j) = du
       end do
+      ! a linear symmetric block: the trapezoidal work ½(k uₙ + k uₙ₊₁)·(uₙ₊₁ − uₙ) is exactly
+      ! the change of ½uᵀku
+      do j = 1, m%nblock
+         w = block_energy(m, j, u)
+         associate (bs => s%blk(j), nd => m%block(j)%node)
+            if (present(w_damp)) then
+               w_links = w_links + (w - s%blk_e(j))
+               if (m%block(j)%damped) w_damp = w_damp + &
+                  0.5_dp*dot_product(bs%fc_n + bs%fc, u(nd) - bs%u_n)
+            end if
+            if (m%block(j)%damped) bs%fc_n = bs%fc
+            bs%u_n = u(nd)
+         end associate
+         s%blk_e(j) = w
+      end do
       if (present(w_damp)) then
          do j = 1, m%ncontact
             if (s%is_penalty(j)) w_contact = w_contact + &
@@ -249,7 +312,21 @@ contains
       do j = 1, m%ncontact
          if (s%is_penalty(j)) p_contact = p_contact + s%con_f_trial(j)*s%con_rate_trial(j)
       end do
+      do j = 1, m%nblock
+         p_links = p_links + dot_product(s%blk(j)%f, v(m%block(j)%node))
+         if (m%block(j)%damped) p_damp = p_damp + dot_product(s%blk(j)%fc, v(m%block(j)%node))
+      end do
    end subroutine element_power
+
+   !> ½ uᵀ k u of stiffness block j.
+   pure real(dp) function block_energy(m, j, u) result(e)
+      type(model_t), intent(in) :: m
+      integer, intent(in) :: j
+      real(dp), intent(in) :: u(0:)
+      associate (nd => m%block(j)%node)
+         e = 0.5_dp*dot_product(u(nd), matmul(m%block(j)%k, u(nd)))
+      end associate
+   end function block_energy
 
    !> Links whose work is damping (no recoverable energy): the energy balance's split.
    pure logical function is_damper(kind)
@@ -298,6 +375,9 @@ contains
                                  m%link_par(L_HARDENING, j), s%link_fc(j), du, eb)
             e_links = e_links + eb
          end select
+      end do
+      do j = 1, m%nblock
+         e_links = e_links + block_energy(m, j, u)
       end do
       do j = 1, m%ncontact
          if (s%is_penalty(j)) e_contacts = e_contacts + &

@@ -4,7 +4,8 @@ module martello_lapack
    use martello_kinds, only: dp
    implicit none
    private
-   public :: dgbsv, dgbtrf, dgbtrs, dlansy, dpbtrf, dpbtrs, dpocon, dpotrf, dpotrs, dsbgvx, dsycon, dsytrf, dsytrs
+   public :: dgbsv, dgbtrf, dgbtrs, dlansy, dpbtrf, dpbtrs, dpocon, dpotrf, dpotrs, dsbgvx, dsycon, dsytrf, &
+      dsytrs, dsygv, dgesv
 
    interface
       subroutine dgbsv(n, kl, ku, nrhs, ab, ldab, ipiv, b, ldb, info)
@@ -83,6 +84,20 @@ module martello_lapack
          real(dp), intent(in) :: vl, vu, abstol
          integer, intent(out) :: m, iwork(*), ifail(*), info
       end subroutine dsbgvx
+      subroutine dgesv(n, nrhs, a, lda, ipiv, b, ldb, info)
+         import :: dp
+         integer, intent(in) :: n, nrhs, lda, ldb
+         real(dp), intent(inout) :: a(lda, *), b(ldb, *)
+         integer, intent(out) :: ipiv(*), info
+      end subroutine dgesv
+      subroutine dsygv(itype, jobz, uplo, n, a, lda, b, ldb, w, work, lwork, info)
+         import :: dp
+         integer, intent(in) :: itype, n, lda, ldb, lwork
+         character, intent(in) :: jobz, uplo
+         real(dp), intent(inout) :: a(lda, *), b(ldb, *)
+         real(dp), intent(out) :: w(*), work(*)
+         integer, intent(out) :: info
+      end subroutine dsygv
       subroutine dsycon(uplo, n, a, lda, ipiv, anorm, rcond, work, iwork, info)
          import :: dp
          character, intent(in) :: uplo

@@ -14,7 +14,7 @@ module martello
       MARTELLO_ERR_EXTERNAL, MARTELLO_ERR_STATE
    use martello_model, only: model_t, model_init, model_set_node, model_add_link, &
       model_add_contact, model_add_mass_coupling, model_add_nodal_force, &
-      model_set_ground_acceleration, SCHEME_PENALTY, SCHEME_LAGRANGE, SCHEME_AUGMENTED, &
+      model_set_ground_acceleration, model_add_stiffness_block, SCHEME_PENALTY, SCHEME_LAGRANGE, SCHEME_AUGMENTED, &
       SCHEME_RESTITUTION
    use martello_statics, only: static_result_t, static_solve
    use martello_links, only: LINK_SPRING, LINK_DASHPOT, LINK_BILINEAR, LINK_FLUID_DAMPER, &

@@ -15,8 +15,19 @@ module martello_model
    private
    public :: model_t, model_init, model_set_node, model_add_link, model_add_contact, &
       model_add_mass_coupling, model_add_nodal_force, model_set_ground_acceleration, &
-      model_bandwidth, rigid_contact_sides, SCHEME_PENALTY, SCHEME_LAGRANGE, SCHEME_AUGMENTED, &
+      model_add_stiffness_block, stiffness_block_t, model_bandwidth, rigid_contact_sides, &
+      SCHEME_PENALTY, SCHEME_LAGRANGE, SCHEME_AUGMENTED, &
       SCHEME_RESTITUTION, scheme_name
+
+   !> Symmetric stiffness and damping matrices between a set of nodes (a statically condensed
+   !> structure, e.g. a planar frame on its lateral DOFs, docs/problems.md P10): internal
+   !> force f(node) = k·u(node) + c·v(node), recoverable energy ½ uᵀ k u. Ground is not a
+   !> block node: a structure's supports are condensed into k.
+   type :: stiffness_block_t
+      integer, allocatable :: node(:)
+      real(dp), allocatable :: k(:, :), c(:, :)
+      logical :: damped = .false.     !< c /= 0
+   end type stiffness_block_t
 
    type :: model_t
       integer :: n = 0
@@ -37,6 +48,9 @@ module martello_model
       integer :: ncoupling = 0
       integer, allocatable :: mc_a(:), mc_b(:)
       real(dp), allocatable :: mc_value(:)
+      ! stiffness blocks (no capacity at model_create: the array grows)
+      integer :: nblock = 0
+      type(stiffness_block_t), allocatable :: block(:)
       ! loads: gravity is an acceleration along +u acting on M; ground acceleration loads −M·1·ü_g
       real(dp) :: gravity = 0.0_dp
       integer :: nforce = 0
@@ -192,6 +206,60 @@ contains
       m%mc_a(m%ncoupling) = a; m%mc_b(m%ncoupling) = b; m%mc_value(m%ncoupling) = value
    end subroutine model_add_mass_coupling
 
+   !> Add the symmetric stiffness block k and damping block c (nb × nb) between the distinct
+   !> nodes node(1:nb). Both must be exactly symmetric (the caller symmetrises), k with a
+   !> positive diagonal, c with a non-negative one; positive semi-definiteness is the
+   !> caller's (a condensed stiffness and a Rayleigh damping are).
+   subroutine model_add_stiffness_block(m, node, k, c, stat)
+      type(model_t), intent(inout) :: m
+      integer, intent(in) :: node(:)
+      real(dp), intent(in) :: k(:, :), c(:, :)
+      integer, intent(out) :: stat
+      type(stiffness_block_t), allocatable :: grown(:)
+      integer :: i, nb
+      stat = MARTELLO_OK
+      nb = size(node)
+      if (nb < 1 .or. size(k, 1) /= nb .or. size(k, 2) /= nb .or. size(c, 1) /= nb .or. &
+          size(c, 2) /= nb) then
+         call fail(m, stat, 'add_stiffness_block: need n >= 1 nodes and n x n matrices'); return
+      end if
+      do i = 1, nb
+         if (.not. node_ok(m, node(i), .false.)) then
+            call fail(m, stat, 'add_stiffness_block: node out of range (ground is not a block'// &
+                      ' node: condense the supports into k)'); return
+         end if
+         if (any(node(:i - 1) == node(i))) then
+            call fail(m, stat, 'add_stiffness_block: a node appears twice'); return
+         end if
+      end do
+      if (.not. (all(ieee_is_finite(k)) .and. all(ieee_is_finite(c)))) then
+         call fail(m, stat, 'add_stiffness_block: k and c must be finite'); return
+      end if
+      if (any(k /= transpose(k)) .or. any(c /= transpose(c))) then
+         call fail(m, stat, 'add_stiffness_block: k and c must be symmetric (give (k + kT)/2)')
+         return
+      end if
+      do i = 1, nb
+         if (.not. (k(i, i) > 0.0_dp .and. c(i, i) >= 0.0_dp)) then
+            call fail(m, stat, 'add_stiffness_block: the diagonal of k must be > 0, of c >= 0')
+            return
+         end if
+      end do
+      allocate (grown(m%nblock + 1))
+      do i = 1, m%nblock
+         call move_alloc(m%block(i)%node, grown(i)%node)
+         call move_alloc(m%block(i)%k, grown(i)%k)
+         call move_alloc(m%block(i)%c, grown(i)%c)
+         grown(i)%damped = m%block(i)%damped
+      end do
+      grown(m%nblock + 1)%node = node
+      grown(m%nblock + 1)%k = k
+      grown(m%nblock + 1)%c = c
+      grown(m%nblock + 1)%damped = any(c /= 0.0_dp)
+      call move_alloc(grown, m%block)
+      m%nblock = m%nblock + 1
+   end subroutine model_add_stiffness_block
+
    subroutine set_function(m, fn, kind, par, t, y, stat)
       type(model_t), intent(inout) :: m
       type(time_function_t), intent(out) :: fn
@@ -248,7 +316,8 @@ contains
    end subroutine model_set_ground_acceleration
 
    !> Half-bandwidth of the mass, stiffness and contact matrices: max |a − b| over every
-   !> two-node element (ground ends do not count). 1 for chains numbered in order.
+   !> two-node element (ground ends do not count) and every stiffness block's node span.
+   !> 1 for chains numbered in order.
    pure integer function model_bandwidth(m) result(kd)
       type(model_t), intent(in) :: m
       integer :: j
@@ -261,6 +330,9 @@ contains
       end do
       do j = 1, m%ncoupling
          kd = max(kd, abs(m%mc_a(j) - m%mc_b(j)))
+      end do
+      do j = 1, m%nblock
+         kd = max(kd, maxval(m%block(j)%node) - minval(m%block(j)%node))
       end do
    end function model_bandwidth
    !> For the impulse-level integrators: which contacts are rigid (restitution or Lagrange,

@@ -25,12 +25,12 @@ module martello_registry
    use martello_run_quantities, only: NCOUNTERS, C_STEPS, C_REJECTED, C_NEWTON, C_RESIDUALS, &
       C_FACTORIZATIONS, C_EVENTS, C_JACOBIANS, C_ROOT_EVALS, C_CHATTER, NENERGY, E_KINETIC, &
       E_RECOVERABLE, E_INPUT, E_DAMPING, E_PLASTIC, E_CONTACT, E_BALANCE, E_INITIAL, E_IMPACT, &
-      NEVENT, EV_T_ON, EV_T_OFF, EV_V_IN, EV_V_OUT, EV_MAX_PEN, EV_MAX_FORCE
+      NEVENT, EV_T_ON, EV_T_OFF, EV_V_IN, EV_V_OUT, EV_MAX_PEN, EV_MAX_FORCE, C_MODES
    implicit none
    private
    public :: SCHEME_PENALTY, SCHEME_LAGRANGE, SCHEME_AUGMENTED, SCHEME_RESTITUTION, &
       INT_NEWMARK, INT_HHT, INT_GENERALIZED_ALPHA, INT_CENTRAL_DIFFERENCE, INT_MOREAU_JEAN, &
-      INT_NEWMARK_LAGRANGE, INT_RKF45, INT_RK8PD, INT_MSBDF, INT_IDA, INT_LAST, &
+      INT_NEWMARK_LAGRANGE, INT_RKF45, INT_RK8PD, INT_MSBDF, INT_IDA, INT_FAST_NONLINEAR, INT_LAST, &
       NSETTINGS, S_DT, S_T_END, S_BETA, S_GAMMA, S_ALPHA, S_RHO_INF, S_TOL_RESIDUAL, &
       S_TOL_INCREMENT, S_MAX_NEWTON, S_CHECK_STABILITY, S_EVERY, S_DIVERGENCE_FACTOR, S_RTOL, &
       S_ATOL, S_THETA, S_EVENT_TOL, S_H_MAX, SETTINGS, INTEGRATORS, setting_t, integrator_t, &
@@ -47,11 +47,12 @@ module martello_registry
    integer, parameter :: INT_NEWMARK = 1, INT_HHT = 2, INT_GENERALIZED_ALPHA = 3, &
                          INT_CENTRAL_DIFFERENCE = 4, INT_MOREAU_JEAN = 5, &
                          INT_NEWMARK_LAGRANGE = 6, INT_RKF45 = 7, INT_RK8PD = 8, INT_MSBDF = 9, &
-                         INT_IDA = 10, INT_LAST = 10
+                         INT_IDA = 10, INT_FAST_NONLINEAR = 11, INT_LAST = 11
 
    ! Integrator families: how the run is carried out (docs/integrators.md).
    integer, parameter :: FAMILY_NEWMARK = 1, FAMILY_TIME_STEPPING = 2, &
-                         FAMILY_CONSTRAINED_NEWMARK = 3, FAMILY_EVENT_DRIVEN = 4, FAMILY_DAE = 5
+                         FAMILY_CONSTRAINED_NEWMARK = 3, FAMILY_EVENT_DRIVEN = 4, FAMILY_DAE = 5, &
+                         FAMILY_MODAL = 6
 
    ! The settings of a run, in the order of the fields of martello_settings after `kind`.
    integer, parameter :: S_DT = 1, S_T_END = 2, S_BETA = 3, S_GAMMA = 4, S_ALPHA = 5, &
@@ -174,7 +175,8 @@ module martello_registry
       named_t('jacobian_evaluations', C_JACOBIANS - 1, 'Jacobian evaluations'), &
       named_t('root_evaluations', C_ROOT_EVALS - 1, 'root-function evaluations'), &
       named_t('contact_chatter_resolutions', C_CHATTER - 1, &
-              'steps where a contact was held open (docs/integrators.md)')]
+              'steps where a contact was held open (docs/integrators.md)'), &
+      named_t('modes', C_MODES - 1, 'modes of the linear part (fast-nonlinear)')]
 
    type(named_t), parameter :: ENERGY_TERMS(*) = [ &
       named_t('kinetic', E_KINETIC - 1, 'kinetic energy [J]'), &
@@ -211,7 +213,9 @@ module martello_registry
               'Newmark with Lagrange multipliers and impact steps (docs/moreau-jean.md)'), &
       named_t('event-driven', FAMILY_EVENT_DRIVEN, &
               'GSL adaptive ODE steppers with event location (docs/event-driven.md)'), &
-      named_t('dae', FAMILY_DAE, 'SUNDIALS IDA on the contact DAE with events (docs/ida.md)')]
+      named_t('dae', FAMILY_DAE, 'SUNDIALS IDA on the contact DAE with events (docs/ida.md)'), &
+      named_t('modal', FAMILY_MODAL, &
+              'modes of the linear part, nonlinear elements as pseudo-forces (docs/integrators.md)')]
 
    type(named_t), parameter :: SETTING_TYPES(*) = [named_t('double', T_DOUBLE, 'C double'), &
       named_t('int', T_INT, 'C int'), named_t('bool', T_BOOL, 'C bool (stdbool.h)')]
@@ -292,7 +296,10 @@ module martello_registry
                    RUNS_PENALTY + RUNS_RIGID, 'multistep BDF (stiff), GSL'), &
       integrator_t('ida', INT_IDA, FAMILY_DAE, .true., &
                    READS_BASE + READS_DIVERGENCE + READS_ADAPTIVE, RUNS_PENALTY + RUNS_RIGID, &
-                   'SUNDIALS IDA, variable-order BDF on the contact DAE')]
+                   'SUNDIALS IDA, variable-order BDF on the contact DAE'), &
+      integrator_t('fast-nonlinear', INT_FAST_NONLINEAR, FAMILY_MODAL, .false., &
+                   READS_BASE + READS_DIVERGENCE + 2**S_TOL_RESIDUAL + 2**S_MAX_NEWTON, &
+                   RUNS_PENALTY, 'Wilson (2002) fast nonlinear analysis: exact modal steps, pseudo-forces')]
 
    !> The tables; text: the prefix of their C constants in c/martello.h ('' if none).
    type(named_t), parameter :: TABLES(*) = [ &

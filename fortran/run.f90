@@ -15,6 +15,8 @@ module martello_run
    use martello_central_difference, only: central_difference_t
    use martello_moreau_jean, only: moreau_jean_t
    use martello_newmark_lagrange, only: newmark_lagrange_t
+   use martello_fast_nonlinear, only: fast_nonlinear_t
+   use martello_registry, only: INT_FAST_NONLINEAR
    implicit none
    private
    public :: run_t, run_dynamic
@@ -77,6 +79,8 @@ contains
             allocate (moreau_jean_t :: stepper)
          case (INT_NEWMARK_LAGRANGE)
             allocate (newmark_lagrange_t :: stepper)
+         case (INT_FAST_NONLINEAR)
+            allocate (fast_nonlinear_t :: stepper)
          case (INT_RKF45, INT_RK8PD, INT_MSBDF)
             stat = c_event_driven_run(c_loc(mp), c_loc(rp))
          case (INT_IDA)

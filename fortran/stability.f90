@@ -46,6 +46,9 @@ contains
          if (m%con_law(j) /= LAW_LINEAR .and. m%con_law(j) /= LAW_KELVIN) cycle
          call pair(dof(m%con_a(j)), dof(m%con_b(j)), m%con_par(P_STIFF, j))
       end do
+      do j = 1, m%nblock
+         call block(m%block(j)%node, m%block(j)%k)
+      end do
       call dsbgvx('N', 'I', 'U', nf, kd, kd, ka, kd + 1, mb, kd + 1, q, 1, 0.0_dp, 0.0_dp, &
                   nf, nf, 0.0_dp, nfound, w, z, 1, work, iwork, ifail, info)
       if (info == 0 .and. nfound >= 1) w_max = sqrt(max(w(1), 0.0_dp))
@@ -60,6 +63,19 @@ contains
             ka(kd + 1 + min(ia, ib) - max(ia, ib), max(ia, ib)) = &
             ka(kd + 1 + min(ia, ib) - max(ia, ib), max(ia, ib)) - k
       end subroutine pair
+      !> a stiffness block's upper triangle on the free DOFs (fixed nodes drop out)
+      subroutine block(nd, kb)
+         integer, intent(in) :: nd(:)
+         real(dp), intent(in) :: kb(:, :)
+         integer :: p, q, ip, iq
+         do q = 1, size(nd)
+            do p = 1, size(nd)
+               ip = dof(nd(p)); iq = dof(nd(q))
+               if (ip > 0 .and. iq > 0 .and. ip <= iq) &
+                  ka(kd + 1 + ip - iq, iq) = ka(kd + 1 + ip - iq, iq) + kb(p, q)
+            end do
+         end do
+      end subroutine block
    end subroutine omega_max
 
    !> M (lumped diagonal plus consistent couplings) on the free nodes, dof-numbered, in

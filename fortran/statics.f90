@@ -88,6 +88,9 @@ contains
          kk = m%link_par(L_STIFF, j)
          call add_pair(kfree, fext, dof, r%u, m%link_a(j), m%link_b(j), kk)
       end do
+      do j = 1, m%nblock
+         call add_block(kfree, fext, dof, r%u, m%block(j)%node, m%block(j)%k)
+      end do
       fscale = 1.0_dp; kscale = 1.0_dp
       if (nf > 0) then
          fscale = max(maxval(abs(fext)), tiny(1.0_dp))
@@ -161,6 +164,26 @@ contains
          if (ia > 0 .and. b > 0 .and. ib == 0) f(ia) = f(ia) + s*u(b)
          if (ib > 0 .and. a > 0 .and. ia == 0) f(ib) = f(ib) + s*u(a)
       end subroutine add_pair
+
+      !> A stiffness block on the free DOFs; a fixed node's prescribed u moves to the rhs.
+      subroutine add_block(kmat, f, dof, u, nd, kb)
+         real(dp), intent(inout) :: kmat(:, :), f(:)
+         integer, intent(in) :: dof(0:), nd(:)
+         real(dp), intent(in) :: u(:), kb(:, :)
+         integer :: p, q, ip, iq
+         do q = 1, size(nd)
+            iq = dof(nd(q))
+            do p = 1, size(nd)
+               ip = dof(nd(p))
+               if (ip == 0) cycle
+               if (iq > 0) then
+                  kmat(ip, iq) = kmat(ip, iq) + kb(p, q)
+               else
+                  f(ip) = f(ip) - kb(p, q)*u(nd(q))
+               end if
+            end do
+         end do
+      end subroutine add_block
 
       !> Every active contact adds a row: Bᵀu − c_j P_j = rhs_j, with B = +1 at a, −1 at b and
       !>  lagrange: c = 0, rhs = d;  penalty: c = 1/ε, rhs = d  (the perturbed-Lagrangian form

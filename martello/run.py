@@ -99,6 +99,8 @@ def build_model(scene):
         m.add_contact(c["a"], c["b"], c["gap"], native.value("schemes", c["scheme"]), law, par)
     for mc in scene.couplings:
         m.add_mass_coupling(mc["a"], mc["b"], mc["value"])
+    for b in scene.blocks:
+        m.add_stiffness_block(b["nodes"], b["k"], b["c"])
     m.set_gravity(scene.gravity)
     for f in scene.forces:
         m.add_nodal_force(f["node"], *_function_args(f["function"], scene.source))
@@ -229,6 +231,12 @@ def _dynamic(scene, model, raise_on_failure=True):
     if st >= 0 and energy["balance_relative"] > 1e-2:
         warnings.append(f"energy balance error {100 * energy['balance_relative']:.1f} % of the energy put in: "
                         "the step is too large for this scene (the result is inaccurate)")
+    frames = {}
+    for fr in scene.extras.get("frames", []):
+        frames[fr["prefix"]], extra_cols = frame_results(fr, columns, hist)
+        if fr["histories"] and len(hist):
+            columns = columns + list(extra_cols)
+            hist = np.hstack([hist, np.column_stack(list(extra_cols.values()))])
     summary = {
         "title": scene.title, "problem": scene.problem,
         "analysis": {k: v for k, v in an.items() if k != "output"} | {"output_every": an["output"]["every"]},
@@ -241,12 +249,56 @@ def _dynamic(scene, model, raise_on_failure=True):
         "links": {l["name"]: {"type": l["type"], "max_abs_force": _finite_or_none(link_f[i]),
                               "max_abs_elongation": _finite_or_none(link_du[i])}
                   for i, l in enumerate(scene.links)},
+        **({"frames": frames} if frames else {}),
         "stability": {"omega_max": extra["omega_max"] or None,
                       "dt_critical": extra["dt_critical"] or None},
         "cost": counters | {"wall_time_s": wall},
         "provenance": provenance(scene),
     }
     return summary, (columns, hist)
+
+
+def frame_results(fr, columns, hist):
+    """A frame's peaks from the recorded lateral displacements (the recovery operators of
+    martello.frame2d, applied to every recorded sample: peaks are over the samples, exact at
+    output.every = 1): signed extremes of every member's end moments and shears with their
+    times, of every storey's drifts and shear. Also the member histories, by column name."""
+    col = {name: i for i, name in enumerate(columns)}
+    t = hist[:, col["t"]] if len(hist) else np.zeros(0)
+    U = hist[:, [col[f"u:{n}"] for n in fr["nodes"]]] if len(hist) else np.zeros((0, len(fr["nodes"])))
+    F = U @ fr["recovery"].T                       # samples x 6·members
+    frame = fr["frame"]
+
+    def extremes(x):
+        if not len(x):
+            return {"max": None, "min": None, "t_max": None, "t_min": None}
+        i, j = int(np.argmax(x)), int(np.argmin(x))
+        return {"max": float(x[i]), "min": float(x[j]), "t_max": float(t[i]), "t_min": float(t[j])}
+    members, series = {}, {}
+    for e, m in enumerate(frame.members):
+        members[m.name] = {"kind": m.kind}
+        for k, q in enumerate(("N_i", "V_i", "M_i", "N_j", "V_j", "M_j")):
+            if q.startswith("N") and m.kind == "beam" and frame.mass_model == "diaphragm":
+                continue          # a rigid diaphragm's beams have no axial deformation
+            members[m.name][q] = extremes(F[:, 6 * e + k])
+            if q in ("M_i", "M_j", "V_i"):
+                series[f"{q}:{fr['prefix']}.{m.name}"] = F[:, 6 * e + k]
+    drift, shear = U @ fr["drift"].T, U @ fr["shear"].T
+    nl = frame.bays + 1
+    storeys = {str(s + 1): {"drift": {str(i): extremes(drift[:, s * nl + i]) for i in range(nl)},
+                            "shear": extremes(shear[:, s])} for s in range(frame.storeys)}
+    return {"members": members, "storeys": storeys,
+            "rayleigh": {"a0": fr["rayleigh"][0], "a1": fr["rayleigh"][1], "zeta": fr["zeta"]}}, series
+
+
+def _static_frame(fr, scene, u):
+    """A frame's member end forces, storey drifts and shears at the static solution."""
+    U = np.array([u[scene.index[n]] for n in fr["nodes"]])
+    F = fr["recovery"] @ U
+    members = {m.name: dict(zip(("N_i", "V_i", "M_i", "N_j", "V_j", "M_j"), map(float, F[6 * e:6 * e + 6])))
+               for e, m in enumerate(fr["frame"].members)}
+    return {"members": members, "drift": [float(x) for x in fr["drift"] @ U],
+            "shear": [float(x) for x in fr["shear"] @ U]}
 
 
 def _static(scene, model):
@@ -276,6 +328,8 @@ def _static(scene, model):
         "warnings": warnings,
         "nodes": {n["name"]: {"u": float(r["u"][i])} for i, n in enumerate(scene.nodes)},
         "contacts": contacts,
+        **({"frames": {fr["prefix"]: _static_frame(fr, scene, r["u"])
+                       for fr in scene.extras["frames"]}} if scene.extras.get("frames") else {}),
         "conditioning": {"rcond": r["rcond"],
                          "condition_estimate": _finite_or_none(1.0 / r["rcond"]) if r["rcond"] > 0 else None,
                          "digits_lost": r["digits_lost"],

@@ -56,6 +56,8 @@ def lib():
         "martello_model_add_contact": (c_int, [_VOID_P, c_int, c_int, c_double, c_int, c_int,
                                                _DOUBLE_P]),
         "martello_model_add_mass_coupling": (c_int, [_VOID_P, c_int, c_int, c_double]),
+        "martello_model_add_stiffness_block": (c_int, [_VOID_P, c_int, _INT_P, _DOUBLE_P,
+                                                       _DOUBLE_P]),
         "martello_model_set_gravity": (c_int, [_VOID_P, c_double]),
         "martello_model_add_nodal_force": (c_int, [_VOID_P, c_int, c_int, _DOUBLE_P, c_int,
                                                    _DOUBLE_P, _DOUBLE_P]),
@@ -329,6 +331,16 @@ class Model(_Handle):
 
     def add_mass_coupling(self, a, b, value):
         self.check(lib().martello_model_add_mass_coupling(self._h, a, b, value), "mass coupling")
+
+    def add_stiffness_block(self, nodes, k, c=None):
+        """Symmetric stiffness k and damping c (n x n; None: undamped) between the nodes
+        (0-based, no ground)."""
+        nodes = np.ascontiguousarray(nodes, dtype=np.int32)
+        k = np.asarray(k, dtype=np.float64)
+        c = np.zeros_like(k) if c is None else np.asarray(c, dtype=np.float64)
+        self.check(lib().martello_model_add_stiffness_block(
+            self._h, len(nodes), nodes, np.ascontiguousarray(k.ravel(order="F")),
+            np.ascontiguousarray(c.ravel(order="F"))), "stiffness block")
 
     def effective_masses(self):
         """m* = 1/(B M⁻¹ Bᵀ) of every contact, as the library computes it (inf: immovable)."""

@@ -65,6 +65,8 @@ def event_located_run(sc, rtol=1e-12, grid=None):
     n = len(sc.nodes)
     if sc.couplings:
         raise Unsupported("consistent-mass couplings")
+    if sc.blocks:
+        raise Unsupported("stiffness blocks ([[frame]])")
     mass = np.array([nd["mass"] for nd in sc.nodes])
     fixed = np.array([nd["fixed"] for nd in sc.nodes])
     springs, dashpots = [], []

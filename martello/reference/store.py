@@ -26,7 +26,10 @@ def physics_digest(scene):
         ground["file"] = Path(ground["file"]).name
     data = {"nodes": scene.nodes, "links": scene.links, "contacts": scene.contacts,
             "gravity": scene.gravity, "forces": scene.forces, "ground": ground,
-            "couplings": scene.couplings}
+            "couplings": scene.couplings,
+            # a frame's block is determined by its matrices (empty for scenes without one)
+            "blocks": [{"nodes": b["nodes"], "k": np.asarray(b["k"]).tolist(),
+                        "c": np.asarray(b["c"]).tolist()} for b in scene.blocks] or None}
     return hashlib.sha256(json.dumps(_canonical(data), sort_keys=True, default=repr).encode()).hexdigest()
 
 

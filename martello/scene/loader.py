@@ -13,6 +13,7 @@ from pathlib import Path
 from ..errors import SceneError
 from .bars import expand_bars
 from .chain import expand_chains
+from .frame import expand_frames, frame_blocks
 from .compatibility import COMPATIBLE
 from ..paths import MiB, UnreadableFile, check_regular, read_input
 from .fields import (ANY, MAX_DEPTH, NONNEG, POSITIVE, check_fields, choice, finite_everywhere,
@@ -41,6 +42,7 @@ class Scene:
     index: dict = field(default_factory=dict)   # node name -> index
     couplings: list = field(default_factory=list)  # dicts: a, b (indices), value
     extras: dict = field(default_factory=dict)     # what generators ([[bar]]) know of the scene
+    blocks: list = field(default_factory=list)     # dicts: name, nodes (indices), k, c ([[frame]])
 
     def node_index(self, name):
         return -1 if name == GROUND else self.index[name]
@@ -144,6 +146,8 @@ def from_dict(data, source="<scene>", base_dir=Path("."), digest=None):
         data = expand_chains(src, data)
     if "bar" in data:
         data, extras["bars"] = expand_bars(src, data)   # [[bar]]: rods meshed into elements (P4)
+    if "frame" in data:
+        data, extras["frames"] = expand_frames(src, data)   # [[frame]]: condensed frames (P10)
 
     # nodes
     raw_nodes = data.get("node")
@@ -267,6 +271,11 @@ def from_dict(data, source="<scene>", base_dir=Path("."), digest=None):
     analysis["type"] = atype
     if atype == "dynamic":
         _dynamic_analysis(src, an, analysis, index, contacts, links)
+        # a frame's member forces are recovered from its lateral displacements: recorded
+        for fr in extras.get("frames", []):
+            out = analysis["output"]["nodes"]
+            analysis["output"]["nodes"] = out + [n for n in fr["nodes"] if n not in out]
+    blocks = frame_blocks(extras.get("frames", []), index)
     ground_k = _ground_stiffness(links)
     for i, lk in enumerate(links):
         if lk["type"] == "dashpot" and lk["zeta"] is not None:
@@ -296,7 +305,8 @@ def from_dict(data, source="<scene>", base_dir=Path("."), digest=None):
     return Scene(source=src, title=meta["title"] or Path(src).stem, problem=meta["problem"],
                  description=meta["description"], nodes=nodes, links=links, contacts=contacts,
                  gravity=lt["gravity"], forces=forces, ground=ground, analysis=analysis,
-                 check=check, digest=digest, index=index, couplings=couplings, extras=extras)
+                 check=check, digest=digest, index=index, couplings=couplings, extras=extras,
+                 blocks=blocks)
 
 
 

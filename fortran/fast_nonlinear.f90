@@ -1,0 +1,349 @@
+!> Fast nonlinear analysis (Wilson, Three-Dimensional Static and Dynamic Analysis of
+!> Structures, 3rd ed. 2002, ch. 18; docs/integrators.md "fast nonlinear analysis") as a
+!> stepper of the fixed-step strategy. The linear part of the scene — springs, bars,
+!> dashpots, stiffness blocks, and the initial stiffness k of bilinear springs (Wilson's
+!> "effective stiffness" of a nonlinear element) — is reduced to its modes (LAPACK dsygv on
+!> the free DOFs: K_L φ = ω² M φ, φᵀ M φ = 1), with the modal damping c_i = φ_iᵀ C_L φ_i.
+!> Everything else is a pseudo-force: penalty contacts, fluid dampers, the departure of
+!> bilinear springs from k, and the off-diagonal modal damping. In modal coordinates
+!>
+!>     q̈_i + c_i q̇_i + ω_i² q_i = p_i,   p = Φᵀ(f_ext − f_int(u, v)) + ω²∘q + c∘q̇,
+!>
+!> with f_int the whole internal force (martello_assembly), so that p holds exactly the
+!> external and pseudo-forces. Over a step p is taken linear in time and each modal equation
+!> is advanced exactly (Nigam & Jennings 1969; here through the exponential of the augmented
+!> 4 × 4 system, valid for every damping ratio, ω = 0 included); p at the end of the step
+!> depends on the state there, so it is iterated to a fixed point (Wilson's iteration)
+!> until ‖Δp‖∞ ≤ tol_residual·max(‖p‖∞, ‖ω²∘q‖∞, ‖c∘q̇‖∞). When that iteration contracts slowly (a stiff contact or
+!> a damper whose regularised slope c·v_reg^(α−1) is large against m/h), the step switches to
+!> Newton on the same fixed point, p ← p − J⁻¹(P(p) − p), J = ∂P/∂p − I from the elements'
+!> tangents in modal coordinates (counted as jacobian_evaluations). All modes are kept: the
+!> linear part is then exact and the only error is the linear interpolation of the
+!> pseudo-forces over the step, O(h²).
+module martello_fast_nonlinear
+   use martello_kinds, only: dp, i8
+   use martello_status
+   use martello_model, only: model_t
+   use martello_links, only: LINK_SPRING, LINK_BAR, LINK_DASHPOT, LINK_BILINEAR, L_STIFF, L_DAMP
+   use martello_assembly, only: internal_forces, external_forces, mech_commit, external_work, &
+      mass_times
+   use martello_observer, only: observer_t, observer_work, observer_fail, C_NEWTON, C_RESIDUALS, &
+      C_FACTORIZATIONS
+   use martello_run_quantities, only: C_MODES
+   use martello_integrator_settings, only: integrator_settings_t
+   use martello_fixed_step, only: stepper_t, stepper_start, stepper_fail, contact_state
+   use martello_lapack, only: dsygv, dgesv
+   use martello_model, only: model_bandwidth
+   use martello_band_matrix, only: band_t, band_init, band_zero
+   use martello_observer, only: C_JACOBIANS
+   implicit none
+   private
+   public :: fast_nonlinear_t, modal_step_coefficients
+
+   type, extends(stepper_t) :: fast_nonlinear_t
+      integer :: nf = 0, max_iter = 30
+      real(dp) :: tol = 1.0e-9_dp
+      integer, allocatable :: free(:)                   !< free node of each DOF
+      real(dp), allocatable :: phi(:, :)                !< nf × nf, mass-normalised modes
+      real(dp), allocatable :: w2(:), c(:)              !< ω², modal damping c_i = 2ζ_iω_i
+      !> z_{n+1} = E z_n + G0 p_n + G1 p_{n+1} for z = (q, q̇): e11 … g1v per mode
+      real(dp), allocatable :: e11(:), e12(:), e21(:), e22(:), g0q(:), g0v(:), g1q(:), g1v(:)
+      real(dp), allocatable :: q(:), qd(:), qn(:), qdn(:), p(:), pn(:), ptrial(:), r(:)
+      real(dp), allocatable :: fint(:), fext(:), fext_n(:), jac(:, :), kt(:, :), ct(:, :)
+      integer, allocatable :: ipiv(:)
+      type(band_t) :: kband, cband
+   contains
+      procedure :: init
+      procedure :: step
+   end type fast_nonlinear_t
+
+contains
+
+   subroutine init(self, m, s, o, stat)
+      class(fast_nonlinear_t), intent(inout) :: self
+      type(model_t), intent(in) :: m
+      type(integrator_settings_t), intent(in) :: s
+      type(observer_t), intent(inout) :: o
+      integer, intent(out) :: stat
+      integer :: n, nf, i, j, info, lwork
+      integer, allocatable :: dof(:)
+      real(dp), allocatable :: kl(:, :), cl(:, :), mm(:, :), work(:), x(:), y(:)
+      character(len=200) :: msg
+
+      stat = MARTELLO_OK
+      n = m%n
+      call stepper_start(self, m, s)
+      self%advice = 'reduce dt (the pseudo-force iteration converges for small h^2 k/m)'
+      self%max_iter = s%max_newton; self%tol = s%tol_residual
+      allocate (dof(0:n)); dof = 0; nf = 0
+      do i = 1, n
+         if (.not. m%fixed(i)) then
+            nf = nf + 1; dof(i) = nf
+         end if
+      end do
+      self%nf = nf
+      self%free = pack([(i, i = 1, n)], .not. m%fixed)
+      allocate (self%fint(0:n), self%fext(0:n), self%fext_n(0:n))
+      allocate (self%jac(nf, nf), self%kt(nf, nf), self%ct(nf, nf), self%ipiv(nf))
+      call band_init(self%kband, n, model_bandwidth(m))
+      call band_init(self%cband, n, model_bandwidth(m))
+      allocate (kl(nf, nf), cl(nf, nf), mm(nf, nf), x(0:n), y(0:n))
+      call linear_part(m, dof, kl, cl)
+      ! M on the free DOFs, column by column (lumped diagonal and consistent couplings)
+      do j = 1, nf
+         x = 0.0_dp
+         x(self%free(j)) = 1.0_dp
+         call mass_times(m, x, y)
+         mm(:, j) = y(self%free)
+      end do
+      allocate (self%w2(nf), self%phi(nf, nf), work(1))
+      self%phi = kl
+      call dsygv(1, 'V', 'U', nf, self%phi, nf, mm, nf, self%w2, work, -1, info)
+      lwork = max(1, int(work(1))); deallocate (work); allocate (work(lwork))
+      if (nf > 0) call dsygv(1, 'V', 'U', nf, self%phi, nf, mm, nf, self%w2, work, lwork, info)
+      o%counters(C_FACTORIZATIONS) = o%counters(C_FACTORIZATIONS) + 1_i8
+      o%counters(C_MODES) = o%counters(C_MODES) + int(nf, i8)
+      if (info /= 0) then
+         write (msg, '(a,i0,a)') 'fast-nonlinear: the modes could not be computed (LAPACK dsygv'// &
+            ' info = ', info, '): the mass matrix is not positive definite on the free nodes'
+         call observer_fail(o, MARTELLO_ERR_SINGULAR, 0.0_dp, trim(msg), stat)
+         return
+      end if
+      ! K_L is positive semi-definite by construction (k > 0 elements, PSD blocks): an
+      ! eigenvalue below 0 is round-off of a zero mode (a node held by nonlinear elements only)
+      self%w2 = max(self%w2, 0.0_dp)
+      ! modal damping: the diagonal of Φᵀ C_L Φ (the rest stays in the pseudo-force)
+      allocate (self%c(nf))
+      do i = 1, nf
+         self%c(i) = dot_product(self%phi(:, i), matmul(cl, self%phi(:, i)))
+      end do
+      allocate (self%e11(nf), self%e12(nf), self%e21(nf), self%e22(nf), self%g0q(nf), &
+                self%g0v(nf), self%g1q(nf), self%g1v(nf))
+      do i = 1, nf
+         call modal_step_coefficients(self%w2(i), self%c(i), self%h, self%e11(i), self%e12(i), &
+                                      self%e21(i), self%e22(i), self%g0q(i), self%g0v(i), &
+                                      self%g1q(i), self%g1v(i))
+      end do
+      ! modal state at t = 0: q = Φᵀ M u, q̇ = Φᵀ M v (free DOFs)
+      allocate (self%q(nf), self%qd(nf), self%qn(nf), self%qdn(nf), self%p(nf), self%pn(nf), &
+                self%ptrial(nf), self%r(nf))
+      call mass_times(m, self%u, y)
+      self%q = matmul(transpose(self%phi), y(self%free))
+      call mass_times(m, self%v, y)
+      self%qd = matmul(transpose(self%phi), y(self%free))
+      call internal_forces(m, self%ms, self%u, self%v, self%fint)
+      call external_forces(m, self%mrow, 0.0_dp, self%fext)
+      o%counters(C_RESIDUALS) = o%counters(C_RESIDUALS) + 1_i8
+      call modal_load(self%p)
+      call set_acceleration(self)
+      call mech_commit(m, self%ms, self%u)
+      call contact_state(self, m)
+
+   contains
+      subroutine modal_load(pp)
+         real(dp), intent(out) :: pp(:)
+         pp = matmul(transpose(self%phi), self%fext(self%free) - self%fint(self%free)) + &
+              self%w2*self%q + self%c*self%qd
+      end subroutine modal_load
+   end subroutine init
+
+   !> K_L and C_L of the linear part on the free DOFs (dof: node → DOF, 0 for fixed/ground).
+   subroutine linear_part(m, dof, kl, cl)
+      type(model_t), intent(in) :: m
+      integer, intent(in) :: dof(0:)
+      real(dp), intent(out) :: kl(:, :), cl(:, :)
+      integer :: j, p, q
+      kl = 0.0_dp; cl = 0.0_dp
+      do j = 1, m%nlink
+         select case (m%link_kind(j))
+         case (LINK_SPRING, LINK_BAR, LINK_BILINEAR)
+            call pair(kl, dof(m%link_a(j)), dof(m%link_b(j)), m%link_par(L_STIFF, j))
+         case (LINK_DASHPOT)
+            call pair(cl, dof(m%link_a(j)), dof(m%link_b(j)), m%link_par(L_DAMP, j))
+         end select
+      end do
+      do j = 1, m%nblock
+         associate (nd => m%block(j)%node)
+            do q = 1, size(nd)
+               do p = 1, size(nd)
+                  if (dof(nd(p)) > 0 .and. dof(nd(q)) > 0) then
+                     kl(dof(nd(p)), dof(nd(q))) = kl(dof(nd(p)), dof(nd(q))) + m%block(j)%k(p, q)
+                     cl(dof(nd(p)), dof(nd(q))) = cl(dof(nd(p)), dof(nd(q))) + m%block(j)%c(p, q)
+                  end if
+               end do
+            end do
+         end associate
+      end do
+   contains
+      subroutine pair(a, i, k, val)
+         real(dp), intent(inout) :: a(:, :)
+         integer, intent(in) :: i, k
+         real(dp), intent(in) :: val
+         if (i > 0) a(i, i) = a(i, i) + val
+         if (k > 0) a(k, k) = a(k, k) + val
+         if (i > 0 .and. k > 0) then
+            a(i, k) = a(i, k) - val; a(k, i) = a(k, i) - val
+         end if
+      end subroutine pair
+   end subroutine linear_part
+
+   !> One step: the modal states advanced exactly for p linear over the step, p at the end
+   !> iterated to its fixed point; works, counters, contact state.
+   subroutine step(self, m, t, o, stat)
+      class(fast_nonlinear_t), intent(inout) :: self
+      type(model_t), intent(in) :: m
+      real(dp), intent(in) :: t
+      type(observer_t), intent(inout) :: o
+      integer, intent(out) :: stat
+      integer :: it, info
+      real(dp) :: change, scale, wd, wl, wc, previous
+      logical :: newton
+      character(len=256) :: msg
+      stat = MARTELLO_OK
+      self%qn = self%q; self%qdn = self%qd; self%pn = self%p
+      self%fext_n = self%fext
+      call external_forces(m, self%mrow, t, self%fext)
+      self%ptrial = self%pn                     ! predictor: the load of the step's start
+      newton = .false.; previous = huge(1.0_dp); change = 0.0_dp; scale = 1.0_dp
+      do it = 1, self%max_iter
+         self%q = self%e11*self%qn + self%e12*self%qdn + self%g0q*self%pn + self%g1q*self%ptrial
+         self%qd = self%e21*self%qn + self%e22*self%qdn + self%g0v*self%pn + self%g1v*self%ptrial
+         call to_nodes(self)
+         if (newton) then
+            call band_zero(self%kband); call band_zero(self%cband)
+            call internal_forces(m, self%ms, self%u, self%v, self%fint, self%kband%ab, 1.0_dp, &
+                                 0.0_dp, self%cband%ab)
+         else
+            call internal_forces(m, self%ms, self%u, self%v, self%fint)
+         end if
+         o%counters(C_RESIDUALS) = o%counters(C_RESIDUALS) + 1_i8
+         o%counters(C_NEWTON) = o%counters(C_NEWTON) + 1_i8
+         self%p = matmul(transpose(self%phi), self%fext(self%free) - self%fint(self%free)) + &
+                  self%w2*self%q + self%c*self%qd
+         self%r = self%p - self%ptrial
+         change = maxval(abs(self%r))
+         ! p is the difference of the internal force and ω²q + cq̇: its round-off is relative
+         ! to those terms, not to p (small in free vibration)
+         scale = max(maxval(abs(self%p)), maxval(abs(self%w2*self%q)), &
+                     maxval(abs(self%c*self%qd)), tiny(1.0_dp))
+         if (self%nf == 0) change = 0.0_dp
+         if (.not. (change == change)) exit        ! NaN: reported below
+         if (change <= self%tol*scale) then
+            ! converged: the state is the one f_int was evaluated at, p its load
+            call set_acceleration(self)
+            call mech_commit(m, self%ms, self%u, wd, wl, wc)
+            call observer_work(o, damping=wd, links=wl, contact=wc)
+            call observer_work(o, external=external_work(m, self%fext_n, self%fext, self%un, self%u))
+            call contact_state(self, m)
+            return
+         end if
+         if (newton) then
+            call newton_update(info)
+            if (info /= 0) exit
+         else
+            self%ptrial = self%p
+            ! Wilson's iteration contracts by about h²k/m per pass: slower than 1/4, Newton
+            if (it >= 2 .and. change > 0.25_dp*previous) newton = .true.
+         end if
+         previous = change
+      end do
+      write (msg, '(a,i0,a,es9.2,a)') 'fast-nonlinear: the pseudo-force iteration did not converge in ', &
+         self%max_iter, ' iterations (last relative change ', change/scale, &
+         '); reduce dt or raise max_newton'
+      call stepper_fail(o, MARTELLO_ERR_NOT_CONVERGED, t, trim(msg), stat)
+
+   contains
+      !> ptrial ← ptrial − J⁻¹ r with J = ∂P/∂p − I at the state just evaluated:
+      !> ∂P/∂q = diag(ω²) − Φᵀ K_t Φ, ∂P/∂q̇ = diag(c) − Φᵀ C_t Φ, ∂q/∂p = g1q, ∂q̇/∂p = g1v.
+      subroutine newton_update(info)
+         integer, intent(out) :: info
+         integer :: i, j, kd
+         kd = self%kband%kd
+         self%kt = 0.0_dp; self%ct = 0.0_dp
+         do j = 1, self%nf
+            do i = 1, self%nf
+               if (abs(self%free(i) - self%free(j)) > kd) cycle
+               self%kt(i, j) = self%kband%ab(2*kd + 1 + self%free(i) - self%free(j), self%free(j))
+               self%ct(i, j) = self%cband%ab(2*kd + 1 + self%free(i) - self%free(j), self%free(j))
+            end do
+         end do
+         self%kt = -matmul(transpose(self%phi), matmul(self%kt, self%phi))
+         self%ct = -matmul(transpose(self%phi), matmul(self%ct, self%phi))
+         do i = 1, self%nf
+            self%kt(i, i) = self%kt(i, i) + self%w2(i)
+            self%ct(i, i) = self%ct(i, i) + self%c(i)
+         end do
+         do j = 1, self%nf
+            self%jac(:, j) = self%kt(:, j)*self%g1q(j) + self%ct(:, j)*self%g1v(j)
+            self%jac(j, j) = self%jac(j, j) - 1.0_dp
+         end do
+         o%counters(C_JACOBIANS) = o%counters(C_JACOBIANS) + 1_i8
+         o%counters(C_FACTORIZATIONS) = o%counters(C_FACTORIZATIONS) + 1_i8
+         self%r = -self%r
+         call dgesv(self%nf, 1, self%jac, self%nf, self%ipiv, self%r, self%nf, info)
+         if (info == 0) self%ptrial = self%ptrial + self%r
+      end subroutine newton_update
+   end subroutine step
+
+   !> u, v on the nodes from the modal state (fixed nodes at u0 and at rest).
+   subroutine to_nodes(self)
+      class(fast_nonlinear_t), intent(inout) :: self
+      self%u(self%free) = matmul(self%phi, self%q)
+      self%v(self%free) = matmul(self%phi, self%qd)
+      self%u(0) = 0.0_dp; self%v(0) = 0.0_dp
+   end subroutine to_nodes
+
+   !> a = Φ q̈ with q̈ = p − c∘q̇ − ω²∘q: the equations of motion at the state.
+   subroutine set_acceleration(self)
+      class(fast_nonlinear_t), intent(inout) :: self
+      self%a = 0.0_dp
+      self%a(self%free) = matmul(self%phi, self%p - self%c*self%qd - self%w2*self%q)
+   end subroutine set_acceleration
+
+   !> The exact step of q̈ + c q̇ + ω² q = p(τ), p linear on [0, h]: (q, q̇)(h) =
+   !> E (q, q̇)(0) + G0 p(0) + G1 p(h), from the exponential of the augmented system
+   !> y = (s q, q̇, p, Δp), ẏ = H y with ṗ = Δp/h (Van Loan 1978), s = max(ω, 1/h) balancing
+   !> the first two rows (so ω = 0 and every damping ratio are covered by one formula).
+   pure subroutine modal_step_coefficients(w2, c, h, e11, e12, e21, e22, g0q, g0v, g1q, g1v)
+      real(dp), intent(in) :: w2, c, h
+      real(dp), intent(out) :: e11, e12, e21, e22, g0q, g0v, g1q, g1v
+      real(dp) :: hm(4, 4), x(4, 4), sc
+      sc = max(sqrt(w2), 1.0_dp/h)
+      hm = 0.0_dp
+      hm(1, 2) = sc                 ! d(s q)/dt = s q̇
+      hm(2, 1) = -w2/sc             ! dq̇/dt = −ω² q − c q̇ + p
+      hm(2, 2) = -c
+      hm(2, 3) = 1.0_dp
+      hm(3, 4) = 1.0_dp/h
+      call expm4(h*hm, x)
+      e11 = x(1, 1); e12 = x(1, 2)/sc; e21 = x(2, 1)*sc; e22 = x(2, 2)
+      ! p(τ) = p0 + Δp τ/h: columns 3 (p0) and 4 (Δp = p1 − p0)
+      g0q = (x(1, 3) - x(1, 4))/sc; g1q = x(1, 4)/sc
+      g0v = x(2, 3) - x(2, 4); g1v = x(2, 4)
+   end subroutine modal_step_coefficients
+
+   !> exp(a) of a 4 × 4 matrix: scaling and squaring with a degree-18 Taylor polynomial
+   !> (‖a/2^k‖₁ ≤ 1/2: truncation below 1e-20, Moler & Van Loan 2003, method 3).
+   pure subroutine expm4(a, x)
+      real(dp), intent(in) :: a(4, 4)
+      real(dp), intent(out) :: x(4, 4)
+      real(dp) :: b(4, 4), term(4, 4), nrm
+      integer :: k, sq, i
+      nrm = maxval(sum(abs(a), dim=1))
+      sq = 0
+      if (nrm > 0.5_dp) sq = ceiling(log(nrm/0.5_dp)/log(2.0_dp))
+      b = a/2.0_dp**sq
+      x = 0.0_dp
+      do i = 1, 4
+         x(i, i) = 1.0_dp
+      end do
+      term = x
+      do k = 1, 18
+         term = matmul(term, b)/real(k, dp)
+         x = x + term
+      end do
+      do k = 1, sq
+         x = matmul(x, x)
+      end do
+   end subroutine expm4
+end module martello_fast_nonlinear

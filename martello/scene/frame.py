@@ -1,0 +1,111 @@
+"""[[frame]] tables: planar frames of beam-columns (docs/problems.md P10, docs/scene-input.md
+"Frames"), expanded into the lateral nodes that carry the floor masses and one stiffness block
+between them (the frame statically condensed, martello.frame2d). The loader keeps what the
+results need (the recovery operator of the member end forces, drifts and shears) in
+scene.extras["frames"]."""
+
+import numpy as np
+
+from ..errors import SceneError
+from ..frame2d import PlanarFrame, rayleigh_coefficients
+from .fields import MAX_GENERATED, POSITIVE, check_fields, choice, per_item
+
+FRAME_KEYS = {"prefix": ("str", True, None, None),
+              "storeys": ("int", True, POSITIVE, None),
+              "bays": ("int", True, POSITIVE, None),
+              "storey_height": ("any", True, None, None),
+              "bay_width": ("any", True, None, None),
+              "column": ("any", True, None, None),
+              "beam": ("any", True, None, None),
+              "mass": ("any", True, None, None),
+              "mass_model": ("str", False, None, "diaphragm"),
+              "base": ("str", False, None, "fixed"),
+              "zeta": ("float", False, (lambda x: 0 <= x < 1, "a number in [0, 1)"), 0.0),
+              "rayleigh_modes": ("list", False, None, [1, 2]),
+              "histories": ("bool", False, None, False)}
+SECTION_KEYS = {"E": ("float", True, POSITIVE, None), "A": ("float", True, POSITIVE, None),
+                "I": ("float", True, POSITIVE, None)}
+MASS_MODELS = ["diaphragm", "joints"]
+BASES = ["fixed", "pinned"]
+# The cap of a frame's lateral DOFs: its block is dense, n² doubles per evaluation.
+MAX_LATERAL = 2000
+
+
+def _sections(src, where, value, rows, per_row):
+    """One section table for all, a list of `rows` (one per storey/floor), or a list of rows
+    of `per_row` tables (one per member). Returns rows x per_row (E, A, I)."""
+    def one(tab, path):
+        s = check_fields(src, tab, path, SECTION_KEYS)
+        return (s["E"], s["A"], s["I"])
+    if isinstance(value, dict):
+        s = one(value, where)
+        return [[s] * per_row for _ in range(rows)]
+    if not isinstance(value, list) or len(value) != rows:
+        raise SceneError(src, where, "must be a section table or a list of one per storey",
+                         f"e.g. {{ E = 2.5e10, A = 0.16, I = 2.1e-3 }} or a list of {rows}")
+    out = []
+    for r, item in enumerate(value):
+        if isinstance(item, dict):
+            out.append([one(item, f"{where}[{r}]")] * per_row)
+        elif isinstance(item, list) and len(item) == per_row:
+            out.append([one(t, f"{where}[{r}][{k}]") for k, t in enumerate(item)])
+        else:
+            raise SceneError(src, f"{where}[{r}]", f"must be a section table or a list of {per_row}",
+                             "one section for the storey, or one per member left to right")
+    return out
+
+
+def expand_frames(src, data):
+    """Replace [[frame]] tables by their lateral nodes; return (data, frames) with frames the
+    list of what each frame stands for (PlanarFrame, node names, K, C, recovery operators)."""
+    data = dict(data)
+    tabs = data.pop("frame")
+    if not isinstance(tabs, list):
+        raise SceneError(src, "frame", "must be an array of tables", "write [[frame]]")
+    nodes, frames, made = list(data.get("node", [])), [], 0
+    for fi, tab in enumerate(tabs):
+        w = f"frame[{fi}]"
+        f = check_fields(src, tab, w, FRAME_KEYS)
+        ns, nb = f["storeys"], f["bays"]
+        choice(src, f"{w}.mass_model", f["mass_model"], MASS_MODELS)
+        choice(src, f"{w}.base", f["base"], BASES)
+        lateral = ns if f["mass_model"] == "diaphragm" else ns * (nb + 1)
+        made += lateral
+        if lateral > MAX_LATERAL or made > MAX_GENERATED:
+            raise SceneError(src, f"{w}.storeys", f"{lateral} lateral DOFs",
+                             f"a frame has at most {MAX_LATERAL} (its condensed block is dense)")
+        modes = f["rayleigh_modes"]
+        if (len(modes) != 2 or not all(isinstance(x, int) and not isinstance(x, bool) and x >= 1
+                                       for x in modes)):
+            raise SceneError(src, f"{w}.rayleigh_modes", f"invalid value {modes!r}",
+                             "two mode numbers >= 1, e.g. [1, 2]")
+        frame = PlanarFrame(
+            heights=per_item(src, f"{w}.storey_height", f["storey_height"], ns, POSITIVE),
+            widths=per_item(src, f"{w}.bay_width", f["bay_width"], nb, POSITIVE),
+            columns=_sections(src, f"{w}.column", f["column"], ns, nb + 1),
+            beams=_sections(src, f"{w}.beam", f["beam"], ns, nb),
+            masses=per_item(src, f"{w}.mass", f["mass"], ns, POSITIVE),
+            base=f["base"], mass_model=f["mass_model"])
+        names = frame.lateral_names(f["prefix"])
+        mass = frame.lateral_masses()
+        K, G = frame.condensed()
+        R = frame.recovery(G)
+        C = np.zeros_like(K)
+        a0 = a1 = 0.0
+        if f["zeta"] > 0:
+            a0, a1 = rayleigh_coefficients(K, mass, f["zeta"], tuple(modes))
+            C = a0 * np.diag(mass) + a1 * K
+        nodes += [{"name": n, "mass": float(m)} for n, m in zip(names, mass)]
+        frames.append({"prefix": f["prefix"], "frame": frame, "nodes": names, "K": K, "C": C,
+                       "rayleigh": (a0, a1), "zeta": f["zeta"], "recovery": R,
+                       "drift": frame.storey_drift_operator(),
+                       "shear": frame.storey_shear_operator(R), "histories": f["histories"]})
+    data["node"] = nodes
+    return data, frames
+
+
+def frame_blocks(frames, index):
+    """The stiffness blocks of the frames: dicts name, nodes (indices), k, c."""
+    return [{"name": fr["prefix"], "nodes": [index[n] for n in fr["nodes"]], "k": fr["K"],
+             "c": fr["C"]} for fr in frames]
+
