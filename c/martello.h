@@ -179,16 +179,18 @@ typedef struct martello_settings {
   double theta;             /* Moreau-Jean theta in [1/2, 1] */
   double event_tol;         /* event location, absolute in time [s] */
   double h_max;             /* adaptive: the largest step [s] (0: no limit) */
+  bool fused_chain;         /* Newmark on a chain: the fused chain step (false: general path) */
 } martello_settings;
 
 /* Indices of martello_run_counters, martello_run_energy and the values of
  * martello_run_events (tables "counters", "energy", "events"). */
-enum { MARTELLO_NCOUNTERS = 10, MARTELLO_NENERGY = 9, MARTELLO_NEVENT = 6 };
+enum { MARTELLO_NCOUNTERS = 11, MARTELLO_NENERGY = 9, MARTELLO_NEVENT = 6 };
 enum { MARTELLO_COUNTER_STEPS = 0, MARTELLO_COUNTER_REJECTED_STEPS = 1,
        MARTELLO_COUNTER_NEWTON_ITERATIONS = 2, MARTELLO_COUNTER_RESIDUAL_EVALUATIONS = 3,
        MARTELLO_COUNTER_FACTORIZATIONS = 4, MARTELLO_COUNTER_EVENTS = 5,
        MARTELLO_COUNTER_JACOBIAN_EVALUATIONS = 6, MARTELLO_COUNTER_ROOT_EVALUATIONS = 7,
-       MARTELLO_COUNTER_CONTACT_CHATTER_RESOLUTIONS = 8, MARTELLO_COUNTER_MODES = 9 };
+       MARTELLO_COUNTER_CONTACT_CHATTER_RESOLUTIONS = 8, MARTELLO_COUNTER_MODES = 9,
+       MARTELLO_COUNTER_FUSED_CHAIN_STEPS = 10 };
 enum { MARTELLO_ENERGY_KINETIC = 0, MARTELLO_ENERGY_RECOVERABLE = 1, MARTELLO_ENERGY_INPUT = 2,
        MARTELLO_ENERGY_DAMPING = 3, MARTELLO_ENERGY_PLASTIC = 4, MARTELLO_ENERGY_CONTACT = 5,
        MARTELLO_ENERGY_BALANCE = 6, MARTELLO_ENERGY_INITIAL = 7, MARTELLO_ENERGY_IMPACT = 8 };

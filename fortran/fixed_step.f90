@@ -46,6 +46,9 @@ module martello_fixed_step
    contains
       procedure(stepper_init), deferred :: init
       procedure(stepper_step), deferred :: step
+      !> (un, vn, an) ← (u, v, a) before a step: copies; a method that writes every entry of
+      !> u, v, a before reading it may swap the buffers instead
+      procedure :: begin_step => stepper_begin_step
    end type stepper_t
 
    abstract interface
@@ -96,7 +99,8 @@ contains
       if (stat /= MARTELLO_OK) return
 
       do k = 1, o%n_grid
-         stp%un = stp%u; stp%vn = stp%v; stp%an = stp%a; stp%t0 = t
+         call stp%begin_step()
+         stp%t0 = t
          t = k*stp%h
          call stp%step(m, t, o, stat)
          if (stat /= MARTELLO_OK) return
@@ -117,6 +121,12 @@ contains
                               stp%ms%link_f, stp%ms%link_u, stp%un(1:), stp%vn(1:), stp%an(1:))
       end subroutine sample
    end subroutine run_fixed_step
+
+   !> The start of a step: the committed state becomes (un, vn, an).
+   subroutine stepper_begin_step(self)
+      class(stepper_t), intent(inout) :: self
+      self%un = self%u; self%vn = self%v; self%an = self%a
+   end subroutine stepper_begin_step
 
    !> The common start of every stepper: sizes, the initial state (fixed nodes at rest), M·1
    !> and the committed link and contact states at t = 0.

@@ -12,7 +12,7 @@ module martello_integrator_settings
       INT_MSBDF, INT_IDA, INT_LAST, SETTINGS, INTEGRATORS, setting_t, NSETTINGS, S_DT, S_T_END, &
       S_BETA, S_GAMMA, S_ALPHA, S_RHO_INF, S_TOL_RESIDUAL, S_TOL_INCREMENT, S_MAX_NEWTON, &
       S_CHECK_STABILITY, S_EVERY, S_DIVERGENCE_FACTOR, S_RTOL, S_ATOL, S_THETA, S_EVENT_TOL, &
-      S_H_MAX, T_INT
+      S_H_MAX, S_FUSED_CHAIN, T_INT
    implicit none
    private
    public :: integrator_settings_t, integrator_name, scheme_supported, settings_default, &
@@ -42,6 +42,8 @@ module martello_integrator_settings
       real(c_double) :: theta = SETTINGS(S_THETA)%default                !< Moreau–Jean θ
       real(c_double) :: event_tol = SETTINGS(S_EVENT_TOL)%default        !< absolute in time [s]
       real(c_double) :: h_max = SETTINGS(S_H_MAX)%default                !< 0: no limit
+      !> Newmark on a chain: the fused chain step (docs/run-layer.md); false: the general path
+      logical(c_bool) :: fused_chain = SETTINGS(S_FUSED_CHAIN)%default /= 0.0_dp
    end type integrator_settings_t
 
 contains
@@ -133,6 +135,7 @@ contains
       case (S_THETA); x = s%theta
       case (S_EVENT_TOL); x = s%event_tol
       case (S_H_MAX); x = s%h_max
+      case (S_FUSED_CHAIN); x = merge(1.0_dp, 0.0_dp, logical(s%fused_chain))
       case default; x = 0.0_dp
       end select
    end function setting_value

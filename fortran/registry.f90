@@ -23,7 +23,7 @@ module martello_registry
    use martello_time_functions, only: TF_CONSTANT, TF_TABLE, TF_SINE, TF_RECTANGULAR, &
       TF_HALF_SINE, NPAR_TF
    use martello_run_quantities, only: NCOUNTERS, C_STEPS, C_REJECTED, C_NEWTON, C_RESIDUALS, &
-      C_FACTORIZATIONS, C_EVENTS, C_JACOBIANS, C_ROOT_EVALS, C_CHATTER, NENERGY, E_KINETIC, &
+      C_FACTORIZATIONS, C_EVENTS, C_JACOBIANS, C_ROOT_EVALS, C_CHATTER, C_FUSED, NENERGY, E_KINETIC, &
       E_RECOVERABLE, E_INPUT, E_DAMPING, E_PLASTIC, E_CONTACT, E_BALANCE, E_INITIAL, E_IMPACT, &
       NEVENT, EV_T_ON, EV_T_OFF, EV_V_IN, EV_V_OUT, EV_MAX_PEN, EV_MAX_FORCE, C_MODES
    implicit none
@@ -33,7 +33,7 @@ module martello_registry
       INT_NEWMARK_LAGRANGE, INT_RKF45, INT_RK8PD, INT_MSBDF, INT_IDA, INT_FAST_NONLINEAR, INT_LAST, &
       NSETTINGS, S_DT, S_T_END, S_BETA, S_GAMMA, S_ALPHA, S_RHO_INF, S_TOL_RESIDUAL, &
       S_TOL_INCREMENT, S_MAX_NEWTON, S_CHECK_STABILITY, S_EVERY, S_DIVERGENCE_FACTOR, S_RTOL, &
-      S_ATOL, S_THETA, S_EVENT_TOL, S_H_MAX, SETTINGS, INTEGRATORS, setting_t, integrator_t, &
+      S_ATOL, S_THETA, S_EVENT_TOL, S_H_MAX, S_FUSED_CHAIN, SETTINGS, INTEGRATORS, setting_t, integrator_t, &
       registry_shape, registry_column, registry_row, registry_find, registry_name, &
       NAME_LEN, TEXT_LEN, MAX_COLS, T_DOUBLE, T_INT, T_BOOL
 
@@ -59,7 +59,8 @@ module martello_registry
                          S_RHO_INF = 6, S_TOL_RESIDUAL = 7, S_TOL_INCREMENT = 8, &
                          S_MAX_NEWTON = 9, S_CHECK_STABILITY = 10, S_EVERY = 11, &
                          S_DIVERGENCE_FACTOR = 12, S_RTOL = 13, S_ATOL = 14, S_THETA = 15, &
-                         S_EVENT_TOL = 16, S_H_MAX = 17, NSETTINGS = 17
+                         S_EVENT_TOL = 16, S_H_MAX = 17, S_FUSED_CHAIN = 18, &
+                         NSETTINGS = 18
    integer, parameter :: MAX_COLS = NSETTINGS   !< the widest table: reads, a column per setting
    ! C types of the settings (rows of the table "setting_types")
    integer, parameter :: T_DOUBLE = 1, T_INT = 2, T_BOOL = 3
@@ -176,7 +177,8 @@ module martello_registry
       named_t('root_evaluations', C_ROOT_EVALS - 1, 'root-function evaluations'), &
       named_t('contact_chatter_resolutions', C_CHATTER - 1, &
               'steps where a contact was held open (docs/integrators.md)'), &
-      named_t('modes', C_MODES - 1, 'modes of the linear part (fast-nonlinear)')]
+      named_t('modes', C_MODES - 1, 'modes of the linear part (fast-nonlinear)'), &
+      named_t('fused_chain_steps', C_FUSED - 1, 'steps taken by the fused chain step (docs/run-layer.md)')]
 
    type(named_t), parameter :: ENERGY_TERMS(*) = [ &
       named_t('kinetic', E_KINETIC - 1, 'kinetic energy [J]'), &
@@ -256,7 +258,8 @@ module martello_registry
       setting_t('atol', T_DOUBLE, 1.0e-12_dp, 0.0_dp, BIG, .true., .false., 'a number > 0'), &
       setting_t('theta', T_DOUBLE, 0.5_dp, 0.5_dp, 1.0_dp, .false., .false., 'a number in [0.5, 1]'), &
       setting_t('event_tol', T_DOUBLE, 1.0e-12_dp, 0.0_dp, BIG, .true., .false., 'a number > 0'), &
-      setting_t('h_max', T_DOUBLE, 0.0_dp, 0.0_dp, BIG, .false., .false., 'a number >= 0')]
+      setting_t('h_max', T_DOUBLE, 0.0_dp, 0.0_dp, BIG, .false., .false., 'a number >= 0'), &
+      setting_t('fused_chain', T_BOOL, 1.0_dp, 0.0_dp, 1.0_dp, .false., .false., 'true or false')]
 
    ! Settings read by groups of integrators (bit S_x).
    integer, parameter :: READS_BASE = 2**S_DT + 2**S_T_END + 2**S_EVERY
@@ -271,7 +274,7 @@ module martello_registry
 
    type(integrator_t), parameter :: INTEGRATORS(INT_LAST) = [ &
       integrator_t('newmark', INT_NEWMARK, FAMILY_NEWMARK, .false., &
-                   READS_BASE + READS_DIVERGENCE + READS_NEWTON + 2**S_BETA + 2**S_GAMMA, &
+                   READS_BASE + READS_DIVERGENCE + READS_NEWTON + 2**S_BETA + 2**S_GAMMA + 2**S_FUSED_CHAIN, &
                    RUNS_PENALTY, 'Newmark (1959) beta-gamma, implicit'), &
       integrator_t('hht', INT_HHT, FAMILY_NEWMARK, .false., &
                    READS_BASE + READS_DIVERGENCE + READS_NEWTON + 2**S_ALPHA, RUNS_PENALTY, &

@@ -17,6 +17,7 @@ module martello_run
    use martello_newmark_lagrange, only: newmark_lagrange_t
    use martello_fast_nonlinear, only: fast_nonlinear_t
    use martello_registry, only: INT_FAST_NONLINEAR
+   use martello_chain_newmark, only: chain_newmark_t, chain_fusable
    implicit none
    private
    public :: run_t, run_dynamic
@@ -72,7 +73,11 @@ contains
       if (stat == MARTELLO_OK) then
          select case (rp%settings%kind)
          case (INT_NEWMARK, INT_HHT, INT_GENERALIZED_ALPHA)
-            allocate (generalized_alpha_t :: stepper)
+            if (chain_fusable(mp, rp%settings)) then
+               allocate (chain_newmark_t :: stepper)
+            else
+               allocate (generalized_alpha_t :: stepper)
+            end if
          case (INT_CENTRAL_DIFFERENCE)
             allocate (central_difference_t :: stepper)
          case (INT_MOREAU_JEAN)

@@ -5,15 +5,15 @@ module martello_run_quantities
    implicit none
    private
    public :: NCOUNTERS, C_STEPS, C_REJECTED, C_NEWTON, C_RESIDUALS, C_FACTORIZATIONS, C_EVENTS, &
-      C_JACOBIANS, C_ROOT_EVALS, C_CHATTER, C_MODES, NENERGY, E_KINETIC, E_RECOVERABLE, E_INPUT, E_DAMPING, &
+      C_JACOBIANS, C_ROOT_EVALS, C_CHATTER, C_MODES, C_FUSED, NENERGY, E_KINETIC, E_RECOVERABLE, E_INPUT, E_DAMPING, &
       E_PLASTIC, E_CONTACT, E_BALANCE, E_INITIAL, E_IMPACT, NEVENT, EV_T_ON, EV_T_OFF, &
       EV_V_IN, EV_V_OUT, EV_MAX_PEN, EV_MAX_FORCE
 
    ! cost counters
-   integer, parameter :: NCOUNTERS = 10
+   integer, parameter :: NCOUNTERS = 11
    integer, parameter :: C_STEPS = 1, C_REJECTED = 2, C_NEWTON = 3, C_RESIDUALS = 4, &
                          C_FACTORIZATIONS = 5, C_EVENTS = 6, C_JACOBIANS = 7, C_ROOT_EVALS = 8, &
-                         C_CHATTER = 9, C_MODES = 10
+                         C_CHATTER = 9, C_MODES = 10, C_FUSED = 11
    ! energy terms [J]: balance = initial + input − kinetic − recoverable − dissipated (≈ 0)
    integer, parameter :: NENERGY = 9
    integer, parameter :: E_KINETIC = 1, E_RECOVERABLE = 2, E_INPUT = 3, E_DAMPING = 4, &

@@ -35,7 +35,7 @@ from .norms import mescd
 
 COST_KEYS = ("steps", "rejected_steps", "newton_iterations", "residual_evaluations",
              "factorizations", "events", "jacobian_evaluations", "root_evaluations",
-             "contact_chatter_resolutions", "wall_time_s")
+             "contact_chatter_resolutions", "fused_chain_steps", "wall_time_s")
 # A phase whose approach speed is below this fraction of the largest one is a graze: its
 # realised restitution −δ̇_out/δ̇_in is a ratio of two tiny numbers and is not scored.
 GRAZE_FRACTION = 1e-2

@@ -99,6 +99,7 @@ ANALYSIS_TYPES = {
                 "theta": _setting("float", "theta"),
                 "event_tol": _setting("float", "event_tol"),
                 "h_max": _setting("float", "h_max"),
+                "fused_chain": _setting("bool", "fused_chain"),
                 "output": ("table", False, None, None)},
 }
 OUTPUT_KEYS = {"every": _setting("int", "every"), "nodes": ("list", False, None, None),
