@@ -69,14 +69,16 @@ contains
 
    !> Whether the fused step runs this scene with these settings: Newmark, fused_chain on, a
    !> tridiagonal stiffness (half-bandwidth ≤ 1), lumped masses, piecewise-linear links and
-   !> penalty contacts with the linear or Kelvin law. Everything else takes the general path.
+   !> penalty contacts with the linear or Kelvin law, no stiffness block. Everything else takes
+   !> the general path.
    logical function chain_fusable(m, s) result(ok)
       type(model_t), intent(in) :: m
       type(integrator_settings_t), intent(in) :: s
       integer :: j
       ok = s%kind == INT_NEWMARK .and. logical(s%fused_chain)
       if (.not. ok) return
-      ok = model_bandwidth(m) <= 1 .and. m%ncoupling == 0
+      ! stiffness blocks (frames) are not in the sweep's per-node parameters
+      ok = model_bandwidth(m) <= 1 .and. m%ncoupling == 0 .and. m%nblock == 0
       do j = 1, m%nlink
          select case (m%link_kind(j))
          case (LINK_SPRING, LINK_BAR, LINK_DASHPOT, LINK_BILINEAR)
