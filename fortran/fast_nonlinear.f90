@@ -48,7 +48,8 @@ module martello_fast_nonlinear
       real(dp), allocatable :: w2(:), c(:)              !< ω², modal damping c_i = 2ζ_iω_i
       !> z_{n+1} = E z_n + G0 p_n + G1 p_{n+1} for z = (q, q̇): e11 … g1v per mode
       real(dp), allocatable :: e11(:), e12(:), e21(:), e22(:), g0q(:), g0v(:), g1q(:), g1v(:)
-      real(dp), allocatable :: q(:), qd(:), qn(:), qdn(:), p(:), pn(:), ptrial(:), r(:)
+      real(dp), allocatable :: q(:), qd(:), qn(:), qdn(:), p(:), pn(:), ptrial(:), r(:), &
+                               pbase(:), dp(:)
       real(dp), allocatable :: fint(:), fext(:), fext_n(:), jac(:, :), kt(:, :), ct(:, :)
       integer, allocatable :: ipiv(:)
       type(band_t) :: kband, cband
@@ -126,7 +127,7 @@ contains
       end do
       ! modal state at t = 0: q = Φᵀ M u, q̇ = Φᵀ M v (free DOFs)
       allocate (self%q(nf), self%qd(nf), self%qn(nf), self%qdn(nf), self%p(nf), self%pn(nf), &
-                self%ptrial(nf), self%r(nf))
+                self%ptrial(nf), self%r(nf), self%pbase(nf), self%dp(nf))
       call mass_times(m, self%u, y)
       self%q = matmul(transpose(self%phi), y(self%free))
       call mass_times(m, self%v, y)
@@ -195,16 +196,17 @@ contains
       real(dp), intent(in) :: t
       type(observer_t), intent(inout) :: o
       integer, intent(out) :: stat
-      integer :: it, info
+      integer :: it, info, halvings
       real(dp) :: change, scale, wd, wl, wc, previous
-      logical :: newton
+      logical :: newton, stepped
       character(len=256) :: msg
       stat = MARTELLO_OK
       self%qn = self%q; self%qdn = self%qd; self%pn = self%p
       self%fext_n = self%fext
       call external_forces(m, self%mrow, t, self%fext)
       self%ptrial = self%pn                     ! predictor: the load of the step's start
-      newton = .false.; previous = huge(1.0_dp); change = 0.0_dp; scale = 1.0_dp
+      newton = .false.; previous = huge(1.0_dp); change = 0.0_dp; scale = 1.0_dp; halvings = 0
+      stepped = .false.            ! a Newton step has been taken (it may be halved)
       do it = 1, self%max_iter
          self%q = self%e11*self%qn + self%e12*self%qdn + self%g0q*self%pn + self%g1q*self%ptrial
          self%qd = self%e21*self%qn + self%e22*self%qdn + self%g0v*self%pn + self%g1v*self%ptrial
@@ -238,8 +240,18 @@ contains
             return
          end if
          if (newton) then
+            ! a Newton step that raised the residual is halved (a damper law |v|^α with α < 1
+            ! makes full steps overshoot and cycle)
+            if (stepped .and. change > previous .and. halvings < 30) then
+               halvings = halvings + 1
+               self%dp = 0.5_dp*self%dp
+               self%ptrial = self%pbase + self%dp
+               cycle
+            end if
+            halvings = 0
             call newton_update(info)
             if (info /= 0) exit
+            stepped = .true.
          else
             self%ptrial = self%p
             ! Wilson's iteration contracts by about h²k/m per pass: slower than 1/4, Newton
@@ -281,7 +293,10 @@ contains
          o%counters(C_FACTORIZATIONS) = o%counters(C_FACTORIZATIONS) + 1_i8
          self%r = -self%r
          call dgesv(self%nf, 1, self%jac, self%nf, self%ipiv, self%r, self%nf, info)
-         if (info == 0) self%ptrial = self%ptrial + self%r
+         if (info == 0) then
+            self%pbase = self%ptrial; self%dp = self%r
+            self%ptrial = self%pbase + self%dp
+         end if
       end subroutine newton_update
    end subroutine step
 
