@@ -176,22 +176,22 @@ def main():
         return 1
     os_res = json.loads((out / "result.json").read_text())
     lines = []
-    print = lines.append     # noqa: A001 (the table is printed and written to docs/p10)
-    print(f"P10 bare, record {args.record}, Newmark (1/2, 1/4), dt = {args.dt:g} s, t_end = {args.t_end:g} s; "
+    emit = lines.append      # the table is printed and written to docs/p10
+    emit(f"P10 bare, record {args.record}, Newmark (1/2, 1/4), dt = {args.dt:g} s, t_end = {args.t_end:g} s; "
           f"OpenSees {os_res['version']} (openseespy)")
-    print(f"{'column':>10} {'martello |M| [N m]':>20} {'OpenSees |M| [N m]':>20} {'rel. diff':>10}")
+    emit(f"{'column':>10} {'martello |M| [N m]':>20} {'OpenSees |M| [N m]':>20} {'rel. diff':>10}")
     worst = 0.0
     for frame in ("A", "B"):
         for name, m in cs.column_peaks(s, frame).items():
             o = os_res["moments"][f"{frame}.{name}"]
             d = abs(m - o) / abs(o)
             worst = max(worst, d)
-            print(f"{frame + '.' + name:>10} {m:>20.9e} {o:>20.9e} {d:>10.2e}")
+            emit(f"{frame + '.' + name:>10} {m:>20.9e} {o:>20.9e} {d:>10.2e}")
     for f in (1, 2):
         m = s["contacts"][f"gap{f}"]["max_penetration"]
         o = max(os_res["penetration"][f - 1], 0.0)
-        print(f"{'gap' + str(f):>10} {m:>20.9e} {o:>20.9e} {abs(m - o) / max(abs(o), 1e-300):>10.2e}  (penetration [m])")
-    print(f"worst relative difference of the column moments: {worst:.2e}")
+        emit(f"{'gap' + str(f):>10} {m:>20.9e} {o:>20.9e} {abs(m - o) / max(abs(o), 1e-300):>10.2e}  (penetration [m])")
+    emit(f"worst relative difference of the column moments: {worst:.2e}")
     text = "\n".join(lines)
     sys.stdout.write(text + "\n")
     if args.t_end == 20.0 and args.record == 1:
