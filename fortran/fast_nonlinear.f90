@@ -32,7 +32,9 @@ module martello_fast_nonlinear
    use martello_run_quantities, only: C_MODES
    use martello_integrator_settings, only: integrator_settings_t
    use martello_fixed_step, only: stepper_t, stepper_start, stepper_fail, contact_state
-   use martello_lapack, only: dsygv, dgesv
+   use martello_lapack, only: dsygv, dgesv, dgetrf, dgetrs
+   use martello_links, only: LINK_FLUID_DAMPER
+   use martello_model, only: SCHEME_PENALTY
    use martello_model, only: model_bandwidth
    use martello_band_matrix, only: band_t, band_init, band_zero
    use martello_observer, only: C_JACOBIANS
@@ -48,9 +50,14 @@ module martello_fast_nonlinear
       real(dp), allocatable :: w2(:), c(:)              !< ω², modal damping c_i = 2ζ_iω_i
       !> z_{n+1} = E z_n + G0 p_n + G1 p_{n+1} for z = (q, q̇): e11 … g1v per mode
       real(dp), allocatable :: e11(:), e12(:), e21(:), e22(:), g0q(:), g0v(:), g1q(:), g1v(:)
-      real(dp), allocatable :: q(:), qd(:), qn(:), qdn(:), p(:), pn(:), ptrial(:), r(:)
-      real(dp), allocatable :: fint(:), fext(:), fext_n(:), jac(:, :), kt(:, :), ct(:, :)
-      integer, allocatable :: ipiv(:)
+      real(dp), allocatable :: q(:), qd(:), qn(:), qdn(:), p(:), pn(:), ptrial(:), r(:), &
+                               pbase(:), dp(:)
+      real(dp), allocatable :: fint(:), fext(:), fext_n(:)
+      !> the nonlinear DOFs S (s of them): Φ(S,:), K_L(S,S), C_L(S,S); J0's LU and J0⁻¹Φ(S,:)ᵀ
+      integer :: ns = 0
+      integer, allocatable :: sdof(:), ipiv(:), ipiv_s(:)
+      real(dp), allocatable :: phis(:, :), kls(:, :), cls(:, :), j0(:, :), w(:, :), vt(:, :), &
+                               small(:, :), dks(:, :), dcs(:, :), y(:), z(:)
       type(band_t) :: kband, cband
    contains
       procedure :: init
@@ -84,7 +91,6 @@ contains
       self%nf = nf
       self%free = pack([(i, i = 1, n)], .not. m%fixed)
       allocate (self%fint(0:n), self%fext(0:n), self%fext_n(0:n))
-      allocate (self%jac(nf, nf), self%kt(nf, nf), self%ct(nf, nf), self%ipiv(nf))
       call band_init(self%kband, n, model_bandwidth(m))
       call band_init(self%cband, n, model_bandwidth(m))
       allocate (kl(nf, nf), cl(nf, nf), mm(nf, nf), x(0:n), y(0:n))
@@ -124,9 +130,15 @@ contains
                                       self%e21(i), self%e22(i), self%g0q(i), self%g0v(i), &
                                       self%g1q(i), self%g1v(i))
       end do
+      call newton_setup(self, m, dof, kl, cl, info)
+      if (info /= 0) then
+         call observer_fail(o, MARTELLO_ERR_SINGULAR, 0.0_dp, 'fast-nonlinear: the constant '// &
+                            'part of the Newton matrix is singular (LAPACK dgetrf)', stat)
+         return
+      end if
       ! modal state at t = 0: q = Φᵀ M u, q̇ = Φᵀ M v (free DOFs)
       allocate (self%q(nf), self%qd(nf), self%qn(nf), self%qdn(nf), self%p(nf), self%pn(nf), &
-                self%ptrial(nf), self%r(nf))
+                self%ptrial(nf), self%r(nf), self%pbase(nf), self%dp(nf))
       call mass_times(m, self%u, y)
       self%q = matmul(transpose(self%phi), y(self%free))
       call mass_times(m, self%v, y)
@@ -146,6 +158,59 @@ contains
               self%w2*self%q + self%c*self%qd
       end subroutine modal_load
    end subroutine init
+
+   !> The Newton matrix's constant part and the nonlinear DOFs (docs/integrators.md): S = the
+   !> free DOFs of penalty contacts, fluid dampers and bilinear springs; J0 = −I − Coff·G1v
+   !> with Coff = Φᵀ C_L Φ less its diagonal; W = J0⁻¹ Φ(S,:)ᵀ.
+   subroutine newton_setup(self, m, dof, kl, cl, info)
+      class(fast_nonlinear_t), intent(inout) :: self
+      type(model_t), intent(in) :: m
+      integer, intent(in) :: dof(0:)
+      real(dp), intent(in) :: kl(:, :), cl(:, :)
+      integer, intent(out) :: info
+      logical :: touched(self%nf)
+      integer :: j, nf
+      real(dp), allocatable :: coff(:, :)
+      nf = self%nf
+      touched = .false.
+      do j = 1, m%ncontact
+         if (m%con_scheme(j) /= SCHEME_PENALTY) cycle
+         call mark(m%con_a(j)); call mark(m%con_b(j))
+      end do
+      do j = 1, m%nlink
+         if (m%link_kind(j) == LINK_FLUID_DAMPER .or. m%link_kind(j) == LINK_BILINEAR) then
+            call mark(m%link_a(j)); call mark(m%link_b(j))
+         end if
+      end do
+      self%sdof = pack([(j, j = 1, nf)], touched)
+      self%ns = size(self%sdof)
+      associate (s => self%sdof, ns => self%ns)
+         self%phis = self%phi(s, :)
+         self%kls = kl(s, s); self%cls = cl(s, s)
+         allocate (self%vt(ns, nf), self%small(ns, ns), self%dks(ns, ns), self%dcs(ns, ns), &
+                   self%ipiv_s(ns), self%y(nf), self%z(ns))
+      end associate
+      coff = matmul(transpose(self%phi), matmul(cl, self%phi))
+      allocate (self%j0(nf, nf), self%ipiv(nf))
+      do j = 1, nf
+         coff(j, j) = 0.0_dp
+         self%j0(:, j) = -coff(:, j)*self%g1v(j)
+         self%j0(j, j) = self%j0(j, j) - 1.0_dp
+      end do
+      info = 0
+      if (nf == 0) return
+      call dgetrf(nf, nf, self%j0, nf, self%ipiv, info)
+      if (info /= 0) return
+      self%w = transpose(self%phis)
+      if (self%ns > 0) call dgetrs('N', nf, self%ns, self%j0, nf, self%ipiv, self%w, nf, info)
+   contains
+      subroutine mark(node)
+         integer, intent(in) :: node
+         if (node > 0) then
+            if (dof(node) > 0) touched(dof(node)) = .true.
+         end if
+      end subroutine mark
+   end subroutine newton_setup
 
    !> K_L and C_L of the linear part on the free DOFs (dof: node → DOF, 0 for fixed/ground).
    subroutine linear_part(m, dof, kl, cl)
@@ -195,16 +260,17 @@ contains
       real(dp), intent(in) :: t
       type(observer_t), intent(inout) :: o
       integer, intent(out) :: stat
-      integer :: it, info
+      integer :: it, info, halvings
       real(dp) :: change, scale, wd, wl, wc, previous
-      logical :: newton
+      logical :: newton, stepped
       character(len=256) :: msg
       stat = MARTELLO_OK
       self%qn = self%q; self%qdn = self%qd; self%pn = self%p
       self%fext_n = self%fext
       call external_forces(m, self%mrow, t, self%fext)
       self%ptrial = self%pn                     ! predictor: the load of the step's start
-      newton = .false.; previous = huge(1.0_dp); change = 0.0_dp; scale = 1.0_dp
+      newton = .false.; previous = huge(1.0_dp); change = 0.0_dp; scale = 1.0_dp; halvings = 0
+      stepped = .false.            ! a Newton step has been taken (it may be halved)
       do it = 1, self%max_iter
          self%q = self%e11*self%qn + self%e12*self%qdn + self%g0q*self%pn + self%g1q*self%ptrial
          self%qd = self%e21*self%qn + self%e22*self%qdn + self%g0v*self%pn + self%g1v*self%ptrial
@@ -238,8 +304,18 @@ contains
             return
          end if
          if (newton) then
+            ! a Newton step that raised the residual is halved (a damper law |v|^α with α < 1
+            ! makes full steps overshoot and cycle)
+            if (stepped .and. change > previous .and. halvings < 30) then
+               halvings = halvings + 1
+               self%dp = 0.5_dp*self%dp
+               self%ptrial = self%pbase + self%dp
+               cycle
+            end if
+            halvings = 0
             call newton_update(info)
             if (info /= 0) exit
+            stepped = .true.
          else
             self%ptrial = self%p
             ! Wilson's iteration contracts by about h²k/m per pass: slower than 1/4, Newton
@@ -254,34 +330,46 @@ contains
 
    contains
       !> ptrial ← ptrial − J⁻¹ r with J = ∂P/∂p − I at the state just evaluated:
-      !> ∂P/∂q = diag(ω²) − Φᵀ K_t Φ, ∂P/∂q̇ = diag(c) − Φᵀ C_t Φ, ∂q/∂p = g1q, ∂q̇/∂p = g1v.
+      !> ∂P/∂q = diag(ω²) − Φᵀ K_t Φ = −Φ(S,:)ᵀ ΔK Φ(S,:) and ∂P/∂q̇ = −Coff − Φ(S,:)ᵀ ΔC Φ(S,:)
+      !> (ΔK = K_t − K_L, ΔC = C_t − C_L: nonzero on S only), ∂q/∂p = g1q, ∂q̇/∂p = g1v. So
+      !> J = J0 − U Vᵀ, U = Φ(S,:)ᵀ, Vᵀ = ΔK Φ(S,:) G1q + ΔC Φ(S,:) G1v, and
+      !> J⁻¹ = J0⁻¹ + W (I − Vᵀ W)⁻¹ Vᵀ J0⁻¹ (Woodbury), W = J0⁻¹U.
       subroutine newton_update(info)
          integer, intent(out) :: info
-         integer :: i, j, kd
+         integer :: i, j, kd, a, b
          kd = self%kband%kd
-         self%kt = 0.0_dp; self%ct = 0.0_dp
-         do j = 1, self%nf
-            do i = 1, self%nf
-               if (abs(self%free(i) - self%free(j)) > kd) cycle
-               self%kt(i, j) = self%kband%ab(2*kd + 1 + self%free(i) - self%free(j), self%free(j))
-               self%ct(i, j) = self%cband%ab(2*kd + 1 + self%free(i) - self%free(j), self%free(j))
+         associate (s => self%sdof, ns => self%ns)
+            do j = 1, ns
+               do i = 1, ns
+                  a = self%free(s(i)); b = self%free(s(j))
+                  self%dks(i, j) = -self%kls(i, j); self%dcs(i, j) = -self%cls(i, j)
+                  if (abs(a - b) > kd) cycle
+                  self%dks(i, j) = self%dks(i, j) + self%kband%ab(2*kd + 1 + a - b, b)
+                  self%dcs(i, j) = self%dcs(i, j) + self%cband%ab(2*kd + 1 + a - b, b)
+               end do
             end do
-         end do
-         self%kt = -matmul(transpose(self%phi), matmul(self%kt, self%phi))
-         self%ct = -matmul(transpose(self%phi), matmul(self%ct, self%phi))
-         do i = 1, self%nf
-            self%kt(i, i) = self%kt(i, i) + self%w2(i)
-            self%ct(i, i) = self%ct(i, i) + self%c(i)
-         end do
-         do j = 1, self%nf
-            self%jac(:, j) = self%kt(:, j)*self%g1q(j) + self%ct(:, j)*self%g1v(j)
-            self%jac(j, j) = self%jac(j, j) - 1.0_dp
-         end do
-         o%counters(C_JACOBIANS) = o%counters(C_JACOBIANS) + 1_i8
-         o%counters(C_FACTORIZATIONS) = o%counters(C_FACTORIZATIONS) + 1_i8
-         self%r = -self%r
-         call dgesv(self%nf, 1, self%jac, self%nf, self%ipiv, self%r, self%nf, info)
-         if (info == 0) self%ptrial = self%ptrial + self%r
+            do j = 1, self%nf
+               self%vt(:, j) = matmul(self%dks, self%phis(:, j))*self%g1q(j) + &
+                               matmul(self%dcs, self%phis(:, j))*self%g1v(j)
+            end do
+            o%counters(C_JACOBIANS) = o%counters(C_JACOBIANS) + 1_i8
+            o%counters(C_FACTORIZATIONS) = o%counters(C_FACTORIZATIONS) + 1_i8
+            self%y = -self%r
+            call dgetrs('N', self%nf, 1, self%j0, self%nf, self%ipiv, self%y, self%nf, info)
+            if (info /= 0) return
+            if (ns > 0) then
+               self%small = -matmul(self%vt, self%w)
+               do i = 1, ns
+                  self%small(i, i) = self%small(i, i) + 1.0_dp
+               end do
+               self%z = matmul(self%vt, self%y)
+               call dgesv(ns, 1, self%small, ns, self%ipiv_s, self%z, ns, info)
+               if (info /= 0) return
+               self%y = self%y + matmul(self%w, self%z)
+            end if
+         end associate
+         self%pbase = self%ptrial; self%dp = self%y
+         self%ptrial = self%pbase + self%dp
       end subroutine newton_update
    end subroutine step
 

@@ -5,7 +5,7 @@ module martello_lapack
    implicit none
    private
    public :: dgbsv, dgbtrf, dgbtrs, dlansy, dpbtrf, dpbtrs, dpocon, dpotrf, dpotrs, dsbgvx, dsycon, dsytrf, &
-      dsytrs, dsygv, dgesv
+      dsytrs, dsygv, dgesv, dgetrf, dgetrs
 
    interface
       subroutine dgbsv(n, kl, ku, nrhs, ab, ldab, ipiv, b, ldb, info)
@@ -84,6 +84,20 @@ module martello_lapack
          real(dp), intent(in) :: vl, vu, abstol
          integer, intent(out) :: m, iwork(*), ifail(*), info
       end subroutine dsbgvx
+      subroutine dgetrf(m, n, a, lda, ipiv, info)
+         import :: dp
+         integer, intent(in) :: m, n, lda
+         real(dp), intent(inout) :: a(lda, *)
+         integer, intent(out) :: ipiv(*), info
+      end subroutine dgetrf
+      subroutine dgetrs(trans, n, nrhs, a, lda, ipiv, b, ldb, info)
+         import :: dp
+         character, intent(in) :: trans
+         integer, intent(in) :: n, nrhs, lda, ldb, ipiv(*)
+         real(dp), intent(in) :: a(lda, *)
+         real(dp), intent(inout) :: b(ldb, *)
+         integer, intent(out) :: info
+      end subroutine dgetrs
       subroutine dgesv(n, nrhs, a, lda, ipiv, b, ldb, info)
          import :: dp
          integer, intent(in) :: n, nrhs, lda, ldb

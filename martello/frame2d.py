@@ -212,6 +212,19 @@ def rayleigh_coefficients(K, M, zeta, modes=(1, 2)):
     return 2 * zeta * w[i] * w[j] / (w[i] + w[j]), 2 * zeta / (w[i] + w[j])
 
 
+def modal_damping(K, M, zeta):
+    """C = M Φ diag(2ζω) Φᵀ M with Φ the mass-normalised modes of K φ = ω² M φ (M diagonal,
+    given as its diagonal): the damping ratio zeta in every mode (Chopra, Dynamics of
+    Structures, §11.5), symmetrised to round-off."""
+    m = np.asarray(M, float)
+    s = 1 / np.sqrt(m)
+    lam, y = np.linalg.eigh(s[:, None] * K * s[None, :])
+    phi = s[:, None] * y                                   # Φᵀ M Φ = I
+    mp = m[:, None] * phi
+    C = mp @ np.diag(2 * zeta * np.sqrt(np.maximum(lam, 0.0))) @ mp.T
+    return 0.5 * (C + C.T)
+
+
 def natural_frequencies(K, M):
     """ω (rad/s, ascending) of K φ = ω² M φ for a diagonal M (given as its diagonal)."""
     s = 1 / np.sqrt(np.asarray(M, float))

@@ -294,3 +294,63 @@ def test_bad_blocks_and_frames_are_refused_with_the_field():
                                                             column=[{"E": 1.0, "A": 1.0, "I": 1.0}])]))
     with pytest.raises(SceneError, match=r"frame\[0\]\.base"):
         from_dict(frame_scene(base="hinged"))
+
+
+def test_interface_link_helpers_follow_the_seed_rules():
+    """The seed's gap stiffness rules (after Muthukumar & DesRoches 2006), by hand: aligned
+    floors, the axial stiffness EA/L of the two connected beams (harmonic mean = their common
+    value when equal; series and sum readings); offset floors, 1.5–2 × 12EI/h³ of the struck
+    column; out-of-range factors refused."""
+    from martello.frame2d import PlanarFrame, gap_stiffness_aligned, gap_stiffness_offset
+    a = PlanarFrame([3.0], [4.0, 5.0], [[(E, 0.1, 1e-3)] * 3], [[(E, 0.2, 1e-3), (E, 0.15, 1e-3)]], [1.0])
+    b = PlanarFrame([3.0, 3.0], [6.0], [[(E, 0.1, 1e-3)] * 2, [(E, 0.1, 2e-3)] * 2],
+                    [[(E, 0.3, 1e-3)], [(E, 0.3, 1e-3)]], [1.0, 1.0])
+    ka, kb = E * 0.15 / 5.0, E * 0.3 / 6.0          # a's last bay, b's first bay at floor 1
+    assert gap_stiffness_aligned(a, b, 1) == pytest.approx(2 / (1 / ka + 1 / kb), rel=1e-15)
+    assert gap_stiffness_aligned(a, b, 1, "series") == pytest.approx(1 / (1 / ka + 1 / kb), rel=1e-15)
+    assert gap_stiffness_aligned(a, b, 1, "sum") == pytest.approx(ka + kb, rel=1e-15)
+    assert gap_stiffness_aligned(b, b, 2) == pytest.approx(E * 0.3 / 6.0, rel=1e-15)
+    assert gap_stiffness_offset(b, 2, 1, 1.5) == pytest.approx(1.5 * 12 * E * 2e-3 / 27.0, rel=1e-15)
+    with pytest.raises(ValueError, match="factor"):
+        gap_stiffness_offset(b, 2, 1, 3.0)
+
+
+def test_the_p10_catalogue_scenes_are_what_the_case_study_writes():
+    """benchmarks/p10/p10_*.toml are written by case_study.py --write-scenes from its model
+    block; a hand edit (or a stale file after a model change) is caught here."""
+    import importlib.util
+    import tomllib
+    from pathlib import Path
+    here = Path(__file__).resolve().parent.parent / "benchmarks" / "p10"
+    spec = importlib.util.spec_from_file_location("p10_case_study", here / "case_study.py")
+    cs = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(cs)
+    for config in cs.CONFIGS:
+        path = here / f"p10_{config}.toml"
+        assert tomllib.loads(path.read_text()) == tomllib.loads(cs._rendered(config)), path
+        sc = cs.scene_for(config, 1)
+        assert len(sc.blocks) == 2 and len(sc.contacts) == 2
+
+
+def test_modal_damping_decays_every_mode_at_zeta():
+    """damping = "modal": a 2-storey frame released in its second mode (the mode from scipy's
+    generalized eigensolver on the block, independent of martello.frame2d) stays in it and
+    decays as exp(−ζω₂t) with the damped frequency, the closed form of one damped mode; rk8pd
+    at rtol 1e-10: 1e-6 of the amplitude."""
+    zeta = 0.05
+    d = frame_scene(storeys=2, zeta=zeta, damping="modal",
+                    analysis={"type": "dynamic", "integrator": "rk8pd", "dt": 1e-4, "t_end": 0.5,
+                              "rtol": 1e-10, "atol": 1e-14})
+    sc = from_dict(d)
+    K = sc.blocks[0]["k"]
+    M = np.diag([n["mass"] for n in sc.nodes])
+    lam, phi = scipy.linalg.eigh(K, M)
+    w2, shape = math.sqrt(lam[1]), phi[:, 1] / np.abs(phi[:, 1]).max() * 0.01
+    for i, n in enumerate(sc.nodes):
+        n["u0"] = float(shape[i])
+    s, (cols, hist) = run_full(sc)
+    t = hist[:, cols.index("t")]
+    wd = w2 * math.sqrt(1 - zeta**2)
+    g = np.exp(-zeta * w2 * t) * (np.cos(wd * t) + zeta / math.sqrt(1 - zeta**2) * np.sin(wd * t))
+    for i, n in enumerate(sc.nodes):
+        assert np.max(np.abs(hist[:, cols.index(f"u:{n['name']}")] - shape[i] * g)) < 1e-6 * 0.01

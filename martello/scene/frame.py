@@ -7,7 +7,7 @@ scene.extras["frames"]."""
 import numpy as np
 
 from ..errors import SceneError
-from ..frame2d import PlanarFrame, rayleigh_coefficients
+from ..frame2d import PlanarFrame, modal_damping, rayleigh_coefficients
 from .fields import MAX_GENERATED, POSITIVE, check_fields, choice, per_item
 
 FRAME_KEYS = {"prefix": ("str", True, None, None),
@@ -21,11 +21,13 @@ FRAME_KEYS = {"prefix": ("str", True, None, None),
               "mass_model": ("str", False, None, "diaphragm"),
               "base": ("str", False, None, "fixed"),
               "zeta": ("float", False, (lambda x: 0 <= x < 1, "a number in [0, 1)"), 0.0),
+              "damping": ("str", False, None, "rayleigh"),
               "rayleigh_modes": ("list", False, None, [1, 2]),
               "histories": ("bool", False, None, False)}
 SECTION_KEYS = {"E": ("float", True, POSITIVE, None), "A": ("float", True, POSITIVE, None),
                 "I": ("float", True, POSITIVE, None)}
 MASS_MODELS = ["diaphragm", "joints"]
+DAMPING = ["rayleigh", "modal"]
 BASES = ["fixed", "pinned"]
 # The cap of a frame's lateral DOFs: its block is dense, n² doubles per evaluation.
 MAX_LATERAL = 2000
@@ -69,6 +71,7 @@ def expand_frames(src, data):
         ns, nb = f["storeys"], f["bays"]
         choice(src, f"{w}.mass_model", f["mass_model"], MASS_MODELS)
         choice(src, f"{w}.base", f["base"], BASES)
+        choice(src, f"{w}.damping", f["damping"], DAMPING)
         lateral = ns if f["mass_model"] == "diaphragm" else ns * (nb + 1)
         made += lateral
         if lateral > MAX_LATERAL or made > MAX_GENERATED:
@@ -92,7 +95,9 @@ def expand_frames(src, data):
         R = frame.recovery(G)
         C = np.zeros_like(K)
         a0 = a1 = 0.0
-        if f["zeta"] > 0:
+        if f["zeta"] > 0 and f["damping"] == "modal":
+            C = modal_damping(K, mass, f["zeta"])
+        elif f["zeta"] > 0:
             a0, a1 = rayleigh_coefficients(K, mass, f["zeta"], tuple(modes))
             C = a0 * np.diag(mass) + a1 * K
         nodes += [{"name": n, "mass": float(m)} for n, m in zip(names, mass)]
