@@ -226,6 +226,12 @@ def _dynamic(scene, model, raise_on_failure=True):
     scale = max(abs(energy["initial"]), abs(energy["input"]), 1e-300)
     energy.update(balance_max=extra["balance_max"], balance_relative=extra["balance_max"] / scale)
     warnings = []
+    if extra["dt_critical"] > 0 and an["integrator"] not in native.adaptive_integrators() \
+            and an["dt"] > extra["dt_critical"]:
+        # check_stability = false let it run past the limit (docs/behaviour.md)
+        warnings.append(f"dt = {an['dt']!r} s is past the stability limit dt_crit = "
+                        f"{extra['dt_critical']:.6g} s (check_stability = false): the result "
+                        "may be wrong although no guard stopped it")
     if st >= 0 and energy["balance_relative"] > 1e-2:
         warnings.append(f"energy balance error {100 * energy['balance_relative']:.1f} % of the energy put in: "
                         "the step is too large for this scene (the result is inaccurate)")
