@@ -330,7 +330,7 @@ def output_estimate(scene):
         if an["integrator"] in native.adaptive_integrators():
             # dt is the output interval; h_max (when > 0) caps every step
             steps = an["t_end"] / an["h_max"] if an.get("h_max") else intervals
-            rows = intervals + 2
+            rows = intervals / out["every"] + 2      # every every-th output time
         else:
             steps = float(np.ceil(intervals))
             rows = steps / out["every"] + 2
