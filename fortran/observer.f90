@@ -11,7 +11,7 @@ module martello_observer
    use martello_assembly, only: mech_state_t, kinetic_energy, recoverable_energy, mass_times
    use martello_integrator_settings, only: integrator_settings_t, integrator_name
    use martello_run_quantities
-   use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan, ieee_is_finite
+   use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan, ieee_is_finite, ieee_is_nan
    use, intrinsic :: iso_c_binding, only: c_funptr, c_ptr, c_null_funptr, c_null_ptr, &
       c_associated, c_f_procpointer, c_int, c_double, c_long_long
    implicit none
@@ -617,12 +617,23 @@ contains
       end do
       if (present(link_f) .and. present(link_du)) then
          do i = 1, size(link_f)
-            ! written as "not ≥" so that the NaN the maxima start from is replaced
-            if (.not. (o%link_force_absmax(i) >= abs(link_f(i)))) o%link_force_absmax(i) = abs(link_f(i))
-            if (.not. (o%link_du_absmax(i) >= abs(link_du(i)))) o%link_du_absmax(i) = abs(link_du(i))
+            call raise_to(o%link_force_absmax(i), abs(link_f(i)))
+            call raise_to(o%link_du_absmax(i), abs(link_du(i)))
          end do
       end if
    contains
+      !> x ← max(x, y), the NaN x starts from replaced without comparing it (an ordered
+      !> comparison with a NaN raises the invalid flag: a trap under -ffpe-trap=invalid)
+      subroutine raise_to(x, y)
+         real(dp), intent(inout) :: x
+         real(dp), intent(in) :: y
+         if (ieee_is_nan(x)) then
+            x = y
+         else if (x < y) then
+            x = y
+         end if
+      end subroutine raise_to
+
       subroutine peaks(un, vn, an)
          real(dp), intent(in) :: un(:), vn(:), an(:)
          associate (umax => o%u_max, umin => o%u_min, vmax => o%v_absmax, amax => o%a_absmax, &
