@@ -202,6 +202,13 @@ int martello_run_set_outputs(martello_run *run, int n_nodes, const int *nodes, i
                              const int *contacts);
 /* Links whose force and elongation the history records (0-based; default none). */
 int martello_run_set_link_outputs(martello_run *run, int n_links, const int *links);
+/* ---- closed forms of catalogue problems (docs/c-api.md "Closed forms") ------------------
+ * The closed form `name` at the n_par parameters par: out (4 values) receives its *n_out
+ * values. MARTELLO_ERR_ARGUMENT for an unknown name, a wrong parameter count or parameters
+ * outside the form's domain. */
+int martello_closed_form(const char *name, const double *par, int n_par, double out[4],
+                         int *n_out);
+
 /* Progress of a running martello_dynamic_run: called about four times a second with user,
  * the simulated time t of t_end, the steps taken and the wall-clock seconds since the start.
  * Return 0 to go on; anything else stops the run at once with MARTELLO_ERR_INTERRUPTED (the

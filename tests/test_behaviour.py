@@ -327,15 +327,16 @@ def test_every_integrator_reports_link_states(tmp_path, integrator):
 # --- energy, stability, divergence -------------------------------------------------------------
 
 def test_balance_max_is_taken_where_the_energy_is_evaluated(tmp_path):
-    """Moreau–Jean evaluates the energy terms only at recorded rows, so balance_max equals the
-    largest |energy:balance| of history.csv (17 significant digits: equal to the last bit).
-    Newmark also evaluates them every 16 steps, so its balance_max is at least the largest
-    recorded |balance|. θ = 1 on P2's Kelvin scene makes the balance non-trivial."""
+    """The fixed-step integrators evaluate the energy terms at recorded rows and every 16
+    steps, so balance_max is at least the largest |energy:balance| of history.csv (and, with
+    rows every 37 steps, may exceed it); an adaptive integrator evaluates them at every
+    accepted step. θ = 1 on P2's Kelvin scene makes Moreau–Jean's balance non-trivial (the
+    linearised Kelvin force jump), HHT's numerical damping HHT's."""
     base = p2_penalty(dt=1e-4, t_end=0.3)
     base["contact"][0].update(law="kelvin", restitution=0.8)
     base["analysis"] = dynamic("moreau-jean", dt=1e-4, t_end=0.3, theta=1.0, output={"every": 37})
     _, s, h = run_scene(tmp_path, base, name="mj")
-    assert s["energy"]["balance_max"] == max(abs(x) for x in h["energy:balance"]) > 0
+    assert s["energy"]["balance_max"] >= max(abs(x) for x in h["energy:balance"]) > 0
     base["analysis"] = dynamic("hht", dt=1e-4, t_end=0.3, alpha=-0.3, output={"every": 37})
     _, s, h = run_scene(tmp_path, base, name="hht")
     assert s["energy"]["balance_max"] >= max(abs(x) for x in h["energy:balance"]) > 0

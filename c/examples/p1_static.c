@@ -101,6 +101,16 @@ int main(void) {
   expect_status("lagrange solve", st, MARTELLO_OK);
   expect_close("lagrange u", u, h, 1e-14);
   expect_close("lagrange P", force, mass * g - k * h, 1e-14);
+  /* the library's own closed form of P1 (docs/c-api.md "Closed forms"): u, lambda, force */
+  {
+    const double par[4] = {mass, k, h, g};
+    double cf[4];
+    int n_cf = 0;
+    expect_status("closed form p1_static_lagrange",
+                  martello_closed_form("p1_static_lagrange", par, 4, cf, &n_cf), MARTELLO_OK);
+    expect_close("closed-form u against the solve", cf[0], u, 1e-14);
+    expect_close("closed-form force against the solve", cf[2], force, 1e-14);
+  }
   martello_model_free(&m);
   checks++;
   if (m != NULL) { failures++; printf("FAIL model_free must null the handle\n"); }

@@ -78,6 +78,8 @@ def lib():
         "martello_run_set_outputs": (c_int, [_VOID_P, c_int, _INT_P, c_int, _INT_P]),
         "martello_dynamic_run": (c_int, [_VOID_P, _VOID_P]),
         "martello_run_set_progress": (c_int, [_VOID_P, PROGRESS_FN, _VOID_P]),
+        "martello_closed_form": (c_int, [c_char_p, _DOUBLE_P, c_int, _DOUBLE_P,
+                                         ctypes.POINTER(c_int)]),
         "martello_run_message": (c_int, [_VOID_P, c_char_p, c_int]),
         "martello_run_history_shape": (c_int, [_VOID_P, ctypes.POINTER(c_int), ctypes.POINTER(c_int)]),
         "martello_run_history": (c_int, [_VOID_P, _DOUBLE_P]),
@@ -464,6 +466,20 @@ class Run(_Handle):
         d = dict(zip(energy_names(), map(float, e)))
         return d, {"balance_max": float(extra[0]), "omega_max": float(extra[1]),
                    "dt_critical": float(extra[2]), "t_reached": float(extra[3])}
+
+
+def closed_form(name, par):
+    """The library's closed form `name` (docs/c-api.md "Closed forms") at the parameters par:
+    the list of its values. SolverError (MARTELLO_ERR_ARGUMENT) for an unknown name or
+    parameters outside its domain."""
+    p = np.ascontiguousarray(par, dtype=np.float64)
+    out, n = np.zeros(4), ctypes.c_int()
+    st = lib().martello_closed_form(str(name).encode(), p if p.size else np.zeros(1), p.size,
+                                    out, ctypes.byref(n))
+    if st < 0:
+        raise SolverError(st, status_name(st), f"closed form {name!r} at {list(map(float, p))}: "
+                          "unknown, or parameters outside its domain (docs/c-api.md)")
+    return [float(x) for x in out[:n.value]]
 
 
 # --- progress and Ctrl-C of a running native loop ------------------------------------
