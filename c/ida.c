@@ -1030,6 +1030,15 @@ static int integrate(ida_problem *P, SUNContext sunctx, void **memp, N_Vector yy
       double tcur = t_last;
       if (IDAGetCurrentTime(mem, &tcur) != IDA_SUCCESS) tcur = t_last;
       P->t_now = tcur;
+      /* a state, rate or step that overflowed (an error norm of inf gives a step of 0 or
+       * NaN) makes IDA blame its inputs, e.g. a stop time "behind" the current time: that
+       * is a divergence, not an IDA failure */
+      double hcur = 0.0;
+      if (IDAGetCurrentStep(mem, &hcur) == IDA_SUCCESS && !(isfinite(hcur) && hcur != 0.0))
+        P->nan_seen = 1;
+      if (!isfinite(tcur)) P->nan_seen = 1;
+      for (sunindextype k = 0; k < P->N; k++)
+        if (!isfinite(N_VGetArrayPointer(yy)[k])) P->nan_seen = 1;
       if (P->nan_seen)
         st = martello_observer_fail(P->obs, MARTELLO_ERR_DIVERGED, tcur, NULL);
       else

@@ -39,6 +39,8 @@ const char *martello_status_name(int status) {
     case MARTELLO_ERR_STEP_UNDERFLOW: return "MARTELLO_ERR_STEP_UNDERFLOW";
     case MARTELLO_ERR_EXTERNAL: return "MARTELLO_ERR_EXTERNAL";
     case MARTELLO_ERR_STATE: return "MARTELLO_ERR_STATE";
+    case MARTELLO_ERR_LIMIT: return "MARTELLO_ERR_LIMIT";
+    case MARTELLO_ERR_INTERRUPTED: return "MARTELLO_ERR_INTERRUPTED";
     default: return "MARTELLO_UNKNOWN_STATUS";
   }
 }

@@ -42,7 +42,9 @@ enum martello_status {
   MARTELLO_ERR_LAPACK = -8,
   MARTELLO_ERR_STEP_UNDERFLOW = -9,
   MARTELLO_ERR_EXTERNAL = -10,      /* GSL or SUNDIALS reported a failure                */
-  MARTELLO_ERR_STATE = -11          /* call out of order                                 */
+  MARTELLO_ERR_STATE = -11,         /* call out of order                                 */
+  MARTELLO_ERR_LIMIT = -12,         /* max_steps or max_wall reached before t_end        */
+  MARTELLO_ERR_INTERRUPTED = -13    /* stopped by the caller's progress callback         */
 };
 
 /* Contact schemes, laws, link kinds and time functions (tables "schemes", "laws", "links",
@@ -180,6 +182,8 @@ typedef struct martello_settings {
   double event_tol;         /* event location, absolute in time [s] */
   double h_max;             /* adaptive: the largest step [s] (0: no limit) */
   bool fused_chain;         /* Newmark on a chain: the fused chain step (false: general path) */
+  double max_steps;         /* steps a run may take (a whole number; the run fails past it) */
+  double max_wall;          /* wall-clock seconds a run may take (0: no limit) */
 } martello_settings;
 
 /* Indices of martello_run_counters, martello_run_energy and the values of
@@ -207,6 +211,20 @@ int martello_run_set_outputs(martello_run *run, int n_nodes, const int *nodes, i
                              const int *contacts);
 /* Links whose force and elongation the history records (0-based; default none). */
 int martello_run_set_link_outputs(martello_run *run, int n_links, const int *links);
+/* ---- closed forms of catalogue problems (docs/c-api.md "Closed forms") ------------------
+ * The closed form `name` at the n_par parameters par: out (4 values) receives its *n_out
+ * values. MARTELLO_ERR_ARGUMENT for an unknown name, a wrong parameter count or parameters
+ * outside the form's domain. */
+int martello_closed_form(const char *name, const double *par, int n_par, double out[4],
+                         int *n_out);
+
+/* Progress of a running martello_dynamic_run: called about four times a second with user,
+ * the simulated time t of t_end, the steps taken and the wall-clock seconds since the start.
+ * Return 0 to go on; anything else stops the run at once with MARTELLO_ERR_INTERRUPTED (the
+ * results so far are not a result). A NULL callback removes it. */
+typedef int (*martello_progress_fn)(void *user, double t, double t_end, long long steps,
+                                    double elapsed);
+int martello_run_set_progress(martello_run *run, martello_progress_fn callback, void *user);
 int martello_dynamic_run(martello_model *model, martello_run *run);
 int martello_run_message(const martello_run *run, char *buf, int buflen);
 /* History: rows records of cols values, record after record, in the column groups of the

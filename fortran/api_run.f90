@@ -87,6 +87,21 @@ contains
       c_run_set_link_outputs = MARTELLO_OK
    end function c_run_set_link_outputs
 
+   !> The progress callback of the run (c/martello.h martello_progress_fn), called with
+   !> user about four times a second while it runs; a NULL callback removes it.
+   integer(c_int) function c_run_set_progress(handle, callback, user) &
+      bind(C, name='martello_run_set_progress')
+      type(c_ptr), value :: handle
+      type(c_funptr), value :: callback
+      type(c_ptr), value :: user
+      type(run_t), pointer :: rp
+      rp => get_run(handle)
+      c_run_set_progress = MARTELLO_ERR_ARGUMENT
+      if (.not. associated(rp)) return
+      rp%progress = callback; rp%progress_user = user
+      c_run_set_progress = MARTELLO_OK
+   end function c_run_set_progress
+
    integer(c_int) function c_dynamic_run(mhandle, rhandle) bind(C, name='martello_dynamic_run')
       type(c_ptr), value :: mhandle, rhandle
       type(model_t), pointer :: mp

@@ -86,7 +86,7 @@ contains
       type(observer_t), intent(inout) :: o
       class(stepper_t), intent(inout) :: stp
       integer, intent(out) :: stat
-      integer :: k
+      integer(i8) :: k
       real(dp) :: t
 
       call check_run_settings(m, s, o%message, stat)
@@ -95,13 +95,13 @@ contains
       if (stat /= MARTELLO_OK) return
       call observer_begin(o, m, stp%ms, stp%u, stp%v, stp%a, ENERGY_CHECK, stp%advice, stp%ke_aMa)
       t = 0.0_dp
-      call sample(0)
+      call sample(0_i8)
       if (stat /= MARTELLO_OK) return
 
-      do k = 1, o%n_grid
+      do k = 1_i8, o%n_grid      ! 64-bit: more than 2^31 steps are counted, not wrapped
          call stp%begin_step()
          stp%t0 = t
-         t = k*stp%h
+         t = real(k, dp)*stp%h
          call stp%step(m, t, o, stat)
          if (stat /= MARTELLO_OK) return
          o%counters(C_STEPS) = o%counters(C_STEPS) + 1_i8
@@ -116,7 +116,7 @@ contains
 
       !> The state at t_k; the previous one is the stepper's own (un, vn, an): no copy.
       subroutine sample(kk)
-         integer, intent(in) :: kk
+         integer(i8), intent(in) :: kk
          call observer_sample(o, m, stp%ms, t, stp%u, stp%v, stp%a, stp%pen, stp%force, kk, stat, &
                               stp%ms%link_f, stp%ms%link_u, stp%un(1:), stp%vn(1:), stp%an(1:))
       end subroutine sample

@@ -13,6 +13,7 @@ module martello_generalized_alpha
    use martello_observer, only: observer_t, observer_work, observer_fail, C_NEWTON, C_RESIDUALS, &
       C_FACTORIZATIONS, C_JACOBIANS, C_CHATTER
    use martello_integrator_settings
+   use martello_stability, only: omega_max
    use martello_fixed_step, only: stepper_t, stepper_rest_start, stepper_fail, newmark_kinematics, &
       contact_state
    implicit none
@@ -76,6 +77,32 @@ contains
       self%cm = (1.0_dp - self%am)/(self%beta*self%h*self%h)
       self%mmax = max(maxval(m%mass), tiny(1.0_dp))
       self%cv = self%gamma/(self%beta*self%h)
+      if (s%kind == INT_NEWMARK .and. 2.0_dp*self%beta < self%gamma) &
+         call newmark_stability(self%beta, self%gamma, self%h, logical(s%check_stability), stat)
+   contains
+
+      !> Newmark with 2β < γ is stable only for ω h ≤ 1/√(γ/2 − β) (undamped; Hughes 1987,
+      !> "The finite element method", §9.1.3; docs/integrators.md): past it, with
+      !> check_stability, the run is refused before its first step, as central difference's.
+      subroutine newmark_stability(beta, gamma, h, check, stat)
+         real(dp), intent(in) :: beta, gamma, h
+         logical, intent(in) :: check
+         integer, intent(inout) :: stat
+         integer :: info
+         character(len=512) :: msg
+         real(dp) :: limit
+         limit = 1.0_dp/sqrt(0.5_dp*gamma - beta)
+         call omega_max(m, o%omega_max, info)
+         if (info /= 0 .or. o%omega_max <= 0.0_dp) return
+         o%dt_critical = limit/o%omega_max
+         if (.not. check .or. h <= o%dt_critical) return
+         write (msg, '(a,es10.3,a,es10.3,a,es12.5,a,es12.5,a,es11.4,a)') 'newmark with beta = ', beta, &
+            ' < gamma/2 (gamma = ', gamma, ') is unstable: dt = ', h, &
+            ' s exceeds dt_crit = 1/(omega_max sqrt(gamma/2 - beta)) = ', o%dt_critical, &
+            ' s (omega_max = ', o%omega_max, ' rad/s, penalty stiffness included); reduce dt or'// &
+            ' take beta >= gamma/2'
+         call observer_fail(o, MARTELLO_ERR_UNSTABLE, 0.0_dp, msg, stat)
+      end subroutine newmark_stability
    end subroutine init
 
    !> One Newton-solved step, its trapezoidal works handed to the observer.

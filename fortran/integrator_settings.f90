@@ -12,7 +12,7 @@ module martello_integrator_settings
       INT_MSBDF, INT_IDA, INT_LAST, SETTINGS, INTEGRATORS, setting_t, NSETTINGS, S_DT, S_T_END, &
       S_BETA, S_GAMMA, S_ALPHA, S_RHO_INF, S_TOL_RESIDUAL, S_TOL_INCREMENT, S_MAX_NEWTON, &
       S_CHECK_STABILITY, S_EVERY, S_DIVERGENCE_FACTOR, S_RTOL, S_ATOL, S_THETA, S_EVENT_TOL, &
-      S_H_MAX, S_FUSED_CHAIN, T_INT
+      S_H_MAX, S_FUSED_CHAIN, S_MAX_STEPS, S_MAX_WALL, T_INT
    implicit none
    private
    public :: integrator_settings_t, integrator_name, scheme_supported, settings_default, &
@@ -44,6 +44,9 @@ module martello_integrator_settings
       real(c_double) :: h_max = SETTINGS(S_H_MAX)%default                !< 0: no limit
       !> Newmark on a chain: the fused chain step (docs/run-layer.md); false: the general path
       logical(c_bool) :: fused_chain = SETTINGS(S_FUSED_CHAIN)%default /= 0.0_dp
+      !> the budget of a run: steps (a whole number) and wall-clock seconds (0: no limit)
+      real(c_double) :: max_steps = SETTINGS(S_MAX_STEPS)%default
+      real(c_double) :: max_wall = SETTINGS(S_MAX_WALL)%default
    end type integrator_settings_t
 
 contains
@@ -99,6 +102,12 @@ contains
             ' is invalid for '//integrator_name(s%kind)//': set it to '//trim(SETTINGS(i)%text)
          return
       end do
+      if (s%max_steps /= aint(s%max_steps)) then
+         write (num, '(es11.4)') s%max_steps
+         message = 'settings.max_steps = '//trim(adjustl(num))//' is invalid for '// &
+            integrator_name(s%kind)//': set it to '//trim(SETTINGS(S_MAX_STEPS)%text)
+         return
+      end if
       stat = MARTELLO_OK
    end subroutine settings_check
 
@@ -136,6 +145,8 @@ contains
       case (S_EVENT_TOL); x = s%event_tol
       case (S_H_MAX); x = s%h_max
       case (S_FUSED_CHAIN); x = merge(1.0_dp, 0.0_dp, logical(s%fused_chain))
+      case (S_MAX_STEPS); x = s%max_steps
+      case (S_MAX_WALL); x = s%max_wall
       case default; x = 0.0_dp
       end select
    end function setting_value

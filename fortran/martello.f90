@@ -11,7 +11,7 @@ module martello
       MARTELLO_ERR_ARGUMENT, MARTELLO_ERR_MEMORY, MARTELLO_ERR_SINGULAR, &
       MARTELLO_ERR_NOT_CONVERGED, MARTELLO_ERR_DIVERGED, MARTELLO_ERR_UNSUPPORTED, &
       MARTELLO_ERR_UNSTABLE, MARTELLO_ERR_LAPACK, MARTELLO_ERR_STEP_UNDERFLOW, &
-      MARTELLO_ERR_EXTERNAL, MARTELLO_ERR_STATE
+      MARTELLO_ERR_EXTERNAL, MARTELLO_ERR_STATE, MARTELLO_ERR_LIMIT, MARTELLO_ERR_INTERRUPTED
    use martello_model, only: model_t, model_init, model_set_node, model_add_link, &
       model_add_contact, model_add_mass_coupling, model_add_nodal_force, &
       model_set_ground_acceleration, model_add_stiffness_block, SCHEME_PENALTY, SCHEME_LAGRANGE, SCHEME_AUGMENTED, &

@@ -11,13 +11,15 @@ module martello_observer
    use martello_assembly, only: mech_state_t, kinetic_energy, recoverable_energy, mass_times
    use martello_integrator_settings, only: integrator_settings_t, integrator_name
    use martello_run_quantities
-   use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan, ieee_is_finite
+   use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan, ieee_is_finite, ieee_is_nan
+   use, intrinsic :: iso_c_binding, only: c_funptr, c_ptr, c_null_funptr, c_null_ptr, &
+      c_associated, c_f_procpointer, c_int, c_double, c_long_long
    implicit none
    private
    public :: results_t, observer_t, observer_init, observer_begin, observer_sample, &
       observer_work, observer_open_phase, observer_close_phase, observer_add_impact, &
       observer_penalty_phases, observer_fail, observer_fail_nonfinite, observer_finish, &
-      free_side_crossing, &
+      free_side_crossing, progress_callback, &
       NCOUNTERS, C_STEPS, C_REJECTED, C_NEWTON, C_RESIDUALS, C_FACTORIZATIONS, C_EVENTS, &
       C_JACOBIANS, C_ROOT_EVALS, C_CHATTER, NENERGY, E_KINETIC, E_RECOVERABLE, E_INPUT, E_DAMPING, &
       E_PLASTIC, E_CONTACT, E_BALANCE, E_INITIAL, E_IMPACT, NEVENT, EV_T_ON, EV_T_OFF, &
@@ -54,10 +56,17 @@ module martello_observer
    type, extends(results_t) :: observer_t
       ! what the run asked for
       integer :: kind = 0, every = 1
-      integer :: n_grid = 1                     !< output grid points t = k·dt, k = 1 … n_grid
+      integer(i8) :: n_grid = 1                 !< output grid points t = k·dt, k = 1 … n_grid
       real(dp) :: divergence_factor = 10.0_dp
       ! energy: evaluated every energy_interval-th sample (and where recorded)
-      integer :: energy_interval = 1, nsamples = -1
+      integer :: energy_interval = 1
+      integer(i8) :: nsamples = -1              !< accepted steps so far (t = 0 is sample 0)
+      ! the budget (max_steps, max_wall [s], 0: none) and the caller's progress callback,
+      ! watched every WATCH_EVERY samples (observer_watch)
+      real(dp) :: t_end = 0.0_dp, max_steps = huge(1.0_dp), max_wall = 0.0_dp
+      integer(i8) :: clock0 = 0, clock_last = 0, clock_rate = 1
+      type(c_funptr) :: progress = c_null_funptr
+      type(c_ptr) :: progress_user = c_null_ptr
       character(len=:), allocatable :: advice   !< ends a divergence message: what to change
       real(dp) :: e0 = 0.0_dp, e_links0 = 0.0_dp, e_cont0 = 0.0_dp, ke_corr0 = 0.0_dp
       !> the method conserves ½vᵀMv − ke_aMa·aᵀMa (central difference: h²/8; else 0)
@@ -76,33 +85,90 @@ module martello_observer
       real(dp), allocatable :: acc(:), c_pen(:), c_force(:)
    end type observer_t
 
+   !> The caller's progress callback (martello_run_set_progress): the simulated time, t_end,
+   !> the steps taken and the wall-clock seconds since the start; a non-zero return stops the
+   !> run (MARTELLO_ERR_INTERRUPTED).
+   abstract interface
+      integer(c_int) function progress_callback(user, t, t_end, steps, elapsed) bind(C)
+         import :: c_int, c_ptr, c_double, c_long_long
+         type(c_ptr), value :: user
+         real(c_double), value :: t, t_end, elapsed
+         integer(c_long_long), value :: steps
+      end function progress_callback
+   end interface
+
+   !> Samples between looks at the clock (a system_clock call costs about a cheap step's
+   !> arithmetic), and seconds between two progress reports.
+   integer, parameter :: WATCH_EVERY = 32
+   real(dp), parameter :: PROGRESS_INTERVAL = 0.25_dp
+   !> Energy the contacts and impacts may create, as a share of the initial energy + input
+   !> work, before the run is a failure: far above what the catalogue's fixed steps leave
+   !> (≤ 1e-4: the trapezoidal work of a contact closing within a step), far below a
+   !> realised restitution past 1 (e = 1.1 creates 21 % of the impact's energy).
+   real(dp), parameter :: CREATED_BOUND = 1.0e-2_dp
+   !> History rows allocated at the start; it grows by doubling beyond (record).
+   integer, parameter :: HIST_START = 4096
+
+   !> Samples of one observer_sample call: the grid point k as a default or a 64-bit integer.
+   interface observer_sample
+      module procedure observer_sample_i8, observer_sample_i4
+   end interface observer_sample
+
 contains
 
    !> Size the results of a run (every integrator) and take the settings the measurement
    !> needs: the output grid t = k·dt, k ≤ n_grid (whole intervals until t_end is reached:
    !> the last one is reported as t_reached, never a shortened one labelled t_end), the
    !> recording cadence and the divergence rule.
+   !> The budget: a run whose output grid alone needs more than max_steps steps is refused
+   !> before it starts (every integrator takes at least one step per grid point);
+   !> stat = MARTELLO_ERR_LIMIT, or MARTELLO_ERR_MEMORY if the arrays cannot be allocated.
    subroutine observer_init(o, s, n_nodes, n_contacts, out_nodes, out_contacts, capacity, &
-                            n_links, out_links)
+                            n_links, out_links, stat)
       type(observer_t), intent(inout) :: o
       type(integrator_settings_t), intent(in) :: s
       integer, intent(in) :: n_nodes, n_contacts, out_nodes(:), out_contacts(:), capacity, &
                              n_links, out_links(:)
+      integer, intent(out), optional :: stat
       type(observer_t) :: fresh
+      real(dp) :: steps
+      integer :: st, st2
       o = fresh        ! every field at its default, every array deallocated
+      if (present(stat)) stat = MARTELLO_OK
       o%kind = s%kind; o%every = max(s%every, 1); o%divergence_factor = s%divergence_factor
-      if (s%dt > 0.0_dp .and. s%t_end > 0.0_dp) &
-         o%n_grid = max(1, ceiling(s%t_end/s%dt*(1.0_dp - 1.0e-12_dp)))
+      o%t_end = s%t_end; o%max_steps = s%max_steps; o%max_wall = s%max_wall
+      call system_clock(o%clock0, o%clock_rate)
+      o%clock_last = o%clock0
+      steps = 1.0_dp
+      if (s%dt > 0.0_dp .and. s%t_end > 0.0_dp) steps = max(1.0_dp, s%t_end/s%dt*(1.0_dp - 1.0e-12_dp))
+      if (steps > o%max_steps .or. .not. ieee_is_finite(steps)) then
+         write (o%message, '(a,a,es10.3,a,es10.3,a)') integrator_name(o%kind), ': the run needs at least ', &
+            steps, ' steps (t_end/dt), more than max_steps = ', o%max_steps, &
+            ': raise dt, shorten t_end or raise max_steps'
+         if (present(stat)) stat = MARTELLO_ERR_LIMIT
+         steps = 1.0_dp
+      end if
+      o%n_grid = ceiling(steps, i8)
       o%out_nodes = out_nodes; o%out_contacts = out_contacts; o%out_links = out_links
       o%ncol = 1 + 3*size(out_nodes) + 2*size(out_contacts) + 2*size(out_links) + NENERGY
-      allocate (o%hist(o%ncol, max(capacity, 2)), o%ev(NEVENT, 16), o%ev_contact(16))
+      allocate (o%hist(o%ncol, max(min(capacity, HIST_START), 2)), o%ev(NEVENT, 16), o%ev_contact(16), &
+                stat=st)
       allocate (o%u_max(n_nodes), o%u_min(n_nodes), o%v_absmax(n_nodes), o%a_absmax(n_nodes), &
                 o%pen_max(n_contacts), o%force_max(n_contacts), o%impacts(n_contacts), &
                 o%u_peak(n_nodes), o%t_peak(n_nodes), o%link_force_absmax(n_links), &
                 o%link_du_absmax(n_links), o%prev_u(n_nodes), o%prev_v(n_nodes), &
                 o%prev_a(n_nodes), o%work(0:n_nodes), o%acc(0:n_nodes), o%c_pen(n_contacts), &
                 o%c_force(n_contacts), o%ph_open(n_contacts), &
-                o%ph_t(n_contacts), o%ph_v(n_contacts), o%ph_pen(n_contacts), o%ph_f(n_contacts))
+                o%ph_t(n_contacts), o%ph_v(n_contacts), o%ph_pen(n_contacts), o%ph_f(n_contacts), &
+                stat=st2)
+      if (st /= 0 .or. st2 /= 0) then
+         write (o%message, '(a,i0,a,i0,a)') 'out of memory allocating the results of a run of ', &
+            n_nodes, ' nodes and ', n_contacts, ' contacts'
+         if (present(stat)) stat = MARTELLO_ERR_MEMORY
+         if (st2 /= 0) error stop 'martello: out of memory allocating the results of a run'
+         if (.not. allocated(o%hist)) allocate (o%hist(o%ncol, 2))
+         if (.not. allocated(o%ev)) allocate (o%ev(NEVENT, 16), o%ev_contact(16))
+      end if
       ! NaN until a state is tracked (a run that fails before its first step)
       o%link_force_absmax = ieee_value(1.0_dp, ieee_quiet_nan)
       o%link_du_absmax = ieee_value(1.0_dp, ieee_quiet_nan)
@@ -177,9 +243,9 @@ contains
    !> The recording cadence: t = 0, every every-th output grid point, and the last one.
    pure logical function recorded(o, k)
       type(observer_t), intent(in) :: o
-      integer, intent(in) :: k
+      integer(i8), intent(in) :: k
       recorded = k == 0
-      if (k > 0) recorded = mod(k, o%every) == 0 .or. k >= o%n_grid
+      if (k > 0) recorded = mod(k, int(o%every, i8)) == 0 .or. k >= o%n_grid
    end function recorded
 
    !> An accepted state at t (once per accepted step and at t = 0, after the step's phase
@@ -188,13 +254,13 @@ contains
    !> where recorded. k: the grid point t = k·dt of the state, or −1. u, v, a on nodes 0:n;
    !> u_prev … the previous state if the method keeps it (saves a copy). stat:
    !> MARTELLO_ERR_DIVERGED, with the message, when the run must stop.
-   subroutine observer_sample(o, m, ms, t, u, v, a, pen, force, k, stat, link_f, link_du, &
-                              u_prev, v_prev, a_prev)
+   subroutine observer_sample_i8(o, m, ms, t, u, v, a, pen, force, k, stat, link_f, link_du, &
+                                 u_prev, v_prev, a_prev)
       type(observer_t), intent(inout) :: o
       type(model_t), intent(in) :: m
       type(mech_state_t), intent(in) :: ms
       real(dp), intent(in) :: t, u(0:), v(0:), a(0:), pen(:), force(:)
-      integer, intent(in) :: k
+      integer(i8), intent(in) :: k
       integer, intent(out) :: stat
       real(dp), intent(in), optional :: link_f(:), link_du(:), u_prev(:), v_prev(:), a_prev(:)
       real(dp) :: e_kin, e_links, e_cont, kc
@@ -202,7 +268,7 @@ contains
       integer :: c
       stat = MARTELLO_OK
       o%nsamples = o%nsamples + 1
-      due = recorded(o, k) .or. mod(o%nsamples, o%energy_interval) == 0 .or. &
+      due = recorded(o, k) .or. mod(o%nsamples, int(o%energy_interval, i8)) == 0 .or. &
             .not. ieee_is_finite(o%w_last + o%d_damp + o%d_links + o%d_contact + o%d_impact)
       do c = 1, size(pen)
          if (.not. o%ph_open(c)) cycle
@@ -217,9 +283,71 @@ contains
                                  o%d_damp, o%d_links, o%d_contact, o%d_impact, kc, o%ke_corr0)
          o%energy_balance_max = max(o%energy_balance_max, abs(o%energy(E_BALANCE)))
       end if
-      if (recorded(o, k)) call record(o, t, u(1:), v(1:), a(1:), pen, force, link_f, link_du)
+      if (recorded(o, k)) then
+         call record(o, t, u(1:), v(1:), a(1:), pen, force, link_f, link_du, stat)
+         if (stat /= MARTELLO_OK) then
+            call observer_finish(o, t); return
+         end if
+      end if
       if (due) call check_divergence(o, t, e_kin + e_links + e_cont, u, v, stat)
-   end subroutine observer_sample
+      if (stat == MARTELLO_OK) call observer_watch(o, t, stat)
+   end subroutine observer_sample_i8
+
+   !> observer_sample with the grid point k as a default integer (the C door, k ≤ 2^31).
+   subroutine observer_sample_i4(o, m, ms, t, u, v, a, pen, force, k, stat, link_f, link_du, &
+                                 u_prev, v_prev, a_prev)
+      type(observer_t), intent(inout) :: o
+      type(model_t), intent(in) :: m
+      type(mech_state_t), intent(in) :: ms
+      real(dp), intent(in) :: t, u(0:), v(0:), a(0:), pen(:), force(:)
+      integer, intent(in) :: k
+      integer, intent(out) :: stat
+      real(dp), intent(in), optional :: link_f(:), link_du(:), u_prev(:), v_prev(:), a_prev(:)
+      call observer_sample_i8(o, m, ms, t, u, v, a, pen, force, int(k, i8), stat, link_f, &
+                              link_du, u_prev, v_prev, a_prev)
+   end subroutine observer_sample_i4
+
+   !> The budget and the caller, after every accepted sample: max_steps (every sample),
+   !> and every WATCH_EVERY samples the clock: max_wall, and the progress callback at most
+   !> every PROGRESS_INTERVAL seconds (a non-zero return stops the run). stat:
+   !> MARTELLO_ERR_LIMIT or MARTELLO_ERR_INTERRUPTED with the message, else unchanged.
+   subroutine observer_watch(o, t, stat)
+      type(observer_t), intent(inout) :: o
+      real(dp), intent(in) :: t
+      integer, intent(inout) :: stat
+      procedure(progress_callback), pointer :: report
+      integer(i8) :: now
+      real(dp) :: elapsed
+      if (real(o%nsamples, dp) > o%max_steps) then
+         write (o%message, '(a,a,es10.3,a,es12.5,a,es12.5,a)') integrator_name(o%kind), &
+            ' took max_steps = ', o%max_steps, ' steps and reached t = ', t, ' s of t_end = ', &
+            o%t_end, ' s: raise max_steps, or soften the scene (a stiffer contact or a lighter'// &
+            ' mass needs more steps)'
+         stat = MARTELLO_ERR_LIMIT
+         call observer_finish(o, t); return
+      end if
+      if (mod(o%nsamples, int(WATCH_EVERY, i8)) /= 0) return
+      if (o%max_wall <= 0.0_dp .and. .not. c_associated(o%progress)) return
+      call system_clock(now)
+      elapsed = real(now - o%clock0, dp)/real(o%clock_rate, dp)
+      if (o%max_wall > 0.0_dp .and. elapsed > o%max_wall) then
+         write (o%message, '(a,a,es10.3,a,i0,a,es12.5,a,es12.5,a)') integrator_name(o%kind), &
+            ' ran for max_wall = ', o%max_wall, ' s (', o%nsamples, ' steps) and reached t = ', &
+            t, ' s of t_end = ', o%t_end, ' s: raise max_wall, or coarsen the run'
+         stat = MARTELLO_ERR_LIMIT
+         call observer_finish(o, t); return
+      end if
+      if (.not. c_associated(o%progress)) return
+      if (real(now - o%clock_last, dp) < PROGRESS_INTERVAL*real(o%clock_rate, dp)) return
+      o%clock_last = now
+      call c_f_procpointer(o%progress, report)
+      if (report(o%progress_user, t, o%t_end, int(o%nsamples, c_long_long), elapsed) /= 0) then
+         write (o%message, '(a,es12.5,a,i0,a)') 'interrupted at t = ', t, ' s (', o%nsamples, &
+            ' steps)'
+         stat = MARTELLO_ERR_INTERRUPTED
+         call observer_finish(o, t)
+      end if
+   end subroutine observer_watch
 
    !> Divergence at time t, one rule for every integrator: a non-finite state or work, or
    !> the mechanical energy beyond divergence_factor·(e0 + Σ|ΔW_ext|), what the run was
@@ -233,6 +361,16 @@ contains
                  all(ieee_is_finite(v)) .and. &
                  ieee_is_finite(o%w_ext + o%d_damp + o%d_links + o%d_contact + o%d_impact))) then
          call observer_fail_nonfinite(o, t, stat)
+      else if (-(o%energy(E_CONTACT) + o%energy(E_IMPACT)) > CREATED_BOUND*(o%e0 + o%w_abs) .and. &
+               o%e0 + o%w_abs > 0.0_dp) then
+         ! a passive contact only takes energy out: the realised restitution exceeds 1
+         write (o%message, '(a,a,es12.5,a,es10.3,a,es10.3,a,a)') integrator_name(o%kind), &
+            ' created energy at its contacts by t = ', t, ' s: ', &
+            -(o%energy(E_CONTACT) + o%energy(E_IMPACT)), ' J, more than 1 % of the initial'// &
+            ' energy + input work (', o%e0 + o%w_abs, ' J): a passive contact cannot'// &
+            ' (restitution > 1); ', o%advice
+         stat = MARTELLO_ERR_DIVERGED
+         call observer_finish(o, t)
       else if (e_mech > o%divergence_factor*(o%e0 + o%w_abs) + tiny(1.0_dp) .and. &
                o%e0 + o%w_abs > 0.0_dp) then
          write (o%message, '(a,a,es12.5,a,es10.3,a,es10.3,a,a)') integrator_name(o%kind), &
@@ -399,14 +537,23 @@ contains
    end function energy_terms
 
    !> Append one history row (grows by doubling when a variable-step integrator needs it).
-   subroutine record(r, t, u, v, a, pen, force, link_f, link_du)
+   !> stat = MARTELLO_ERR_MEMORY (message set) if the history cannot grow.
+   subroutine record(r, t, u, v, a, pen, force, link_f, link_du, stat)
       class(results_t), intent(inout) :: r
       real(dp), intent(in) :: t, u(:), v(:), a(:), pen(:), force(:)
       real(dp), intent(in), optional :: link_f(:), link_du(:)   !< absent: NaN columns
+      integer, intent(out) :: stat
       real(dp), allocatable :: tmp(:, :)
-      integer :: k, c, nn, nc, nl
+      integer :: k, c, nn, nc, nl, st
+      stat = MARTELLO_OK
       if (r%nrec == size(r%hist, 2)) then
-         allocate (tmp(r%ncol, 2*size(r%hist, 2)))
+         allocate (tmp(r%ncol, 2*size(r%hist, 2)), stat=st)
+         if (st /= 0) then
+            write (r%message, '(a,i0,a,i0,a)') 'out of memory growing the history to ', &
+               2*size(r%hist, 2), ' rows of ', r%ncol, ' columns: record less (output.every,'// &
+               ' output.nodes, output.contacts)'
+            stat = MARTELLO_ERR_MEMORY; return
+         end if
          tmp(:, 1:r%nrec) = r%hist(:, 1:r%nrec)
          call move_alloc(tmp, r%hist)
       end if
@@ -470,12 +617,23 @@ contains
       end do
       if (present(link_f) .and. present(link_du)) then
          do i = 1, size(link_f)
-            ! written as "not ≥" so that the NaN the maxima start from is replaced
-            if (.not. (o%link_force_absmax(i) >= abs(link_f(i)))) o%link_force_absmax(i) = abs(link_f(i))
-            if (.not. (o%link_du_absmax(i) >= abs(link_du(i)))) o%link_du_absmax(i) = abs(link_du(i))
+            call raise_to(o%link_force_absmax(i), abs(link_f(i)))
+            call raise_to(o%link_du_absmax(i), abs(link_du(i)))
          end do
       end if
    contains
+      !> x ← max(x, y), the NaN x starts from replaced without comparing it (an ordered
+      !> comparison with a NaN raises the invalid flag: a trap under -ffpe-trap=invalid)
+      subroutine raise_to(x, y)
+         real(dp), intent(inout) :: x
+         real(dp), intent(in) :: y
+         if (ieee_is_nan(x)) then
+            x = y
+         else if (x < y) then
+            x = y
+         end if
+      end subroutine raise_to
+
       subroutine peaks(un, vn, an)
          real(dp), intent(in) :: un(:), vn(:), an(:)
          associate (umax => o%u_max, umin => o%u_min, vmax => o%v_absmax, amax => o%a_absmax, &

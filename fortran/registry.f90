@@ -33,7 +33,8 @@ module martello_registry
       INT_NEWMARK_LAGRANGE, INT_RKF45, INT_RK8PD, INT_MSBDF, INT_IDA, INT_FAST_NONLINEAR, INT_LAST, &
       NSETTINGS, S_DT, S_T_END, S_BETA, S_GAMMA, S_ALPHA, S_RHO_INF, S_TOL_RESIDUAL, &
       S_TOL_INCREMENT, S_MAX_NEWTON, S_CHECK_STABILITY, S_EVERY, S_DIVERGENCE_FACTOR, S_RTOL, &
-      S_ATOL, S_THETA, S_EVENT_TOL, S_H_MAX, S_FUSED_CHAIN, SETTINGS, INTEGRATORS, setting_t, integrator_t, &
+      S_ATOL, S_THETA, S_EVENT_TOL, S_H_MAX, S_FUSED_CHAIN, S_MAX_STEPS, S_MAX_WALL, SETTINGS, &
+      INTEGRATORS, setting_t, integrator_t, &
       registry_shape, registry_column, registry_row, registry_find, registry_name, &
       NAME_LEN, TEXT_LEN, MAX_COLS, T_DOUBLE, T_INT, T_BOOL
 
@@ -60,7 +61,7 @@ module martello_registry
                          S_MAX_NEWTON = 9, S_CHECK_STABILITY = 10, S_EVERY = 11, &
                          S_DIVERGENCE_FACTOR = 12, S_RTOL = 13, S_ATOL = 14, S_THETA = 15, &
                          S_EVENT_TOL = 16, S_H_MAX = 17, S_FUSED_CHAIN = 18, &
-                         NSETTINGS = 18
+                         S_MAX_STEPS = 19, S_MAX_WALL = 20, NSETTINGS = 20
    integer, parameter :: MAX_COLS = NSETTINGS   !< the widest table: reads, a column per setting
    ! C types of the settings (rows of the table "setting_types")
    integer, parameter :: T_DOUBLE = 1, T_INT = 2, T_BOOL = 3
@@ -116,7 +117,10 @@ module martello_registry
       named_t('MARTELLO_ERR_STEP_UNDERFLOW', MARTELLO_ERR_STEP_UNDERFLOW, &
               'the step size fell below what the time resolves'), &
       named_t('MARTELLO_ERR_EXTERNAL', MARTELLO_ERR_EXTERNAL, 'GSL or SUNDIALS reported a failure'), &
-      named_t('MARTELLO_ERR_STATE', MARTELLO_ERR_STATE, 'call out of order')]
+      named_t('MARTELLO_ERR_STATE', MARTELLO_ERR_STATE, 'call out of order'), &
+      named_t('MARTELLO_ERR_LIMIT', MARTELLO_ERR_LIMIT, 'max_steps or max_wall reached before t_end'), &
+      named_t('MARTELLO_ERR_INTERRUPTED', MARTELLO_ERR_INTERRUPTED, &
+              'stopped by the caller (its progress callback asked to)')]
 
    type(named_t), parameter :: SCHEMES(*) = [ &
       named_t('penalty', SCHEME_PENALTY, 'a force law on the penetration'), &
@@ -259,10 +263,14 @@ module martello_registry
       setting_t('theta', T_DOUBLE, 0.5_dp, 0.5_dp, 1.0_dp, .false., .false., 'a number in [0.5, 1]'), &
       setting_t('event_tol', T_DOUBLE, 1.0e-12_dp, 0.0_dp, BIG, .true., .false., 'a number > 0'), &
       setting_t('h_max', T_DOUBLE, 0.0_dp, 0.0_dp, BIG, .false., .false., 'a number >= 0'), &
-      setting_t('fused_chain', T_BOOL, 1.0_dp, 0.0_dp, 1.0_dp, .false., .false., 'true or false')]
+      setting_t('fused_chain', T_BOOL, 1.0_dp, 0.0_dp, 1.0_dp, .false., .false., 'true or false'), &
+      setting_t('max_steps', T_DOUBLE, 1.0e8_dp, 1.0_dp, 2.0_dp**53, .false., .false., &
+                'a whole number in [1, 2^53]'), &
+      setting_t('max_wall', T_DOUBLE, 0.0_dp, 0.0_dp, BIG, .false., .false., &
+                'a number >= 0 [s] (0: no limit)')]
 
    ! Settings read by groups of integrators (bit S_x).
-   integer, parameter :: READS_BASE = 2**S_DT + 2**S_T_END + 2**S_EVERY
+   integer, parameter :: READS_BASE = 2**S_DT + 2**S_T_END + 2**S_EVERY + 2**S_MAX_STEPS + 2**S_MAX_WALL
    integer, parameter :: READS_DIVERGENCE = 2**S_DIVERGENCE_FACTOR
    integer, parameter :: READS_NEWTON = 2**S_TOL_RESIDUAL + 2**S_TOL_INCREMENT + 2**S_MAX_NEWTON
    integer, parameter :: READS_ADAPTIVE = 2**S_RTOL + 2**S_ATOL + 2**S_EVENT_TOL + 2**S_H_MAX
@@ -274,7 +282,8 @@ module martello_registry
 
    type(integrator_t), parameter :: INTEGRATORS(INT_LAST) = [ &
       integrator_t('newmark', INT_NEWMARK, FAMILY_NEWMARK, .false., &
-                   READS_BASE + READS_DIVERGENCE + READS_NEWTON + 2**S_BETA + 2**S_GAMMA + 2**S_FUSED_CHAIN, &
+                   READS_BASE + READS_DIVERGENCE + READS_NEWTON + 2**S_BETA + 2**S_GAMMA + &
+                   2**S_CHECK_STABILITY + 2**S_FUSED_CHAIN, &
                    RUNS_PENALTY, 'Newmark (1959) beta-gamma, implicit'), &
       integrator_t('hht', INT_HHT, FAMILY_NEWMARK, .false., &
                    READS_BASE + READS_DIVERGENCE + READS_NEWTON + 2**S_ALPHA, RUNS_PENALTY, &

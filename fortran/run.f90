@@ -2,7 +2,7 @@
 !> to), and run_dynamic, which validates the run against the model and dispatches it to the
 !> integrator. The C door (martello_api_run) only converts arguments and calls this.
 module martello_run
-   use, intrinsic :: iso_c_binding, only: c_int, c_ptr, c_loc
+   use, intrinsic :: iso_c_binding, only: c_int, c_ptr, c_loc, c_funptr, c_null_funptr, c_null_ptr
    use martello_kinds, only: dp
    use martello_status
    use martello_model, only: model_t
@@ -39,6 +39,9 @@ module martello_run
       type(observer_t) :: results     !< what the run measured (martello_observer)
       integer, allocatable :: out_nodes(:), out_contacts(:), out_links(:)
       logical :: configured = .false., done = .false.
+      !> the caller's progress callback and its argument (martello_run_set_progress)
+      type(c_funptr) :: progress = c_null_funptr
+      type(c_ptr) :: progress_user = c_null_ptr
    end type run_t
 
 contains
@@ -65,10 +68,13 @@ contains
       if (any(rp%out_links < 1 .or. rp%out_links > mp%nlink)) then
          rp%results%message = 'dynamic_run: an output link is out of range'; return
       end if
+      ! the rows a fixed step records; the history starts at most at HIST_START rows of
+      ! them and grows as needed (observer record)
       cap = int(min(rp%settings%t_end/rp%settings%dt/rp%settings%every + 3.0_dp, 1.0e7_dp))
       call observer_init(rp%results, rp%settings, mp%n, mp%ncontact, rp%out_nodes, &
-                         rp%out_contacts, cap, mp%nlink, rp%out_links)
-      call check_schemes(mp, rp%settings%kind, rp%results%message, stat)
+                         rp%out_contacts, cap, mp%nlink, rp%out_links, stat)
+      rp%results%progress = rp%progress; rp%results%progress_user = rp%progress_user
+      if (stat == MARTELLO_OK) call check_schemes(mp, rp%settings%kind, rp%results%message, stat)
       if (stat == MARTELLO_OK) call effective_mass_prepare(mp, rp%results%message, stat)
       if (stat == MARTELLO_OK) then
          select case (rp%settings%kind)

@@ -8,7 +8,7 @@ module martello_status
       MARTELLO_ERR_ARGUMENT, MARTELLO_ERR_MEMORY, MARTELLO_ERR_SINGULAR, &
       MARTELLO_ERR_NOT_CONVERGED, MARTELLO_ERR_DIVERGED, MARTELLO_ERR_UNSUPPORTED, &
       MARTELLO_ERR_UNSTABLE, MARTELLO_ERR_LAPACK, MARTELLO_ERR_STEP_UNDERFLOW, &
-      MARTELLO_ERR_EXTERNAL, MARTELLO_ERR_STATE
+      MARTELLO_ERR_EXTERNAL, MARTELLO_ERR_STATE, MARTELLO_ERR_LIMIT, MARTELLO_ERR_INTERRUPTED
 
    integer, parameter :: MARTELLO_OK = 0
    integer, parameter :: MARTELLO_ILL_CONDITIONED = 1  !< solved, but digits were lost
@@ -24,4 +24,6 @@ module martello_status
    integer, parameter :: MARTELLO_ERR_STEP_UNDERFLOW = -9
    integer, parameter :: MARTELLO_ERR_EXTERNAL = -10   !< GSL or SUNDIALS reported a failure
    integer, parameter :: MARTELLO_ERR_STATE = -11      !< call out of order (e.g. run before build)
+   integer, parameter :: MARTELLO_ERR_LIMIT = -12      !< max_steps or max_wall reached
+   integer, parameter :: MARTELLO_ERR_INTERRUPTED = -13 !< the caller's progress callback stopped it
 end module martello_status

@@ -135,22 +135,42 @@ def run(scene):
     return Result(s, summary, history)
 
 
-def reference(scene, spec=None):
+def reference(scene, spec=None, *, compute=True, refresh=False, jobs=0, stream=None):
     """The Reference a scene is scored against (martello.reference.base.Reference):
     stored reference data for its physics (reference/references.toml), else the closed-form
-    history its ``[check]`` implies. ``spec`` names another, as a study's ``reference``
-    entry does: ``{"closed_form": NAME, "params": {...}}`` or ``{"data": "reference/<name>"}``.
+    history its ``[check]`` implies, else — for any other dynamic scene, unless
+    ``compute=False`` — one computed as ``martello reference`` does (docs/reference.md): the
+    event-complete integrators and the independent engine, its trusted digits measured, kept
+    in the user cache per scene hash (computed once; ``refresh=True`` recomputes it; ``jobs``
+    processes; progress on ``stream``, default stderr). ``compute="always"`` takes the
+    computed one even when stored data or a closed form exists.
+
+    ``spec`` names another, as a study's ``reference`` entry does: ``{"closed_form": NAME,
+    "params": {...}}`` or ``{"data": "reference/<name>"}``.
 
     ``ref.at(t, columns)`` evaluates it at times t; ``ref.trusted_digits()`` says how far it
-    can be trusted. Raises ReferenceError if the scene has none."""
+    can be trusted; a computed one's ``ref.provenance`` holds its method, digits and cache
+    key. Raises ReferenceError if the scene has none (a static scene, compute=False)."""
     from .reference.base import ReferenceError
     from .reference.selection import reference_for_scene
     s = _scene(scene)
-    ref = reference_for_scene(s, spec=spec)
-    if ref is None:
+    ref = None if compute == "always" else reference_for_scene(s, spec=spec)
+    if ref is not None:
+        return ref
+    if not compute:
         raise ReferenceError(f"{s.source}: no reference: no closed-form history ([check]) and no "
-                             "stored reference data for its physics (reference/references.toml)")
-    return ref
+                             "stored reference data for its physics (reference/references.toml); "
+                             "compute=True computes one")
+    from .reference import cache
+    if isinstance(scene, dict):
+        sdict = {k: v for k, v in scene.items() if k != "check"}
+        where = Path.cwd() / "scene.toml"     # relative record paths: from here, as from_dict
+        return cache.computed_reference(s, sdict, where, refresh=refresh, jobs=jobs,
+                                        stream=stream)[0]
+    if not Path(s.source).is_file():
+        raise ReferenceError(f"{s.source}: a Scene made from a dict keeps no tables to compute a "
+                             "reference from: give martello.reference the dict itself, or a file")
+    return cache.reference_for_file(s.source, refresh=refresh, jobs=jobs, stream=stream)[0]
 
 
 def compare(history, against):

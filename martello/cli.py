@@ -49,7 +49,14 @@ def cmd_run(args):
     s = load(catalogue.find(args.scene))   # a file, or a path in the catalogue
     for w in check_budget(s, force=args.force):     # steps and output size, before running
         print(f"warning: {w}", file=sys.stderr)
-    summary, history = run_measured(s)     # with the problem's measures (P4), as check does
+    show = sys.stderr.isatty() if args.progress is None else args.progress
+    line = ProgressLine(sys.stderr) if show else None
+    try:
+        with native.reporting(line):
+            summary, history = run_measured(s)   # with the problem's measures (P4), as check does
+    finally:
+        if line:
+            line.close()
     out = Path(args.output) if args.output else Path("out") / Path(args.scene).stem
     path = write_results(summary, out, history)
     for w in summary.get("warnings", []):
@@ -59,6 +66,44 @@ def cmd_run(args):
     if args.print:
         print(json.dumps(summary, indent=2, default=float))
     return 0
+
+
+class ProgressLine:
+    """The progress of a running dynamic run on a stream, once it has run for a second:
+    simulated time, share of t_end, steps, rate and ETA. On a terminal one line rewritten in
+    place (cleared when the run returns), else a line every few seconds."""
+
+    START, EVERY_PLAIN = 1.0, 5.0
+
+    def __init__(self, stream):
+        self.stream, self.tty, self.last, self.shown = stream, stream.isatty(), -1e300, False
+
+    def __call__(self, t, t_end, steps, elapsed):
+        if elapsed < self.START or (not self.tty and elapsed - self.last < self.EVERY_PLAIN):
+            return
+        self.last = elapsed
+        share = min(max(t / t_end, 0.0), 1.0) if t_end > 0 else 0.0
+        rate = steps / elapsed if elapsed > 0 else 0.0
+        eta = elapsed * (1.0 - share) / share if share > 0 else float("inf")
+        line = (f"t = {t:.4g} of {t_end:.4g} s ({100 * share:.1f} %), {steps:.3g} steps, "
+                f"{rate:.3g} steps/s, ETA {_duration(eta)}")
+        if self.tty:
+            self.stream.write("\r\033[K" + line)
+            self.shown = True
+        else:
+            self.stream.write(line + "\n")
+        self.stream.flush()
+
+    def close(self):
+        if self.shown:
+            self.stream.write("\r\033[K")
+            self.stream.flush()
+
+
+def _duration(s):
+    if s != s or s == float("inf"):
+        return "unknown"
+    return f"{s:.0f} s" if s < 120 else f"{s / 60:.0f} min" if s < 7200 else f"{s / 3600:.1f} h"
 
 
 def cmd_study(args):
@@ -132,6 +177,10 @@ def run_command(args):
         code = args.func(args)
         sys.stdout.flush()       # here, not at exit: a reader that went away shows below
         return code
+    except errors.Interrupted as exc:
+        text = _one_line(exc)
+        print(f"martello: {text[text.find('interrupted at'):]}: nothing written", file=sys.stderr)
+        return 130
     except MartelloError as exc:
         print(f"martello: error: {_one_line(exc)}", file=sys.stderr)
     except KeyboardInterrupt:
@@ -179,6 +228,9 @@ def main(argv=None):
     p.add_argument("--print", action="store_true", help="also print the summary")
     p.add_argument("--force", action="store_true",
                    help="run even if it needs more than 1e9 node-steps or writes more than 1 GB")
+    p.add_argument("--progress", action=argparse.BooleanOptionalAction, default=None,
+                   help="a progress line on stderr for a run longer than a second (default: "
+                   "when stderr is a terminal)")
     p.set_defaults(func=cmd_run)
 
     p = sub.add_parser("check", help="verify scenes against their closed forms",

@@ -65,3 +65,8 @@ class DivergenceError(SolverError):
     """A run diverged (NaN, energy growth beyond the input, step past the stability limit).
 
     Its partial results are never written out as if they were a result."""
+
+
+class Interrupted(SolverError):
+    """The run was stopped by the user (Ctrl-C, through the native loop's progress callback):
+    nothing it computed is a result. The command line exits 130."""

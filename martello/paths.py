@@ -18,7 +18,10 @@ opened for reading (opening a FIFO blocks until a writer comes; /dev/zero never 
 so is a file larger than its reader's limit (docs/behaviour.md, "Failures and limits")."""
 
 import os
+import shutil
 import stat
+import tempfile
+from contextlib import contextmanager
 from pathlib import Path
 
 PACKAGE = Path(__file__).resolve().parent
@@ -123,3 +126,56 @@ def write_text_atomic(path, text):
     except BaseException:
         tmp.unlink(missing_ok=True)
         raise
+
+
+@contextmanager
+def folder_replaced(outdir, marker, refuse):
+    """Fill a folder that replaces outdir whole, atomically: the block gets a temporary folder
+    beside outdir to write into; when it ends without an exception the temporary folder is
+    renamed into place (an earlier outdir, stale files included, goes), so outdir holds one
+    complete output or none; on an exception it is removed and outdir stays as it was.
+
+    outdir may exist only as a folder that is empty or holds the file `marker` (an earlier
+    output of the same kind); else, or if the folders cannot be made or renamed, refuse(text)
+    is raised (an exception class taking the one-line message)."""
+    outdir = Path(os.path.abspath(outdir))
+    if not outdir.name:
+        raise refuse(f"{outdir}: cannot be an output folder (give a folder to create)")
+    if outdir.exists() or outdir.is_symlink():
+        if not outdir.is_dir() or outdir.is_symlink():
+            raise refuse(f"{outdir}: is not a folder (-o names the folder the results go to: "
+                         "give a new folder, or an earlier one of the same command)")
+        held = sorted(p.name for p in outdir.iterdir())
+        if held and marker not in held:
+            shown = ", ".join(held[:3]) + (", ..." if len(held) > 3 else "")
+            raise refuse(f"{outdir}: holds files of something else ({shown}): the output "
+                         "replaces its whole folder (give a new or empty folder, or an earlier "
+                         "one of the same command)")
+    try:
+        outdir.parent.mkdir(parents=True, exist_ok=True)
+        tmp = Path(tempfile.mkdtemp(prefix=f".{outdir.name}.", suffix=".tmp", dir=outdir.parent))
+    except OSError as exc:
+        raise refuse(f"{outdir}: cannot create the output folder: {exc.strerror or exc}") from None
+    try:
+        yield tmp
+    except BaseException:
+        shutil.rmtree(tmp, ignore_errors=True)
+        raise
+    old = None
+    try:
+        mask = os.umask(0)
+        os.umask(mask)
+        os.chmod(tmp, 0o777 & ~mask)
+        if outdir.is_dir():
+            old = Path(tempfile.mkdtemp(prefix=f".{outdir.name}.", suffix=".old", dir=outdir.parent))
+            os.replace(outdir, old)      # onto the empty folder just made: atomic
+        os.replace(tmp, outdir)
+    except OSError as exc:
+        shutil.rmtree(tmp, ignore_errors=True)
+        if old is not None and not outdir.exists():
+            os.replace(old, outdir)      # put the earlier output back
+            old = None
+        raise refuse(f"{outdir}: cannot write the results: {exc.strerror or exc}") from None
+    finally:
+        if old is not None:
+            shutil.rmtree(old, ignore_errors=True)

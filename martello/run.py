@@ -3,8 +3,6 @@ the results as a summary dict (and, for dynamic runs, a history) ready to be wri
 
 import json
 import os
-import shutil
-import tempfile
 import time
 from pathlib import Path
 
@@ -14,6 +12,7 @@ from .binding import native
 from .binding.native import constant
 from .errors import RecordError, ResultError, SceneError
 from .ground_motion.records import read_record
+from .paths import folder_replaced
 
 # Default exponent n of each law's elastic part F ~ δ^n (fixed, or Hertz's when the law reads it).
 LAW_EXPONENT = {r.name: r.values["exponent"] for r in native.registry("laws")}
@@ -228,6 +227,12 @@ def _dynamic(scene, model, raise_on_failure=True):
     scale = max(abs(energy["initial"]), abs(energy["input"]), 1e-300)
     energy.update(balance_max=extra["balance_max"], balance_relative=extra["balance_max"] / scale)
     warnings = []
+    if extra["dt_critical"] > 0 and an["integrator"] not in native.adaptive_integrators() \
+            and an["dt"] > extra["dt_critical"]:
+        # check_stability = false let it run past the limit (docs/behaviour.md)
+        warnings.append(f"dt = {an['dt']!r} s is past the stability limit dt_crit = "
+                        f"{extra['dt_critical']:.6g} s (check_stability = false): the result "
+                        "may be wrong although no guard stopped it")
     if st >= 0 and energy["balance_relative"] > 1e-2:
         warnings.append(f"energy balance error {100 * energy['balance_relative']:.1f} % of the energy put in: "
                         "the step is too large for this scene (the result is inaccurate)")
@@ -378,7 +383,7 @@ def output_estimate(scene):
         if an["integrator"] in native.adaptive_integrators():
             # dt is the output interval; h_max (when > 0) caps every step
             steps = an["t_end"] / an["h_max"] if an.get("h_max") else intervals
-            rows = intervals + 2
+            rows = intervals / out["every"] + 2      # every every-th output time
         else:
             steps = float(np.ceil(intervals))
             rows = steps / out["every"] + 2
@@ -486,51 +491,14 @@ def write_results(summary, outdir, history=None):
     check_finite(summary, history)
     text = json.dumps(summary, indent=2, allow_nan=False, default=float) + "\n"
     given = Path(outdir)
-    outdir = Path(os.path.abspath(outdir))
-    if not outdir.name:
-        raise ResultError(f"{outdir}: cannot be an output folder (give a folder to create)")
-    if outdir.exists() or outdir.is_symlink():
-        if not outdir.is_dir() or outdir.is_symlink():
-            raise ResultError(f"{outdir}: is not a folder (-o names the folder the results "
-                              "go to: give a new folder, or an earlier run's)")
-        held = sorted(p.name for p in outdir.iterdir())
-        if held and "summary.json" not in held:
-            shown = ", ".join(held[:3]) + (", ..." if len(held) > 3 else "")
-            raise ResultError(f"{outdir}: holds files of something else ({shown}): a run "
-                              "replaces its whole output folder (give a new or empty folder, "
-                              "or an earlier run's)")
-    try:
-        outdir.parent.mkdir(parents=True, exist_ok=True)
-        tmp = Path(tempfile.mkdtemp(prefix=f".{outdir.name}.", suffix=".tmp", dir=outdir.parent))
-    except OSError as exc:
-        raise ResultError(f"{outdir}: cannot create the output folder: "
-                          f"{exc.strerror or exc}") from None
-    old = None
-    try:
-        if history is not None:
-            columns, data = history
-            np.savetxt(tmp / "history.csv", data, delimiter=",", header=",".join(columns),
-                       comments="", fmt="%.17g")
-        (tmp / "summary.json").write_text(text)
-        os.chmod(tmp, 0o777 & ~_umask())
-        if outdir.is_dir():
-            old = Path(tempfile.mkdtemp(prefix=f".{outdir.name}.", suffix=".old",
-                                        dir=outdir.parent))
-            os.replace(outdir, old)      # onto the empty folder just made: atomic
-        os.replace(tmp, outdir)
-    except OSError as exc:
-        shutil.rmtree(tmp, ignore_errors=True)
-        if old is not None and not outdir.exists():
-            os.replace(old, outdir)      # put the earlier run back
-            old = None
-        raise ResultError(f"{outdir}: cannot write the results: {exc.strerror or exc}") from None
-    finally:
-        if old is not None:
-            shutil.rmtree(old, ignore_errors=True)
+    with folder_replaced(outdir, "summary.json", ResultError) as tmp:
+        try:
+            if history is not None:
+                columns, data = history
+                np.savetxt(tmp / "history.csv", data, delimiter=",", header=",".join(columns),
+                           comments="", fmt="%.17g")
+            (tmp / "summary.json").write_text(text)
+        except OSError as exc:
+            raise ResultError(f"{os.path.abspath(outdir)}: cannot write the results: "
+                              f"{exc.strerror or exc}") from None
     return given / "summary.json"
-
-
-def _umask():
-    mask = os.umask(0)
-    os.umask(mask)
-    return mask

@@ -74,10 +74,11 @@ def test_classification_of_failures():
 
 def test_an_impact_that_creates_energy_is_unstable():
     # one impact at Δt = 2 Δt_crit: the trapezoidal rule with a penalty wall rebounds
-    # faster than it arrived (realised e ≈ 2.1 for a target 0.8): energy growth
+    # faster than it arrived (realised e ≈ 2.1 for a target 0.8): energy created at the
+    # contact, which the run layer reports as a divergence (docs/behaviour.md)
     (cls, det), res, _ = point(NEWMARK, "impact", 2.0, stiffness_ratio=1e4)
-    assert cls == "unstable" and det["energy_growth"] > 1.0
-    assert res["summary"]["contacts"]["wall"]["restitution"][0] > 1.0
+    assert cls == "unstable"
+    assert res["status"] == "MARTELLO_ERR_DIVERGED" and "created energy" in res["message"]
 
 
 ATLAS = """

@@ -232,7 +232,7 @@ def test_ends_at_nodes_cannot_be_exact_at_courant_one():
     # check it diverges.
     with pytest.raises(DivergenceError, match="central difference is unstable"):
         measures(N=10, ends="node", courant=1.0)
-    with pytest.raises(DivergenceError, match="diverged"):
+    with pytest.raises(DivergenceError, match="diverged|created energy"):
         measures(N=10, ends="node", courant=1.0, check_stability=False)
 
 

@@ -180,13 +180,14 @@ def test_p2_energy_identity_theta_half(p2_zeno):
 
 def test_p2_impulse_work_sign_needs_theta_one_plus_e_at_most_one():
     """θ = 1, e = 0.8: θ(1 + e) = 1.8 > 1, so ġ_θ p = (1 − θ(1+e)) ġ_k p > 0 at an impact:
-    the impulses put energy in, and only the θ-dissipation −(θ−½)(‖Δv‖²_M + ‖Δq‖²_K) keeps the
-    scheme dissipative. Both show: some impact step lowers E_IMPACT, and the balance (which
-    holds exactly that θ-dissipation for linear forces) is positive and never decreases."""
+    the impulses alone put energy in, and only the θ-dissipation (θ−½)(‖Δv‖²_M + ‖Δq‖²_K)
+    keeps the scheme dissipative. energy.impact holds both (docs/moreau-jean.md "Energy"):
+    it ends positive, and the balance, which held the θ-dissipation before, is round-off for
+    these linear forces (8 ε of the input per step, accumulated)."""
     s, h = p2(1e-3, 2.0, theta=1.0)
-    assert np.diff(h["energy:impact"]).min() < -1e-6
+    assert h["energy:impact"][-1] > 1e-3
     bal = h["energy:balance"]
-    assert bal[-1] > 1e-3 and np.diff(bal).min() >= -8 * EPS * s["energy"]["input"]
+    assert np.abs(bal).max() <= 2000 * 8 * EPS * s["energy"]["input"]
 
 
 def test_p2_elastic_impacts_conserve_energy():
@@ -282,3 +283,22 @@ def test_lagrange_contact_defaults_to_plastic():
     ref = newton_impact(1.0, 3.0, 1.0, 0.0, 0.0)
     assert h["v:m1"][-1] == pytest.approx(ref.v1, abs=8 * EPS)
     assert h["v:m2"][-1] == pytest.approx(ref.v2, abs=8 * EPS)
+
+
+@pytest.mark.parametrize("theta", [0.75, 1.0])
+def test_theta_above_half_balances_with_its_numerical_dissipation(theta):
+    """θ > ½ dissipates (θ − ½)(ΔvᵀMΔv + ΔqᵀKΔq) a step (docs/moreau-jean.md "Energy"): that
+    term goes with the impulses' work into energy.impact, so P2 (e = 0.8, linear spring)
+    balances to round-off at any θ (an identity of the method; it was a false 'step too
+    large' warning at θ = 1) and the impacts and the scheme together take energy out."""
+    import tomllib
+    import martello
+    from martello.run import run_full
+    path = Path(__file__).resolve().parent.parent / "benchmarks/p2/p2_moreau_jean_e08.toml"
+    d = tomllib.loads(path.read_text())
+    d.pop("check", None)
+    d["analysis"]["theta"] = theta
+    s, _ = run_full(martello.Scene.from_dict(d, base_dir=path.parent))
+    assert s["status"] == "MARTELLO_OK" and s["warnings"] == []
+    assert s["energy"]["balance_relative"] < 1e-12
+    assert s["energy"]["impact"] > 0

@@ -75,8 +75,14 @@ def test_md_cell_keeps_a_table_row_one_row():
 
 
 def test_tiny_study_end_to_end(tmp_path):
+    # an earlier study's folder: replaced whole, its stale file gone (docs/studies.md)
+    (tmp_path / "out").mkdir()
+    (tmp_path / "out" / "runs.csv").write_text("old\n")
+    (tmp_path / "out" / "stale.png").write_text("old\n")
     r = martello("study", write(tmp_path, TINY), "-o", tmp_path / "out", "-j", "2")
     assert r.returncode == 0, r.stderr
+    assert not (tmp_path / "out" / "stale.png").exists()
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["out", "study.toml"]  # no temporaries
     rows = list(csv.DictReader(open(tmp_path / "out" / "runs.csv")))
     # one row per run, failed or not: 2 schemes x (3 + 2) steps
     assert len(rows) == 10
@@ -110,6 +116,16 @@ def test_tiny_study_end_to_end(tmp_path):
     assert any(table_cells(ln)[0] == r"linear \| penalty linear" for ln in table)
     assert "/10 runs" in r.stderr            # the progress bar
     assert "p = " in r.stdout
+
+
+def test_study_output_folder_of_something_else_is_refused_before_any_run(tmp_path):
+    (tmp_path / "out").mkdir()
+    (tmp_path / "out" / "notes.txt").write_text("mine\n")
+    r = martello("study", write(tmp_path, TINY), "-o", tmp_path / "out")
+    assert r.returncode == 1 and len(r.stderr.strip().splitlines()) == 1
+    assert "holds files of something else (notes.txt)" in r.stderr and "runs" not in r.stdout
+    assert [p.name for p in (tmp_path / "out").iterdir()] == ["notes.txt"]
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["out", "study.toml"]
 
 
 @pytest.mark.parametrize("text,match", [

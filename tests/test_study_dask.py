@@ -27,9 +27,11 @@ rtol = [1e-6, 1e-8, 1e-10]
 """
 
 # Starts a LocalCluster of two worker processes (one thread each, as docs/studies.md asks of
-# real workers) and runs the study on it through the command line.
+# real workers) and runs the study on it through the command line, the cluster named by the
+# study file's own `scheduler` key (written at the top of a copy of it).
 DASK_RUN = """
 import sys, time
+from pathlib import Path
 from distributed import LocalCluster
 from martello.cli import main
 if __name__ == "__main__":
@@ -37,7 +39,9 @@ if __name__ == "__main__":
     with LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
                       dashboard_address=":0") as cluster:
         t1 = time.perf_counter()
-        rc = main(["study", sys.argv[1], "-o", sys.argv[2], "--scheduler", cluster.scheduler_address])
+        study = Path(sys.argv[1]).with_name("on_dask.toml")
+        study.write_text(f'scheduler = "{cluster.scheduler_address}"\\n' + Path(sys.argv[1]).read_text())
+        rc = main(["study", str(study), "-o", sys.argv[2]])
         print(f"cluster start {t1 - t0:.1f} s, study {time.perf_counter() - t1:.1f} s")
     sys.exit(rc)
 """

@@ -8,17 +8,23 @@ functions built on it), never copied here."""
 
 import ctypes
 import os
+import signal
+import threading
+from contextlib import contextmanager
 from collections import namedtuple
 from functools import lru_cache
 from pathlib import Path
 
 import numpy as np
 
-from ..errors import MartelloError, SolverError, DivergenceError
+from ..errors import MartelloError, SolverError, DivergenceError, Interrupted
 from ..paths import LIBRARIES
 _DOUBLE_P = np.ctypeslib.ndpointer(dtype=np.float64, flags="C_CONTIGUOUS")
 _INT_P = np.ctypeslib.ndpointer(dtype=np.int32, flags="C_CONTIGUOUS")
 _VOID_P = ctypes.c_void_p
+# martello_progress_fn of c/martello.h: (user, t, t_end, steps, elapsed) -> 0 to go on
+PROGRESS_FN = ctypes.CFUNCTYPE(ctypes.c_int, ctypes.c_void_p, ctypes.c_double, ctypes.c_double,
+                               ctypes.c_longlong, ctypes.c_double)
 
 
 def library_path():
@@ -73,6 +79,9 @@ def lib():
         "martello_run_settings": (c_int, [_VOID_P, _VOID_P]),
         "martello_run_set_outputs": (c_int, [_VOID_P, c_int, _INT_P, c_int, _INT_P]),
         "martello_dynamic_run": (c_int, [_VOID_P, _VOID_P]),
+        "martello_run_set_progress": (c_int, [_VOID_P, PROGRESS_FN, _VOID_P]),
+        "martello_closed_form": (c_int, [c_char_p, _DOUBLE_P, c_int, _DOUBLE_P,
+                                         ctypes.POINTER(c_int)]),
         "martello_run_message": (c_int, [_VOID_P, c_char_p, c_int]),
         "martello_run_history_shape": (c_int, [_VOID_P, ctypes.POINTER(c_int), ctypes.POINTER(c_int)]),
         "martello_run_history": (c_int, [_VOID_P, _DOUBLE_P]),
@@ -301,6 +310,8 @@ class _Handle:
         if status < 0:
             cls = DivergenceError if status in (constant("MARTELLO_ERR_DIVERGED"),
                                                 constant("MARTELLO_ERR_UNSTABLE")) else SolverError
+            if status == constant("MARTELLO_ERR_INTERRUPTED"):
+                cls = Interrupted
             raise cls(status, status_name(status), f"{what}: {self.message()}")
         return status
 
@@ -412,12 +423,21 @@ class Run(_Handle):
         return f[:n_links], du[:n_links]
 
     def execute(self, model):
-        """Run; raises on failure (DivergenceError for diverged/unstable runs)."""
-        return self._check(lib().martello_dynamic_run(model.handle, self._h), "dynamic run")
+        """Run; raises on failure (DivergenceError for diverged/unstable runs, Interrupted
+        after Ctrl-C)."""
+        return self._check(self.status_of(model), "dynamic run")
 
     def status_of(self, model):
-        """Run without raising; returns the status code (for studies that classify failures)."""
-        return lib().martello_dynamic_run(model.handle, self._h)
+        """Run without raising; returns the status code (for studies that classify failures).
+        The native loop calls back about four times a second: the reporter of ``reporting``
+        (if any) sees its progress, and Ctrl-C (SIGINT, in the main thread) stops it cleanly
+        with MARTELLO_ERR_INTERRUPTED instead of waiting for the end of the run."""
+        with _watch() as callback:
+            lib().martello_run_set_progress(self._h, callback, None)
+            try:
+                return lib().martello_dynamic_run(model.handle, self._h)
+            finally:
+                lib().martello_run_set_progress(self._h, PROGRESS_FN(), None)
 
     def history(self):
         rows, cols = ctypes.c_int(), ctypes.c_int()
@@ -458,3 +478,69 @@ class Run(_Handle):
         d = dict(zip(energy_names(), map(float, e)))
         return d, {"balance_max": float(extra[0]), "omega_max": float(extra[1]),
                    "dt_critical": float(extra[2]), "t_reached": float(extra[3])}
+
+
+def closed_form(name, par):
+    """The library's closed form `name` (docs/c-api.md "Closed forms") at the parameters par:
+    the list of its values. SolverError (MARTELLO_ERR_ARGUMENT) for an unknown name or
+    parameters outside its domain."""
+    p = np.ascontiguousarray(par, dtype=np.float64)
+    out, n = np.zeros(4), ctypes.c_int()
+    st = lib().martello_closed_form(str(name).encode(), p if p.size else np.zeros(1), p.size,
+                                    out, ctypes.byref(n))
+    if st < 0:
+        raise SolverError(st, status_name(st), f"closed form {name!r} at {list(map(float, p))}: "
+                          "unknown, or parameters outside its domain (docs/c-api.md)")
+    return [float(x) for x in out[:n.value]]
+
+
+# --- progress and Ctrl-C of a running native loop ------------------------------------
+
+_reporter = None
+
+
+@contextmanager
+def reporting(reporter):
+    """Within the block, every dynamic run calls reporter(t, t_end, steps, elapsed) about
+    four times a second (martello run's progress line). A reporter that raises stops the
+    run; the exception is raised when the run returns."""
+    global _reporter
+    old, _reporter = _reporter, reporter
+    try:
+        yield
+    finally:
+        _reporter = old
+
+
+@contextmanager
+def _watch():
+    """The progress callback of one run: Ctrl-C (SIGINT, caught here while the native loop
+    runs, when Python's default handler is in place in the main thread) makes it return 1,
+    so the loop stops at its next look at the clock; reports go to the reporter."""
+    state = {"stop": False, "error": None}
+    reporter = _reporter
+
+    def on_sigint(signum, frame):
+        state["stop"] = True
+
+    def progress(user, t, t_end, steps, elapsed):
+        if reporter is not None and not state["stop"]:
+            try:
+                reporter(t, t_end, steps, elapsed)
+            except BaseException as exc:       # noqa: BLE001 - raised after the run
+                state["error"] = exc
+                return 1
+        return 1 if state["stop"] else 0
+
+    callback = PROGRESS_FN(progress)
+    old = None
+    if (threading.current_thread() is threading.main_thread()
+            and signal.getsignal(signal.SIGINT) is signal.default_int_handler):
+        old = signal.signal(signal.SIGINT, on_sigint)
+    try:
+        yield callback
+    finally:
+        if old is not None:
+            signal.signal(signal.SIGINT, old)
+    if state["error"] is not None:
+        raise state["error"]

@@ -77,6 +77,13 @@ def _setting(kind, name, required=False, default=True):
             native.settings_defaults()[name] if default and not required else None)
 
 
+def _whole(spec):
+    """A float setting that must be a whole number (max_steps: up to 2^53, past a 64-bit
+    int's TOML range for none of its values but past the library's 32-bit int for most)."""
+    kind, required, (check, text), default = spec
+    return kind, required, (lambda x: check(x) and float(x).is_integer(), text), default
+
+
 NEWMARK_PRESETS = {"average-acceleration": (0.25, 0.5), "linear-acceleration": (1.0 / 6.0, 0.5)}
 ANALYSIS_TYPES = {
     "static": {"tol": ("float", False, POSITIVE, 1e-14),
@@ -100,6 +107,8 @@ ANALYSIS_TYPES = {
                 "event_tol": _setting("float", "event_tol"),
                 "h_max": _setting("float", "h_max"),
                 "fused_chain": _setting("bool", "fused_chain"),
+                "max_steps": _whole(_setting("float", "max_steps")),
+                "max_wall": _setting("float", "max_wall"),
                 "output": ("table", False, None, None)},
 }
 OUTPUT_KEYS = {"every": _setting("int", "every"), "nodes": ("list", False, None, None),

@@ -47,10 +47,10 @@ import numpy as np
 
 from ..batch import run_specs
 from ..binding import native
-from ..errors import StudyError
+from ..errors import MartelloError, StudyError
 from ..history import history_dict
 from ..oracles.p2_bouncing import bouncing_oscillator_restitution
-from ..paths import OUTPUT_ROOT, REPO
+from ..paths import OUTPUT_ROOT, REPO, folder_replaced
 from ..reference.closed_form import kelvin_bounce_reference, two_body_kelvin_reference
 from ..scene.spec import ADAPTIVE, INTEGRATORS
 from .outcome import failed_rows, status_class
@@ -292,8 +292,6 @@ def point_spec(mp, method, xv, yv, ident):
 
 
 def run_atlas(atlas, outdir, jobs=0, plots=True, stream=sys.stderr):
-    outdir = Path(outdir)
-    outdir.mkdir(parents=True, exist_ok=True)
     t0 = time.perf_counter()
     specs, info = [], {}
     for mp in atlas["maps"]:
@@ -347,13 +345,15 @@ def run_atlas(atlas, outdir, jobs=0, plots=True, stream=sys.stderr):
     rows.sort(key=lambda r: r["run"])
     elapsed = time.perf_counter() - t0
     keys = list(rows[0]) if rows else []
-    with open(outdir / "atlas.csv", "w", newline="") as fh:
-        w = csv.DictWriter(fh, fieldnames=keys)
-        w.writeheader()
-        w.writerows({k: csv_cell(v) for k, v in r.items()} for r in rows)
     bounds = boundaries(rows)
-    pngs = [plot_map(atlas, mp, rows, outdir) for mp in atlas["maps"]] if plots else []
-    _markdown(atlas, rows, bounds, pngs, elapsed, outdir / "atlas.md")
+    # the folder is replaced whole once everything is written (docs/studies.md)
+    with folder_replaced(outdir, "atlas.csv", MartelloError) as tmp:
+        with open(tmp / "atlas.csv", "w", newline="") as fh:
+            w = csv.DictWriter(fh, fieldnames=keys)
+            w.writeheader()
+            w.writerows({k: csv_cell(v) for k, v in r.items()} for r in rows)
+        pngs = [plot_map(atlas, mp, rows, tmp) for mp in atlas["maps"]] if plots else []
+        _markdown(atlas, rows, bounds, pngs, elapsed, tmp / "atlas.md")
     return rows, bounds
 
 

@@ -17,7 +17,7 @@ from ..scene.spec import ADAPTIVE, INTEGRATORS
 from ..scene.variants import override_contacts
 
 STUDY_KEYS = {"title", "description", "output", "t_end", "repeat", "compare", "scene", "scheme",
-              "integrator", "atlas", "kind"}
+              "integrator", "atlas", "kind", "scheduler"}
 SCENE_KEYS = {"file", "label", "reference", "t_end", "scheme"}
 SCHEME_KEYS = {"label", "contact", "reference", "scenes"}
 INTEGRATOR_KEYS = {"name", "label", "params", "dt", "rtol", "order", "scenes", "schemes"}
@@ -61,6 +61,7 @@ class Study:
     cases: list
     methods: list
     raw: dict = field(default_factory=dict)
+    scheduler: str | None = None     # a Dask scheduler's address (--scheduler overrides it)
 
 
 MAX_LEVELS = 10_000     # steps or tolerances one integrator sweeps
@@ -212,8 +213,13 @@ def load_study(path):
         methods.append(Method(label=it.get("label", method_label(name, params)), name=name,
                               params=params, dts=dts, rtols=rtols,
                               order=it.get("order"), scenes=it.get("scenes"), schemes=it.get("schemes")))
+    scheduler = raw.get("scheduler")
+    if scheduler is not None and not (isinstance(scheduler, str) and scheduler.strip()):
+        raise StudyError(path, "scheduler", f"is {scheduler!r}"[:100],
+                         "the address of a Dask scheduler, e.g. \"tcp://host:8786\", or the path "
+                         "of its scheduler file (.json)")
     return Study(path=path, title=raw.get("title", path.stem), description=raw.get("description", ""),
-                 output=raw.get("output"), compare=compare,
+                 output=raw.get("output"), compare=compare, scheduler=scheduler,
                  repeat=_number(path, "repeat", raw.get("repeat", 1), int, True),
                  cases=cases, methods=methods, raw=raw)
 

@@ -25,7 +25,7 @@ from ..batch import run_specs
 from ..binding import native
 from ..errors import MartelloError, SceneError
 from ..metrics.score import COST_KEYS, cost, score
-from ..paths import OUTPUT_ROOT, REPO
+from ..paths import OUTPUT_ROOT, REPO, folder_replaced
 from ..reference.selection import reference_for_scene
 from ..scene.loader import from_dict
 from ..scene.spec import ADAPTIVE
@@ -335,33 +335,34 @@ def run_study(study, outdir, jobs=0, plots=True, stream=None, executor=None, whe
     The runs go to local processes, or to `executor` (a Dask cluster's: study.cluster),
     described by `where`. Returns (rows, order_rows)."""
     stream = stream or sys.stderr
-    outdir = Path(outdir)
-    outdir.mkdir(parents=True, exist_ok=True)
     t0 = time.perf_counter()
     specs, refs, notes = build_specs(study)
-    print(f"{study.title}: {len(study.cases)} case(s) x {len(study.methods)} method(s): "
-          f"{len(specs)} runs on {where or f'{jobs or os.cpu_count()} worker(s)'}", file=stream)
-    progress = Progress(len(specs), stream=stream)
-    by_id = {s["id"]: s for s in specs}
-    rows = []
-    for res in run_specs(specs, jobs, progress, executor=executor):
-        spec = by_id[res["id"]]
-        rows.append(make_row(study, spec, res, refs.get(spec["case"])))
-    rows.sort(key=lambda r: r["run"])
-    elapsed = time.perf_counter() - t0
-    write_csv(rows, outdir / "runs.csv")
-    order_rows = orders(study, rows, refs)
-    with open(outdir / "orders.csv", "w", newline="") as fh:
-        if order_rows:
-            w = csv.DictWriter(fh, fieldnames=list(order_rows[0]))
-            w.writeheader()
-            w.writerows({k: csv_cell(v) for k, v in o.items()} for o in order_rows)
-    pngs = []
-    if plots:
-        for ci, case in enumerate(study.cases):
-            if any(r["case"] == case.label for r in rows):
-                pngs.append(plot_case(study, case, ci, rows, order_rows, refs.get(ci), outdir))
-    _markdown(study, rows, order_rows, refs, notes, pngs, elapsed, outdir / "study.md")
+    # the folder is refused before any run if it is not a study's, and replaced whole once
+    # everything is written (docs/studies.md)
+    with folder_replaced(outdir, "runs.csv", MartelloError) as tmp:
+        print(f"{study.title}: {len(study.cases)} case(s) x {len(study.methods)} method(s): "
+              f"{len(specs)} runs on {where or f'{jobs or os.cpu_count()} worker(s)'}", file=stream)
+        progress = Progress(len(specs), stream=stream)
+        by_id = {s["id"]: s for s in specs}
+        rows = []
+        for res in run_specs(specs, jobs, progress, executor=executor):
+            spec = by_id[res["id"]]
+            rows.append(make_row(study, spec, res, refs.get(spec["case"])))
+        rows.sort(key=lambda r: r["run"])
+        elapsed = time.perf_counter() - t0
+        order_rows = orders(study, rows, refs)
+        write_csv(rows, tmp / "runs.csv")
+        with open(tmp / "orders.csv", "w", newline="") as fh:
+            if order_rows:
+                w = csv.DictWriter(fh, fieldnames=list(order_rows[0]))
+                w.writeheader()
+                w.writerows({k: csv_cell(v) for k, v in o.items()} for o in order_rows)
+        pngs = []
+        if plots:
+            for ci, case in enumerate(study.cases):
+                if any(r["case"] == case.label for r in rows):
+                    pngs.append(plot_case(study, case, ci, rows, order_rows, refs.get(ci), tmp))
+        _markdown(study, rows, order_rows, refs, notes, pngs, elapsed, tmp / "study.md")
     for n in notes:
         print(f"note: {n}", file=stream)
     return rows, order_rows
@@ -372,7 +373,9 @@ def main(args):
     study = load_study(path)
     out = Path(args.output) if args.output else (OUTPUT_ROOT / study.output if study.output
                                                  else Path("out") / "studies" / path.stem)
-    scheduler = getattr(args, "scheduler", None)
+    scheduler = getattr(args, "scheduler", None) or study.scheduler
+    if scheduler and not getattr(args, "scheduler", None) and scheduler.endswith(".json"):
+        scheduler = str(path.parent / scheduler)     # a scheduler file beside the study file
     if scheduler:
         from .cluster import dask_executor
         with dask_executor(scheduler) as (executor, workers):

@@ -1,0 +1,158 @@
+"""The run layer's guards on cost and on the caller: 64-bit step counts, the max_steps and
+max_wall budget, the progress callback and Ctrl-C through it, a history grown as needed,
+and the warning of a run let past its stability limit (docs/behaviour.md "Failures and
+limits", docs/scene-input.md). Failures are asserted by message, exit code and the absence of
+output."""
+
+import os
+import re
+import signal
+import subprocess
+import sys
+import time
+
+import numpy as np
+import pytest
+
+import martello
+from martello.binding import native
+from benchmarks.fuzz.mutations import to_toml
+from divergence_cases import p2
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+
+
+def _write(tmp_path, d, name="scene"):
+    f = tmp_path / f"{name}.toml"
+    f.write_text(to_toml(d))
+    return f
+
+
+def _cli(*args):
+    return subprocess.run([sys.executable, "-m", "martello", *map(str, args)], cwd=ROOT,
+                          capture_output=True, text=True)
+
+
+def test_more_steps_than_a_32_bit_int_are_refused_by_the_budget_or_counted(tmp_path):
+    """P2 at dt = 1e-10 s to t_end = 0.7 s needs 7e9 steps, past 2^31 = 2.1e9: with the
+    default max_steps = 1e8 it is refused before its first step; with max_steps = 1e12 it
+    runs (no wrap to one step reported OK) until max_wall = 0.5 s stops it, and the time it
+    reached is its step count times dt (each step is dt: t_k = k dt)."""
+    d = p2(dt=1e-10, t_end=0.7, output={"every": 10 ** 9})
+    assert 0.7 / 1e-10 > 2 ** 31
+    r = _cli("run", _write(tmp_path, d), "-o", tmp_path / "o1", "--force")
+    err = r.stderr.strip().splitlines()[-1]
+    assert r.returncode == 1 and "MARTELLO_ERR_LIMIT" in err
+    assert re.search(r"needs at least +7.000E\+09 steps .* max_steps = +1.000E\+08", err), err
+    assert not (tmp_path / "o1").exists()
+    d["analysis"].update(max_steps=1e12, max_wall=0.5)
+    r = _cli("run", _write(tmp_path, d, "wall"), "-o", tmp_path / "o2", "--force")
+    err = r.stderr.strip().splitlines()[-1]
+    assert r.returncode == 1 and "MARTELLO_ERR_LIMIT" in err and "ran for max_wall" in err
+    m = re.search(r"\((\d+) steps\) and reached t = +(\S+) s", err)
+    steps, t = int(m.group(1)), float(m.group(2))
+    assert steps > 1000 and t == pytest.approx(steps * 1e-10, rel=1e-5)  # t printed to 6 digits
+    assert not (tmp_path / "o2").exists()
+
+
+def test_max_steps_must_be_a_whole_number(tmp_path):
+    r = _cli("run", _write(tmp_path, p2(max_steps=1e4 + 0.5)), "-o", tmp_path / "o")
+    assert r.returncode == 1 and len(r.stderr.strip().splitlines()) == 1
+    assert "analysis.max_steps" in r.stderr and "whole number" in r.stderr
+
+
+def test_progress_reaches_the_caller_with_growing_time_and_steps():
+    """The native loop reports about four times a second: t rises to t_end, steps with it,
+    and t = steps x dt on the fixed step (each report is a state of the grid)."""
+    calls = []
+    d = p2(dt=1e-7, t_end=0.15, output={"every": 10 ** 6})     # 1.5e6 steps, about a second
+    with native.reporting(lambda t, t_end, steps, elapsed: calls.append((t, t_end, steps, elapsed))):
+        res = martello.run(martello.Scene.from_dict(d))
+    assert res.status == "MARTELLO_OK"
+    if not calls:
+        pytest.skip("the run took under a quarter of a second: nothing to report")
+    t, t_end, steps, elapsed = map(np.array, zip(*calls))
+    assert np.all(np.diff(t) > 0) and np.all(np.diff(steps) > 0) and np.all(np.diff(elapsed) > 0)
+    assert np.all(t_end == 0.15) and np.all(t <= 0.15)
+    assert np.allclose(t, steps * 1e-7, rtol=1e-9)
+
+
+def test_a_reporter_that_fails_stops_the_run_and_its_error_is_raised():
+    d = p2(dt=1e-7, t_end=0.7, output={"every": 10 ** 6})
+    seen = []
+
+    def reporter(t, t_end, steps, elapsed):
+        seen.append(t)
+        raise RuntimeError("reporter broke")
+
+    t0 = time.perf_counter()
+    with native.reporting(reporter), pytest.raises(RuntimeError, match="reporter broke"):
+        martello.run(martello.Scene.from_dict(d))
+    assert len(seen) == 1 and time.perf_counter() - t0 < 3.0    # stopped at the first report
+
+
+def test_ctrl_c_stops_the_native_loop_says_so_exits_130_and_writes_nothing(tmp_path):
+    """A run of about 50 s (P2 at dt = 1e-8 s): once its progress line shows it running,
+    SIGINT stops it within a second or two, with one line 'interrupted at t = ...: nothing
+    written' and exit code 130; no output folder appears."""
+    d = p2(dt=1e-8, t_end=0.7, output={"every": 10 ** 9})
+    out = tmp_path / "o"
+    p = subprocess.Popen([sys.executable, "-m", "martello", "run", str(_write(tmp_path, d)),
+                          "-o", str(out), "--progress", "--force"], cwd=ROOT, text=True,
+                         stderr=subprocess.PIPE, stdout=subprocess.DEVNULL,
+                         # a background job may inherit SIGINT ignored: restore the default
+                         preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
+    lines = []
+    try:
+        while True:
+            line = p.stderr.readline()
+            assert line, f"the run ended before reporting progress: {lines}"
+            lines.append(line)
+            if line.startswith("t = "):
+                break
+        assert re.match(r"t = \S+ of 0.7 s \(\S+ %\), \S+ steps, \S+ steps/s, ETA ", line), line
+        p.send_signal(signal.SIGINT)
+        t0 = time.perf_counter()
+        _, rest = p.communicate(timeout=20)
+        waited = time.perf_counter() - t0
+    finally:
+        if p.poll() is None:
+            p.kill()
+    assert p.returncode == 130 and waited < 5.0
+    last = rest.strip().splitlines()
+    assert len([l for l in last if not l.startswith("t = ")]) == 1
+    assert re.fullmatch(r"martello: interrupted at t = +\S+ s \(\d+ steps\): nothing written", last[-1])
+    assert not out.exists() and not any(tmp_path.glob(".o.*"))
+
+
+def test_no_progress_line_unless_asked_when_stderr_is_not_a_terminal(tmp_path):
+    d = p2(dt=1e-7, t_end=0.2, output={"every": 10 ** 6})   # 2e6 steps: over a second
+    r = _cli("run", _write(tmp_path, d), "-o", tmp_path / "o")
+    assert r.returncode == 0 and not [l for l in r.stderr.splitlines() if l.startswith("t = ")]
+
+
+def test_history_grows_past_its_first_allocation():
+    """The history starts at 4096 rows and doubles as needed: 20 000 steps recorded each give
+    20 001 rows at t = k dt (free flight at 1 m/s: u = t, an identity of any method)."""
+    d = {"node": [{"name": "m", "mass": 1.0, "v0": 1.0}],
+         "analysis": {"type": "dynamic", "integrator": "newmark", "dt": 1e-4, "t_end": 2.0,
+                      "output": {"every": 1}}}
+    res = martello.run(martello.Scene.from_dict(d))
+    t, u = res.data[:, 0], res.data[:, res.columns.index("u:m")]
+    assert len(t) == 20001
+    assert np.allclose(t, np.arange(20001) * 1e-4, rtol=0, atol=1e-12)
+    assert np.allclose(u, t, rtol=0, atol=1e-10)   # 2e4 roundings of u + h v, ~2e-16 each
+
+
+def test_a_run_let_past_its_stability_limit_says_so_first(tmp_path):
+    """check_stability = false, central difference at dt = 0.21 s > 2/omega = 0.2 s on a
+    10 rad/s oscillator, for 2 steps: the energy has not grown tenfold yet, so no guard stops
+    it; the summary's first warning says it is past the limit."""
+    d = {"node": [{"name": "m", "mass": 1.0, "u0": 0.01}],
+         "link": [{"type": "spring", "a": "m", "b": "ground", "k": 100.0}],
+         "analysis": {"type": "dynamic", "integrator": "central-difference", "dt": 0.21,
+                      "t_end": 0.42, "check_stability": False}}
+    res = martello.run(martello.Scene.from_dict(d))
+    assert res.status == "MARTELLO_OK"
+    assert res.summary["stability"]["dt_critical"] == pytest.approx(0.2, rel=1e-12)
+    assert "past the stability limit dt_crit = 0.2 s" in res.summary["warnings"][0]
