@@ -87,6 +87,7 @@ typedef struct {
    * roots 2 nc .. 2 nc + nsw - 1 */
   int nsw, *sw_a, *sw_b;
   double *sw_al, *sw_be, *sw_ga;
+  double *t_impact, *flight;  /* per rigid contact: its last impact, the flight that ended there */
   /* settings */
   double rtol, atol, event_tol, t_end, h_max, out_dt, dt;
   int every;     /* output intervals dt per stop time out_dt */
@@ -144,6 +145,14 @@ static void apply_B(const ida_problem *P, const double *lam, double *x) {
 }
 
 static double dot_B(const ida_problem *P, int j, const double *x) { return pen_rate(P, j, x); }
+
+/* The first recorded output time after t (t = k every dt, or t_end): the horizon of the
+ * accumulation policy. */
+static double next_output(const ida_problem *P, double t) {
+  double k = floor(t / P->out_dt) + 1.0, tk;
+  while ((tk = k * P->every * P->dt) <= t) k += 1.0;
+  return fmin(tk, P->t_end);
+}
 
 /* Gap within which a rigid contact touches (see POSITION_TOL_FACTOR). */
 static double position_tol(const ida_problem *P, int j, const double *u) {
@@ -413,6 +422,9 @@ static int rigid_impacts(ida_problem *P, double t, double *u, double *v) {
       if (P->rhs[k] > 0.0 && !P->closed[r]) {
         P->hit[r] = 1;
         P->w_in[j] = P->w0[k];
+        /* the impact sequence the accumulation policy reads */
+        P->flight[r] = P->t_impact[r] >= 0.0 ? t - P->t_impact[r] : 0.0;
+        P->t_impact[r] = t;
         if (P->act[j] != ACT_IMPACT) P->events++;
       }
     }
@@ -448,8 +460,8 @@ static int rigid_impacts(ida_problem *P, double t, double *u, double *v) {
     double e = P->rest[j] >= 0.0 ? P->rest[j] : 0.0;
     for (int l = 0; l < mc; l++) an -= P->S[k + ma * l] * P->w0[l];
     /* tentative: rigid_multipliers opens it again if its multiplier is not compressive */
-    if (martello_impulse_accumulation(e, rebound, an, t, P->event_tol, position_tol(P, j, u),
-                                      &t_inf))
+    if (martello_impulse_accumulation(e, rebound, an, t, P->flight[r], P->event_tol,
+                                      next_output(P, t), P->t_end, &t_inf))
       P->closed[r] = 1;
   }
   return project_closed(P, t, u, v);
@@ -749,7 +761,7 @@ static void release(ida_problem *P) {
                  P->rig_con, P->iu, P->iv, P->ip, P->im, P->closed, P->act,
                  P->opened, P->was_closed, P->hit, P->cand, P->q, P->w0, P->w_in, P->u, P->v, P->a, P->x, P->uq, P->vq, P->fint, P->fext,
                  P->force, P->lam, P->S, P->rhs, P->mb, P->cols, P->dc, P->aset,
-                 P->sw_a, P->sw_b, P->sw_al, P->sw_be, P->sw_ga};
+                 P->sw_a, P->sw_b, P->sw_al, P->sw_be, P->sw_ga, P->t_impact, P->flight};
   for (size_t k = 0; k < sizeof all / sizeof all[0]; k++) free(all[k]);
   if (P->ev) martello_eval_free(&P->ev);
 }
@@ -864,6 +876,8 @@ static int setup(ida_problem *P, martello_model *model, martello_run *run) {
   P->act = take(ucn, sizeof(int), &ok);
   P->w_in = take(ucn, sizeof(double), &ok);
   P->force = take(ucn, sizeof(double), &ok);
+  P->t_impact = take(nr, sizeof(double), &ok);
+  P->flight = take(nr, sizeof(double), &ok);
   double **work[] = {&P->u, &P->v, &P->a, &P->x, &P->uq, &P->vq, &P->fint, &P->fext, &P->mb};
   for (size_t k = 0; k < sizeof work / sizeof work[0]; k++) *work[k] = take(un, sizeof(double), &ok);
   if (!ok) return fail(P, MARTELLO_ERR_MEMORY, "IDA: out of memory");
@@ -883,6 +897,7 @@ static int setup(ida_problem *P, martello_model *model, martello_run *run) {
     }
   }
   P->N = pos;
+  for (int r = 0; r < P->nr; r++) P->t_impact[r] = -1.0;   /* no impact yet */
   if ((st = martello_eval_create(model, &P->ev)) != MARTELLO_OK)
     return fail(P, st, "IDA: could not create the force evaluator");
   /* every switching surface of the laws is a root: hold them on smooth branches */
