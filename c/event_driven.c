@@ -807,6 +807,59 @@ static int locate(ed_t *w, double t0, double t1, double *te) {
 
 /* ---- observation ----------------------------------------------------------------------- */
 
+/* The extrema of the node displacements inside the smooth stretch (t0, y0) -> (t1, w->y)
+ * (before the events at t1 are processed), located on the stepper's own solution
+ * (docs/run-layer.md, located extrema): a node whose velocity changes sign gets the root
+ * of the derivative of the quintic Hermite interpolant of its u (u, v, a at both ends) as a
+ * first guess, one re-integration to it, and the parabolic correction
+ * u - v^2/(2a) at t - v/a from the re-integrated state: the error is that of the stepper
+ * plus |v|^3 |a'|/a^3, below it wherever the guess is within the interpolant's O(h^5). */
+static int node_extrema(ed_t *w, double t0, double t1) {
+  const int n = w->n;
+  const double h = t1 - t0;
+  int i, st, have_end = 0;
+  if (!(h > 0.0)) return MARTELLO_OK;
+  for (i = 0; i < n; i++) {
+    const double v0 = w->y0[n + i], v1 = w->y[n + i];
+    int is_max, it;
+    hermite_t p;
+    double lo = 0.0, hi = 1.0, tm, uc, vc, ac, tau;
+    if (w->fixed[i]) continue;
+    if (v0 > 0.0 && v1 <= 0.0) is_max = 1;
+    else if (v0 < 0.0 && v1 >= 0.0) is_max = 0;
+    else continue;
+    if (v1 == 0.0) {   /* the step ends on it */
+      st = martello_observer_extremum(w->obs, i, t1, w->y[i], is_max);
+      if (st != MARTELLO_OK) return fail(w, st, t1, "event-driven: martello_observer_extremum failed");
+      continue;
+    }
+    if (!have_end) {   /* the acceleration at the end of the stretch */
+      st = eval_point(w, t1, w->y, w->f1, NULL);
+      if (st != MARTELLO_OK) return fail_eval(w, st, t1);
+      have_end = 1;
+    }
+    hermite_build(&p, h, w->y0[i], v0, w->fstart[n + i], w->y[i], v1, w->f1[n + i]);
+    for (it = 0; it < 60; it++) {
+      const double mid = 0.5 * (lo + hi);
+      if ((hermite_rate(&p, mid) > 0.0) == (v0 > 0.0)) lo = mid; else hi = mid;
+    }
+    tm = t0 + 0.5 * (lo + hi) * h;
+    st = reintegrate(w, t0, tm - t0, w->yc);
+    if (st != MARTELLO_OK) return st;
+    st = eval_point(w, tm, w->yc, w->fj, NULL);
+    if (st != MARTELLO_OK) return fail_eval(w, st, tm);
+    uc = w->yc[i]; vc = w->yc[n + i]; ac = w->fj[n + i];
+    tau = (ac != 0.0) ? -vc / ac : 0.0;
+    if (fabs(tau) <= h) {
+      uc += vc * tau + 0.5 * ac * tau * tau;
+      tm += tau;
+    }
+    st = martello_observer_extremum(w->obs, i, tm, uc, is_max);
+    if (st != MARTELLO_OK) return fail(w, st, tm, "event-driven: martello_observer_extremum failed");
+  }
+  return MARTELLO_OK;
+}
+
 /* Accept the state w->y at t: path-dependent links commit, and the works since the last
  * accepted state go to the observer (w_start: the work integrals y[2n .. 2n+3] there). */
 static int commit(ed_t *w, double t, const double *w_start) {
@@ -1033,6 +1086,8 @@ static int ed_integrate(ed_t *w) {
     kinematics(w, w->y, w->f1 + n, w->pen1, w->rate1, w->acc1);
     ev = locate(w, t0, t, &te);
     if (ev < 0) return ev;
+    st = node_extrema(w, t0, ev == 1 ? te : t);
+    if (st != MARTELLO_OK) return st;
     if (ev == 1) {
       t = te;
       st = process_events(w, t);

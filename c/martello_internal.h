@@ -66,6 +66,10 @@ int martello_observer_begin(martello_observer *obs, martello_eval *ev, const dou
  * Returns MARTELLO_ERR_DIVERGED (message set) when the run must stop. */
 int martello_observer_sample(martello_observer *obs, martello_eval *ev, double t, const double *u,
                              const double *v, const double *a, const double *force, int k);
+/* An extremum of node `node`'s displacement located inside an accepted step (the root of its
+ * velocity), at t with value u; maximum = 1 for a maximum, 0 for a minimum. From the first
+ * call on, u_peak holds located maxima only. */
+int martello_observer_extremum(martello_observer *obs, int node, double t, double u, int maximum);
 /* Work increments since the last call [J], integrated along the method's own solution:
  * external, total internal (f_int . v), of the links other than dampers and of the penalty
  * contacts (martello_eval_power), and the kinetic energy impulses took out. Damping is
