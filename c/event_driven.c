@@ -80,6 +80,7 @@ typedef struct {
   int *ilist, *hk;
   double *Wl, *ql, *pl, *wl, *sl, *el, *tg;
   double *t_hold;                 /* predicted accumulation time of a contact being held */
+  double *t_impact, *flight;      /* per contact: its last impact, the flight that ended there */
   /* the switches of the laws' branches (martello_eval_switches), refreshed at every commit */
   int nsw, *sw_a, *sw_b;
   double *sw_al, *sw_be, *sw_ga;
@@ -142,14 +143,13 @@ static double gap_tol(const ed_t *w, int j, const double *u) {
   return 16.0 * DBL_EPSILON * gap_scale(w, j, u) + w->atol;
 }
 
-/* The height of the flights the integrator resolves (the band of the accumulation policy,
- * docs/impulse.md §4): RESOLUTION_MARGIN times the position error it controls, atol + rtol
- * (|u_a| + |u_b| + |gap|). A margin of 1 is not enough: msbdf locates events on rk4imp runs
- * that do not resolve flights at their own error level (measured on P2, e = 0.8, rtol 1e-12:
- * the Zeno time moves by 5.0e-6 s with a margin of 1, 2.5e-7 s with 1e3). */
-#define RESOLUTION_MARGIN 1.0e3
-static double position_res(const ed_t *w, int j, const double *u) {
-  return RESOLUTION_MARGIN * (w->atol + w->rtol * gap_scale(w, j, u));
+/* The first recorded output time after t (t = k every dt, or t_end): the horizon of the
+ * accumulation policy. */
+static double next_output(const ed_t *w, double t) {
+  const double di = w->dt_out * w->every;
+  double k = floor(t / di) + 1.0, tk;
+  while ((tk = k * w->every * w->dt_out) <= t) k += 1.0;
+  return fmin(tk, w->t_end);
 }
 
 /* The value of switch slot s on the state y: g > 0 once its branch is left. */
@@ -402,6 +402,9 @@ static int impacts(ed_t *w, double t, int *n_impacts) {
     if (w->held[jj]) continue;   /* a persistent contact takes its share without an event */
     martello_observer_add_impact(w->obs, jj, t, w->sl[k], r_after,
                                  fmax(gdot(w, jj, u) - w->gap[jj], 0.0), w->pl[k]);
+    /* the impact sequence the accumulation policy reads */
+    w->flight[jj] = w->t_impact[jj] >= 0.0 ? t - w->t_impact[jj] : 0.0;
+    w->t_impact[jj] = t;
     w->cnt[MARTELLO_COUNTER_EVENTS]++;
     (*n_impacts)++;
   }
@@ -431,8 +434,8 @@ static int accumulations(ed_t *w, double t, int *changed) {
       /* the free system presses a held contact with (W_H P_H)_j */
       for (k = 0; k < w->nh && w->hlist[k] != j; k++) continue;
       for (acc = 0.0, l = 0; l < w->nh; l++) acc += w->Wl[k + w->nh * l] * w->lam1[w->hlist[l]];
-      if (martello_impulse_accumulation(w->e[j], s, acc, t, w->event_tol, position_res(w, j, u),
-                                        &t_inf)) {
+      if (martello_impulse_accumulation(w->e[j], s, acc, t, w->flight[j], w->event_tol,
+                                        next_output(w, t), w->t_end, &t_inf)) {
         w->ilist[m++] = j;
       } else {
         *changed = 1;
@@ -441,8 +444,9 @@ static int accumulations(ed_t *w, double t, int *changed) {
     }
     if (gdot(w, j, u) - w->gap[j] < -gap_tol(w, j, u)) continue;
     acc = gdot(w, j, w->f + w->n);
-    if (!(acc > 0.0) || !martello_impulse_accumulation(w->e[j], s, acc, t, w->event_tol,
-                                                       position_res(w, j, u), &t_inf))
+    if (!(acc > 0.0) || !martello_impulse_accumulation(w->e[j], s, acc, t, w->flight[j],
+                                                       w->event_tol, next_output(w, t),
+                                                       w->t_end, &t_inf))
       continue;
     w->t_hold[j] = t_inf;
     w->ilist[m++] = j;
@@ -803,6 +807,59 @@ static int locate(ed_t *w, double t0, double t1, double *te) {
 
 /* ---- observation ----------------------------------------------------------------------- */
 
+/* The extrema of the node displacements inside the smooth stretch (t0, y0) -> (t1, w->y)
+ * (before the events at t1 are processed), located on the stepper's own solution
+ * (docs/run-layer.md, located extrema): a node whose velocity changes sign gets the root
+ * of the derivative of the quintic Hermite interpolant of its u (u, v, a at both ends) as a
+ * first guess, one re-integration to it, and the parabolic correction
+ * u - v^2/(2a) at t - v/a from the re-integrated state: the error is that of the stepper
+ * plus |v|^3 |a'|/a^3, below it wherever the guess is within the interpolant's O(h^5). */
+static int node_extrema(ed_t *w, double t0, double t1) {
+  const int n = w->n;
+  const double h = t1 - t0;
+  int i, st, have_end = 0;
+  if (!(h > 0.0)) return MARTELLO_OK;
+  for (i = 0; i < n; i++) {
+    const double v0 = w->y0[n + i], v1 = w->y[n + i];
+    int is_max, it;
+    hermite_t p;
+    double lo = 0.0, hi = 1.0, tm, uc, vc, ac, tau;
+    if (w->fixed[i]) continue;
+    if (v0 > 0.0 && v1 <= 0.0) is_max = 1;
+    else if (v0 < 0.0 && v1 >= 0.0) is_max = 0;
+    else continue;
+    if (v1 == 0.0) {   /* the step ends on it */
+      st = martello_observer_extremum(w->obs, i, t1, w->y[i], is_max);
+      if (st != MARTELLO_OK) return fail(w, st, t1, "event-driven: martello_observer_extremum failed");
+      continue;
+    }
+    if (!have_end) {   /* the acceleration at the end of the stretch */
+      st = eval_point(w, t1, w->y, w->f1, NULL);
+      if (st != MARTELLO_OK) return fail_eval(w, st, t1);
+      have_end = 1;
+    }
+    hermite_build(&p, h, w->y0[i], v0, w->fstart[n + i], w->y[i], v1, w->f1[n + i]);
+    for (it = 0; it < 60; it++) {
+      const double mid = 0.5 * (lo + hi);
+      if ((hermite_rate(&p, mid) > 0.0) == (v0 > 0.0)) lo = mid; else hi = mid;
+    }
+    tm = t0 + 0.5 * (lo + hi) * h;
+    st = reintegrate(w, t0, tm - t0, w->yc);
+    if (st != MARTELLO_OK) return st;
+    st = eval_point(w, tm, w->yc, w->fj, NULL);
+    if (st != MARTELLO_OK) return fail_eval(w, st, tm);
+    uc = w->yc[i]; vc = w->yc[n + i]; ac = w->fj[n + i];
+    tau = (ac != 0.0) ? -vc / ac : 0.0;
+    if (fabs(tau) <= h) {
+      uc += vc * tau + 0.5 * ac * tau * tau;
+      tm += tau;
+    }
+    st = martello_observer_extremum(w->obs, i, tm, uc, is_max);
+    if (st != MARTELLO_OK) return fail(w, st, tm, "event-driven: martello_observer_extremum failed");
+  }
+  return MARTELLO_OK;
+}
+
 /* Accept the state w->y at t: path-dependent links commit, and the works since the last
  * accepted state go to the observer (w_start: the work integrals y[2n .. 2n+3] there). */
 static int commit(ed_t *w, double t, const double *w_start) {
@@ -837,7 +894,7 @@ static void ed_free(ed_t *w) {
                   w->yerr, w->fstart, w->f, w->f1, w->fj, w->yj, w->fint, w->fext,
                   w->pen0, w->rate0, w->acc0, w->pen1, w->rate1, w->acc1, w->pen, w->rate,
                   w->force, w->lam, w->lam0, w->lam1, w->lamtol, w->hlist, w->held, w->Wh,
-                  w->rh, w->ilist, w->hk, w->Wl, w->ql, w->pl, w->wl, w->sl, w->el, w->tg, w->t_hold,
+                  w->rh, w->ilist, w->hk, w->Wl, w->ql, w->pl, w->wl, w->sl, w->el, w->tg, w->t_hold, w->t_impact, w->flight,
                   w->sw_a, w->sw_b, w->sw_al, w->sw_be, w->sw_ga};
   size_t i;
   for (i = 0; i < sizeof bufs / sizeof bufs[0]; i++) free(bufs[i]);
@@ -891,8 +948,10 @@ static int ed_setup(ed_t *w) {
         ALLOC(w->Wh, (size_t)w->nu * (size_t)w->nu) && ALLOC(w->rh, nc) && ALLOC(w->ilist, nc) &&
         ALLOC(w->Wl, (size_t)w->nu * (size_t)w->nu) && ALLOC(w->ql, nc) && ALLOC(w->pl, nc) &&
         ALLOC(w->wl, nc) && ALLOC(w->sl, nc) && ALLOC(w->el, nc) && ALLOC(w->tg, nc) &&
-        ALLOC(w->hk, nc) && ALLOC(w->t_hold, nc)))
+        ALLOC(w->hk, nc) && ALLOC(w->t_hold, nc) && ALLOC(w->t_impact, nc) &&
+        ALLOC(w->flight, nc)))
     return MARTELLO_ERR_MEMORY;
+  for (j = 0; j < nc; j++) w->t_impact[j] = -1.0;   /* no impact yet */
   st = martello_eval_create(w->model, &w->ev);
   if (st != MARTELLO_OK) return fail(w, st, 0.0, "event-driven: martello_eval_create failed");
   /* every switching surface of the laws is an event: hold them on smooth branches */
@@ -1027,6 +1086,8 @@ static int ed_integrate(ed_t *w) {
     kinematics(w, w->y, w->f1 + n, w->pen1, w->rate1, w->acc1);
     ev = locate(w, t0, t, &te);
     if (ev < 0) return ev;
+    st = node_extrema(w, t0, ev == 1 ? te : t);
+    if (st != MARTELLO_OK) return st;
     if (ev == 1) {
       t = te;
       st = process_events(w, t);

@@ -87,6 +87,8 @@ typedef struct {
    * roots 2 nc .. 2 nc + nsw - 1 */
   int nsw, *sw_a, *sw_b;
   double *sw_al, *sw_be, *sw_ga;
+  double *t_impact, *flight;  /* per rigid contact: its last impact, the flight that ended there */
+  double *v_last;             /* node velocities at the last accepted state (located extrema) */
   /* settings */
   double rtol, atol, event_tol, t_end, h_max, out_dt, dt;
   int every;     /* output intervals dt per stop time out_dt */
@@ -144,6 +146,14 @@ static void apply_B(const ida_problem *P, const double *lam, double *x) {
 }
 
 static double dot_B(const ida_problem *P, int j, const double *x) { return pen_rate(P, j, x); }
+
+/* The first recorded output time after t (t = k every dt, or t_end): the horizon of the
+ * accumulation policy. */
+static double next_output(const ida_problem *P, double t) {
+  double k = floor(t / P->out_dt) + 1.0, tk;
+  while ((tk = k * P->every * P->dt) <= t) k += 1.0;
+  return fmin(tk, P->t_end);
+}
 
 /* Gap within which a rigid contact touches (see POSITION_TOL_FACTOR). */
 static double position_tol(const ida_problem *P, int j, const double *u) {
@@ -413,6 +423,9 @@ static int rigid_impacts(ida_problem *P, double t, double *u, double *v) {
       if (P->rhs[k] > 0.0 && !P->closed[r]) {
         P->hit[r] = 1;
         P->w_in[j] = P->w0[k];
+        /* the impact sequence the accumulation policy reads */
+        P->flight[r] = P->t_impact[r] >= 0.0 ? t - P->t_impact[r] : 0.0;
+        P->t_impact[r] = t;
         if (P->act[j] != ACT_IMPACT) P->events++;
       }
     }
@@ -448,8 +461,8 @@ static int rigid_impacts(ida_problem *P, double t, double *u, double *v) {
     double e = P->rest[j] >= 0.0 ? P->rest[j] : 0.0;
     for (int l = 0; l < mc; l++) an -= P->S[k + ma * l] * P->w0[l];
     /* tentative: rigid_multipliers opens it again if its multiplier is not compressive */
-    if (martello_impulse_accumulation(e, rebound, an, t, P->event_tol, position_tol(P, j, u),
-                                      &t_inf))
+    if (martello_impulse_accumulation(e, rebound, an, t, P->flight[r], P->event_tol,
+                                      next_output(P, t), P->t_end, &t_inf))
       P->closed[r] = 1;
   }
   return project_closed(P, t, u, v);
@@ -749,7 +762,8 @@ static void release(ida_problem *P) {
                  P->rig_con, P->iu, P->iv, P->ip, P->im, P->closed, P->act,
                  P->opened, P->was_closed, P->hit, P->cand, P->q, P->w0, P->w_in, P->u, P->v, P->a, P->x, P->uq, P->vq, P->fint, P->fext,
                  P->force, P->lam, P->S, P->rhs, P->mb, P->cols, P->dc, P->aset,
-                 P->sw_a, P->sw_b, P->sw_al, P->sw_be, P->sw_ga};
+                 P->sw_a, P->sw_b, P->sw_al, P->sw_be, P->sw_ga, P->t_impact, P->flight,
+                 P->v_last};
   for (size_t k = 0; k < sizeof all / sizeof all[0]; k++) free(all[k]);
   if (P->ev) martello_eval_free(&P->ev);
 }
@@ -864,6 +878,9 @@ static int setup(ida_problem *P, martello_model *model, martello_run *run) {
   P->act = take(ucn, sizeof(int), &ok);
   P->w_in = take(ucn, sizeof(double), &ok);
   P->force = take(ucn, sizeof(double), &ok);
+  P->t_impact = take(nr, sizeof(double), &ok);
+  P->v_last = take(un, sizeof(double), &ok);
+  P->flight = take(nr, sizeof(double), &ok);
   double **work[] = {&P->u, &P->v, &P->a, &P->x, &P->uq, &P->vq, &P->fint, &P->fext, &P->mb};
   for (size_t k = 0; k < sizeof work / sizeof work[0]; k++) *work[k] = take(un, sizeof(double), &ok);
   if (!ok) return fail(P, MARTELLO_ERR_MEMORY, "IDA: out of memory");
@@ -883,6 +900,7 @@ static int setup(ida_problem *P, martello_model *model, martello_run *run) {
     }
   }
   P->N = pos;
+  for (int r = 0; r < P->nr; r++) P->t_impact[r] = -1.0;   /* no impact yet */
   if ((st = martello_eval_create(model, &P->ev)) != MARTELLO_OK)
     return fail(P, st, "IDA: could not create the force evaluator");
   /* every switching surface of the laws is a root: hold them on smooth branches */
@@ -926,6 +944,41 @@ static int initial_step(ida_problem *P, double t, const double *u, const double 
     double wu = P->rtol * fabs(u[i]) + P->atol, wv = P->rtol * fabs(v[i]) + P->atol;
     if (ju > 0.0) *h0 = fmin(*h0, SAFETY * sqrt(2.0 * wu / ju));
     if (jv > 0.0) *h0 = fmin(*h0, SAFETY * sqrt(2.0 * wv / jv));
+  }
+  return MARTELLO_OK;
+}
+
+/* The extrema of the node displacements on [t0, t1], inside IDA's last step: a node whose
+ * velocity changes sign against P->v_last gets the root of v located by bisection on IDA's
+ * interpolant (IDAGetDky, of the method's order: the error of the step) and u there
+ * (docs/run-layer.md, located extrema). */
+static int node_extrema(ida_problem *P, void *mem, double t0, double t1, const double *y1,
+                        N_Vector ytmp) {
+  for (int i = 0; i < P->n; i++) {
+    const double v0 = P->v_last[i], v1 = y1[P->iv[i]];
+    int is_max;
+    if (P->fixed[i]) continue;
+    if (v0 > 0.0 && v1 <= 0.0) is_max = 1;
+    else if (v0 < 0.0 && v1 >= 0.0) is_max = 0;
+    else continue;
+    double lo = t0, hi = t1, u = y1[P->iu[i]];
+    for (int it = 0; it < 200 && hi - lo > fmax(P->event_tol, 4.0 * DBL_EPSILON * fabs(hi)); it++) {
+      const double tm = 0.5 * (lo + hi);
+      int flag = IDAGetDky(mem, tm, 0, ytmp);
+      if (flag != IDA_SUCCESS)
+        return fail(P, MARTELLO_ERR_EXTERNAL, "IDAGetDky failed at t = %.9e s: %s", tm,
+                    IDAGetReturnFlagName(flag));
+      if ((N_VGetArrayPointer(ytmp)[P->iv[i]] > 0.0) == (v0 > 0.0)) lo = tm; else hi = tm;
+    }
+    if (hi < t1) {
+      int flag = IDAGetDky(mem, hi, 0, ytmp);
+      if (flag != IDA_SUCCESS)
+        return fail(P, MARTELLO_ERR_EXTERNAL, "IDAGetDky failed at t = %.9e s: %s", hi,
+                    IDAGetReturnFlagName(flag));
+      u = N_VGetArrayPointer(ytmp)[P->iu[i]];
+    }
+    int st = martello_observer_extremum(P->obs, i, hi, u, is_max);
+    if (st != MARTELLO_OK) return fail(P, st, "IDA: martello_observer_extremum failed");
   }
   return MARTELLO_OK;
 }
@@ -1015,6 +1068,7 @@ static int integrate(ida_problem *P, SUNContext sunctx, void **memp, N_Vector yy
   int k_out = 1;
   double t_out = fmin((double)P->every * P->dt, P->t_end), t_last = 0.0;
   if ((st = observe(P, 0.0, N_VGetArrayPointer(yy), N_VGetArrayPointer(yp), 0)) != MARTELLO_OK) return st;
+  for (int i = 0; i < n; i++) P->v_last[i] = N_VGetArrayPointer(yy)[P->iv[i]];
   double t_stop = next_stop(P, 0.0, t_out);
   if ((st = check(P, IDASetStopTime(mem, t_stop), "IDASetStopTime"))) return st;
   int *found = calloc((size_t)(2 * P->nc + P->nsw + 1), sizeof(int));
@@ -1078,6 +1132,7 @@ static int integrate(ida_problem *P, SUNContext sunctx, void **memp, N_Vector yy
       if ((st = check(P, f0 < 0 ? f0 : f1, "IDAGetDky"))) break;
     }
     if ((st = work_quadrature(P, mem, t_last, t_r, ytmp)) != MARTELLO_OK) break;
+    if ((st = node_extrema(P, mem, t_last, t_r, N_VGetArrayPointer(yy), ytmp)) != MARTELLO_OK) break;
     t_last = t_r;
     P->t_now = t_r;
     const double *y = N_VGetArrayPointer(yy);
@@ -1104,6 +1159,7 @@ static int integrate(ida_problem *P, SUNContext sunctx, void **memp, N_Vector yy
     if ((st = observe(P, t_r, N_VGetArrayPointer(yy), N_VGetArrayPointer(yp),
                       at_output ? k_out * P->every : -1)) != MARTELLO_OK)
       break;
+    for (int i = 0; i < n; i++) P->v_last[i] = N_VGetArrayPointer(yy)[P->iv[i]];   /* after a restart's jumps */
     if (at_output) {
       if (t_out >= P->t_end) {
         t_last = P->t_end;

@@ -66,6 +66,10 @@ int martello_observer_begin(martello_observer *obs, martello_eval *ev, const dou
  * Returns MARTELLO_ERR_DIVERGED (message set) when the run must stop. */
 int martello_observer_sample(martello_observer *obs, martello_eval *ev, double t, const double *u,
                              const double *v, const double *a, const double *force, int k);
+/* An extremum of node `node`'s displacement located inside an accepted step (the root of its
+ * velocity), at t with value u; maximum = 1 for a maximum, 0 for a minimum. From the first
+ * call on, u_peak holds located maxima only. */
+int martello_observer_extremum(martello_observer *obs, int node, double t, double u, int maximum);
 /* Work increments since the last call [J], integrated along the method's own solution:
  * external, total internal (f_int . v), of the links other than dampers and of the penalty
  * contacts (martello_eval_power), and the kinetic energy impulses took out. Damping is
@@ -119,13 +123,16 @@ int martello_impulse_factor(int n, int m, const int *list, const int *a, const i
 int martello_impulse_project(int n, int m, const int *list, const int *a, const int *b,
                              const int *col, const double *cols, const double *L,
                              const double *target, double *x, double *P);
-/* The accumulation policy (docs/impulse.md §4): 1 if the impacts of a contact leaving at t
- * with separation speed s >= 0, pressed by the relative acceleration a, restitution e, have
- * accumulated: no rebound, or a next flight 2 s/a shorter than tau_res or lower than
- * height_res (the integrator's resolution). *t_inf = the accumulation point t + 2 s/(a (1 - e))
- * (t without rebound, HUGE_VAL-like when there is none). */
-int martello_impulse_accumulation(double e, double s, double a, double t, double tau_res,
-                                  double height_res, double *t_inf);
+/* The accumulation policy (docs/impulse.md §4, from the impact sequence): 1 if the impacts of
+ * a contact leaving at t with separation speed s >= 0, pressed by the relative acceleration a,
+ * restitution e, have accumulated: no rebound; or, with the accumulation point
+ * *t_inf = t + 2 s/(a (1 - e)) before t_end, a next flight 2 s/a no longer than tau_res (the
+ * method's time resolution) or shorter than the flight tau_prev that ended at t (0: none seen)
+ * with *t_inf strictly before t_horizon (the next output time). *t_inf = t without rebound,
+ * HUGE_VAL-like when there is no accumulation point. */
+int martello_impulse_accumulation(double e, double s, double a, double t, double tau_prev,
+                                  double tau_res, double t_horizon, double t_end,
+                                  double *t_inf);
 
 /* The C integrators, dispatched by martello_dynamic_run. */
 int martello_event_driven_run(martello_model *model, martello_run *run);

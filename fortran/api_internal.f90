@@ -275,6 +275,21 @@ contains
       c_observer_sample = stat
    end function c_observer_sample
 
+   !> A located extremum of node `node` (0-based) at t, value u; maximum = 1 for a maximum.
+   integer(c_int) function c_observer_extremum(handle, node, t, u, maximum) &
+      bind(C, name='martello_observer_extremum')
+      type(c_ptr), value :: handle
+      integer(c_int), value :: node, maximum
+      real(c_double), value :: t, u
+      type(observer_t), pointer :: op
+      op => get_observer(handle)
+      c_observer_extremum = MARTELLO_ERR_ARGUMENT
+      if (.not. associated(op)) return
+      if (node < 0 .or. node >= size(op%u_max)) return
+      call observer_extremum(op, node + 1, t, u, maximum /= 0)
+      c_observer_extremum = MARTELLO_OK
+   end function c_observer_extremum
+
    integer(c_int) function c_observer_work(handle, w_ext, w_int, w_links, w_contact, w_impact) &
       bind(C, name='martello_observer_work')
       type(c_ptr), value :: handle

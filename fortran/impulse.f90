@@ -221,30 +221,38 @@ contains
       call apply_impulses(c, p, x)
    end subroutine project_factored
 
-   !> The accumulation (Zeno) policy, the one rule of every integrator (docs/impulse.md §4).
-   !> A contact leaving at t with separation speed s ≥ 0, pressed by its relative acceleration
-   !> a > 0, makes the geometric series of flights τ, eτ, e²τ, … (τ = 2s/a; Moreau 1988, §9)
-   !> that ends at the accumulation point t∞ = t + 2s/(a(1 − e)), returned in t_inf (huge when
-   !> there is none): the contact is persistent from there. The flights are no longer resolved
-   !> one by one when there is no rebound (s = 0 or e = 0: t∞ = t, and the persistent-contact
-   !> rule decides whether the contact stays closed), or when the next flight is below the
-   !> integrator's resolution: shorter than tau_res (the step of a time-stepping scheme,
-   !> event_tol for the event-driven ones) or with its apex s²/(2a) lower than height_res (0
-   !> for time stepping; the heights an event-driven integrator resolves). Deciding on "t∞
-   !> inside the current interval" was measured and rejected: docs/impulse.md §4 says why.
+   !> The accumulation (Zeno) policy, the one rule of every integrator (docs/impulse.md §4),
+   !> decided from the impact sequence, not from error tolerances. A contact leaving at t with
+   !> separation speed s ≥ 0, pressed by its relative acceleration a > 0, makes the geometric
+   !> series of flights τ, eτ, e²τ, … (τ = 2s/a; Moreau 1988, §9) that ends at the accumulation
+   !> point t∞ = t + 2s/(a(1 − e)), returned in t_inf (huge when there is none): the contact
+   !> is persistent from there. It has accumulated
+   !>  1. with no rebound (s = 0 or e = 0): t∞ = t, the persistent-contact rule decides;
+   !>  2. otherwise only if t∞ < t_end (no event is ever written after the run), and
+   !>     a. the next flight τ is shorter than the method's time resolution tau_res (the step
+   !>        of a time-stepping scheme, event_tol for the event-driven ones: closer events are
+   !>        simultaneous), or
+   !>     b. the sequence is seen to decay — τ shorter than the flight tau_prev that ended at t
+   !>        (0: none observed) — and t∞ comes strictly before t_horizon, the next output time:
+   !>        the rest of the series is over before anything is recorded.
    !> No accumulation without pressing (a ≤ 0) or dissipation (e ≥ 1).
-   pure subroutine impulse_accumulation(e, s, a, t, tau_res, height_res, accumulates, t_inf)
-      real(dp), intent(in) :: e, s, a, t, tau_res, height_res
+   pure subroutine impulse_accumulation(e, s, a, t, tau_prev, tau_res, t_horizon, t_end, &
+                                        accumulates, t_inf)
+      real(dp), intent(in) :: e, s, a, t, tau_prev, tau_res, t_horizon, t_end
       logical, intent(out) :: accumulates
       real(dp), intent(out) :: t_inf
+      real(dp) :: tau
       accumulates = .true.
       t_inf = t
       if (s <= 0.0_dp .or. e <= 0.0_dp) return
       accumulates = .false.
       t_inf = huge(1.0_dp)
       if (.not. (a > 0.0_dp) .or. e >= 1.0_dp) return
-      t_inf = t + 2.0_dp*s/(a*(1.0_dp - e))
-      accumulates = 2.0_dp*s/a <= tau_res .or. s*s/(2.0_dp*a) <= height_res
+      tau = 2.0_dp*s/a
+      t_inf = t + tau/(1.0_dp - e)
+      if (.not. (t_inf < t_end)) return
+      accumulates = tau <= tau_res .or. (tau_prev > 0.0_dp .and. tau < tau_prev .and. &
+                                         t_inf < t_horizon)
    end subroutine impulse_accumulation
 
    ! ---- the LCP solvers (docs/impulse.md §2) -----------------------------------------------

@@ -19,7 +19,7 @@ module martello_observer
    public :: results_t, observer_t, observer_init, observer_begin, observer_sample, &
       observer_work, observer_open_phase, observer_close_phase, observer_add_impact, &
       observer_penalty_phases, observer_fail, observer_fail_nonfinite, observer_finish, &
-      free_side_crossing, progress_callback, &
+      free_side_crossing, progress_callback, observer_extremum, &
       NCOUNTERS, C_STEPS, C_REJECTED, C_NEWTON, C_RESIDUALS, C_FACTORIZATIONS, C_EVENTS, &
       C_JACOBIANS, C_ROOT_EVALS, C_CHATTER, NENERGY, E_KINETIC, E_RECOVERABLE, E_INPUT, E_DAMPING, &
       E_PLASTIC, E_CONTACT, E_BALANCE, E_INITIAL, E_IMPACT, NEVENT, EV_T_ON, EV_T_OFF, &
@@ -40,6 +40,9 @@ module martello_observer
       !> the largest local maximum of u, interpolated between steps (u_peak at t_peak); the
       !> step maxima above are O(h) in time, these are O(h²)
       real(dp), allocatable :: u_peak(:), t_peak(:)
+      !> the method locates the extrema of u inside its steps (observer_extremum): u_peak is
+      !> its largest located maximum, not an interpolation
+      logical :: located_extrema = .false.
       real(dp), allocatable :: pen_max(:), force_max(:)
       !> per link: max |force| and max |elongation| (storey shear and drift of a frame)
       real(dp), allocatable :: link_force_absmax(:), link_du_absmax(:)
@@ -641,7 +644,8 @@ contains
             do i = 1, size(u)
                umax(i) = max(umax(i), u(i)); umin(i) = min(umin(i), u(i))
                vmax(i) = max(vmax(i), abs(v(i))); amax(i) = max(amax(i), abs(a(i)))
-               if (o%prev_t >= 0.0_dp .and. vn(i) > 0.0_dp .and. v(i) <= 0.0_dp) then
+               if (.not. o%located_extrema .and. o%prev_t >= 0.0_dp .and. vn(i) > 0.0_dp .and. &
+                   v(i) <= 0.0_dp) then
                   if (an(i) < 0.0_dp) then
                      tau = min(-vn(i)/an(i), h)
                      up = un(i) + vn(i)*tau + 0.5_dp*an(i)*tau*tau
@@ -654,4 +658,23 @@ contains
          end associate
       end subroutine peaks
    end subroutine track
+
+   !> An extremum of node i's displacement located by the method inside an accepted step, at t
+   !> with value u (the root of the node's velocity on the stepper's own solution,
+   !> docs/run-layer.md): folded into u_max, u_min, and for a maximum (maximum = .true.) into
+   !> u_peak, t_peak. From the first call on, u_peak holds located maxima only.
+   subroutine observer_extremum(o, i, t, u, maximum)
+      type(observer_t), intent(inout) :: o
+      integer, intent(in) :: i
+      real(dp), intent(in) :: t, u
+      logical, intent(in) :: maximum
+      if (.not. o%located_extrema) then
+         o%located_extrema = .true.
+         o%u_peak = -huge(1.0_dp); o%t_peak = -1.0_dp
+      end if
+      o%u_max(i) = max(o%u_max(i), u); o%u_min(i) = min(o%u_min(i), u)
+      if (maximum .and. u > o%u_peak(i)) then
+         o%u_peak(i) = u; o%t_peak(i) = t
+      end if
+   end subroutine observer_extremum
 end module martello_observer

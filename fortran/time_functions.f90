@@ -36,7 +36,7 @@ contains
       real(dp), intent(in) :: t
       real(dp) :: y
       real(dp), parameter :: pi = acos(-1.0_dp)
-      integer :: lo, hi, mid, n
+      integer :: lo, hi, n
       real(dp) :: w
 
       y = 0.0_dp
@@ -55,15 +55,7 @@ contains
          n = size(tf%t)
          if (n < 2) return
          if (t < tf%t(1) .or. t > tf%t(n)) return
-         lo = 1; hi = n
-         do while (hi - lo > 1)
-            mid = (lo + hi)/2
-            if (tf%t(mid) <= t) then
-               lo = mid
-            else
-               hi = mid
-            end if
-         end do
+         call bracket_sample(tf%t, t, lo, hi)
          w = (t - tf%t(lo))/(tf%t(hi) - tf%t(lo))
          y = tf%par(1)*((1.0_dp - w)*tf%y(lo) + w*tf%y(hi))
       end select
@@ -76,7 +68,7 @@ contains
       type(time_function_t), intent(in) :: tf
       real(dp), intent(in) :: t
       real(dp) :: tb
-      integer :: lo, hi, mid, n
+      integer :: lo, hi, n
 
       tb = huge(1.0_dp)
       select case (tf%kind)
@@ -94,16 +86,25 @@ contains
             tb = tf%t(1)
             return
          end if
-         lo = 1; hi = n          ! invariant: t(lo) <= t < t(hi)
-         do while (hi - lo > 1)
-            mid = (lo + hi)/2
-            if (tf%t(mid) <= t) then
-               lo = mid
-            else
-               hi = mid
-            end if
-         end do
+         call bracket_sample(tf%t, t, lo, hi)
          tb = tf%t(hi)
       end select
    end function tf_next_breakpoint
+
+   !> The samples around t by bisection, ts(lo) <= t < ts(hi) (hi = n at t = ts(n)), for
+   !> ts(1) <= t <= ts(n): O(log n), no saved cursor (pure, thread-safe).
+   pure subroutine bracket_sample(ts, t, lo, hi)
+      real(dp), intent(in) :: ts(:), t
+      integer, intent(out) :: lo, hi
+      integer :: mid
+      lo = 1; hi = size(ts)
+      do while (hi - lo > 1)
+         mid = (lo + hi)/2
+         if (ts(mid) <= t) then
+            lo = mid
+         else
+            hi = mid
+         end if
+      end do
+   end subroutine bracket_sample
 end module martello_time_functions

@@ -71,13 +71,19 @@ def test_p2_impact_times_and_speeds(e):
     # rk8pd at rtol 1e-12: the flights are smooth and the roots are located to event_tol =
     # 1e-12 s, so the impact times carry the integration error only (measured ≤ 2.7e-12 s,
     # speeds ≤ 4e-12 m/s); 1e-9 (absolute, times ~1 s and speeds ~1 m/s) is the bar.
+    # The impacts resolved one by one: all of them up to the first after which the closed-form
+    # accumulation point comes before the next output (docs/impulse.md §4; e = 0.5: the 8th of
+    # 10 at dt = 0.01), or 10.
     s, hist = execute(p2(restitution(e), adaptive(t_end=P2_T_END[e], **TIGHT)))
     ref = bouncing_oscillator_restitution(M, K, H, G, e, 10)
     t, vin, _ = impacts_of(s["contacts"]["plane"])
-    assert len(t) >= len(ref.t)
     n = len(ref.t)                    # 10, or 1 for e = 0 (a plastic impact sticks)
-    assert np.abs(t[:n] - ref.t).max() <= 1e-9
-    assert np.abs(vin[:n] - ref.v).max() <= 1e-9
+    if 0.0 < e < 1.0:
+        held = [k for k in range(1, n) if ref.zeno_time < (np.floor(ref.t[k] / 0.01) + 1) * 0.01]
+        n = held[0] + 1 if held else n
+    assert len(t) >= n
+    assert np.abs(t[:n] - ref.t[:n]).max() <= 1e-9
+    assert np.abs(vin[:n] - ref.v[:n]).max() <= 1e-9
     # Newton's law at the impact is exact: the rebound speed is e times the approach speed
     c = s["contacts"]["plane"]
     out = np.array(c["separation_speeds"][:n])
@@ -396,3 +402,24 @@ def test_bad_settings_through_the_c_api(field, value, what):
     assert info.value.status == constant("MARTELLO_ERR_ARGUMENT")
     assert what in r.message()
     assert r.status_of(m) == constant("MARTELLO_ERR_STATE")   # refused settings are not kept
+
+
+@pytest.mark.parametrize("integrator", ["rkf45", "rk8pd", "msbdf", "ida"])
+def test_loose_tolerance_keeps_every_bounce(integrator):
+    # The accumulation policy reads the impact sequence, not the tolerances (docs/impulse.md
+    # §4): at rtol 1e-3 the bouncing oscillator (P2, e = 0.8) keeps every bounce of the
+    # closed form before t_end = 0.7 s (its accumulation point, 1.3 s, lies beyond the run, so
+    # nothing is held and no event is written after t_end). The old height band 1e3 (atol +
+    # rtol scale) held it after the first impact and wrote a phase at 1.53 s. Impact times
+    # carry the loose integration error, growing from impact to impact: bar 1e-3 s (msbdf,
+    # whose low-order BDF errs most at this tolerance, measured 5.5e-3 s at the 4th: 1e-2 s).
+    e, t_end = 0.8, 0.7
+    s, _ = execute(p2(restitution(e), adaptive(integrator, t_end=t_end, rtol=1e-3, atol=1e-6)))
+    ref = bouncing_oscillator_restitution(M, K, H, G, e, 20)
+    expected = ref.t[ref.t < t_end]
+    assert ref.zeno_time > t_end
+    c = s["contacts"]["plane"]
+    t = np.array(c["impact_times"])
+    assert len(t) == len(expected) and len(expected) >= 4
+    assert np.abs(t - expected).max() < (1e-2 if integrator == "msbdf" else 1e-3)
+    assert all(x is not None and x <= t_end for x in c["separation_times"])

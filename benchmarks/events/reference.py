@@ -29,11 +29,15 @@ OPEN, ON, CUT = 0, 1, 2
 
 
 class Scene:
-    """The scene's data read straight from its TOML file (no martello code)."""
+    """The scene's data read straight from its TOML file, or from the dict of its tables (no
+    martello code)."""
 
     def __init__(self, path):
-        with open(path, "rb") as fh:
-            d = tomllib.load(fh)
+        if isinstance(path, dict):
+            d = path
+        else:
+            with open(path, "rb") as fh:
+                d = tomllib.load(fh)
         self.names = [n["name"] for n in d["node"]]
         idx = {n: i for i, n in enumerate(self.names)}
         self.m = np.array([n["mass"] for n in d["node"]], float)

@@ -134,8 +134,8 @@ def hostile_value(ch, old=None):
     kind = ch.integer(0, 9)
     if kind <= 3:
         return ch.choice(NUMBERS)
-    if kind <= 5:
-        return ch.choice(OTHERS)
+    if kind <= 5:   # a copy: a later edit of the scene must not change the shared constants
+        return copy.deepcopy(ch.choice(OTHERS))
     if kind == 6 and isinstance(old, (int, float)) and not isinstance(old, bool):
         return old * ch.choice([-1, 0, 1e-300, 1e-9, 1e9, 1e300])
     if kind == 7:
