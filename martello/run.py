@@ -13,7 +13,6 @@ import numpy as np
 from .binding import native
 from .binding.native import constant
 from .errors import RecordError, ResultError, SceneError
-from .ground_motion.records import read_record
 
 # Default exponent n of each law's elastic part F ~ δ^n (fixed, or Hertz's when the law reads it).
 LAW_EXPONENT = {r.name: r.values["exponent"] for r in native.registry("laws")}
@@ -75,6 +74,7 @@ def _function_args(fn, source="<scene>"):
         par[0] = fn["scale"]
         return constant("TF_TABLE"), par, fn["t"], fn["values"]
     if kind == "record":
+        from .ground_motion.records import read_record    # only a scene with a record needs it
         try:
             rec = read_record(fn["file"], fmt=fn["format"], units=fn["units"], scale=fn["scale"])
         except RecordError as exc:
