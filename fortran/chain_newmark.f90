@@ -5,15 +5,14 @@
 !>
 !> Newton's method on the step equations, as the general path (martello_generalized_alpha)
 !> does, but on such a scene one Newton step from a state is exact as long as no law changes
-!> branch between the linearisation and the new iterate; so a step is: evaluate the elements
-!> at the start (law resolved once per kind, one loop per kind), one forward sweep (residual,
-!> forward substitution, the factorisation only when a branch changed), one backward sweep
-!> (substitution and the update of u, v, a), the elements at the new state: if no law changed
-!> branch the step has converged, to round-off, with no further solve. The factorisation
-!> J = L D Lᵀ (reciprocal pivots) is kept from step to step while no branch flips.
-!> A step that does not settle in MAX_FUSED iterations, or meets a pivot ≤ 0, is taken by
-!> the general path (line search, chatter rule, its failure messages): the answers are the
-!> general path's, to its Newton tolerance.
+!> branch between the linearisation and the new iterate. A step is one forward sweep (the
+!> residual at u = uₙ linearised about the committed state, forward substitution with the
+!> kept factors J = L D Lᵀ, reciprocal pivots), one backward sweep (Δu; u, v, a by the
+!> Newmark relations), and the elements at the new state, one loop per kind: if no law
+!> changed branch the step has converged, to round-off, with no further solve; otherwise J is
+!> factorised on the new branches and Newton goes on. A step that does not settle in
+!> MAX_FUSED solves, or meets a pivot ≤ 0, is taken by the general path (line search, chatter
+!> rule, its failure messages): the answers are the general path's, to its Newton tolerance.
 module martello_chain_newmark
    use, intrinsic :: iso_fortran_env, only: int8
    use martello_kinds, only: dp, i8
@@ -27,8 +26,9 @@ module martello_chain_newmark
    use martello_observer, only: observer_t, observer_work
    use martello_run_quantities, only: C_NEWTON, C_RESIDUALS, C_FACTORIZATIONS, C_JACOBIANS, C_FUSED
    use martello_integrator_settings, only: integrator_settings_t, INT_NEWMARK
-   use martello_fixed_step, only: contact_state, stepper_t
+   use martello_fixed_step, only: contact_state
    use martello_generalized_alpha, only: generalized_alpha_t
+   use martello_band_matrix, only: band_init
    implicit none
    private
    public :: chain_newmark_t, chain_fusable
@@ -65,7 +65,7 @@ module martello_chain_newmark
       real(dp) :: mdu = 0.0_dp, acc_n = 0.0_dp, acc = 0.0_dp
       !> branch of every bilinear link and contact at the last evaluation, and of the factors
       integer(int8), allocatable :: br_link(:), br_con(:), fac_link(:), fac_con(:)
-      logical :: factored = .false., has_damping = .false.
+      logical :: factored = .false.
       !> trapezoidal works of the last evaluation (dampers, other links, contacts)
       real(dp) :: wd = 0.0_dp, wl = 0.0_dp, wc = 0.0_dp
    contains
@@ -120,12 +120,16 @@ contains
       self%ck = m%con_par(P_STIFF, 1:nc)
       self%cc = merge(m%con_par(P_DAMPING, 1:nc), 0.0_dp, m%con_law(1:nc) == LAW_KELVIN)
       self%clip = m%con_law(1:nc) == LAW_KELVIN .and. m%con_par(P_CLIP, 1:nc) > 0.5_dp
-      self%has_damping = any(m%link_kind(1:nl) == LINK_DASHPOT) .or. any(self%cc /= 0.0_dp)
       self%bilinears = pack([(j, j = 1, nl)], m%link_kind(1:nl) == LINK_BILINEAR)
       self%linears = pack([(j, j = 1, nl)], m%link_kind(1:nl) /= LINK_BILINEAR)
       allocate (self%fnod(m%nforce)); self%fnod = 0.0_dp
       self%own_link_peaks = .true.
       self%acc = uniform_acceleration(m, 0.0_dp)
+      ! the general path's workspaces (three band matrices, seven vectors: ~260 B per DOF)
+      ! are needed only for a step handed over; general_workspaces makes them then
+      call band_init(self%jac, 0, 0); call band_init(self%mband, 0, 0)
+      call band_init(self%cjac, 0, 0)
+      deallocate (self%fint, self%fint_n, self%res, self%du, self%work, self%ma, self%man)
       self%br_link = B_ELASTIC; self%br_con = B_OFF
       self%g = 0.0_dp; self%y = 0.0_dp; self%cd = 0.0_dp; self%co = 0.0_dp
       self%factored = .false.
@@ -180,6 +184,7 @@ contains
          call committed_links(self, m, self%un, self%vn)
          call external_forces(m, self%mrow, self%t0, self%fext)
          self%tangent_valid = .false.
+         call general_workspaces(self)
          call self%generalized_alpha_t%step(m, t, o, stat)
          self%acc = uniform_acceleration(m, t)
          ! its link states are committed in ms: their peaks, which the fused step tracks
@@ -205,6 +210,20 @@ contains
       call observer_work(o, external=w_ext)
       call contact_state(self, m)
    end subroutine chain_step
+
+   !> The workspaces of the general path, made on its first step (zero: the Newmark residual
+   !> reads fint_n times α_f = 0).
+   subroutine general_workspaces(self)
+      class(chain_newmark_t), intent(inout) :: self
+      integer :: n
+      n = self%n
+      if (allocated(self%fint)) return
+      call band_init(self%jac, n, self%kd); call band_init(self%mband, n, self%kd)
+      call band_init(self%cjac, n, self%kd)
+      allocate (self%fint(0:n), self%fint_n(0:n), self%res(0:n), self%du(n), self%work(0:n), &
+                self%ma(0:n), self%man(0:n))
+      self%fint = 0.0_dp; self%fint_n = 0.0_dp; self%res = 0.0_dp; self%work = 0.0_dp
+   end subroutine general_workspaces
 
    !> fe ← f_int − the nodal forces at t (fnod: those it holds now).
    subroutine nodal_forces(self, m, t)

@@ -75,12 +75,14 @@ def opensees_one(n, steps, dt, out):
     import openseespy.opensees as ops
     ops.wipe()
     ops.model("basic", "-ndm", 1, "-ndf", 1)
-    g = n + 1                                   # the ground node (fixed, no DOF)
-    for tag in range(1, n + 2):
-        ops.node(tag, 0.0)
-    ops.fix(g, 1)
+    # oscillator i is node 2i, its own fixed ground point node 2i − 1 (zeroLength elements):
+    # tags in that order keep the band of the system at its chain width (a single ground
+    # node joined to every oscillator would make BandGeneral's band n wide)
     for i in range(1, n + 1):
-        ops.mass(i, M)
+        ops.node(2 * i - 1, 0.0)
+        ops.node(2 * i, 0.0)
+        ops.fix(2 * i - 1, 1)
+        ops.mass(2 * i, M)
     c1, c2 = 2 * ZETA * math.sqrt(K1 * M), 2 * ZETA * math.sqrt(K2 * M)
     ops.uniaxialMaterial("Elastic", 1, K1)
     ops.uniaxialMaterial("Elastic", 2, K2)
@@ -93,17 +95,17 @@ def opensees_one(n, steps, dt, out):
     for i in range(1, n + 1):
         odd = i % 2 == 1                        # b1, b3, ...: k = 100 (martello's k[0], k[2] ...)
         e += 1
-        ops.element("zeroLength", e, g, i, "-mat", 1 if odd else 2, "-dir", 1)
+        ops.element("zeroLength", e, 2 * i - 1, 2 * i, "-mat", 1 if odd else 2, "-dir", 1)
         e += 1
-        ops.element("zeroLength", e, g, i, "-mat", 3 if odd else 4, "-dir", 1)
+        ops.element("zeroLength", e, 2 * i - 1, 2 * i, "-mat", 3 if odd else 4, "-dir", 1)
     for i in range(1, n):
         e += 1
-        ops.element("zeroLength", e, i + 1, i, "-mat", 5, "-dir", 1)
+        ops.element("zeroLength", e, 2 * i + 2, 2 * i, "-mat", 5, "-dir", 1)
     ops.timeSeries("Trig", 1, 0.0, 1.0e6, 2 * math.pi / OMEGA, "-factor", AMP)
     ops.pattern("UniformExcitation", 1, 1, "-accel", 1)
     env = Path(out) / "envelope.out"
-    ops.recorder("EnvelopeNode", "-file", str(env), "-precision", 16, "-nodeRange", 1, n,
-                 "-dof", 1, "disp")
+    ops.recorder("EnvelopeNode", "-file", str(env), "-precision", 16, "-node",
+                 *range(2, 2 * n + 1, 2), "-dof", 1, "disp")
     ops.constraints("Plain")
     ops.numberer("Plain")
     ops.system("BandGeneral")
