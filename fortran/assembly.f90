@@ -15,7 +15,7 @@ module martello_assembly
    private
    public :: mech_state_t, mech_init, internal_forces, external_forces, mech_commit, &
       element_power, recoverable_energy, mass_times, external_work, kinetic_energy, &
-      assemble_mass, ONSET_SPEED_FLOOR
+      assemble_mass, uniform_acceleration, ONSET_SPEED_FLOOR
 
    !> Hunt–Crossley-type laws scale damping by 1/v_in; a contact first seen while δ̇ ≤ 0
    !> (grazing, or a step that lands inside) uses this floor [m/s] instead of a division by 0.
@@ -340,6 +340,14 @@ contains
       call move_alloc(x, tmp); call move_alloc(y, x); call move_alloc(tmp, y)
    end subroutine swap
 
+   !> The acceleration every mass is loaded with at t: gravity − ü_g (relative coordinates).
+   real(dp) function uniform_acceleration(m, t) result(acc)
+      type(model_t), intent(in) :: m
+      real(dp), intent(in) :: t
+      acc = m%gravity
+      if (m%ground_accel%kind /= TF_NONE) acc = acc - tf_value(m%ground_accel, t)
+   end function uniform_acceleration
+
    !> Gravity on M·1, nodal forces, and −M·1·ü_g (relative coordinates), at time t.
    subroutine external_forces(m, mass_row_sum, t, fext)
       type(model_t), intent(in) :: m
@@ -347,8 +355,7 @@ contains
       real(dp), intent(out) :: fext(0:)
       integer :: j
       real(dp) :: acc
-      acc = m%gravity
-      if (m%ground_accel%kind /= TF_NONE) acc = acc - tf_value(m%ground_accel, t)
+      acc = uniform_acceleration(m, t)
       fext = acc*mass_row_sum
       do j = 1, m%nforce
          fext(m%force_node(j)) = fext(m%force_node(j)) + tf_value(m%force_fn(j), t)

@@ -15,7 +15,7 @@ module martello_fixed_step
    use martello_integrator_settings, only: integrator_settings_t
    use martello_run_checks, only: check_run_settings
    use martello_observer, only: observer_t, observer_begin, observer_sample, observer_fail, &
-      observer_penalty_phases, observer_finish, C_STEPS, C_FACTORIZATIONS
+      observer_penalty_phases, observer_finish, observer_recorded, C_STEPS, C_FACTORIZATIONS
    implicit none
    private
    public :: run_fixed_step, stepper_t, stepper_start, stepper_rest_start, solve_free_mass, &
@@ -43,12 +43,18 @@ module martello_fixed_step
       !> the energy the method conserves is ½vᵀMv − ke_aMa·aᵀMa (h²/8 for velocity Verlet,
       !> 0 for the others): the observer's kinetic energy in the balance
       real(dp) :: ke_aMa = 0.0_dp
+      !> the method tracks the link peaks (o%link_force_absmax, o%link_du_absmax) itself and
+      !> builds ms%link_f, ms%link_u only for the recorded samples (link_states)
+      logical :: own_link_peaks = .false.
    contains
       procedure(stepper_init), deferred :: init
       procedure(stepper_step), deferred :: step
       !> (un, vn, an) ← (u, v, a) before a step: copies; a method that writes every entry of
       !> u, v, a before reading it may swap the buffers instead
       procedure :: begin_step => stepper_begin_step
+      !> ms%link_f, ms%link_u at the committed state, for a method that keeps them only
+      !> where they are read (own_link_peaks): before a recorded sample
+      procedure :: link_states => stepper_link_states
    end type stepper_t
 
    abstract interface
@@ -117,10 +123,22 @@ contains
       !> The state at t_k; the previous one is the stepper's own (un, vn, an): no copy.
       subroutine sample(kk)
          integer(i8), intent(in) :: kk
+         if (stp%own_link_peaks .and. .not. observer_recorded(o, kk)) then
+            call observer_sample(o, m, stp%ms, t, stp%u, stp%v, stp%a, stp%pen, stp%force, kk, &
+                                 stat, u_prev=stp%un(1:), v_prev=stp%vn(1:), a_prev=stp%an(1:))
+            return
+         end if
+         if (stp%own_link_peaks) call stp%link_states(m)
          call observer_sample(o, m, stp%ms, t, stp%u, stp%v, stp%a, stp%pen, stp%force, kk, stat, &
                               stp%ms%link_f, stp%ms%link_u, stp%un(1:), stp%vn(1:), stp%an(1:))
       end subroutine sample
    end subroutine run_fixed_step
+
+   !> Nothing to build: the steppers keep ms%link_f, ms%link_u committed at every step.
+   subroutine stepper_link_states(self, m)
+      class(stepper_t), intent(inout) :: self
+      type(model_t), intent(in) :: m
+   end subroutine stepper_link_states
 
    !> The start of a step: the committed state becomes (un, vn, an).
    subroutine stepper_begin_step(self)

@@ -19,7 +19,7 @@ module martello_observer
    public :: results_t, observer_t, observer_init, observer_begin, observer_sample, &
       observer_work, observer_open_phase, observer_close_phase, observer_add_impact, &
       observer_penalty_phases, observer_fail, observer_fail_nonfinite, observer_finish, &
-      free_side_crossing, progress_callback, observer_extremum, &
+      free_side_crossing, progress_callback, observer_extremum, observer_recorded, &
       NCOUNTERS, C_STEPS, C_REJECTED, C_NEWTON, C_RESIDUALS, C_FACTORIZATIONS, C_EVENTS, &
       C_JACOBIANS, C_ROOT_EVALS, C_CHATTER, NENERGY, E_KINETIC, E_RECOVERABLE, E_INPUT, E_DAMPING, &
       E_PLASTIC, E_CONTACT, E_BALANCE, E_INITIAL, E_IMPACT, NEVENT, EV_T_ON, EV_T_OFF, &
@@ -250,6 +250,14 @@ contains
       recorded = k == 0
       if (k > 0) recorded = mod(k, int(o%every, i8)) == 0 .or. k >= o%n_grid
    end function recorded
+
+   !> Whether the state at grid point k is a history row (a method that keeps some states
+   !> lazily builds them for these samples only).
+   pure logical function observer_recorded(o, k)
+      type(observer_t), intent(in) :: o
+      integer(i8), intent(in) :: k
+      observer_recorded = recorded(o, k)
+   end function observer_recorded
 
    !> An accepted state at t (once per accepted step and at t = 0, after the step's phase
    !> changes): phase maxima and peaks; the energy terms and the divergence test where
@@ -614,9 +622,11 @@ contains
          o%prev_u = u; o%prev_v = v; o%prev_a = a
       end if
       o%prev_t = t
+      ! the maxima are stored only when they change: a peak array is then read, not
+      ! rewritten, at every step (these passes are a fair part of a chain step's memory traffic)
       do i = 1, size(pen)
-         o%pen_max(i) = max(o%pen_max(i), pen(i))
-         o%force_max(i) = max(o%force_max(i), force(i))
+         if (pen(i) > o%pen_max(i)) o%pen_max(i) = pen(i)
+         if (force(i) > o%force_max(i)) o%force_max(i) = force(i)
       end do
       if (present(link_f) .and. present(link_du)) then
          do i = 1, size(link_f)
@@ -642,8 +652,10 @@ contains
          associate (umax => o%u_max, umin => o%u_min, vmax => o%v_absmax, amax => o%a_absmax, &
                     upk => o%u_peak, tpk => o%t_peak)
             do i = 1, size(u)
-               umax(i) = max(umax(i), u(i)); umin(i) = min(umin(i), u(i))
-               vmax(i) = max(vmax(i), abs(v(i))); amax(i) = max(amax(i), abs(a(i)))
+               if (u(i) > umax(i)) umax(i) = u(i)
+               if (u(i) < umin(i)) umin(i) = u(i)
+               if (abs(v(i)) > vmax(i)) vmax(i) = abs(v(i))
+               if (abs(a(i)) > amax(i)) amax(i) = abs(a(i))
                if (.not. o%located_extrema .and. o%prev_t >= 0.0_dp .and. vn(i) > 0.0_dp .and. &
                    v(i) <= 0.0_dp) then
                   if (an(i) < 0.0_dp) then

@@ -145,6 +145,18 @@ def test_import_martello_loads_nothing_else():
     assert r.stdout.split() == ["martello"]
 
 
+def test_a_plain_run_loads_no_heavy_package():
+    # `martello run` on a scene without a ground-motion record: what its command imports, and
+    # nothing of scipy, matplotlib or pandas (their imports alone cost more than a small run;
+    # docs/performance.md)
+    r = subprocess.run([sys.executable, "-c", "import sys, martello.cli, martello.run, "
+                        "martello.checks.measures; print(' '.join(sys.modules))"],
+                       cwd=ROOT, capture_output=True, text=True, check=True)
+    loaded = set(r.stdout.split())
+    heavy = {m for m in loaded if m.partition(".")[0] in ("scipy", "matplotlib", "pandas")}
+    assert not heavy and "martello.ground_motion" not in loaded, sorted(heavy)
+
+
 def test_oracles_know_no_solver():
     # the closed forms are written from the mathematics: no run layer, no native library
     for m in (m for m in MODULES if m.startswith("martello.oracles")):

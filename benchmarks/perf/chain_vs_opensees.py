@@ -1,0 +1,304 @@
+#!/usr/bin/env python3
+"""martello and OpenSeesPy side by side on the same chain scenes (docs/performance.md).
+
+The scene: n oscillators in a row, m = 1 kg, k alternating 100 and 400 N/m (P7's two
+buildings repeated), 5 % damping as a dashpot to ground, 10 mm gaps closed by linear
+compression-only contacts (ε = 1e5 N/m; OpenSees: zeroLength + ElasticPPGap, as
+benchmarks/perf/opensees_compare.py), ground acceleration 3 sin 8t m/s²; Newmark average
+acceleration, Δt = 1 ms. Every pair of neighbours pounds: the contacts close and open
+throughout the run. OpenSees: BandGeneral, Newton, NormDispIncr 1e-12 (30 iterations).
+
+Each run is its own process (peak RSS is that run's), the two codes alternate, and each
+figure is the median of the repeats. Reported per n: the time loop in ns per DOF per step
+(martello: the library's own clock around its time loop, `cost.wall_time_s`; OpenSees: the
+clock around `analyze`), their ratio, the whole process (martello: `martello run` from scene
+file to summary.json written), peak RSS per DOF, the Python share of martello's process, and
+the agreement of the two codes on every node's peak |u|. Then the cost exponent in n (least
+squares on log t against log n), a STREAM-like triad (benchmarks/perf/triad.c) for the memory
+floor, and P7's two oscillators with the linear contact, whole process against whole process.
+
+OpenSeesPy runs in its own environment (default out/bench-venv, created with pip if missing;
+the comparison is skipped with a message if that fails). The machine is shared: the load
+average is printed with every figure.
+
+    .venv/bin/python benchmarks/perf/chain_vs_opensees.py [--n 1000 10000 100000]
+        [--steps 8000] [--repeats 3] [--out out/perf] [--opensees-max-n 10000]
+"""
+
+import argparse
+import json
+import math
+import os
+import statistics
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[2]
+M, K1, K2, ZETA, GAP, EPS, AMP, OMEGA, DT = 1.0, 100.0, 400.0, 0.05, 0.01, 1.0e5, 3.0, 8.0, 1e-3
+
+
+def scene_toml(n, steps, dt=DT, every=None):
+    """The chain as a martello scene ([[chain]]); records two nodes, every 1000th step."""
+    ks = ", ".join("100.0" if i % 2 == 0 else "400.0" for i in range(n))
+    every = every or max(1, min(steps, 1000))
+    return f"""title = "chain of {n} pounding oscillators (linear contacts)"
+[[chain]]
+prefix = "b"
+n = {n}
+mass = {M}
+k = [{ks}]
+zeta = {ZETA}
+gap = {GAP}
+contact = {{ scheme = "penalty", law = "linear", stiffness = {EPS} }}
+[loads.ground_acceleration]
+type = "sine"
+amplitude = {AMP}
+omega = {OMEGA}
+[analysis]
+type = "dynamic"
+integrator = "newmark"
+preset = "average-acceleration"
+dt = {dt}
+t_end = {steps * dt!r}
+[analysis.output]
+every = {every}
+nodes = ["b1", "b{n}"]
+contacts = []
+"""
+
+
+def opensees_one(n, steps, dt, out):
+    """Runs inside the OpenSeesPy environment: the same chain, the time loop timed."""
+    t_start = time.perf_counter()
+    import openseespy.opensees as ops
+    ops.wipe()
+    ops.model("basic", "-ndm", 1, "-ndf", 1)
+    # oscillator i is node 2i, its own fixed ground point node 2i − 1 (zeroLength elements):
+    # tags in that order keep the band of the system at its chain width (a single ground
+    # node joined to every oscillator would make BandGeneral's band n wide)
+    for i in range(1, n + 1):
+        ops.node(2 * i - 1, 0.0)
+        ops.node(2 * i, 0.0)
+        ops.fix(2 * i - 1, 1)
+        ops.mass(2 * i, M)
+    c1, c2 = 2 * ZETA * math.sqrt(K1 * M), 2 * ZETA * math.sqrt(K2 * M)
+    ops.uniaxialMaterial("Elastic", 1, K1)
+    ops.uniaxialMaterial("Elastic", 2, K2)
+    ops.uniaxialMaterial("Viscous", 3, c1, 1.0)
+    ops.uniaxialMaterial("Viscous", 4, c2, 1.0)
+    # contact i, i+1: deformation u_i − u_{i+1} (node j minus node i of the element), a
+    # linear spring in tension past the gap (F_y far beyond any force)
+    ops.uniaxialMaterial("ElasticPPGap", 5, EPS, 1.0e12, GAP)
+    e = 0
+    for i in range(1, n + 1):
+        odd = i % 2 == 1                        # b1, b3, ...: k = 100 (martello's k[0], k[2] ...)
+        e += 1
+        ops.element("zeroLength", e, 2 * i - 1, 2 * i, "-mat", 1 if odd else 2, "-dir", 1)
+        e += 1
+        ops.element("zeroLength", e, 2 * i - 1, 2 * i, "-mat", 3 if odd else 4, "-dir", 1)
+    for i in range(1, n):
+        e += 1
+        ops.element("zeroLength", e, 2 * i + 2, 2 * i, "-mat", 5, "-dir", 1)
+    ops.timeSeries("Trig", 1, 0.0, 1.0e6, 2 * math.pi / OMEGA, "-factor", AMP)
+    ops.pattern("UniformExcitation", 1, 1, "-accel", 1)
+    env = Path(out) / "envelope.out"
+    ops.recorder("EnvelopeNode", "-file", str(env), "-precision", 16, "-node",
+                 *range(2, 2 * n + 1, 2), "-dof", 1, "disp")
+    ops.constraints("Plain")
+    ops.numberer("Plain")
+    ops.system("BandGeneral")
+    ops.test("NormDispIncr", 1.0e-12, 30)
+    ops.algorithm("Newton")
+    ops.integrator("Newmark", 0.5, 0.25)
+    ops.analysis("Transient")
+    t0 = time.perf_counter()
+    ok = ops.analyze(steps, dt)
+    loop = time.perf_counter() - t0
+    ops.wipe()                                  # flushes the recorder
+    rows = [list(map(float, line.split())) for line in env.read_text().split("\n") if line.strip()]
+    print(json.dumps({"ok": ok == 0, "loop_s": loop, "setup_s": t0 - t_start,
+                      "absmax": rows[2] if len(rows) >= 3 else None}))
+
+
+def run_child(cmd):
+    """cmd in a child process, measured by a wrapper that reports its own rusage."""
+    wrapper = ("import json, os, resource, subprocess, sys, time\n"
+               "t0 = time.perf_counter(); p = subprocess.run(sys.argv[1:], capture_output=True, text=True)\n"
+               "w = time.perf_counter() - t0; r = resource.getrusage(resource.RUSAGE_CHILDREN)\n"
+               "print(json.dumps({'rc': p.returncode, 'wall': w, 'cpu': r.ru_utime + r.ru_stime,\n"
+               "  'rss': r.ru_maxrss * 1024, 'out': p.stdout, 'err': p.stderr[-2000:]}))\n")
+    p = subprocess.run([sys.executable, "-c", wrapper, *map(str, cmd)], capture_output=True, text=True)
+    r = json.loads(p.stdout)
+    if r["rc"] != 0:
+        raise RuntimeError(f"{cmd[0]} ... failed: {r['err'].strip()[-600:]}")
+    return r
+
+
+def martello_once(scene, out):
+    # --force: the output-size estimate assumes every contact phase listed (docs/results.md)
+    r = run_child([sys.executable, "-m", "martello", "run", scene, "-o", out, "--force"])
+    s = json.loads((Path(out) / "summary.json").read_text())
+    r.update(native=s["cost"]["wall_time_s"], steps=s["cost"]["steps"],
+             fused=s["cost"].get("fused_chain_steps"), status=s["status"],
+             absmax=[max(abs(v["u_max"]), abs(v["u_min"])) for v in s["nodes"].values()])
+    return r
+
+
+def opensees_once(py, n, steps, out):
+    r = run_child([py, __file__, "--opensees-one", n, steps, DT, out])
+    r.update(json.loads(r["out"].strip().splitlines()[-1]))
+    return r
+
+
+def opensees_python(path):
+    """The OpenSeesPy environment: path, else out/bench-venv (made here with pip); None and a
+    message when it cannot be had."""
+    py = Path(path) if path else ROOT / "out" / "bench-venv" / "bin" / "python"
+    if py.exists():
+        return str(py)
+    if path:
+        print(f"OpenSees comparison skipped: {py} does not exist")
+        return None
+    venv = py.parents[1]
+    print(f"creating {venv} with openseespy (pip) ...", flush=True)
+    try:
+        subprocess.run([sys.executable, "-m", "venv", str(venv)], check=True)
+        subprocess.run([str(py), "-m", "pip", "install", "-q", "openseespy"], check=True)
+    except (subprocess.CalledProcessError, OSError) as e:
+        print(f"OpenSees comparison skipped: openseespy could not be installed ({e})")
+        return None
+    return str(py)
+
+
+def triad_gbs(out):
+    exe = Path(out) / "triad"
+    src = Path(__file__).with_name("triad.c")
+    subprocess.run(["cc", "-O2", "-o", str(exe), str(src)], check=True)
+    return float(subprocess.run([str(exe), "20000000", "10"], capture_output=True, text=True,
+                                check=True).stdout)
+
+
+def load():
+    return os.getloadavg()[0]
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--n", type=int, nargs="+", default=[1000, 10000, 100000])
+    ap.add_argument("--steps", type=int, default=8000)
+    ap.add_argument("--repeats", type=int, default=3)
+    ap.add_argument("--out", default=str(ROOT / "out" / "perf"))
+    ap.add_argument("--opensees-python", help="a Python with openseespy (default out/bench-venv)")
+    ap.add_argument("--opensees-max-n", type=int, default=10000,
+                    help="largest n OpenSees runs (it takes ~2 µs per DOF-step)")
+    ap.add_argument("--skip-pounding", action="store_true")
+    ap.add_argument("--opensees-one", nargs=4, help=argparse.SUPPRESS)
+    a = ap.parse_args()
+    if a.opensees_one:
+        n, steps, dt, out = a.opensees_one
+        opensees_one(int(n), int(steps), float(dt), out)
+        return
+    out = Path(a.out)
+    out.mkdir(parents=True, exist_ok=True)
+    py = opensees_python(a.opensees_python)
+    sys.path.insert(0, str(ROOT))
+    from martello.binding import native
+    print(f"martello {native.version()}; {os.cpu_count()} cores; "
+          f"{os.uname().machine} {os.uname().release}; load {load():.2f}")
+    gbs = triad_gbs(out)
+    print(f"triad (STREAM-like, 3 x 160 MB): {gbs:.1f} GB/s -> {140 / gbs:.1f} ns per DOF-step "
+          f"at 140 B/DOF/step (a tridiagonal implicit step with contacts and peaks)")
+    rows = []
+    hdr = (f"{'n':>8} {'steps':>5} {'martello ns':>11} {'OpenSees ns':>11} {'ratio':>6} "
+           f"{'m. process s':>12} {'py share':>8} {'m. B/DOF':>9} {'OS B/DOF':>9} "
+           f"{'peak |u| rel':>12} {'load':>5}")
+    print(hdr)
+    for n in a.n:
+        d = out / f"n{n}"
+        d.mkdir(exist_ok=True)
+        scene = d / "scene.toml"
+        scene.write_text(scene_toml(n, a.steps))
+        mr, orr = [], []
+        loads = []
+        with_os = py is not None and n <= a.opensees_max_n
+        for rep in range(a.repeats):
+            loads.append(load())
+            order = ("m", "o") if rep % 2 == 0 else ("o", "m")
+            for who in order:
+                if who == "m":
+                    mr.append(martello_once(scene, d / "martello"))
+                elif with_os:
+                    (d / "opensees").mkdir(exist_ok=True)
+                    orr.append(opensees_once(py, n, a.steps, d / "opensees"))
+        dofsteps = n * a.steps
+        m_ns = statistics.median(r["native"] for r in mr) / dofsteps * 1e9
+        m_wall = statistics.median(r["wall"] for r in mr)
+        m_rss = statistics.median(r["rss"] for r in mr) / n
+        share = statistics.median((r["wall"] - r["native"]) / r["wall"] for r in mr)
+        row = {"n": n, "steps": a.steps, "martello_ns_per_dof_step": m_ns, "martello_process_s": m_wall,
+               "martello_peak_rss_bytes_per_dof": m_rss, "python_share": share,
+               "fused_steps": mr[-1]["fused"], "load": statistics.median(loads),
+               "martello_native_s": [r["native"] for r in mr]}
+        o_ns = o_rss = agree = ratio = None
+        if orr:
+            o_ns = statistics.median(r["loop_s"] for r in orr) / dofsteps * 1e9
+            o_rss = statistics.median(r["rss"] for r in orr) / n
+            ratio = o_ns / m_ns
+            om = orr[-1]["absmax"]
+            agree = max(abs(x - y) / max(abs(y), 1e-300) for x, y in zip(mr[-1]["absmax"], om))
+            row.update(opensees_ns_per_dof_step=o_ns, ratio=ratio, opensees_peak_rss_bytes_per_dof=o_rss,
+                       peak_u_max_rel_diff=agree, opensees_loop_s=[r["loop_s"] for r in orr])
+        rows.append(row)
+        f = lambda x, fmt: format(x, fmt) if x is not None else "-"
+        print(f"{n:>8} {a.steps:>5} {m_ns:>11.1f} {f(o_ns, '11.1f'):>11} {f(ratio, '6.1f'):>6} "
+              f"{m_wall:>12.2f} {share:>8.1%} {m_rss:>9.0f} {f(o_rss, '9.0f'):>9} "
+              f"{f(agree, '12.1e'):>12} {row['load']:>5.2f}", flush=True)
+    big = [r for r in rows if r["n"] >= 1000]
+    if len(big) >= 2:
+        xs = [math.log(r["n"]) for r in big]
+        ys = [math.log(r["martello_ns_per_dof_step"] * r["n"]) for r in big]
+        mx, my = sum(xs) / len(xs), sum(ys) / len(ys)
+        slope = sum((x - mx) * (y - my) for x, y in zip(xs, ys)) / sum((x - mx) ** 2 for x in xs)
+        print(f"cost exponent (time loop ~ n^p, n = {big[0]['n']} ... {big[-1]['n']}): p = {slope:.3f}")
+    if not a.skip_pounding:
+        pounding(py, out, a.repeats, rows)
+    (out / "chain_vs_opensees.json").write_text(json.dumps(
+        {"triad_gbs": gbs, "rows": rows, "machine": os.uname()._asdict() if hasattr(os.uname(), "_asdict")
+         else list(os.uname())}, indent=1))
+    print(f"results: {out / 'chain_vs_opensees.json'}")
+
+
+def pounding(py, out, repeats, rows):
+    """P7's two oscillators with the linear contact (benchmarks/perf/opensees_compare.py's
+    scene), Δt = 1e-4 s for 4 s: both codes run Newmark average acceleration at the same step,
+    so they have the same accuracy (their peaks agree to the figure printed); whole process
+    against whole process."""
+    d = out / "pounding"
+    d.mkdir(exist_ok=True)
+    scene = d / "scene.toml"
+    scene.write_text(scene_toml(2, 40000, dt=1e-4, every=10))
+    mw, ow, agree = [], [], None
+    for rep in range(repeats):
+        for who in (("m", "o") if rep % 2 == 0 else ("o", "m")):
+            if who == "m":
+                mr = martello_once(scene, d / "martello")
+                mw.append(mr["wall"])
+            elif py:
+                (d / "opensees").mkdir(exist_ok=True)
+                r = run_child([py, __file__, "--opensees-one", 2, 40000, 1e-4, d / "opensees"])
+                ow.append(r["wall"])
+                om = json.loads(r["out"].strip().splitlines()[-1])["absmax"]
+                agree = max(abs(x - y) / abs(y) for x, y in zip(mr["absmax"], om))
+    line = (f"P7 two oscillators, linear contact, Newmark dt = 1e-4 s, 40000 steps: whole process "
+            f"martello {statistics.median(mw):.3f} s")
+    if ow:
+        line += f", OpenSeesPy {statistics.median(ow):.3f} s; peak |u| agree to {agree:.1e}"
+    print(line + f" (load {load():.2f})")
+    rows.append({"pounding_martello_process_s": mw, "pounding_opensees_process_s": ow,
+                 "pounding_peak_u_rel_diff": agree})
+
+
+if __name__ == "__main__":
+    main()
