@@ -137,7 +137,11 @@ def hostile_value(ch, old=None):
     if kind <= 5:   # a copy: a later edit of the scene must not change the shared constants
         return copy.deepcopy(ch.choice(OTHERS))
     if kind == 6 and isinstance(old, (int, float)) and not isinstance(old, bool):
-        return old * ch.choice([-1, 0, 1e-300, 1e-9, 1e9, 1e300])
+        factor = ch.choice([-1, 0, 1e-300, 1e-9, 1e9, 1e300])
+        try:
+            return old * factor
+        except OverflowError:      # an earlier edit left an integer beyond any float
+            return old
     if kind == 7:
         return _nested(ch.choice([3, 20, 100, 2000]))
     if kind == 8 and old is not None:

@@ -89,9 +89,17 @@ def expand_frames(src, data):
             beams=_sections(src, f"{w}.beam", f["beam"], ns, nb),
             masses=per_item(src, f"{w}.mass", f["mass"], ns, POSITIVE),
             base=f["base"], mass_model=f["mass_model"])
+        if lateral > 1 and max(modes) > lateral:
+            raise SceneError(src, f"{w}.rayleigh_modes", f"mode {max(modes)} of a frame with "
+                             f"{lateral} lateral DOFs", f"mode numbers in [1, {lateral}]")
         names = frame.lateral_names(f["prefix"])
         mass = frame.lateral_masses()
-        K, G = frame.condensed()
+        try:
+            with np.errstate(all="ignore"):
+                K, G = frame.condensed()
+        except np.linalg.LinAlgError:
+            K = G = np.array([[np.nan]])         # a singular condensation: refused just below
+        _check_stiffness(src, w, K, G, mass)
         R = frame.recovery(G)
         C = np.zeros_like(K)
         a0 = a1 = 0.0
@@ -107,6 +115,22 @@ def expand_frames(src, data):
                        "shear": frame.storey_shear_operator(R), "histories": f["histories"]})
     data["node"] = nodes
     return data, frames
+
+
+def _check_stiffness(src, where, K, G, mass):
+    """The condensed frame must be a finite, positive definite stiffness over finite masses:
+    sections or dimensions whose products overflow, or that leave a mechanism, are refused
+    here (not as a failed eigen-solve or a NaN run later)."""
+    if not (np.all(np.isfinite(K)) and np.all(np.isfinite(G)) and np.all(np.isfinite(mass))):
+        raise SceneError(src, where, "the condensed stiffness is not finite (the products of "
+                         "E, A, I and the dimensions overflow)",
+                         "give sections and dimensions in SI units of a real frame")
+    try:
+        np.linalg.cholesky(K)
+    except np.linalg.LinAlgError:
+        raise SceneError(src, where, "the condensed stiffness is not positive definite (a "
+                         "mechanism, or sections too disparate for double precision)",
+                         "give sections and dimensions in SI units of a real frame") from None
 
 
 def frame_blocks(frames, index):
