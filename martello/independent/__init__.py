@@ -126,10 +126,8 @@ def compare(a: dict, b: dict) -> tuple[dict, list]:
             ambiguous.append(nm)
             dig["contacts"][nm] = {"impacts": 0.0}
             continue
-        if any(p["max_penetration"] <= 100.0 * u_err for p in ca["phases"]) and ca["phases"] and \
-                ca["phases"][0].get("max_penetration") is not None and \
-                a["contacts"][nm]["max_force"] > 0:
-            ambiguous.append(nm)
+        if any(0.0 < p["max_penetration"] <= 100.0 * u_err for p in ca["phases"]):
+            ambiguous.append(nm)          # a penalty phase within the uncertainty: a graze
         rows = []
         for pa, pb in zip(ca["phases"], cb["phases"]):
             rows.append({"t_on": _digits(pa["t_on"], pb["t_on"], abs(pa["t_on"]) or 1.0),

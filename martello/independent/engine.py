@@ -379,6 +379,13 @@ def integrate(m: Model, method: str = "DOP853", rtol: float = 1e-11, atol_scale:
             # Newton's law (docs/problems.md P5): the impulse (1 + e) m* δ̇ on both sides
             if c.e == 0.0:
                 raise Unsupported(f"contact {c.name}: a plastic impact sticks (persistent contact)")
+            if dd <= 0.0:
+                return y                  # at the root but already opening: no impulse
+            if dd <= AT_SWITCH * sysm.vscale:
+                # the impacts accumulate (Zeno): the motion continues as a persistent
+                # contact, which this engine does not model
+                raise Unsupported(f"contact {c.name}: impacts accumulate at t = {t:.9g} s (Zeno); "
+                                  "persistent contact is not modelled")
             p = (1.0 + c.e) * c.mstar * dd
             y = y.copy()
             if c.a != GROUND and sysm.free[c.a]:
@@ -430,7 +437,12 @@ def integrate(m: Model, method: str = "DOP853", rtol: float = 1e-11, atol_scale:
                     # the same root (a turning point), and only a clear crossing counts
                     at_root = abs(gv) <= tol and s.gdot(y, acc) * s.direction > 0 and \
                         _element(m, s) not in done
-                    if gv * s.direction > tol or at_root:
+                    crossed = gv * s.direction > tol
+                    if crossed and s.kind == "onset" and m.contacts[s.index].scheme == "restitution":
+                        # an impact needs an approach: a slightly penetrated pair that is
+                        # already opening (just after its impulse) is left to open
+                        crossed = s.gdot(y, acc) > 0.0
+                    if crossed or at_root:
                         chosen = s
                         break
             if chosen is None:
