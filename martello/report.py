@@ -65,7 +65,10 @@ def check_catalogue(files, outdir, plots=True, stream=sys.stdout, require_checks
                 print(f"{s.title[:44]:<44} (no closed form or reference data: ran, not verified)",
                       file=stream)
                 continue
+            laws = ",".join(sorted({c["scheme"] if c["scheme"] != "penalty" else c.get("law") or "linear"
+                                    for c in s.contacts})) or "-"
             for r in rows_here:
+                r.update(integrator=s.analysis.get("integrator") or "static", laws=laws)
                 r.update(scheme=schemes, analysis=s.analysis["type"], status=summary["status"],
                          problem=s.problem,
                          digits_lost=summary.get("conditioning", {}).get("digits_lost", 0.0))
@@ -93,6 +96,7 @@ def check_catalogue(files, outdir, plots=True, stream=sys.stdout, require_checks
     _write_csv(rows, outdir / "verification.csv")
     pngs = _plots(rows, outdir) if plots and rows else []
     _write_markdown(rows, failures, pngs, outdir / "report.md", elapsed)
+    (outdir / "coverage.md").write_text(coverage_markdown(rows) + "\n")
     print("\n" + headline(rows, failures, len(files), elapsed) + f" Report: {outdir / 'report.md'}",
           file=stream)
     for f in failures:
@@ -112,6 +116,47 @@ def headline(rows, failures, n_scenes, elapsed):
     return (f"verification: {sum(r['passed'] for r in ver)} of {len(ver)} checks passed ({kinds}); "
             f"regression, not verification: {sum(r['passed'] for r in other)} of {len(other)} passed; "
             f"{len(failures)} failure(s); {n_scenes} scenes in {elapsed:.1f} s.")
+
+
+def coverage(rows):
+    """The coverage matrix: one cell per problem × contact law (or scheme) × integrator, with
+    its kind of evidence (the strongest of its rows: closed form, then independent reference,
+    else regression only: self-consistent), its fewest digits among the verifying rows, and
+    whether every row of the cell passed."""
+    cells = {}
+    for r in rows:
+        key = (r.get("problem") or "-", r.get("laws", "-"), r.get("integrator", "-"))
+        c = cells.setdefault(key, {"kinds": set(), "digits": [], "n": 0, "ok": True})
+        c["kinds"].add(r.get("evidence", "regression"))
+        c["n"] += 1
+        c["ok"] &= bool(r["passed"])
+        if r.get("evidence") in VERIFICATION:
+            c["digits"].append(r["digits"])
+    out = []
+    for (problem, laws, integ), c in sorted(cells.items()):
+        kind = next((k for k in VERIFICATION if k in c["kinds"]), "regression only (self-consistent)")
+        out.append({"problem": problem, "law": laws, "integrator": integ, "evidence": kind,
+                    "digits": min(c["digits"]) if c["digits"] else None, "rows": c["n"],
+                    "state": "verified" if c["ok"] and kind in VERIFICATION else
+                    ("WRONG" if not c["ok"] else "self-consistent only")})
+    return out
+
+
+def coverage_markdown(rows):
+    cells = coverage(rows)
+    n_ver = sum(c["state"] == "verified" for c in cells)
+    n_bad = sum(c["state"] == "WRONG" for c in cells)
+    n_self = sum(c["state"] == "self-consistent only" for c in cells)
+    lines = [f"{n_ver} cells verified against a closed form or the independent reference, "
+             f"{n_bad} wrong, {n_self} self-consistent only (regression against data martello made), "
+             f"of {len(cells)} problem × law/scheme × integrator cells that `martello check` ran.", "",
+             "| problem | law / scheme | integrator | evidence | fewest digits | rows | state |",
+             "|---|---|---|---|---|---|---|"]
+    for c in cells:
+        d = f"{c['digits']:.1f}" if c["digits"] is not None else "—"
+        lines.append(f"| {c['problem']} | {c['law']} | {c['integrator']} | {c['evidence']} | {d} | "
+                     f"{c['rows']} | {c['state']} |")
+    return "\n".join(lines)
 
 
 def _missing_reference_data(path):
@@ -209,7 +254,7 @@ def _write_markdown(rows, failures, pngs, path, elapsed):
              "(martello.independent, docs/independent-reference.md: digits = min(the run's, the "
              "reference's trusted digits), tolerance from the run's measured order), "
              "*regression* (drift from stored data made by martello itself: not verification).", "",
-             _problem_table(rows), "",
+             _problem_table(rows), "", "## Coverage", "", coverage_markdown(rows), "", "## Rows", "",
              "| scene | scheme | analysis | evidence | quantity | value | reference | digits | rtol | pass |",
              "|---|---|---|---|---|---|---|---|---|---|"]
     for r in rows:

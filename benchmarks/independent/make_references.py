@@ -37,6 +37,10 @@ REFERENCES = {
     "p7_two_oscillators_restitution": (TWO, {"scheme": "restitution", "restitution": 0.65}),
     "p7_chain_10": ("benchmarks/p7/p7_chain_10.toml", None),
     "p7_row_3": ("benchmarks/p7/p7_row_3.toml", None),
+    # P2's plane with every law (one physics each; the scenes on three integrators share it)
+    **{f"p2_{law.replace('-', '_')}": (f"benchmarks/p2/laws/p2_{law.replace('-', '_')}_newmark.toml", None)
+       for law in ("linear", "hertz", "kelvin_clipped", "hunt-crossley", "lankarani-nikravesh",
+                   "flores", "gonthier", "hertzdamp", "jankowski")},
     "p8_bare": ("benchmarks/p8/p8_bare.toml", None),
     "p8_A": ("benchmarks/p8/p8_A.toml", None),
     "p8_B": ("benchmarks/p8/p8_B.toml", None),
@@ -49,7 +53,7 @@ REFERENCES = {
 # 2.5e-6, to impact times ~3.6e-6 s and peaks ~2e-5 (relative) away from this reference, which
 # the library's own rk8pd matches to 5e-12: a difference of the fixed-step contact path, not
 # an error that shrinks with Δt (docs/independent-reference.md "Open")
-NOT_IN_CATALOGUE = {"p7_chain_10", "p7_two_oscillators_kelvin", "p7_row_3"}
+NOT_IN_CATALOGUE = {"p7_chain_10", "p7_two_oscillators_kelvin", "p7_row_3", "p2_kelvin"}
 # the rtol of the primary integration (the second is at 100 × rtol); P8's records restart
 # the integration every 10 ms, where 1e-10 already gives ≥ 6 trusted digits
 RTOL = {"p8_bare": 1e-10, "p8_A": 1e-10, "p8_B": 1e-10}
@@ -69,6 +73,7 @@ def build(name):
     # (a variant with a contact override is another physics, never matched to the file)
     out["physics_sha256"] = None if contact else physics_digest(load(ROOT / scene))
     out["catalogue"] = name not in NOT_IN_CATALOGUE
+    out["t_end"] = load(ROOT / scene).analysis["t_end"]
     out["date"] = datetime.date.today().isoformat()
     out["command"] = f"benchmarks/independent/make_references.py {name}"
     OUT.mkdir(parents=True, exist_ok=True)

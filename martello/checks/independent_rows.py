@@ -34,7 +34,8 @@ def find_independent(scene, root=INDEPENDENT_ROOT):
     digest = physics_digest(scene)
     for f in sorted(root.glob("*.json")):
         ref = json.loads(f.read_text())
-        if ref.get("physics_sha256") == digest and ref.get("catalogue", True):
+        if ref.get("physics_sha256") == digest and ref.get("catalogue", True) and \
+                ref.get("t_end") == scene.analysis.get("t_end"):
             return ref
     return None
 
@@ -48,6 +49,10 @@ def _quantities(summary):
             q[f"contacts.{nm}.impact_times.{i}"] = t
         for i, p in enumerate(c.get("phase_max_penetration") or []):
             q[f"contacts.{nm}.phase_max_penetration.{i}"] = p
+        for i, t in enumerate(c.get("separation_times") or []):
+            q[f"contacts.{nm}.separation_times.{i}"] = t
+        for i, e in enumerate(c.get("restitution") or []):
+            q[f"contacts.{nm}.restitution.{i}"] = e
     for nm, r in summary["nodes"].items():
         q[f"nodes.{nm}.u_max"] = r["u_max"]
         q[f"nodes.{nm}.u_min"] = r["u_min"]
@@ -67,7 +72,13 @@ def _reference_quantities(ref):
         for i, p in enumerate(c["phases"]):
             q[f"contacts.{nm}.impact_times.{i}"] = p["t_on"]
             q[f"contacts.{nm}.phase_max_penetration.{i}"] = p["max_penetration"]
-            owner[f"contacts.{nm}.impact_times.{i}"] = owner[f"contacts.{nm}.phase_max_penetration.{i}"] = nm
+            q[f"contacts.{nm}.separation_times.{i}"] = p["t_off"]
+            q[f"contacts.{nm}.restitution.{i}"] = p["restitution"]
+            for k in ("impact_times", "phase_max_penetration", "separation_times", "restitution"):
+                owner[f"contacts.{nm}.{k}.{i}"] = nm
+            if i < len(rows):
+                dig[f"contacts.{nm}.separation_times.{i}"] = rows[i]["t_off"]
+                dig[f"contacts.{nm}.restitution.{i}"] = rows[i]["restitution"]
             if i < len(rows):
                 dig[f"contacts.{nm}.impact_times.{i}"] = rows[i]["t_on"]
                 dig[f"contacts.{nm}.phase_max_penetration.{i}"] = rows[i]["max_penetration"]
@@ -96,6 +107,8 @@ def _scales(ref, owner):
             return ref["contacts"][owner[key]]["max_penetration"] or 1e-300
         if key.startswith("energy."):
             return e
+        if ".restitution." in key:
+            return 1.0
         return abs(value) or 1.0       # event times: relative to the time
     return scale
 
