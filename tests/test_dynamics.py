@@ -144,8 +144,10 @@ def test_energy_balance_closes_on_every_dynamic_catalogue_scene():
         # a work–energy identity, exact to round-off for average acceleration: below 1e-6 of
         # the energy put in; HHT and generalized-α dissipate the high modes by design (Hilber
         # et al. 1977, Chung & Hulbert 1993), here the stiff contact phases (ωΔt ≈ 0.05 for
-        # K = 1e8 on benchmarks/p2/laws/), which the trapezoidal works do not book: 1e-4
-        bound = 1e-4 if s.analysis["integrator"] in ("hht", "generalized-alpha") else 1e-6
+        # K = 1e8 on benchmarks/p2/laws/), which the trapezoidal works do not book: their
+        # balance is that dissipation, bounded by 1e-3 of the energy put in; so is
+        # Moreau–Jean's with penalty laws, linearised once a step (docs/moreau-jean.md §4)
+        bound = 1e-3 if s.analysis["integrator"] in ("hht", "generalized-alpha", "moreau-jean") else 1e-6
         assert e["balance_max"] <= bound * scale, (s.source, e)
         checked += 1
     assert checked >= 10
