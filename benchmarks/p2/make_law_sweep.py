@@ -1,5 +1,5 @@
 """Write benchmarks/p2/laws/: P2's bouncing oscillator (docs/problems.md P2) on a penalty
-plane with every law, on Newmark, HHT and generalized-α, checked against the independent
+plane with every law, on Newmark, HHT, generalized-α, rk8pd and IDA, checked against the independent
 engine (reference/independent/, docs/independent-reference.md): impact and separation times,
 realised e, peak penetration of every phase, peaks and energies. Regenerate the scenes with
 
@@ -15,7 +15,8 @@ LAWS = {  # law: (stiffness, target e, clipped); the P2 plane of docs/problems.m
     "lankarani-nikravesh": (1e8, 0.8, False), "flores": (1e8, 0.8, False), "gonthier": (1e8, 0.8, False),
     "hertzdamp": (1e8, 0.8, False), "jankowski": (1e8, 0.8, False)}
 INTEGRATORS = {"newmark": 'preset = "average-acceleration"', "hht": "alpha = -0.05",
-               "generalized-alpha": "rho_inf = 0.9"}
+               "generalized-alpha": "rho_inf = 0.9", "rk8pd": "rtol = 1.0e-10\natol = 1.0e-14",
+               "ida": "rtol = 1.0e-10\natol = 1.0e-14"}
 
 
 def name(law, integ):
