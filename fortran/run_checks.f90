@@ -4,7 +4,10 @@ module martello_run_checks
    use martello_kinds, only: dp
    use martello_status
    use martello_model, only: model_t, scheme_name
-   use martello_integrator_settings, only: integrator_settings_t, integrator_name, scheme_supported, INT_LAST
+   use martello_integrator_settings, only: integrator_settings_t, integrator_name, scheme_supported, INT_LAST, &
+      INT_MOREAU_JEAN
+   use martello_registry, only: SCHEME_PENALTY
+   use martello_contact_laws, only: LAW_JANKOWSKI
    implicit none
    private
    public :: check_run_settings, check_schemes
@@ -50,5 +53,20 @@ contains
             scheme_name(m%con_scheme(j))//' is static only; use analysis type static'
          return
       end do
+      ! Moreau-Jean linearises the smooth forces once per step with the start-of-step
+      ! tangent (docs/moreau-jean.md); Jankowski's dF/d(delta) is unbounded at first touch,
+      ! so the step overshoots and the impact comes out elastic (e near 1 for a target 0.65,
+      ! docs/behaviour.md): refused, not run wrong
+      if (kind == INT_MOREAU_JEAN) then
+         do j = 1, m%ncontact
+            if (m%con_scheme(j) /= SCHEME_PENALTY .or. m%con_law(j) /= LAW_JANKOWSKI) cycle
+            write (num, '(i0)') j - 1
+            stat = MARTELLO_ERR_UNSUPPORTED
+            message = 'contact '//trim(num)//': law jankowski cannot run on moreau-jean '// &
+               '(its one linearisation per step misses the unbounded stiffness at first touch); '// &
+               'use newmark, hht, generalized-alpha, central-difference, rkf45, rk8pd, msbdf or ida'
+            return
+         end do
+      end if
    end subroutine check_schemes
 end module martello_run_checks

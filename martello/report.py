@@ -9,6 +9,7 @@ from pathlib import Path
 
 from .binding import native
 from .checks.measures import run_measured
+from .checks.independent_rows import verify_independent
 from .checks.reference_data import verify_reference_data
 from .checks.verify import verify
 from . import errors
@@ -43,8 +44,14 @@ def check_catalogue(files, outdir, plots=True, stream=sys.stdout, require_checks
             schemes = ",".join(sorted({c["scheme"] for c in s.contacts})) or "-"
             # closed form where the scene names one, else the stored reference data (reference/)
             rows_here = verify(s, summary) if s.check is not None else []
+            for r in rows_here:
+                r.setdefault("evidence", "closed form")
             if history is not None:
-                rows_here += verify_reference_data(s, summary, history)
+                # accuracy against the independent engine where it has the scene; else the
+                # stored reference data, which only show drift (regression, not verification)
+                acc = verify_independent(s, summary, lambda sc: run_measured(sc)[0])
+                rows_here += acc or [dict(r, evidence="regression")
+                                     for r in verify_reference_data(s, summary, history)]
             if not rows_here:
                 missing = _missing_reference_data(path)
                 if missing:
@@ -58,7 +65,10 @@ def check_catalogue(files, outdir, plots=True, stream=sys.stdout, require_checks
                 print(f"{s.title[:44]:<44} (no closed form or reference data: ran, not verified)",
                       file=stream)
                 continue
+            laws = ",".join(sorted({c["scheme"] if c["scheme"] != "penalty" else c.get("law") or "linear"
+                                    for c in s.contacts})) or "-"
             for r in rows_here:
+                r.update(integrator=s.analysis.get("integrator") or "static", laws=laws)
                 r.update(scheme=schemes, analysis=s.analysis["type"], status=summary["status"],
                          problem=s.problem,
                          digits_lost=summary.get("conditioning", {}).get("digits_lost", 0.0))
@@ -86,12 +96,67 @@ def check_catalogue(files, outdir, plots=True, stream=sys.stdout, require_checks
     _write_csv(rows, outdir / "verification.csv")
     pngs = _plots(rows, outdir) if plots and rows else []
     _write_markdown(rows, failures, pngs, outdir / "report.md", elapsed)
-    n_pass = sum(r["passed"] for r in rows)
-    print(f"\n{n_pass} of {len(rows)} checks passed; {len(failures)} failure(s); "
-          f"{len(files)} scenes in {elapsed:.1f} s. Report: {outdir / 'report.md'}", file=stream)
+    (outdir / "coverage.md").write_text(coverage_markdown(rows) + "\n")
+    print("\n" + headline(rows, failures, len(files), elapsed) + f" Report: {outdir / 'report.md'}",
+          file=stream)
     for f in failures:
         print(f"  FAILED {f}", file=stream)
     return not failures
+
+
+VERIFICATION = ("closed form", "independent reference")
+
+
+def headline(rows, failures, n_scenes, elapsed):
+    """Only rows against a closed form or the independent reference count as verification;
+    regression rows (drift from stored data) and identities are counted apart."""
+    ver = [r for r in rows if r.get("evidence") in VERIFICATION]
+    other = [r for r in rows if r.get("evidence") not in VERIFICATION]
+    kinds = ", ".join(f"{sum(r['evidence'] == k for r in ver)} vs {k}" for k in VERIFICATION)
+    return (f"verification: {sum(r['passed'] for r in ver)} of {len(ver)} checks passed ({kinds}); "
+            f"regression, not verification: {sum(r['passed'] for r in other)} of {len(other)} passed; "
+            f"{len(failures)} failure(s); {n_scenes} scenes in {elapsed:.1f} s.")
+
+
+def coverage(rows):
+    """The coverage matrix: one cell per problem × contact law (or scheme) × integrator, with
+    its kind of evidence (the strongest of its rows: closed form, then independent reference,
+    else regression only: self-consistent), its fewest digits among the verifying rows, and
+    whether every row of the cell passed."""
+    cells = {}
+    for r in rows:
+        key = (r.get("problem") or "-", r.get("laws", "-"), r.get("integrator", "-"))
+        c = cells.setdefault(key, {"kinds": set(), "digits": [], "n": 0, "ok": True})
+        c["kinds"].add(r.get("evidence", "regression"))
+        c["n"] += 1
+        c["ok"] &= bool(r["passed"])
+        if r.get("evidence") in VERIFICATION:
+            c["digits"].append(r["digits"])
+    out = []
+    for (problem, laws, integ), c in sorted(cells.items()):
+        kind = next((k for k in VERIFICATION if k in c["kinds"]), "regression only (self-consistent)")
+        out.append({"problem": problem, "law": laws, "integrator": integ, "evidence": kind,
+                    "digits": min(c["digits"]) if c["digits"] else None, "rows": c["n"],
+                    "state": "verified" if c["ok"] and kind in VERIFICATION else
+                    ("WRONG" if not c["ok"] else "self-consistent only")})
+    return out
+
+
+def coverage_markdown(rows):
+    cells = coverage(rows)
+    n_ver = sum(c["state"] == "verified" for c in cells)
+    n_bad = sum(c["state"] == "WRONG" for c in cells)
+    n_self = sum(c["state"] == "self-consistent only" for c in cells)
+    lines = [f"{n_ver} cells verified against a closed form or the independent reference, "
+             f"{n_bad} wrong, {n_self} self-consistent only (regression against data martello made), "
+             f"of {len(cells)} problem × law/scheme × integrator cells that `martello check` ran.", "",
+             "| problem | law / scheme | integrator | evidence | fewest digits | rows | state |",
+             "|---|---|---|---|---|---|---|"]
+    for c in cells:
+        d = f"{c['digits']:.1f}" if c["digits"] is not None else "—"
+        lines.append(f"| {c['problem']} | {c['law']} | {c['integrator']} | {c['evidence']} | {d} | "
+                     f"{c['rows']} | {c['state']} |")
+    return "\n".join(lines)
 
 
 def _missing_reference_data(path):
@@ -105,7 +170,7 @@ def _missing_reference_data(path):
 
 
 def _write_csv(rows, path):
-    keys = ["scene", "file", "scheme", "analysis", "quantity", "value", "reference", "abs_error",
+    keys = ["scene", "file", "scheme", "analysis", "evidence", "quantity", "value", "reference", "abs_error",
             "rel_error", "digits", "rtol", "atol", "passed", "status", "digits_lost", "why"]
     with open(path, "w", newline="") as fh:
         w = csv.DictWriter(fh, fieldnames=keys, extrasaction="ignore")
@@ -184,11 +249,16 @@ def _write_markdown(rows, failures, pngs, path, elapsed):
              "within twice what this scene's own settings showed when the reference was made: "
              "it checks for drift, and its digits show the accuracy of the scene's settings). "
              "digits = −log10 of the relative error (16 = exact to round-off).", "",
-             _problem_table(rows), "",
-             "| scene | scheme | analysis | quantity | value | reference | digits | rtol | pass |",
-             "|---|---|---|---|---|---|---|---|---|"]
+             "**" + headline(rows, failures, len({r['file'] for r in rows}), elapsed) + "** "
+             "Kinds of evidence: *closed form* (martello.oracles), *independent reference* "
+             "(martello.independent, docs/independent-reference.md: digits = min(the run's, the "
+             "reference's trusted digits), tolerance from the run's measured order), "
+             "*regression* (drift from stored data made by martello itself: not verification).", "",
+             _problem_table(rows), "", "## Coverage", "", coverage_markdown(rows), "", "## Rows", "",
+             "| scene | scheme | analysis | evidence | quantity | value | reference | digits | rtol | pass |",
+             "|---|---|---|---|---|---|---|---|---|---|"]
     for r in rows:
-        lines.append(f"| {r['scene']} | {r['scheme']} | {r['analysis']} | `{r['quantity']}` | "
+        lines.append(f"| {r['scene']} | {r['scheme']} | {r['analysis']} | {r.get('evidence', '')} | `{r['quantity']}` | "
                      f"{_fmt(r['value'])} | {_fmt(r['reference'])} | {r['digits']:.1f} | "
                      f"{_tol(r)} | {'yes' if r['passed'] else '**NO**'} |")
     if failures:

@@ -101,7 +101,7 @@ def test_the_cycle_finder_finds_a_cycle():
 # its own unit (subpackage or top-level module) or of a lower layer, never of a higher one.
 # The package's own __init__ ("martello") is its face: it gives the API's names lazily
 # (PEP 562), so it sits on top; test_import_martello_loads_nothing_else keeps it cheap.
-LAYERS = [("martello.errors", "martello.paths", "martello.history"),
+LAYERS = [("martello.errors", "martello.paths", "martello.history", "martello.independent"),
           ("martello.binding", "martello.oracles"), ("martello.closed_forms", "martello.frame2d"),
           ("martello.scene", "martello.ground_motion"),
           ("martello.run",), ("martello.batch",),
@@ -163,6 +163,16 @@ def test_oracles_know_no_solver():
         bad = {x for x in loaded_after(m)
                if x == "martello.run" or x.startswith("martello.binding")}
         assert not bad, f"{m} loads {sorted(bad)}"
+
+
+def test_the_independent_engine_is_a_leaf():
+    # the independent reference shares no code with what it checks (docs/independent-reference.md):
+    # no other martello module, and outside the standard library numpy and scipy only
+    for m in (m for m in MODULES if m.startswith("martello.independent")):
+        other = {x for x in loaded_after(m) if not x.startswith("martello.independent") and x != "martello"}
+        assert not other, f"{m} loads {sorted(other)}"
+        ext = external_imports(m) - set(sys.stdlib_module_names) - {"numpy", "scipy", "__future__"}
+        assert not ext, f"{m} imports {sorted(ext)}"
 
 
 def test_the_run_layer_knows_no_oracle():

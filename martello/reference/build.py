@@ -29,6 +29,24 @@ from .event_located import Unsupported, event_located_run
 from .store import load_reference, manifest, physics_digest
 
 
+
+def _finite(x):
+    """Non-finite numbers as None: reference files are strict JSON (RFC 8259 has no NaN)."""
+    if isinstance(x, dict):
+        return {k: _finite(v) for k, v in x.items()}
+    if isinstance(x, (list, tuple)):
+        return [_finite(v) for v in x]
+    if isinstance(x, float) or hasattr(x, "dtype"):
+        x = float(x) if not isinstance(x, bool) and not isinstance(x, (int,)) else x
+        return x if not isinstance(x, float) or math.isfinite(x) else None
+    return x
+
+
+def strict_json(meta) -> str:
+    """meta as strict JSON: `null` for a value that is not a finite number (an observed order
+    that is not asymptotic), never `NaN`; anything not finite left over is an error."""
+    return json.dumps(_finite(meta), indent=1, default=float, allow_nan=False)
+
 def _spec(method, scene_dict, scene_path, dt, rtol, store, keep_output=False):
     """The run spec of one method at one step (or tolerance), output every `store` s: every
     node and contact (the loader's default), or the scene's own selection if keep_output."""
@@ -91,10 +109,10 @@ def build_reference(entry, root=REFERENCE_ROOT, stream=sys.stderr, jobs=0):
         meta["catalogue_error"] = {k: sc.get(k) for k in ("max_rel_error", "impact_time_error",
                                                           "peak_penetration_error", "impact_count_error")}
         meta["catalogue_settings"] = {k: v for k, v in sdict["analysis"].items() if k != "output"}
-        (folder / "reference.json").write_text(json.dumps(meta, indent=1, default=float) + "\n")
+        (folder / "reference.json").write_text(strict_json(meta) + "\n")
     print(f"  -> {folder}: {len(out['grid'])} rows, digits trusted (min over u) "
           f"{min(v for k, v in out['digits'].items() if k.startswith('u:')):.1f}, "
-          f"observed order {out['meta']['observed_order']:.2f}", file=stream)
+          f"observed order {out['meta']['observed_order'] or math.nan:.2f}", file=stream)
     return folder
 
 
@@ -300,7 +318,7 @@ def write_reference(folder, out, meta):
                fmt=f"%.{prec - 1}e")
     meta = dict(meta)
     meta["stored"] = dict(meta.get("stored", {}), significant_digits=prec)
-    (folder / "reference.json").write_text(json.dumps(meta, indent=1, default=float) + "\n")
+    (folder / "reference.json").write_text(strict_json(meta) + "\n")
     return folder
 
 

@@ -341,6 +341,12 @@ def _dynamic_analysis(src, raw, an, index, contacts, links):
             raise SceneError(src, f"contact[{i}].scheme",
                              f"scheme {c['scheme']} cannot run on integrator {integ}",
                              f"integrators that can: {works}")
+        if integ == "moreau-jean" and c["scheme"] == "penalty" and c.get("law") == "jankowski":
+            # the library refuses the pair (fortran/run_checks.f90): one linearisation per
+            # step misses Jankowski's unbounded stiffness at first touch (docs/moreau-jean.md)
+            raise SceneError(src, f"contact[{i}].law", "law jankowski cannot run on integrator moreau-jean",
+                             "use newmark, hht, generalized-alpha, central-difference, rkf45, rk8pd, "
+                             "msbdf or ida")
     if an["dt"] > an["t_end"]:
         raise SceneError(src, "analysis.dt", f"{an['dt']} is longer than t_end = {an['t_end']}",
                          "choose dt <= t_end")

@@ -1,0 +1,87 @@
+"""Write the independent engine's references (docs/independent-reference.md) for P7 and P8
+into reference/independent/<name>.json: strict JSON, each with its trusted digits.
+
+    .venv/bin/python benchmarks/independent/make_references.py [NAME ...]
+
+Each entry is a catalogue scene, optionally with every contact replaced (the law variants
+of P7's two oscillators). P8's records make 2000 restarts per run: a few minutes each."""
+
+from __future__ import annotations
+
+import datetime
+import hashlib
+import sys
+import time
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[2]
+sys.path.insert(0, str(ROOT))
+
+from martello import independent  # noqa: E402
+from martello.reference.store import physics_digest  # noqa: E402
+from martello.scene.loader import load  # noqa: E402
+
+OUT = ROOT / "reference" / "independent"
+TWO = "benchmarks/p7/p7_two_oscillators.toml"
+HERTZ_K = 3.0e6          # N/m^1.5: the P7 Hunt–Crossley variant's stiffness (reference/references.toml)
+
+REFERENCES = {
+    "p7_two_oscillators_kelvin": (TWO, None),
+    "p7_two_oscillators_kelvin_clipped": (TWO, {"scheme": "penalty", "law": "kelvin", "stiffness": 1.0e5,
+                                               "restitution": 0.65, "clipped": True}),
+    "p7_two_oscillators_linear": (TWO, {"scheme": "penalty", "law": "linear", "stiffness": 1.0e5}),
+    "p7_two_oscillators_hertz": (TWO, {"scheme": "penalty", "law": "hertz", "stiffness": HERTZ_K}),
+    **{f"p7_two_oscillators_{law.replace('-', '_')}": (TWO, {"scheme": "penalty", "law": law, "stiffness": HERTZ_K,
+                                                             "restitution": 0.65})
+       for law in ("hunt-crossley", "lankarani-nikravesh", "flores", "gonthier", "hertzdamp", "jankowski")},
+    "p7_two_oscillators_restitution": (TWO, {"scheme": "restitution", "restitution": 0.65}),
+    "p7_chain_10": ("benchmarks/p7/p7_chain_10.toml", None),
+    "p7_row_3": ("benchmarks/p7/p7_row_3.toml", None),
+    # P2's plane with every law (one physics each; the scenes on three integrators share it)
+    **{f"p2_{law.replace('-', '_')}": (f"benchmarks/p2/laws/p2_{law.replace('-', '_')}_newmark.toml", None)
+       for law in ("linear", "hertz", "kelvin_clipped", "hunt-crossley", "lankarani-nikravesh",
+                   "flores", "gonthier", "hertzdamp", "jankowski")},
+    "p8_bare": ("benchmarks/p8/p8_bare.toml", None),
+    "p8_A": ("benchmarks/p8/p8_A.toml", None),
+    "p8_B": ("benchmarks/p8/p8_B.toml", None),
+}
+# stored, but not used by `martello check` (docs/independent-reference.md "Open"):
+# Newmark on the 10-chain settles, for Δt from 4e-5 to 1e-5, on a second impact time
+# 1.8e-5 s away from this reference (and from its own Δt = 5e-7 run): not a Richardson-
+# predictable error, so no accuracy row can be justified until it is understood
+# Newmark on the two Kelvin oscillators (and the Kelvin row) converges, for Δt from 1e-5 to
+# 2.5e-6, to impact times ~3.6e-6 s and peaks ~2e-5 (relative) away from this reference, which
+# the library's own rk8pd matches to 5e-12: a difference of the fixed-step contact path, not
+# an error that shrinks with Δt (docs/independent-reference.md "Open")
+NOT_IN_CATALOGUE = {"p7_chain_10", "p7_two_oscillators_kelvin", "p7_row_3", "p2_kelvin"}
+# the rtol of the primary integration (the second is at 100 × rtol); P8's records restart
+# the integration every 10 ms, where 1e-10 already gives ≥ 6 trusted digits
+RTOL = {"p8_bare": 1e-10, "p8_A": 1e-10, "p8_B": 1e-10}
+
+
+def build(name):
+    scene, contact = REFERENCES[name]
+    t0 = time.perf_counter()
+    ref = independent.solve(ROOT / scene, rtol=RTOL.get(name, 1e-11), contact=contact)
+    out = ref.to_json()
+    out.pop("events")            # kept short: the phases carry the contact events
+    out["name"] = name
+    out["scene"] = scene
+    out["scene_sha256"] = hashlib.sha256((ROOT / scene).read_bytes()).hexdigest()
+    out["contact_override"] = contact
+    # the key `martello check` finds it by: the physics of the scene as martello reads it
+    # (a variant with a contact override is another physics, never matched to the file)
+    out["physics_sha256"] = None if contact else physics_digest(load(ROOT / scene))
+    out["catalogue"] = name not in NOT_IN_CATALOGUE
+    out["t_end"] = load(ROOT / scene).analysis["t_end"]
+    out["date"] = datetime.date.today().isoformat()
+    out["command"] = f"benchmarks/independent/make_references.py {name}"
+    OUT.mkdir(parents=True, exist_ok=True)
+    (OUT / f"{name}.json").write_text(independent.dumps(out) + "\n")
+    print(f"{name}: trusted digits {ref.trusted_digits:.1f}, ambiguous {ref.ambiguous}, "
+          f"{time.perf_counter() - t0:.1f} s", flush=True)
+
+
+if __name__ == "__main__":
+    for name in sys.argv[1:] or REFERENCES:
+        build(name)

@@ -1,0 +1,151 @@
+"""The independent reference engine (martello/independent, docs/independent-reference.md)
+against closed forms: verification of the oracle itself, before it verifies anything else.
+Every expected value comes from martello.oracles (the mathematics), never from the engine."""
+
+import json
+import math
+
+import numpy as np
+import pytest
+
+from martello import independent
+from martello.oracles.linear_sdof import sdof_sine_ground_response
+from martello.oracles.p5_contact_laws import (hertz_impact, hunt_crossley_realised_e,
+                                               jankowski_realised_e, jankowski_xi,
+                                               kelvin_clipped_restitution, kelvin_xi_from_e,
+                                               linear_contact_time)
+from martello.oracles.p6_hysteresis import elastoplastic_impulse
+
+
+def two_body(law, **keys):
+    """P5's free two-body impact (docs/problems.md P5): m1 = 1 kg at 1 m/s, m2 = 2 kg, 1 mm gap."""
+    contact = {"name": "impact", "a": "m1", "b": "m2", "gap": 1e-3, "scheme": "penalty", "law": law, **keys}
+    return {"node": [{"name": "m1", "mass": 1.0, "v0": 1.0}, {"name": "m2", "mass": 2.0}],
+            "contact": [contact], "analysis": {"type": "dynamic", "t_end": 6e-3}}
+
+
+MSTAR = 2.0 / 3.0
+
+
+def phase(ref):
+    return ref.contacts["impact"]["phases"][0]
+
+
+def test_linear_law_contact_time_and_restitution():
+    ref = independent.solve(two_body("linear", stiffness=1e6))
+    p = phase(ref)
+    # a conservative linear impact: e = 1 and t_c = π√(m*/k) exactly; DOP853 at rtol 1e-11
+    assert p["contact_time"] == pytest.approx(linear_contact_time(MSTAR, 1e6), rel=1e-9)
+    assert p["restitution"] == pytest.approx(1.0, abs=1e-9)
+    assert p["max_penetration"] == pytest.approx(math.sqrt(MSTAR / 1e6), rel=1e-10)
+    assert ref.trusted_digits >= 8
+
+
+def test_hertz_law_contact_time_and_peak():
+    ref = independent.solve(two_body("hertz", stiffness=1e8))
+    h = hertz_impact(MSTAR, 1e8, 1.0)
+    p = phase(ref)
+    assert p["contact_time"] == pytest.approx(h.t_c, rel=1e-8)
+    assert p["max_penetration"] == pytest.approx(h.delta_max, rel=1e-9)
+    assert p["max_force"] == pytest.approx(h.force_max, rel=1e-9)
+
+
+@pytest.mark.parametrize("clipped", [False, True])
+def test_kelvin_restitution_clipped_and_not(clipped):
+    ref = independent.solve(two_body("kelvin", stiffness=1e6, restitution=0.5, clipped=clipped))
+    e = phase(ref)["restitution"]
+    expected = kelvin_clipped_restitution(kelvin_xi_from_e(0.5)) if clipped else 0.5
+    assert e == pytest.approx(expected, abs=1e-9)
+
+
+@pytest.mark.parametrize("law,target", [("hunt-crossley", 0.5), ("lankarani-nikravesh", 0.8),
+                                        ("flores", 0.5), ("gonthier", 0.5), ("hertzdamp", 0.8)])
+def test_hunt_crossley_family_realised_restitution(law, target):
+    from martello.oracles.p5_contact_laws import HC_FACTORS
+    key = {"hunt-crossley": "hunt_crossley", "lankarani-nikravesh": "lankarani_nikravesh",
+           "hertzdamp": "lankarani_nikravesh", "flores": "flores", "gonthier": "gonthier"}[law]
+    a = HC_FACTORS[key](target)
+    ref = independent.solve(two_body(law, stiffness=1e8, restitution=target))
+    # the exact relation (1 + e) a = ln[(1 + a)/(1 − e a)], independent of n, K and m*
+    assert phase(ref)["restitution"] == pytest.approx(hunt_crossley_realised_e(a), abs=1e-8)
+
+
+def test_jankowski_realised_restitution():
+    ref = independent.solve(two_body("jankowski", stiffness=1e8, restitution=0.65))
+    assert phase(ref)["restitution"] == pytest.approx(jankowski_realised_e(jankowski_xi(0.65)), abs=1e-7)
+
+
+@pytest.mark.parametrize("rho", [0.0, 0.05])
+def test_bilinear_yield_is_located(rho):
+    scene = {"node": [{"name": "m", "mass": 1.0, "v0": 0.5}],
+             "link": [{"type": "bilinear", "a": "m", "b": "ground", "k": 100.0, "fy": 1.0, "hardening": rho}],
+             "analysis": {"type": "dynamic", "t_end": 0.8}}
+    ref = independent.solve(scene)
+    ex = elastoplastic_impulse(1.0, 100.0, 0.01, rho, 0.5)
+    assert ref.nodes["m"]["u_max"] == pytest.approx(ex.u_max, rel=1e-10)
+    assert ref.nodes["m"]["t_max"] == pytest.approx(ex.t_max, rel=1e-7)    # a flat maximum
+    assert ref.events[0]["kind"] == "yield+"
+    # bookkeeping of the engine's own energies: plastic work is what the hysteresis takes
+    assert abs(ref.energy["balance"]) < 1e-9 * ref.energy["initial"]
+
+
+def test_sine_ground_motion_on_a_damped_sdof():
+    scene = {"node": [{"name": "m", "mass": 2.0}],
+             "link": [{"type": "spring", "a": "m", "b": "ground", "k": 800.0},
+                      {"type": "dashpot", "a": "m", "b": "ground", "zeta": 0.05}],
+             "loads": {"ground_acceleration": {"type": "sine", "amplitude": 3.0, "omega": 13.0}},
+             "analysis": {"type": "dynamic", "t_end": 2.0}}
+    ref = independent.solve(scene)
+    ex = sdof_sine_ground_response(2.0, 800.0, 0.05, 3.0, 13.0, np.array([2.0]))
+    assert ref.nodes["m"]["u_final"] == pytest.approx(float(ex.u[0]), abs=1e-11)
+
+
+def test_a_grazing_contact_inside_one_step_is_found():
+    # an undamped SDOF of amplitude A against a plane at A(1 − 1e-8): the contact lasts
+    # ~2√(2·1e-8)/ω, far inside one DOP853 step, and no step end sees δ > 0
+    A, w = 0.01, 10.0
+    scene = {"node": [{"name": "m", "mass": 1.0, "v0": A * w}],
+             "link": [{"type": "spring", "a": "m", "b": "ground", "k": w * w}],
+             "contact": [{"name": "plane", "a": "m", "b": "ground", "gap": A * (1 - 1e-8),
+                          "scheme": "penalty", "law": "linear", "stiffness": 1e3}],
+             "analysis": {"type": "dynamic", "t_end": 1.0}}
+    run = independent.run_once(scene, rtol=1e-10)
+    c = run["contacts"]["plane"]
+    assert c["impacts"] == 2                         # at ωt ≈ π/2 and 5π/2
+    assert c["phases"][0]["t_on"] == pytest.approx(math.pi / 2 / w, rel=1e-3)
+
+
+def test_restitution_scheme_impulse():
+    scene = two_body("linear", stiffness=1.0)
+    scene["contact"][0] = {"name": "impact", "a": "m1", "b": "m2", "gap": 1e-3, "scheme": "restitution",
+                           "restitution": 0.3}
+    ref = independent.solve(scene)
+    # Newton's law: v1' = v1 − (1 + e) m2 v0/(m1 + m2)
+    assert ref.nodes["m1"]["v_final"] == pytest.approx(1.0 - 1.3 * 2.0 / 3.0, rel=1e-14)
+    assert ref.energy["impact"] == pytest.approx(0.5 * (1 - 0.09) * MSTAR, rel=1e-14)
+
+
+def test_identical_neighbours_never_touch():
+    # docs/problems.md P7: identical oscillators with the same initial state move together
+    scene = {"chain": [{"prefix": "s", "n": 3, "mass": 1.0, "k": 100.0, "zeta": 0.05, "gap": 0.001,
+                        "contact": {"scheme": "penalty", "law": "kelvin", "stiffness": 1e5, "restitution": 0.65}}],
+             "loads": {"ground_acceleration": {"type": "sine", "amplitude": 3.0, "omega": 8.0}},
+             "analysis": {"type": "dynamic", "t_end": 2.0}}
+    run = independent.run_once(scene)
+    assert all(c["impacts"] == 0 for c in run["contacts"].values())
+
+
+def test_the_report_is_strict_json():
+    ref = independent.solve(two_body("linear", stiffness=1e6))
+    text = independent.dumps(ref.to_json())
+    json.loads(text, parse_constant=lambda c: pytest.fail(f"{c} in the report"))
+    with pytest.raises(ValueError):
+        json.dumps({"x": float("nan")}, allow_nan=False)
+    assert independent.dumps({"x": float("nan")}) == '{\n "x": null\n}'
+
+
+def test_unsupported_parts_are_refused():
+    scene = two_body("linear", stiffness=1e6)
+    scene["contact"][0]["scheme"] = "lagrange"
+    with pytest.raises(independent.Unsupported, match="lagrange"):
+        independent.solve(scene)

@@ -1,0 +1,131 @@
+"""Tests that would have caught each finding of the verification audit (docs/coverage.md
+"Kinds of evidence"): a wrong cell reported as success (Moreau–Jean × Jankowski), a drift
+row passing with a missed impact, NaN in a JSON reference file, the energy balance read as
+accuracy. Each says what kind of evidence it is."""
+
+import copy
+import json
+import math
+from pathlib import Path
+
+import pytest
+
+from martello.checks.independent_rows import INDEPENDENT_ROOT, accuracy_rows, find_independent
+from martello.checks.measures import run_measured
+from martello.errors import SceneError
+from martello.oracles.linear_sdof import sdof_free_response
+from martello.report import headline
+from martello.run import run_full
+from martello.scene.loader import from_dict, load
+
+ROOT = Path(__file__).resolve().parent.parent
+
+
+def test_every_reference_file_is_strict_json():
+    # RFC 8259 has no NaN or Infinity; Python's json writes them unless told not to
+    files = sorted((ROOT / "reference").rglob("*.json"))
+    assert len(files) >= 20
+    for f in files:
+        json.loads(f.read_text(), parse_constant=lambda c, f=f: pytest.fail(f"{c} in {f}"))
+
+
+def test_the_reference_writer_refuses_nan():
+    from martello.reference.build import strict_json
+    assert json.loads(strict_json({"observed_order": math.nan})) == {"observed_order": None}
+
+
+def jankowski_on(integrator):
+    text = (ROOT / "benchmarks/p5/p5_jankowski.toml").read_text()
+    text = text.replace('integrator = "newmark"', f'integrator = "{integrator}"') \
+        .replace('preset = "average-acceleration"\n', "")
+    return text
+
+
+def test_moreau_jean_refuses_jankowski(tmp_path):
+    # it bounced with e ≈ 1 instead of 0.647 (status OK, no warning): now refused, with the fix
+    p = tmp_path / "mj_jankowski.toml"
+    p.write_text(jankowski_on("moreau-jean"))
+    with pytest.raises(SceneError, match="law jankowski cannot run on integrator moreau-jean"):
+        load(p)
+
+
+def test_the_library_refuses_moreau_jean_with_jankowski_too(tmp_path):
+    # a caller that skips the loader meets the same refusal in fortran/run_checks.f90
+    p = tmp_path / "nm.toml"
+    p.write_text(jankowski_on("newmark").replace("t_end = 0.005", "t_end = 0.0011"))
+    s = load(p)
+    s.analysis.update(integrator="moreau-jean", theta=0.5)
+    for k in ("beta", "gamma", "tol_residual", "tol_increment", "max_newton", "preset"):
+        s.analysis.pop(k, None)
+    from martello.errors import MartelloError
+    with pytest.raises(MartelloError, match="jankowski cannot run on moreau-jean"):
+        run_full(s)
+
+
+def p8_bare():
+    s = load(ROOT / "benchmarks/p8/p8_bare.toml")
+    ref = find_independent(s)
+    assert ref is not None and ref["name"] == "p8_bare"
+    return s, ref
+
+
+def test_an_accuracy_row_fails_on_a_missed_impact():
+    # the drift rows passed with one impact missed (tolerance = the old count error); an
+    # accuracy row against the independent reference needs the exact count
+    s, ref = p8_bare()
+    summary = run_measured(s)[0]
+    rows = accuracy_rows(s.title, s.source, ref, [summary, summary, summary], dt=s.analysis["dt"])
+    assert rows and all(r["passed"] for r in rows if r["quantity"].endswith(".impacts vs independent"))
+    missed = copy.deepcopy(summary)
+    c = missed["contacts"]["f2.gap1"]
+    c["impacts"] -= 1
+    for k in ("impact_times", "phase_max_penetration"):
+        c[k] = c[k][:-1]
+    rows = accuracy_rows(s.title, s.source, ref, [missed] * 3, dt=s.analysis["dt"])
+    count = {r["quantity"]: r["passed"] for r in rows if r["quantity"].endswith(".impacts vs independent")}
+    assert count.pop("contacts.f2.gap1.impacts vs independent") is False
+    assert all(count.values())
+
+
+def test_p8_is_verified_against_the_independent_engine():
+    # verification against an independent reference: peaks, every impact, dissipated energy
+    s, ref = p8_bare()
+    summary = run_measured(s)[0]
+    runs = [summary]
+    for f in (2.0, 4.0):
+        s2 = copy.deepcopy(s)
+        s2.analysis["dt"] *= f
+        runs.append(run_measured(s2)[0])
+    rows = accuracy_rows(s.title, s.source, ref, runs, dt=s.analysis["dt"])
+    assert len(rows) > 100 and all(r["passed"] for r in rows), [r for r in rows if not r["passed"]][:2]
+    assert {r["evidence"] for r in rows} == {"independent reference"}
+    energy = [r for r in rows if r["quantity"].startswith("energy.")]
+    assert len(energy) == 2 and min(r["digits"] for r in energy) >= 4
+
+
+def test_the_energy_balance_is_an_identity_not_accuracy():
+    # trapezoidal Newmark: an SDOF at ωΔt = 0.5 is far off the exact solution while its
+    # work-energy balance is exact to round-off; the balance must not be read as accuracy
+    scene = {"node": [{"name": "m", "mass": 1.0, "u0": 0.01}],
+             "link": [{"type": "spring", "a": "m", "b": "ground", "k": 100.0}],
+             "analysis": {"type": "dynamic", "integrator": "newmark", "dt": 0.05, "t_end": 2.0,
+                          "output": {"nodes": ["m"]}}}
+    summary, _ = run_full(from_dict(scene))
+    exact = float(sdof_free_response(1.0, 100.0, 0.0, [2.0], u0=0.01).u[0])
+    assert abs(summary["energy"]["balance_relative"]) < 1e-12
+    assert abs(summary["nodes"]["m"]["u_final"] - exact) > 0.3 * 0.01
+
+
+def test_the_headline_counts_only_verification():
+    rows = [{"evidence": "closed form", "passed": True}, {"evidence": "independent reference", "passed": True},
+            {"evidence": "regression", "passed": True}]
+    text = headline(rows, [], 3, 1.0)
+    assert text.startswith("verification: 2 of 2 checks passed (1 vs closed form, 1 vs independent reference)")
+    assert "regression, not verification: 1 of 1 passed" in text
+
+
+def test_stored_independent_references_say_what_they_are():
+    for f in sorted(INDEPENDENT_ROOT.glob("*.json")):
+        ref = json.loads(f.read_text())
+        assert ref["provenance"]["engine"] == "martello.independent"
+        assert ref["trusted_digits"] is not None and ref["name"] == f.stem
