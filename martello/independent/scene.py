@@ -191,6 +191,8 @@ def model_from_dict(doc: dict, base: Path | None = None, t_end: float | None = N
     doc = expand_chains(doc)
     if doc.get("mass_coupling") or doc.get("bar"):
         raise Unsupported("bars and mass couplings (the engine takes a diagonal mass matrix)")
+    if doc.get("frame"):
+        raise Unsupported("[[frame]] stiffness blocks (the engine models nodes, links and contacts)")
     an = doc.get("analysis", {})
     if an.get("type") != "dynamic" and t_end is None:
         raise Unsupported("a static analysis")
