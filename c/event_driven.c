@@ -1092,8 +1092,11 @@ static int ed_integrate(ed_t *w) {
       t = te;
       st = process_events(w, t);
       if (st != MARTELLO_OK) return st;
-      /* the motion is not smooth across an event: the stepper starts afresh */
+      /* the motion is not smooth across an event: the stepper starts afresh, and its first
+       * step is no longer than the stretch just integrated (the suggestion came from the
+       * motion before the event: a free flight's step is no guide to the contact after it) */
       gsl_odeiv2_driver_reset(w->drv);
+      if (t > t0) h = fmin(h, t - t0);
       stuck = (t - t0 <= w->event_tol) ? stuck + 1 : 0;
       if (stuck > MAX_EVENTS_AT_ONCE)
         return fail(w, MARTELLO_ERR_STEP_UNDERFLOW, t,
