@@ -215,3 +215,30 @@ def test_records_regenerate_bit_identically(tmp_path):
         new, committed = p.read_bytes(), (P8 / "records" / p.name).read_bytes()
         assert b"# generator: martello " in committed
         assert without_version(new) == without_version(committed), p.name
+
+
+def test_record_check_tells_round_off_from_a_changed_record(tmp_path):
+    """make_records --check: a copy differing by a few ulps of the PGA (another build) agrees
+    to round-off; one sample moved by 1e-9 of the PGA, or a changed header, does not."""
+    mr = _load_script("make_records")
+    committed = P8 / "records" / "opcm3274_z2_C_1.csv"
+    lines = committed.read_text().splitlines()
+    data = [i for i, l in enumerate(lines) if l and not l.startswith("#") and l[0] in "-0123456789"]
+    pga = max(abs(float(lines[i].split(",")[1])) for i in data)
+
+    def moved(by, header=None):
+        out = list(lines)
+        t, a = out[data[100]].split(",")
+        out[data[100]] = f"{t},{float(a) + by * pga!r}"
+        if header:
+            out[0] = header
+        p = tmp_path / f"r{len(list(tmp_path.iterdir()))}.csv"
+        p.write_text("\n".join(out) + "\n")
+        return p
+
+    assert mr.compare(committed, committed) == (True, "regenerated bit-identically")
+    ok, why = mr.compare(moved(3e-15), committed)
+    assert ok and "round-off" in why
+    ok, why = mr.compare(moved(1e-9), committed)
+    assert not ok and "more than round-off" in why
+    assert mr.compare(moved(0.0, header="# something else"), committed) == (False, "headers differ")

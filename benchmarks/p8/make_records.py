@@ -24,14 +24,19 @@ target).  Settings, all written into each file's header:
   worst deviation re-measured with martello.ground_motion.response_spectrum on 2000
   log-spaced periods).
 
-Bit-identical regeneration holds for the same native build (same FFTW/GSL, same CPU
-family: FFTW_ESTIMATE plans may pick different SIMD codelets on another machine, which can
-change the last bits of the matching and hence of the records).
+Regeneration (--check) is bit-identical for the same native build; another build type or
+machine (optimisation level, FFTW_ESTIMATE picking other SIMD codelets) changes the last bits
+of the iterative matching: measured 0.5e-14 to 4.1e-14 of the PGA between the Debug and
+Release builds of martello 0.2.0 on one machine. --check then passes if every sample agrees to
+ROUNDOFF x PGA and says so; the P8 runs read the committed files, so their results do not
+depend on the build that made them. The "# generator: martello X.Y.Z" line names the version
+that wrote a file and is not compared (versions move on; samples must not).
 """
 
 from __future__ import annotations
 
 import argparse
+import re
 import dataclasses
 import sys
 import tempfile
@@ -54,6 +59,11 @@ DURATION, DT = 20.0, 0.01
 BAND, T_MIN, T_MAX = 0.10, 0.15, 2.0
 CHECK_PERIODS = np.geomspace(T_MIN, T_MAX, 2000)   # re-measurement of the achieved band
 STEM = "opcm3274_z2_C"
+# Agreement to round-off of a regeneration by another build (relative to the PGA): ~50
+# iterations of FFT-based matching lose some hundred ulps at most
+# (measured up to 4.1e-14); 1e-12 is far below any physical content of a record given to
+# 17 digits.
+ROUNDOFF = 1e-12
 
 
 def target():
@@ -95,21 +105,52 @@ def write(directory):
     return paths
 
 
+def _parts(path):
+    """(header lines without the generator's version, samples as an array)."""
+    head, rows = [], []
+    for line in Path(path).read_text().splitlines():
+        if line.startswith("#"):
+            head.append(re.sub(r"^(# generator: martello )\d+\.\d+\.\d+ ", r"\1", line))
+        elif line and (line[0].isdigit() or line[0] in "-+."):
+            rows.append([float(x) for x in line.split(",")])
+        else:
+            head.append(line)
+    return head, np.array(rows)
+
+
+def compare(new, committed):
+    """(agrees, how): bit-identical samples, or agreement to ROUNDOFF x PGA (another build)."""
+    if not Path(committed).exists():
+        return False, "no committed file"
+    (h1, x1), (h2, x2) = _parts(new), _parts(committed)
+    if h1 != h2:
+        return False, "headers differ"
+    if x1.shape != x2.shape:
+        return False, f"{x1.shape[0]} samples against {x2.shape[0]}"
+    if np.array_equal(x1, x2):
+        return True, "regenerated bit-identically"
+    pga = np.max(np.abs(x2[:, 1]))
+    dev = float(np.max(np.abs(x1 - x2)) / pga)
+    if dev <= ROUNDOFF:
+        return True, f"regenerated to round-off ({dev:.1e} of the PGA: another build)"
+    return False, f"samples differ by {dev:.1e} of the PGA (more than round-off, {ROUNDOFF:g})"
+
+
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--check", action="store_true",
-                    help="regenerate into a temporary folder and compare with records/ byte for byte")
+                    help="regenerate into a temporary folder and compare with records/ "
+                         "(bit for bit, or to round-off from another build)")
     args = ap.parse_args(argv)
     if args.check:
         with tempfile.TemporaryDirectory() as tmp:
-            paths = write(tmp)
-            bad = [p.name for p in paths
-                   if not (RECORD_DIR / p.name).exists()
-                   or (RECORD_DIR / p.name).read_bytes() != p.read_bytes()]
+            results = [(p.name, compare(p, RECORD_DIR / p.name)) for p in write(tmp)]
+        bad = [f"{name} ({why})" for name, (ok, why) in results if not ok]
         if bad:
-            print("differ from the committed records: " + ", ".join(bad))
+            print("differ from the committed records: " + "; ".join(bad))
             return 1
-        print(f"{len(paths)} records regenerated bit-identically")
+        for name, (_, why) in results:
+            print(f"{name}: {why}")
         return 0
     RECORD_DIR.mkdir(parents=True, exist_ok=True)
     for p in write(RECORD_DIR):
