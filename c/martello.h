@@ -184,6 +184,7 @@ typedef struct martello_settings {
   bool fused_chain;         /* Newmark on a chain: the fused chain step (false: general path) */
   double max_steps;         /* steps a run may take (a whole number; the run fails past it) */
   double max_wall;          /* wall-clock seconds a run may take (0: no limit) */
+  bool event_split;         /* Newmark family: split a step at a penalty onset/separation */
 } martello_settings;
 
 /* Indices of martello_run_counters, martello_run_energy and the values of
