@@ -656,8 +656,10 @@ contains
                umax(i) = max(umax(i), u(i)); umin(i) = min(umin(i), u(i))
                vmax(i) = max(vmax(i), abs(v(i))); amax(i) = max(amax(i), abs(a(i)))
                call fold_absmax(o, i, t, u(i))
-               if (o%fixed_steps .and. o%prev_t >= 0.0_dp .and. h > 0.0_dp) &
+               if (o%fixed_steps .and. o%prev_t >= 0.0_dp .and. h > 0.0_dp) then
                   call hermite_extremum(o, i, o%prev_t, h, un(i), vn(i), an(i), u(i), v(i), a(i))
+                  call hermite_v_extremum(vmax(i), h, vn(i), an(i), v(i), a(i))
+               end if
                if (.not. o%located_extrema .and. o%prev_t >= 0.0_dp .and. vn(i) > 0.0_dp .and. &
                    v(i) <= 0.0_dp) then
                   if (an(i) < 0.0_dp) then
@@ -714,11 +716,38 @@ contains
       type(observer_t), intent(inout) :: o
       integer, intent(in) :: i
       real(dp), intent(in) :: t0, h, u0, v0, a0, u1, v1, a1
-      real(dp) :: qa, qb, qc, disc, r(2), s, p
+      real(dp) :: s(2), p(2)
       integer :: k
       if (.not. (v0*v1 < 0.0_dp)) return
       if (v0 > 0.0_dp .and. min(a0, a1) >= 0.0_dp) return
       if (v0 < 0.0_dp .and. max(a0, a1) <= 0.0_dp) return
+      call cubic_hermite_extrema(h, u0, v0, u1, v1, s, p)
+      do k = 1, 2
+         if (s(k) > 0.0_dp .and. s(k) < 1.0_dp) call fold_absmax(o, i, t0 + s(k)*h, p(k))
+      end do
+   end subroutine hermite_extremum
+
+   !> |v| at the extremum of v inside a fixed step, on the cubic Hermite of (v, a) at both
+   !> ends, where a changes sign inside the step (O(h⁴) in v; docs/results.md): into vmax.
+   subroutine hermite_v_extremum(vmax, h, v0, a0, v1, a1)
+      real(dp), intent(inout) :: vmax
+      real(dp), intent(in) :: h, v0, a0, v1, a1
+      real(dp) :: s(2), p(2)
+      integer :: k
+      if (.not. (a0*a1 < 0.0_dp)) return
+      call cubic_hermite_extrema(h, v0, a0, v1, a1, s, p)
+      do k = 1, 2
+         if (s(k) > 0.0_dp .and. s(k) < 1.0_dp) vmax = max(vmax, abs(p(k)))
+      end do
+   end subroutine hermite_v_extremum
+
+   !> The stationary points s (in units of h; outside (0, 1) if none) and values p of the
+   !> cubic Hermite interpolant of y with derivative d at both ends of a step of length h.
+   pure subroutine cubic_hermite_extrema(h, u0, v0, u1, v1, s, p)
+      real(dp), intent(in) :: h, u0, v0, u1, v1
+      real(dp), intent(out) :: s(2), p(2)
+      real(dp) :: qa, qb, qc, disc, r(2), x
+      integer :: k
       ! p'(s) = qa s² + qb s + qc, from H00' = 6s² − 6s, H10' = 3s² − 4s + 1,
       ! H01' = −6s² + 6s, H11' = 3s² − 2s
       qa = 6.0_dp*(u0 - u1) + 3.0_dp*h*(v0 + v1)
@@ -733,11 +762,10 @@ contains
          r(2) = qc/(qa*r(1))
       end if
       do k = 1, 2
-         s = r(k)
-         if (.not. (s > 0.0_dp .and. s < 1.0_dp)) cycle
-         p = u0*(2.0_dp*s**3 - 3.0_dp*s**2 + 1.0_dp) + h*v0*(s**3 - 2.0_dp*s**2 + s) + &
-             u1*(-2.0_dp*s**3 + 3.0_dp*s**2) + h*v1*(s**3 - s**2)
-         call fold_absmax(o, i, t0 + s*h, p)
+         x = r(k); s(k) = x; p(k) = 0.0_dp
+         if (.not. (x > 0.0_dp .and. x < 1.0_dp)) cycle   ! (no cube of a far root: overflow)
+         p(k) = u0*(2.0_dp*x**3 - 3.0_dp*x**2 + 1.0_dp) + h*v0*(x**3 - 2.0_dp*x**2 + x) + &
+                u1*(-2.0_dp*x**3 + 3.0_dp*x**2) + h*v1*(x**3 - x**2)
       end do
-   end subroutine hermite_extremum
+   end subroutine cubic_hermite_extrema
 end module martello_observer
