@@ -184,6 +184,7 @@ typedef struct martello_settings {
   bool fused_chain;         /* Newmark on a chain: the fused chain step (false: general path) */
   double max_steps;         /* steps a run may take (a whole number; the run fails past it) */
   double max_wall;          /* wall-clock seconds a run may take (0: no limit) */
+  bool event_split;         /* Newmark family: split a step at a penalty onset/separation */
 } martello_settings;
 
 /* Indices of martello_run_counters, martello_run_energy and the values of
@@ -245,6 +246,9 @@ int martello_run_counters(const martello_run *run, long long counters[MARTELLO_N
 int martello_run_peaks(const martello_run *run, double *u_max, double *u_min, double *v_absmax,
                        double *a_absmax, double *pen_max, double *force_max, int *impacts,
                        double *u_peak, double *t_peak);
+/* Per node: the largest |u| and its time t_absmax: at the steps, at the extrema the adaptive
+ * integrators locate, and on each fixed step's cubic Hermite on (u, v) (docs/results.md). */
+int martello_run_abs_peaks(const martello_run *run, double *u_absmax, double *t_absmax);
 /* energy indexed by MARTELLO_ENERGY_*; extra = {max |balance|, omega_max, dt_crit
  * (explicit), time reached} */
 int martello_run_energy(const martello_run *run, double energy[MARTELLO_NENERGY], double extra[4]);

@@ -98,6 +98,21 @@ contains
       c_run_peaks = MARTELLO_OK
    end function c_run_peaks
 
+   !> Per node: the largest |u| and its time (docs/results.md, u_absmax)
+   integer(c_int) function c_run_abs_peaks(handle, u_absmax, t_absmax) bind(C, name='martello_run_abs_peaks')
+      type(c_ptr), value :: handle
+      real(c_double), intent(out) :: u_absmax(*), t_absmax(*)
+      type(run_t), pointer :: rp
+      integer :: n
+      rp => get_run(handle)
+      c_run_abs_peaks = MARTELLO_ERR_ARGUMENT
+      if (.not. associated(rp)) return
+      if (.not. allocated(rp%results%u_absmax)) return
+      n = size(rp%results%u_absmax)
+      u_absmax(1:n) = rp%results%u_absmax; t_absmax(1:n) = rp%results%t_absmax
+      c_run_abs_peaks = MARTELLO_OK
+   end function c_run_abs_peaks
+
    !> energy[9] = {kinetic, recoverable, input, damping, plastic, contact, balance, initial,
    !> impact}; extra[4] = {max |balance| over the run, omega_max, dt_crit, t reached}
    integer(c_int) function c_run_energy(handle, energy, extra) bind(C, name='martello_run_energy')

@@ -11,11 +11,12 @@ module martello_generalized_alpha
    use martello_band_matrix
    use martello_assembly
    use martello_observer, only: observer_t, observer_work, observer_fail, C_NEWTON, C_RESIDUALS, &
-      C_FACTORIZATIONS, C_JACOBIANS, C_CHATTER
+      C_FACTORIZATIONS, C_JACOBIANS, C_CHATTER, free_side_crossing
+   use martello_contact_laws, only: contact_force, LAW_KELVIN, P_CLIP
    use martello_integrator_settings
    use martello_stability, only: omega_max
    use martello_fixed_step, only: stepper_t, stepper_rest_start, stepper_fail, newmark_kinematics, &
-      contact_state
+      contact_state, solve_free_mass
    implicit none
    private
    public :: generalized_alpha_t, generalized_alpha_coefficients
@@ -29,6 +30,10 @@ module martello_generalized_alpha
       type(band_t) :: jac, mband, cjac
       !> J of the last converged iterate is intact (kd ≤ 1): the next step starts from it
       logical :: tangent_valid = .false.
+      !> event_split: a step is split at the located onset/separation of a Kelvin contact
+      !> (docs/integrators.md, event-split steps); the step's start state is kept in us, vs, as
+      logical :: event_split = .false.
+      real(dp), allocatable :: us(:), vs(:), as(:), jump(:)
    contains
       procedure :: init
       procedure :: step
@@ -77,6 +82,8 @@ contains
       self%cm = (1.0_dp - self%am)/(self%beta*self%h*self%h)
       self%mmax = max(maxval(m%mass), tiny(1.0_dp))
       self%cv = self%gamma/(self%beta*self%h)
+      self%event_split = logical(s%event_split) .and. any(m%con_law == LAW_KELVIN)
+      if (self%event_split) allocate (self%us(0:n), self%vs(0:n), self%as(0:n), self%jump(0:n))
       if (s%kind == INT_NEWMARK .and. 2.0_dp*self%beta < self%gamma) &
          call newmark_stability(self%beta, self%gamma, self%h, logical(s%check_stability), stat)
    contains
@@ -125,6 +132,9 @@ contains
       fext_mag = maxval(abs(self%fext))
       call newton_step(converged)
       if (.not. converged) return
+      if (self%event_split) then
+         if (split_step()) return
+      end if
       ! energy balance: trapezoidal work of every force over the step (elements in commit)
       call mech_commit(m, self%ms, self%u, wd, wl, wc)
       call observer_work(o, damping=wd, links=wl, contact=wc)
@@ -132,6 +142,133 @@ contains
       call contact_state(self, m)
 
    contains
+
+      !> The event-split step (docs/integrators.md): where a Kelvin contact's δ changes sign
+      !> over the step just solved, the crossing τ is located from the start of the step on the
+      !> quadratic δ + δ̇τ + ½δ̈τ² (the start is on the smooth branch up to the crossing:
+      !> O(h³) in time), and the step is re-taken as two Newmark sub-steps [t0, t0 + τ] and
+      !> [t0 + τ, t]. At the boundary the contact force jumps to its other branch's value
+      !> (onset: kδ + cδ̇, clipped as the law says; separation: 0) in the internal force, the
+      !> committed contact force and the acceleration (M Δa = −ΔF): the jump falls on a sub-step
+      !> boundary, so each sub-step integrates a smooth force. False: no crossing, the step
+      !> stands as solved.
+      logical function split_step() result(split)
+         real(dp), parameter :: SPLIT_MIN = 1.0e-6_dp
+         integer :: j, ia, ib, first, branch
+         real(dp) :: tau, tj, d0, r0, q0, d1, h_full, fplus, dfd, dfv
+         logical :: ok2
+         split = .false.
+         tau = h; first = 0
+         do j = 1, m%ncontact
+            if (.not. self%ms%is_penalty(j) .or. m%con_law(j) /= LAW_KELVIN) cycle
+            ia = m%con_a(j); ib = m%con_b(j)
+            d0 = self%un(ia) - self%un(ib) - m%con_gap(j)
+            ! clipped Kelvin separates at its cut-off, F = 0 on both sides of δ = 0: no jump
+            if (d0 > 0.0_dp .and. m%con_par(P_CLIP, j) > 0.5_dp) cycle
+            d1 = self%u(ia) - self%u(ib) - m%con_gap(j)
+            r0 = self%vn(ia) - self%vn(ib); q0 = self%an(ia) - self%an(ib)
+            ! the start's quadratic crosses inside the step (the solved step may not: the
+            ! chatter rule can have held the contact open), or the solved step changes sign
+            tj = first_root(d0, r0, q0)
+            if (tj >= h) then
+               if ((d0 > 0.0_dp) .eqv. (d1 > 0.0_dp)) cycle
+               tj = free_side_crossing(d0, r0, q0, 0.0_dp, h)
+            end if
+            if (tj > 0.0_dp .and. tj < tau) then
+               tau = tj; first = j
+            end if
+         end do
+         ! a crossing within SPLIT_MIN·h of a step end is left in the step: its jump then
+         ! acts over at most SPLIT_MIN·h (an error SPLIT_MIN·h·ΔF/m, far below the O(h²) of the
+         ! step), where a sub-step that short would leave Newton only rounding to work with
+         if (first == 0 .or. tau <= SPLIT_MIN*h .or. h - tau <= SPLIT_MIN*h) return
+         split = .true.
+         h_full = h
+         self%us = self%un; self%vs = self%vn; self%as = self%an
+         ! sub-step 1, [t0, t0 + τ]: on the start's branch up to its end, whatever the sign of
+         ! δ there (δ = 0 to the step's O(h³)): the left limit of the force
+         call set_step(tau)
+         self%ms%forced_off = .false.
+         branch = self%ms%con_branch(first)
+         ia = m%con_a(first); ib = m%con_b(first)
+         self%ms%con_branch(first) = merge(CONTACT_ON, CONTACT_OPEN, &
+                                           self%us(ia) - self%us(ib) - m%con_gap(first) > 0.0_dp)
+         call external_forces(m, self%mrow, self%t0 + tau, self%fext)
+         fext_mag = maxval(abs(self%fext))
+         call newton_step(converged)
+         if (.not. converged) return
+         call commit_works()
+         self%ms%con_branch(first) = branch
+         ! the jump of the crossing contact's force at the boundary, to its other branch
+         d0 = self%u(ia) - self%u(ib) - m%con_gap(first)
+         r0 = self%v(ia) - self%v(ib)
+         fplus = 0.0_dp
+         if (self%us(ia) - self%us(ib) - m%con_gap(first) <= 0.0_dp) &   ! an onset
+            call contact_force(LAW_KELVIN, m%con_par(1, first), m%con_mstar(first), &
+                               max(d0, tiny(1.0_dp)), r0, r0, fplus, dfd, dfv)
+         self%ms%con_on(first) = fplus /= 0.0_dp
+         self%jump = 0.0_dp
+         self%jump(ia) = -(fplus - self%ms%con_f(first)); self%jump(ib) = fplus - self%ms%con_f(first)
+         self%fint(ia) = self%fint(ia) - self%jump(ia); self%fint(ib) = self%fint(ib) - self%jump(ib)
+         self%fint(0) = 0.0_dp
+         self%ms%con_f(first) = fplus
+         call solve_free_mass(m, self%fixed_nodes, self%mband, self%jump, ok2)
+         if (.not. ok2) then
+            call stepper_fail(o, MARTELLO_ERR_SINGULAR, t, 'singular mass at an event-split boundary', stat)
+            return
+         end if
+         self%a = self%a + self%jump
+         ! sub-step 2, [t0 + τ, t]: from the boundary state on the other branch
+         self%un = self%u; self%vn = self%v; self%an = self%a
+         self%fint_n = self%fint; self%fext_n = self%fext
+         call mass_times(m, self%an, self%man)
+         call set_step(h_full - tau)
+         call external_forces(m, self%mrow, t, self%fext)
+         fext_mag = maxval(abs(self%fext))
+         call newton_step(converged)
+         if (.not. converged) return
+         call commit_works()
+         ! the step as the strategy and the observer know it: [t0, t]
+         self%un = self%us; self%vn = self%vs; self%an = self%as
+         call set_step(h_full)
+         call contact_state(self, m)
+      end function split_step
+
+      !> The first root τ in (0, h) of d + rτ + ½qτ² (h if none)
+      real(dp) function first_root(d, r, q) result(tau)
+         real(dp), intent(in) :: d, r, q
+         real(dp) :: disc, w, t1, t2
+         tau = h
+         if (q == 0.0_dp) then
+            if (r /= 0.0_dp) t1 = -d/r
+            if (r /= 0.0_dp .and. t1 > 0.0_dp .and. t1 < h) tau = t1
+            return
+         end if
+         disc = r*r - 2.0_dp*q*d
+         if (disc < 0.0_dp) return
+         w = -(r + sign(sqrt(disc), r))         ! the cancellation-free pair: w/q and 2d/w
+         t1 = w/q
+         t2 = h
+         if (w /= 0.0_dp) t2 = 2.0_dp*d/w
+         if (t1 > 0.0_dp .and. t1 < tau) tau = t1
+         if (t2 > 0.0_dp .and. t2 < tau) tau = t2
+      end function first_root
+
+      !> The step length hh in the Newmark coefficients; the next Newton starts from the predictor
+      subroutine set_step(hh)
+         real(dp), intent(in) :: hh
+         h = hh; self%h = hh
+         self%cm = (1.0_dp - self%am)/(self%beta*hh*hh)
+         self%cv = self%gamma/(self%beta*hh)
+         self%tangent_valid = .false.
+      end subroutine set_step
+
+      !> Commit a (sub-)step: its trapezoidal works to the observer
+      subroutine commit_works()
+         call mech_commit(m, self%ms, self%u, wd, wl, wc)
+         call observer_work(o, damping=wd, links=wl, contact=wc)
+         call observer_work(o, external=external_work(m, self%fext_n, self%fext, self%un, self%u))
+      end subroutine commit_works
 
       !> Newton on the step. A law whose force jumps at δ = 0 (Kelvin: cδ̇ at first touch and
       !> at separation) can leave the step without any root: the iterates then flip the

@@ -12,7 +12,7 @@ module martello_integrator_settings
       INT_MSBDF, INT_IDA, INT_LAST, SETTINGS, INTEGRATORS, setting_t, NSETTINGS, S_DT, S_T_END, &
       S_BETA, S_GAMMA, S_ALPHA, S_RHO_INF, S_TOL_RESIDUAL, S_TOL_INCREMENT, S_MAX_NEWTON, &
       S_CHECK_STABILITY, S_EVERY, S_DIVERGENCE_FACTOR, S_RTOL, S_ATOL, S_THETA, S_EVENT_TOL, &
-      S_H_MAX, S_FUSED_CHAIN, S_MAX_STEPS, S_MAX_WALL, T_INT
+      S_H_MAX, S_FUSED_CHAIN, S_MAX_STEPS, S_MAX_WALL, S_EVENT_SPLIT, T_INT
    implicit none
    private
    public :: integrator_settings_t, integrator_name, scheme_supported, settings_default, &
@@ -47,6 +47,8 @@ module martello_integrator_settings
       !> the budget of a run: steps (a whole number) and wall-clock seconds (0: no limit)
       real(c_double) :: max_steps = SETTINGS(S_MAX_STEPS)%default
       real(c_double) :: max_wall = SETTINGS(S_MAX_WALL)%default
+      !> the Newmark family: split a step at a located penalty onset/separation (docs/integrators.md)
+      logical(c_bool) :: event_split = SETTINGS(S_EVENT_SPLIT)%default /= 0.0_dp
    end type integrator_settings_t
 
 contains
@@ -147,6 +149,7 @@ contains
       case (S_FUSED_CHAIN); x = merge(1.0_dp, 0.0_dp, logical(s%fused_chain))
       case (S_MAX_STEPS); x = s%max_steps
       case (S_MAX_WALL); x = s%max_wall
+      case (S_EVENT_SPLIT); x = merge(1.0_dp, 0.0_dp, logical(s%event_split))
       case default; x = 0.0_dp
       end select
    end function setting_value

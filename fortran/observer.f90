@@ -11,6 +11,7 @@ module martello_observer
    use martello_assembly, only: mech_state_t, kinetic_energy, recoverable_energy, mass_times
    use martello_integrator_settings, only: integrator_settings_t, integrator_name
    use martello_run_quantities
+   use martello_registry, only: INTEGRATORS
    use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan, ieee_is_finite, ieee_is_nan
    use, intrinsic :: iso_c_binding, only: c_funptr, c_ptr, c_null_funptr, c_null_ptr, &
       c_associated, c_f_procpointer, c_int, c_double, c_long_long
@@ -40,9 +41,15 @@ module martello_observer
       !> the largest local maximum of u, interpolated between steps (u_peak at t_peak); the
       !> step maxima above are O(h) in time, these are O(h²)
       real(dp), allocatable :: u_peak(:), t_peak(:)
+      !> the largest |u| and its time: at the steps, at the located extrema (observer_extremum)
+      !> and, for the fixed-step methods, at the root of v of the step's cubic Hermite on
+      !> (u, v) at both ends (hermite_extremum; docs/results.md)
+      real(dp), allocatable :: u_absmax(:), t_absmax(:)
       !> the method locates the extrema of u inside its steps (observer_extremum): u_peak is
       !> its largest located maximum, not an interpolation
       logical :: located_extrema = .false.
+      !> a fixed-step method: |u| is also located on each step's cubic Hermite (hermite_extremum)
+      logical :: fixed_steps = .false.
       real(dp), allocatable :: pen_max(:), force_max(:)
       !> per link: max |force| and max |elongation| (storey shear and drift of a frame)
       real(dp), allocatable :: link_force_absmax(:), link_du_absmax(:)
@@ -138,7 +145,9 @@ contains
       integer :: st, st2
       o = fresh        ! every field at its default, every array deallocated
       if (present(stat)) stat = MARTELLO_OK
-      o%kind = s%kind; o%every = max(s%every, 1); o%divergence_factor = s%divergence_factor
+      o%kind = s%kind
+      if (s%kind >= 1 .and. s%kind <= size(INTEGRATORS)) o%fixed_steps = .not. INTEGRATORS(s%kind)%adaptive
+      o%every = max(s%every, 1); o%divergence_factor = s%divergence_factor
       o%t_end = s%t_end; o%max_steps = s%max_steps; o%max_wall = s%max_wall
       call system_clock(o%clock0, o%clock_rate)
       o%clock_last = o%clock0
@@ -159,6 +168,7 @@ contains
       allocate (o%u_max(n_nodes), o%u_min(n_nodes), o%v_absmax(n_nodes), o%a_absmax(n_nodes), &
                 o%pen_max(n_contacts), o%force_max(n_contacts), o%impacts(n_contacts), &
                 o%u_peak(n_nodes), o%t_peak(n_nodes), o%link_force_absmax(n_links), &
+                o%u_absmax(n_nodes), o%t_absmax(n_nodes), &
                 o%link_du_absmax(n_links), o%prev_u(n_nodes), o%prev_v(n_nodes), &
                 o%prev_a(n_nodes), o%work(0:n_nodes), o%acc(0:n_nodes), o%c_pen(n_contacts), &
                 o%c_force(n_contacts), o%ph_open(n_contacts), &
@@ -176,6 +186,7 @@ contains
       o%link_force_absmax = ieee_value(1.0_dp, ieee_quiet_nan)
       o%link_du_absmax = ieee_value(1.0_dp, ieee_quiet_nan)
       o%u_peak = -huge(1.0_dp); o%t_peak = -1.0_dp
+      o%u_absmax = -1.0_dp; o%t_absmax = -1.0_dp
       o%u_max = -huge(1.0_dp); o%u_min = huge(1.0_dp); o%v_absmax = 0.0_dp
       o%a_absmax = 0.0_dp; o%pen_max = -huge(1.0_dp); o%force_max = 0.0_dp; o%impacts = 0
       o%ph_open = .false.
@@ -656,6 +667,11 @@ contains
                if (u(i) < umin(i)) umin(i) = u(i)
                if (abs(v(i)) > vmax(i)) vmax(i) = abs(v(i))
                if (abs(a(i)) > amax(i)) amax(i) = abs(a(i))
+               call fold_absmax(o, i, t, u(i))
+               if (o%fixed_steps .and. o%prev_t >= 0.0_dp .and. h > 0.0_dp) then
+                  call hermite_extremum(o, i, o%prev_t, h, un(i), vn(i), an(i), u(i), v(i), a(i))
+                  call hermite_v_extremum(vmax(i), h, vn(i), an(i), v(i), a(i))
+               end if
                if (.not. o%located_extrema .and. o%prev_t >= 0.0_dp .and. vn(i) > 0.0_dp .and. &
                    v(i) <= 0.0_dp) then
                   if (an(i) < 0.0_dp) then
@@ -685,8 +701,83 @@ contains
          o%u_peak = -huge(1.0_dp); o%t_peak = -1.0_dp
       end if
       o%u_max(i) = max(o%u_max(i), u); o%u_min(i) = min(o%u_min(i), u)
+      call fold_absmax(o, i, t, u)
       if (maximum .and. u > o%u_peak(i)) then
          o%u_peak(i) = u; o%t_peak(i) = t
       end if
    end subroutine observer_extremum
+
+   !> u_absmax(i), t_absmax(i) ← |u|, t where |u| is larger
+   subroutine fold_absmax(o, i, t, u)
+      type(observer_t), intent(inout) :: o
+      integer, intent(in) :: i
+      real(dp), intent(in) :: t, u
+      if (abs(u) > o%u_absmax(i)) then
+         o%u_absmax(i) = abs(u); o%t_absmax(i) = t
+      end if
+   end subroutine fold_absmax
+
+   !> The extremum of u inside a fixed step [t0, t0 + h], located on the cubic Hermite
+   !> interpolant of (u, v) at both ends, p(s) = u0 H00 + h v0 H10 + u1 H01 + h v1 H11
+   !> (s = τ/h): the root of p'(s), a quadratic, where v changes sign inside the step.
+   !> Interpolation error O(h⁴) in u (O(h³) in the time of the extremum), below the
+   !> O(h²) of the structural steps themselves (docs/results.md). A turn the step's
+   !> accelerations do not support (v reversed by an impulse: no a of the turn's sign at
+   !> either end) is not a smooth extremum and is left to the step values.
+   subroutine hermite_extremum(o, i, t0, h, u0, v0, a0, u1, v1, a1)
+      type(observer_t), intent(inout) :: o
+      integer, intent(in) :: i
+      real(dp), intent(in) :: t0, h, u0, v0, a0, u1, v1, a1
+      real(dp) :: s(2), p(2)
+      integer :: k
+      if (.not. (v0*v1 < 0.0_dp)) return
+      if (v0 > 0.0_dp .and. min(a0, a1) >= 0.0_dp) return
+      if (v0 < 0.0_dp .and. max(a0, a1) <= 0.0_dp) return
+      call cubic_hermite_extrema(h, u0, v0, u1, v1, s, p)
+      do k = 1, 2
+         if (s(k) > 0.0_dp .and. s(k) < 1.0_dp) call fold_absmax(o, i, t0 + s(k)*h, p(k))
+      end do
+   end subroutine hermite_extremum
+
+   !> |v| at the extremum of v inside a fixed step, on the cubic Hermite of (v, a) at both
+   !> ends, where a changes sign inside the step (O(h⁴) in v; docs/results.md): into vmax.
+   subroutine hermite_v_extremum(vmax, h, v0, a0, v1, a1)
+      real(dp), intent(inout) :: vmax
+      real(dp), intent(in) :: h, v0, a0, v1, a1
+      real(dp) :: s(2), p(2)
+      integer :: k
+      if (.not. (a0*a1 < 0.0_dp)) return
+      call cubic_hermite_extrema(h, v0, a0, v1, a1, s, p)
+      do k = 1, 2
+         if (s(k) > 0.0_dp .and. s(k) < 1.0_dp) vmax = max(vmax, abs(p(k)))
+      end do
+   end subroutine hermite_v_extremum
+
+   !> The stationary points s (in units of h; outside (0, 1) if none) and values p of the
+   !> cubic Hermite interpolant of y with derivative d at both ends of a step of length h.
+   pure subroutine cubic_hermite_extrema(h, u0, v0, u1, v1, s, p)
+      real(dp), intent(in) :: h, u0, v0, u1, v1
+      real(dp), intent(out) :: s(2), p(2)
+      real(dp) :: qa, qb, qc, disc, r(2), x
+      integer :: k
+      ! p'(s) = qa s² + qb s + qc, from H00' = 6s² − 6s, H10' = 3s² − 4s + 1,
+      ! H01' = −6s² + 6s, H11' = 3s² − 2s
+      qa = 6.0_dp*(u0 - u1) + 3.0_dp*h*(v0 + v1)
+      qb = -6.0_dp*(u0 - u1) - h*(4.0_dp*v0 + 2.0_dp*v1)
+      qc = h*v0
+      if (abs(qa) <= epsilon(1.0_dp)*(abs(qb) + abs(qc))) then
+         r = -qc/qb
+      else
+         disc = max(qb*qb - 4.0_dp*qa*qc, 0.0_dp)
+         ! the cancellation-free pair of roots
+         r(1) = -0.5_dp*(qb + sign(sqrt(disc), qb))/qa
+         r(2) = qc/(qa*r(1))
+      end if
+      do k = 1, 2
+         x = r(k); s(k) = x; p(k) = 0.0_dp
+         if (.not. (x > 0.0_dp .and. x < 1.0_dp)) cycle   ! (no cube of a far root: overflow)
+         p(k) = u0*(2.0_dp*x**3 - 3.0_dp*x**2 + 1.0_dp) + h*v0*(x**3 - 2.0_dp*x**2 + x) + &
+                u1*(-2.0_dp*x**3 + 3.0_dp*x**2) + h*v1*(x**3 - x**2)
+      end do
+   end subroutine cubic_hermite_extrema
 end module martello_observer

@@ -33,7 +33,7 @@ module martello_registry
       INT_NEWMARK_LAGRANGE, INT_RKF45, INT_RK8PD, INT_MSBDF, INT_IDA, INT_FAST_NONLINEAR, INT_LAST, &
       NSETTINGS, S_DT, S_T_END, S_BETA, S_GAMMA, S_ALPHA, S_RHO_INF, S_TOL_RESIDUAL, &
       S_TOL_INCREMENT, S_MAX_NEWTON, S_CHECK_STABILITY, S_EVERY, S_DIVERGENCE_FACTOR, S_RTOL, &
-      S_ATOL, S_THETA, S_EVENT_TOL, S_H_MAX, S_FUSED_CHAIN, S_MAX_STEPS, S_MAX_WALL, SETTINGS, &
+      S_ATOL, S_THETA, S_EVENT_TOL, S_H_MAX, S_FUSED_CHAIN, S_MAX_STEPS, S_MAX_WALL, S_EVENT_SPLIT, SETTINGS, &
       INTEGRATORS, setting_t, integrator_t, &
       registry_shape, registry_column, registry_row, registry_find, registry_name, &
       NAME_LEN, TEXT_LEN, MAX_COLS, T_DOUBLE, T_INT, T_BOOL
@@ -61,7 +61,8 @@ module martello_registry
                          S_MAX_NEWTON = 9, S_CHECK_STABILITY = 10, S_EVERY = 11, &
                          S_DIVERGENCE_FACTOR = 12, S_RTOL = 13, S_ATOL = 14, S_THETA = 15, &
                          S_EVENT_TOL = 16, S_H_MAX = 17, S_FUSED_CHAIN = 18, &
-                         S_MAX_STEPS = 19, S_MAX_WALL = 20, NSETTINGS = 20
+                         S_MAX_STEPS = 19, S_MAX_WALL = 20, S_EVENT_SPLIT = 21, &
+                         NSETTINGS = 21
    integer, parameter :: MAX_COLS = NSETTINGS   !< the widest table: reads, a column per setting
    ! C types of the settings (rows of the table "setting_types")
    integer, parameter :: T_DOUBLE = 1, T_INT = 2, T_BOOL = 3
@@ -267,7 +268,8 @@ module martello_registry
       setting_t('max_steps', T_DOUBLE, 1.0e8_dp, 1.0_dp, 2.0_dp**53, .false., .false., &
                 'a whole number in [1, 2^53]'), &
       setting_t('max_wall', T_DOUBLE, 0.0_dp, 0.0_dp, BIG, .false., .false., &
-                'a number >= 0 [s] (0: no limit)')]
+                'a number >= 0 [s] (0: no limit)'), &
+      setting_t('event_split', T_BOOL, 0.0_dp, 0.0_dp, 1.0_dp, .false., .false., 'true or false')]
 
    ! Settings read by groups of integrators (bit S_x).
    integer, parameter :: READS_BASE = 2**S_DT + 2**S_T_END + 2**S_EVERY + 2**S_MAX_STEPS + 2**S_MAX_WALL
@@ -283,13 +285,15 @@ module martello_registry
    type(integrator_t), parameter :: INTEGRATORS(INT_LAST) = [ &
       integrator_t('newmark', INT_NEWMARK, FAMILY_NEWMARK, .false., &
                    READS_BASE + READS_DIVERGENCE + READS_NEWTON + 2**S_BETA + 2**S_GAMMA + &
-                   2**S_CHECK_STABILITY + 2**S_FUSED_CHAIN, &
+                   2**S_CHECK_STABILITY + 2**S_FUSED_CHAIN + 2**S_EVENT_SPLIT, &
                    RUNS_PENALTY, 'Newmark (1959) beta-gamma, implicit'), &
       integrator_t('hht', INT_HHT, FAMILY_NEWMARK, .false., &
-                   READS_BASE + READS_DIVERGENCE + READS_NEWTON + 2**S_ALPHA, RUNS_PENALTY, &
+                   READS_BASE + READS_DIVERGENCE + READS_NEWTON + 2**S_ALPHA + 2**S_EVENT_SPLIT, &
+                   RUNS_PENALTY, &
                    'Hilber, Hughes & Taylor (1977) alpha method'), &
       integrator_t('generalized-alpha', INT_GENERALIZED_ALPHA, FAMILY_NEWMARK, .false., &
-                   READS_BASE + READS_DIVERGENCE + READS_NEWTON + 2**S_RHO_INF, RUNS_PENALTY, &
+                   READS_BASE + READS_DIVERGENCE + READS_NEWTON + 2**S_RHO_INF + 2**S_EVENT_SPLIT, &
+                   RUNS_PENALTY, &
                    'Chung & Hulbert (1993) generalized-alpha'), &
       integrator_t('central-difference', INT_CENTRAL_DIFFERENCE, FAMILY_NEWMARK, .false., &
                    READS_BASE + READS_DIVERGENCE + 2**S_CHECK_STABILITY, RUNS_PENALTY, &

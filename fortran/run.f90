@@ -79,7 +79,7 @@ contains
       if (stat == MARTELLO_OK) then
          select case (rp%settings%kind)
          case (INT_NEWMARK, INT_HHT, INT_GENERALIZED_ALPHA)
-            if (chain_fusable(mp, rp%settings)) then
+            if (chain_fusable(mp, rp%settings) .and. .not. logical(rp%settings%event_split)) then
                allocate (chain_newmark_t :: stepper)
             else
                allocate (generalized_alpha_t :: stepper)

@@ -185,7 +185,9 @@ def _dynamic(scene, model, raise_on_failure=True):
     for i, n in enumerate(scene.nodes):
         nodes[n["name"]] = {"u_max": float(peaks["u_max"][i]), "u_min": float(peaks["u_min"][i]),
                             "v_absmax": float(peaks["v_absmax"][i]),
-                            "a_absmax": float(peaks["a_absmax"][i])}
+                            "a_absmax": float(peaks["a_absmax"][i]),
+                            "u_absmax": float(peaks["u_absmax"][i]),
+                            "t_absmax": float(peaks["t_absmax"][i])}
         if peaks["t_peak"][i] >= 0:
             nodes[n["name"]].update(u_peak=float(peaks["u_peak"][i]), t_peak=float(peaks["t_peak"][i]))
         if f"u:{n['name']}" in col and len(hist):

@@ -91,6 +91,7 @@ def lib():
         "martello_run_energy": (c_int, [_VOID_P, _DOUBLE_P, _DOUBLE_P]),
         "martello_run_set_link_outputs": (c_int, [_VOID_P, c_int, _INT_P]),
         "martello_run_link_peaks": (c_int, [_VOID_P, _DOUBLE_P, _DOUBLE_P]),
+        "martello_run_abs_peaks": (c_int, [_VOID_P, _DOUBLE_P, _DOUBLE_P]),
     }
     for name, (res, args) in protos.items():
         fn = getattr(L, name)
@@ -470,6 +471,9 @@ class Run(_Handle):
         out = {k: a[: (n_nodes if i < 4 else n_contacts)] for i, (k, a) in enumerate(zip(names, arrays))}
         out["impacts"] = impacts[:n_contacts]
         out["u_peak"], out["t_peak"] = peak[0][:n_nodes], peak[1][:n_nodes]
+        absmax = [np.zeros(max(n_nodes, 1)) for _ in range(2)]
+        lib().martello_run_abs_peaks(self._h, *absmax)
+        out["u_absmax"], out["t_absmax"] = absmax[0][:n_nodes], absmax[1][:n_nodes]
         return out
 
     def energy(self):

@@ -109,6 +109,7 @@ ANALYSIS_TYPES = {
                 "fused_chain": _setting("bool", "fused_chain"),
                 "max_steps": _whole(_setting("float", "max_steps")),
                 "max_wall": _setting("float", "max_wall"),
+                "event_split": _setting("bool", "event_split"),
                 "output": ("table", False, None, None)},
 }
 OUTPUT_KEYS = {"every": _setting("int", "every"), "nodes": ("list", False, None, None),
