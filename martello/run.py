@@ -17,43 +17,83 @@ from .paths import folder_replaced
 LAW_EXPONENT = {r.name: r.values["exponent"] for r in native.registry("laws")}
 
 
-def _link_par(lk):
-    par = np.zeros(constant("NPAR_LINK"))
-    if lk["type"] == "spring":
-        par[constant("L_STIFF")] = lk["k"]
-    elif lk["type"] == "dashpot":
-        par[constant("L_DAMP")] = lk["c"]
-    elif lk["type"] == "bilinear":
-        par[constant("L_STIFF")] = lk["k"]
-        par[constant("L_YIELD")] = lk["fy"]
-        par[constant("L_HARDENING")] = lk["hardening"]
-    elif lk["type"] == "fluid_damper":
-        par[constant("L_DAMP")] = lk["c"]
-        par[constant("L_ALPHA")] = lk["alpha"]
-        par[constant("L_VREG")] = lk["v_reg"]
-    elif lk["type"] == "bar":
-        par[constant("L_STIFF")] = lk["EA"] / lk["L"]
-    return par
+def _column(items, idx, key):
+    """items[i][key] for i in idx, as float64 (the scene loader checked every value)."""
+    return np.fromiter((items[i][key] for i in idx), np.float64, len(idx))
 
 
-def _contact_par(scene, c):
-    par = np.zeros(constant("NPAR_CONTACT"))
-    par[constant("P_RESTITUTION")] = -1.0
-    law = 0
-    if c["scheme"] == "penalty":
-        law = native.value("laws", c["law"])
-        par[constant("P_STIFF")] = c["stiffness"]
-        par[constant("P_EXPONENT")] = c["exponent"] or LAW_EXPONENT[c["law"]]
-        if c["damping"] is not None:
-            par[constant("P_DAMPING")] = c["damping"]
-        if c["restitution"] is not None:
-            par[constant("P_RESTITUTION")] = c["restitution"]
-        par[constant("P_CLIP")] = 1.0 if c["clipped"] else 0.0
-    elif c["scheme"] == "augmented-lagrange":
-        par[constant("P_STIFF")] = c["stiffness"]
-    elif c.get("restitution") is not None:
-        par[constant("P_RESTITUTION")] = c["restitution"]
-    return law, par
+def _groups(names):
+    """{name: indices} of a list of names (link types, contact schemes)."""
+    arr = np.array(names, dtype=object)
+    return {name: np.flatnonzero(arr == name) for name in dict.fromkeys(names)}
+
+
+# The parameter slots each link type fills: slot -> its scene field (bar: EA/L, below).
+LINK_SLOTS = {"spring": {"L_STIFF": "k"}, "dashpot": {"L_DAMP": "c"},
+              "bilinear": {"L_STIFF": "k", "L_YIELD": "fy", "L_HARDENING": "hardening"},
+              "fluid_damper": {"L_DAMP": "c", "L_ALPHA": "alpha", "L_VREG": "v_reg"}}
+
+
+def link_arrays(links):
+    """(kind, a, b, par[n, NPAR_LINK]) of the scene's links, for Model.add_links."""
+    n = len(links)
+    kind = np.zeros(n, np.int32)
+    par = np.zeros((n, constant("NPAR_LINK")))
+    for name, idx in _groups([lk["type"] for lk in links]).items():
+        kind[idx] = native.value("links", name)
+        for slot, key in LINK_SLOTS.get(name, {}).items():
+            par[idx, constant(slot)] = _column(links, idx, key)
+        if name == "bar":
+            par[idx, constant("L_STIFF")] = _column(links, idx, "EA") / _column(links, idx, "L")
+    a = np.fromiter((lk["a"] for lk in links), np.int32, n)
+    b = np.fromiter((lk["b"] for lk in links), np.int32, n)
+    return kind, a, b, par
+
+
+def _optional(items, idx, key, absent):
+    """items[i][key], or absent where it is None or not given."""
+    return np.fromiter((absent if items[i].get(key) is None else items[i][key] for i in idx),
+                       np.float64, len(idx))
+
+
+def contact_arrays(contacts):
+    """(a, b, gap, scheme, law, par[n, NPAR_CONTACT]) of the scene's contacts, for
+    Model.add_contacts. A restitution slot of −1 means none given (docs/c-api.md)."""
+    n = len(contacts)
+    scheme = np.zeros(n, np.int32)
+    law = np.zeros(n, np.int32)
+    par = np.zeros((n, constant("NPAR_CONTACT")))
+    par[:, constant("P_RESTITUTION")] = -1.0
+    for name, idx in _groups([c["scheme"] for c in contacts]).items():
+        scheme[idx] = native.value("schemes", name)
+        if name == "penalty":
+            for law_name, sub in _groups([contacts[i]["law"] for i in idx]).items():
+                law[idx[sub]] = native.value("laws", law_name)
+                # an exponent of None (or 0) means the law's own (LAW_EXPONENT)
+                par[idx[sub], constant("P_EXPONENT")] = np.fromiter(
+                    (contacts[i]["exponent"] or LAW_EXPONENT[law_name] for i in idx[sub]),
+                    np.float64, len(sub))
+            par[idx, constant("P_STIFF")] = _column(contacts, idx, "stiffness")
+            par[idx, constant("P_DAMPING")] = _optional(contacts, idx, "damping", 0.0)
+            par[idx, constant("P_RESTITUTION")] = _optional(contacts, idx, "restitution", -1.0)
+            par[idx, constant("P_CLIP")] = np.fromiter(
+                (1.0 if contacts[i]["clipped"] else 0.0 for i in idx), np.float64, len(idx))
+        elif name == "augmented-lagrange":
+            par[idx, constant("P_STIFF")] = _column(contacts, idx, "stiffness")
+        else:
+            par[idx, constant("P_RESTITUTION")] = _optional(contacts, idx, "restitution", -1.0)
+    a = np.fromiter((c["a"] for c in contacts), np.int32, n)
+    b = np.fromiter((c["b"] for c in contacts), np.int32, n)
+    gap = np.fromiter((c["gap"] for c in contacts), np.float64, n)
+    return a, b, gap, scheme, law, par
+
+
+def node_arrays(nodes):
+    """(mass, u0, v0, fixed) of the scene's nodes, for Model.set_nodes."""
+    n = len(nodes)
+    return tuple(np.fromiter((nd[key] for nd in nodes), dt, n)
+                 for key, dt in (("mass", np.float64), ("u0", np.float64), ("v0", np.float64),
+                                 ("fixed", np.int32)))
 
 
 def _function_args(fn, source="<scene>"):
@@ -89,13 +129,10 @@ def build_model(scene):
     """A native Model holding the scene (the caller frees it, or uses a with-block)."""
     m = native.Model(len(scene.nodes), len(scene.links), len(scene.contacts), len(scene.forces),
                      len(scene.couplings))
-    for i, n in enumerate(scene.nodes):
-        m.set_node(i, n["mass"], n["u0"], n["v0"], n["fixed"])
-    for lk in scene.links:
-        m.add_link(native.value("links", lk["type"]), lk["a"], lk["b"], _link_par(lk))
-    for c in scene.contacts:
-        law, par = _contact_par(scene, c)
-        m.add_contact(c["a"], c["b"], c["gap"], native.value("schemes", c["scheme"]), law, par)
+    # one call per array (docs/c-api.md, "Building a large model")
+    m.set_nodes(*node_arrays(scene.nodes))
+    m.add_links(*link_arrays(scene.links))
+    m.add_contacts(*contact_arrays(scene.contacts))
     for mc in scene.couplings:
         m.add_mass_coupling(mc["a"], mc["b"], mc["value"])
     for b in scene.blocks:
