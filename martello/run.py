@@ -218,38 +218,35 @@ def _dynamic(scene, model, raise_on_failure=True):
     columns = native.history_columns(an["output"]["nodes"], an["output"]["contacts"],
                                      an["output"]["links"])
     col = {name: i for i, name in enumerate(columns)}
-    nodes = {}
-    for i, n in enumerate(scene.nodes):
-        nodes[n["name"]] = {"u_max": float(peaks["u_max"][i]), "u_min": float(peaks["u_min"][i]),
-                            "v_absmax": float(peaks["v_absmax"][i]),
-                            "a_absmax": float(peaks["a_absmax"][i])}
-        if peaks["t_peak"][i] >= 0:
-            nodes[n["name"]].update(u_peak=float(peaks["u_peak"][i]), t_peak=float(peaks["t_peak"][i]))
-        if f"u:{n['name']}" in col and len(hist):
-            nodes[n["name"]].update(u_final=float(hist[-1, col[f"u:{n['name']}"]]),
-                                    v_final=float(hist[-1, col[f"v:{n['name']}"]]))
+    nodes = _node_results(scene, peaks)
+    for name in an["output"]["nodes"]:
+        if f"u:{name}" in col and len(hist):
+            nodes[name].update(u_final=float(hist[-1, col[f"u:{name}"]]),
+                               v_final=float(hist[-1, col[f"v:{name}"]]))
     contacts = {}
     # events grouped by contact once (a long chain has one or more per contact)
     order = np.argsort(ev_contacts, kind="stable")
     bounds = np.searchsorted(ev_contacts[order], np.arange(len(scene.contacts) + 1))
     every_phase = len(scene.contacts) <= PHASE_LISTS or set(an["output"]["contacts"])
+    # the per-contact columns as Python lists, read once (docs/results.md)
+    pen_max = peaks["pen_max"]
+    pen = np.where(0.0 > pen_max, 0.0, pen_max).tolist()     # max(pen, 0), NaN kept
+    force_max = np.asarray(peaks["force_max"], np.float64).tolist()
+    impacts = np.asarray(peaks["impacts"]).astype(np.int64).tolist()
+    first, last = _first_last_phases(ev, order, bounds)
     for j, c in enumerate(scene.contacts):
-        mine = ev[order[bounds[j]:bounds[j + 1]]]
-        closed = mine[mine[:, 1] >= 0]
         if every_phase is not True and c["name"] not in every_phase:
             # a large scene: the phase counts, maxima, first and last phase (docs/results.md)
             contacts[c["name"]] = {
-                "scheme": c["scheme"], "law": c.get("law"),
-                "max_penetration": float(max(peaks["pen_max"][j], 0.0)),
-                "max_force": float(peaks["force_max"][j]), "impacts": int(peaks["impacts"][j]),
-                "first_phase": _phase(mine[0]) if len(mine) else None,
-                "last_phase": _phase(mine[-1]) if len(mine) else None}
+                "scheme": c["scheme"], "law": c.get("law"), "max_penetration": pen[j],
+                "max_force": force_max[j], "impacts": impacts[j],
+                "first_phase": first[j], "last_phase": last[j]}
             continue
+        mine = ev[order[bounds[j]:bounds[j + 1]]]
+        closed = mine[mine[:, 1] >= 0]
         contacts[c["name"]] = {
             "scheme": c["scheme"], "law": c.get("law"),
-            "max_penetration": float(max(peaks["pen_max"][j], 0.0)),
-            "max_force": float(peaks["force_max"][j]),
-            "impacts": int(peaks["impacts"][j]),
+            "max_penetration": pen[j], "max_force": force_max[j], "impacts": impacts[j],
             "impact_times": [float(x) for x in mine[:, 0]],
             "separation_times": [float(x) if x >= 0 else None for x in mine[:, 1]],
             "approach_speeds": [float(x) for x in mine[:, 2]],
@@ -298,9 +295,7 @@ def _dynamic(scene, model, raise_on_failure=True):
         "warnings": warnings,
         "t_reached": extra["t_reached"],
         "nodes": nodes, "contacts": contacts, "energy": energy,
-        "links": {l["name"]: {"type": l["type"], "max_abs_force": _finite_or_none(link_f[i]),
-                              "max_abs_elongation": _finite_or_none(link_du[i])}
-                  for i, l in enumerate(scene.links)},
+        "links": _link_results(scene, link_f, link_du),
         **({"frames": frames} if frames else {}),
         "stability": {"omega_max": extra["omega_max"] or None,
                       "dt_critical": extra["dt_critical"] or None},
@@ -308,6 +303,53 @@ def _dynamic(scene, model, raise_on_failure=True):
         "provenance": provenance(scene),
     }
     return summary, (columns, hist)
+
+
+def _node_results(scene, peaks):
+    """{node: its peaks} from the library's per-node arrays, column by column."""
+    cols = [np.asarray(peaks[k], np.float64).tolist()
+            for k in ("u_max", "u_min", "v_absmax", "a_absmax")]
+    names = [n["name"] for n in scene.nodes]
+    nodes = {name: {"u_max": a, "u_min": b, "v_absmax": v, "a_absmax": acc}
+             for name, a, b, v, acc in zip(names, *cols)}
+    t_peak = np.asarray(peaks["t_peak"], np.float64)
+    has = np.flatnonzero(t_peak >= 0)
+    for i, u, t in zip(has.tolist(), np.asarray(peaks["u_peak"], np.float64)[has].tolist(),
+                       t_peak[has].tolist()):
+        nodes[names[i]].update(u_peak=u, t_peak=t)
+    return nodes
+
+
+def _first_last_phases(ev, order, bounds):
+    """Each contact's first and last phase of the event table (None without one), from the
+    table sorted by contact (order) and each contact's slice of it (bounds)."""
+    n = len(bounds) - 1
+    first, last = [None] * n, [None] * n
+    has = np.flatnonzero(np.diff(bounds) > 0)
+    if len(has):
+        for rows, at in ((first, bounds[has]), (last, bounds[has + 1] - 1)):
+            for j, phase in zip(has.tolist(), _phases(ev[order[at]])):
+                rows[j] = phase
+    return first, last
+
+
+def _phases(table):
+    """_phase of every row of an event table, column by column."""
+    cols = [np.asarray(table[:, k], np.float64).tolist() for k in range(6)]
+    return [{"impact_time": on, "separation_time": off if off >= 0 else None,
+             "approach_speed": v_in, "separation_speed": v_out if off >= 0 else None,
+             "max_penetration": pen, "max_force": f}
+            for on, off, v_in, v_out, pen, f in zip(*cols)]
+
+
+def _link_results(scene, link_f, link_du):
+    f = np.asarray(link_f, np.float64)
+    du = np.asarray(link_du, np.float64)
+    f_out = np.where(np.isfinite(f), f, np.nan).tolist()
+    du_out = np.where(np.isfinite(du), du, np.nan).tolist()
+    return {l["name"]: {"type": l["type"], "max_abs_force": None if fv != fv else fv,
+                        "max_abs_elongation": None if dv != dv else dv}
+            for l, fv, dv in zip(scene.links, f_out, du_out)}
 
 
 def frame_results(fr, columns, hist):
