@@ -1,9 +1,11 @@
 """Run a scene: build the native model from a validated Scene, run its analysis, and shape
 the results as a summary dict (and, for dynamic runs, a history) ready to be written."""
 
+import gc
 import json
 import os
 import time
+from contextlib import contextmanager
 from pathlib import Path
 
 import numpy as np
@@ -193,6 +195,21 @@ def integrator_description(an):
     return d
 
 
+@contextmanager
+def _collector_paused():
+    """The cyclic garbage collector off for a while. A large scene's summary is millions of
+    acyclic dicts and lists: each collection the allocations trigger rescans all of them and
+    frees none (at n = 1e6 that doubled the time to build the summary)."""
+    was = gc.isenabled()
+    gc.disable()
+    try:
+        yield
+    finally:
+        if was:
+            gc.enable()
+
+
+@_collector_paused()
 def _dynamic(scene, model, raise_on_failure=True):
     an = scene.analysis
     out_nodes = [scene.index[n] for n in an["output"]["nodes"]]
