@@ -107,6 +107,18 @@ int martello_model_add_link(martello_model *model, int kind, int a, int b,
 int martello_model_add_contact(martello_model *model, int a, int b, double gap, int scheme,
                                int law, const double par[MARTELLO_NPAR_CONTACT]);
 int martello_model_add_mass_coupling(martello_model *model, int a, int b, double value);
+/* Bulk doors for large models: n entries in one call, each checked exactly as by
+ * martello_model_set_node / _add_link / _add_contact, in order (so the model is the one the
+ * one-entry calls build). Nodes 0..n-1 are set from mass[i], u0[i], v0[i], fixed[i];
+ * par is n rows, row-major (par[i*MARTELLO_NPAR_LINK + j], par[i*MARTELLO_NPAR_CONTACT + j]).
+ * The first bad entry stops the call; martello_model_message names its 0-based index. */
+int martello_model_set_nodes(martello_model *model, int n, const double *mass, const double *u0,
+                             const double *v0, const int *fixed);
+int martello_model_add_links(martello_model *model, int n, const int *kind, const int *a,
+                             const int *b, const double *par);
+int martello_model_add_contacts(martello_model *model, int n, const int *a, const int *b,
+                                const double *gap, const int *scheme, const int *law,
+                                const double *par);
 /* A symmetric stiffness block between n distinct nodes (0-based, no ground): internal force
  * f[nodes[i]] += sum_j (k[i + n*j] u[nodes[j]] + c[i + n*j] v[nodes[j]]) (k, c column-major
  * n x n, exactly symmetric, diag k > 0, diag c >= 0; c may be NULL: undamped) -- a

@@ -90,6 +90,84 @@ contains
       c_model_add_contact = stat
    end function c_model_add_contact
 
+   !> The bulk doors: n entries in one call, each checked exactly as by the one-entry door it
+   !> repeats (same model, same order); the first bad entry stops the call, and the message
+   !> names its 0-based index (docs/c-api.md, "Building a large model").
+   integer(c_int) function c_model_set_nodes(handle, n, mass, u0, v0, fixed) &
+      bind(C, name='martello_model_set_nodes')
+      type(c_ptr), value :: handle
+      integer(c_int), value :: n
+      real(c_double), intent(in) :: mass(*), u0(*), v0(*)
+      integer(c_int), intent(in) :: fixed(*)
+      type(model_t), pointer :: mp
+      integer :: i, stat
+      mp => get_model(handle)
+      if (.not. associated(mp) .or. n < 0) then
+         c_model_set_nodes = MARTELLO_ERR_ARGUMENT; return
+      end if
+      stat = MARTELLO_OK
+      do i = 1, n
+         call model_set_node(mp, i, mass(i), u0(i), v0(i), fixed(i) /= 0, stat)
+         if (stat /= MARTELLO_OK) exit
+      end do
+      if (stat /= MARTELLO_OK) call name_entry(mp, i)
+      c_model_set_nodes = stat
+   end function c_model_set_nodes
+
+   !> par is n rows of MARTELLO_NPAR_LINK (row-major in C: par[i*NPAR_LINK + j]).
+   integer(c_int) function c_model_add_links(handle, n, kind, a, b, par) &
+      bind(C, name='martello_model_add_links')
+      type(c_ptr), value :: handle
+      integer(c_int), value :: n
+      integer(c_int), intent(in) :: kind(*), a(*), b(*)
+      real(c_double), intent(in) :: par(NPAR_LINK, *)
+      type(model_t), pointer :: mp
+      integer :: i, stat
+      mp => get_model(handle)
+      if (.not. associated(mp) .or. n < 0) then
+         c_model_add_links = MARTELLO_ERR_ARGUMENT; return
+      end if
+      stat = MARTELLO_OK
+      do i = 1, n
+         call model_add_link(mp, int(kind(i)), int(a(i)) + 1, int(b(i)) + 1, par(:, i), stat)
+         if (stat /= MARTELLO_OK) exit
+      end do
+      if (stat /= MARTELLO_OK) call name_entry(mp, i)
+      c_model_add_links = stat
+   end function c_model_add_links
+
+   !> par is n rows of MARTELLO_NPAR_CONTACT (row-major in C).
+   integer(c_int) function c_model_add_contacts(handle, n, a, b, gap, scheme, law, par) &
+      bind(C, name='martello_model_add_contacts')
+      type(c_ptr), value :: handle
+      integer(c_int), value :: n
+      integer(c_int), intent(in) :: a(*), b(*), scheme(*), law(*)
+      real(c_double), intent(in) :: gap(*), par(NPAR_CONTACT, *)
+      type(model_t), pointer :: mp
+      integer :: i, stat
+      mp => get_model(handle)
+      if (.not. associated(mp) .or. n < 0) then
+         c_model_add_contacts = MARTELLO_ERR_ARGUMENT; return
+      end if
+      stat = MARTELLO_OK
+      do i = 1, n
+         call model_add_contact(mp, int(a(i)) + 1, int(b(i)) + 1, gap(i), int(scheme(i)), &
+                                int(law(i)), par(:, i), stat)
+         if (stat /= MARTELLO_OK) exit
+      end do
+      if (stat /= MARTELLO_OK) call name_entry(mp, i)
+      c_model_add_contacts = stat
+   end function c_model_add_contacts
+
+   !> Prefix the model's message with the failing bulk entry's 0-based index.
+   subroutine name_entry(mp, i)
+      type(model_t), intent(inout) :: mp
+      integer, intent(in) :: i
+      character(len=24) :: idx
+      write (idx, '(i0)') i - 1
+      mp%errmsg = 'entry '//trim(idx)//': '//trim(mp%errmsg)
+   end subroutine name_entry
+
    integer(c_int) function c_model_add_mass_coupling(handle, a, b, value) &
       bind(C, name='martello_model_add_mass_coupling')
       type(c_ptr), value :: handle

@@ -1,9 +1,11 @@
 """Run a scene: build the native model from a validated Scene, run its analysis, and shape
 the results as a summary dict (and, for dynamic runs, a history) ready to be written."""
 
+import gc
 import json
 import os
 import time
+from contextlib import contextmanager
 from pathlib import Path
 
 import numpy as np
@@ -17,43 +19,83 @@ from .paths import folder_replaced
 LAW_EXPONENT = {r.name: r.values["exponent"] for r in native.registry("laws")}
 
 
-def _link_par(lk):
-    par = np.zeros(constant("NPAR_LINK"))
-    if lk["type"] == "spring":
-        par[constant("L_STIFF")] = lk["k"]
-    elif lk["type"] == "dashpot":
-        par[constant("L_DAMP")] = lk["c"]
-    elif lk["type"] == "bilinear":
-        par[constant("L_STIFF")] = lk["k"]
-        par[constant("L_YIELD")] = lk["fy"]
-        par[constant("L_HARDENING")] = lk["hardening"]
-    elif lk["type"] == "fluid_damper":
-        par[constant("L_DAMP")] = lk["c"]
-        par[constant("L_ALPHA")] = lk["alpha"]
-        par[constant("L_VREG")] = lk["v_reg"]
-    elif lk["type"] == "bar":
-        par[constant("L_STIFF")] = lk["EA"] / lk["L"]
-    return par
+def _column(items, idx, key):
+    """items[i][key] for i in idx, as float64 (the scene loader checked every value)."""
+    return np.fromiter((items[i][key] for i in idx), np.float64, len(idx))
 
 
-def _contact_par(scene, c):
-    par = np.zeros(constant("NPAR_CONTACT"))
-    par[constant("P_RESTITUTION")] = -1.0
-    law = 0
-    if c["scheme"] == "penalty":
-        law = native.value("laws", c["law"])
-        par[constant("P_STIFF")] = c["stiffness"]
-        par[constant("P_EXPONENT")] = c["exponent"] or LAW_EXPONENT[c["law"]]
-        if c["damping"] is not None:
-            par[constant("P_DAMPING")] = c["damping"]
-        if c["restitution"] is not None:
-            par[constant("P_RESTITUTION")] = c["restitution"]
-        par[constant("P_CLIP")] = 1.0 if c["clipped"] else 0.0
-    elif c["scheme"] == "augmented-lagrange":
-        par[constant("P_STIFF")] = c["stiffness"]
-    elif c.get("restitution") is not None:
-        par[constant("P_RESTITUTION")] = c["restitution"]
-    return law, par
+def _groups(names):
+    """{name: indices} of a list of names (link types, contact schemes)."""
+    arr = np.array(names, dtype=object)
+    return {name: np.flatnonzero(arr == name) for name in dict.fromkeys(names)}
+
+
+# The parameter slots each link type fills: slot -> its scene field (bar: EA/L, below).
+LINK_SLOTS = {"spring": {"L_STIFF": "k"}, "dashpot": {"L_DAMP": "c"},
+              "bilinear": {"L_STIFF": "k", "L_YIELD": "fy", "L_HARDENING": "hardening"},
+              "fluid_damper": {"L_DAMP": "c", "L_ALPHA": "alpha", "L_VREG": "v_reg"}}
+
+
+def link_arrays(links):
+    """(kind, a, b, par[n, NPAR_LINK]) of the scene's links, for Model.add_links."""
+    n = len(links)
+    kind = np.zeros(n, np.int32)
+    par = np.zeros((n, constant("NPAR_LINK")))
+    for name, idx in _groups([lk["type"] for lk in links]).items():
+        kind[idx] = native.value("links", name)
+        for slot, key in LINK_SLOTS.get(name, {}).items():
+            par[idx, constant(slot)] = _column(links, idx, key)
+        if name == "bar":
+            par[idx, constant("L_STIFF")] = _column(links, idx, "EA") / _column(links, idx, "L")
+    a = np.fromiter((lk["a"] for lk in links), np.int32, n)
+    b = np.fromiter((lk["b"] for lk in links), np.int32, n)
+    return kind, a, b, par
+
+
+def _optional(items, idx, key, absent):
+    """items[i][key], or absent where it is None or not given."""
+    return np.fromiter((absent if items[i].get(key) is None else items[i][key] for i in idx),
+                       np.float64, len(idx))
+
+
+def contact_arrays(contacts):
+    """(a, b, gap, scheme, law, par[n, NPAR_CONTACT]) of the scene's contacts, for
+    Model.add_contacts. A restitution slot of −1 means none given (docs/c-api.md)."""
+    n = len(contacts)
+    scheme = np.zeros(n, np.int32)
+    law = np.zeros(n, np.int32)
+    par = np.zeros((n, constant("NPAR_CONTACT")))
+    par[:, constant("P_RESTITUTION")] = -1.0
+    for name, idx in _groups([c["scheme"] for c in contacts]).items():
+        scheme[idx] = native.value("schemes", name)
+        if name == "penalty":
+            for law_name, sub in _groups([contacts[i]["law"] for i in idx]).items():
+                law[idx[sub]] = native.value("laws", law_name)
+                # an exponent of None (or 0) means the law's own (LAW_EXPONENT)
+                par[idx[sub], constant("P_EXPONENT")] = np.fromiter(
+                    (contacts[i]["exponent"] or LAW_EXPONENT[law_name] for i in idx[sub]),
+                    np.float64, len(sub))
+            par[idx, constant("P_STIFF")] = _column(contacts, idx, "stiffness")
+            par[idx, constant("P_DAMPING")] = _optional(contacts, idx, "damping", 0.0)
+            par[idx, constant("P_RESTITUTION")] = _optional(contacts, idx, "restitution", -1.0)
+            par[idx, constant("P_CLIP")] = np.fromiter(
+                (1.0 if contacts[i]["clipped"] else 0.0 for i in idx), np.float64, len(idx))
+        elif name == "augmented-lagrange":
+            par[idx, constant("P_STIFF")] = _column(contacts, idx, "stiffness")
+        else:
+            par[idx, constant("P_RESTITUTION")] = _optional(contacts, idx, "restitution", -1.0)
+    a = np.fromiter((c["a"] for c in contacts), np.int32, n)
+    b = np.fromiter((c["b"] for c in contacts), np.int32, n)
+    gap = np.fromiter((c["gap"] for c in contacts), np.float64, n)
+    return a, b, gap, scheme, law, par
+
+
+def node_arrays(nodes):
+    """(mass, u0, v0, fixed) of the scene's nodes, for Model.set_nodes."""
+    n = len(nodes)
+    return tuple(np.fromiter((nd[key] for nd in nodes), dt, n)
+                 for key, dt in (("mass", np.float64), ("u0", np.float64), ("v0", np.float64),
+                                 ("fixed", np.int32)))
 
 
 def _function_args(fn, source="<scene>"):
@@ -89,13 +131,10 @@ def build_model(scene):
     """A native Model holding the scene (the caller frees it, or uses a with-block)."""
     m = native.Model(len(scene.nodes), len(scene.links), len(scene.contacts), len(scene.forces),
                      len(scene.couplings))
-    for i, n in enumerate(scene.nodes):
-        m.set_node(i, n["mass"], n["u0"], n["v0"], n["fixed"])
-    for lk in scene.links:
-        m.add_link(native.value("links", lk["type"]), lk["a"], lk["b"], _link_par(lk))
-    for c in scene.contacts:
-        law, par = _contact_par(scene, c)
-        m.add_contact(c["a"], c["b"], c["gap"], native.value("schemes", c["scheme"]), law, par)
+    # one call per array (docs/c-api.md, "Building a large model")
+    m.set_nodes(*node_arrays(scene.nodes))
+    m.add_links(*link_arrays(scene.links))
+    m.add_contacts(*contact_arrays(scene.contacts))
     for mc in scene.couplings:
         m.add_mass_coupling(mc["a"], mc["b"], mc["value"])
     for b in scene.blocks:
@@ -156,6 +195,21 @@ def integrator_description(an):
     return d
 
 
+@contextmanager
+def _collector_paused():
+    """The cyclic garbage collector off for a while. A large scene's summary is millions of
+    acyclic dicts and lists: each collection the allocations trigger rescans all of them and
+    frees none (at n = 1e6 that doubled the time to build the summary)."""
+    was = gc.isenabled()
+    gc.disable()
+    try:
+        yield
+    finally:
+        if was:
+            gc.enable()
+
+
+@_collector_paused()
 def _dynamic(scene, model, raise_on_failure=True):
     an = scene.analysis
     out_nodes = [scene.index[n] for n in an["output"]["nodes"]]
@@ -181,40 +235,35 @@ def _dynamic(scene, model, raise_on_failure=True):
     columns = native.history_columns(an["output"]["nodes"], an["output"]["contacts"],
                                      an["output"]["links"])
     col = {name: i for i, name in enumerate(columns)}
-    nodes = {}
-    for i, n in enumerate(scene.nodes):
-        nodes[n["name"]] = {"u_max": float(peaks["u_max"][i]), "u_min": float(peaks["u_min"][i]),
-                            "v_absmax": float(peaks["v_absmax"][i]),
-                            "a_absmax": float(peaks["a_absmax"][i]),
-                            "u_absmax": float(peaks["u_absmax"][i]),
-                            "t_absmax": float(peaks["t_absmax"][i])}
-        if peaks["t_peak"][i] >= 0:
-            nodes[n["name"]].update(u_peak=float(peaks["u_peak"][i]), t_peak=float(peaks["t_peak"][i]))
-        if f"u:{n['name']}" in col and len(hist):
-            nodes[n["name"]].update(u_final=float(hist[-1, col[f"u:{n['name']}"]]),
-                                    v_final=float(hist[-1, col[f"v:{n['name']}"]]))
+    nodes = _node_results(scene, peaks)
+    for name in an["output"]["nodes"]:
+        if f"u:{name}" in col and len(hist):
+            nodes[name].update(u_final=float(hist[-1, col[f"u:{name}"]]),
+                               v_final=float(hist[-1, col[f"v:{name}"]]))
     contacts = {}
     # events grouped by contact once (a long chain has one or more per contact)
     order = np.argsort(ev_contacts, kind="stable")
     bounds = np.searchsorted(ev_contacts[order], np.arange(len(scene.contacts) + 1))
     every_phase = len(scene.contacts) <= PHASE_LISTS or set(an["output"]["contacts"])
+    # the per-contact columns as Python lists, read once (docs/results.md)
+    pen_max = peaks["pen_max"]
+    pen = np.where(0.0 > pen_max, 0.0, pen_max).tolist()     # max(pen, 0), NaN kept
+    force_max = np.asarray(peaks["force_max"], np.float64).tolist()
+    impacts = np.asarray(peaks["impacts"]).astype(np.int64).tolist()
+    first, last = _first_last_phases(ev, order, bounds)
     for j, c in enumerate(scene.contacts):
-        mine = ev[order[bounds[j]:bounds[j + 1]]]
-        closed = mine[mine[:, 1] >= 0]
         if every_phase is not True and c["name"] not in every_phase:
             # a large scene: the phase counts, maxima, first and last phase (docs/results.md)
             contacts[c["name"]] = {
-                "scheme": c["scheme"], "law": c.get("law"),
-                "max_penetration": float(max(peaks["pen_max"][j], 0.0)),
-                "max_force": float(peaks["force_max"][j]), "impacts": int(peaks["impacts"][j]),
-                "first_phase": _phase(mine[0]) if len(mine) else None,
-                "last_phase": _phase(mine[-1]) if len(mine) else None}
+                "scheme": c["scheme"], "law": c.get("law"), "max_penetration": pen[j],
+                "max_force": force_max[j], "impacts": impacts[j],
+                "first_phase": first[j], "last_phase": last[j]}
             continue
+        mine = ev[order[bounds[j]:bounds[j + 1]]]
+        closed = mine[mine[:, 1] >= 0]
         contacts[c["name"]] = {
             "scheme": c["scheme"], "law": c.get("law"),
-            "max_penetration": float(max(peaks["pen_max"][j], 0.0)),
-            "max_force": float(peaks["force_max"][j]),
-            "impacts": int(peaks["impacts"][j]),
+            "max_penetration": pen[j], "max_force": force_max[j], "impacts": impacts[j],
             "impact_times": [float(x) for x in mine[:, 0]],
             "separation_times": [float(x) if x >= 0 else None for x in mine[:, 1]],
             "approach_speeds": [float(x) for x in mine[:, 2]],
@@ -263,9 +312,7 @@ def _dynamic(scene, model, raise_on_failure=True):
         "warnings": warnings,
         "t_reached": extra["t_reached"],
         "nodes": nodes, "contacts": contacts, "energy": energy,
-        "links": {l["name"]: {"type": l["type"], "max_abs_force": _finite_or_none(link_f[i]),
-                              "max_abs_elongation": _finite_or_none(link_du[i])}
-                  for i, l in enumerate(scene.links)},
+        "links": _link_results(scene, link_f, link_du),
         **({"frames": frames} if frames else {}),
         "stability": {"omega_max": extra["omega_max"] or None,
                       "dt_critical": extra["dt_critical"] or None},
@@ -273,6 +320,52 @@ def _dynamic(scene, model, raise_on_failure=True):
         "provenance": provenance(scene),
     }
     return summary, (columns, hist)
+
+
+def _node_results(scene, peaks):
+    """{node: its peaks} from the library's per-node arrays, column by column."""
+    keys = ("u_max", "u_min", "v_absmax", "a_absmax", "u_absmax", "t_absmax")
+    cols = [np.asarray(peaks[k], np.float64).tolist() for k in keys]
+    names = [n["name"] for n in scene.nodes]
+    nodes = {name: dict(zip(keys, row)) for name, *row in zip(names, *cols)}
+    t_peak = np.asarray(peaks["t_peak"], np.float64)
+    has = np.flatnonzero(t_peak >= 0)
+    for i, u, t in zip(has.tolist(), np.asarray(peaks["u_peak"], np.float64)[has].tolist(),
+                       t_peak[has].tolist()):
+        nodes[names[i]].update(u_peak=u, t_peak=t)
+    return nodes
+
+
+def _first_last_phases(ev, order, bounds):
+    """Each contact's first and last phase of the event table (None without one), from the
+    table sorted by contact (order) and each contact's slice of it (bounds)."""
+    n = len(bounds) - 1
+    first, last = [None] * n, [None] * n
+    has = np.flatnonzero(np.diff(bounds) > 0)
+    if len(has):
+        for rows, at in ((first, bounds[has]), (last, bounds[has + 1] - 1)):
+            for j, phase in zip(has.tolist(), _phases(ev[order[at]])):
+                rows[j] = phase
+    return first, last
+
+
+def _phases(table):
+    """_phase of every row of an event table, column by column."""
+    cols = [np.asarray(table[:, k], np.float64).tolist() for k in range(6)]
+    return [{"impact_time": on, "separation_time": off if off >= 0 else None,
+             "approach_speed": v_in, "separation_speed": v_out if off >= 0 else None,
+             "max_penetration": pen, "max_force": f}
+            for on, off, v_in, v_out, pen, f in zip(*cols)]
+
+
+def _link_results(scene, link_f, link_du):
+    f = np.asarray(link_f, np.float64)
+    du = np.asarray(link_du, np.float64)
+    f_out = np.where(np.isfinite(f), f, np.nan).tolist()
+    du_out = np.where(np.isfinite(du), du, np.nan).tolist()
+    return {l["name"]: {"type": l["type"], "max_abs_force": None if fv != fv else fv,
+                        "max_abs_elongation": None if dv != dv else dv}
+            for l, fv, dv in zip(scene.links, f_out, du_out)}
 
 
 def frame_results(fr, columns, hist):

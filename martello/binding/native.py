@@ -61,6 +61,11 @@ def lib():
         "martello_model_add_link": (c_int, [_VOID_P, c_int, c_int, c_int, _DOUBLE_P]),
         "martello_model_add_contact": (c_int, [_VOID_P, c_int, c_int, c_double, c_int, c_int,
                                                _DOUBLE_P]),
+        "martello_model_set_nodes": (c_int, [_VOID_P, c_int, _DOUBLE_P, _DOUBLE_P, _DOUBLE_P,
+                                             _INT_P]),
+        "martello_model_add_links": (c_int, [_VOID_P, c_int, _INT_P, _INT_P, _INT_P, _DOUBLE_P]),
+        "martello_model_add_contacts": (c_int, [_VOID_P, c_int, _INT_P, _INT_P, _DOUBLE_P, _INT_P,
+                                                _INT_P, _DOUBLE_P]),
         "martello_model_add_mass_coupling": (c_int, [_VOID_P, c_int, c_int, c_double]),
         "martello_model_add_stiffness_block": (c_int, [_VOID_P, c_int, _INT_P, _DOUBLE_P,
                                                        _DOUBLE_P]),
@@ -271,6 +276,21 @@ def _f64(values, n=None):
     return a
 
 
+
+def _i32(values, n=None):
+    a = np.ascontiguousarray(values, dtype=np.int32)
+    if n is not None and a.size != n:
+        raise ValueError(f"expected {n} values, got {a.size}")
+    return a
+
+
+def _f64_rows(values, n, width):
+    """n parameter rows of width values, C order (row i at [i*width:(i+1)*width])."""
+    a = np.ascontiguousarray(values, dtype=np.float64)
+    if a.shape != (n, width):
+        raise ValueError(f"expected {n} rows of {width} values, got shape {a.shape}")
+    return a
+
 class _Handle:
     """A native handle with a lifecycle (create ... free) and a last message; the base of
     Model and Run. free() (or a with-block) releases it."""
@@ -340,6 +360,28 @@ class Model(_Handle):
                                                     _f64(par, constant("NPAR_CONTACT"))),
                    "contact")
         self.n_contacts += 1
+
+    # The bulk doors (docs/c-api.md, "Building a large model"): one call per array.
+    def set_nodes(self, mass, u0, v0, fixed):
+        mass = _f64(mass, self.n_nodes)
+        self.check(lib().martello_model_set_nodes(self._h, len(mass), mass, _f64(u0, len(mass)),
+                                                  _f64(v0, len(mass)), _i32(fixed, len(mass))),
+                   "nodes")
+
+    def add_links(self, kind, a, b, par):
+        kind = _i32(kind)
+        n = len(kind)
+        self.check(lib().martello_model_add_links(
+            self._h, n, kind, _i32(a, n), _i32(b, n), _f64_rows(par, n, constant("NPAR_LINK"))),
+            "links")
+
+    def add_contacts(self, a, b, gap, scheme, law, par):
+        a = _i32(a)
+        n = len(a)
+        self.check(lib().martello_model_add_contacts(
+            self._h, n, a, _i32(b, n), _f64(gap, n), _i32(scheme, n), _i32(law, n),
+            _f64_rows(par, n, constant("NPAR_CONTACT"))), "contacts")
+        self.n_contacts += n
 
     def add_mass_coupling(self, a, b, value):
         self.check(lib().martello_model_add_mass_coupling(self._h, a, b, value), "mass coupling")

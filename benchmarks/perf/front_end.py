@@ -1,0 +1,84 @@
+#!/usr/bin/env python3
+"""Front-end phases of a large chain run: scene expansion and validation (from_dict), building
+the native model (martello.run.build_model), the native run, and building the summary from
+the library's result arrays — wall seconds of each, in one process per n.
+
+The scene is benchmarks/perf/chain_perf.py's chain (bilinear oscillators, Kelvin contacts
+pre-compressed, ground sine), run for --steps steps (default 10: the native time loop is
+measured by chain_perf.py; here it only has to produce results to summarise).
+Usage: benchmarks/perf/front_end.py [--n 100000 1000000] [--steps 10] [--repeat 1]
+To time another version of the Python front end against this library (e.g. `git archive OLD
+martello | tar -x -C /tmp/old`): --front-end /tmp/old with MARTELLO_LIB=build/libmartello.so."""
+
+import argparse
+import json
+import os
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+HERE = Path(__file__).resolve().parent
+ROOT = HERE.parents[1]
+
+
+def one(n, steps, front_end=None):
+    """Time the phases of one size in this process; print a JSON line."""
+    sys.path.insert(0, str(HERE))
+    from chain_perf import chain_scene     # (puts this checkout on sys.path)
+    if front_end:
+        # ahead of the checkout's editable install (a finder on sys.meta_path)
+        sys.meta_path[:] = [f for f in sys.meta_path if "Editable" not in type(f).__name__
+                            and "editable" not in type(f).__module__]
+        sys.path.insert(0, front_end)
+    import martello.run as run_module
+    from martello.binding import native
+    from martello.scene.loader import from_dict
+    dt = 1e-3
+    t0 = time.perf_counter()
+    scene = from_dict(chain_scene(n, t_end=steps * dt, dt=dt))
+    t1 = time.perf_counter()
+    model = run_module.build_model(scene)
+    t2 = time.perf_counter()
+    # the native run's own clock (cost.wall_time_s) splits _dynamic into run and summary
+    summary, _ = run_module._dynamic(scene, model)
+    t3 = time.perf_counter()
+    model.free()
+    native_s = summary["cost"]["wall_time_s"]
+    print(json.dumps({"n": n, "steps": summary["cost"]["steps"], "version": native.version(),
+                      "front_end": run_module.__file__,
+                      "expand_s": t1 - t0, "build_model_s": t2 - t1, "native_run_s": native_s,
+                      "summary_s": t3 - t2 - native_s}))
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__,
+                                 formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--n", type=int, nargs="*", default=[100000, 1000000])
+    ap.add_argument("--steps", type=int, default=10)
+    ap.add_argument("--repeat", type=int, default=1)
+    ap.add_argument("--front-end", help="a directory holding another martello package to time")
+    ap.add_argument("--one", type=int, help=argparse.SUPPRESS)
+    args = ap.parse_args()
+    if args.one:
+        one(args.one, args.steps, args.front_end)
+        return
+    print(f"{os.cpu_count()} cores, load average {os.getloadavg()[0]:.2f}")
+    print(f"{'n':>8} {'steps':>6} {'expand s':>9} {'build s':>8} {'run s':>7} {'summary s':>9}")
+    for n in args.n:
+        for _ in range(args.repeat):
+            p = subprocess.run([sys.executable, __file__, "--one", str(n), "--steps",
+                                str(args.steps)] + (["--front-end", args.front_end] if args.front_end else []),
+                               capture_output=True, text=True)
+            if p.returncode != 0:
+                print(f"{n:>8} failed: {p.stderr.strip().splitlines()[-1]}")
+                continue
+            r = json.loads(p.stdout.strip().splitlines()[-1])
+            print(f"{r['n']:>8} {r['steps']:>6} {r['expand_s']:>9.2f} {r['build_model_s']:>8.2f} "
+                  f"{r['native_run_s']:>7.2f} {r['summary_s']:>9.2f}   {r['version']} "
+                  f"{r['front_end']}")
+    print(f"load average after: {os.getloadavg()[0]:.2f}")
+
+
+if __name__ == "__main__":
+    main()
