@@ -46,6 +46,12 @@ module martello_fixed_step
       !> the method tracks the link peaks (o%link_force_absmax, o%link_du_absmax) itself and
       !> builds ms%link_f, ms%link_u only for the recorded samples (link_states)
       logical :: own_link_peaks = .false.
+      !> the method's velocity jumps from v_k to v_{k+1} inside the step (Moreau–Jean: the
+      !> positions are q_k + h((1−θ)v_k + θv_{k+1})): a penalty phase then starts at v_k of
+      !> the step it opens in and ends at v_{k+1} of the step it closes in, the velocities
+      !> the method carries on with (docs/moreau-jean.md "Penalty contacts"), not a value
+      !> extrapolated with the step's mean acceleration, which holds the contact force
+      logical :: velocity_jump_phases = .false.
    contains
       procedure(stepper_init), deferred :: init
       procedure(stepper_step), deferred :: step
@@ -94,11 +100,14 @@ contains
       integer, intent(out) :: stat
       integer(i8) :: k
       real(dp) :: t
+      real(dp), allocatable :: no_acc(:)
 
       call check_run_settings(m, s, o%message, stat)
       if (stat /= MARTELLO_OK) return
       call stp%init(m, s, o, stat)
       if (stat /= MARTELLO_OK) return
+      ! velocity-jump phases: located and valued with the end velocities (no acceleration)
+      if (stp%velocity_jump_phases) allocate (no_acc(0:stp%n), source=0.0_dp)
       call observer_begin(o, m, stp%ms, stp%u, stp%v, stp%a, ENERGY_CHECK, stp%advice, stp%ke_aMa)
       t = 0.0_dp
       call sample(0_i8)
@@ -111,8 +120,13 @@ contains
          call stp%step(m, t, o, stat)
          if (stat /= MARTELLO_OK) return
          o%counters(C_STEPS) = o%counters(C_STEPS) + 1_i8
-         call observer_penalty_phases(o, m, stp%ms, stp%un, stp%vn, stp%an, stp%u, stp%v, stp%a, &
-                                      t, stp%h)
+         if (stp%velocity_jump_phases) then
+            call observer_penalty_phases(o, m, stp%ms, stp%un, stp%vn, no_acc, stp%u, stp%v, no_acc, &
+                                         t, stp%h)
+         else
+            call observer_penalty_phases(o, m, stp%ms, stp%un, stp%vn, stp%an, stp%u, stp%v, stp%a, &
+                                         t, stp%h)
+         end if
          call sample(k)
          if (stat /= MARTELLO_OK) return
       end do

@@ -76,6 +76,7 @@ contains
       call stepper_start(self, m, s)
       n = m%n; nc = m%ncontact
       self%advice = 'the linearised smooth forces need a smaller step'
+      self%velocity_jump_phases = .true.   ! penalty phases valued with v_k, v_{k+1}
       self%theta = s%theta
       self%hth = self%h*self%theta
       self%hth2 = self%hth*self%hth

@@ -129,3 +129,31 @@ def test_stored_independent_references_say_what_they_are():
         ref = json.loads(f.read_text())
         assert ref["provenance"]["engine"] == "martello.independent"
         assert ref["trusted_digits"] is not None and ref["name"] == f.stem
+
+
+@pytest.mark.parametrize("law", ["linear", "hertz", "lankarani_nikravesh"])
+def test_moreau_jean_penalty_restitution_is_that_of_its_own_velocities(law):
+    # It reported e from a separation velocity extrapolated with the step's mean acceleration
+    # (which holds the contact force): 0.99999993 on the linear law at h = 1e-6 while its
+    # final velocities gave 0.99999939. P5's bodies are free after the contact, so the
+    # summary's e must be −(v1 − v2)/(v1 − v2)_0 of the last state to round-off (an identity
+    # of the method's own states), and that e must match the closed form two_body_impact
+    # (verification): Moreau–Jean linearises the force once a step, O(ωh) with ωh = 1.2e-3
+    # at h = 1e-6 (ω = √(K/m*) = 1.2e3 /s on the linear law, √(1.5 K √δ_max / m*) ≈ 2.3e3 /s
+    # at the Hertz and LN peak tangent); 5 ωh covers an O(ωh) constant of 5.
+    from martello.checks.dispatchers import two_body_impact
+    s = load(ROOT / f"benchmarks/p5/laws/p5_{law}_moreau_jean.toml")
+    s.analysis["dt"] = 1e-6
+    s.analysis["output"]["every"] = 1
+    summary, (cols, data) = run_full(s)
+    e = summary["contacts"]["impact"]["restitution"]
+    assert len(e) == 1
+    v_rel0 = 1.0
+    e_states = -(data[-1, cols.index("v:m1")] - data[-1, cols.index("v:m2")]) / v_rel0
+    assert e[0] == pytest.approx(e_states, rel=1e-12, abs=1e-13)
+    p = s.check["params"]
+    closed = two_body_impact(**p)
+    mstar = 2.0 / 3.0
+    tangent = p["stiffness"] if law == "linear" else 1.5 * p["stiffness"] * math.sqrt(closed["max_penetration"])
+    omega_h = math.sqrt(tangent / mstar) * 1e-6
+    assert abs(e[0] - closed["restitution"]) <= 5.0 * omega_h
