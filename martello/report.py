@@ -225,16 +225,23 @@ def _tol(r):
 
 
 def _problem_table(rows):
-    """Per problem: scenes, checks, passed, fewest digits."""
+    """Per problem: scenes, checks, passed, and the fewest digits of its verification rows
+    (regression rows measure drift from stored data, not accuracy: counted apart)."""
     by = {}
     for r in rows:
         key = r.get("problem") or r["scene"].split()[0]
-        d = by.setdefault(key, {"scenes": set(), "n": 0, "ok": 0, "min": 16.0})
-        d["scenes"].add(r["scene"]); d["n"] += 1; d["ok"] += r["passed"]; d["min"] = min(d["min"], r["digits"])
-    lines = ["| problem | scenes | checks | passed | fewest digits |", "|---|---|---|---|---|"]
+        d = by.setdefault(key, {"scenes": set(), "n": 0, "ok": 0, "min": None, "reg": 0})
+        d["scenes"].add(r["scene"]); d["n"] += 1; d["ok"] += r["passed"]
+        if r.get("evidence") in VERIFICATION:
+            d["min"] = r["digits"] if d["min"] is None else min(d["min"], r["digits"])
+        else:
+            d["reg"] += 1
+    lines = ["| problem | scenes | checks | passed | of them regression | fewest digits "
+             "(verification rows) |", "|---|---|---|---|---|---|"]
     for k in sorted(by):
         d = by[k]
-        lines.append(f"| {k} | {len(d['scenes'])} | {d['n']} | {d['ok']} | {d['min']:.1f} |")
+        low = "-" if d["min"] is None else f"{d['min']:.1f}"
+        lines.append(f"| {k} | {len(d['scenes'])} | {d['n']} | {d['ok']} | {d['reg']} | {low} |")
     return "\n".join(lines)
 
 
@@ -244,10 +251,11 @@ def _write_markdown(rows, failures, pngs, path, elapsed):
              f"{time.strftime('%Y-%m-%d %H:%M UTC', time.gmtime())}; {elapsed:.1f} s.", "",
              "Each row compares one quantity of one run with the closed form named in the "
              "scene's `[check]` table (martello.oracles, coded independently of the "
-             "solvers) or, for scenes without one, with the stored reference data in "
-             "`reference/` (event-located, tight tolerance; such a row passes when the error is "
-             "within twice what this scene's own settings showed when the reference was made: "
-             "it checks for drift, and its digits show the accuracy of the scene's settings). "
+             "solvers), with the independent reference engine's stored solution "
+             "(martello.independent), or, as regression only, with stored data martello made "
+             "itself in `reference/` (such a row passes when the error is within twice what "
+             "this scene's own settings showed when the data were made: it checks for drift, "
+             "not accuracy). "
              "digits = −log10 of the relative error (16 = exact to round-off).", "",
              "**" + headline(rows, failures, len({r['file'] for r in rows}), elapsed) + "** "
              "Kinds of evidence: *closed form* (martello.oracles), *independent reference* "
