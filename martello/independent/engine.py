@@ -209,8 +209,9 @@ class System:
             return vE[sysm.ca[j]] - vE[sysm.cb[j]]
 
         if not modes.active[j]:
-            return [Switch("onset", j, g, gdot, 1.0, self._onset)]
-        out = [Switch("separation", j, g, gdot, -1.0, self._separation)]
+            # the onset and separation actions need the run's state: integrate() binds them
+            return [Switch("onset", j, g, gdot, 1.0, None)]
+        out = [Switch("separation", j, g, gdot, -1.0, None)]
         sw = c.branch_switch(0.0, 0.0, modes.v_in[j], modes.branch[j])
         if sw is not None:
             _, direction, target = sw
@@ -241,11 +242,6 @@ class System:
                 return y
             out.append(Switch(f"branch:{target}", j, gb, gbdot, direction, apply))
         return out
-
-    def _onset(self, t, y, md, j=None):
-        raise NotImplementedError    # bound per switch in integrate()
-
-    _separation = _onset
 
     def _bilinear_switches(self, i, modes):
         sysm = self
