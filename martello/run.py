@@ -14,6 +14,7 @@ from .binding import native
 from .binding.native import constant
 from .errors import RecordError, ResultError, SceneError
 from .paths import folder_replaced
+from .scene.items import ItemTable
 
 # Default exponent n of each law's elastic part F ~ δ^n (fixed, or Hertz's when the law reads it).
 LAW_EXPONENT = {r.name: r.values["exponent"] for r in native.registry("laws")}
@@ -91,11 +92,83 @@ def contact_arrays(contacts):
 
 
 def node_arrays(nodes):
-    """(mass, u0, v0, fixed) of the scene's nodes, for Model.set_nodes."""
-    n = len(nodes)
-    return tuple(np.fromiter((nd[key] for nd in nodes), dt, n)
-                 for key, dt in (("mass", np.float64), ("u0", np.float64), ("v0", np.float64),
-                                 ("fixed", np.int32)))
+    """(mass, u0, v0, fixed) of the scene's nodes, for Model.set_nodes: a listed segment's
+    read from its dicts, a chain's arrays as they are."""
+    parts = []
+    for seg in segments(nodes):
+        if isinstance(seg, list):
+            parts.append([np.fromiter((nd[key] for nd in seg), dt, len(seg))
+                          for key, dt in (("mass", np.float64), ("u0", np.float64),
+                                          ("v0", np.float64), ("fixed", np.int32))])
+        else:
+            b = seg.block
+            parts.append([b.mass, b.u0, b.v0, np.zeros(b.n, np.int32)])
+    return tuple(np.concatenate([p[k] for p in parts]) if parts else np.zeros(0)
+                 for k in range(4))
+
+
+def names_of(table):
+    """The names of an item table (a Names, or a list for a plain list of dicts)."""
+    return table.names if isinstance(table, ItemTable) else [it["name"] for it in table]
+
+
+def segments(table):
+    """The segments of an item table (martello.scene.items); a plain list is one segment."""
+    return table.segments if isinstance(table, ItemTable) else [list(table)]
+
+
+# Generated items go to the library this many at a time: the rows of parameters handed
+# over stay a few MB whatever the chain's length (docs/performance.md, "The front end").
+CHUNK = 1 << 16
+
+
+def link_chunks(links):
+    """(kind, a, b, par) arrays of the scene's links, in order, a chunk at a time."""
+    for seg in segments(links):
+        if isinstance(seg, list):
+            if seg:
+                yield link_arrays(seg)
+            continue
+        b = seg.block
+        spring, damper = seg.spring, seg.damper
+        kind_spring = native.value("links", "spring" if b.fy is None else "bilinear")
+        for i0 in range(0, b.n, CHUNK):
+            i1 = min(i0 + CHUNK, b.n)
+            d0, d1 = np.searchsorted(b.dampers, (i0, i1))
+            at = spring[i0]
+            s, d = spring[i0:i1] - at, damper[d0:d1] - at
+            m = (i1 - i0) + (d1 - d0)
+            kind = np.empty(m, np.int32)
+            a = np.empty(m, np.int32)
+            par = np.zeros((m, constant("NPAR_LINK")))
+            kind[s] = kind_spring
+            a[s] = b.node0 + np.arange(i0, i1)
+            par[s, constant("L_STIFF")] = b.k[i0:i1]
+            if b.fy is not None:
+                par[s, constant("L_YIELD")] = b.fy[i0:i1]
+                par[s, constant("L_HARDENING")] = b.hardening[i0:i1]
+            kind[d] = native.value("links", "dashpot")
+            a[d] = b.node0 + b.dampers[d0:d1]
+            par[d, constant("L_DAMP")] = b.c[d0:d1]
+            yield kind, a, np.full(m, -1, np.int32), par
+
+
+def contact_chunks(contacts):
+    """(a, b, gap, scheme, law, par) arrays of the scene's contacts, in order, a chunk at a
+    time; a chain's contacts share one row of parameters, its template's."""
+    for seg in segments(contacts):
+        if isinstance(seg, list):
+            if seg:
+                yield contact_arrays(seg)
+            continue
+        b = seg.block
+        _, _, _, scheme, law, row = contact_arrays([b.template])
+        for j0 in range(0, len(seg), CHUNK):
+            j1 = min(j0 + CHUNK, len(seg))
+            m = j1 - j0
+            a = (b.node0 + np.arange(j0, j1)).astype(np.int32)
+            yield (a, a + 1, b.gap[j0:j1], np.full(m, scheme[0], np.int32),
+                   np.full(m, law[0], np.int32), np.repeat(row, m, axis=0))
 
 
 def _function_args(fn, source="<scene>"):
@@ -131,10 +204,12 @@ def build_model(scene):
     """A native Model holding the scene (the caller frees it, or uses a with-block)."""
     m = native.Model(len(scene.nodes), len(scene.links), len(scene.contacts), len(scene.forces),
                      len(scene.couplings))
-    # one call per array (docs/c-api.md, "Building a large model")
+    # one call per array, or per chunk of a generator's (docs/c-api.md, "Building a large model")
     m.set_nodes(*node_arrays(scene.nodes))
-    m.add_links(*link_arrays(scene.links))
-    m.add_contacts(*contact_arrays(scene.contacts))
+    for chunk in link_chunks(scene.links):
+        m.add_links(*chunk)
+    for chunk in contact_chunks(scene.contacts):
+        m.add_contacts(*chunk)
     for mc in scene.couplings:
         m.add_mass_coupling(mc["a"], mc["b"], mc["value"])
     for b in scene.blocks:
@@ -213,13 +288,11 @@ def _collector_paused():
 def _dynamic(scene, model, raise_on_failure=True):
     an = scene.analysis
     out_nodes = [scene.index[n] for n in an["output"]["nodes"]]
-    cnames = [c["name"] for c in scene.contacts]
-    out_contacts = [cnames.index(c) for c in an["output"]["contacts"]]
+    out_contacts = [names_of(scene.contacts).index(c) for c in an["output"]["contacts"]]
     with native.Run() as r:
         r.set_settings(integrator_settings(an))
         r.set_outputs(out_nodes, out_contacts)
-        lnames = [l["name"] for l in scene.links]
-        out_links = [lnames.index(n) for n in an["output"]["links"]]
+        out_links = [names_of(scene.links).index(n) for n in an["output"]["links"]]
         r.set_link_outputs(out_links)
         t0 = time.perf_counter()
         st = r.execute(model) if raise_on_failure else r.status_of(model)

@@ -154,11 +154,12 @@ def mesh_rod(name, L, N, rhoA, mass="lumped", ends="node", x0=0.0):
             "elements": elements, "element_length": Le}
 
 
-def expand_bars(src, data):
+def expand_bars(src, data, generated=()):
     """Replace the scene's [[bar]] tables by nodes, bar links and mass couplings.
 
     Returns (data, info): a new scene dict (the input is not modified) and one dict per rod
-    describing it (module docstring)."""
+    describing it (module docstring). `generated` holds the names of the nodes the chains
+    made before (martello.scene.items.Names): they count and are taken too."""
     data = dict(data)
     bars = data.pop("bar")
     if not isinstance(bars, list) or not bars:
@@ -167,7 +168,7 @@ def expand_bars(src, data):
     links = list(data.get("link", []))
     couplings = list(data.get("mass_coupling", []))
     taken = {n.get("name") for n in nodes if isinstance(n, dict)}
-    explicit_nodes = [n.get("name") for n in nodes if isinstance(n, dict)]
+    explicit_nodes = [n.get("name") for n in nodes if isinstance(n, dict)] + list(generated)
     out_nodes, info, bar_names = [], [], set()
     for bi, tab in enumerate(bars):
         where = f"bar[{bi}]"
@@ -184,7 +185,7 @@ def expand_bars(src, data):
         fixed = _choice(src, f"{where}.fixed", b["fixed"], FIXED_KINDS)
         output = _choice(src, f"{where}.output", b["output"], OUTPUT_KINDS)
         N = b["elements"]
-        made = len(nodes) + N + 1
+        made = len(nodes) + len(generated) + N + 1
         if made > MAX_GENERATED:
             raise SceneError(src, f"{where}.elements", f"invalid value {N!r}",
                              f"the generators of a scene make at most {MAX_GENERATED} nodes in all")
@@ -201,7 +202,7 @@ def expand_bars(src, data):
         mesh = mesh_rod(name, L, N, rhoA, mass, ends, b["x0"])
         names, Le = mesh["names"], mesh["element_length"]
         for nm in names:
-            if nm in taken:
+            if nm in taken or nm in generated:
                 raise SceneError(src, f"{where}.name", f"generates the node {nm!r}, which already exists",
                                  "choose another rod name")
             taken.add(nm)
