@@ -422,11 +422,9 @@ def item_arrays(scene, peaks, link_f, link_du, ev, order, bounds):
                 "impacts": np.asarray(peaks["impacts"]).astype(np.int64)}
     has = np.diff(bounds) > 0
     for p, at in (("first", bounds[:-1]), ("last", bounds[1:] - 1)):
-        rows = np.full(len(has), -1, np.int64)         # each contact's row of ev, −1: none
-        rows[has] = order[at[has]]
+        phase = _phases(ev, order[at[has]], has)
         for k, field in enumerate(PHASE_FIELDS):
-            contacts[f"{p}.{field}"] = (lambda rows=rows, k=k:
-                                        _phase_column(ev, rows, k))
+            contacts[f"{p}.{field}"] = phase[:, k]
     names = {kind: _names(table) for kind, table in
              (("nodes", scene.nodes), ("links", scene.links), ("contacts", scene.contacts))}
     return ItemArrays(names, {"nodes": nodes, "links": links, "contacts": contacts},
@@ -434,15 +432,13 @@ def item_arrays(scene, peaks, link_f, link_du, ev, order, bounds):
                        "contacts": {"scheme": list(SCHEMES), "law": list(LAWS)}})
 
 
-def _phase_column(ev, rows, k):
-    """Field k (PHASE_FIELDS) of the event rows (−1: none, NaN); separation fields are NaN
-    while a phase is open (t_off < 0)."""
-    out = np.full(len(rows), np.nan)
-    has = rows >= 0
-    values = ev[rows[has], k]
-    if PHASE_FIELDS[k].startswith("separation"):
-        values = np.where(ev[rows[has], 1] >= 0, values, np.nan)
-    out[has] = values
+def _phases(ev, rows, has):
+    """One phase per contact as rows of PHASE_FIELDS: the event rows ev[rows] where `has`,
+    NaN elsewhere; the separation fields NaN while a phase is open (t_off < 0)."""
+    out = np.full((len(has), len(PHASE_FIELDS)), np.nan)
+    out[has] = ev[rows]
+    open_ = has & ~(out[:, 1] >= 0)
+    out[open_, 1] = out[open_, 3] = np.nan
     return out
 
 

@@ -1,7 +1,8 @@
 #!/usr/bin/env python3
 """Front-end phases of a large chain run: scene expansion and validation (from_dict), building
-the native model (martello.run.build_model), the native run, and building the summary from
-the library's result arrays — wall seconds of each, in one process per n.
+the native model (martello.run.build_model), the native run, building the summary from the
+library's result arrays, and writing the results (martello.run.write_results, to a temporary
+folder) — wall seconds of each, and the process' peak RSS per DOF, in one process per n.
 
 The scene is benchmarks/perf/chain_perf.py's chain (bilinear oscillators, Kelvin contacts
 pre-compressed, ground sine), run for --steps steps (default 10: the native time loop is
@@ -31,6 +32,8 @@ def one(n, steps, front_end=None):
         sys.meta_path[:] = [f for f in sys.meta_path if "Editable" not in type(f).__name__
                             and "editable" not in type(f).__module__]
         sys.path.insert(0, front_end)
+    import resource
+    import tempfile
     import martello.run as run_module
     from martello.binding import native
     from martello.scene.loader import from_dict
@@ -41,14 +44,22 @@ def one(n, steps, front_end=None):
     model = run_module.build_model(scene)
     t2 = time.perf_counter()
     # the native run's own clock (cost.wall_time_s) splits _dynamic into run and summary
-    summary, _ = run_module._dynamic(scene, model)
+    summary, history = run_module._dynamic(scene, model)
     t3 = time.perf_counter()
     model.free()
+    write_s = None
+    if hasattr(run_module, "write_history"):        # this front end writes what it built
+        with tempfile.TemporaryDirectory() as tmp:
+            t4 = time.perf_counter()
+            run_module.write_results(summary, Path(tmp) / "out", history)
+            write_s = time.perf_counter() - t4
     native_s = summary["cost"]["wall_time_s"]
     print(json.dumps({"n": n, "steps": summary["cost"]["steps"], "version": native.version(),
                       "front_end": run_module.__file__,
                       "expand_s": t1 - t0, "build_model_s": t2 - t1, "native_run_s": native_s,
-                      "summary_s": t3 - t2 - native_s}))
+                      "summary_s": t3 - t2 - native_s, "write_s": write_s,
+                      "peak_rss_bytes_per_dof": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
+                      * 1024 / n}))
 
 
 def main():
@@ -64,7 +75,8 @@ def main():
         one(args.one, args.steps, args.front_end)
         return
     print(f"{os.cpu_count()} cores, load average {os.getloadavg()[0]:.2f}")
-    print(f"{'n':>8} {'steps':>6} {'expand s':>9} {'build s':>8} {'run s':>7} {'summary s':>9}")
+    print(f"{'n':>8} {'steps':>6} {'expand s':>9} {'build s':>8} {'run s':>7} {'summary s':>9} "
+          f"{'write s':>8} {'B/DOF':>7} {'load':>5}")
     for n in args.n:
         for _ in range(args.repeat):
             p = subprocess.run([sys.executable, __file__, "--one", str(n), "--steps",
@@ -74,9 +86,12 @@ def main():
                 print(f"{n:>8} failed: {p.stderr.strip().splitlines()[-1]}")
                 continue
             r = json.loads(p.stdout.strip().splitlines()[-1])
+            w = f"{r['write_s']:>8.2f}" if r.get("write_s") is not None else f"{'-':>8}"
+            rss = r.get("peak_rss_bytes_per_dof")
             print(f"{r['n']:>8} {r['steps']:>6} {r['expand_s']:>9.2f} {r['build_model_s']:>8.2f} "
-                  f"{r['native_run_s']:>7.2f} {r['summary_s']:>9.2f}   {r['version']} "
-                  f"{r['front_end']}")
+                  f"{r['native_run_s']:>7.2f} {r['summary_s']:>9.2f} {w} "
+                  f"{rss if rss is None else format(rss, '7.0f')} {os.getloadavg()[0]:>5.2f}  "
+                  f"{r['version']} {r['front_end']}")
     print(f"load average after: {os.getloadavg()[0]:.2f}")
 
 

@@ -16,6 +16,7 @@ tables (martello.scene.items) the block's items as dicts on demand, equal to tho
 made from the expanded tables."""
 
 from dataclasses import dataclass, field
+from functools import cached_property
 
 import numpy as np
 
@@ -184,7 +185,20 @@ class ChainLinks:
 
     def __init__(self, block):
         self.block = block
-        self.spring, self.damper = block.link_positions()
+
+    @cached_property
+    def positions(self):
+        return self.block.link_positions()
+
+    @property
+    def spring(self):
+        """Position of each oscillator's spring among the chain's links."""
+        return self.positions[0]
+
+    @property
+    def damper(self):
+        """Position of each damper among the chain's links."""
+        return self.positions[1]
 
     def __len__(self):
         return self.block.n_links

@@ -17,6 +17,7 @@ them back: that is how results.npz names its rows without a string per item
 
 from bisect import bisect_right
 from collections.abc import Mapping, Sequence
+from functools import cached_property
 
 
 def _key(arrays):
@@ -113,10 +114,15 @@ class Alternating:
         import numpy as np
         self.prefix, self.a, self.b, self.first = prefix, a, b, first
         self.second = np.asarray(second, bool)
-        # position of item i's first name: i plus the second names before it
-        self.start = np.arange(len(self.second)) + np.concatenate(
-            ([0], np.cumsum(self.second[:-1]))).astype(np.int64)
         self.count = len(self.second) + int(self.second.sum())
+
+    @cached_property
+    def start(self):
+        """Position of item i's first name: i plus the second names before it (made when a
+        name is first asked for by position or found)."""
+        import numpy as np
+        return np.arange(len(self.second)) + np.concatenate(
+            ([0], np.cumsum(self.second[:-1]))).astype(np.int64)
 
     def __len__(self):
         return self.count
