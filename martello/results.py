@@ -20,7 +20,6 @@ never closed (and the separation of a phase still open). Every other value is fi
 writer refuses anything else, naming the item, and writes nothing."""
 
 import json
-import zipfile
 from pathlib import Path
 
 import numpy as np
@@ -143,6 +142,7 @@ class ItemArrays(dict):
     def write(self, folder):
         """results.npz into folder, one array at a time (a column made by a function exists
         only while it is written); the caller checked them (check_finite)."""
+        import zipfile                      # only a large scene's run writes one
         with zipfile.ZipFile(Path(folder) / ARRAYS_FILE, "w", zipfile.ZIP_STORED,
                              allowZip64=True) as zf:
             for key, value in self.extra.items():
@@ -154,6 +154,7 @@ class ItemArrays(dict):
     @classmethod
     def read(cls, description, folder):
         """The ItemArrays a summary.json describes, its arrays read from folder when used."""
+        import zipfile
         path = Path(folder) / description.get("file", ARRAYS_FILE)
         try:
             npz = np.load(path, allow_pickle=False)

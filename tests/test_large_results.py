@@ -100,3 +100,11 @@ def test_a_large_scene_with_a_value_that_is_not_finite_writes_nothing(tmp_path):
     with pytest.raises(ResultError, match=r"nodes\.b1235\.u_max is inf: a result must be finite"):
         write_results(s, tmp_path / "out")
     assert not (tmp_path / "out").exists()
+
+
+def test_a_run_folder_without_its_arrays_is_refused_by_name(tmp_path):
+    s, history = run_full(big_chain(n=3400))
+    write_results(s, tmp_path / "run", history)
+    (tmp_path / "run" / "results.npz").unlink()
+    with pytest.raises(ResultError, match=r"results\.npz: cannot be read .*run the scene again"):
+        results.read_summary(tmp_path / "run")
