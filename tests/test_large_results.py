@@ -108,3 +108,21 @@ def test_a_run_folder_without_its_arrays_is_refused_by_name(tmp_path):
     (tmp_path / "run" / "results.npz").unlink()
     with pytest.raises(ResultError, match=r"results\.npz: cannot be read .*run the scene again"):
         results.read_summary(tmp_path / "run")
+
+
+def test_martello_run_writes_and_names_the_arrays_of_a_large_scene(tmp_path):
+    import subprocess
+    import sys
+    scene = tmp_path / "chain.toml"
+    scene.write_text('[[chain]]\nprefix = "b"\nn = 3400\nmass = 1.0\nk = 100.0\nzeta = 0.05\n'
+                     'gap = 0.001\ncontact = { scheme = "penalty", stiffness = 1e5 }\n'
+                     '[loads.ground_acceleration]\ntype = "sine"\namplitude = 3.0\nomega = 8.0\n'
+                     '[analysis]\ntype = "dynamic"\nintegrator = "newmark"\ndt = 1e-3\nt_end = 0.1\n')
+    r = subprocess.run([sys.executable, "-m", "martello", "run", scene, "-o", tmp_path / "out"],
+                       capture_output=True, text=True)
+    assert r.returncode == 0, r.stderr
+    assert r.stdout.strip().endswith("history.csv and " + str(tmp_path / "out" / "results.npz"))
+    import martello
+    back = martello.read(tmp_path / "out")
+    assert back.summary["nodes"] == {} and back.arrays["nodes"]["count"] == 3400
+    assert back.item("links", "b3400.damper")["type"] == "dashpot"
