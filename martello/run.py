@@ -15,6 +15,7 @@ from .binding.native import constant
 from .errors import RecordError, ResultError, SceneError
 from .paths import folder_replaced
 from .results import (ARRAYS_FILE, PHASE_FIELDS, ItemArrays, is_large)
+from .scene.bars import RodElements, RodNodes
 from .scene.items import ItemTable, Listed, Names
 
 # The names a link's type, a contact's scheme and law take (the library's tables); results
@@ -104,6 +105,8 @@ def node_arrays(nodes):
             parts.append([np.fromiter((nd[key] for nd in seg), dt, len(seg))
                           for key, dt in (("mass", np.float64), ("u0", np.float64),
                                           ("v0", np.float64), ("fixed", np.int32))])
+        elif isinstance(seg, RodNodes):
+            parts.append(list(seg.arrays()))
         else:
             b = seg.block
             parts.append([b.mass, b.u0, b.v0, np.zeros(b.n, np.int32)])
@@ -132,6 +135,15 @@ def link_chunks(links):
         if isinstance(seg, list):
             if seg:
                 yield link_arrays(seg)
+            continue
+        if isinstance(seg, RodElements):
+            r = seg.rod
+            for k0 in range(0, len(seg), CHUNK):
+                m = min(CHUNK, len(seg) - k0)
+                a = (r.node0 + np.arange(k0, k0 + m)).astype(np.int32)   # element k: k, k + 1
+                par = np.zeros((m, constant("NPAR_LINK")))
+                par[:, constant("L_STIFF")] = r.EA / r.mesh["element_length"]
+                yield np.full(m, native.value("links", "bar"), np.int32), a, a + 1, par
             continue
         b = seg.block
         spring, damper = seg.spring, seg.damper
@@ -214,8 +226,13 @@ def build_model(scene):
         m.add_links(*chunk)
     for chunk in contact_chunks(scene.contacts):
         m.add_contacts(*chunk)
-    for mc in scene.couplings:
-        m.add_mass_coupling(mc["a"], mc["b"], mc["value"])
+    for seg in segments(scene.couplings):
+        if isinstance(seg, list):
+            for mc in seg:
+                m.add_mass_coupling(mc["a"], mc["b"], mc["value"])
+        else:                       # a rod's consistent mass, from its mesh (no dict each)
+            for i, j, value in seg.rod.mesh["couplings"]:
+                m.add_mass_coupling(seg.rod.node0 + i, seg.rod.node0 + j, value)
     for b in scene.blocks:
         m.add_stiffness_block(b["nodes"], b["k"], b["c"])
     m.set_gravity(scene.gravity)
@@ -455,6 +472,9 @@ def _codes(table, key, categories):
     for seg in segments(table):
         if isinstance(seg, list):
             parts.append(np.fromiter((at.get(it.get(key), -1) for it in seg), np.int8, len(seg)))
+            continue
+        if isinstance(seg, RodElements):
+            parts.append(np.full(len(seg), at["bar"], np.int8))
             continue
         b = seg.block
         if key == "type":          # the chain's springs, then dampers where it has them

@@ -167,3 +167,74 @@ def test_names_by_rule_find_their_own_names_only():
         assert nm not in names, nm
     arrays = {}
     assert list(Names.from_spec(names.spec(arrays), arrays)) == every
+
+
+def rods_written_out(data):
+    """The scene with every [[bar]] replaced by the tables docs/p4-bars.md says it stands for
+    (lumped or consistent mass, node or half-cell ends, held ends), one dict per item."""
+    data = copy.deepcopy(data)
+    nodes, links, couplings = data.get("node", []), data.get("link", []), data.get("mass_coupling", [])
+    for b in data.pop("bar"):
+        name, N, L, EA, rhoA = b["name"], b["elements"], b["L"], b["EA"], b["rhoA"]
+        Le, ends, mass = L / N, b.get("ends", "node"), b.get("mass", "lumped")
+        fixed, v0 = b.get("fixed", "none"), b.get("v0", 0.0)
+        me = rhoA * Le
+        n = N + 1 if ends == "node" else N
+        names = [f"{name}.left"] + [f"{name}.{i}" for i in range(1, n - 1)] + [f"{name}.right"]
+        for i, nm in enumerate(names):
+            end = i in (0, n - 1)
+            m = me if ends != "node" else ((me / 3.0 if end else 2.0 * me / 3.0) if mass == "consistent"
+                                           else (0.5 * me if end else me))
+            node = {"name": nm, "mass": m}
+            held = ends == "node" and ((i == 0 and fixed in ("left", "both"))
+                                       or (i == n - 1 and fixed in ("right", "both")))
+            if held:
+                node["fixed"] = True
+            elif v0:
+                node["v0"] = v0
+            nodes.append(node)
+        for k in range(n - 1):
+            links.append({"name": f"{name}.e{k + 1}", "type": "bar", "a": names[k], "b": names[k + 1],
+                          "EA": EA, "L": Le})
+            if mass == "consistent":
+                couplings.append({"a": names[k], "b": names[k + 1], "value": me / 6.0})
+        if ends == "half-cell" and fixed in ("left", "both"):
+            links.append({"name": f"{name}.support.left", "type": "bar", "a": "ground", "b": names[0],
+                          "EA": EA, "L": 0.5 * Le})
+        if ends == "half-cell" and fixed in ("right", "both"):
+            links.append({"name": f"{name}.support.right", "type": "bar", "a": names[-1], "b": "ground",
+                          "EA": EA, "L": 0.5 * Le})
+    data.update(node=nodes, link=links, mass_coupling=couplings)
+    return data
+
+
+ROD = {"L": 1.0, "EA": 2e7, "rhoA": 0.785, "output": "none"}
+ROD_CASES = {
+    "lumped, held left, moving": [dict(ROD, name="A", elements=7, fixed="left", v0=1.5)],
+    "consistent, two rods": [dict(ROD, name="A", elements=5, mass="consistent", fixed="both"),
+                             dict(ROD, name="B", elements=3, mass="consistent", v0=-0.0)],
+    "half-cell, both held": [dict(ROD, name="H", elements=6, ends="half-cell", fixed="both")],
+}
+
+
+@pytest.mark.parametrize("case", ROD_CASES)
+def test_a_rod_is_the_tables_it_stands_for(case):
+    d = {"bar": ROD_CASES[case], "node": [{"name": "w", "mass": 1.0}],
+         "contact": [{"name": "c", "a": ROD_CASES[case][0]["name"] + ".right", "b": "w",
+                      "scheme": "penalty", "stiffness": 1e6}],
+         "link": [{"type": "dashpot", "a": "w", "b": "ground", "c": 1.0}],
+         "analysis": {"type": "dynamic", "integrator": "newmark", "dt": 1e-5, "t_end": 1e-3,
+                      "output": {"nodes": ["w"]}}}
+    s, w = from_dict(d), from_dict(rods_written_out(d))
+    for kind in ("nodes", "links", "contacts", "couplings"):
+        assert text(getattr(s, kind)) == text(getattr(w, kind)), kind
+    assert list(s.nodes.names) == [n["name"] for n in w.nodes] and s.index == w.index
+    assert list(s.links.names) == [lk["name"] for lk in w.links]
+    assert physics_digest(s) == physics_digest(w)
+
+
+def test_a_rod_node_taken_already_is_the_rods_error():
+    d = scene([{"prefix": "A.", "n": 3, "mass": 1.0, "k": 1.0}],
+              bar=[dict(ROD, name="A", elements=4)])
+    assert fails(d).endswith("bar[0].name: generates the node 'A.1', which already exists "
+                             "(choose another rod name)")

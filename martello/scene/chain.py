@@ -174,6 +174,12 @@ class ChainNodes:
     def __len__(self):
         return self.block.n
 
+    def place(self, pos):
+        self.block.node0 = pos
+
+    def names(self):
+        return [self.block.node_names()]
+
     def item(self, i):
         b = self.block
         return {"name": f"{b.prefix}{i + 1}", "mass": float(b.mass[i]), "u0": float(b.u0[i]),
@@ -202,6 +208,12 @@ class ChainLinks:
 
     def __len__(self):
         return self.block.n_links
+
+    def place(self, pos):
+        self.block.link0 = pos
+
+    def names(self):
+        return [self.block.link_names()]
 
     def item(self, j):
         b = self.block

@@ -153,24 +153,25 @@ def from_dict(data, source="<scene>", base_dir=Path("."), digest=None):
     if "chain" in data:
         data, chains = expand_chains(src, data)
     chain_nodes = Names([b.node_names() for b in chains])
+    rods = {"node": [], "link": [], "mass_coupling": []}
     if "bar" in data:
         # [[bar]]: rods meshed into elements (P4)
-        data, extras["bars"] = expand_bars(src, data, generated=chain_nodes)
+        data, extras["bars"], rods = expand_bars(src, data, generated=chain_nodes)
     if "frame" in data:
         from .frame import expand_frames        # numpy.linalg and the frame model: only here
         data, extras["frames"] = expand_frames(src, data)   # [[frame]]: condensed frames (P10)
 
     # nodes
-    raw_nodes = data.get("node", [] if chains else None)
-    if not isinstance(raw_nodes, list) or not (raw_nodes or chains):
+    generated = [ChainNodes(b) for b in chains] + rods["node"]
+    raw_nodes = data.get("node", [] if generated else None)
+    if not isinstance(raw_nodes, list) or not (raw_nodes or generated):
         raise SceneError(src, "node", "missing", "a scene needs at least one [[node]]")
     w = len(written["node"])
-    node_segments = _segments(raw_nodes[:w], [ChainNodes(b) for b in chains], raw_nodes[w:])
+    node_segments = _segments(raw_nodes[:w], generated, raw_nodes[w:])
     node_names, pos = Names(), 0
-    for k, seg in enumerate(node_segments):
+    for seg in node_segments:
         if not isinstance(seg, list):
-            seg.block.node0 = pos
-            _unique(src, "node", pos, node_names, node_names.extend(seg.block.node_names()))
+            _place(src, "node", seg, pos, node_names)
             pos += len(seg)
             continue
         for i, tab in enumerate(seg, start=pos):
@@ -210,12 +211,12 @@ def from_dict(data, source="<scene>", base_dir=Path("."), digest=None):
     # links
     raw_links = data.get("link", [])
     w = len(written["link"])
-    link_segments = _segments(raw_links[:w], [ChainLinks(b) for b in chains], raw_links[w:])
+    link_segments = _segments(raw_links[:w], [ChainLinks(b) for b in chains] + rods["link"],
+                              raw_links[w:])
     link_names, pos = Names(), 0
     for seg in link_segments:
         if not isinstance(seg, list):
-            seg.block.link0 = pos
-            _unique(src, "link", pos, link_names, link_names.extend(seg.block.link_names()))
+            _place(src, "link", seg, pos, link_names)
             pos += len(seg)
             continue
         for i, tab in enumerate(seg, start=pos):
@@ -326,6 +327,7 @@ def from_dict(data, source="<scene>", base_dir=Path("."), digest=None):
         if mc["a"] == mc["b"]:
             raise SceneError(src, f"{where}.b", "couples a node with itself", "name two different nodes")
         couplings.append(mc)
+    couplings = ItemTable([couplings] + rods["mass_coupling"], None)
 
     meta = {k: data.get(k, "") for k in ("title", "problem", "description")}
     for k, v in meta.items():
@@ -343,6 +345,15 @@ def _segments(listed, generated, after=()):
     """The segments of an item table: the listed dicts (copied: validation replaces them),
     the generated segments, then the listed dicts that follow them."""
     return [list(listed)] + list(generated) + [list(after)]
+
+
+def _place(src, kind, seg, pos, names):
+    """A generated segment placed at pos: its names appended (the first one taken already
+    is the loader's duplicate error)."""
+    seg.place(pos)
+    for rule in seg.names():
+        _unique(src, kind, pos, names, names.extend(rule))
+        pos += len(rule)
 
 
 def _unique(src, kind, pos, names, j):
