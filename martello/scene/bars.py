@@ -2,8 +2,9 @@
 
 A `[[bar]]` table stands for one straight elastic rod along the scene's axis. The loader
 (martello.scene.loader) calls :func:`expand_bars` before it validates nodes and links; the rod
-becomes ordinary `[[node]]`, `[[link]]` (type "bar") and, for a consistent mass matrix,
-`[[mass_coupling]]` entries, so every integrator sees plain scene items.
+stands for ordinary `[[node]]`, `[[link]]` (type "bar") and, for a consistent mass matrix,
+`[[mass_coupling]]` entries, so every integrator sees plain scene items. They are kept as the
+rod's mesh (segments of the scene's item tables, martello.scene.items), not one dict each.
 
 Keys (SI units):
 
