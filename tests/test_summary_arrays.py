@@ -1,4 +1,5 @@
-"""The summary built column by column (martello.run.item_arrays, martello.results.ItemArrays)
+"""The summary built column by column (martello.run.item_arrays and phase_rows,
+martello.results.ItemArrays)
 against the element-by-element expressions it replaced.
 
 Kind of evidence: an identity of the method (the same numbers reshaped), not a verification.
@@ -11,7 +12,7 @@ from types import SimpleNamespace
 
 import numpy as np
 
-from martello.run import item_arrays
+from martello.run import item_arrays, phase_rows
 
 RNG = np.random.default_rng(7)
 SPECIAL = np.array([np.nan, np.inf, -np.inf, -0.0, 0.0, 1e-300, -1.5])
@@ -53,7 +54,8 @@ def arrays_of(n_nodes=0, n_links=0, n_contacts=0, n_events=0):
     ev[RNG.random(n_events) < 0.3, 1] = -1.0                      # open phases
     order = np.argsort(ev_contacts, kind="stable")
     bounds = np.searchsorted(ev_contacts[order], np.arange(n_contacts + 1))
-    return scene, peaks, f, du, ev, order, bounds, item_arrays(scene, peaks, f, du, ev, order, bounds)
+    arrays = item_arrays(scene, peaks, f, du, ev, *phase_rows(ev_contacts, n_contacts))
+    return scene, peaks, f, du, ev, order, bounds, arrays
 
 
 def test_node_entries_equal_the_per_node_dicts():
@@ -90,3 +92,11 @@ def test_link_entries_equal_the_per_link_dicts():
                             "max_abs_elongation": float(du[i]) if np.isfinite(du[i]) else None}
                 for i, l in enumerate(scene.links)}
     assert text(arrays.entries("links", range(400))) == text(expected)
+
+
+def test_phase_rows_are_the_first_and_last_of_each_contacts_rows():
+    ev_contacts = RNG.integers(0, 50, 400)
+    first, last = phase_rows(ev_contacts, 60)                # contacts 50..59 have none
+    for j in range(60):
+        rows = [i for i, c in enumerate(ev_contacts) if c == j]
+        assert (first[j], last[j]) == ((rows[0], rows[-1]) if rows else (-1, -1))
