@@ -8,7 +8,7 @@ The Python API (docs/python-api.md)::
     result.summary["contacts"]["ground"]["impact_times"][:3]
     martello.closed_forms.newton_impact(1.0, 1.0, 1.0, 0.0, 0.5)
 
-``load``, ``Scene`` (``Scene.from_dict``), ``run`` -> ``Result``, ``reference``,
+``load``, ``Scene`` (``Scene.from_dict``), ``run`` -> ``Result``, ``read``, ``reference``,
 ``compare``, ``catalogue``, ``closed_forms``, ``__version__`` and the exceptions
 (``MartelloError``, ``SceneError``, ``SolverError``, ``DivergenceError``) are attributes of
 the package, loaded the first time they are used: ``import martello`` itself loads no other
@@ -38,10 +38,11 @@ import sys
 _ModuleType = type(sys)
 
 __all__ = ["DivergenceError", "MartelloError", "Result", "Scene", "SceneError", "SolverError",
-           "catalogue", "closed_forms", "compare", "load", "reference", "run"]
+           "catalogue", "closed_forms", "compare", "load", "read", "reference", "run"]
 
 # name -> (module, attribute); attribute None: the module itself
-_LAZY = {"load": ("martello.api", "load"), "Scene": ("martello.api", "Scene"),
+_LAZY = {"load": ("martello.api", "load"), "read": ("martello.api", "read"),
+         "Scene": ("martello.api", "Scene"),
          "Result": ("martello.api", "Result"), "catalogue": ("martello.api", "catalogue"),
          "closed_forms": ("martello.closed_forms", None),
          "MartelloError": ("martello.errors", "MartelloError"),

@@ -6,8 +6,9 @@ package lazily; this module is imported the first time one of them is used, and 
 imports what it needs (the run layer, the checks, scipy) when it is first called.
 
 * ``load(path)``, ``Scene.from_dict(d)``: a validated Scene;
-* ``run(scene) -> Result``: the summary (a dict, what summary.json holds) and the history
-  (numpy arrays, ``Result.dataframe()`` with pandas);
+* ``run(scene) -> Result``: the summary (a dict, what summary.json holds), the history
+  (numpy arrays, ``Result.dataframe()`` with pandas) and a large scene's per-item arrays;
+* ``read(folder)``: the Result a run folder holds;
 * ``reference(scene)``: the Reference the scene is scored against;
 * ``compare(history, against)``: another code's history scored against a scene's reference,
   as ``martello compare`` does;
@@ -35,7 +36,7 @@ from .scene.loader import Scene
 # The run layer (the native library), the checks, the references and compare (scipy) are
 # imported by the functions that need them: martello.load and martello.Scene stay light.
 
-__all__ = ["Result", "Scene", "catalogue", "compare", "load", "reference", "run"]
+__all__ = ["Result", "Scene", "catalogue", "compare", "load", "read", "reference", "run"]
 
 
 def catalogue():
@@ -79,7 +80,7 @@ class Result:
     sample) and ``history`` the same as {column: 1D array}; a static run has none."""
 
     def __init__(self, scene, summary, history=None):
-        self.scene = scene
+        self.scene = scene               # None for a Result read from a folder (read())
         self.summary = summary
         if history is None:
             self.columns, self.data = (), np.empty((0, 0))
@@ -90,6 +91,21 @@ class Result:
     def status(self):
         """The run's status, e.g. ``MARTELLO_OK``."""
         return self.summary["status"]
+
+    @property
+    def arrays(self):
+        """A large scene's per-item results as arrays (martello.results.ItemArrays: its
+        ``table("nodes")`` is {"name": names, "u_max": array, ...}, ``item("nodes", name)``
+        one entry); None for a scene whose summary holds every item (docs/results.md)."""
+        from .results import ItemArrays
+        arrays = self.summary.get("arrays")
+        return arrays if isinstance(arrays, ItemArrays) else None
+
+    def item(self, kind, name):
+        """The entry of one node, link or contact ("nodes", "links", "contacts") by name, from
+        the summary or, for a large scene, its arrays."""
+        from .results import lookup_item
+        return lookup_item(self.summary, kind, name)
 
     @property
     def history(self):
@@ -118,7 +134,8 @@ class Result:
 
     def __repr__(self):
         shape = f", {len(self.data)} samples x {len(self.columns)} columns" if self.columns else ""
-        return f"<martello.Result {self.scene.title!r}: {self.status}{shape}>"
+        title = self.scene.title if self.scene is not None else self.summary.get("title")
+        return f"<martello.Result {title!r}: {self.status}{shape}>"
 
 
 def run(scene):
@@ -133,6 +150,21 @@ def run(scene):
     s = _scene(scene)
     summary, history = run_measured(s)
     return Result(s, summary, history)
+
+
+def read(folder):
+    """The ``Result`` of a run folder (``martello run -o folder``, ``Result.write``):
+    summary.json, history.csv if any, and a large scene's results.npz (``Result.arrays``);
+    its ``scene`` is None."""
+    from .results import read_summary
+    folder = Path(folder)
+    summary = read_summary(folder)
+    history, csv = None, folder / "history.csv"
+    if csv.exists():
+        with open(csv) as fh:
+            columns = fh.readline().strip().split(",")
+        history = (columns, np.loadtxt(csv, delimiter=",", skiprows=1, ndmin=2))
+    return Result(None, summary, history)
 
 
 def reference(scene, spec=None, *, compute=True, refresh=False, jobs=0, stream=None):

@@ -61,7 +61,9 @@ def cmd_run(args):
     path = write_results(summary, out, history)
     for w in summary.get("warnings", []):
         print(f"warning: {w}", file=sys.stderr)
-    written = f"{path}" + (f" and {path.parent / 'history.csv'}" if history is not None else "")
+    files = [path] + ([path.parent / "history.csv"] if history is not None else []) \
+        + ([path.parent / summary["arrays"]["file"]] if "arrays" in summary else [])
+    written = ", ".join(map(str, files[:-1])) + " and " + str(files[-1]) if len(files) > 1 else str(path)
     print(f"{s.title}: {summary['status']} -> {written}")
     if args.print:
         print(json.dumps(summary, indent=2, default=float))

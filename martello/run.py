@@ -14,7 +14,13 @@ from .binding import native
 from .binding.native import constant
 from .errors import RecordError, ResultError, SceneError
 from .paths import folder_replaced
+from .results import (ARRAYS_FILE, PHASE_FIELDS, ItemArrays, is_large)
+from .scene.bars import RodElements, RodNodes
+from .scene.items import ItemTable, Listed, Names
 
+# The names a link's type, a contact's scheme and law take (the library's tables); results
+# store them as codes into these (martello.results).
+LINK_KINDS, SCHEMES, LAWS = native.names("links"), native.names("schemes"), native.names("laws")
 # Default exponent n of each law's elastic part F ~ δ^n (fixed, or Hertz's when the law reads it).
 LAW_EXPONENT = {r.name: r.values["exponent"] for r in native.registry("laws")}
 
@@ -91,11 +97,94 @@ def contact_arrays(contacts):
 
 
 def node_arrays(nodes):
-    """(mass, u0, v0, fixed) of the scene's nodes, for Model.set_nodes."""
-    n = len(nodes)
-    return tuple(np.fromiter((nd[key] for nd in nodes), dt, n)
-                 for key, dt in (("mass", np.float64), ("u0", np.float64), ("v0", np.float64),
-                                 ("fixed", np.int32)))
+    """(mass, u0, v0, fixed) of the scene's nodes, for Model.set_nodes: a listed segment's
+    read from its dicts, a chain's arrays as they are."""
+    parts = []
+    for seg in segments(nodes):
+        if isinstance(seg, list):
+            parts.append([np.fromiter((nd[key] for nd in seg), dt, len(seg))
+                          for key, dt in (("mass", np.float64), ("u0", np.float64),
+                                          ("v0", np.float64), ("fixed", np.int32))])
+        elif isinstance(seg, RodNodes):
+            parts.append(list(seg.arrays()))
+        else:
+            b = seg.block
+            parts.append([b.mass, b.u0, b.v0, np.zeros(b.n, np.int32)])
+    return tuple(np.concatenate([p[k] for p in parts]) if parts else np.zeros(0)
+                 for k in range(4))
+
+
+def names_of(table):
+    """The names of an item table (a Names, or a list for a plain list of dicts)."""
+    return table.names if isinstance(table, ItemTable) else [it["name"] for it in table]
+
+
+def segments(table):
+    """The segments of an item table (martello.scene.items); a plain list is one segment."""
+    return table.segments if isinstance(table, ItemTable) else [list(table)]
+
+
+# Generated items go to the library this many at a time: the rows of parameters handed
+# over stay a few MB whatever the chain's length (docs/performance.md, "The front end").
+CHUNK = 1 << 16
+
+
+def link_chunks(links):
+    """(kind, a, b, par) arrays of the scene's links, in order, a chunk at a time."""
+    for seg in segments(links):
+        if isinstance(seg, list):
+            if seg:
+                yield link_arrays(seg)
+            continue
+        if isinstance(seg, RodElements):
+            r = seg.rod
+            for k0 in range(0, len(seg), CHUNK):
+                m = min(CHUNK, len(seg) - k0)
+                a = (r.node0 + np.arange(k0, k0 + m)).astype(np.int32)   # element k: k, k + 1
+                par = np.zeros((m, constant("NPAR_LINK")))
+                par[:, constant("L_STIFF")] = r.EA / r.mesh["element_length"]
+                yield np.full(m, native.value("links", "bar"), np.int32), a, a + 1, par
+            continue
+        b = seg.block
+        spring, damper = seg.spring, seg.damper
+        kind_spring = native.value("links", "spring" if b.fy is None else "bilinear")
+        for i0 in range(0, b.n, CHUNK):
+            i1 = min(i0 + CHUNK, b.n)
+            d0, d1 = np.searchsorted(b.dampers, (i0, i1))
+            at = spring[i0]
+            s, d = spring[i0:i1] - at, damper[d0:d1] - at
+            m = (i1 - i0) + (d1 - d0)
+            kind = np.empty(m, np.int32)
+            a = np.empty(m, np.int32)
+            par = np.zeros((m, constant("NPAR_LINK")))
+            kind[s] = kind_spring
+            a[s] = b.node0 + np.arange(i0, i1)
+            par[s, constant("L_STIFF")] = b.k[i0:i1]
+            if b.fy is not None:
+                par[s, constant("L_YIELD")] = b.fy[i0:i1]
+                par[s, constant("L_HARDENING")] = b.hardening[i0:i1]
+            kind[d] = native.value("links", "dashpot")
+            a[d] = b.node0 + b.dampers[d0:d1]
+            par[d, constant("L_DAMP")] = b.c[d0:d1]
+            yield kind, a, np.full(m, -1, np.int32), par
+
+
+def contact_chunks(contacts):
+    """(a, b, gap, scheme, law, par) arrays of the scene's contacts, in order, a chunk at a
+    time; a chain's contacts share one row of parameters, its template's."""
+    for seg in segments(contacts):
+        if isinstance(seg, list):
+            if seg:
+                yield contact_arrays(seg)
+            continue
+        b = seg.block
+        _, _, _, scheme, law, row = contact_arrays([b.template])
+        for j0 in range(0, len(seg), CHUNK):
+            j1 = min(j0 + CHUNK, len(seg))
+            m = j1 - j0
+            a = (b.node0 + np.arange(j0, j1)).astype(np.int32)
+            yield (a, a + 1, b.gap[j0:j1], np.full(m, scheme[0], np.int32),
+                   np.full(m, law[0], np.int32), np.repeat(row, m, axis=0))
 
 
 def _function_args(fn, source="<scene>"):
@@ -131,12 +220,19 @@ def build_model(scene):
     """A native Model holding the scene (the caller frees it, or uses a with-block)."""
     m = native.Model(len(scene.nodes), len(scene.links), len(scene.contacts), len(scene.forces),
                      len(scene.couplings))
-    # one call per array (docs/c-api.md, "Building a large model")
+    # one call per array, or per chunk of a generator's (docs/c-api.md, "Building a large model")
     m.set_nodes(*node_arrays(scene.nodes))
-    m.add_links(*link_arrays(scene.links))
-    m.add_contacts(*contact_arrays(scene.contacts))
-    for mc in scene.couplings:
-        m.add_mass_coupling(mc["a"], mc["b"], mc["value"])
+    for chunk in link_chunks(scene.links):
+        m.add_links(*chunk)
+    for chunk in contact_chunks(scene.contacts):
+        m.add_contacts(*chunk)
+    for seg in segments(scene.couplings):
+        if isinstance(seg, list):
+            for mc in seg:
+                m.add_mass_coupling(mc["a"], mc["b"], mc["value"])
+        else:                       # a rod's consistent mass, from its mesh (no dict each)
+            for i, j, value in seg.rod.mesh["couplings"]:
+                m.add_mass_coupling(seg.rod.node0 + i, seg.rod.node0 + j, value)
     for b in scene.blocks:
         m.add_stiffness_block(b["nodes"], b["k"], b["c"])
     m.set_gravity(scene.gravity)
@@ -213,13 +309,11 @@ def _collector_paused():
 def _dynamic(scene, model, raise_on_failure=True):
     an = scene.analysis
     out_nodes = [scene.index[n] for n in an["output"]["nodes"]]
-    cnames = [c["name"] for c in scene.contacts]
-    out_contacts = [cnames.index(c) for c in an["output"]["contacts"]]
+    out_contacts = [names_of(scene.contacts).index(c) for c in an["output"]["contacts"]]
     with native.Run() as r:
         r.set_settings(integrator_settings(an))
         r.set_outputs(out_nodes, out_contacts)
-        lnames = [l["name"] for l in scene.links]
-        out_links = [lnames.index(n) for n in an["output"]["links"]]
+        out_links = [names_of(scene.links).index(n) for n in an["output"]["links"]]
         r.set_link_outputs(out_links)
         t0 = time.perf_counter()
         st = r.execute(model) if raise_on_failure else r.status_of(model)
@@ -235,35 +329,34 @@ def _dynamic(scene, model, raise_on_failure=True):
     columns = native.history_columns(an["output"]["nodes"], an["output"]["contacts"],
                                      an["output"]["links"])
     col = {name: i for i, name in enumerate(columns)}
-    nodes = _node_results(scene, peaks)
+    arrays = item_arrays(scene, peaks, link_f, link_du, ev,
+                         *phase_rows(ev_contacts, len(scene.contacts)))
+    # a large scene: the items named in output in summary.json, all of them as arrays
+    # (docs/results.md, "Results as arrays"); a small one: every item in summary.json
+    large = is_large(scene)
+    pick = (lambda kind, named: list(dict.fromkeys(named))) if large else \
+        (lambda kind, named: range(len(arrays.names[kind])))
+    nodes = arrays.entries("nodes", pick("nodes", out_nodes))
     for name in an["output"]["nodes"]:
         if f"u:{name}" in col and len(hist):
             nodes[name].update(u_final=float(hist[-1, col[f"u:{name}"]]),
                                v_final=float(hist[-1, col[f"v:{name}"]]))
-    contacts = {}
-    # events grouped by contact once (a long chain has one or more per contact)
-    order = np.argsort(ev_contacts, kind="stable")
-    bounds = np.searchsorted(ev_contacts[order], np.arange(len(scene.contacts) + 1))
+    contacts = arrays.entries("contacts", pick("contacts", out_contacts))
     every_phase = len(scene.contacts) <= PHASE_LISTS or set(an["output"]["contacts"])
-    # the per-contact columns as Python lists, read once (docs/results.md)
-    pen_max = peaks["pen_max"]
-    pen = np.where(0.0 > pen_max, 0.0, pen_max).tolist()     # max(pen, 0), NaN kept
-    force_max = np.asarray(peaks["force_max"], np.float64).tolist()
-    impacts = np.asarray(peaks["impacts"]).astype(np.int64).tolist()
-    first, last = _first_last_phases(ev, order, bounds)
-    for j, c in enumerate(scene.contacts):
-        if every_phase is not True and c["name"] not in every_phase:
-            # a large scene: the phase counts, maxima, first and last phase (docs/results.md)
-            contacts[c["name"]] = {
-                "scheme": c["scheme"], "law": c.get("law"), "max_penetration": pen[j],
-                "max_force": force_max[j], "impacts": impacts[j],
-                "first_phase": first[j], "last_phase": last[j]}
-            continue
-        mine = ev[order[bounds[j]:bounds[j + 1]]]
+    if every_phase is True:
+        # the events grouped by contact once (each contact's rows in the table's order)
+        order = np.argsort(ev_contacts, kind="stable")
+        bounds = np.searchsorted(ev_contacts[order], np.arange(len(scene.contacts) + 1))
+        rows_of = lambda j: order[bounds[j]:bounds[j + 1]]          # noqa: E731
+    else:       # a few named contacts of many: their rows found without sorting the table
+        rows_of = lambda j: np.flatnonzero(ev_contacts == j)       # noqa: E731
+    for name, e in contacts.items():
+        if every_phase is not True and name not in every_phase:
+            continue       # a scene of many contacts: the first and last phase (docs/results.md)
+        mine = ev[rows_of(arrays.names["contacts"].position(name))]
         closed = mine[mine[:, 1] >= 0]
-        contacts[c["name"]] = {
-            "scheme": c["scheme"], "law": c.get("law"),
-            "max_penetration": pen[j], "max_force": force_max[j], "impacts": impacts[j],
+        del e["first_phase"], e["last_phase"]
+        e.update({
             "impact_times": [float(x) for x in mine[:, 0]],
             "separation_times": [float(x) if x >= 0 else None for x in mine[:, 1]],
             "approach_speeds": [float(x) for x in mine[:, 2]],
@@ -271,20 +364,20 @@ def _dynamic(scene, model, raise_on_failure=True):
             # realised restitution of each completed contact phase: −δ̇_out/δ̇_in
             "restitution": [float(-vo / vi) if vi > 0 else None for vi, vo in closed[:, 2:4]],
             "phase_max_penetration": [float(x) for x in mine[:, 4]],
-            "phase_max_force": [float(x) for x in mine[:, 5]]}
+            "phase_max_force": [float(x) for x in mine[:, 5]]})
         if len(closed):
-            contacts[c["name"]]["contact_time"] = float(closed[0, 1] - closed[0, 0])  # first phase
-        if c["name"] in an["output"]["contacts"] and len(hist):
+            e["contact_time"] = float(closed[0, 1] - closed[0, 0])  # first phase
+        if name in an["output"]["contacts"] and len(hist):
             # the state at t_end: a persistent contact's multiplier (e.g. k h − m g after Zeno)
-            contacts[c["name"]]["penetration_final"] = float(hist[-1, col[f"penetration:{c['name']}"]])
-            contacts[c["name"]]["force_final"] = float(hist[-1, col[f"force:{c['name']}"]])
-            contacts[c["name"]]["lambda_final"] = 0.0 - contacts[c["name"]]["force_final"]  # seed sign
-        if c["scheme"] in ("restitution", "lagrange"):
+            e["penetration_final"] = float(hist[-1, col[f"penetration:{name}"]])
+            e["force_final"] = float(hist[-1, col[f"force:{name}"]])
+            e["lambda_final"] = 0.0 - e["force_final"]  # seed sign
+        if e["scheme"] in ("restitution", "lagrange"):
             # the start of the first lasting contact phase: the accumulation (Zeno) time of
             # an impact sequence, or a plastic impact's instant (impacts have t_off = t_on)
             lasting = [row for row in mine if row[1] < 0 or row[1] > row[0]]
             if lasting:
-                contacts[c["name"]]["persistent_from"] = float(lasting[0][0])
+                e["persistent_from"] = float(lasting[0][0])
     scale = max(abs(energy["initial"]), abs(energy["input"]), 1e-300)
     energy.update(balance_max=extra["balance_max"], balance_relative=extra["balance_max"] / scale)
     warnings = []
@@ -312,7 +405,8 @@ def _dynamic(scene, model, raise_on_failure=True):
         "warnings": warnings,
         "t_reached": extra["t_reached"],
         "nodes": nodes, "contacts": contacts, "energy": energy,
-        "links": _link_results(scene, link_f, link_du),
+        "links": arrays.entries("links", pick("links", out_links)),
+        **({"arrays": arrays} if large else {}),
         **({"frames": frames} if frames else {}),
         "stability": {"omega_max": extra["omega_max"] or None,
                       "dt_critical": extra["dt_critical"] or None},
@@ -322,50 +416,91 @@ def _dynamic(scene, model, raise_on_failure=True):
     return summary, (columns, hist)
 
 
-def _node_results(scene, peaks):
-    """{node: its peaks} from the library's per-node arrays, column by column."""
-    keys = ("u_max", "u_min", "v_absmax", "a_absmax", "u_absmax", "t_absmax")
-    cols = [np.asarray(peaks[k], np.float64).tolist() for k in keys]
-    names = [n["name"] for n in scene.nodes]
-    nodes = {name: dict(zip(keys, row)) for name, *row in zip(names, *cols)}
-    t_peak = np.asarray(peaks["t_peak"], np.float64)
-    has = np.flatnonzero(t_peak >= 0)
-    for i, u, t in zip(has.tolist(), np.asarray(peaks["u_peak"], np.float64)[has].tolist(),
-                       t_peak[has].tolist()):
-        nodes[names[i]].update(u_peak=u, t_peak=t)
-    return nodes
+# The library's per-node peaks that are a node's results, in the order summary.json lists
+# them (docs/results.md, "Nodes"); a new peak of martello_run_peaks is a new name here.
+NODE_PEAKS = ("u_max", "u_min", "v_absmax", "a_absmax", "u_absmax", "t_absmax")
 
 
-def _first_last_phases(ev, order, bounds):
-    """Each contact's first and last phase of the event table (None without one), from the
-    table sorted by contact (order) and each contact's slice of it (bounds)."""
-    n = len(bounds) - 1
-    first, last = [None] * n, [None] * n
-    has = np.flatnonzero(np.diff(bounds) > 0)
-    if len(has):
-        for rows, at in ((first, bounds[has]), (last, bounds[has + 1] - 1)):
-            for j, phase in zip(has.tolist(), _phases(ev[order[at]])):
-                rows[j] = phase
+def phase_rows(ev_contacts, n_contacts):
+    """Each contact's first and last row of the event table (−1 where it has none), in one
+    pass over the table's contact column, without sorting it (at 23.5 million phases a
+    stable sort took ~10 s and 0.3 GB)."""
+    rows = np.arange(len(ev_contacts), dtype=np.int64)
+    first = np.full(n_contacts, len(ev_contacts), np.int64)
+    last = np.full(n_contacts, -1, np.int64)
+    np.minimum.at(first, ev_contacts, rows)
+    np.maximum.at(last, ev_contacts, rows)
+    first[first == len(ev_contacts)] = -1
     return first, last
 
 
-def _phases(table):
-    """_phase of every row of an event table, column by column."""
-    cols = [np.asarray(table[:, k], np.float64).tolist() for k in range(6)]
-    return [{"impact_time": on, "separation_time": off if off >= 0 else None,
-             "approach_speed": v_in, "separation_speed": v_out if off >= 0 else None,
-             "max_penetration": pen, "max_force": f}
-            for on, off, v_in, v_out, pen, f in zip(*cols)]
+def item_arrays(scene, peaks, link_f, link_du, ev, first, last):
+    """The per-item results of a dynamic run as columns (martello.results.ItemArrays) from
+    the library's arrays: peaks (martello_run_peaks), link peaks, and the event table ev with
+    each contact's first and last row of it (phase_rows)."""
+    f64 = lambda x: np.asarray(x, np.float64)             # noqa: E731
+    t_peak = f64(peaks["t_peak"])
+    has_peak = t_peak >= 0                                  # else: no local maximum of u
+    nodes = {k: f64(peaks[k]) for k in NODE_PEAKS}
+    nodes["u_peak"] = np.where(has_peak, f64(peaks["u_peak"]), np.nan)
+    nodes["t_peak"] = np.where(has_peak, t_peak, np.nan)
+    f, du = f64(link_f), f64(link_du)
+    links = {"type": _codes(scene.links, "type", LINK_KINDS),
+             "max_abs_force": np.where(np.isfinite(f), f, np.nan),   # null: not reported
+             "max_abs_elongation": np.where(np.isfinite(du), du, np.nan)}
+    pen = f64(peaks["pen_max"])
+    contacts = {"scheme": _codes(scene.contacts, "scheme", SCHEMES),
+                "law": _codes(scene.contacts, "law", LAWS),
+                "max_penetration": np.where(0.0 > pen, 0.0, pen),   # max(pen, 0), NaN kept
+                "max_force": f64(peaks["force_max"]),
+                "impacts": np.asarray(peaks["impacts"]).astype(np.int64)}
+    for p, rows in (("first", first), ("last", last)):
+        has = rows >= 0
+        phase = _phases(ev, rows[has], has)
+        for k, field in enumerate(PHASE_FIELDS):
+            contacts[f"{p}.{field}"] = phase[:, k]
+    names = {kind: _names(table) for kind, table in
+             (("nodes", scene.nodes), ("links", scene.links), ("contacts", scene.contacts))}
+    return ItemArrays(names, {"nodes": nodes, "links": links, "contacts": contacts},
+                      {"links": {"type": list(LINK_KINDS)},
+                       "contacts": {"scheme": list(SCHEMES), "law": list(LAWS)}})
 
 
-def _link_results(scene, link_f, link_du):
-    f = np.asarray(link_f, np.float64)
-    du = np.asarray(link_du, np.float64)
-    f_out = np.where(np.isfinite(f), f, np.nan).tolist()
-    du_out = np.where(np.isfinite(du), du, np.nan).tolist()
-    return {l["name"]: {"type": l["type"], "max_abs_force": None if fv != fv else fv,
-                        "max_abs_elongation": None if dv != dv else dv}
-            for l, fv, dv in zip(scene.links, f_out, du_out)}
+def _phases(ev, rows, has):
+    """One phase per contact as rows of PHASE_FIELDS: the event rows ev[rows] where `has`,
+    NaN elsewhere; the separation fields NaN while a phase is open (t_off < 0)."""
+    out = np.full((len(has), len(PHASE_FIELDS)), np.nan)
+    out[has] = ev[rows]
+    open_ = has & ~(out[:, 1] >= 0)
+    out[open_, 1] = out[open_, 3] = np.nan
+    return out
+
+
+def _names(table):
+    """The Names of an item table (a plain list of dicts: its names listed)."""
+    return table.names if isinstance(table, ItemTable) else Names([Listed([it["name"] for it in table])])
+
+
+def _codes(table, key, categories):
+    """Codes of a category column (index into categories, −1 where None), segment by
+    segment: a chain's from its block."""
+    at = {c: i for i, c in enumerate(categories)}
+    parts = []
+    for seg in segments(table):
+        if isinstance(seg, list):
+            parts.append(np.fromiter((at.get(it.get(key), -1) for it in seg), np.int8, len(seg)))
+            continue
+        if isinstance(seg, RodElements):
+            parts.append(np.full(len(seg), at["bar"], np.int8))
+            continue
+        b = seg.block
+        if key == "type":          # the chain's springs, then dampers where it has them
+            codes = np.full(len(seg), at["spring" if b.fy is None else "bilinear"], np.int8)
+            codes[seg.damper] = at["dashpot"]
+        else:
+            codes = np.full(len(seg), at.get(b.template.get(key), -1), np.int8)
+        parts.append(codes)
+    return np.concatenate(parts) if parts else np.zeros(0, np.int8)
 
 
 def frame_results(fr, columns, hist):
@@ -458,13 +593,6 @@ def _static(scene, model):
 PHASE_LISTS = 1000
 
 
-def _phase(row):
-    """One contact phase of the event table: onset and separation (null while open)."""
-    return {"impact_time": float(row[0]), "separation_time": float(row[1]) if row[1] >= 0 else None,
-            "approach_speed": float(row[2]), "separation_speed": float(row[3]) if row[1] >= 0 else None,
-            "max_penetration": float(row[4]), "max_force": float(row[5])}
-
-
 def _finite_or_none(x):
     return float(x) if np.isfinite(x) else None
 
@@ -480,8 +608,10 @@ MAX_WORK = 1e9
 OUTPUT_WARN = 100e6
 OUTPUT_LIMIT = 1e9
 # Bytes per value of history.csv (%.17g and a comma; 23 on average) and, in summary.json, per
-# node, contact (without its events), event and link: measured on the catalogue, rounded up.
+# node, contact (without its events), event and link: measured on the catalogue, rounded up;
+# in results.npz per node, link and contact: their columns' bytes (martello.run.item_arrays).
 _CSV_VALUE, _NODE, _CONTACT, _EVENT, _LINK, _BASE = 24, 200, 600, 200, 150, 6000
+_NPZ_NODE, _NPZ_LINK, _NPZ_CONTACT = 64, 17, 122
 
 
 def output_estimate(scene):
@@ -496,6 +626,12 @@ def output_estimate(scene):
                                   + (_CONTACT + _EVENT) * n_contacts)}
     if an["type"] == "dynamic":
         out = an["output"]
+        if is_large(scene):
+            # the named items in summary.json, every item in results.npz
+            est["summary_bytes"] = float(
+                _BASE + _NODE * len(out["nodes"]) + _LINK * len(out["links"])
+                + (_CONTACT + _EVENT) * len(out["contacts"])
+                + _NPZ_NODE * n_nodes + _NPZ_LINK * n_links + _NPZ_CONTACT * n_contacts)
         intervals = an["t_end"] / an["dt"]
         if an["integrator"] in native.adaptive_integrators():
             # dt is the output interval; h_max (when > 0) caps every step
@@ -599,33 +735,40 @@ def check_finite(summary, history=None):
                                       "(nothing written)")
 
 
-RESULT_FILES = ("summary.json", "history.csv")
-# summary.json of a scene with more nodes, contacts and links than this is written on one line
-INDENTED_ITEMS = 10_000
+RESULT_FILES = ("summary.json", "history.csv", ARRAYS_FILE)
 
 
 def write_results(summary, outdir, history=None):
-    """Write summary.json (and history.csv) as the folder outdir, atomically: they are written
-    to a temporary folder beside it, which is renamed into place, so outdir holds one complete
-    run or none, never a part of one nor files of an earlier run. An existing outdir is
-    replaced only if it is empty or an earlier run's (it holds a summary.json); every result
-    must be finite (check_finite). ResultError for anything that stops it; nothing is
-    written then."""
+    """Write summary.json (and history.csv, and a large scene's results.npz) as the folder
+    outdir, atomically: they are written to a temporary folder beside it, which is renamed
+    into place, so outdir holds one complete run or none, never a part of one nor files of an
+    earlier run. An existing outdir is replaced only if it is empty or an earlier run's (it
+    holds a summary.json); every result must be finite (check_finite, and
+    ItemArrays.check_finite). ResultError for anything that stops it; nothing is written
+    then."""
     check_finite(summary, history)
-    # indented for reading, unless the scene is large: json's C encoder writes no indentation,
-    # and is ~10x faster on a summary of 1e5 items (docs/results.md)
-    items = sum(len(summary.get(k) or ()) for k in ("nodes", "contacts", "links"))
-    text = json.dumps(summary, indent=2 if items <= INDENTED_ITEMS else None, allow_nan=False,
-                      default=float) + "\n"
+    arrays = summary.get("arrays")
+    if isinstance(arrays, ItemArrays):
+        arrays.check_finite()
+    text = json.dumps(summary, indent=2, allow_nan=False, default=float) + "\n"
     given = Path(outdir)
     with folder_replaced(outdir, "summary.json", ResultError) as tmp:
         try:
             if history is not None:
-                columns, data = history
-                np.savetxt(tmp / "history.csv", data, delimiter=",", header=",".join(columns),
-                           comments="", fmt="%.17g")
+                write_history(tmp / "history.csv", *history)
+            if isinstance(arrays, ItemArrays):
+                arrays.write(tmp)
             (tmp / "summary.json").write_text(text)
         except OSError as exc:
             raise ResultError(f"{os.path.abspath(outdir)}: cannot write the results: "
                               f"{exc.strerror or exc}") from None
     return given / "summary.json"
+
+
+def write_history(path, columns, data):
+    """history.csv: a header, then one line per row, %.17g (docs/results.md): what
+    numpy.savetxt writes, formatted from Python floats at about twice its speed."""
+    fmt = ",".join(["%.17g"] * len(columns))
+    with open(path, "w") as fh:
+        fh.write(",".join(columns) + "\n")
+        fh.writelines(fmt % tuple(row) + "\n" for row in np.asarray(data, float).tolist())

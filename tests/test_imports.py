@@ -103,7 +103,7 @@ def test_the_cycle_finder_finds_a_cycle():
 # (PEP 562), so it sits on top; test_import_martello_loads_nothing_else keeps it cheap.
 LAYERS = [("martello.errors", "martello.paths", "martello.history", "martello.independent"),
           ("martello.binding", "martello.oracles"), ("martello.closed_forms", "martello.frame2d"),
-          ("martello.scene", "martello.ground_motion"),
+          ("martello.scene", "martello.ground_motion"), ("martello.results",),
           ("martello.run",), ("martello.batch",),
           ("martello.metrics",), ("martello.reference",),
           ("martello.checks",),

@@ -1,11 +1,18 @@
 """What a large scene's run writes (docs/results.md): the phases of each contact are listed only
-for the contacts named in output.contacts once a scene has more than 1000 contacts, and the
-summary of more than 10 000 items is written on one line. Identities of the summary: the first
-and last phase of a contact are the first and last entries of the lists it would have had."""
+for the contacts named in output.contacts once a scene has more than 1000 contacts, and a scene
+of more than 10 000 items writes them as arrays (results.npz). Identities of the summary: the
+first and last phase of a contact are the first and last entries of the lists it would have
+had; an item read from the arrays is its entry in summary.json."""
 
 import json
 
-from martello.run import run, write_results
+import numpy as np
+import pytest
+
+from martello import results
+from martello.checks.verify import lookup
+from martello.errors import ResultError
+from martello.run import run, run_full, write_results
 from martello.scene.loader import from_dict
 
 N = 1002          # 1001 contacts: past the 1000 of docs/results.md
@@ -38,13 +45,84 @@ def test_a_large_scene_lists_the_phases_of_the_named_contacts_only():
     assert last["approach_speed"] == full["approach_speeds"][-1]
 
 
-def test_a_summary_of_more_than_ten_thousand_items_is_one_line(tmp_path):
-    s = run(chain())
-    assert len(s["nodes"]) + len(s["contacts"]) + len(s["links"]) < 10_000
-    write_results(s, tmp_path / "small")
-    assert (tmp_path / "small" / "summary.json").read_text().count("\n") > 1000
-    s["links"].update({f"extra{i}": {"type": "spring", "max_abs_force": 1.0, "max_abs_elongation": 0.1}
-                       for i in range(8000)})
-    write_results(s, tmp_path / "large")
-    text = (tmp_path / "large" / "summary.json").read_text()
-    assert text.count("\n") == 1 and json.loads(text)["links"]["extra7"]["max_abs_force"] == 1.0
+def big_chain(n=3400):
+    """n + 2n + (n - 1) items: past the 10 000 of docs/results.md for n = 3400."""
+    return from_dict({
+        "chain": [{"prefix": "b", "n": n, "mass": 1.0,
+                   "k": [100.0 if i % 2 == 0 else 400.0 for i in range(n)],
+                   "zeta": [0.05 if i % 3 else 0.0 for i in range(n)], "fy": 1.0, "hardening": 0.1,
+                   "gap": 0.001, "contact": {"scheme": "penalty", "law": "linear", "stiffness": 1e5}}],
+        "loads": {"ground_acceleration": {"type": "sine", "amplitude": 3.0, "omega": 8.0}},
+        "analysis": {"type": "dynamic", "integrator": "newmark", "dt": 1e-3, "t_end": 0.5,
+                     "output": {"every": 100, "nodes": ["b7"], "contacts": ["b7-b8"],
+                                "links": ["b7.spring"]}}})
+
+
+def test_a_large_scene_writes_its_items_as_arrays_and_names_those_of_output(tmp_path, monkeypatch):
+    """Identity of the method: every item's entry read back from results.npz is the entry the
+    same run writes into summary.json when the scene counts as small."""
+    scene = big_chain()
+    assert 10_000 < len(scene.nodes) + len(scene.links) + len(scene.contacts)
+    s, history = run_full(scene)
+    write_results(s, tmp_path / "large", history)
+    assert sorted(p.name for p in (tmp_path / "large").iterdir()) == ["history.csv", "results.npz",
+                                                                      "summary.json"]
+    small_text = (tmp_path / "large" / "summary.json").read_text()
+    assert len(small_text) < 20_000
+    back = results.read_summary(tmp_path / "large")
+    assert list(back["nodes"]) == ["b7"] and list(back["contacts"]) == ["b7-b8"] \
+        and list(back["links"]) == ["b7.spring"]
+    monkeypatch.setattr(results, "ARRAY_ITEMS", 10 ** 9)
+    full = json.loads(json.dumps(run(scene)))
+    assert "arrays" not in full
+    arrays = back["arrays"]
+    for kind in ("nodes", "links", "contacts"):
+        assert arrays[kind]["count"] == len(full[kind])
+        got = arrays.entries(kind, range(len(full[kind])))
+        for name, entry in full[kind].items():
+            if name in back[kind]:           # the named items, as the small form has them
+                assert back[kind][name] == entry
+                continue
+            assert got[name] == entry, (kind, name)
+    # it meets contacts that never closed, closed and opened, and are closed at the end
+    impacts = arrays.column("contacts", "impacts")
+    open_at_end = ~np.isnan(arrays.column("contacts", "last.impact_time")) & \
+        np.isnan(arrays.column("contacts", "last.separation_time"))
+    assert (impacts == 0).any() and (impacts > 1).any() and open_at_end.any()
+    assert lookup(back, "nodes.b3000.u_max") == full["nodes"]["b3000"]["u_max"]
+    assert lookup(back, "links.b3000.damper.max_abs_force") == \
+        full["links"]["b3000.damper"]["max_abs_force"]
+
+
+def test_a_large_scene_with_a_value_that_is_not_finite_writes_nothing(tmp_path):
+    s = run(big_chain())
+    s["arrays"].columns["nodes"]["u_max"][1234] = float("inf")
+    with pytest.raises(ResultError, match=r"nodes\.b1235\.u_max is inf: a result must be finite"):
+        write_results(s, tmp_path / "out")
+    assert not (tmp_path / "out").exists()
+
+
+def test_a_run_folder_without_its_arrays_is_refused_by_name(tmp_path):
+    s, history = run_full(big_chain(n=3400))
+    write_results(s, tmp_path / "run", history)
+    (tmp_path / "run" / "results.npz").unlink()
+    with pytest.raises(ResultError, match=r"results\.npz: cannot be read .*run the scene again"):
+        results.read_summary(tmp_path / "run")
+
+
+def test_martello_run_writes_and_names_the_arrays_of_a_large_scene(tmp_path):
+    import subprocess
+    import sys
+    scene = tmp_path / "chain.toml"
+    scene.write_text('[[chain]]\nprefix = "b"\nn = 3400\nmass = 1.0\nk = 100.0\nzeta = 0.05\n'
+                     'gap = 0.001\ncontact = { scheme = "penalty", stiffness = 1e5 }\n'
+                     '[loads.ground_acceleration]\ntype = "sine"\namplitude = 3.0\nomega = 8.0\n'
+                     '[analysis]\ntype = "dynamic"\nintegrator = "newmark"\ndt = 1e-3\nt_end = 0.1\n')
+    r = subprocess.run([sys.executable, "-m", "martello", "run", scene, "-o", tmp_path / "out"],
+                       capture_output=True, text=True)
+    assert r.returncode == 0, r.stderr
+    assert r.stdout.strip().endswith("history.csv and " + str(tmp_path / "out" / "results.npz"))
+    import martello
+    back = martello.read(tmp_path / "out")
+    assert back.summary["nodes"] == {} and back.arrays["nodes"]["count"] == 3400
+    assert back.item("links", "b3400.damper")["type"] == "dashpot"

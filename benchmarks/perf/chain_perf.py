@@ -46,13 +46,15 @@ def one(n):
     wall = time.perf_counter() - t0
     native = r["cost"]["wall_time_s"]
     steps = r["cost"]["steps"]
-    active = sum(1 for c in r["contacts"].values() if c["max_force"] > 0)
+    from martello.results import lookup_item
+    active = sum(1 for name in s.contacts.names if lookup_item(r, "contacts", name)["max_force"] > 0) \
+        if "arrays" not in r else int((r["arrays"].column("contacts", "max_force") > 0).sum())
     print(json.dumps({
         "n": n, "steps": steps, "native_s": native, "total_s": wall,
         "ns_per_dof_step": native / (n * steps) * 1e9,
         "newton_per_step": r["cost"]["newton_iterations"] / steps,
         "residuals_per_step": r["cost"]["residual_evaluations"] / steps,
-        "active_contacts": active, "contacts": len(r["contacts"]),
+        "active_contacts": active, "contacts": len(s.contacts),
         "peak_rss_mib": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024,
         "status": r["status"], "energy_balance_relative": r["energy"]["balance_relative"]}))
 

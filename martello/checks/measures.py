@@ -37,8 +37,6 @@ formed are left out and `notes` says why; nothing here raises for a scene that d
 
 import numpy as np
 
-from ..oracles.p4_rod_impact import rod_impact
-from ..oracles.p4_wave_theory import rod_point_displacement, vibration_energy_fraction
 from ..run import run_full
 
 REL_SAME = 1e-12     # two rods with c and Z equal to this relative tolerance are "the same bar"
@@ -146,6 +144,9 @@ def _hold_l1(t, p, t0, t1, level):
 
 
 def rod_impact_measures(scene, summary, history):
+    # the wave-theory oracles: only for a scene of rods (a plain run does not load them)
+    from ..oracles.p4_rod_impact import rod_impact
+    from ..oracles.p4_wave_theory import rod_point_displacement, vibration_energy_fraction
     rods = scene.extras["bars"]
     got = _applicability(scene, rods)
     if isinstance(got, str):

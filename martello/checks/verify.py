@@ -7,6 +7,7 @@ solvers: a scene and its reference are two independent statements of the same pr
 import math
 
 from ..errors import SceneError
+from ..results import KINDS, ItemArrays
 from .oracle_names import closed_form
 
 DIGITS_CAP = 16.0   # a double carries ~15.95 digits; an exact match is reported as 16
@@ -14,7 +15,18 @@ DIGITS_CAP = 16.0   # a double carries ~15.95 digits; an exact match is reported
 
 def lookup(summary, path):
     """Follow a dotted path; names may contain dots themselves (chain links such as
-    b1.spring): at each level the longest key that the rest of the path starts with wins."""
+    b1.spring): at each level the longest key that the rest of the path starts with wins.
+    A large scene's nodes, links and contacts not in summary.json are read from its arrays
+    (martello.results)."""
+    kind, _, rest = path.partition(".")
+    arrays = summary.get("arrays") if isinstance(summary, dict) else None
+    if kind in KINDS and isinstance(arrays, ItemArrays) and rest:
+        names = arrays.names[kind]
+        # the longest name the rest of the path starts with, as below
+        heads = [i for i in range(len(rest), 0, -1) if i == len(rest) or rest[i] == "."]
+        for i in heads:
+            if rest[:i] not in (summary.get(kind) or {}) and rest[:i] in names:
+                return lookup({kind: {rest[:i]: arrays.item(kind, rest[:i])}}, path)
     node, rest = summary, path
     while rest:
         if isinstance(node, list):

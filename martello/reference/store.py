@@ -11,6 +11,7 @@ from pathlib import Path
 import numpy as np
 
 from ..paths import REFERENCE_ROOT, REPO
+from ..scene.items import ItemTable
 from .base import Reference, ReferenceError
 
 MANIFEST = "references.toml"
@@ -38,7 +39,7 @@ def _canonical(x):
     key (with an unset or false default) does not change the digest of existing scenes."""
     if isinstance(x, dict):
         return {k: _canonical(v) for k, v in x.items() if v is not None and v is not False}
-    if isinstance(x, (list, tuple)):
+    if isinstance(x, (list, tuple, ItemTable)):        # a scene's item table: its dicts
         return [_canonical(v) for v in x]
     return x
 

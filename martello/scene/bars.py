@@ -2,8 +2,9 @@
 
 A `[[bar]]` table stands for one straight elastic rod along the scene's axis. The loader
 (martello.scene.loader) calls :func:`expand_bars` before it validates nodes and links; the rod
-becomes ordinary `[[node]]`, `[[link]]` (type "bar") and, for a consistent mass matrix,
-`[[mass_coupling]]` entries, so every integrator sees plain scene items.
+stands for ordinary `[[node]]`, `[[link]]` (type "bar") and, for a consistent mass matrix,
+`[[mass_coupling]]` entries, so every integrator sees plain scene items. They are kept as the
+rod's mesh (segments of the scene's item tables, martello.scene.items), not one dict each.
 
 Keys (SI units):
 
@@ -45,8 +46,11 @@ velocity history without the native model.
 
 import math
 
+import numpy as np
+
 from ..errors import SceneError
 from .fields import MAX_GENERATED, TINY, check_fields
+from .items import Listed, Numbered
 
 BAR_KEYS = {
     "name": ("str", True, None, None),
@@ -154,21 +158,26 @@ def mesh_rod(name, L, N, rhoA, mass="lumped", ends="node", x0=0.0):
             "elements": elements, "element_length": Le}
 
 
-def expand_bars(src, data):
-    """Replace the scene's [[bar]] tables by nodes, bar links and mass couplings.
+def expand_bars(src, data, generated=()):
+    """Validate the scene's [[bar]] tables and mesh each rod.
 
-    Returns (data, info): a new scene dict (the input is not modified) and one dict per rod
-    describing it (module docstring)."""
+    Returns (data, info, segments): the scene dict without its [[bar]] tables (the input is
+    not modified; analysis.output.nodes gets the rods' recorded nodes), one dict per rod
+    describing it (module docstring), and the rods' items as segments of the scene's item
+    tables (martello.scene.items): {"node": [...], "link": [...], "mass_coupling": [...]} —
+    each rod's nodes, elements and couplings generated from its mesh (``RodNodes``,
+    ``RodElements``, ``RodCouplings``), its supports as listed dicts. `generated` holds the
+    names of the nodes the chains made before (martello.scene.items.Names): they count and
+    are taken too."""
     data = dict(data)
     bars = data.pop("bar")
     if not isinstance(bars, list) or not bars:
         raise SceneError(src, "bar", "must be a non-empty array of tables", "write [[bar]]")
     nodes = list(data.get("node", []))
-    links = list(data.get("link", []))
-    couplings = list(data.get("mass_coupling", []))
     taken = {n.get("name") for n in nodes if isinstance(n, dict)}
-    explicit_nodes = [n.get("name") for n in nodes if isinstance(n, dict)]
-    out_nodes, info, bar_names = [], [], set()
+    explicit_nodes = [n.get("name") for n in nodes if isinstance(n, dict)] + list(generated)
+    out_nodes, info, bar_names, made = [], [], set(), len(nodes) + len(generated)
+    segments = {"node": [], "link": [], "mass_coupling": []}
     for bi, tab in enumerate(bars):
         where = f"bar[{bi}]"
         b = check_fields(src, tab, where, BAR_KEYS)
@@ -184,8 +193,7 @@ def expand_bars(src, data):
         fixed = _choice(src, f"{where}.fixed", b["fixed"], FIXED_KINDS)
         output = _choice(src, f"{where}.output", b["output"], OUTPUT_KINDS)
         N = b["elements"]
-        made = len(nodes) + N + 1
-        if made > MAX_GENERATED:
+        if made + N + 1 > MAX_GENERATED:
             raise SceneError(src, f"{where}.elements", f"invalid value {N!r}",
                              f"the generators of a scene make at most {MAX_GENERATED} nodes in all")
         if ends == "half-cell":
@@ -201,32 +209,26 @@ def expand_bars(src, data):
         mesh = mesh_rod(name, L, N, rhoA, mass, ends, b["x0"])
         names, Le = mesh["names"], mesh["element_length"]
         for nm in names:
-            if nm in taken:
+            if nm in taken or nm in generated:
                 raise SceneError(src, f"{where}.name", f"generates the node {nm!r}, which already exists",
                                  "choose another rod name")
             taken.add(nm)
+        made += len(names)
         fix_left, fix_right = fixed in ("left", "both"), fixed in ("right", "both")
-        for i, nm in enumerate(names):
-            held = ends == "node" and ((i == 0 and fix_left) or (i == len(names) - 1 and fix_right))
-            node = {"name": nm, "mass": mesh["node_mass"][i]}
-            if held:
-                node["fixed"] = True
-            elif b["v0"] != 0.0:
-                node["v0"] = b["v0"]
-            nodes.append(node)
-        for k, (i, j) in enumerate(mesh["elements"]):
-            links.append({"name": f"{name}.e{k + 1}", "type": "bar", "a": names[i], "b": names[j],
-                          "EA": EA, "L": Le})
+        rod = Rod(name, mesh, EA, b["v0"], ends == "node" and fix_left, ends == "node" and fix_right)
+        segments["node"].append(RodNodes(rod))
+        segments["link"].append(RodElements(rod))
         if ends == "half-cell":
             # a held end: the half cell between the end node and the support is a bar of L_e/2
+            supports = []
             if fix_left:
-                links.append({"name": f"{name}.support.left", "type": "bar", "a": "ground",
-                              "b": names[0], "EA": EA, "L": 0.5 * Le})
+                supports.append({"name": f"{name}.support.left", "type": "bar", "a": "ground",
+                                 "b": names[0], "EA": EA, "L": 0.5 * Le})
             if fix_right:
-                links.append({"name": f"{name}.support.right", "type": "bar", "a": names[-1],
-                              "b": "ground", "EA": EA, "L": 0.5 * Le})
-        for i, j, value in mesh["couplings"]:
-            couplings.append({"a": names[i], "b": names[j], "value": value})
+                supports.append({"name": f"{name}.support.right", "type": "bar", "a": names[-1],
+                                 "b": "ground", "EA": EA, "L": 0.5 * Le})
+            segments["link"].append(supports)
+        segments["mass_coupling"].append(RodCouplings(rod))
         if output == "all":
             out_nodes += names
         elif output == "ends":
@@ -243,12 +245,90 @@ def expand_bars(src, data):
             "node_mass": mesh["node_mass"],
             "couplings": [(names[i], names[j], v) for i, j, v in mesh["couplings"]],
         })
-    data["node"] = nodes
-    data["link"] = links
-    if couplings:
-        data["mass_coupling"] = couplings
     data["analysis"] = _with_output_nodes(data.get("analysis"), explicit_nodes, out_nodes)
-    return data, info
+    return data, info, segments
+
+
+class Rod:
+    """One rod's mesh as the loader places it: its first node's position in the scene
+    (node0, set by the loader), the mesh of mesh_rod, EA, v0 and which end nodes are held."""
+
+    def __init__(self, name, mesh, EA, v0, held_left, held_right):
+        self.name, self.mesh, self.EA, self.v0 = name, mesh, EA, v0
+        self.held = (held_left, held_right)
+        self.node0 = 0
+
+    def is_held(self, i):
+        return (i == 0 and self.held[0]) or (i == len(self.mesh["names"]) - 1 and self.held[1])
+
+
+class RodNodes:
+    """A rod's nodes as a segment of the scene's node table (martello.scene.items)."""
+
+    def __init__(self, rod):
+        self.rod = rod
+
+    def __len__(self):
+        return len(self.rod.mesh["names"])
+
+    def place(self, pos):
+        self.rod.node0 = pos
+
+    def names(self):
+        names = self.rod.mesh["names"]
+        middle = Numbered(f"{self.rod.name}.", "", 1, len(names) - 2)
+        return [Listed(names[:1]), middle, Listed(names[-1:])] if len(names) > 1 else [Listed(names)]
+
+    def item(self, i):
+        r = self.rod
+        held = r.is_held(i)
+        return {"name": r.mesh["names"][i], "mass": float(r.mesh["node_mass"][i]), "u0": 0.0,
+                "v0": 0.0 if held or r.v0 == 0.0 else float(r.v0), "fixed": held}
+
+    def arrays(self):
+        """(mass, u0, v0, fixed) of its nodes, for the run layer."""
+        n = len(self)
+        fixed = np.zeros(n, np.int32)
+        fixed[0], fixed[-1] = self.rod.held
+        v0 = 0.0 if self.rod.v0 == 0.0 else float(self.rod.v0)     # a −0.0 given is 0.0
+        return (np.array(self.rod.mesh["node_mass"], np.float64), np.zeros(n),
+                np.where(fixed != 0, 0.0, v0), fixed)
+
+
+class RodElements:
+    """A rod's bar elements as a segment of the scene's link table."""
+
+    def __init__(self, rod):
+        self.rod = rod
+
+    def __len__(self):
+        return len(self.rod.mesh["elements"])
+
+    def place(self, pos):
+        pass
+
+    def names(self):
+        return [Numbered(f"{self.rod.name}.e", "", 1, len(self))]
+
+    def item(self, k):
+        r = self.rod
+        i, j = r.mesh["elements"][k]
+        return {"name": f"{r.name}.e{k + 1}", "type": "bar", "a": r.node0 + i, "b": r.node0 + j,
+                "EA": r.EA, "L": r.mesh["element_length"]}
+
+
+class RodCouplings:
+    """A rod's consistent-mass couplings as a segment of the scene's coupling table."""
+
+    def __init__(self, rod):
+        self.rod = rod
+
+    def __len__(self):
+        return len(self.rod.mesh["couplings"])
+
+    def item(self, k):
+        i, j, value = self.rod.mesh["couplings"][k]
+        return {"a": self.rod.node0 + i, "b": self.rod.node0 + j, "value": value}
 
 
 def _with_output_nodes(analysis, explicit_nodes, rod_nodes):

@@ -7,13 +7,15 @@ in docs/scene-format.md. Every error names the file, the field and what would be
 import hashlib
 import json
 import tomllib
+
+import numpy as np
 from dataclasses import dataclass, field
 from pathlib import Path
 
 from ..errors import SceneError
 from .bars import expand_bars
-from .chain import expand_chains
-from .frame import expand_frames, frame_blocks
+from .chain import ChainContacts, ChainLinks, ChainNodes, expand_chains
+from .items import ItemTable, NameIndex, Names
 from .compatibility import COMPATIBLE
 from ..paths import MiB, UnreadableFile, check_regular, read_input
 from .fields import (ANY, MAX_DEPTH, NONNEG, POSITIVE, check_fields, choice, finite_everywhere,
@@ -30,6 +32,8 @@ class Scene:
     title: str
     problem: str
     description: str
+    # item tables (martello.scene.items.ItemTable: sequences of dicts, a generator's stored
+    # as arrays; .names their names, .segments what the run layer reads)
     nodes: list          # dicts: name, mass, u0, v0, fixed
     links: list          # dicts: name, type, a, b (indices, -1 ground) + parameters
     contacts: list       # dicts: name, a, b, gap, scheme + parameters
@@ -39,7 +43,7 @@ class Scene:
     analysis: dict
     check: dict | None
     digest: str          # sha256 of the file (or of the canonical JSON of a dict scene)
-    index: dict = field(default_factory=dict)   # node name -> index
+    index: dict = field(default_factory=dict)   # node name -> index (a NameIndex)
     couplings: list = field(default_factory=list)  # dicts: a, b (indices), value
     extras: dict = field(default_factory=dict)     # what generators ([[bar]]) know of the scene
     blocks: list = field(default_factory=list)     # dicts: name, nodes (indices), k, c ([[frame]])
@@ -142,41 +146,60 @@ def from_dict(data, source="<scene>", base_dir=Path("."), digest=None):
         if key not in TOP_KEYS:
             raise SceneError(src, key, "unknown key", "valid top-level keys: " + ", ".join(sorted(TOP_KEYS)))
     extras = {}
+    # the entries written in the file come first; the generators' follow, in the order
+    # chains, rods, frames (docs/scene-input.md, "Generators")
+    written = {key: data.get(key) if isinstance(data.get(key), list) else [] for key in ("node", "link")}
+    chains = []
     if "chain" in data:
-        data = expand_chains(src, data)
+        data, chains = expand_chains(src, data)
+    chain_nodes = Names([b.node_names() for b in chains])
+    rods = {"node": [], "link": [], "mass_coupling": []}
     if "bar" in data:
-        data, extras["bars"] = expand_bars(src, data)   # [[bar]]: rods meshed into elements (P4)
+        # [[bar]]: rods meshed into elements (P4)
+        data, extras["bars"], rods = expand_bars(src, data, generated=chain_nodes)
     if "frame" in data:
+        from .frame import expand_frames        # numpy.linalg and the frame model: only here
         data, extras["frames"] = expand_frames(src, data)   # [[frame]]: condensed frames (P10)
 
     # nodes
-    raw_nodes = data.get("node")
-    if not isinstance(raw_nodes, list) or not raw_nodes:
+    generated = [ChainNodes(b) for b in chains] + rods["node"]
+    raw_nodes = data.get("node", [] if generated else None)
+    if not isinstance(raw_nodes, list) or not (raw_nodes or generated):
         raise SceneError(src, "node", "missing", "a scene needs at least one [[node]]")
-    nodes, index = [], {}
-    for i, tab in enumerate(raw_nodes):
-        where = f"node[{i}]"
-        n = check_fields(src, tab, where, NODE_KEYS)
-        if n["name"] == GROUND:
-            raise SceneError(src, f"{where}.name", "'ground' is reserved", "choose another name")
-        if n["name"] in index:
-            raise SceneError(src, f"{where}.name", f"duplicate name {n['name']!r}", "names must be unique")
-        if n["fixed"]:
-            if n["mass"] < 0:
-                raise SceneError(src, f"{where}.mass", f"invalid value {n['mass']!r}", "must be >= 0 for a fixed node")
-        elif not n["mass"] > 0:
-            raise SceneError(src, f"{where}.mass", f"invalid value {n['mass']!r}", "must be > 0 (or set fixed = true)")
-        index[n["name"]] = i
-        nodes.append(n)
+    w = len(written["node"])
+    node_segments = _segments(raw_nodes[:w], generated, raw_nodes[w:])
+    node_names, pos = Names(), 0
+    for seg in node_segments:
+        if not isinstance(seg, list):
+            _place(src, "node", seg, pos, node_names)
+            pos += len(seg)
+            continue
+        for i, tab in enumerate(seg, start=pos):
+            where = f"node[{i}]"
+            n = check_fields(src, tab, where, NODE_KEYS)
+            if n["name"] == GROUND:
+                raise SceneError(src, f"{where}.name", "'ground' is reserved", "choose another name")
+            if node_names.add(n["name"]) >= 0:
+                raise SceneError(src, f"{where}.name", f"duplicate name {n['name']!r}", "names must be unique")
+            if n["fixed"]:
+                if n["mass"] < 0:
+                    raise SceneError(src, f"{where}.mass", f"invalid value {n['mass']!r}", "must be >= 0 for a fixed node")
+            elif not n["mass"] > 0:
+                raise SceneError(src, f"{where}.mass", f"invalid value {n['mass']!r}", "must be > 0 (or set fixed = true)")
+            seg[i - pos] = n
+        pos += len(seg)
+    nodes = ItemTable(node_segments, node_names)
+    index = NameIndex(node_names)
 
     def node_ref(path, name, ground_ok=True):
         if name == GROUND and ground_ok:
             return -1
-        if name not in index:
-            known = ", ".join(list(index)[:8]) + (", ..." if len(index) > 8 else "")
+        i = node_names.position(name) if isinstance(name, str) else -1
+        if i < 0:
+            known = ", ".join(node_names[:8]) + (", ..." if len(node_names) > 8 else "")
             raise SceneError(src, path, f"names no node {name!r}",
                              f"use one of: {known}" + (", ground" if ground_ok else ""))
-        return index[name]
+        return i
 
     for key in ("link", "contact", "mass_coupling"):
         if key in data and not isinstance(data[key], list):
@@ -186,58 +209,57 @@ def from_dict(data, source="<scene>", base_dir=Path("."), digest=None):
     if "force" in data.get("loads", {}) and not isinstance(data["loads"]["force"], list):
         raise SceneError(src, "loads.force", "must be an array of tables", "write [[loads.force]]")
     # links
-    links, lnames = [], set()
-    for i, tab in enumerate(data.get("link", [])):
-        where = f"link[{i}]"
-        if not isinstance(tab, dict) or "type" not in tab:
-            raise SceneError(src, f"{where}.type", "missing", "valid: " + ", ".join(LINK_TYPES))
-        kind = choice(src, f"{where}.type", tab["type"], list(LINK_TYPES))
-        spec = dict(LINK_COMMON, **LINK_TYPES[kind])
-        lk = check_fields(src, tab, where, spec)
-        lk["a"], lk["b"] = node_ref(f"{where}.a", lk["a"]), node_ref(f"{where}.b", lk["b"])
-        if lk["a"] == lk["b"]:
-            raise SceneError(src, f"{where}.b", "connects a node to itself", "name two different nodes")
-        lk["name"] = lk["name"] or f"link{i}"
-        if lk["name"] in lnames:
-            raise SceneError(src, f"{where}.name", f"duplicate name {lk['name']!r}", "names must be unique")
-        lnames.add(lk["name"])
-        if kind == "dashpot" and (lk["c"] is None) == (lk["zeta"] is None):
-            raise SceneError(src, where, "needs exactly one of c or zeta",
-                             "c = damping [N s/m], or zeta = damping ratio of a node-to-ground oscillator")
-        links.append(lk)
+    raw_links = data.get("link", [])
+    w = len(written["link"])
+    link_segments = _segments(raw_links[:w], [ChainLinks(b) for b in chains] + rods["link"],
+                              raw_links[w:])
+    link_names, pos = Names(), 0
+    for seg in link_segments:
+        if not isinstance(seg, list):
+            _place(src, "link", seg, pos, link_names)
+            pos += len(seg)
+            continue
+        for i, tab in enumerate(seg, start=pos):
+            where = f"link[{i}]"
+            if not isinstance(tab, dict) or "type" not in tab:
+                raise SceneError(src, f"{where}.type", "missing", "valid: " + ", ".join(LINK_TYPES))
+            kind = choice(src, f"{where}.type", tab["type"], list(LINK_TYPES))
+            spec = dict(LINK_COMMON, **LINK_TYPES[kind])
+            lk = check_fields(src, tab, where, spec)
+            lk["a"], lk["b"] = node_ref(f"{where}.a", lk["a"]), node_ref(f"{where}.b", lk["b"])
+            if lk["a"] == lk["b"]:
+                raise SceneError(src, f"{where}.b", "connects a node to itself", "name two different nodes")
+            lk["name"] = lk["name"] or f"link{i}"
+            if link_names.add(lk["name"]) >= 0:
+                raise SceneError(src, f"{where}.name", f"duplicate name {lk['name']!r}", "names must be unique")
+            if kind == "dashpot" and (lk["c"] is None) == (lk["zeta"] is None):
+                raise SceneError(src, where, "needs exactly one of c or zeta",
+                                 "c = damping [N s/m], or zeta = damping ratio of a node-to-ground oscillator")
+            seg[i - pos] = lk
+        pos += len(seg)
+    links = ItemTable(link_segments, link_names)
 
-    # contacts
-    contacts, cnames = [], set()
-    for i, tab in enumerate(data.get("contact", [])):
-        where = f"contact[{i}]"
-        if not isinstance(tab, dict) or "scheme" not in tab:
-            raise SceneError(src, f"{where}.scheme", "missing", "valid: " + ", ".join(SCHEMES))
-        scheme = choice(src, f"{where}.scheme", tab["scheme"], SCHEMES)
-        c = check_fields(src, tab, where, dict(CONTACT_COMMON, **CONTACT_SCHEMES[scheme]))
-        if c["name"] in cnames:
-            raise SceneError(src, f"{where}.name", f"duplicate name {c['name']!r}", "names must be unique")
-        cnames.add(c["name"])
-        c["a"], c["b"] = node_ref(f"{where}.a", c["a"]), node_ref(f"{where}.b", c["b"])
-        if c["a"] == c["b"]:
-            raise SceneError(src, f"{where}.b", "pairs a node with itself", "name two different nodes or ground")
-        if scheme == "penalty":
-            choice(src, f"{where}.law", c["law"], LAWS)
-            if c["clipped"] and c["law"] != "kelvin":
-                raise SceneError(src, f"{where}.clipped", "applies to law kelvin only", "remove it")
-            if c["exponent"] is not None and c["law"] in FIXED_EXPONENT:
-                raise SceneError(src, f"{where}.exponent", f"does not apply to law {c['law']}",
-                                 f"its exponent is fixed at {FIXED_EXPONENT[c['law']]:g}; remove it")
-            if c["law"] in ("linear", "hertz") and (c["damping"] is not None or c["restitution"] is not None):
-                key = "damping" if c["damping"] is not None else "restitution"
-                raise SceneError(src, f"{where}.{key}", f"law {c['law']} is elastic (e = 1)",
-                                 "remove it, or choose a damped law (kelvin, hunt-crossley, ...)")
-            if c["law"] in ("flores", "gonthier", "jankowski") and c["restitution"] == 0:
-                raise SceneError(src, f"{where}.restitution", f"law {c['law']} divides by e",
-                                 "give e > 0 (e = 0 is a plastic impact: use scheme restitution)")
-            if c["damping"] is not None and c["restitution"] is not None:
-                raise SceneError(src, f"{where}.damping", "given together with restitution",
-                                 "give one: damping directly, or restitution to derive it")
-        contacts.append(c)
+    # contacts: those written, then each chain's (one contact table each, validated once as
+    # its first contact, where the per-item expansion would have found its errors)
+    contact_segments = _segments(data.get("contact", []), [ChainContacts(b) for b in chains if b.n_contacts])
+    contact_names, pos = Names(), 0
+    for seg in contact_segments:
+        if not isinstance(seg, list):
+            b = seg.block
+            b.contact0 = pos
+            first = {"name": f"{b.prefix}1-{b.prefix}2", "a": f"{b.prefix}1", "b": f"{b.prefix}2",
+                     "gap": float(b.gap[0])}
+            first.update(b.contact)
+            clash = []
+            b.template = _contact(src, first, pos, node_ref, lambda nm: clash.append(
+                contact_names.extend(b.contact_names())) or clash[0] == 0)
+            _unique(src, "contact", pos, contact_names, clash[0])
+            pos += len(seg)
+            continue
+        for i, tab in enumerate(seg, start=pos):
+            seg[i - pos] = _contact(src, tab, i, node_ref, lambda nm: contact_names.add(nm) >= 0)
+        pos += len(seg)
+    contacts = ItemTable(contact_segments, contact_names)
 
     # loads
     loads = data.get("loads", {})
@@ -275,11 +297,19 @@ def from_dict(data, source="<scene>", base_dir=Path("."), digest=None):
         for fr in extras.get("frames", []):
             out = analysis["output"]["nodes"]
             analysis["output"]["nodes"] = out + [n for n in fr["nodes"] if n not in out]
-    blocks = frame_blocks(extras.get("frames", []), index)
-    ground_k = _ground_stiffness(links)
-    for i, lk in enumerate(links):
+    if "frames" in extras:
+        from .frame import frame_blocks
+        blocks = frame_blocks(extras["frames"], index)
+    else:
+        blocks = []
+    listed = [(i, lk) for seg, at in zip(links.segments, links.offsets) if isinstance(seg, list)
+              for i, lk in enumerate(seg, start=at)]
+    ground_k = _ground_stiffness(lk for _, lk in listed)
+    for i, lk in listed:
         if lk["type"] == "dashpot" and lk["zeta"] is not None:
-            lk["c"] = _dashpot_from_zeta(src, i, lk, ground_k, nodes)
+            lk["c"] = _dashpot_from_zeta(src, i, lk, ground_k, nodes, chains)
+    for b in chains:
+        b.c = _chain_dampers(b, ground_k)
 
     check = data.get("check")
     if check is not None:
@@ -297,6 +327,7 @@ def from_dict(data, source="<scene>", base_dir=Path("."), digest=None):
         if mc["a"] == mc["b"]:
             raise SceneError(src, f"{where}.b", "couples a node with itself", "name two different nodes")
         couplings.append(mc)
+    couplings = ItemTable([couplings] + rods["mass_coupling"], None)
 
     meta = {k: data.get(k, "") for k in ("title", "problem", "description")}
     for k, v in meta.items():
@@ -308,6 +339,62 @@ def from_dict(data, source="<scene>", base_dir=Path("."), digest=None):
                  check=check, digest=digest, index=index, couplings=couplings, extras=extras,
                  blocks=blocks)
 
+
+
+def _segments(listed, generated, after=()):
+    """The segments of an item table: the listed dicts (copied: validation replaces them),
+    the generated segments, then the listed dicts that follow them."""
+    return [list(listed)] + list(generated) + [list(after)]
+
+
+def _place(src, kind, seg, pos, names):
+    """A generated segment placed at pos: its names appended (the first one taken already
+    is the loader's duplicate error)."""
+    seg.place(pos)
+    for rule in seg.names():
+        _unique(src, kind, pos, names, names.extend(rule))
+        pos += len(rule)
+
+
+def _unique(src, kind, pos, names, j):
+    """The duplicate name a generated segment starting at pos made at its index j (j < 0:
+    none)."""
+    if j >= 0:
+        raise SceneError(src, f"{kind}[{pos + j}].name", f"duplicate name {names[pos + j]!r}",
+                         "names must be unique")
+
+
+def _contact(src, tab, i, node_ref, duplicate):
+    """One contact table validated as contact[i]; duplicate(name) says whether its name is
+    taken (and takes it)."""
+    where = f"contact[{i}]"
+    if not isinstance(tab, dict) or "scheme" not in tab:
+        raise SceneError(src, f"{where}.scheme", "missing", "valid: " + ", ".join(SCHEMES))
+    scheme = choice(src, f"{where}.scheme", tab["scheme"], SCHEMES)
+    c = check_fields(src, tab, where, dict(CONTACT_COMMON, **CONTACT_SCHEMES[scheme]))
+    if duplicate(c["name"]):
+        raise SceneError(src, f"{where}.name", f"duplicate name {c['name']!r}", "names must be unique")
+    c["a"], c["b"] = node_ref(f"{where}.a", c["a"]), node_ref(f"{where}.b", c["b"])
+    if c["a"] == c["b"]:
+        raise SceneError(src, f"{where}.b", "pairs a node with itself", "name two different nodes or ground")
+    if scheme == "penalty":
+        choice(src, f"{where}.law", c["law"], LAWS)
+        if c["clipped"] and c["law"] != "kelvin":
+            raise SceneError(src, f"{where}.clipped", "applies to law kelvin only", "remove it")
+        if c["exponent"] is not None and c["law"] in FIXED_EXPONENT:
+            raise SceneError(src, f"{where}.exponent", f"does not apply to law {c['law']}",
+                             f"its exponent is fixed at {FIXED_EXPONENT[c['law']]:g}; remove it")
+        if c["law"] in ("linear", "hertz") and (c["damping"] is not None or c["restitution"] is not None):
+            key = "damping" if c["damping"] is not None else "restitution"
+            raise SceneError(src, f"{where}.{key}", f"law {c['law']} is elastic (e = 1)",
+                             "remove it, or choose a damped law (kelvin, hunt-crossley, ...)")
+        if c["law"] in ("flores", "gonthier", "jankowski") and c["restitution"] == 0:
+            raise SceneError(src, f"{where}.restitution", f"law {c['law']} divides by e",
+                             "give e > 0 (e = 0 is a plastic impact: use scheme restitution)")
+        if c["damping"] is not None and c["restitution"] is not None:
+            raise SceneError(src, f"{where}.damping", "given together with restitution",
+                             "give one: damping directly, or restitution to derive it")
+    return c
 
 
 def _dynamic_analysis(src, raw, an, index, contacts, links):
@@ -335,7 +422,11 @@ def _dynamic_analysis(src, raw, an, index, contacts, links):
         raise SceneError(src, "analysis.alpha", "missing", "HHT needs alpha in [-1/3, 0]")
     if integ == "generalized-alpha" and an["rho_inf"] is None:
         raise SceneError(src, "analysis.rho_inf", "missing", "generalized-alpha needs rho_inf in [0, 1]")
-    for i, c in enumerate(contacts):
+    # one contact of each generated segment stands for all of it (they share their table)
+    kinds = [(i, c) for seg, at in zip(contacts.segments, contacts.offsets)
+             for i, c in (enumerate(seg, start=at) if isinstance(seg, list)
+                          else [(at, seg.block.template)])]
+    for i, c in kinds:
         if integ not in COMPATIBLE[c["scheme"]]:
             works = ", ".join(COMPATIBLE[c["scheme"]]) or "none (a static scheme: use analysis type static)"
             raise SceneError(src, f"contact[{i}].scheme",
@@ -351,12 +442,11 @@ def _dynamic_analysis(src, raw, an, index, contacts, links):
         raise SceneError(src, "analysis.dt", f"{an['dt']} is longer than t_end = {an['t_end']}",
                          "choose dt <= t_end")
     out = check_fields(src, an["output"] or {}, "analysis.output", OUTPUT_KEYS)
-    names = list(index)
     # default: every node and contact of a small scene; none of a large one (peaks are always there)
-    out["nodes"] = out["nodes"] if out["nodes"] is not None else (names if len(names) <= 50 else [])
-    contact_names = [c["name"] for c in contacts]
+    out["nodes"] = out["nodes"] if out["nodes"] is not None else (list(index) if len(index) <= 50 else [])
+    contact_names = contacts.names
     out["contacts"] = (out["contacts"] if out["contacts"] is not None
-                       else (contact_names if len(contact_names) <= 50 else []))
+                       else (list(contact_names) if len(contact_names) <= 50 else []))
     for key in ("nodes", "contacts", "links"):
         for i, nm in enumerate(out[key]):
             if not isinstance(nm, str):
@@ -370,7 +460,7 @@ def _dynamic_analysis(src, raw, an, index, contacts, links):
         if nm not in contact_names:
             raise SceneError(src, f"analysis.output.contacts[{i}]", f"names no contact {nm!r}",
                              "use contact names of this scene")
-    link_names = [l["name"] for l in links]
+    link_names = links.names
     for i, nm in enumerate(out["links"]):
         if nm not in link_names:
             raise SceneError(src, f"analysis.output.links[{i}]", f"names no link {nm!r}",
@@ -388,8 +478,33 @@ def _ground_stiffness(links):
     return k
 
 
-def _dashpot_from_zeta(src, i, lk, ground_k, nodes):
-    """c = 2ζ√(k m) for a dashpot from a node to ground, k the node's springs to ground."""
+def _chain_k(chains, node):
+    """The stiffness of the chain spring from a node to ground (0 if it is no chain's)."""
+    for b in chains:
+        if b.node0 <= node < b.node0 + b.n:
+            return float(b.k[node - b.node0])
+    return 0.0
+
+
+def _chain_dampers(b, ground_k):
+    """c = 2ζ√(k m) of a chain's dampers: k its spring plus the written springs from the node
+    to ground (which come before it in the scene's links; ground_k)."""
+    d = b.dampers
+    if not len(d):
+        return np.zeros(0)
+    k = np.array(b.k[d], np.float64)
+    for node, kw in ground_k.items():
+        i = node - b.node0
+        if 0 <= i < b.n and b.zeta[i] > 0:
+            k[np.searchsorted(d, i)] = kw + b.k[i]
+    # float_power is libm's pow, as `** 0.5` of the listed dashpots (np.sqrt and np.power
+    # round differently in the last bit now and then)
+    return 2.0 * b.zeta[d] * np.float_power(k * b.mass[d], 0.5)
+
+
+def _dashpot_from_zeta(src, i, lk, ground_k, nodes, chains=()):
+    """c = 2ζ√(k m) for a dashpot from a node to ground, k the node's springs to ground
+    (written ones, then a chain's)."""
     where = f"link[{i}].zeta"
     if lk["b"] != -1 and lk["a"] != -1:
         raise SceneError(src, where, "applies to a dashpot between a node and ground",
@@ -398,6 +513,8 @@ def _dashpot_from_zeta(src, i, lk, ground_k, nodes):
     if nodes[node]["fixed"]:
         raise SceneError(src, where, "the node is fixed", "a damping ratio needs a free node")
     k = ground_k.get(node, 0.0)
+    if chains and _chain_k(chains, node) > 0:
+        k = k + _chain_k(chains, node)
     if k <= 0:
         raise SceneError(src, where, "the node has no spring to ground to define a frequency",
                          "give c directly")
