@@ -13,6 +13,7 @@ module martello_generalized_alpha
    use martello_observer, only: observer_t, observer_work, observer_fail, C_NEWTON, C_RESIDUALS, &
       C_FACTORIZATIONS, C_JACOBIANS, C_CHATTER, free_side_crossing
    use martello_contact_laws, only: contact_force, LAW_KELVIN, P_CLIP
+   use martello_links, only: LINK_BILINEAR, L_STIFF, L_YIELD, L_HARDENING
    use martello_integrator_settings
    use martello_stability, only: omega_max
    use martello_fixed_step, only: stepper_t, stepper_rest_start, stepper_fail, newmark_kinematics, &
@@ -82,7 +83,8 @@ contains
       self%cm = (1.0_dp - self%am)/(self%beta*self%h*self%h)
       self%mmax = max(maxval(m%mass), tiny(1.0_dp))
       self%cv = self%gamma/(self%beta*self%h)
-      self%event_split = logical(s%event_split) .and. any(m%con_law == LAW_KELVIN)
+      self%event_split = logical(s%event_split) .and. (any(m%con_law == LAW_KELVIN) .or. &
+                                                        any(m%link_kind == LINK_BILINEAR))
       if (self%event_split) allocate (self%us(0:n), self%vs(0:n), self%as(0:n), self%jump(0:n))
       if (s%kind == INT_NEWMARK .and. 2.0_dp*self%beta < self%gamma) &
          call newmark_stability(self%beta, self%gamma, self%h, logical(s%check_stability), stat)
@@ -120,9 +122,13 @@ contains
       type(observer_t), intent(inout) :: o
       integer, intent(out) :: stat
       real(dp) :: rnorm, incr, fscale, uscale, fmag, fext_mag, wd, wl, wc, h
+      real(dp) :: t_a      !< event-split steps: the start of the stretch being solved
       integer :: n
       logical :: ok, converged
       character(len=256) :: msg
+      !> a Kelvin switch within SPLIT_MIN·h of a stretch's end is put on that end: a sub-step
+      !> that short would leave Newton only rounding to work with
+      real(dp), parameter :: SPLIT_MIN = 1.0e-6_dp
 
       stat = MARTELLO_OK
       n = self%n; h = self%h
@@ -143,96 +149,223 @@ contains
 
    contains
 
-      !> The event-split step (docs/integrators.md): where a Kelvin contact's δ changes sign
-      !> over the step just solved, the crossing τ is located from the start of the step on the
-      !> quadratic δ + δ̇τ + ½δ̈τ² (the start is on the smooth branch up to the crossing:
-      !> O(h³) in time), and the step is re-taken as two Newmark sub-steps [t0, t0 + τ] and
-      !> [t0 + τ, t]. At the boundary the contact force jumps to its other branch's value
-      !> (onset: kδ + cδ̇, clipped as the law says; separation: 0) in the internal force, the
-      !> committed contact force and the acceleration (M Δa = −ΔF): the jump falls on a sub-step
-      !> boundary, so each sub-step integrates a smooth force. False: no crossing, the step
-      !> stands as solved.
+      !> The event-split step (docs/integrators.md, event-split steps). The switches of the
+      !> piecewise-smooth laws — the onset and separation of a Kelvin contact (its force jumps
+      !> by cδ̇) and the yield and unloading of a bilinear link (the slope of its force jumps) —
+      !> are looked for in the stretch just solved (first_switch). At the first, τ from the
+      !> stretch's start, the stretch is re-taken as a sub-step [t_a, t_a + τ] with the laws on
+      !> the start's branches (the left limit: a Kelvin contact held on its branch; a bilinear
+      !> link reaches its surface at the end to O(h³) under the return map), the Kelvin force
+      !> jumps to its other branch at the boundary (boundary_jump: the right limit), and the
+      !> rest [t_a + τ, t] is solved and looked at again, up to MAX_SPLITS switches a step.
+      !> Each sub-step then integrates a smooth force. A Kelvin switch within SPLIT_MIN·h of
+      !> a stretch end is put on that end (the jump at the start, or at the end after a
+      !> sub-step over the whole stretch); a bilinear one there is already on a boundary.
+      !> False: no switch, the step stands as solved.
       logical function split_step() result(split)
-         real(dp), parameter :: SPLIT_MIN = 1.0e-6_dp
-         integer :: j, ia, ib, first, branch
-         real(dp) :: tau, tj, d0, r0, q0, d1, h_full, fplus, dfd, dfv
-         logical :: ok2
+         integer, parameter :: MAX_SPLITS = 8
+         integer :: k, first, branch
+         real(dp) :: tau, h_full
+         logical :: pending
          split = .false.
-         tau = h; first = 0
-         do j = 1, m%ncontact
-            if (.not. self%ms%is_penalty(j) .or. m%con_law(j) /= LAW_KELVIN) cycle
-            ia = m%con_a(j); ib = m%con_b(j)
-            d0 = self%un(ia) - self%un(ib) - m%con_gap(j)
-            ! clipped Kelvin separates at its cut-off, F = 0 on both sides of δ = 0: no jump
-            if (d0 > 0.0_dp .and. m%con_par(P_CLIP, j) > 0.5_dp) cycle
-            d1 = self%u(ia) - self%u(ib) - m%con_gap(j)
-            r0 = self%vn(ia) - self%vn(ib); q0 = self%an(ia) - self%an(ib)
-            ! the start's quadratic crosses inside the step (the solved step may not: the
-            ! chatter rule can have held the contact open), or the solved step changes sign
-            tj = first_root(d0, r0, q0)
-            if (tj >= h) then
-               if ((d0 > 0.0_dp) .eqv. (d1 > 0.0_dp)) cycle
-               tj = free_side_crossing(d0, r0, q0, 0.0_dp, h)
-            end if
-            if (tj > 0.0_dp .and. tj < tau) then
-               tau = tj; first = j
-            end if
-         end do
-         ! a crossing within SPLIT_MIN·h of a step end is left in the step: its jump then
-         ! acts over at most SPLIT_MIN·h (an error SPLIT_MIN·h·ΔF/m, far below the O(h²) of the
-         ! step), where a sub-step that short would leave Newton only rounding to work with
-         if (first == 0 .or. tau <= SPLIT_MIN*h .or. h - tau <= SPLIT_MIN*h) return
-         split = .true.
+         pending = .true.                ! the solved stretch is not committed
          h_full = h
-         self%us = self%un; self%vs = self%vn; self%as = self%an
-         ! sub-step 1, [t0, t0 + τ]: on the start's branch up to its end, whatever the sign of
-         ! δ there (δ = 0 to the step's O(h³)): the left limit of the force
-         call set_step(tau)
-         self%ms%forced_off = .false.
-         branch = self%ms%con_branch(first)
-         ia = m%con_a(first); ib = m%con_b(first)
-         self%ms%con_branch(first) = merge(CONTACT_ON, CONTACT_OPEN, &
-                                           self%us(ia) - self%us(ib) - m%con_gap(first) > 0.0_dp)
-         call external_forces(m, self%mrow, self%t0 + tau, self%fext)
-         fext_mag = maxval(abs(self%fext))
-         call newton_step(converged)
-         if (.not. converged) return
-         call commit_works()
-         self%ms%con_branch(first) = branch
-         ! the jump of the crossing contact's force at the boundary, to its other branch
-         d0 = self%u(ia) - self%u(ib) - m%con_gap(first)
-         r0 = self%v(ia) - self%v(ib)
-         fplus = 0.0_dp
-         if (self%us(ia) - self%us(ib) - m%con_gap(first) <= 0.0_dp) &   ! an onset
-            call contact_force(LAW_KELVIN, m%con_par(1, first), m%con_mstar(first), &
-                               max(d0, tiny(1.0_dp)), r0, r0, fplus, dfd, dfv)
-         self%ms%con_on(first) = fplus /= 0.0_dp
-         self%jump = 0.0_dp
-         self%jump(ia) = -(fplus - self%ms%con_f(first)); self%jump(ib) = fplus - self%ms%con_f(first)
-         self%fint(ia) = self%fint(ia) - self%jump(ia); self%fint(ib) = self%fint(ib) - self%jump(ib)
-         self%fint(0) = 0.0_dp
-         self%ms%con_f(first) = fplus
-         call solve_free_mass(m, self%fixed_nodes, self%mband, self%jump, ok2)
-         if (.not. ok2) then
-            call stepper_fail(o, MARTELLO_ERR_SINGULAR, t, 'singular mass at an event-split boundary', stat)
-            return
-         end if
-         self%a = self%a + self%jump
-         ! sub-step 2, [t0 + τ, t]: from the boundary state on the other branch
-         self%un = self%u; self%vn = self%v; self%an = self%a
-         self%fint_n = self%fint; self%fext_n = self%fext
-         call mass_times(m, self%an, self%man)
-         call set_step(h_full - tau)
-         call external_forces(m, self%mrow, t, self%fext)
-         fext_mag = maxval(abs(self%fext))
-         call newton_step(converged)
-         if (.not. converged) return
-         call commit_works()
+         t_a = self%t0                   ! the stretch [t_a, t] of length h
+         do k = 1, MAX_SPLITS
+            call first_switch(first, tau)
+            if (first == 0) exit
+            if (.not. split) then
+               self%us = self%un; self%vs = self%vn; self%as = self%an
+               split = .true.
+            end if
+            if (tau == 0.0_dp) then
+               ! a Kelvin switch at the stretch's start: the jump there, the stretch again
+               self%u = self%un; self%v = self%vn; self%a = self%an; self%fint = self%fint_n
+               if (.not. boundary_jump(first, switched_force(first))) return
+               self%an = self%a; self%fint_n = self%fint
+               call solve_stretch(t_a, h)
+               if (.not. converged) return
+               cycle
+            end if
+            ! the sub-step to the switch, a Kelvin contact held on the start's branch up to
+            ! its end (whatever the sign of δ there, δ = 0 to the step's O(h³))
+            self%ms%forced_off = .false.
+            if (first > 0) then
+               branch = self%ms%con_branch(first)
+               self%ms%con_branch(first) = merge(CONTACT_ON, CONTACT_OPEN, self%ms%con_on(first))
+            end if
+            call set_step(tau)
+            call external_forces(m, self%mrow, t_a + tau, self%fext)
+            fext_mag = maxval(abs(self%fext))
+            call newton_step(converged)
+            if (first > 0) self%ms%con_branch(first) = branch
+            if (.not. converged) return
+            call commit_works()
+            pending = .false.
+            if (first > 0) then
+               if (.not. boundary_jump(first, switched_force(first))) return
+            end if
+            if (tau >= h) exit                      ! the switch is on the step's end
+            ! the rest of the step, from the boundary
+            self%un = self%u; self%vn = self%v; self%an = self%a
+            self%fint_n = self%fint; self%fext_n = self%fext
+            call solve_stretch(t_a + tau, h - tau)
+            if (.not. converged) return
+            pending = .true.
+         end do
+         if (.not. split) return
+         if (pending) call commit_works()
          ! the step as the strategy and the observer know it: [t0, t]
          self%un = self%us; self%vn = self%vs; self%an = self%as
          call set_step(h_full)
          call contact_state(self, m)
       end function split_step
+
+      !> Solve the stretch [ta, t] of length hh from the state (un, vn, an) (uncommitted)
+      subroutine solve_stretch(ta, hh)
+         real(dp), intent(in) :: ta, hh
+         t_a = ta
+         call mass_times(m, self%an, self%man)
+         call set_step(hh)
+         call external_forces(m, self%mrow, t, self%fext)
+         fext_mag = maxval(abs(self%fext))
+         self%ms%forced_off = .false.
+         call newton_step(converged)
+      end subroutine solve_stretch
+
+      !> The first switch of the stretch just solved, from its start (un, vn, an; the laws
+      !> committed there) to its solved end (u), on the branches committed at the start:
+      !> first = j > 0 for Kelvin contact j (an onset if it is open, a separation if it is
+      !> closed; a clipped one separates at its cut-off with F = 0 on both sides: no jump),
+      !> −j for bilinear link j (yield from the elastic band, unloading from a yield line);
+      !> 0 if none. Each switch g (> 0: the branch is left) is followed on the start's
+      !> quadratic g + ġτ + ½g̈τ² (g̈ of the elastic band's surfaces; 0 for unloading, whose
+      !> ġ = −du̇̇ needs the jerk), and a sign change of the solved end is a switch where the
+      !> quadratic has none (chatter rule, or the return map past its surface). tau: from the
+      !> stretch's start (0 and h are the ends for a Kelvin switch within SPLIT_MIN·h).
+      subroutine first_switch(first, tau)
+         integer, intent(out) :: first
+         real(dp), intent(out) :: tau
+         integer :: j, ia, ib, sw
+         real(dp) :: sg, d0, r0, q0, d1, tj, k, rho, r, fp, c0, round
+         first = 0; tau = huge(1.0_dp)
+         do j = 1, m%ncontact
+            if (.not. self%ms%is_penalty(j) .or. m%con_law(j) /= LAW_KELVIN) cycle
+            if (self%ms%con_on(j) .and. m%con_par(P_CLIP, j) > 0.5_dp) cycle
+            ia = m%con_a(j); ib = m%con_b(j)
+            sg = merge(-1.0_dp, 1.0_dp, self%ms%con_on(j))     ! g = δ (onset), −δ (separation)
+            d0 = sg*(self%un(ia) - self%un(ib) - m%con_gap(j))
+            r0 = sg*(self%vn(ia) - self%vn(ib)); q0 = sg*(self%an(ia) - self%an(ib))
+            d1 = sg*(self%u(ia) - self%u(ib) - m%con_gap(j))
+            tj = switch_time(d0, r0, q0, d1, .true.)
+            if (tj < tau) then
+               tau = tj; first = j
+            end if
+         end do
+         do j = 1, m%nlink
+            if (m%link_kind(j) /= LINK_BILINEAR) cycle
+            ia = m%link_a(j); ib = m%link_b(j)
+            k = m%link_par(L_STIFF, j); rho = m%link_par(L_HARDENING, j)
+            if (rho >= 1.0_dp) cycle
+            r = (1.0_dp - rho)*m%link_par(L_YIELD, j)
+            r0 = self%vn(ia) - self%vn(ib); q0 = self%an(ia) - self%an(ib)
+            ! the branch committed: on a yield line (to the rounding of the return map's clamp)
+            ! while loading outward, else in the elastic band
+            fp = self%ms%link_fc(j) - rho*k*self%ms%link_u(j)
+            round = 64.0_dp*epsilon(1.0_dp)*(abs(self%ms%link_fc(j)) + rho*k*abs(self%ms%link_u(j)) + r)
+            sw = 0
+            if (fp >= r - round .and. r0 > 0.0_dp) sw = 1
+            if (fp <= -(r - round) .and. r0 < 0.0_dp) sw = -1
+            if (sw /= 0) then
+               ! unloading: g = ∓du̇
+               tj = switch_time(-sw*r0, -sw*q0, 0.0_dp, -sw*(self%v(ia) - self%v(ib)), .false.)
+               if (tj < tau) then
+                  tau = tj; first = -j
+               end if
+               cycle
+            end if
+            ! yield: g = ±(f_n + k(du − u_n) − ρk du) − (1 − ρ)F_y, in force units
+            c0 = self%ms%link_fc(j) - k*self%ms%link_u(j)
+            d0 = self%un(ia) - self%un(ib); d1 = self%u(ia) - self%u(ib)
+            do sw = 1, -1, -2
+               tj = switch_time(sw*(c0 + (1.0_dp - rho)*k*d0) - r, sw*(1.0_dp - rho)*k*r0, &
+                                sw*(1.0_dp - rho)*k*q0, sw*(c0 + (1.0_dp - rho)*k*d1) - r, .false.)
+               if (tj < tau) then
+                  tau = tj; first = -j
+               end if
+            end do
+         end do
+         if (first == 0) tau = 0.0_dp
+      end subroutine first_switch
+
+      !> When g (≤ 0 at the stretch's start: a value past 0 there is a switch just taken, to
+      !> the O(h³) of its location) first becomes > 0 in the stretch [0, h]: on the start's
+      !> quadratic g0 + g1 τ + ½g2 τ², or at the crossing of the solved end g_end > 0 located
+      !> on the free side; huge if never. ends: a switch within SPLIT_MIN·h of an end is put
+      !> on that end (0 or h); otherwise it is no switch of the stretch (huge).
+      real(dp) function switch_time(g0, g1, g2, g_end, ends) result(tau)
+         real(dp), intent(in) :: g0, g1, g2, g_end
+         logical, intent(in) :: ends
+         real(dp) :: g
+         tau = huge(1.0_dp)
+         g = min(g0, 0.0_dp)
+         if (g == 0.0_dp .and. (g1 > 0.0_dp .or. (g1 == 0.0_dp .and. g2 > 0.0_dp))) then
+            tau = 0.0_dp
+         else
+            tau = first_root(g, g1, g2)
+            if (tau >= h) then
+               tau = huge(1.0_dp)
+               if (g_end > 0.0_dp) tau = free_side_crossing(g, g1, g2, 0.0_dp, h)
+            end if
+         end if
+         if (tau > h) return
+         if (tau <= SPLIT_MIN*h) then
+            tau = merge(0.0_dp, huge(1.0_dp), ends)
+         else if (h - tau <= SPLIT_MIN*h) then
+            tau = merge(h, huge(1.0_dp), ends)
+         end if
+      end function switch_time
+
+      !> The force of Kelvin contact j on its other branch at the current state (a boundary):
+      !> at an onset kδ + cδ̇ (clipped as the law says), at a separation 0.
+      real(dp) function switched_force(j) result(fplus)
+         integer, intent(in) :: j
+         fplus = 0.0_dp
+         if (.not. self%ms%con_on(j)) fplus = onset_force(j)
+      end function switched_force
+      !> The Kelvin force just past the onset of contact j at the current end state (δ ≥ 0
+      !> to the step's accuracy: kδ + cδ̇, clipped as the law says).
+      real(dp) function onset_force(j) result(fplus)
+         integer, intent(in) :: j
+         real(dp) :: d, r, dfd, dfv
+         d = self%u(m%con_a(j)) - self%u(m%con_b(j)) - m%con_gap(j)
+         r = self%v(m%con_a(j)) - self%v(m%con_b(j))
+         call contact_force(LAW_KELVIN, m%con_par(1, j), m%con_mstar(j), max(d, tiny(1.0_dp)), &
+                            r, r, fplus, dfd, dfv)
+      end function onset_force
+
+      !> The force of contact j jumps to fplus at the current end state, a boundary of the
+      !> smooth stretches: in the internal force, the committed contact force and the
+      !> acceleration (M Δa = −ΔF). False (with the failure handed over) if M is singular.
+      logical function boundary_jump(j, fplus) result(ok)
+         integer, intent(in) :: j
+         real(dp), intent(in) :: fplus
+         integer :: ia, ib
+         ia = m%con_a(j); ib = m%con_b(j)
+         self%ms%con_on(j) = fplus /= 0.0_dp
+         self%jump = 0.0_dp
+         self%jump(ia) = -(fplus - self%ms%con_f(j)); self%jump(ib) = fplus - self%ms%con_f(j)
+         self%fint(ia) = self%fint(ia) - self%jump(ia); self%fint(ib) = self%fint(ib) - self%jump(ib)
+         self%fint(0) = 0.0_dp
+         self%ms%con_f(j) = fplus
+         call solve_free_mass(m, self%fixed_nodes, self%mband, self%jump, ok)
+         if (.not. ok) then
+            call stepper_fail(o, MARTELLO_ERR_SINGULAR, t, 'singular mass at an event-split boundary', stat)
+            return
+         end if
+         self%a = self%a + self%jump
+         self%tangent_valid = .false.
+      end function boundary_jump
 
       !> The first root τ in (0, h) of d + rτ + ½qτ² (h if none)
       real(dp) function first_root(d, r, q) result(tau)
@@ -429,7 +562,7 @@ contains
                   return
                end if
                if (it >= 2) then
-                  call line_search()
+                  call line_search(flips, was_on)
                else
                   u(1:n) = u(1:n) + du
                end if
@@ -440,9 +573,16 @@ contains
       !> Backtracking on ‖r‖∞ once plain Newton has taken two steps without converging: laws
       !> whose tangent is unbounded at first touch (Jankowski: ∂F/∂δ ~ δ^{−3/4}) or that switch
       !> branch inside a step make full steps overshoot; halving restores a decrease.
-      subroutine line_search()
+      !> A full step rejected while it would close or open a contact counts as a flip of it
+      !> (the chatter rule): where the step's solution sits on a jump of the force (a Kelvin
+      !> contact whose δ = 0 falls on the step's end: the force cδ̇ on one side of the
+      !> rounding of δ, none on the other), halving approaches the jump from one side without
+      !> ever flipping, and Newton would stall there instead of holding the contact open.
+      subroutine line_search(flips, was_on)
+         integer, intent(inout) :: flips(:)
+         logical, intent(in) :: was_on(:)
          real(dp) :: lam, r0
-         integer :: k
+         integer :: k, i
          r0 = rnorm
          self%work(1:n) = self%u(1:n)
          lam = 1.0_dp
@@ -450,6 +590,12 @@ contains
             self%u(1:n) = self%work(1:n) + lam*self%du
             call evaluate(.false.)       ! the residual alone
             if (rnorm < r0) return
+            if (k == 1) then
+               do i = 1, m%ncontact
+                  if ((self%ms%con_pen_trial(i) > 0.0_dp .and. .not. self%ms%forced_off(i)) &
+                      .neqv. was_on(i)) flips(i) = flips(i) + 1
+               end do
+            end if
             lam = 0.5_dp*lam
          end do
       end subroutine line_search

@@ -26,19 +26,19 @@ REALISED = {"kelvin": E, "hunt-crossley": hunt_crossley_realised_e(1.5 * (1.0 - 
 STEPS = [1e-4, 5e-5, 2.5e-5, 1.25e-5, 6.25e-6]
 
 
-def scene(law, integrator, dt, **extra):
+def scene(law, integrator, dt, gap=GAP, **extra):
     an = {"type": "dynamic", "integrator": integrator, "dt": dt, "t_end": 0.008}
     if integrator == "newmark":
         an["preset"] = "average-acceleration"
     an.update(extra)
-    c = {"name": "impact", "a": "m1", "b": "m2", "gap": GAP, "scheme": "penalty", "law": law}
+    c = {"name": "impact", "a": "m1", "b": "m2", "gap": gap, "scheme": "penalty", "law": law}
     c.update(LAWS[law])
     return {"node": [{"name": "m1", "mass": M1, "v0": V0}, {"name": "m2", "mass": M2}],
             "contact": [c], "analysis": an}
 
 
-def v1_error(law, integrator, dt, **extra):
-    s = api.run(scene(law, integrator, dt, **extra)).summary
+def v1_error(law, integrator, dt, gap=GAP, **extra):
+    s = api.run(scene(law, integrator, dt, gap, **extra)).summary
     exact = newton_impact(M1, M2, V0, 0.0, REALISED[law]).v1
     return abs(s["nodes"]["m1"]["v_final"] - exact)
 
