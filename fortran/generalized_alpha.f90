@@ -12,7 +12,7 @@ module martello_generalized_alpha
    use martello_assembly
    use martello_observer, only: observer_t, observer_work, observer_fail, C_NEWTON, C_RESIDUALS, &
       C_FACTORIZATIONS, C_JACOBIANS, C_CHATTER, free_side_crossing
-   use martello_contact_laws, only: contact_force, LAW_KELVIN, P_CLIP
+   use martello_contact_laws, only: contact_force, LAW_KELVIN, LAW_LINEAR, P_CLIP, P_STIFF, P_DAMPING
    use martello_links, only: LINK_BILINEAR, L_STIFF, L_YIELD, L_HARDENING
    use martello_integrator_settings
    use martello_stability, only: omega_max
@@ -21,6 +21,11 @@ module martello_generalized_alpha
    implicit none
    private
    public :: generalized_alpha_t, generalized_alpha_coefficients
+
+   !> The switches of a contact in an event-split step (first_switch), and the branch a
+   !> contact is held on up to each (the left limit)
+   integer, parameter :: SW_ONSET = 1, SW_SEPARATION = 2, SW_CUT = 3, SW_REENGAGE = 4
+   integer, parameter :: HELD(4) = [CONTACT_OPEN, CONTACT_ON, CONTACT_ON, CONTACT_CUT]
 
    type, extends(stepper_t) :: generalized_alpha_t
       integer :: kd = 0, max_newton = 30
@@ -84,6 +89,7 @@ contains
       self%mmax = max(maxval(m%mass), tiny(1.0_dp))
       self%cv = self%gamma/(self%beta*self%h)
       self%event_split = logical(s%event_split) .and. (any(m%con_law == LAW_KELVIN) .or. &
+                                                        any(m%con_law == LAW_LINEAR) .or. &
                                                         any(m%link_kind == LINK_BILINEAR))
       if (self%event_split) allocate (self%us(0:n), self%vs(0:n), self%as(0:n), self%jump(0:n))
       if (s%kind == INT_NEWMARK .and. 2.0_dp*self%beta < self%gamma) &
@@ -150,50 +156,52 @@ contains
    contains
 
       !> The event-split step (docs/integrators.md, event-split steps). The switches of the
-      !> piecewise-smooth laws — the onset and separation of a Kelvin contact (its force jumps
-      !> by cδ̇) and the yield and unloading of a bilinear link (the slope of its force jumps) —
+      !> piecewise-smooth laws — a Kelvin contact's onset and separation (its force jumps by
+      !> cδ̇), its cut-off and re-engagement when clipped, a linear contact's onset and
+      !> separation, a bilinear link's yield and unloading (the slope of the force jumps) —
       !> are looked for in the stretch just solved (first_switch). At the first, τ from the
       !> stretch's start, the stretch is re-taken as a sub-step [t_a, t_a + τ] with the laws on
-      !> the start's branches (the left limit: a Kelvin contact held on its branch; a bilinear
-      !> link reaches its surface at the end to O(h³) under the return map), the Kelvin force
-      !> jumps to its other branch at the boundary (boundary_jump: the right limit), and the
-      !> rest [t_a + τ, t] is solved and looked at again, up to MAX_SPLITS switches a step.
-      !> Each sub-step then integrates a smooth force. A Kelvin switch within SPLIT_MIN·h of
-      !> a stretch end is put on that end (the jump at the start, or at the end after a
-      !> sub-step over the whole stretch); a bilinear one there is already on a boundary.
-      !> False: no switch, the step stands as solved.
+      !> the start's branches (the left limit: a contact held on its branch; a bilinear link
+      !> reaches its yield line at the end to O(h³) under the return map, and is put on it),
+      !> the contact force takes its new branch's value at the boundary (boundary_jump: the
+      !> right limit), and the rest [t_a + τ, t] is solved and looked at again, up to
+      !> MAX_SPLITS switches a step. Each sub-step then integrates a smooth force. A contact's
+      !> switch within SPLIT_MIN·h of a stretch end is put on that end (the jump at the start,
+      !> or at the end after a sub-step over the whole stretch); a link's is already on a
+      !> boundary. False: no switch, the step stands as solved.
       logical function split_step() result(split)
          integer, parameter :: MAX_SPLITS = 8
-         integer :: k, first, branch
-         real(dp) :: tau, h_full
+         integer :: k, first, branch, kind
+         real(dp) :: tau, h_full, h_left
          logical :: pending
          split = .false.
          pending = .true.                ! the solved stretch is not committed
          h_full = h
          t_a = self%t0                   ! the stretch [t_a, t] of length h
          do k = 1, MAX_SPLITS
-            call first_switch(first, tau)
+            call first_switch(first, tau, kind)
             if (first == 0) exit
             if (.not. split) then
                self%us = self%un; self%vs = self%vn; self%as = self%an
                split = .true.
             end if
             if (tau == 0.0_dp) then
-               ! a Kelvin switch at the stretch's start: the jump there, the stretch again
+               ! a contact's switch at the stretch's start: the jump there, the stretch again
                self%u = self%un; self%v = self%vn; self%a = self%an; self%fint = self%fint_n
-               if (.not. boundary_jump(first, switched_force(first))) return
+               if (.not. boundary_jump(first, kind)) return
                self%an = self%a; self%fint_n = self%fint
                call solve_stretch(t_a, h)
                if (.not. converged) return
                cycle
             end if
-            ! the sub-step to the switch, a Kelvin contact held on the start's branch up to
-            ! its end (whatever the sign of δ there, δ = 0 to the step's O(h³))
+            ! the sub-step to the switch, a contact held on the start's branch up to its end
+            ! (whatever the sign of its switch there, 0 to the step's O(h³))
             self%ms%forced_off = .false.
             if (first > 0) then
                branch = self%ms%con_branch(first)
-               self%ms%con_branch(first) = merge(CONTACT_ON, CONTACT_OPEN, self%ms%con_on(first))
+               self%ms%con_branch(first) = HELD(kind)
             end if
+            h_left = h
             call set_step(tau)
             call external_forces(m, self%mrow, t_a + tau, self%fext)
             fext_mag = maxval(abs(self%fext))
@@ -203,13 +211,22 @@ contains
             call commit_works()
             pending = .false.
             if (first > 0) then
-               if (.not. boundary_jump(first, switched_force(first))) return
+               if (.not. boundary_jump(first, kind)) return
+            else if (kind /= 0) then
+               ! a yield: the boundary is on the yield line (the sub-step's end is on it to
+               ! O(h³), either side): the committed force is put on it, so the rest of the
+               ! step starts on the line, not an O(h³) short of it
+               associate (j => -first)
+                  self%ms%link_fc(j) = m%link_par(L_HARDENING, j)*m%link_par(L_STIFF, j)* &
+                                       self%ms%link_u(j) + kind*(1.0_dp - &
+                                       m%link_par(L_HARDENING, j))*m%link_par(L_YIELD, j)
+               end associate
             end if
-            if (tau >= h) exit                      ! the switch is on the step's end
+            if (tau >= h_left) exit                 ! the switch is on the step's end
             ! the rest of the step, from the boundary
             self%un = self%u; self%vn = self%v; self%an = self%a
             self%fint_n = self%fint; self%fext_n = self%fext
-            call solve_stretch(t_a + tau, h - tau)
+            call solve_stretch(t_a + tau, h_left - tau)
             if (.not. converged) return
             pending = .true.
          end do
@@ -234,32 +251,43 @@ contains
       end subroutine solve_stretch
 
       !> The first switch of the stretch just solved, from its start (un, vn, an; the laws
-      !> committed there) to its solved end (u), on the branches committed at the start:
-      !> first = j > 0 for Kelvin contact j (an onset if it is open, a separation if it is
-      !> closed; a clipped one separates at its cut-off with F = 0 on both sides: no jump),
-      !> −j for bilinear link j (yield from the elastic band, unloading from a yield line);
-      !> 0 if none. Each switch g (> 0: the branch is left) is followed on the start's
-      !> quadratic g + ġτ + ½g̈τ² (g̈ of the elastic band's surfaces; 0 for unloading, whose
-      !> ġ = −du̇̇ needs the jerk), and a sign change of the solved end is a switch where the
-      !> quadratic has none (chatter rule, or the return map past its surface). tau: from the
-      !> stretch's start (0 and h are the ends for a Kelvin switch within SPLIT_MIN·h).
-      subroutine first_switch(first, tau)
-         integer, intent(out) :: first
+      !> committed there) to its solved end (u, v), on the branches committed at the start:
+      !> first = j > 0 for contact j, with kind its switch (SW_ONSET from open, SW_SEPARATION
+      !> from closed, a clipped Kelvin's SW_CUT where kδ + cδ̇ turns tensile and SW_REENGAGE
+      !> where it turns compressive again while δ > 0; a clipped one separates from its
+      !> cut-off state with F = 0 on both sides: no switch), −j for bilinear link j, with
+      !> kind = ±1 for a yield onto the upper or lower line and 0 for unloading; 0 if none.
+      !> Each switch g (> 0: the branch is left) is followed on the start's quadratic
+      !> g + ġτ + ½g̈τ² (without the jerk where g holds a rate: unloading −du̇, the Kelvin
+      !> force kδ + cδ̇), and a sign change of the solved end is a switch where the quadratic
+      !> has none (chatter rule, or the return map past its surface). tau: from the stretch's
+      !> start (0 and h: a contact's switch within SPLIT_MIN·h of that end).
+      subroutine first_switch(first, tau, kind)
+         integer, intent(out) :: first, kind
          real(dp), intent(out) :: tau
-         integer :: j, ia, ib, sw
-         real(dp) :: sg, d0, r0, q0, d1, tj, k, rho, r, fp, c0, round
-         first = 0; tau = huge(1.0_dp)
+         integer :: j, ia, ib, sw, kj
+         real(dp) :: sg, d0, r0, q0, d1, r1, tj, k, rho, r, fp, c0, round, kap
+         first = 0; tau = huge(1.0_dp); kind = 0
          do j = 1, m%ncontact
-            if (.not. self%ms%is_penalty(j) .or. m%con_law(j) /= LAW_KELVIN) cycle
-            if (self%ms%con_on(j) .and. m%con_par(P_CLIP, j) > 0.5_dp) cycle
+            if (.not. self%ms%is_penalty(j) .or. .not. kinked_law(j)) cycle
             ia = m%con_a(j); ib = m%con_b(j)
-            sg = merge(-1.0_dp, 1.0_dp, self%ms%con_on(j))     ! g = δ (onset), −δ (separation)
-            d0 = sg*(self%un(ia) - self%un(ib) - m%con_gap(j))
-            r0 = sg*(self%vn(ia) - self%vn(ib)); q0 = sg*(self%an(ia) - self%an(ib))
-            d1 = sg*(self%u(ia) - self%u(ib) - m%con_gap(j))
-            tj = switch_time(d0, r0, q0, d1, .true.)
+            d0 = self%un(ia) - self%un(ib) - m%con_gap(j); d1 = self%u(ia) - self%u(ib) - m%con_gap(j)
+            r0 = self%vn(ia) - self%vn(ib); r1 = self%v(ia) - self%v(ib)
+            q0 = self%an(ia) - self%an(ib)
+            if (.not. self%ms%con_on(j)) then
+               kj = SW_ONSET; sg = 1.0_dp                  ! g = δ
+            else if (.not. clipped(j)) then
+               kj = SW_SEPARATION; sg = -1.0_dp            ! g = −δ
+            else
+               ! the clipped Kelvin force over k, δ + κδ̇: −(it) while it pushes, +(it) while cut
+               kap = m%con_par(P_DAMPING, j)/m%con_par(P_STIFF, j)
+               kj = merge(SW_CUT, SW_REENGAGE, self%ms%con_f(j) > 0.0_dp)
+               sg = merge(-1.0_dp, 1.0_dp, kj == SW_CUT)
+               d0 = d0 + kap*r0; d1 = d1 + kap*r1; r0 = r0 + kap*q0
+            end if
+            tj = switch_time(sg*d0, sg*r0, sg*q0, sg*d1, .true.)
             if (tj < tau) then
-               tau = tj; first = j
+               tau = tj; first = j; kind = kj
             end if
          end do
          do j = 1, m%nlink
@@ -280,7 +308,7 @@ contains
                ! unloading: g = ∓du̇
                tj = switch_time(-sw*r0, -sw*q0, 0.0_dp, -sw*(self%v(ia) - self%v(ib)), .false.)
                if (tj < tau) then
-                  tau = tj; first = -j
+                  tau = tj; first = -j; kind = 0
                end if
                cycle
             end if
@@ -291,11 +319,10 @@ contains
                tj = switch_time(sw*(c0 + (1.0_dp - rho)*k*d0) - r, sw*(1.0_dp - rho)*k*r0, &
                                 sw*(1.0_dp - rho)*k*q0, sw*(c0 + (1.0_dp - rho)*k*d1) - r, .false.)
                if (tj < tau) then
-                  tau = tj; first = -j
+                  tau = tj; first = -j; kind = sw
                end if
             end do
          end do
-         if (first == 0) tau = 0.0_dp
       end subroutine first_switch
 
       !> When g (≤ 0 at the stretch's start: a value past 0 there is a switch just taken, to
@@ -307,7 +334,6 @@ contains
          real(dp), intent(in) :: g0, g1, g2, g_end
          logical, intent(in) :: ends
          real(dp) :: g
-         tau = huge(1.0_dp)
          g = min(g0, 0.0_dp)
          if (g == 0.0_dp .and. (g1 > 0.0_dp .or. (g1 == 0.0_dp .and. g2 > 0.0_dp))) then
             tau = 0.0_dp
@@ -326,33 +352,43 @@ contains
          end if
       end function switch_time
 
-      !> The force of Kelvin contact j on its other branch at the current state (a boundary):
-      !> at an onset kδ + cδ̇ (clipped as the law says), at a separation 0.
-      real(dp) function switched_force(j) result(fplus)
-         integer, intent(in) :: j
-         fplus = 0.0_dp
-         if (.not. self%ms%con_on(j)) fplus = onset_force(j)
-      end function switched_force
-      !> The Kelvin force just past the onset of contact j at the current end state (δ ≥ 0
-      !> to the step's accuracy: kδ + cδ̇, clipped as the law says).
+      !> The force of contact j just past its onset at the current end state (δ ≥ 0 to the
+      !> step's accuracy: Kelvin kδ + cδ̇, clipped as the law says; linear kδ, ≈ 0).
       real(dp) function onset_force(j) result(fplus)
          integer, intent(in) :: j
          real(dp) :: d, r, dfd, dfv
          d = self%u(m%con_a(j)) - self%u(m%con_b(j)) - m%con_gap(j)
          r = self%v(m%con_a(j)) - self%v(m%con_b(j))
-         call contact_force(LAW_KELVIN, m%con_par(1, j), m%con_mstar(j), max(d, tiny(1.0_dp)), &
+         call contact_force(m%con_law(j), m%con_par(1, j), m%con_mstar(j), max(d, tiny(1.0_dp)), &
                             r, r, fplus, dfd, dfv)
       end function onset_force
 
-      !> The force of contact j jumps to fplus at the current end state, a boundary of the
-      !> smooth stretches: in the internal force, the committed contact force and the
-      !> acceleration (M Δa = −ΔF). False (with the failure handed over) if M is singular.
-      logical function boundary_jump(j, fplus) result(ok)
+      !> The contact laws whose force is not smooth at δ = 0: Kelvin (it jumps by cδ̇) and
+      !> linear (its slope jumps by k); the Hertz and Hunt–Crossley family rise as δ^n, n > 1.
+      pure logical function kinked_law(j)
          integer, intent(in) :: j
-         real(dp), intent(in) :: fplus
+         kinked_law = m%con_law(j) == LAW_KELVIN .or. m%con_law(j) == LAW_LINEAR
+      end function kinked_law
+
+      pure logical function clipped(j)
+         integer, intent(in) :: j
+         clipped = m%con_law(j) == LAW_KELVIN .and. m%con_par(P_CLIP, j) > 0.5_dp
+      end function clipped
+
+      !> Contact j takes its new branch at the current end state, a boundary of the smooth
+      !> stretches (switch kind of first_switch): the force of that branch (an onset or a
+      !> re-engagement: the law's; a separation or a cut-off: 0) in the internal force, the
+      !> committed contact force and the acceleration (M Δa = −ΔF), and con_on (in contact,
+      !> δ > 0, for the phases) but for a separation. False (with the failure handed over)
+      !> if M is singular.
+      logical function boundary_jump(j, kind) result(ok)
+         integer, intent(in) :: j, kind
          integer :: ia, ib
+         real(dp) :: fplus
          ia = m%con_a(j); ib = m%con_b(j)
-         self%ms%con_on(j) = fplus /= 0.0_dp
+         fplus = 0.0_dp
+         if (kind == SW_ONSET .or. kind == SW_REENGAGE) fplus = max(onset_force(j), 0.0_dp)
+         self%ms%con_on(j) = kind /= SW_SEPARATION
          self%jump = 0.0_dp
          self%jump(ia) = -(fplus - self%ms%con_f(j)); self%jump(ib) = fplus - self%ms%con_f(j)
          self%fint(ia) = self%fint(ia) - self%jump(ia); self%fint(ib) = self%fint(ib) - self%jump(ib)
