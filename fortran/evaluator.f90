@@ -8,13 +8,12 @@ module martello_evaluator
    use martello_assembly
    use martello_band_matrix
    use martello_switching, only: switch_count, switching_choose, switching_functions
-   use martello_time_functions, only: tf_next_breakpoint, TF_NONE
    implicit none
    private
    public :: evaluator_t, evaluator_init, evaluator_load, evaluator_acceleration, &
       evaluator_forces, evaluator_solve_mass, evaluator_commit, &
       evaluator_energy, evaluator_power, evaluator_use_branches, evaluator_switches, &
-      evaluator_next_breakpoint
+      evaluator_next_breakpoint, evaluator_element_rates
 
    type :: evaluator_t
       type(model_t), pointer :: m => null()
@@ -130,13 +129,40 @@ contains
       type(evaluator_t), intent(in) :: ev
       real(dp), intent(in) :: t
       real(dp) :: tb
-      integer :: j
-      tb = huge(1.0_dp)
-      if (ev%m%ground_accel%kind /= TF_NONE) tb = tf_next_breakpoint(ev%m%ground_accel, t)
-      do j = 1, ev%m%nforce
-         tb = min(tb, tf_next_breakpoint(ev%m%force_fn(j), t))
-      end do
+      tb = load_breakpoint(ev%m, t)
    end function evaluator_next_breakpoint
+
+   !> Every element's peak quantities and their rates at the state (t, u, v) with
+   !> accelerations a (length n), on the laws' branches held: per contact δ, δ̇, the force
+   !> P (penalty contacts; 0 for the others) and Ṗ = P_δ δ̇ + P_δ̇ δ̈; per link the elongation
+   !> du, du̇, the force f and ḟ = f_du du̇ + f_du̇ dü (docs/run-layer.md, located peaks).
+   subroutine evaluator_element_rates(ev, u, v, a, pen, pen_rate, force, force_rate, du, dv, &
+                                      lf, lf_rate)
+      type(evaluator_t), intent(inout) :: ev
+      real(dp), intent(in) :: u(:), v(:), a(:)
+      real(dp), intent(out) :: pen(:), pen_rate(:), force(:), force_rate(:), du(:), dv(:), &
+                               lf(:), lf_rate(:)
+      real(dp) :: ltan(2, ev%m%nlink), ctan(2, ev%m%ncontact), acc(0:ev%m%n), da
+      integer :: j, ia, ib
+      call evaluator_load(ev, u, v)
+      acc(0) = 0.0_dp; acc(1:) = a
+      call internal_forces(ev%m, ev%ms, ev%u, ev%v, ev%f, link_tan=ltan, con_tan=ctan)
+      do j = 1, ev%m%ncontact
+         ia = ev%m%con_a(j); ib = ev%m%con_b(j)
+         pen(j) = ev%u(ia) - ev%u(ib) - ev%m%con_gap(j)
+         pen_rate(j) = ev%v(ia) - ev%v(ib)
+         force(j) = 0.0_dp; force_rate(j) = 0.0_dp
+         if (.not. ev%ms%is_penalty(j)) cycle
+         force(j) = ev%ms%con_f_trial(j)
+         force_rate(j) = ctan(1, j)*pen_rate(j) + ctan(2, j)*(acc(ia) - acc(ib))
+      end do
+      do j = 1, ev%m%nlink
+         ia = ev%m%link_a(j); ib = ev%m%link_b(j)
+         du(j) = ev%u(ia) - ev%u(ib); dv(j) = ev%v(ia) - ev%v(ib); da = acc(ia) - acc(ib)
+         lf(j) = ev%ms%link_f_trial(j)
+         lf_rate(j) = ltan(1, j)*dv(j) + ltan(2, j)*da
+      end do
+   end subroutine evaluator_element_rates
 
    !> The powers at the state of the last force evaluation: of the external and the internal
    !> forces on the free nodes, f·v, and of the dampers, the other links and the penalty

@@ -108,6 +108,9 @@ contains
       if (stat /= MARTELLO_OK) return
       ! velocity-jump phases: located and valued with the end velocities (no acceleration)
       if (stp%velocity_jump_phases) allocate (no_acc(0:stp%n), source=0.0_dp)
+      ! the other methods' states lie on a smooth motion between phase changes: their peaks
+      ! are located inside the steps (docs/results.md)
+      o%smooth_steps = .not. stp%velocity_jump_phases
       call observer_begin(o, m, stp%ms, stp%u, stp%v, stp%a, ENERGY_CHECK, stp%advice, stp%ke_aMa)
       t = 0.0_dp
       call sample(0_i8)
