@@ -83,10 +83,10 @@ typedef struct {
   double *sw_al, *sw_be, *sw_ga;
   /* located peaks (c/located_peaks.c): the element quantities and their rates
    * (martello_eval_element_rates: 4 blocks of nc, then 4 of nl) at the start (0) and end
-   * (1) of the smooth stretch and at a probed state (c); node jerks at both ends (the
-   * quintic Hermite's), the stretch's start time */
+   * (1) of the smooth stretch and at a probed state (c); node jerks at both ends, the
+   * stretch's start time */
   int nl;
-  double *el0, *el1, *elc, *jk0, *jk1, *yp, *fp;
+  double *el0, *el1, *elc, *jk0, *jk1, *fp;
   double t_stretch;
   /* cost counters; kinetic energy taken out by impulses since the last commit */
   long long cnt[MARTELLO_NCOUNTERS];
@@ -864,9 +864,8 @@ static int element_state(ed_t *w, double t, const double *y, const double *acc, 
 }
 
 /* The probe of c/located_peaks.c: quantity kind of item j at t inside the stretch, on the
- * stepper's own solution (re-integrated from its start); the jerk of a node by a forward
- * difference of the RHS along the motion (its error, ~1e-8 of the jerk's scale, moves the
- * located time by that much: the value by its square). */
+ * stepper's own solution (re-integrated from its start); a node's jerk from the elements'
+ * tangents (martello_eval_jerk). */
 static int peak_probe(void *ctx, double t, int kind, int j, double *q, double *r) {
   ed_t *w = ctx;
   const int n = w->n, nc = w->nc, nl = w->nl;
@@ -879,12 +878,9 @@ static int peak_probe(void *ctx, double t, int kind, int j, double *q, double *r
     return MARTELLO_OK;
   }
   if (kind == MARTELLO_PEAK_A) {
-    const double eps = sqrt(DBL_EPSILON) * fmax(t - w->t_stretch, DBL_EPSILON * fabs(t));
-    size_t i;
-    for (i = 0; i < w->dim; i++) w->yp[i] = w->yc[i] + eps * w->fj[i];
-    st = eval_point(w, t + eps, w->yp, w->fp, NULL);
-    if (st != MARTELLO_OK) return fail_eval(w, st, t + eps);
-    *q = w->fj[n + j]; *r = (w->fp[n + j] - w->fj[n + j]) / eps;
+    st = martello_eval_jerk(w->ev, t, w->yc, w->yc + n, w->fj + n, w->fp);
+    if (st != MARTELLO_OK) return fail_eval(w, st, t);
+    *q = w->fj[n + j]; *r = w->fp[j];
     return MARTELLO_OK;
   }
   st = element_state(w, t, w->yc, w->fj + n, w->elc);
@@ -910,24 +906,19 @@ static int peak_skip(void *ctx, int kind, int j) {
 
 /* The peaks inside the smooth stretch (t0, y0, fstart) -> (t1, w->y, f1), before the events
  * at t1 (docs/run-layer.md, located peaks): every quantity's value and rate at both ends,
- * the node jerks there from the quintic Hermite of u (u, v, a at both ends: a screen; the
- * located extremum uses the jerk on the solution), then c/located_peaks.c. */
+ * then c/located_peaks.c. */
 static int located_peaks(ed_t *w, double t0, double t1) {
   const int n = w->n, nc = w->nc, nl = w->nl;
   const double h = t1 - t0;
   martello_peak_ends e;
-  int i, st, k;
+  int st, k;
   if (!(h > 0.0)) return MARTELLO_OK;
   st = element_state(w, t0, w->y0, w->fstart + n, w->el0);
   if (st == MARTELLO_OK) st = element_state(w, t1, w->y, w->f1 + n, w->el1);
   if (st != MARTELLO_OK) return st;
-  for (i = 0; i < n; i++) {
-    hermite_t p;
-    hermite_build(&p, h, w->y0[i], w->y0[n + i], w->fstart[n + i], w->y[i], w->y[n + i],
-                  w->f1[n + i]);
-    w->jk0[i] = 6.0 * p.c[3] / (h * h * h);
-    w->jk1[i] = (6.0 * p.c[3] + 24.0 * p.c[4] + 60.0 * p.c[5]) / (h * h * h);
-  }
+  st = martello_eval_jerk(w->ev, t0, w->y0, w->y0 + n, w->fstart + n, w->jk0);
+  if (st == MARTELLO_OK) st = martello_eval_jerk(w->ev, t1, w->y, w->y + n, w->f1 + n, w->jk1);
+  if (st != MARTELLO_OK) return fail_eval(w, st, t1);
   memset(&e, 0, sizeof e);
   e.count[MARTELLO_PEAK_V] = e.count[MARTELLO_PEAK_A] = n;
   e.q0[MARTELLO_PEAK_V] = w->y0 + n; e.r0[MARTELLO_PEAK_V] = w->fstart + n;
@@ -984,7 +975,7 @@ static void ed_free(ed_t *w) {
                   w->force, w->lam, w->lam0, w->lam1, w->lamtol, w->hlist, w->held, w->Wh,
                   w->rh, w->ilist, w->hk, w->Wl, w->ql, w->pl, w->wl, w->sl, w->el, w->tg, w->t_hold, w->t_impact, w->flight,
                   w->sw_a, w->sw_b, w->sw_al, w->sw_be, w->sw_ga, w->el0, w->el1, w->elc,
-                  w->jk0, w->jk1, w->yp, w->fp};
+                  w->jk0, w->jk1, w->fp};
   size_t i;
   for (i = 0; i < sizeof bufs / sizeof bufs[0]; i++) free(bufs[i]);
   if (w->drv) gsl_odeiv2_driver_free(w->drv);
@@ -1047,7 +1038,7 @@ static int ed_setup(ed_t *w) {
   if (st != MARTELLO_OK) return fail(w, st, 0.0, "event-driven: martello_eval_link_count failed");
   if (!(ALLOC(w->el0, 4 * (nc + w->nl)) && ALLOC(w->el1, 4 * (nc + w->nl)) &&
         ALLOC(w->elc, 4 * (nc + w->nl)) && ALLOC(w->jk0, n) && ALLOC(w->jk1, n) &&
-        ALLOC(w->yp, dim) && ALLOC(w->fp, dim)))
+        ALLOC(w->fp, n)))
     return MARTELLO_ERR_MEMORY;
   /* every switching surface of the laws is an event: hold them on smooth branches */
   st = martello_eval_use_branches(w->ev, &w->nsw);

@@ -1016,17 +1016,11 @@ static int interpolated(ida_problem *P, double t) {
   return MARTELLO_OK;
 }
 
-/* The nodes' jerk at t in [t0, t1] on the interpolant: the centred difference of its a, one
- * sided at the ends (the interpolant is a polynomial: its a' is the method's). */
-static int interpolated_jerk(ida_problem *P, double t, double t0, double t1, double *jerk) {
-  const double eps = 1e-4 * (t1 - t0);
-  const double lo = fmax(t - eps, t0), hi = fmin(t + eps, t1);
-  int st = interpolated(P, hi);
-  if (st != MARTELLO_OK) return st;
-  memcpy(jerk, P->aa, sizeof(double) * (size_t)P->n);
-  if ((st = interpolated(P, lo)) != MARTELLO_OK) return st;
-  for (int i = 0; i < P->n; i++) jerk[i] = (jerk[i] - P->aa[i]) / (hi - lo);
-  return MARTELLO_OK;
+/* The nodes' jerk at the interpolated state of t (after interpolated(P, t)), from the
+ * elements' tangents (martello_eval_jerk). */
+static int interpolated_jerk(ida_problem *P, double t, double *jerk) {
+  int st = martello_eval_jerk(P->ev, t, P->ua, P->va, P->aa, jerk);
+  return st == MARTELLO_OK ? st : fail(P, st, "IDA: jerk failed at t = %.9e s", t);
 }
 
 /* The element quantities and rates at t on the interpolant into e. */
@@ -1042,7 +1036,6 @@ static int interpolated_elements(ida_problem *P, double t, double *e) {
 
 /* The probe of c/located_peaks.c on IDA's interpolant of the last step (of the method's
  * order: its own solution between the steps' ends). */
-static double peak_t0, peak_t1;
 static int peak_probe(void *ctx, double t, int kind, int j, double *q, double *r) {
   ida_problem *P = ctx;
   const int nc = P->nc, nl = P->nl;
@@ -1053,9 +1046,9 @@ static int peak_probe(void *ctx, double t, int kind, int j, double *q, double *r
     return MARTELLO_OK;
   }
   if (kind == MARTELLO_PEAK_A) {
-    if ((st = interpolated_jerk(P, t, peak_t0, peak_t1, P->pj1)) != MARTELLO_OK) return st;
     if ((st = interpolated(P, t)) != MARTELLO_OK) return st;
-    *q = P->aa[j]; *r = P->pj1[j];
+    if ((st = interpolated_jerk(P, t, P->x)) != MARTELLO_OK) return st;
+    *q = P->aa[j]; *r = P->x[j];
     return MARTELLO_OK;
   }
   if ((st = interpolated_elements(P, t, P->elc)) != MARTELLO_OK) return st;
@@ -1085,13 +1078,12 @@ static int located_peaks(ida_problem *P, void *mem, double t0, double t1) {
   int st, k;
   if (!(t1 > t0)) return MARTELLO_OK;
   P->mem_now = mem;
-  peak_t0 = t0; peak_t1 = t1;
-  if ((st = interpolated_jerk(P, t0, t0, t1, P->pj0)) != MARTELLO_OK) return st;
-  if ((st = interpolated_jerk(P, t1, t0, t1, P->pj1)) != MARTELLO_OK) return st;
   if ((st = interpolated_elements(P, t0, P->el0)) != MARTELLO_OK) return st;
+  if ((st = interpolated_jerk(P, t0, P->pj0)) != MARTELLO_OK) return st;
   memcpy(P->pv0, P->va, sizeof(double) * (size_t)n);
   memcpy(P->pa0, P->aa, sizeof(double) * (size_t)n);
   if ((st = interpolated_elements(P, t1, P->el1)) != MARTELLO_OK) return st;
+  if ((st = interpolated_jerk(P, t1, P->pj1)) != MARTELLO_OK) return st;
   memcpy(P->pv1, P->va, sizeof(double) * (size_t)n);
   memcpy(P->pa1, P->aa, sizeof(double) * (size_t)n);
   memset(&e, 0, sizeof e);

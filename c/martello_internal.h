@@ -47,6 +47,11 @@ int martello_eval_next_breakpoint(martello_eval *ev, double t, double *tb);
 int martello_eval_power(martello_eval *ev, double power[5]);
 int martello_eval_energy(martello_eval *ev, const double *u, const double *v, double *kinetic,
                          double *recoverable);
+/* The nodes' jerk a' = M^-1 (f_ext' - f_int') at (t, u, v) with accelerations a, the laws on
+ * their branches held (every element's tangents; the loads' rate by a centred difference in
+ * time). MARTELLO_ERR_SINGULAR for a singular mass matrix. */
+int martello_eval_jerk(martello_eval *ev, double t, const double *u, const double *v,
+                       const double *a, double *jerk);
 /* The number of links of the scene. */
 int martello_eval_link_count(martello_eval *ev, int *n_links);
 /* The peak quantities of every element and their rates at the state (u, v) with accelerations

@@ -184,6 +184,23 @@ contains
       c_eval_next_breakpoint = MARTELLO_OK
    end function c_eval_next_breakpoint
 
+   !> The nodes' jerk at (t, u, v) with accelerations a (evaluator_jerk).
+   integer(c_int) function c_eval_jerk(handle, t, u, v, a, jerk) bind(C, name='martello_eval_jerk')
+      type(c_ptr), value :: handle
+      real(c_double), value :: t
+      real(c_double), intent(in) :: u(*), v(*), a(*)
+      real(c_double), intent(out) :: jerk(*)
+      type(evaluator_t), pointer :: ep
+      integer :: n
+      logical :: ok
+      ep => get_eval(handle)
+      c_eval_jerk = MARTELLO_ERR_ARGUMENT
+      if (.not. associated(ep)) return
+      n = ep%m%n
+      call evaluator_jerk(ep, t, u(1:n), v(1:n), a(1:n), jerk(1:n), ok)
+      c_eval_jerk = merge(MARTELLO_OK, MARTELLO_ERR_SINGULAR, ok)
+   end function c_eval_jerk
+
    !> The number of links of the evaluator's scene.
    integer(c_int) function c_eval_link_count(handle, n_links) bind(C, name='martello_eval_link_count')
       type(c_ptr), value :: handle

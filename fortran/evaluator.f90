@@ -13,7 +13,7 @@ module martello_evaluator
    public :: evaluator_t, evaluator_init, evaluator_load, evaluator_acceleration, &
       evaluator_forces, evaluator_solve_mass, evaluator_commit, &
       evaluator_energy, evaluator_power, evaluator_use_branches, evaluator_switches, &
-      evaluator_next_breakpoint, evaluator_element_rates
+      evaluator_next_breakpoint, evaluator_element_rates, evaluator_jerk
 
    type :: evaluator_t
       type(model_t), pointer :: m => null()
@@ -163,6 +163,48 @@ contains
          lf_rate(j) = ltan(1, j)*dv(j) + ltan(2, j)*da
       end do
    end subroutine evaluator_element_rates
+
+   !> The nodes' jerk ȧ = M⁻¹(ḟ_ext − ḟ_int) at the state (t, u, v) with accelerations a
+   !> (length n), the laws on their branches held: ḟ_int from every element's tangents
+   !> (f_du du̇ + f_du̇ dü; a stiffness block's K v + C a), ḟ_ext by a centred difference in
+   !> time of the loads (smooth between the stops at their kinks). ok = .false. if M is
+   !> singular. The rate of |a| for its located peak (docs/run-layer.md).
+   subroutine evaluator_jerk(ev, t, u, v, a, jerk, ok)
+      type(evaluator_t), intent(inout) :: ev
+      real(dp), intent(in) :: t, u(:), v(:), a(:)
+      real(dp), intent(out) :: jerk(:)
+      logical, intent(out) :: ok
+      real(dp) :: ltan(2, ev%m%nlink), ctan(2, ev%m%ncontact), acc(0:ev%m%n), fd(0:ev%m%n), &
+                  fp(0:ev%m%n), r, eps
+      integer :: j, ia, ib
+      associate (m => ev%m)
+         call evaluator_load(ev, u, v)
+         acc(0) = 0.0_dp; acc(1:) = a
+         call internal_forces(m, ev%ms, ev%u, ev%v, ev%f, link_tan=ltan, con_tan=ctan)
+         eps = sqrt(epsilon(1.0_dp))*max(abs(t), 1.0e-3_dp)
+         call external_forces(m, ev%mrow, t + eps, fp)
+         call external_forces(m, ev%mrow, t - eps, fd)
+         fd = (fp - fd)/(2.0_dp*eps)
+         do j = 1, m%nlink
+            ia = m%link_a(j); ib = m%link_b(j)
+            r = ltan(1, j)*(ev%v(ia) - ev%v(ib)) + ltan(2, j)*(acc(ia) - acc(ib))
+            fd(ia) = fd(ia) - r; fd(ib) = fd(ib) + r
+         end do
+         do j = 1, m%ncontact
+            ia = m%con_a(j); ib = m%con_b(j)
+            r = ctan(1, j)*(ev%v(ia) - ev%v(ib)) + ctan(2, j)*(acc(ia) - acc(ib))
+            fd(ia) = fd(ia) - r; fd(ib) = fd(ib) + r
+         end do
+         do j = 1, m%nblock
+            associate (nd => m%block(j)%node)
+               fd(nd) = fd(nd) - matmul(m%block(j)%k, ev%v(nd))
+               if (m%block(j)%damped) fd(nd) = fd(nd) - matmul(m%block(j)%c, acc(nd))
+            end associate
+         end do
+         jerk = fd(1:)
+         call evaluator_solve_mass(ev, jerk, ok)
+      end associate
+   end subroutine evaluator_jerk
 
    !> The powers at the state of the last force evaluation: of the external and the internal
    !> forces on the free nodes, f·v, and of the dampers, the other links and the penalty

@@ -26,6 +26,7 @@ module martello_observer
       observer_penalty_phases, observer_fail, observer_fail_nonfinite, observer_finish, &
       free_side_crossing, progress_callback, observer_extremum, observer_recorded, &
       observer_peak, observer_peak_value, peak_items, observer_link_step_extremum, &
+      observer_link_step_peaks, &
       PEAK_V, PEAK_A, PEAK_PEN, PEAK_FORCE, PEAK_LINK_FORCE, PEAK_LINK_DU, &
       NCOUNTERS, C_STEPS, C_REJECTED, C_NEWTON, C_RESIDUALS, C_FACTORIZATIONS, C_EVENTS, &
       C_JACOBIANS, C_ROOT_EVALS, C_CHATTER, NENERGY, E_KINETIC, E_RECOVERABLE, E_INPUT, E_DAMPING, &
@@ -42,19 +43,16 @@ module martello_observer
       integer :: nevents = 0
       integer, allocatable :: ev_contact(:)
       real(dp), allocatable :: ev(:, :)
-      ! peaks over every accepted step
+      ! peaks over every accepted step and located inside the steps (docs/results.md): the
+      ! adaptive methods hand theirs (observer_extremum, observer_peak), the fixed-step ones
+      ! are located on each step's polynomial (track)
       real(dp), allocatable :: u_max(:), u_min(:), v_absmax(:), a_absmax(:)
-      !> the largest local maximum of u, interpolated between steps (u_peak at t_peak); the
-      !> step maxima above are O(h) in time, these are O(h²)
+      !> the largest local maximum of u (u_peak at t_peak)
       real(dp), allocatable :: u_peak(:), t_peak(:)
-      !> the largest |u| and its time: at the steps, at the located extrema (observer_extremum)
-      !> and, for the fixed-step methods, at the root of v of the step's cubic Hermite on
-      !> (u, v) at both ends (hermite_extremum; docs/results.md)
+      !> the largest |u| and its time
       real(dp), allocatable :: u_absmax(:), t_absmax(:)
-      !> the method locates the extrema of u inside its steps (observer_extremum): u_peak is
-      !> its largest located maximum, not an interpolation
-      logical :: located_extrema = .false.
-      !> a fixed-step method: |u| is also located on each step's cubic Hermite (hermite_extremum)
+      !> a fixed-step method: the extrema of u and v are located on each step's cubic Hermite
+      !> (hermite_extremum, hermite_v_extremum)
       logical :: fixed_steps = .false.
       real(dp), allocatable :: pen_max(:), force_max(:)
       !> per link: max |force| and max |elongation| (storey shear and drift of a frame)
@@ -111,14 +109,17 @@ module martello_observer
       integer(i8) :: chatter_prev = 0_i8
       !> per contact: its force and force rate at the previous sample, while in contact there
       real(dp), allocatable :: c_prev_f(:), c_prev_fr(:)
-      !> the peak of |a| on fixed steps: a sample that raised it waits for the next one for
-      !> the parabola through three (a_pend: its nodes, a_prev2 their a one sample earlier;
-      !> pend_t0, pend_stamp: the time and the change count of that earlier sample)
-      integer, allocatable :: a_pend(:)
-      integer :: npend = 0
-      real(dp), allocatable :: a_prev2(:)
-      real(dp) :: pend_t0 = 0.0_dp
-      integer(i8) :: pend_stamp = 0_i8
+      !> the peak of |a| on fixed steps (a_parabolas): a sample k that raised it waits two
+      !> samples for the parabola through k − 1, k, k + 1 and the smoothness test with k + 2.
+      !> Per node: a at k − 1, k, k + 1 and the sample k of its latest candidate (a_gen);
+      !> the candidates of the last two samples (pend1: k = the last, pend2: the one before),
+      !> with the time and the chatter count of their sample k − 1
+      real(dp), allocatable :: a_m1(:), a_0(:), a_p1(:)
+      integer(i8), allocatable :: a_gen(:)
+      integer, allocatable :: pend1(:), pend2(:)
+      integer :: npend1 = 0, npend2 = 0
+      real(dp) :: pend1_t0 = 0.0_dp, pend2_t0 = 0.0_dp
+      integer(i8) :: pend1_stamp = 0_i8, pend2_stamp = 0_i8
    end type observer_t
 
    !> The caller's progress callback (martello_run_set_progress): the simulated time, t_end,
@@ -198,7 +199,8 @@ contains
                 o%link_du_absmax(n_links), o%prev_u(n_nodes), o%prev_v(n_nodes), &
                 o%prev_a(n_nodes), o%work(0:n_nodes), o%acc(0:n_nodes), o%c_pen(n_contacts), &
                 o%c_force(n_contacts), o%ph_open(n_contacts), o%c_prev_f(n_contacts), &
-                o%c_prev_fr(n_contacts), o%a_pend(n_nodes), o%a_prev2(n_nodes), &
+                o%c_prev_fr(n_contacts), o%a_m1(n_nodes), o%a_0(n_nodes), o%a_p1(n_nodes), &
+                o%a_gen(n_nodes), o%pend1(n_nodes), o%pend2(n_nodes), &
                 o%ph_t(n_contacts), o%ph_v(n_contacts), o%ph_pen(n_contacts), o%ph_f(n_contacts), &
                 stat=st2)
       if (st /= 0 .or. st2 /= 0) then
@@ -658,11 +660,11 @@ contains
       r%ev_contact(r%nevents) = contact
    end subroutine add_event
 
-   !> Peaks over every accepted state: extremes of u, |v|, |a|, penetration and force, and
-   !> the largest local maximum of u interpolated between the previous and this state by
-   !> u + vτ + ½aτ², τ = −v/a (O(h²) in time where the step maxima are O(h)); on the steps of
-   !> a fixed-step method also the extrema inside them (hermite_extremum, hermite_v_extremum,
-   !> the parabola of |a| and locate_step_peaks; docs/results.md).
+   !> Peaks over every accepted state: extremes of u, |v|, |a|, penetration and force; on the
+   !> steps of a fixed-step method also the extrema inside them (hermite_extremum: u max,
+   !> min, |u| and the largest local maximum u_peak; hermite_v_extremum; the parabola of |a|;
+   !> contact_step_peaks, observer_link_step_extremum; docs/results.md). The adaptive
+   !> methods hand theirs (observer_extremum, observer_peak).
    subroutine track(o, m, ms, t, u, v, a, pen, force, link_f, link_du, u_prev, v_prev, a_prev)
       type(observer_t), intent(inout) :: o
       type(model_t), intent(in) :: m
@@ -671,12 +673,12 @@ contains
       real(dp), intent(in), optional :: link_f(:), link_du(:)
       real(dp), intent(in), optional :: u_prev(:), v_prev(:), a_prev(:)
       integer :: i
-      real(dp) :: tau, up, h
+      real(dp) :: h
       logical :: stepped
       h = t - o%prev_t
       stepped = o%smooth_steps .and. o%prev_t >= 0.0_dp .and. h > 0.0_dp
       if (present(u_prev)) then
-         if (stepped) call a_parabolas(a_prev)
+         if (stepped) call a_parabolas()
          call peaks(u_prev, v_prev, a_prev)
       else
          call peaks(o%prev_u, o%prev_v, o%prev_a)
@@ -696,23 +698,10 @@ contains
       end if
       if (stepped .and. present(u_prev)) then
          call contact_step_peaks(o, m, ms, o%prev_t, h, u_prev, v_prev, v, a, pen, force)
-         if (present(link_f)) then
-            do i = 1, m%nlink
-               call observer_link_step_extremum(o, m, i, h, &
-                  nodal(u_prev, m%link_a(i)) - nodal(u_prev, m%link_b(i)), &
-                  nodal(v_prev, m%link_a(i)) - nodal(v_prev, m%link_b(i)), &
-                  nodal(a_prev, m%link_a(i)) - nodal(a_prev, m%link_b(i)), &
-                  nodal(u, m%link_a(i)) - nodal(u, m%link_b(i)), &
-                  nodal(v, m%link_a(i)) - nodal(v, m%link_b(i)), &
-                  nodal(a, m%link_a(i)) - nodal(a, m%link_b(i)), link_f(i))
-            end do
-         end if
+         if (present(link_f)) call observer_link_step_peaks(o, m, ms, h, u_prev, v_prev, a_prev, &
+                                                            u, v, a, link_f)
       end if
-      if (o%smooth_steps) then
-         o%pend_t0 = o%prev_t
-         o%pend_stamp = o%chatter_prev
-         o%chatter_prev = o%counters(C_CHATTER)
-      end if
+      if (o%smooth_steps) o%chatter_prev = o%counters(C_CHATTER)
       o%prev_t = t
    contains
       subroutine peaks(un, vn, an)
@@ -728,50 +717,57 @@ contains
                   ! a new sampled peak of |a|: located on the parabola through this sample,
                   ! the one before and the next (a_parabolas)
                   if (stepped) then
-                     o%npend = o%npend + 1; o%a_pend(o%npend) = i; o%a_prev2(i) = an(i)
+                     o%npend1 = o%npend1 + 1; o%pend1(o%npend1) = i
+                     o%a_m1(i) = an(i); o%a_0(i) = a(i); o%a_gen(i) = o%nsamples
                   end if
                end if
                call fold_absmax(o, i, t, u(i))
                if (o%fixed_steps .and. o%prev_t >= 0.0_dp .and. h > 0.0_dp) then
                   call hermite_extremum(o, i, o%prev_t, h, un(i), vn(i), an(i), u(i), v(i), a(i))
                   call hermite_v_extremum(vmax(i), h, vn(i), an(i), v(i), a(i))
-               end if
-               if (.not. o%located_extrema .and. o%prev_t >= 0.0_dp .and. vn(i) > 0.0_dp .and. &
-                   v(i) <= 0.0_dp) then
-                  if (an(i) < 0.0_dp) then
-                     tau = min(-vn(i)/an(i), h)
-                     up = un(i) + vn(i)*tau + 0.5_dp*an(i)*tau*tau
-                     if (up > upk(i)) then
-                        upk(i) = up; tpk(i) = o%prev_t + tau
-                     end if
+                  ! a maximum on the step's end
+                  if (vn(i) > 0.0_dp .and. v(i) == 0.0_dp .and. u(i) > upk(i)) then
+                     upk(i) = u(i); tpk(i) = t
                   end if
                end if
             end do
          end associate
       end subroutine peaks
 
-      !> The samples of the last step that raised the peak of |a| (a_pend, with a one sample
-      !> before them in a_prev2): with this sample, the vertex of the parabola through the
-      !> three (equal steps), where the middle one is the largest in magnitude — O(h³) in
-      !> a, below the O(h²) of the steps — unless the two steps hold a jump of the forces:
-      !> a phase change of a contact at the node, a chatter resolution, a kink of a load.
-      subroutine a_parabolas(an)
-         real(dp), intent(in) :: an(:)
+      !> The peak of |a| between the samples: a sample k that raised it (a candidate) is the
+      !> middle of the parabola through k − 1, k, k + 1, whose vertex (equal steps; inside
+      !> the middle step when the middle sample is the largest) is O(h³) in a, below the O(h²)
+      !> of the steps, if a is smooth there: no jump of the forces (a phase change of a
+      !> contact at the node, a chatter resolution, a kink of a load) from k − 1 to k + 2,
+      !> and no kink — the second differences at k and k + 1 agree to half their size (a slope
+      !> kink at the peak, as a bilinear spring's yield onto a flat line, makes them differ by
+      !> O(h); its vertex would overshoot by O(h)). Candidates of sample k are completed here
+      !> at k + 1 (a_p1) and decided at k + 2.
+      subroutine a_parabolas()
          integer :: k, j
-         real(dp) :: ym, y0, yp, d2, sg
+         real(dp) :: ym, y0, yp, yq, d2, sg
          logical :: smooth
-         if (o%npend == 0) return
-         smooth = o%counters(C_CHATTER) == o%pend_stamp .and. load_breakpoint(m, o%pend_t0) > t
-         do k = 1, o%npend
-            j = o%a_pend(k)
-            if (.not. smooth .or. o%node_change(j) > o%pend_t0) cycle
-            sg = sign(1.0_dp, an(j))
-            ym = sg*o%a_prev2(j); y0 = sg*an(j); yp = sg*a(j)
-            d2 = ym - 2.0_dp*y0 + yp
-            if (y0 >= ym .and. y0 >= yp .and. d2 < 0.0_dp) &
+         if (o%npend2 > 0) then
+            smooth = o%counters(C_CHATTER) == o%pend2_stamp .and. load_breakpoint(m, o%pend2_t0) > t
+            do k = 1, o%npend2
+               j = o%pend2(k)
+               if (.not. smooth .or. o%a_gen(j) /= o%nsamples - 2 .or. o%node_change(j) > o%pend2_t0) cycle
+               sg = sign(1.0_dp, o%a_0(j))
+               ym = sg*o%a_m1(j); y0 = sg*o%a_0(j); yp = sg*o%a_p1(j); yq = sg*a(j)
+               d2 = ym - 2.0_dp*y0 + yp
+               if (.not. (y0 >= ym .and. y0 >= yp .and. d2 < 0.0_dp)) cycle
+               if (abs((y0 - 2.0_dp*yp + yq) - d2) > 0.5_dp*abs(d2)) cycle
                o%a_absmax(j) = max(o%a_absmax(j), y0 - (yp - ym)**2/(8.0_dp*d2))
+            end do
+         end if
+         ! the last sample's candidates, completed with this one's a
+         do k = 1, o%npend1
+            j = o%pend1(k)
+            o%pend2(k) = j
+            if (o%a_gen(j) == o%nsamples - 1) o%a_p1(j) = a(j)
          end do
-         o%npend = 0
+         o%npend2 = o%npend1; o%pend2_t0 = o%pend1_t0; o%pend2_stamp = o%pend1_stamp
+         o%npend1 = 0; o%pend1_t0 = o%prev_t; o%pend1_stamp = o%chatter_prev
       end subroutine a_parabolas
    end subroutine track
 
@@ -883,6 +879,35 @@ contains
       end select
    end subroutine observer_link_step_extremum
 
+   !> The peaks of every link inside a fixed step of h from (un, vn, an) to (u, v, a) (nodes
+   !> 1..n; observer_link_step_extremum). f1: the link forces at the step's end; absent, the
+   !> law's for springs and bars and the committed ms%link_f for bilinear springs (what the
+   !> fused chain step keeps between its recorded samples; a damper's is not needed).
+   subroutine observer_link_step_peaks(o, m, ms, h, un, vn, an, u, v, a, f1)
+      type(observer_t), intent(inout) :: o
+      type(model_t), intent(in) :: m
+      type(mech_state_t), intent(in) :: ms
+      real(dp), intent(in) :: h, un(:), vn(:), an(:), u(:), v(:), a(:)
+      real(dp), intent(in), optional :: f1(:)
+      integer :: j, ia, ib
+      real(dp) :: du1, f
+      do j = 1, m%nlink
+         ia = m%link_a(j); ib = m%link_b(j)
+         du1 = nodal(u, ia) - nodal(u, ib)
+         if (present(f1)) then
+            f = f1(j)
+         else if (m%link_kind(j) == LINK_BILINEAR) then
+            f = ms%link_f(j)
+         else
+            f = m%link_par(L_STIFF, j)*du1
+         end if
+         call observer_link_step_extremum(o, m, j, h, nodal(un, ia) - nodal(un, ib), &
+                                          nodal(vn, ia) - nodal(vn, ib), &
+                                          nodal(an, ia) - nodal(an, ib), du1, &
+                                          nodal(v, ia) - nodal(v, ib), nodal(a, ia) - nodal(a, ib), f)
+      end do
+   end subroutine observer_link_step_peaks
+
    !> A peak of kind (PEAK_*) of item j (node, contact or link) located by the method inside
    !> an accepted step, with value q (signed: |q| enters the node and link peaks; δ and the
    !> contact force their maxima and those of the open phase).
@@ -952,16 +977,12 @@ contains
    !> An extremum of node i's displacement located by the method inside an accepted step, at t
    !> with value u (the root of the node's velocity on the stepper's own solution,
    !> docs/run-layer.md): folded into u_max, u_min, and for a maximum (maximum = .true.) into
-   !> u_peak, t_peak. From the first call on, u_peak holds located maxima only.
+   !> u_peak, t_peak.
    subroutine observer_extremum(o, i, t, u, maximum)
       type(observer_t), intent(inout) :: o
       integer, intent(in) :: i
       real(dp), intent(in) :: t, u
       logical, intent(in) :: maximum
-      if (.not. o%located_extrema) then
-         o%located_extrema = .true.
-         o%u_peak = -huge(1.0_dp); o%t_peak = -1.0_dp
-      end if
       o%u_max(i) = max(o%u_max(i), u); o%u_min(i) = min(o%u_min(i), u)
       call fold_absmax(o, i, t, u)
       if (maximum .and. u > o%u_peak(i)) then
@@ -981,7 +1002,8 @@ contains
 
    !> The extremum of u inside a fixed step [t0, t0 + h], located on the cubic Hermite
    !> interpolant of (u, v) at both ends, p(s) = u0 H00 + h v0 H10 + u1 H01 + h v1 H11
-   !> (s = τ/h): the root of p'(s), a quadratic, where v changes sign inside the step.
+   !> (s = τ/h): the root of p'(s), a quadratic, where v changes sign inside the step; into
+   !> u_max, u_min, u_absmax and, a maximum, u_peak.
    !> Interpolation error O(h⁴) in u (O(h³) in the time of the extremum), below the
    !> O(h²) of the structural steps themselves (docs/results.md). A turn the step's
    !> accelerations do not support (v reversed by an impulse: no a of the turn's sign at
@@ -997,7 +1019,12 @@ contains
       if (v0 < 0.0_dp .and. max(a0, a1) <= 0.0_dp) return
       call cubic_hermite_extrema(h, u0, v0, u1, v1, s, p)
       do k = 1, 2
-         if (s(k) > 0.0_dp .and. s(k) < 1.0_dp) call fold_absmax(o, i, t0 + s(k)*h, p(k))
+         if (.not. (s(k) > 0.0_dp .and. s(k) < 1.0_dp)) cycle
+         call fold_absmax(o, i, t0 + s(k)*h, p(k))
+         o%u_max(i) = max(o%u_max(i), p(k)); o%u_min(i) = min(o%u_min(i), p(k))
+         if (v0 > 0.0_dp .and. p(k) > o%u_peak(i)) then      ! a local maximum
+            o%u_peak(i) = p(k); o%t_peak(i) = t0 + s(k)*h
+         end if
       end do
    end subroutine hermite_extremum
 
