@@ -82,10 +82,10 @@ typedef struct {
   int nsw, *sw_a, *sw_b;
   double *sw_al, *sw_be, *sw_ga;
   /* located peaks (c/located_peaks.c): the element quantities and their rates
-   * (martello_eval_element_rates: 4 blocks of nc, then 4 of nl) at the start (0) and end
+   * (c/located_peaks.c's packed layout) at the start (0) and end
    * (1) of the smooth stretch and at a probed state (c); node jerks at both ends, the
    * stretch's start time */
-  int nl;
+  int nl, start_rates;
   double *el0, *el1, *elc, *jk0, *jk1, *fp;
   double t_stretch;
   /* cost counters; kinetic energy taken out by impulses since the last commit */
@@ -854,43 +854,25 @@ static int node_extrema(ed_t *w, double t0, double t1) {
   return MARTELLO_OK;
 }
 
-/* The element quantities and rates at the state y with accelerations acc into e. */
-static int element_state(ed_t *w, double t, const double *y, const double *acc, double *e) {
-  const int nc = w->nc, nl = w->nl;
-  int st = martello_eval_element_rates(w->ev, y, y + w->n, acc, e, e + nc, e + 2 * nc,
-                                       e + 3 * nc, e + 4 * nc, e + 4 * nc + nl,
-                                       e + 4 * nc + 2 * nl, e + 4 * nc + 3 * nl);
+/* The rates of the peak quantities at the state (t, y) with accelerations acc: elements into
+ * e (c/located_peaks.c's packed layout), node jerks into jerk. */
+static int rates(ed_t *w, double t, const double *y, const double *acc, double *e, double *jerk) {
+  int st = martello_peak_rates(w->ev, t, y, y + w->n, acc, w->nc, w->nl, e, jerk);
   return st == MARTELLO_OK ? st : fail_eval(w, st, t);
 }
 
 /* The probe of c/located_peaks.c: quantity kind of item j at t inside the stretch, on the
- * stepper's own solution (re-integrated from its start); a node's jerk from the elements'
- * tangents (martello_eval_jerk). */
+ * stepper's own solution (re-integrated from its start). */
 static int peak_probe(void *ctx, double t, int kind, int j, double *q, double *r) {
   ed_t *w = ctx;
-  const int n = w->n, nc = w->nc, nl = w->nl;
+  const int n = w->n;
   int st = reintegrate(w, w->t_stretch, t - w->t_stretch, w->yc);
   if (st != MARTELLO_OK) return st;
   st = eval_point(w, t, w->yc, w->fj, NULL);
   if (st != MARTELLO_OK) return fail_eval(w, st, t);
-  if (kind == MARTELLO_PEAK_V) {
-    *q = w->yc[n + j]; *r = w->fj[n + j];
-    return MARTELLO_OK;
-  }
-  if (kind == MARTELLO_PEAK_A) {
-    st = martello_eval_jerk(w->ev, t, w->yc, w->yc + n, w->fj + n, w->fp);
-    if (st != MARTELLO_OK) return fail_eval(w, st, t);
-    *q = w->fj[n + j]; *r = w->fp[j];
-    return MARTELLO_OK;
-  }
-  st = element_state(w, t, w->yc, w->fj + n, w->elc);
-  if (st != MARTELLO_OK) return st;
-  switch (kind) {
-  case MARTELLO_PEAK_PEN: *q = w->elc[j]; *r = w->elc[nc + j]; break;
-  case MARTELLO_PEAK_FORCE: *q = w->elc[2 * nc + j]; *r = w->elc[3 * nc + j]; break;
-  case MARTELLO_PEAK_LINK_DU: *q = w->elc[4 * nc + j]; *r = w->elc[4 * nc + nl + j]; break;
-  default: *q = w->elc[4 * nc + 2 * nl + j]; *r = w->elc[4 * nc + 3 * nl + j]; break;
-  }
+  if (kind != MARTELLO_PEAK_V && (st = rates(w, t, w->yc, w->fj + n, w->elc, w->fp)) != MARTELLO_OK)
+    return st;
+  martello_peak_pick(kind, j, w->nc, w->nl, w->yc + n, w->fj + n, w->fp, w->elc, q, r);
   return MARTELLO_OK;
 }
 
@@ -905,38 +887,33 @@ static int peak_skip(void *ctx, int kind, int j) {
 }
 
 /* The peaks inside the smooth stretch (t0, y0, fstart) -> (t1, w->y, f1), before the events
- * at t1 (docs/run-layer.md, located peaks): every quantity's value and rate at both ends,
+ * at t1 (docs/run-layer.md, located peaks): every quantity's value and rate at both ends
+ * (the start's kept from the last stretch's end when nothing happened there: w->start_rates),
  * then c/located_peaks.c. */
 static int located_peaks(ed_t *w, double t0, double t1) {
-  const int n = w->n, nc = w->nc, nl = w->nl;
-  const double h = t1 - t0;
+  const int n = w->n;
   martello_peak_ends e;
-  int st, k;
-  if (!(h > 0.0)) return MARTELLO_OK;
-  st = element_state(w, t0, w->y0, w->fstart + n, w->el0);
-  if (st == MARTELLO_OK) st = element_state(w, t1, w->y, w->f1 + n, w->el1);
-  if (st != MARTELLO_OK) return st;
-  st = martello_eval_jerk(w->ev, t0, w->y0, w->y0 + n, w->fstart + n, w->jk0);
-  if (st == MARTELLO_OK) st = martello_eval_jerk(w->ev, t1, w->y, w->y + n, w->f1 + n, w->jk1);
-  if (st != MARTELLO_OK) return fail_eval(w, st, t1);
+  int st;
+  if (!(t1 - t0 > 0.0)) return MARTELLO_OK;
+  if (!w->start_rates && (st = rates(w, t0, w->y0, w->fstart + n, w->el0, w->jk0)) != MARTELLO_OK)
+    return st;
+  if ((st = rates(w, t1, w->y, w->f1 + n, w->el1, w->jk1)) != MARTELLO_OK) return st;
   memset(&e, 0, sizeof e);
-  e.count[MARTELLO_PEAK_V] = e.count[MARTELLO_PEAK_A] = n;
-  e.q0[MARTELLO_PEAK_V] = w->y0 + n; e.r0[MARTELLO_PEAK_V] = w->fstart + n;
-  e.q1[MARTELLO_PEAK_V] = w->y + n; e.r1[MARTELLO_PEAK_V] = w->f1 + n;
-  e.q0[MARTELLO_PEAK_A] = w->fstart + n; e.r0[MARTELLO_PEAK_A] = w->jk0;
-  e.q1[MARTELLO_PEAK_A] = w->f1 + n; e.r1[MARTELLO_PEAK_A] = w->jk1;
-  for (k = MARTELLO_PEAK_PEN; k <= MARTELLO_PEAK_LINK_DU; k++) {
-    /* the block of the value and of its rate in martello_eval_element_rates' layout */
-    const int qb = k == MARTELLO_PEAK_PEN ? 0 : k == MARTELLO_PEAK_FORCE ? 2 * nc
-                   : k == MARTELLO_PEAK_LINK_DU ? 4 * nc : 4 * nc + 2 * nl;
-    const int rb = qb + (k <= MARTELLO_PEAK_FORCE ? nc : nl);
-    e.count[k] = k <= MARTELLO_PEAK_FORCE ? nc : nl;
-    e.q0[k] = w->el0 + qb; e.r0[k] = w->el0 + rb;
-    e.q1[k] = w->el1 + qb; e.r1[k] = w->el1 + rb;
-  }
+  martello_peak_ends_set(&e, 0, n, w->nc, w->nl, w->y0 + n, w->fstart + n, w->jk0, w->el0);
+  martello_peak_ends_set(&e, 1, n, w->nc, w->nl, w->y + n, w->f1 + n, w->jk1, w->el1);
   e.skip = peak_skip;
   w->t_stretch = t0;
   return martello_locate_peaks(w->obs, &e, t0, t1, w->rtol, w->event_tol, peak_probe, w);
+}
+
+/* After a step: the rates at its end are the next step's start when the state and the laws'
+ * branches went on unchanged (no event, no kink of a load there). */
+static void keep_end_rates(ed_t *w, int unchanged) {
+  double *tmp;
+  w->start_rates = unchanged;
+  if (!unchanged) return;
+  tmp = w->el0; w->el0 = w->el1; w->el1 = tmp;
+  tmp = w->jk0; w->jk0 = w->jk1; w->jk1 = tmp;
 }
 
 /* Accept the state w->y at t: path-dependent links commit, and the works since the last
@@ -1197,6 +1174,7 @@ static int ed_integrate(ed_t *w) {
     else if (t >= t_stop && t_stop < t_out) {
       gsl_odeiv2_driver_reset(w->drv);   /* across a kink of the load: start afresh */
     }
+    keep_end_rates(w, ev == 0 && !(t >= t_stop && t_stop < t_out));
     st = commit(w, t, w->y0 + 2 * n);
     if (st != MARTELLO_OK) return st;
     if (t >= t_out) {   /* on the output grid: the observer records it */

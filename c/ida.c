@@ -90,10 +90,10 @@ typedef struct {
   double *t_impact, *flight;  /* per rigid contact: its last impact, the flight that ended there */
   double *v_last;             /* node velocities at the last accepted state (located extrema) */
   /* located peaks (c/located_peaks.c): element quantities and rates (the layout of
-   * martello_eval_element_rates: 4 blocks of nc, 4 of nl) at the ends of the stretch (0, 1)
+   * c/located_peaks.c's packed layout) at the ends of the stretch (0, 1)
    * and at a probe (c); node v, a and jerk at both ends; the step's interpolant */
   int nl;
-  double *el0, *el1, *elc, *pv0, *pa0, *pj0, *pv1, *pa1, *pj1, *ua, *va, *aa;
+  double *el0, *el1, *elc, *pv0, *pa0, *pj0, *pj1, *ua, *va, *aa;
   void *mem_now;
   N_Vector ytd;
   /* settings */
@@ -770,8 +770,8 @@ static void release(ida_problem *P) {
                  P->opened, P->was_closed, P->hit, P->cand, P->q, P->w0, P->w_in, P->u, P->v, P->a, P->x, P->uq, P->vq, P->fint, P->fext,
                  P->force, P->lam, P->S, P->rhs, P->mb, P->cols, P->dc, P->aset,
                  P->sw_a, P->sw_b, P->sw_al, P->sw_be, P->sw_ga, P->t_impact, P->flight,
-                 P->v_last, P->el0, P->el1, P->elc, P->pv0, P->pa0, P->pj0, P->pv1, P->pa1,
-                 P->pj1, P->ua, P->va, P->aa};
+                 P->v_last, P->el0, P->el1, P->elc, P->pv0, P->pa0, P->pj0, P->pj1, P->ua,
+                 P->va, P->aa};
   for (size_t k = 0; k < sizeof all / sizeof all[0]; k++) free(all[k]);
   if (P->ev) martello_eval_free(&P->ev);
 }
@@ -916,7 +916,7 @@ static int setup(ida_problem *P, martello_model *model, martello_run *run) {
   {
     const size_t ne = 4 * ((size_t)nc + (size_t)P->nl);
     double **el[] = {&P->el0, &P->el1, &P->elc};
-    double **nd[] = {&P->pv0, &P->pa0, &P->pj0, &P->pv1, &P->pa1, &P->pj1, &P->ua, &P->va, &P->aa};
+    double **nd[] = {&P->pv0, &P->pa0, &P->pj0, &P->pj1, &P->ua, &P->va, &P->aa};
     for (size_t k = 0; k < sizeof el / sizeof el[0]; k++) *el[k] = take(ne, sizeof(double), &ok);
     for (size_t k = 0; k < sizeof nd / sizeof nd[0]; k++) *nd[k] = take((size_t)n, sizeof(double), &ok);
     if (!ok) return fail(P, MARTELLO_ERR_MEMORY, "IDA: out of memory");
@@ -1016,48 +1016,22 @@ static int interpolated(ida_problem *P, double t) {
   return MARTELLO_OK;
 }
 
-/* The nodes' jerk at the interpolated state of t (after interpolated(P, t)), from the
- * elements' tangents (martello_eval_jerk). */
-static int interpolated_jerk(ida_problem *P, double t, double *jerk) {
-  int st = martello_eval_jerk(P->ev, t, P->ua, P->va, P->aa, jerk);
-  return st == MARTELLO_OK ? st : fail(P, st, "IDA: jerk failed at t = %.9e s", t);
-}
-
-/* The element quantities and rates at t on the interpolant into e. */
-static int interpolated_elements(ida_problem *P, double t, double *e) {
-  const int nc = P->nc, nl = P->nl;
+/* The rates of the peak quantities at t on the interpolant: elements into e (packed), node
+ * jerks into jerk; P->va, P->aa hold v and a there. */
+static int interpolated_rates(ida_problem *P, double t, double *e, double *jerk) {
   int st = interpolated(P, t);
-  if (st == MARTELLO_OK)
-    st = martello_eval_element_rates(P->ev, P->ua, P->va, P->aa, e, e + nc, e + 2 * nc, e + 3 * nc,
-                                     e + 4 * nc, e + 4 * nc + nl, e + 4 * nc + 2 * nl,
-                                     e + 4 * nc + 3 * nl);
-  return st == MARTELLO_OK ? st : fail(P, st, "IDA: element rates failed at t = %.9e s", t);
+  if (st != MARTELLO_OK) return st;
+  st = martello_peak_rates(P->ev, t, P->ua, P->va, P->aa, P->nc, P->nl, e, jerk);
+  return st == MARTELLO_OK ? st : fail(P, st, "IDA: the rates of the peaks failed at t = %.9e s", t);
 }
 
 /* The probe of c/located_peaks.c on IDA's interpolant of the last step (of the method's
  * order: its own solution between the steps' ends). */
 static int peak_probe(void *ctx, double t, int kind, int j, double *q, double *r) {
   ida_problem *P = ctx;
-  const int nc = P->nc, nl = P->nl;
-  int st;
-  if (kind == MARTELLO_PEAK_V) {
-    if ((st = interpolated(P, t)) != MARTELLO_OK) return st;
-    *q = P->va[j]; *r = P->aa[j];
-    return MARTELLO_OK;
-  }
-  if (kind == MARTELLO_PEAK_A) {
-    if ((st = interpolated(P, t)) != MARTELLO_OK) return st;
-    if ((st = interpolated_jerk(P, t, P->x)) != MARTELLO_OK) return st;
-    *q = P->aa[j]; *r = P->x[j];
-    return MARTELLO_OK;
-  }
-  if ((st = interpolated_elements(P, t, P->elc)) != MARTELLO_OK) return st;
-  switch (kind) {
-  case MARTELLO_PEAK_PEN: *q = P->elc[j]; *r = P->elc[nc + j]; break;
-  case MARTELLO_PEAK_FORCE: *q = P->elc[2 * nc + j]; *r = P->elc[3 * nc + j]; break;
-  case MARTELLO_PEAK_LINK_DU: *q = P->elc[4 * nc + j]; *r = P->elc[4 * nc + nl + j]; break;
-  default: *q = P->elc[4 * nc + 2 * nl + j]; *r = P->elc[4 * nc + 3 * nl + j]; break;
-  }
+  int st = interpolated_rates(P, t, P->elc, P->x);
+  if (st != MARTELLO_OK) return st;
+  martello_peak_pick(kind, j, P->nc, P->nl, P->va, P->aa, P->x, P->elc, q, r);
   return MARTELLO_OK;
 }
 
@@ -1073,33 +1047,18 @@ static int peak_skip(void *ctx, int kind, int j) {
 /* The peaks inside [t0, t1] of IDA's last step, on its interpolant (docs/run-layer.md,
  * located peaks): every quantity's value and rate at both ends, then c/located_peaks.c. */
 static int located_peaks(ida_problem *P, void *mem, double t0, double t1) {
-  const int n = P->n, nc = P->nc, nl = P->nl;
+  const int n = P->n;
   martello_peak_ends e;
-  int st, k;
+  int st;
   if (!(t1 > t0)) return MARTELLO_OK;
   P->mem_now = mem;
-  if ((st = interpolated_elements(P, t0, P->el0)) != MARTELLO_OK) return st;
-  if ((st = interpolated_jerk(P, t0, P->pj0)) != MARTELLO_OK) return st;
+  if ((st = interpolated_rates(P, t0, P->el0, P->pj0)) != MARTELLO_OK) return st;
   memcpy(P->pv0, P->va, sizeof(double) * (size_t)n);
   memcpy(P->pa0, P->aa, sizeof(double) * (size_t)n);
-  if ((st = interpolated_elements(P, t1, P->el1)) != MARTELLO_OK) return st;
-  if ((st = interpolated_jerk(P, t1, P->pj1)) != MARTELLO_OK) return st;
-  memcpy(P->pv1, P->va, sizeof(double) * (size_t)n);
-  memcpy(P->pa1, P->aa, sizeof(double) * (size_t)n);
+  if ((st = interpolated_rates(P, t1, P->el1, P->pj1)) != MARTELLO_OK) return st;
   memset(&e, 0, sizeof e);
-  e.count[MARTELLO_PEAK_V] = e.count[MARTELLO_PEAK_A] = n;
-  e.q0[MARTELLO_PEAK_V] = P->pv0; e.r0[MARTELLO_PEAK_V] = P->pa0;
-  e.q1[MARTELLO_PEAK_V] = P->pv1; e.r1[MARTELLO_PEAK_V] = P->pa1;
-  e.q0[MARTELLO_PEAK_A] = P->pa0; e.r0[MARTELLO_PEAK_A] = P->pj0;
-  e.q1[MARTELLO_PEAK_A] = P->pa1; e.r1[MARTELLO_PEAK_A] = P->pj1;
-  for (k = MARTELLO_PEAK_PEN; k <= MARTELLO_PEAK_LINK_DU; k++) {
-    const int qb = k == MARTELLO_PEAK_PEN ? 0 : k == MARTELLO_PEAK_FORCE ? 2 * nc
-                   : k == MARTELLO_PEAK_LINK_DU ? 4 * nc : 4 * nc + 2 * nl;
-    const int rb = qb + (k <= MARTELLO_PEAK_FORCE ? nc : nl);
-    e.count[k] = k <= MARTELLO_PEAK_FORCE ? nc : nl;
-    e.q0[k] = P->el0 + qb; e.r0[k] = P->el0 + rb;
-    e.q1[k] = P->el1 + qb; e.r1[k] = P->el1 + rb;
-  }
+  martello_peak_ends_set(&e, 0, n, P->nc, P->nl, P->pv0, P->pa0, P->pj0, P->el0);
+  martello_peak_ends_set(&e, 1, n, P->nc, P->nl, P->va, P->aa, P->pj1, P->el1);
   e.skip = peak_skip;
   return martello_locate_peaks(P->obs, &e, t0, t1, P->rtol, P->event_tol, peak_probe, P);
 }

@@ -95,3 +95,48 @@ int martello_locate_peaks(martello_observer *obs, const martello_peak_ends *ends
   }
   return MARTELLO_OK;
 }
+
+/* The block of kind's value (and, one block on, of its rate) in the packed element rates. */
+static const double *block(int kind, int nc, int nl, const double *el) {
+  switch (kind) {
+  case MARTELLO_PEAK_PEN: return el;
+  case MARTELLO_PEAK_FORCE: return el + 2 * nc;
+  case MARTELLO_PEAK_LINK_DU: return el + 4 * nc;
+  default: return el + 4 * nc + 2 * nl;
+  }
+}
+
+int martello_peak_rates(martello_eval *ev, double t, const double *u, const double *v,
+                        const double *a, int nc, int nl, double *el, double *jerk) {
+  return martello_eval_rates(ev, t, u, v, a, el, el + nc, el + 2 * nc, el + 3 * nc, el + 4 * nc,
+                             el + 4 * nc + nl, el + 4 * nc + 2 * nl, el + 4 * nc + 3 * nl, jerk);
+}
+
+void martello_peak_ends_set(martello_peak_ends *e, int end, int n, int nc, int nl,
+                            const double *v, const double *a, const double *jerk,
+                            const double *el) {
+  int k;
+  const double **q = end ? e->q1 : e->q0, **r = end ? e->r1 : e->r0;
+  e->count[MARTELLO_PEAK_V] = e->count[MARTELLO_PEAK_A] = n;
+  q[MARTELLO_PEAK_V] = v; r[MARTELLO_PEAK_V] = a;
+  q[MARTELLO_PEAK_A] = a; r[MARTELLO_PEAK_A] = jerk;
+  for (k = MARTELLO_PEAK_PEN; k <= MARTELLO_PEAK_LINK_DU; k++) {
+    const int items = k <= MARTELLO_PEAK_FORCE ? nc : nl;
+    e->count[k] = items;
+    q[k] = block(k, nc, nl, el);
+    r[k] = q[k] + items;
+  }
+}
+
+void martello_peak_pick(int kind, int j, int nc, int nl, const double *v, const double *a,
+                        const double *jerk, const double *el, double *q, double *r) {
+  if (kind == MARTELLO_PEAK_V) {
+    *q = v[j]; *r = a[j];
+  } else if (kind == MARTELLO_PEAK_A) {
+    *q = a[j]; *r = jerk[j];
+  } else {
+    const double *b = block(kind, nc, nl, el);
+    *q = b[j];
+    *r = b[(kind <= MARTELLO_PEAK_FORCE ? nc : nl) + j];
+  }
+}

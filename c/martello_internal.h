@@ -47,21 +47,18 @@ int martello_eval_next_breakpoint(martello_eval *ev, double t, double *tb);
 int martello_eval_power(martello_eval *ev, double power[5]);
 int martello_eval_energy(martello_eval *ev, const double *u, const double *v, double *kinetic,
                          double *recoverable);
-/* The nodes' jerk a' = M^-1 (f_ext' - f_int') at (t, u, v) with accelerations a, the laws on
- * their branches held (every element's tangents; the loads' rate by a centred difference in
- * time). MARTELLO_ERR_SINGULAR for a singular mass matrix. */
-int martello_eval_jerk(martello_eval *ev, double t, const double *u, const double *v,
-                       const double *a, double *jerk);
 /* The number of links of the scene. */
 int martello_eval_link_count(martello_eval *ev, int *n_links);
-/* The peak quantities of every element and their rates at the state (u, v) with accelerations
- * a, on the laws' branches held (docs/run-layer.md, located peaks): per contact pen = delta,
- * pen_rate, force (penalty contacts; 0 for the others), force_rate = F_delta delta' +
- * F_delta' delta''; per link du, dv, lf (its force) and lf_rate = f_du du' + f_du' du''. */
-int martello_eval_element_rates(martello_eval *ev, const double *u, const double *v,
-                                const double *a, double *pen, double *pen_rate, double *force,
-                                double *force_rate, double *du, double *dv, double *lf,
-                                double *lf_rate);
+/* The rates of the peak quantities at the state (t, u, v) with accelerations a, on the laws'
+ * branches held (docs/run-layer.md, located peaks): per contact pen = delta, pen_rate, force
+ * (penalty contacts; 0 for the others), force_rate = F_delta delta' + F_delta' delta''; per
+ * link du, dv, lf (its force), lf_rate = f_du du' + f_du' du''; per node the jerk
+ * a' = M^-1 (f_ext' - f_int'), f_int' the sum of the element rates, f_ext' a centred
+ * difference in time of the loads. MARTELLO_ERR_SINGULAR for a singular mass matrix. */
+int martello_eval_rates(martello_eval *ev, double t, const double *u, const double *v,
+                        const double *a, double *pen, double *pen_rate, double *force,
+                        double *force_rate, double *du, double *dv, double *lf, double *lf_rate,
+                        double *jerk);
 
 /* The run being filled: its settings, as martello_run_set_settings validated them, and its
  * observer. */
@@ -113,6 +110,18 @@ typedef int (*martello_peak_probe)(void *ctx, double t, int kind, int index, dou
 int martello_locate_peaks(martello_observer *obs, const martello_peak_ends *ends, double t0,
                           double t1, double rtol, double event_tol, martello_peak_probe probe,
                           void *ctx);
+/* The rates of one state in the packed layout of the adaptive methods: el holds
+ * martello_eval_rates' element outputs in its order (4 blocks of nc, then 4 of nl), jerk the
+ * nodes'. */
+int martello_peak_rates(martello_eval *ev, double t, const double *u, const double *v,
+                        const double *a, int nc, int nl, double *el, double *jerk);
+/* The start (end = 0) or end (1) of ends from one state: node v, a, jerk, packed el. */
+void martello_peak_ends_set(martello_peak_ends *e, int end, int n, int nc, int nl,
+                            const double *v, const double *a, const double *jerk,
+                            const double *el);
+/* q and r of item j of kind from one state (as martello_peak_ends_set reads them). */
+void martello_peak_pick(int kind, int j, int nc, int nl, const double *v, const double *a,
+                        const double *jerk, const double *el, double *q, double *r);
 /* Work increments since the last call [J], integrated along the method's own solution:
  * external, total internal (f_int . v), of the links other than dampers and of the penalty
  * contacts (martello_eval_power), and the kinetic energy impulses took out. Damping is

@@ -184,23 +184,6 @@ contains
       c_eval_next_breakpoint = MARTELLO_OK
    end function c_eval_next_breakpoint
 
-   !> The nodes' jerk at (t, u, v) with accelerations a (evaluator_jerk).
-   integer(c_int) function c_eval_jerk(handle, t, u, v, a, jerk) bind(C, name='martello_eval_jerk')
-      type(c_ptr), value :: handle
-      real(c_double), value :: t
-      real(c_double), intent(in) :: u(*), v(*), a(*)
-      real(c_double), intent(out) :: jerk(*)
-      type(evaluator_t), pointer :: ep
-      integer :: n
-      logical :: ok
-      ep => get_eval(handle)
-      c_eval_jerk = MARTELLO_ERR_ARGUMENT
-      if (.not. associated(ep)) return
-      n = ep%m%n
-      call evaluator_jerk(ep, t, u(1:n), v(1:n), a(1:n), jerk(1:n), ok)
-      c_eval_jerk = merge(MARTELLO_OK, MARTELLO_ERR_SINGULAR, ok)
-   end function c_eval_jerk
-
    !> The number of links of the evaluator's scene.
    integer(c_int) function c_eval_link_count(handle, n_links) bind(C, name='martello_eval_link_count')
       type(c_ptr), value :: handle
@@ -214,27 +197,28 @@ contains
       c_eval_link_count = MARTELLO_OK
    end function c_eval_link_count
 
-   !> Every element's peak quantities and rates at (u, v) with accelerations a
-   !> (evaluator_element_rates): per contact pen, pen_rate, force, force_rate; per link du,
-   !> dv, lf, lf_rate.
-   integer(c_int) function c_eval_element_rates(handle, u, v, a, pen, pen_rate, force, force_rate, &
-                                                du, dv, lf, lf_rate) &
-      bind(C, name='martello_eval_element_rates')
+   !> The rates of the peak quantities at (t, u, v) with accelerations a (evaluator_rates):
+   !> per contact pen, pen_rate, force, force_rate; per link du, dv, lf, lf_rate; per node the
+   !> jerk. MARTELLO_ERR_SINGULAR for a singular mass matrix.
+   integer(c_int) function c_eval_rates(handle, t, u, v, a, pen, pen_rate, force, force_rate, &
+                                        du, dv, lf, lf_rate, jerk) bind(C, name='martello_eval_rates')
       type(c_ptr), value :: handle
+      real(c_double), value :: t
       real(c_double), intent(in) :: u(*), v(*), a(*)
       real(c_double), intent(out) :: pen(*), pen_rate(*), force(*), force_rate(*), du(*), dv(*), &
-                                     lf(*), lf_rate(*)
+                                     lf(*), lf_rate(*), jerk(*)
       type(evaluator_t), pointer :: ep
       integer :: n, nc, nl
+      logical :: ok
       ep => get_eval(handle)
-      c_eval_element_rates = MARTELLO_ERR_ARGUMENT
+      c_eval_rates = MARTELLO_ERR_ARGUMENT
       if (.not. associated(ep)) return
       n = ep%m%n; nc = ep%m%ncontact; nl = ep%m%nlink
-      call evaluator_element_rates(ep, u(1:n), v(1:n), a(1:n), pen(1:nc), pen_rate(1:nc), &
-                                   force(1:nc), force_rate(1:nc), du(1:nl), dv(1:nl), lf(1:nl), &
-                                   lf_rate(1:nl))
-      c_eval_element_rates = MARTELLO_OK
-   end function c_eval_element_rates
+      call evaluator_rates(ep, t, u(1:n), v(1:n), a(1:n), pen(1:nc), pen_rate(1:nc), force(1:nc), &
+                           force_rate(1:nc), du(1:nl), dv(1:nl), lf(1:nl), lf_rate(1:nl), &
+                           jerk(1:n), ok)
+      c_eval_rates = merge(MARTELLO_OK, MARTELLO_ERR_SINGULAR, ok)
+   end function c_eval_rates
 
    integer(c_int) function c_eval_power(handle, power) bind(C, name='martello_eval_power')
       type(c_ptr), value :: handle

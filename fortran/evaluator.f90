@@ -13,7 +13,7 @@ module martello_evaluator
    public :: evaluator_t, evaluator_init, evaluator_load, evaluator_acceleration, &
       evaluator_forces, evaluator_solve_mass, evaluator_commit, &
       evaluator_energy, evaluator_power, evaluator_use_branches, evaluator_switches, &
-      evaluator_next_breakpoint, evaluator_element_rates, evaluator_jerk
+      evaluator_next_breakpoint, evaluator_rates
 
    type :: evaluator_t
       type(model_t), pointer :: m => null()
@@ -132,50 +132,22 @@ contains
       tb = load_breakpoint(ev%m, t)
    end function evaluator_next_breakpoint
 
-   !> Every element's peak quantities and their rates at the state (t, u, v) with
-   !> accelerations a (length n), on the laws' branches held: per contact δ, δ̇, the force
-   !> P (penalty contacts; 0 for the others) and Ṗ = P_δ δ̇ + P_δ̇ δ̈; per link the elongation
-   !> du, du̇, the force f and ḟ = f_du du̇ + f_du̇ dü (docs/run-layer.md, located peaks).
-   subroutine evaluator_element_rates(ev, u, v, a, pen, pen_rate, force, force_rate, du, dv, &
-                                      lf, lf_rate)
-      type(evaluator_t), intent(inout) :: ev
-      real(dp), intent(in) :: u(:), v(:), a(:)
-      real(dp), intent(out) :: pen(:), pen_rate(:), force(:), force_rate(:), du(:), dv(:), &
-                               lf(:), lf_rate(:)
-      real(dp) :: ltan(2, ev%m%nlink), ctan(2, ev%m%ncontact), acc(0:ev%m%n), da
-      integer :: j, ia, ib
-      call evaluator_load(ev, u, v)
-      acc(0) = 0.0_dp; acc(1:) = a
-      call internal_forces(ev%m, ev%ms, ev%u, ev%v, ev%f, link_tan=ltan, con_tan=ctan)
-      do j = 1, ev%m%ncontact
-         ia = ev%m%con_a(j); ib = ev%m%con_b(j)
-         pen(j) = ev%u(ia) - ev%u(ib) - ev%m%con_gap(j)
-         pen_rate(j) = ev%v(ia) - ev%v(ib)
-         force(j) = 0.0_dp; force_rate(j) = 0.0_dp
-         if (.not. ev%ms%is_penalty(j)) cycle
-         force(j) = ev%ms%con_f_trial(j)
-         force_rate(j) = ctan(1, j)*pen_rate(j) + ctan(2, j)*(acc(ia) - acc(ib))
-      end do
-      do j = 1, ev%m%nlink
-         ia = ev%m%link_a(j); ib = ev%m%link_b(j)
-         du(j) = ev%u(ia) - ev%u(ib); dv(j) = ev%v(ia) - ev%v(ib); da = acc(ia) - acc(ib)
-         lf(j) = ev%ms%link_f_trial(j)
-         lf_rate(j) = ltan(1, j)*dv(j) + ltan(2, j)*da
-      end do
-   end subroutine evaluator_element_rates
-
-   !> The nodes' jerk ȧ = M⁻¹(ḟ_ext − ḟ_int) at the state (t, u, v) with accelerations a
-   !> (length n), the laws on their branches held: ḟ_int from every element's tangents
-   !> (f_du du̇ + f_du̇ dü; a stiffness block's K v + C a), ḟ_ext by a centred difference in
-   !> time of the loads (smooth between the stops at their kinks). ok = .false. if M is
-   !> singular. The rate of |a| for its located peak (docs/run-layer.md).
-   subroutine evaluator_jerk(ev, t, u, v, a, jerk, ok)
+   !> The rates of the peak quantities at the state (t, u, v) with accelerations a (length
+   !> n), on the laws' branches held (docs/run-layer.md, located peaks): per contact δ, δ̇,
+   !> the force P (penalty contacts; 0 for the others) and Ṗ = P_δ δ̇ + P_δ̇ δ̈; per link the
+   !> elongation du, du̇, the force f and ḟ = f_du du̇ + f_du̇ dü; per node the jerk
+   !> ȧ = M⁻¹(ḟ_ext − ḟ_int), ḟ_int the sum of the element rates (a stiffness block's
+   !> K v + C a), ḟ_ext a centred difference in time of the loads (smooth between the stops at
+   !> their kinks). ok = .false. if M is singular.
+   subroutine evaluator_rates(ev, t, u, v, a, pen, pen_rate, force, force_rate, du, dv, lf, &
+                              lf_rate, jerk, ok)
       type(evaluator_t), intent(inout) :: ev
       real(dp), intent(in) :: t, u(:), v(:), a(:)
-      real(dp), intent(out) :: jerk(:)
+      real(dp), intent(out) :: pen(:), pen_rate(:), force(:), force_rate(:), du(:), dv(:), &
+                               lf(:), lf_rate(:), jerk(:)
       logical, intent(out) :: ok
       real(dp) :: ltan(2, ev%m%nlink), ctan(2, ev%m%ncontact), acc(0:ev%m%n), fd(0:ev%m%n), &
-                  fp(0:ev%m%n), r, eps
+                  fp(0:ev%m%n), eps
       integer :: j, ia, ib
       associate (m => ev%m)
          call evaluator_load(ev, u, v)
@@ -185,15 +157,22 @@ contains
          call external_forces(m, ev%mrow, t + eps, fp)
          call external_forces(m, ev%mrow, t - eps, fd)
          fd = (fp - fd)/(2.0_dp*eps)
-         do j = 1, m%nlink
-            ia = m%link_a(j); ib = m%link_b(j)
-            r = ltan(1, j)*(ev%v(ia) - ev%v(ib)) + ltan(2, j)*(acc(ia) - acc(ib))
-            fd(ia) = fd(ia) - r; fd(ib) = fd(ib) + r
-         end do
          do j = 1, m%ncontact
             ia = m%con_a(j); ib = m%con_b(j)
-            r = ctan(1, j)*(ev%v(ia) - ev%v(ib)) + ctan(2, j)*(acc(ia) - acc(ib))
-            fd(ia) = fd(ia) - r; fd(ib) = fd(ib) + r
+            pen(j) = ev%u(ia) - ev%u(ib) - m%con_gap(j)
+            pen_rate(j) = ev%v(ia) - ev%v(ib)
+            force(j) = 0.0_dp; force_rate(j) = 0.0_dp
+            if (.not. ev%ms%is_penalty(j)) cycle
+            force(j) = ev%ms%con_f_trial(j)
+            force_rate(j) = ctan(1, j)*pen_rate(j) + ctan(2, j)*(acc(ia) - acc(ib))
+            fd(ia) = fd(ia) - force_rate(j); fd(ib) = fd(ib) + force_rate(j)
+         end do
+         do j = 1, m%nlink
+            ia = m%link_a(j); ib = m%link_b(j)
+            du(j) = ev%u(ia) - ev%u(ib); dv(j) = ev%v(ia) - ev%v(ib)
+            lf(j) = ev%ms%link_f_trial(j)
+            lf_rate(j) = ltan(1, j)*dv(j) + ltan(2, j)*(acc(ia) - acc(ib))
+            fd(ia) = fd(ia) - lf_rate(j); fd(ib) = fd(ib) + lf_rate(j)
          end do
          do j = 1, m%nblock
             associate (nd => m%block(j)%node)
@@ -204,7 +183,7 @@ contains
          jerk = fd(1:)
          call evaluator_solve_mass(ev, jerk, ok)
       end associate
-   end subroutine evaluator_jerk
+   end subroutine evaluator_rates
 
    !> The powers at the state of the last force evaluation: of the external and the internal
    !> forces on the free nodes, f·v, and of the dampers, the other links and the penalty
