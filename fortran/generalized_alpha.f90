@@ -24,8 +24,9 @@ module martello_generalized_alpha
 
    !> The switches of a contact in an event-split step (first_switch), and the branch a
    !> contact is held on up to each (the left limit)
-   integer, parameter :: SW_ONSET = 1, SW_SEPARATION = 2, SW_CUT = 3, SW_REENGAGE = 4
-   integer, parameter :: HELD(4) = [CONTACT_OPEN, CONTACT_ON, CONTACT_ON, CONTACT_CUT]
+   integer, parameter :: SW_ONSET = 1, SW_SEPARATION = 2, SW_CUT = 3, SW_REENGAGE = 4, &
+                         SW_CUT_SEPARATION = 5
+   integer, parameter :: HELD(5) = [CONTACT_OPEN, CONTACT_ON, CONTACT_ON, CONTACT_CUT, CONTACT_CUT]
 
    type, extends(stepper_t) :: generalized_alpha_t
       integer :: kd = 0, max_newton = 30
@@ -129,12 +130,17 @@ contains
       integer, intent(out) :: stat
       real(dp) :: rnorm, incr, fscale, uscale, fmag, fext_mag, wd, wl, wc, h
       real(dp) :: t_a      !< event-split steps: the start of the stretch being solved
+      integer :: turned    !< event-split steps: a link unloaded at the stretch's start
       integer :: n
       logical :: ok, converged
       character(len=256) :: msg
-      !> a Kelvin switch within SPLIT_MIN·h of a stretch's end is put on that end: a sub-step
-      !> that short would leave Newton only rounding to work with
-      real(dp), parameter :: SPLIT_MIN = 1.0e-6_dp
+      !> A switch within SPLIT_MIN·h of a stretch's end is not a sub-step's end: a sub-step τ
+      !> that short carries the rounding of u into its velocity as ~2ε|u|/τ (3.7e-7 m/s at
+      !> τ = 6e-11 s, |u| = 5 cm: the order-2 error it was to remove, and more). A contact's
+      !> switch there is put on that end (its jump acts up to SPLIT_MIN·h early or late: a
+      !> velocity error ≤ 1e-4·h·ΔF/m, below the O(h²) of the step); a link's kink there is
+      !> already on a boundary (an error second order in the distance).
+      real(dp), parameter :: SPLIT_MIN = 1.0e-4_dp
 
       stat = MARTELLO_OK
       n = self%n; h = self%h
@@ -178,6 +184,7 @@ contains
          pending = .true.                ! the solved stretch is not committed
          h_full = h
          t_a = self%t0                   ! the stretch [t_a, t] of length h
+         turned = 0
          do k = 1, MAX_SPLITS
             call first_switch(first, tau, kind)
             if (first == 0) exit
@@ -222,6 +229,10 @@ contains
                                        m%link_par(L_HARDENING, j))*m%link_par(L_YIELD, j)
                end associate
             end if
+            ! an unloading: the link has turned at the boundary (located to O(h²) in time, its
+            ! du̇ may still point outward there): the rest of the step starts it elastic
+            turned = 0
+            if (first < 0 .and. kind == 0) turned = -first
             if (tau >= h_left) exit                 ! the switch is on the step's end
             ! the rest of the step, from the boundary
             self%un = self%u; self%vn = self%v; self%an = self%a
@@ -253,9 +264,9 @@ contains
       !> The first switch of the stretch just solved, from its start (un, vn, an; the laws
       !> committed there) to its solved end (u, v), on the branches committed at the start:
       !> first = j > 0 for contact j, with kind its switch (SW_ONSET from open, SW_SEPARATION
-      !> from closed, a clipped Kelvin's SW_CUT where kδ + cδ̇ turns tensile and SW_REENGAGE
-      !> where it turns compressive again while δ > 0; a clipped one separates from its
-      !> cut-off state with F = 0 on both sides: no switch), −j for bilinear link j, with
+      !> from closed, a clipped Kelvin's SW_CUT where kδ + cδ̇ turns tensile, SW_REENGAGE
+      !> where it turns compressive again while δ > 0 and SW_CUT_SEPARATION where it
+      !> separates from its cut-off state, with F = 0 on both sides), −j for bilinear link j, with
       !> kind = ±1 for a yield onto the upper or lower line and 0 for unloading; 0 if none.
       !> Each switch g (> 0: the branch is left) is followed on the start's quadratic
       !> g + ġτ + ½g̈τ² (without the jerk where g holds a rate: unloading −du̇, the Kelvin
@@ -279,6 +290,14 @@ contains
             else if (.not. clipped(j)) then
                kj = SW_SEPARATION; sg = -1.0_dp            ! g = −δ
             else
+               ! cut off (no force while δ > 0): it separates at δ = 0 with F = 0 on both sides,
+               ! a switch without a jump that makes a later closing an onset
+               if (.not. (self%ms%con_f(j) > 0.0_dp)) then
+                  tj = switch_time(-d0, -r0, -q0, -d1, .true.)
+                  if (tj < tau) then
+                     tau = tj; first = j; kind = SW_CUT_SEPARATION
+                  end if
+               end if
                ! the clipped Kelvin force over k, δ + κδ̇: −(it) while it pushes, +(it) while cut
                kap = m%con_par(P_DAMPING, j)/m%con_par(P_STIFF, j)
                kj = merge(SW_CUT, SW_REENGAGE, self%ms%con_f(j) > 0.0_dp)
@@ -304,6 +323,7 @@ contains
             sw = 0
             if (fp >= r - round .and. r0 > 0.0_dp) sw = 1
             if (fp <= -(r - round) .and. r0 < 0.0_dp) sw = -1
+            if (j == turned) sw = 0
             if (sw /= 0) then
                ! unloading: g = ∓du̇
                tj = switch_time(-sw*r0, -sw*q0, 0.0_dp, -sw*(self%v(ia) - self%v(ib)), .false.)
@@ -379,7 +399,7 @@ contains
       !> stretches (switch kind of first_switch): the force of that branch (an onset or a
       !> re-engagement: the law's; a separation or a cut-off: 0) in the internal force, the
       !> committed contact force and the acceleration (M Δa = −ΔF), and con_on (in contact,
-      !> δ > 0, for the phases) but for a separation. False (with the failure handed over)
+      !> δ > 0, for the phases) but for the separations. False (with the failure handed over)
       !> if M is singular.
       logical function boundary_jump(j, kind) result(ok)
          integer, intent(in) :: j, kind
@@ -388,7 +408,7 @@ contains
          ia = m%con_a(j); ib = m%con_b(j)
          fplus = 0.0_dp
          if (kind == SW_ONSET .or. kind == SW_REENGAGE) fplus = max(onset_force(j), 0.0_dp)
-         self%ms%con_on(j) = kind /= SW_SEPARATION
+         self%ms%con_on(j) = kind /= SW_SEPARATION .and. kind /= SW_CUT_SEPARATION
          self%jump = 0.0_dp
          self%jump(ia) = -(fplus - self%ms%con_f(j)); self%jump(ib) = fplus - self%ms%con_f(j)
          self%fint(ia) = self%fint(ia) - self%jump(ia); self%fint(ib) = self%fint(ib) - self%jump(ib)
