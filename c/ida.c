@@ -92,8 +92,8 @@ typedef struct {
   /* located peaks (c/located_peaks.c): element quantities and rates (the layout of
    * c/located_peaks.c's packed layout) at the ends of the stretch (0, 1)
    * and at a probe (c); node v, a and jerk at both ends; the step's interpolant */
-  int nl;
-  double *el0, *el1, *elc, *pv0, *pa0, *pj0, *pj1, *ua, *va, *aa;
+  int nl, start_rates;
+  double *el0, *el1, *elc, *pv0, *pa0, *pj0, *pv1, *pa1, *pj1, *ua, *va, *aa;
   void *mem_now;
   N_Vector ytd;
   /* settings */
@@ -770,8 +770,8 @@ static void release(ida_problem *P) {
                  P->opened, P->was_closed, P->hit, P->cand, P->q, P->w0, P->w_in, P->u, P->v, P->a, P->x, P->uq, P->vq, P->fint, P->fext,
                  P->force, P->lam, P->S, P->rhs, P->mb, P->cols, P->dc, P->aset,
                  P->sw_a, P->sw_b, P->sw_al, P->sw_be, P->sw_ga, P->t_impact, P->flight,
-                 P->v_last, P->el0, P->el1, P->elc, P->pv0, P->pa0, P->pj0, P->pj1, P->ua,
-                 P->va, P->aa};
+                 P->v_last, P->el0, P->el1, P->elc, P->pv0, P->pa0, P->pj0, P->pv1, P->pa1,
+                 P->pj1, P->ua, P->va, P->aa};
   for (size_t k = 0; k < sizeof all / sizeof all[0]; k++) free(all[k]);
   if (P->ev) martello_eval_free(&P->ev);
 }
@@ -916,7 +916,7 @@ static int setup(ida_problem *P, martello_model *model, martello_run *run) {
   {
     const size_t ne = 4 * ((size_t)nc + (size_t)P->nl);
     double **el[] = {&P->el0, &P->el1, &P->elc};
-    double **nd[] = {&P->pv0, &P->pa0, &P->pj0, &P->pj1, &P->ua, &P->va, &P->aa};
+    double **nd[] = {&P->pv0, &P->pa0, &P->pj0, &P->pv1, &P->pa1, &P->pj1, &P->ua, &P->va, &P->aa};
     for (size_t k = 0; k < sizeof el / sizeof el[0]; k++) *el[k] = take(ne, sizeof(double), &ok);
     for (size_t k = 0; k < sizeof nd / sizeof nd[0]; k++) *nd[k] = take((size_t)n, sizeof(double), &ok);
     if (!ok) return fail(P, MARTELLO_ERR_MEMORY, "IDA: out of memory");
@@ -1045,22 +1045,39 @@ static int peak_skip(void *ctx, int kind, int j) {
 }
 
 /* The peaks inside [t0, t1] of IDA's last step, on its interpolant (docs/run-layer.md,
- * located peaks): every quantity's value and rate at both ends, then c/located_peaks.c. */
+ * located peaks): every quantity's value and rate at both ends (the start's kept from the
+ * last step's end when IDA went on: P->start_rates), then c/located_peaks.c. */
 static int located_peaks(ida_problem *P, void *mem, double t0, double t1) {
   const int n = P->n;
   martello_peak_ends e;
   int st;
   if (!(t1 > t0)) return MARTELLO_OK;
   P->mem_now = mem;
-  if ((st = interpolated_rates(P, t0, P->el0, P->pj0)) != MARTELLO_OK) return st;
-  memcpy(P->pv0, P->va, sizeof(double) * (size_t)n);
-  memcpy(P->pa0, P->aa, sizeof(double) * (size_t)n);
+  if (!P->start_rates) {
+    if ((st = interpolated_rates(P, t0, P->el0, P->pj0)) != MARTELLO_OK) return st;
+    memcpy(P->pv0, P->va, sizeof(double) * (size_t)n);
+    memcpy(P->pa0, P->aa, sizeof(double) * (size_t)n);
+  }
   if ((st = interpolated_rates(P, t1, P->el1, P->pj1)) != MARTELLO_OK) return st;
+  memcpy(P->pv1, P->va, sizeof(double) * (size_t)n);
+  memcpy(P->pa1, P->aa, sizeof(double) * (size_t)n);
   memset(&e, 0, sizeof e);
   martello_peak_ends_set(&e, 0, n, P->nc, P->nl, P->pv0, P->pa0, P->pj0, P->el0);
-  martello_peak_ends_set(&e, 1, n, P->nc, P->nl, P->va, P->aa, P->pj1, P->el1);
+  martello_peak_ends_set(&e, 1, n, P->nc, P->nl, P->pv1, P->pa1, P->pj1, P->el1);
   e.skip = peak_skip;
   return martello_locate_peaks(P->obs, &e, t0, t1, P->rtol, P->event_tol, peak_probe, P);
+}
+
+/* After a step: its end's rates are the next step's start unless IDA restarts there (the
+ * state and the laws' branches change at a restart). */
+static void keep_end_rates(ida_problem *P, int unchanged) {
+  double *tmp;
+  P->start_rates = unchanged;
+  if (!unchanged) return;
+  tmp = P->el0; P->el0 = P->el1; P->el1 = tmp;
+  tmp = P->pj0; P->pj0 = P->pj1; P->pj1 = tmp;
+  tmp = P->pv0; P->pv0 = P->pv1; P->pv1 = tmp;
+  tmp = P->pa0; P->pa0 = P->pa1; P->pa1 = tmp;
 }
 
 /* The next stop after t: the output time t_out, or a kink of the load before it. */
@@ -1214,6 +1231,7 @@ static int integrate(ida_problem *P, SUNContext sunctx, void **memp, N_Vector yy
     if ((st = work_quadrature(P, mem, t_last, t_r, ytmp)) != MARTELLO_OK) break;
     if ((st = node_extrema(P, mem, t_last, t_r, N_VGetArrayPointer(yy), ytmp)) != MARTELLO_OK) break;
     if ((st = located_peaks(P, mem, t_last, t_r)) != MARTELLO_OK) break;
+    keep_end_rates(P, !restart);
     t_last = t_r;
     P->t_now = t_r;
     const double *y = N_VGetArrayPointer(yy);
