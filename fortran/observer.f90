@@ -99,7 +99,7 @@ module martello_observer
       real(dp), allocatable :: acc(:), c_pen(:), c_force(:)
       !> the fixed-step method's states lie on one smooth motion between the phase changes
       !> (not Moreau–Jean's velocity jumps): the peaks of a, δ, the contact and link forces
-      !> and elongations are located on its steps (locate_step_peaks)
+      !> and elongations are located on its steps (track)
       logical :: smooth_steps = .false.
       !> per node (0:n): the time of the last phase change (onset, separation, impact) of a
       !> contact at it; the chatter resolutions at the previous sample (the jumps of the
