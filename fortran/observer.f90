@@ -12,7 +12,7 @@ module martello_observer
       load_breakpoint
    use martello_links, only: link_force, LINK_SPRING, LINK_BAR, LINK_BILINEAR, LINK_DASHPOT, &
       LINK_FLUID_DAMPER, L_STIFF
-   use martello_contact_laws, only: contact_force
+   use martello_contact_laws, only: contact_force, LAW_LINEAR, LAW_KELVIN, P_STIFF, P_DAMPING
    use martello_integrator_settings, only: integrator_settings_t, integrator_name
    use martello_run_quantities
    use martello_registry, only: INTEGRATORS
@@ -107,8 +107,9 @@ module martello_observer
       real(dp), allocatable :: node_change(:)
       integer, allocatable :: con_nodes(:, :)
       integer(i8) :: chatter_prev = 0_i8
-      !> per contact: its force and force rate at the previous sample, while in contact there
-      real(dp), allocatable :: c_prev_f(:), c_prev_fr(:)
+      !> per contact: its force and force rate at the previous sample, while in contact there;
+      !> the linear and Kelvin laws' k and c, contiguous (read at every step of a chain)
+      real(dp), allocatable :: c_prev_f(:), c_prev_fr(:), c_k(:), c_c(:)
       !> the peak of |a| on fixed steps (a_parabolas): a sample k that raised it waits two
       !> samples for the parabola through k − 1, k, k + 1 and the smoothness test with k + 2.
       !> Per node: a at k − 1, k, k + 1 and the sample k of its latest candidate (a_gen);
@@ -237,6 +238,8 @@ contains
       real(dp) :: e_kin
       integer :: c
       o%con_nodes = reshape([(m%con_a(c), m%con_b(c), c = 1, m%ncontact)], [2, m%ncontact])
+      o%c_k = m%con_par(P_STIFF, 1:m%ncontact)
+      o%c_c = merge(m%con_par(P_DAMPING, 1:m%ncontact), 0.0_dp, m%con_law(1:m%ncontact) == LAW_KELVIN)
       allocate (o%node_change(0:m%n), source=-huge(1.0_dp))
       do c = 1, m%ncontact
          if (ms%con_on(c)) call observer_open_phase(o, c, 0.0_dp, v(m%con_a(c)) - v(m%con_b(c)))
@@ -805,12 +808,20 @@ contains
       integer :: c, ia, ib
       real(dp) :: d0, r0, r1, q1, f, dfd, dfv, fr1
       do c = 1, m%ncontact
-         if (.not. ms%is_penalty(c) .or. .not. (pen(c) > 0.0_dp)) cycle
+         if (.not. (pen(c) > 0.0_dp)) cycle
+         if (.not. ms%is_penalty(c)) cycle
          ia = m%con_a(c); ib = m%con_b(c)
          r1 = nodal(v, ia) - nodal(v, ib); q1 = nodal(a, ia) - nodal(a, ib)
-         call contact_force(m%con_law(c), m%con_par(:, c), m%con_mstar(c), pen(c), r1, &
-                            ms%con_vin(c), f, dfd, dfv)
-         fr1 = dfd*r1 + dfv*q1
+         ! the law's tangents (the linear and Kelvin ones in line: a chain's every step)
+         select case (m%con_law(c))
+         case (LAW_LINEAR, LAW_KELVIN)
+            fr1 = 0.0_dp
+            if (force(c) > 0.0_dp) fr1 = o%c_k(c)*r1 + o%c_c(c)*q1
+         case default
+            call contact_force(m%con_law(c), m%con_par(:, c), m%con_mstar(c), pen(c), r1, &
+                               ms%con_vin(c), f, dfd, dfv)
+            fr1 = dfd*r1 + dfv*q1
+         end select
          d0 = nodal(un, ia) - nodal(un, ib) - m%con_gap(c)
          if (d0 > 0.0_dp .and. o%ph_open(c) .and. o%ph_t(c) <= t0) then
             r0 = nodal(vn, ia) - nodal(vn, ib)
@@ -890,9 +901,17 @@ contains
       real(dp), intent(in) :: h, un(:), vn(:), an(:), u(:), v(:), a(:)
       real(dp), intent(in), optional :: f1(:)
       integer :: j, ia, ib
-      real(dp) :: du1, f
+      real(dp) :: du1, dv0, dv1, f
+      logical :: damper
       do j = 1, m%nlink
          ia = m%link_a(j); ib = m%link_b(j)
+         ! only a step where du̇ (or, for a damper, dü) changes sign holds a peak
+         dv0 = nodal(vn, ia) - nodal(vn, ib); dv1 = nodal(v, ia) - nodal(v, ib)
+         damper = m%link_kind(j) == LINK_DASHPOT .or. m%link_kind(j) == LINK_FLUID_DAMPER
+         if (.not. (dv0*dv1 < 0.0_dp)) then
+            if (.not. damper) cycle
+            if (.not. ((nodal(an, ia) - nodal(an, ib))*(nodal(a, ia) - nodal(a, ib)) < 0.0_dp)) cycle
+         end if
          du1 = nodal(u, ia) - nodal(u, ib)
          if (present(f1)) then
             f = f1(j)
@@ -901,10 +920,9 @@ contains
          else
             f = m%link_par(L_STIFF, j)*du1
          end if
-         call observer_link_step_extremum(o, m, j, h, nodal(un, ia) - nodal(un, ib), &
-                                          nodal(vn, ia) - nodal(vn, ib), &
-                                          nodal(an, ia) - nodal(an, ib), du1, &
-                                          nodal(v, ia) - nodal(v, ib), nodal(a, ia) - nodal(a, ib), f)
+         call observer_link_step_extremum(o, m, j, h, nodal(un, ia) - nodal(un, ib), dv0, &
+                                          nodal(an, ia) - nodal(an, ib), du1, dv1, &
+                                          nodal(a, ia) - nodal(a, ib), f)
       end do
    end subroutine observer_link_step_peaks
 
