@@ -220,7 +220,7 @@ contains
       o%u_max = -huge(1.0_dp); o%u_min = huge(1.0_dp); o%v_absmax = 0.0_dp
       o%a_absmax = 0.0_dp; o%pen_max = -huge(1.0_dp); o%force_max = 0.0_dp; o%impacts = 0
       o%ph_open = .false.
-      o%c_prev_f = 0.0_dp; o%c_prev_fr = 0.0_dp
+      o%c_prev_f = 0.0_dp; o%c_prev_fr = 0.0_dp; o%a_gen = -10_i8
    end subroutine observer_init
 
    !> The state at t = 0, before its first sample: the initial energies the balance starts
