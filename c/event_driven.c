@@ -39,9 +39,6 @@
 enum { ROOT_IMPACT,      /* unilateral gap closing: delta >= 0                     */
        ROOT_ONSET,       /* penalty gap: delta > 0 (the law's force starts)         */
        ROOT_SEPARATION,  /* penalty gap: delta <= 0                                */
-       ROOT_PEAK,        /* penalty contact at its deepest: delta' <= 0 (no change of
-                            state; the step ends there so the peak force and
-                            penetration are observed, not interpolated)             */
        ROOT_RELEASE,     /* persistent contact: multiplier P below -tolerance       */
        ROOT_SWITCH };    /* a law's branch left: switch g > 0 (index nc + slot)     */
 
@@ -84,6 +81,13 @@ typedef struct {
   /* the switches of the laws' branches (martello_eval_switches), refreshed at every commit */
   int nsw, *sw_a, *sw_b;
   double *sw_al, *sw_be, *sw_ga;
+  /* located peaks (c/located_peaks.c): the element quantities and their rates
+   * (c/located_peaks.c's packed layout) at the start (0) and end
+   * (1) of the smooth stretch and at a probed state (c); node jerks at both ends, the
+   * stretch's start time */
+  int nl, start_rates;
+  double *el0, *el1, *elc, *jk0, *jk1, *fp;
+  double t_stretch;
   /* cost counters; kinetic energy taken out by impulses since the last commit */
   long long cnt[MARTELLO_NCOUNTERS];
   double e_impact;
@@ -527,15 +531,10 @@ static int root_value(ed_t *w, int j, int type, double t, const double *y, doubl
     if (rate) *rate = 0.0;
     return MARTELLO_OK;
   }
-  if (type == ROOT_RELEASE) {
-    int st = eval_point(w, t, y, w->f1, NULL);
+  if (type == ROOT_RELEASE) {   /* (the step end's RHS in f1 stays) */
+    int st = eval_point(w, t, y, w->fj, NULL);
     if (st != MARTELLO_OK) return fail_eval(w, st, t);
     *g = -(w->lam[j] + w->lamtol[j]);
-    if (rate) *rate = 0.0;
-    return MARTELLO_OK;
-  }
-  if (type == ROOT_PEAK) {
-    *g = -gdot(w, j, y + w->n);
     if (rate) *rate = 0.0;
     return MARTELLO_OK;
   }
@@ -718,9 +717,9 @@ static int bracket(ed_t *w, int j, int type, double t0, double t1, double *ta, d
   int st;
   *ta = t0; *tb = t1;
   if (type == ROOT_SWITCH) return bracket_switch(w, j - w->nc, t0, t1, ga, tb, gb);
-  if (type == ROOT_RELEASE || type == ROOT_PEAK) {
-    *ga = type == ROOT_PEAK ? -w->rate0[j] : -(w->lam0[j] + w->lamtol[j]);
-    *gb = type == ROOT_PEAK ? -w->rate1[j] : -(w->lam1[j] + w->lamtol[j]);
+  if (type == ROOT_RELEASE) {
+    *ga = -(w->lam0[j] + w->lamtol[j]);
+    *gb = -(w->lam1[j] + w->lamtol[j]);
     if (after(type, *ga) || !after(type, *gb)) return 0;
     memcpy(w->yb, w->y, w->dim * sizeof *w->yb);
     return 1;
@@ -788,9 +787,9 @@ static int locate(ed_t *w, double t0, double t1, double *te) {
   for (j = 0; j < w->nc && st >= 0; j++) {
     if (w->inert[j]) continue;
     if (w->is_pen[j] && w->pen0[j] > 0.0) {
-      /* a penalty contact in contact waits for its peak and for its separation */
-      st = consider(w, j, ROOT_PEAK, t0, t1, &found, &best);
-      if (st >= 0) st = consider(w, j, ROOT_SEPARATION, t0, t1, &found, &best);
+      /* a penalty contact in contact waits for its separation (its peaks are located inside
+       * the steps, c/located_peaks.c) */
+      st = consider(w, j, ROOT_SEPARATION, t0, t1, &found, &best);
     } else {
       st = consider(w, j, w->is_pen[j] ? ROOT_ONSET : w->held[j] ? ROOT_RELEASE : ROOT_IMPACT,
                     t0, t1, &found, &best);
@@ -808,7 +807,7 @@ static int locate(ed_t *w, double t0, double t1, double *te) {
 /* ---- observation ----------------------------------------------------------------------- */
 
 /* The extrema of the node displacements inside the smooth stretch (t0, y0) -> (t1, w->y)
- * (before the events at t1 are processed), located on the stepper's own solution
+ * (before the events at t1 are processed; its RHS in f1), located on the stepper's own solution
  * (docs/run-layer.md, located extrema): a node whose velocity changes sign gets the root
  * of the derivative of the quintic Hermite interpolant of its u (u, v, a at both ends) as a
  * first guess, one re-integration to it, and the parabolic correction
@@ -817,7 +816,7 @@ static int locate(ed_t *w, double t0, double t1, double *te) {
 static int node_extrema(ed_t *w, double t0, double t1) {
   const int n = w->n;
   const double h = t1 - t0;
-  int i, st, have_end = 0;
+  int i, st;
   if (!(h > 0.0)) return MARTELLO_OK;
   for (i = 0; i < n; i++) {
     const double v0 = w->y0[n + i], v1 = w->y[n + i];
@@ -832,11 +831,6 @@ static int node_extrema(ed_t *w, double t0, double t1) {
       st = martello_observer_extremum(w->obs, i, t1, w->y[i], is_max);
       if (st != MARTELLO_OK) return fail(w, st, t1, "event-driven: martello_observer_extremum failed");
       continue;
-    }
-    if (!have_end) {   /* the acceleration at the end of the stretch */
-      st = eval_point(w, t1, w->y, w->f1, NULL);
-      if (st != MARTELLO_OK) return fail_eval(w, st, t1);
-      have_end = 1;
     }
     hermite_build(&p, h, w->y0[i], v0, w->fstart[n + i], w->y[i], v1, w->f1[n + i]);
     for (it = 0; it < 60; it++) {
@@ -858,6 +852,68 @@ static int node_extrema(ed_t *w, double t0, double t1) {
     if (st != MARTELLO_OK) return fail(w, st, tm, "event-driven: martello_observer_extremum failed");
   }
   return MARTELLO_OK;
+}
+
+/* The rates of the peak quantities at the state (t, y) with accelerations acc: elements into
+ * e (c/located_peaks.c's packed layout), node jerks into jerk. */
+static int rates(ed_t *w, double t, const double *y, const double *acc, double *e, double *jerk) {
+  int st = martello_peak_rates(w->ev, t, y, y + w->n, acc, w->nc, w->nl, e, jerk);
+  return st == MARTELLO_OK ? st : fail_eval(w, st, t);
+}
+
+/* The probe of c/located_peaks.c: quantity kind of item j at t inside the stretch, on the
+ * stepper's own solution (re-integrated from its start). */
+static int peak_probe(void *ctx, double t, int kind, int j, double *q, double *r) {
+  ed_t *w = ctx;
+  const int n = w->n;
+  int st = reintegrate(w, w->t_stretch, t - w->t_stretch, w->yc);
+  if (st != MARTELLO_OK) return st;
+  st = eval_point(w, t, w->yc, w->fj, NULL);
+  if (st != MARTELLO_OK) return fail_eval(w, st, t);
+  if (kind != MARTELLO_PEAK_V && (st = rates(w, t, w->yc, w->fj + n, w->elc, w->fp)) != MARTELLO_OK)
+    return st;
+  martello_peak_pick(kind, j, w->nc, w->nl, w->yc + n, w->fj + n, w->fp, w->elc, q, r);
+  return MARTELLO_OK;
+}
+
+/* Items without a peak of their own here: fixed nodes, contacts that are not penalty ones
+ * or not in a phase. */
+static int peak_skip(void *ctx, int kind, int j) {
+  ed_t *w = ctx;
+  if (kind == MARTELLO_PEAK_V || kind == MARTELLO_PEAK_A) return w->fixed[j];
+  if (kind == MARTELLO_PEAK_PEN || kind == MARTELLO_PEAK_FORCE)
+    return !w->is_pen[j] || !martello_observer_in_phase(w->obs, j);
+  return 0;
+}
+
+/* The peaks inside the smooth stretch (t0, y0, fstart) -> (t1, w->y, f1), before the events
+ * at t1 (docs/run-layer.md, located peaks): every quantity's value and rate at both ends
+ * (the start's kept from the last stretch's end when nothing happened there: w->start_rates),
+ * then c/located_peaks.c. */
+static int located_peaks(ed_t *w, double t0, double t1) {
+  const int n = w->n;
+  martello_peak_ends e;
+  int st;
+  if (!(t1 - t0 > 0.0)) return MARTELLO_OK;
+  if (!w->start_rates && (st = rates(w, t0, w->y0, w->fstart + n, w->el0, w->jk0)) != MARTELLO_OK)
+    return st;
+  if ((st = rates(w, t1, w->y, w->f1 + n, w->el1, w->jk1)) != MARTELLO_OK) return st;
+  memset(&e, 0, sizeof e);
+  martello_peak_ends_set(&e, 0, n, w->nc, w->nl, w->y0 + n, w->fstart + n, w->jk0, w->el0);
+  martello_peak_ends_set(&e, 1, n, w->nc, w->nl, w->y + n, w->f1 + n, w->jk1, w->el1);
+  e.skip = peak_skip;
+  w->t_stretch = t0;
+  return martello_locate_peaks(w->obs, &e, t0, t1, w->rtol, w->event_tol, peak_probe, w);
+}
+
+/* After a step: the rates at its end are the next step's start when the state and the laws'
+ * branches went on unchanged (no event, no kink of a load there). */
+static void keep_end_rates(ed_t *w, int unchanged) {
+  double *tmp;
+  w->start_rates = unchanged;
+  if (!unchanged) return;
+  tmp = w->el0; w->el0 = w->el1; w->el1 = tmp;
+  tmp = w->jk0; w->jk0 = w->jk1; w->jk1 = tmp;
 }
 
 /* Accept the state w->y at t: path-dependent links commit, and the works since the last
@@ -895,7 +951,8 @@ static void ed_free(ed_t *w) {
                   w->pen0, w->rate0, w->acc0, w->pen1, w->rate1, w->acc1, w->pen, w->rate,
                   w->force, w->lam, w->lam0, w->lam1, w->lamtol, w->hlist, w->held, w->Wh,
                   w->rh, w->ilist, w->hk, w->Wl, w->ql, w->pl, w->wl, w->sl, w->el, w->tg, w->t_hold, w->t_impact, w->flight,
-                  w->sw_a, w->sw_b, w->sw_al, w->sw_be, w->sw_ga};
+                  w->sw_a, w->sw_b, w->sw_al, w->sw_be, w->sw_ga, w->el0, w->el1, w->elc,
+                  w->jk0, w->jk1, w->fp};
   size_t i;
   for (i = 0; i < sizeof bufs / sizeof bufs[0]; i++) free(bufs[i]);
   if (w->drv) gsl_odeiv2_driver_free(w->drv);
@@ -954,6 +1011,12 @@ static int ed_setup(ed_t *w) {
   for (j = 0; j < nc; j++) w->t_impact[j] = -1.0;   /* no impact yet */
   st = martello_eval_create(w->model, &w->ev);
   if (st != MARTELLO_OK) return fail(w, st, 0.0, "event-driven: martello_eval_create failed");
+  st = martello_eval_link_count(w->ev, &w->nl);
+  if (st != MARTELLO_OK) return fail(w, st, 0.0, "event-driven: martello_eval_link_count failed");
+  if (!(ALLOC(w->el0, 4 * (nc + w->nl)) && ALLOC(w->el1, 4 * (nc + w->nl)) &&
+        ALLOC(w->elc, 4 * (nc + w->nl)) && ALLOC(w->jk0, n) && ALLOC(w->jk1, n) &&
+        ALLOC(w->fp, n)))
+    return MARTELLO_ERR_MEMORY;
   /* every switching surface of the laws is an event: hold them on smooth branches */
   st = martello_eval_use_branches(w->ev, &w->nsw);
   if (st != MARTELLO_OK) return fail(w, st, 0.0, "event-driven: martello_eval_use_branches failed");
@@ -1086,7 +1149,12 @@ static int ed_integrate(ed_t *w) {
     kinematics(w, w->y, w->f1 + n, w->pen1, w->rate1, w->acc1);
     ev = locate(w, t0, t, &te);
     if (ev < 0) return ev;
+    if (ev == 1) {   /* the smooth stretch ends at the event: its RHS there */
+      st = eval_point(w, te, w->y, w->f1, NULL);
+      if (st != MARTELLO_OK) return fail_eval(w, st, te);
+    }
     st = node_extrema(w, t0, ev == 1 ? te : t);
+    if (st == MARTELLO_OK) st = located_peaks(w, t0, ev == 1 ? te : t);
     if (st != MARTELLO_OK) return st;
     if (ev == 1) {
       t = te;
@@ -1106,6 +1174,7 @@ static int ed_integrate(ed_t *w) {
     else if (t >= t_stop && t_stop < t_out) {
       gsl_odeiv2_driver_reset(w->drv);   /* across a kink of the load: start afresh */
     }
+    keep_end_rates(w, ev == 0 && !(t >= t_stop && t_stop < t_out));
     st = commit(w, t, w->y0 + 2 * n);
     if (st != MARTELLO_OK) return st;
     if (t >= t_out) {   /* on the output grid: the observer records it */

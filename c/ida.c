@@ -89,6 +89,13 @@ typedef struct {
   double *sw_al, *sw_be, *sw_ga;
   double *t_impact, *flight;  /* per rigid contact: its last impact, the flight that ended there */
   double *v_last;             /* node velocities at the last accepted state (located extrema) */
+  /* located peaks (c/located_peaks.c): element quantities and rates (the layout of
+   * c/located_peaks.c's packed layout) at the ends of the stretch (0, 1)
+   * and at a probe (c); node v, a and jerk at both ends; the step's interpolant */
+  int nl, start_rates;
+  double *el0, *el1, *elc, *pv0, *pa0, *pj0, *pv1, *pa1, *pj1, *ua, *va, *aa;
+  void *mem_now;
+  N_Vector ytd;
   /* settings */
   double rtol, atol, event_tol, t_end, h_max, out_dt, dt;
   int every;     /* output intervals dt per stop time out_dt */
@@ -763,7 +770,8 @@ static void release(ida_problem *P) {
                  P->opened, P->was_closed, P->hit, P->cand, P->q, P->w0, P->w_in, P->u, P->v, P->a, P->x, P->uq, P->vq, P->fint, P->fext,
                  P->force, P->lam, P->S, P->rhs, P->mb, P->cols, P->dc, P->aset,
                  P->sw_a, P->sw_b, P->sw_al, P->sw_be, P->sw_ga, P->t_impact, P->flight,
-                 P->v_last};
+                 P->v_last, P->el0, P->el1, P->elc, P->pv0, P->pa0, P->pj0, P->pv1, P->pa1,
+                 P->pj1, P->ua, P->va, P->aa};
   for (size_t k = 0; k < sizeof all / sizeof all[0]; k++) free(all[k]);
   if (P->ev) martello_eval_free(&P->ev);
 }
@@ -903,6 +911,16 @@ static int setup(ida_problem *P, martello_model *model, martello_run *run) {
   for (int r = 0; r < P->nr; r++) P->t_impact[r] = -1.0;   /* no impact yet */
   if ((st = martello_eval_create(model, &P->ev)) != MARTELLO_OK)
     return fail(P, st, "IDA: could not create the force evaluator");
+  if ((st = martello_eval_link_count(P->ev, &P->nl)) != MARTELLO_OK)
+    return fail(P, st, "IDA: martello_eval_link_count failed");
+  {
+    const size_t ne = 4 * ((size_t)nc + (size_t)P->nl);
+    double **el[] = {&P->el0, &P->el1, &P->elc};
+    double **nd[] = {&P->pv0, &P->pa0, &P->pj0, &P->pv1, &P->pa1, &P->pj1, &P->ua, &P->va, &P->aa};
+    for (size_t k = 0; k < sizeof el / sizeof el[0]; k++) *el[k] = take(ne, sizeof(double), &ok);
+    for (size_t k = 0; k < sizeof nd / sizeof nd[0]; k++) *nd[k] = take((size_t)n, sizeof(double), &ok);
+    if (!ok) return fail(P, MARTELLO_ERR_MEMORY, "IDA: out of memory");
+  }
   /* every switching surface of the laws is a root: hold them on smooth branches */
   if ((st = martello_eval_use_branches(P->ev, &P->nsw)) != MARTELLO_OK)
     return fail(P, st, "IDA: martello_eval_use_branches failed");
@@ -981,6 +999,85 @@ static int node_extrema(ida_problem *P, void *mem, double t0, double t1, const d
     if (st != MARTELLO_OK) return fail(P, st, "IDA: martello_observer_extremum failed");
   }
   return MARTELLO_OK;
+}
+
+/* u, v, a (P->ua, va, aa) of the nodes at t on the last step's interpolant (IDAGetDky: y
+ * and y'; a is the v rows of y'). */
+static int interpolated(ida_problem *P, double t) {
+  void *mem = P->mem_now;
+  int f0 = IDAGetDky(mem, t, 0, P->ytd);
+  if (f0 != IDA_SUCCESS)
+    return fail(P, MARTELLO_ERR_EXTERNAL, "IDAGetDky failed at t = %.9e s: %s", t, IDAGetReturnFlagName(f0));
+  gather(P, N_VGetArrayPointer(P->ytd), P->ua, P->va);
+  f0 = IDAGetDky(mem, t, 1, P->ytd);
+  if (f0 != IDA_SUCCESS)
+    return fail(P, MARTELLO_ERR_EXTERNAL, "IDAGetDky failed at t = %.9e s: %s", t, IDAGetReturnFlagName(f0));
+  for (int i = 0; i < P->n; i++) P->aa[i] = N_VGetArrayPointer(P->ytd)[P->iv[i]];
+  return MARTELLO_OK;
+}
+
+/* The rates of the peak quantities at t on the interpolant: elements into e (packed), node
+ * jerks into jerk; P->va, P->aa hold v and a there. */
+static int interpolated_rates(ida_problem *P, double t, double *e, double *jerk) {
+  int st = interpolated(P, t);
+  if (st != MARTELLO_OK) return st;
+  st = martello_peak_rates(P->ev, t, P->ua, P->va, P->aa, P->nc, P->nl, e, jerk);
+  return st == MARTELLO_OK ? st : fail(P, st, "IDA: the rates of the peaks failed at t = %.9e s", t);
+}
+
+/* The probe of c/located_peaks.c on IDA's interpolant of the last step (of the method's
+ * order: its own solution between the steps' ends). */
+static int peak_probe(void *ctx, double t, int kind, int j, double *q, double *r) {
+  ida_problem *P = ctx;
+  int st = interpolated_rates(P, t, P->elc, P->x);
+  if (st != MARTELLO_OK) return st;
+  martello_peak_pick(kind, j, P->nc, P->nl, P->va, P->aa, P->x, P->elc, q, r);
+  return MARTELLO_OK;
+}
+
+/* Fixed nodes, rigid contacts and penalty contacts out of a phase have no peak here. */
+static int peak_skip(void *ctx, int kind, int j) {
+  ida_problem *P = ctx;
+  if (kind == MARTELLO_PEAK_V || kind == MARTELLO_PEAK_A) return P->fixed[j];
+  if (kind == MARTELLO_PEAK_PEN || kind == MARTELLO_PEAK_FORCE)
+    return P->rig[j] >= 0 || !martello_observer_in_phase(P->obs, j);
+  return 0;
+}
+
+/* The peaks inside [t0, t1] of IDA's last step, on its interpolant (docs/run-layer.md,
+ * located peaks): every quantity's value and rate at both ends (the start's kept from the
+ * last step's end when IDA went on: P->start_rates), then c/located_peaks.c. */
+static int located_peaks(ida_problem *P, void *mem, double t0, double t1) {
+  const int n = P->n;
+  martello_peak_ends e;
+  int st;
+  if (!(t1 > t0)) return MARTELLO_OK;
+  P->mem_now = mem;
+  if (!P->start_rates) {
+    if ((st = interpolated_rates(P, t0, P->el0, P->pj0)) != MARTELLO_OK) return st;
+    memcpy(P->pv0, P->va, sizeof(double) * (size_t)n);
+    memcpy(P->pa0, P->aa, sizeof(double) * (size_t)n);
+  }
+  if ((st = interpolated_rates(P, t1, P->el1, P->pj1)) != MARTELLO_OK) return st;
+  memcpy(P->pv1, P->va, sizeof(double) * (size_t)n);
+  memcpy(P->pa1, P->aa, sizeof(double) * (size_t)n);
+  memset(&e, 0, sizeof e);
+  martello_peak_ends_set(&e, 0, n, P->nc, P->nl, P->pv0, P->pa0, P->pj0, P->el0);
+  martello_peak_ends_set(&e, 1, n, P->nc, P->nl, P->pv1, P->pa1, P->pj1, P->el1);
+  e.skip = peak_skip;
+  return martello_locate_peaks(P->obs, &e, t0, t1, P->rtol, P->event_tol, peak_probe, P);
+}
+
+/* After a step: its end's rates are the next step's start unless IDA restarts there (the
+ * state and the laws' branches change at a restart). */
+static void keep_end_rates(ida_problem *P, int unchanged) {
+  double *tmp;
+  P->start_rates = unchanged;
+  if (!unchanged) return;
+  tmp = P->el0; P->el0 = P->el1; P->el1 = tmp;
+  tmp = P->pj0; P->pj0 = P->pj1; P->pj1 = tmp;
+  tmp = P->pv0; P->pv0 = P->pv1; P->pv1 = tmp;
+  tmp = P->pa0; P->pa0 = P->pa1; P->pa1 = tmp;
 }
 
 /* The next stop after t: the output time t_out, or a kink of the load before it. */
@@ -1133,6 +1230,8 @@ static int integrate(ida_problem *P, SUNContext sunctx, void **memp, N_Vector yy
     }
     if ((st = work_quadrature(P, mem, t_last, t_r, ytmp)) != MARTELLO_OK) break;
     if ((st = node_extrema(P, mem, t_last, t_r, N_VGetArrayPointer(yy), ytmp)) != MARTELLO_OK) break;
+    if ((st = located_peaks(P, mem, t_last, t_r)) != MARTELLO_OK) break;
+    keep_end_rates(P, !restart);
     t_last = t_r;
     P->t_now = t_r;
     const double *y = N_VGetArrayPointer(yy);
@@ -1210,7 +1309,9 @@ int martello_ida_run(martello_model *model, martello_run *run) {
     yp = N_VNew_Serial(P->N, sunctx);
     id = N_VNew_Serial(P->N, sunctx);
     ytmp = N_VNew_Serial(P->N, sunctx);
-    if (!yy || !yp || !id || !ytmp) st = fail(P, MARTELLO_ERR_MEMORY, "IDA: could not create the vectors");
+    P->ytd = N_VNew_Serial(P->N, sunctx);
+    if (!yy || !yp || !id || !ytmp || !P->ytd)
+      st = fail(P, MARTELLO_ERR_MEMORY, "IDA: could not create the vectors");
   }
   /* a failed run keeps what it computed (the observer closed its open phases) */
   if (st == MARTELLO_OK) st = integrate(P, sunctx, &mem, yy, yp, id, ytmp, &J, &LS);
@@ -1221,6 +1322,7 @@ int martello_ida_run(martello_model *model, martello_run *run) {
   if (yp) N_VDestroy(yp);
   if (id) N_VDestroy(id);
   if (ytmp) N_VDestroy(ytmp);
+  if (P->ytd) N_VDestroy(P->ytd);
   if (sunctx) SUNContext_Free(&sunctx);
   release(P);
   return st;

@@ -47,6 +47,18 @@ int martello_eval_next_breakpoint(martello_eval *ev, double t, double *tb);
 int martello_eval_power(martello_eval *ev, double power[5]);
 int martello_eval_energy(martello_eval *ev, const double *u, const double *v, double *kinetic,
                          double *recoverable);
+/* The number of links of the scene. */
+int martello_eval_link_count(martello_eval *ev, int *n_links);
+/* The rates of the peak quantities at the state (t, u, v) with accelerations a, on the laws'
+ * branches held (docs/run-layer.md, located peaks): per contact pen = delta, pen_rate, force
+ * (penalty contacts; 0 for the others), force_rate = F_delta delta' + F_delta' delta''; per
+ * link du, dv, lf (its force), lf_rate = f_du du' + f_du' du''; per node the jerk
+ * a' = M^-1 (f_ext' - f_int'), f_int' the sum of the element rates, f_ext' a centred
+ * difference in time of the loads. MARTELLO_ERR_SINGULAR for a singular mass matrix. */
+int martello_eval_rates(martello_eval *ev, double t, const double *u, const double *v,
+                        const double *a, double *pen, double *pen_rate, double *force,
+                        double *force_rate, double *du, double *dv, double *lf, double *lf_rate,
+                        double *jerk);
 
 /* The run being filled: its settings, as martello_run_set_settings validated them, and its
  * observer. */
@@ -70,6 +82,46 @@ int martello_observer_sample(martello_observer *obs, martello_eval *ev, double t
  * velocity), at t with value u; maximum = 1 for a maximum, 0 for a minimum. From the first
  * call on, u_peak holds located maxima only. */
 int martello_observer_extremum(martello_observer *obs, int node, double t, double u, int maximum);
+/* The peaks a method locates inside its accepted steps (fortran/run_quantities.f90 PEAK_*):
+ * node |v| and |a|, contact delta and force, link |force| and |elongation|. */
+enum { MARTELLO_PEAK_V = 1, MARTELLO_PEAK_A, MARTELLO_PEAK_PEN, MARTELLO_PEAK_FORCE,
+       MARTELLO_PEAK_LINK_FORCE, MARTELLO_PEAK_LINK_DU };
+/* A peak of kind MARTELLO_PEAK_* of item `index` (0-based node, contact or link) located
+ * inside an accepted step, value q (signed; delta and the contact force also enter the open
+ * phase's maxima). */
+int martello_observer_peak(martello_observer *obs, int kind, int index, double q);
+/* What a located peak of kind, index must exceed to change the report (|.| for nodes and
+ * links; the open phase's maximum for a contact in a phase), into *q. */
+int martello_observer_peak_value(martello_observer *obs, int kind, int index, double *q);
+/* Located peaks (c/located_peaks.c): the values q and rates r of every quantity of kind k
+ * (items count[k]; q0[k] NULL: not tracked) at both ends of a smooth stretch; skip (NULL:
+ * none) leaves an item out (e.g. a contact not in contact). probe gives q and r of item j of
+ * kind at an interior time t on the method's own solution. */
+typedef struct {
+  int count[MARTELLO_PEAK_LINK_DU + 1];
+  const double *q0[MARTELLO_PEAK_LINK_DU + 1], *r0[MARTELLO_PEAK_LINK_DU + 1],
+      *q1[MARTELLO_PEAK_LINK_DU + 1], *r1[MARTELLO_PEAK_LINK_DU + 1];
+  int (*skip)(void *ctx, int kind, int index);
+} martello_peak_ends;
+typedef int (*martello_peak_probe)(void *ctx, double t, int kind, int index, double *q, double *r);
+/* Every extremum inside [t0, t1] that can raise a reported peak, located on the method's
+ * solution (secant on the rate from the cubic Hermite's root, parabolic value) and handed to
+ * the observer (martello_observer_peak). rtol, event_tol: the method's. */
+int martello_locate_peaks(martello_observer *obs, const martello_peak_ends *ends, double t0,
+                          double t1, double rtol, double event_tol, martello_peak_probe probe,
+                          void *ctx);
+/* The rates of one state in the packed layout of the adaptive methods: el holds
+ * martello_eval_rates' element outputs in its order (4 blocks of nc, then 4 of nl), jerk the
+ * nodes'. */
+int martello_peak_rates(martello_eval *ev, double t, const double *u, const double *v,
+                        const double *a, int nc, int nl, double *el, double *jerk);
+/* The start (end = 0) or end (1) of ends from one state: node v, a, jerk, packed el. */
+void martello_peak_ends_set(martello_peak_ends *e, int end, int n, int nc, int nl,
+                            const double *v, const double *a, const double *jerk,
+                            const double *el);
+/* q and r of item j of kind from one state (as martello_peak_ends_set reads them). */
+void martello_peak_pick(int kind, int j, int nc, int nl, const double *v, const double *a,
+                        const double *jerk, const double *el, double *q, double *r);
 /* Work increments since the last call [J], integrated along the method's own solution:
  * external, total internal (f_int . v), of the links other than dampers and of the penalty
  * contacts (martello_eval_power), and the kinetic energy impulses took out. Damping is

@@ -184,6 +184,42 @@ contains
       c_eval_next_breakpoint = MARTELLO_OK
    end function c_eval_next_breakpoint
 
+   !> The number of links of the evaluator's scene.
+   integer(c_int) function c_eval_link_count(handle, n_links) bind(C, name='martello_eval_link_count')
+      type(c_ptr), value :: handle
+      integer(c_int), intent(out) :: n_links
+      type(evaluator_t), pointer :: ep
+      ep => get_eval(handle)
+      n_links = 0
+      c_eval_link_count = MARTELLO_ERR_ARGUMENT
+      if (.not. associated(ep)) return
+      n_links = ep%m%nlink
+      c_eval_link_count = MARTELLO_OK
+   end function c_eval_link_count
+
+   !> The rates of the peak quantities at (t, u, v) with accelerations a (evaluator_rates):
+   !> per contact pen, pen_rate, force, force_rate; per link du, dv, lf, lf_rate; per node the
+   !> jerk. MARTELLO_ERR_SINGULAR for a singular mass matrix.
+   integer(c_int) function c_eval_rates(handle, t, u, v, a, pen, pen_rate, force, force_rate, &
+                                        du, dv, lf, lf_rate, jerk) bind(C, name='martello_eval_rates')
+      type(c_ptr), value :: handle
+      real(c_double), value :: t
+      real(c_double), intent(in) :: u(*), v(*), a(*)
+      real(c_double), intent(out) :: pen(*), pen_rate(*), force(*), force_rate(*), du(*), dv(*), &
+                                     lf(*), lf_rate(*), jerk(*)
+      type(evaluator_t), pointer :: ep
+      integer :: n, nc, nl
+      logical :: ok
+      ep => get_eval(handle)
+      c_eval_rates = MARTELLO_ERR_ARGUMENT
+      if (.not. associated(ep)) return
+      n = ep%m%n; nc = ep%m%ncontact; nl = ep%m%nlink
+      call evaluator_rates(ep, t, u(1:n), v(1:n), a(1:n), pen(1:nc), pen_rate(1:nc), force(1:nc), &
+                           force_rate(1:nc), du(1:nl), dv(1:nl), lf(1:nl), lf_rate(1:nl), &
+                           jerk(1:n), ok)
+      c_eval_rates = merge(MARTELLO_OK, MARTELLO_ERR_SINGULAR, ok)
+   end function c_eval_rates
+
    integer(c_int) function c_eval_power(handle, power) bind(C, name='martello_eval_power')
       type(c_ptr), value :: handle
       real(c_double), intent(out) :: power(5)
@@ -289,6 +325,38 @@ contains
       call observer_extremum(op, node + 1, t, u, maximum /= 0)
       c_observer_extremum = MARTELLO_OK
    end function c_observer_extremum
+
+   !> A peak of kind (PEAK_*, as fortran/run_quantities.f90) of item index (0-based node,
+   !> contact or link) located by the method inside a step, value q.
+   integer(c_int) function c_observer_peak(handle, kind, index, q) &
+      bind(C, name='martello_observer_peak')
+      type(c_ptr), value :: handle
+      integer(c_int), value :: kind, index
+      real(c_double), value :: q
+      type(observer_t), pointer :: op
+      op => get_observer(handle)
+      c_observer_peak = MARTELLO_ERR_ARGUMENT
+      if (.not. associated(op)) return
+      if (index < 0 .or. index >= peak_items(op, kind)) return
+      call observer_peak(op, kind, index + 1, q)
+      c_observer_peak = MARTELLO_OK
+   end function c_observer_peak
+
+   !> The value a located peak of kind, index must exceed to count (observer_peak_value).
+   integer(c_int) function c_observer_peak_value(handle, kind, index, q) &
+      bind(C, name='martello_observer_peak_value')
+      type(c_ptr), value :: handle
+      integer(c_int), value :: kind, index
+      real(c_double), intent(out) :: q
+      type(observer_t), pointer :: op
+      op => get_observer(handle)
+      q = 0.0_dp
+      c_observer_peak_value = MARTELLO_ERR_ARGUMENT
+      if (.not. associated(op)) return
+      if (index < 0 .or. index >= peak_items(op, kind)) return
+      q = observer_peak_value(op, kind, index + 1)
+      c_observer_peak_value = MARTELLO_OK
+   end function c_observer_peak_value
 
    integer(c_int) function c_observer_work(handle, w_ext, w_int, w_links, w_contact, w_impact) &
       bind(C, name='martello_observer_work')

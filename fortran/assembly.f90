@@ -10,12 +10,12 @@ module martello_assembly
    use martello_contact_laws, only: contact_force, contact_elastic_energy, LAW_LINEAR, LAW_KELVIN, &
       P_STIFF, P_DAMPING
    use martello_band_matrix, only: band_t, band_add
-   use martello_time_functions, only: tf_value, TF_NONE
+   use martello_time_functions, only: tf_value, tf_next_breakpoint, TF_NONE
    implicit none
    private
    public :: mech_state_t, mech_init, internal_forces, external_forces, mech_commit, &
       element_power, recoverable_energy, mass_times, external_work, kinetic_energy, &
-      assemble_mass, uniform_acceleration, ONSET_SPEED_FLOOR
+      assemble_mass, uniform_acceleration, load_breakpoint, ONSET_SPEED_FLOOR
 
    !> Hunt–Crossley-type laws scale damping by 1/v_in; a contact first seen while δ̇ ≤ 0
    !> (grazing, or a step that lands inside) uses this floor [m/s] instead of a division by 0.
@@ -98,10 +98,12 @@ contains
    end subroutine mech_init
 
    !> fint(0:n) of links and penalty contacts at (u, v); with jac present, also
-   !> jac += ck·K_t + cc·C_t (tangent stiffness and damping), ground rows skipped.
+   !> jac += ck·K_t + cc·C_t (tangent stiffness and damping), ground rows skipped; with
+   !> link_tan, con_tan present, each element's (∂f/∂du, ∂f/∂du̇) (the rates of the element
+   !> forces for their located peaks, docs/run-layer.md).
    !> This loop is the cost of a chain step: the linear kinds (spring, bar, dashpot, linear
    !> penalty) are evaluated in line, the others through their constitutive kernels.
-   subroutine internal_forces(m, s, u, v, fint, jac, ck, cc, cmat)
+   subroutine internal_forces(m, s, u, v, fint, jac, ck, cc, cmat, link_tan, con_tan)
       type(model_t), intent(in) :: m
       type(mech_state_t), intent(inout) :: s
       real(dp), intent(in), contiguous :: u(0:), v(0:)
@@ -110,6 +112,7 @@ contains
       real(dp), intent(inout), contiguous, optional :: jac(:, :)
       real(dp), intent(in), optional :: ck, cc
       real(dp), intent(inout), contiguous, optional :: cmat(:, :)   !< += C_t alone
+      real(dp), intent(out), optional :: link_tan(:, :), con_tan(:, :)   !< (2, nlink), (2, ncontact)
       integer :: j, a, b, r
       real(dp) :: du, dv, f, kt, ct, fnew, pen, rate, vin, dfd, dfv
       logical :: tangent
@@ -145,8 +148,10 @@ contains
             fint(b) = fint(b) - f
             if (tangent) call stencil(jac, a, b, ck*kt + cc*ct)
             if (present(cmat) .and. ct /= 0.0_dp) call stencil(cmat, a, b, ct)
+            if (present(link_tan)) link_tan(:, j) = [kt, ct]
          end do
       end associate
+      if (present(con_tan)) con_tan = 0.0_dp
       do j = 1, m%ncontact
          if (.not. s%is_penalty(j)) cycle
          a = m%con_a(j); b = m%con_b(j)
@@ -182,6 +187,7 @@ contains
             s%con_vin_trial(j) = 0.0_dp
          end if
          s%con_f_trial(j) = f
+         if (present(con_tan)) con_tan(:, j) = [dfd, dfv]
          fint(a) = fint(a) + f
          fint(b) = fint(b) - f
          if (tangent .and. (dfd /= 0.0_dp .or. dfv /= 0.0_dp)) call stencil(jac, a, b, ck*dfd + cc*dfv)
@@ -347,6 +353,20 @@ contains
       acc = m%gravity
       if (m%ground_accel%kind /= TF_NONE) acc = acc - tf_value(m%ground_accel, t)
    end function uniform_acceleration
+
+   !> The first time after t where a load of the scene has a kink (tf_next_breakpoint: a
+   !> window's start or end, a table's sample), or huge().
+   pure function load_breakpoint(m, t) result(tb)
+      type(model_t), intent(in) :: m
+      real(dp), intent(in) :: t
+      real(dp) :: tb
+      integer :: j
+      tb = huge(1.0_dp)
+      if (m%ground_accel%kind /= TF_NONE) tb = tf_next_breakpoint(m%ground_accel, t)
+      do j = 1, m%nforce
+         tb = min(tb, tf_next_breakpoint(m%force_fn(j), t))
+      end do
+   end function load_breakpoint
 
    !> Gravity on M·1, nodal forces, and −M·1·ü_g (relative coordinates), at time t.
    subroutine external_forces(m, mass_row_sum, t, fext)

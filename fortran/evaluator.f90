@@ -8,13 +8,12 @@ module martello_evaluator
    use martello_assembly
    use martello_band_matrix
    use martello_switching, only: switch_count, switching_choose, switching_functions
-   use martello_time_functions, only: tf_next_breakpoint, TF_NONE
    implicit none
    private
    public :: evaluator_t, evaluator_init, evaluator_load, evaluator_acceleration, &
       evaluator_forces, evaluator_solve_mass, evaluator_commit, &
       evaluator_energy, evaluator_power, evaluator_use_branches, evaluator_switches, &
-      evaluator_next_breakpoint
+      evaluator_next_breakpoint, evaluator_rates
 
    type :: evaluator_t
       type(model_t), pointer :: m => null()
@@ -130,13 +129,61 @@ contains
       type(evaluator_t), intent(in) :: ev
       real(dp), intent(in) :: t
       real(dp) :: tb
-      integer :: j
-      tb = huge(1.0_dp)
-      if (ev%m%ground_accel%kind /= TF_NONE) tb = tf_next_breakpoint(ev%m%ground_accel, t)
-      do j = 1, ev%m%nforce
-         tb = min(tb, tf_next_breakpoint(ev%m%force_fn(j), t))
-      end do
+      tb = load_breakpoint(ev%m, t)
    end function evaluator_next_breakpoint
+
+   !> The rates of the peak quantities at the state (t, u, v) with accelerations a (length
+   !> n), on the laws' branches held (docs/run-layer.md, located peaks): per contact δ, δ̇,
+   !> the force P (penalty contacts; 0 for the others) and Ṗ = P_δ δ̇ + P_δ̇ δ̈; per link the
+   !> elongation du, du̇, the force f and ḟ = f_du du̇ + f_du̇ dü; per node the jerk
+   !> ȧ = M⁻¹(ḟ_ext − ḟ_int), ḟ_int the sum of the element rates (a stiffness block's
+   !> K v + C a), ḟ_ext a centred difference in time of the loads (smooth between the stops at
+   !> their kinks). ok = .false. if M is singular.
+   subroutine evaluator_rates(ev, t, u, v, a, pen, pen_rate, force, force_rate, du, dv, lf, &
+                              lf_rate, jerk, ok)
+      type(evaluator_t), intent(inout) :: ev
+      real(dp), intent(in) :: t, u(:), v(:), a(:)
+      real(dp), intent(out) :: pen(:), pen_rate(:), force(:), force_rate(:), du(:), dv(:), &
+                               lf(:), lf_rate(:), jerk(:)
+      logical, intent(out) :: ok
+      real(dp) :: ltan(2, ev%m%nlink), ctan(2, ev%m%ncontact), acc(0:ev%m%n), fd(0:ev%m%n), &
+                  fp(0:ev%m%n), eps
+      integer :: j, ia, ib
+      associate (m => ev%m)
+         call evaluator_load(ev, u, v)
+         acc(0) = 0.0_dp; acc(1:) = a
+         call internal_forces(m, ev%ms, ev%u, ev%v, ev%f, link_tan=ltan, con_tan=ctan)
+         eps = sqrt(epsilon(1.0_dp))*max(abs(t), 1.0e-3_dp)
+         call external_forces(m, ev%mrow, t + eps, fp)
+         call external_forces(m, ev%mrow, t - eps, fd)
+         fd = (fp - fd)/(2.0_dp*eps)
+         do j = 1, m%ncontact
+            ia = m%con_a(j); ib = m%con_b(j)
+            pen(j) = ev%u(ia) - ev%u(ib) - m%con_gap(j)
+            pen_rate(j) = ev%v(ia) - ev%v(ib)
+            force(j) = 0.0_dp; force_rate(j) = 0.0_dp
+            if (.not. ev%ms%is_penalty(j)) cycle
+            force(j) = ev%ms%con_f_trial(j)
+            force_rate(j) = ctan(1, j)*pen_rate(j) + ctan(2, j)*(acc(ia) - acc(ib))
+            fd(ia) = fd(ia) - force_rate(j); fd(ib) = fd(ib) + force_rate(j)
+         end do
+         do j = 1, m%nlink
+            ia = m%link_a(j); ib = m%link_b(j)
+            du(j) = ev%u(ia) - ev%u(ib); dv(j) = ev%v(ia) - ev%v(ib)
+            lf(j) = ev%ms%link_f_trial(j)
+            lf_rate(j) = ltan(1, j)*dv(j) + ltan(2, j)*(acc(ia) - acc(ib))
+            fd(ia) = fd(ia) - lf_rate(j); fd(ib) = fd(ib) + lf_rate(j)
+         end do
+         do j = 1, m%nblock
+            associate (nd => m%block(j)%node)
+               fd(nd) = fd(nd) - matmul(m%block(j)%k, ev%v(nd))
+               if (m%block(j)%damped) fd(nd) = fd(nd) - matmul(m%block(j)%c, acc(nd))
+            end associate
+         end do
+         jerk = fd(1:)
+         call evaluator_solve_mass(ev, jerk, ok)
+      end associate
+   end subroutine evaluator_rates
 
    !> The powers at the state of the last force evaluation: of the external and the internal
    !> forces on the free nodes, f·v, and of the dampers, the other links and the penalty

@@ -15,7 +15,8 @@ module martello_fixed_step
    use martello_integrator_settings, only: integrator_settings_t
    use martello_run_checks, only: check_run_settings
    use martello_observer, only: observer_t, observer_begin, observer_sample, observer_fail, &
-      observer_penalty_phases, observer_finish, observer_recorded, C_STEPS, C_FACTORIZATIONS
+      observer_penalty_phases, observer_finish, observer_recorded, observer_link_step_peaks, &
+      C_STEPS, C_FACTORIZATIONS
    implicit none
    private
    public :: run_fixed_step, stepper_t, stepper_start, stepper_rest_start, solve_free_mass, &
@@ -108,6 +109,9 @@ contains
       if (stat /= MARTELLO_OK) return
       ! velocity-jump phases: located and valued with the end velocities (no acceleration)
       if (stp%velocity_jump_phases) allocate (no_acc(0:stp%n), source=0.0_dp)
+      ! the other methods' states lie on a smooth motion between phase changes: their peaks
+      ! are located inside the steps (docs/results.md)
+      o%smooth_steps = .not. stp%velocity_jump_phases
       call observer_begin(o, m, stp%ms, stp%u, stp%v, stp%a, ENERGY_CHECK, stp%advice, stp%ke_aMa)
       t = 0.0_dp
       call sample(0_i8)
@@ -140,6 +144,10 @@ contains
          if (stp%own_link_peaks .and. .not. observer_recorded(o, kk)) then
             call observer_sample(o, m, stp%ms, t, stp%u, stp%v, stp%a, stp%pen, stp%force, kk, &
                                  stat, u_prev=stp%un(1:), v_prev=stp%vn(1:), a_prev=stp%an(1:))
+            ! its link peaks inside the step (a pass of its own: the fused step could locate
+            ! them in its element loop, where du, du̇ are at hand)
+            if (kk > 0) call observer_link_step_peaks(o, m, stp%ms, stp%h, stp%un(1:), stp%vn(1:), &
+                                                      stp%an(1:), stp%u(1:), stp%v(1:), stp%a(1:))
             return
          end if
          if (stp%own_link_peaks) call stp%link_states(m)

@@ -12,7 +12,8 @@ module martello_generalized_alpha
    use martello_assembly
    use martello_observer, only: observer_t, observer_work, observer_fail, C_NEWTON, C_RESIDUALS, &
       C_FACTORIZATIONS, C_JACOBIANS, C_CHATTER, free_side_crossing
-   use martello_contact_laws, only: contact_force, LAW_KELVIN, P_CLIP
+   use martello_contact_laws, only: contact_force, LAW_KELVIN, LAW_LINEAR, P_CLIP, P_STIFF, P_DAMPING
+   use martello_links, only: LINK_BILINEAR, L_STIFF, L_YIELD, L_HARDENING
    use martello_integrator_settings
    use martello_stability, only: omega_max
    use martello_fixed_step, only: stepper_t, stepper_rest_start, stepper_fail, newmark_kinematics, &
@@ -20,6 +21,12 @@ module martello_generalized_alpha
    implicit none
    private
    public :: generalized_alpha_t, generalized_alpha_coefficients
+
+   !> The switches of a contact in an event-split step (first_switch), and the branch a
+   !> contact is held on up to each (the left limit)
+   integer, parameter :: SW_ONSET = 1, SW_SEPARATION = 2, SW_CUT = 3, SW_REENGAGE = 4, &
+                         SW_CUT_SEPARATION = 5
+   integer, parameter :: HELD(5) = [CONTACT_OPEN, CONTACT_ON, CONTACT_ON, CONTACT_CUT, CONTACT_CUT]
 
    type, extends(stepper_t) :: generalized_alpha_t
       integer :: kd = 0, max_newton = 30
@@ -82,7 +89,9 @@ contains
       self%cm = (1.0_dp - self%am)/(self%beta*self%h*self%h)
       self%mmax = max(maxval(m%mass), tiny(1.0_dp))
       self%cv = self%gamma/(self%beta*self%h)
-      self%event_split = logical(s%event_split) .and. any(m%con_law == LAW_KELVIN)
+      self%event_split = logical(s%event_split) .and. (any(m%con_law == LAW_KELVIN) .or. &
+                                                        any(m%con_law == LAW_LINEAR) .or. &
+                                                        any(m%link_kind == LINK_BILINEAR))
       if (self%event_split) allocate (self%us(0:n), self%vs(0:n), self%as(0:n), self%jump(0:n))
       if (s%kind == INT_NEWMARK .and. 2.0_dp*self%beta < self%gamma) &
          call newmark_stability(self%beta, self%gamma, self%h, logical(s%check_stability), stat)
@@ -120,9 +129,18 @@ contains
       type(observer_t), intent(inout) :: o
       integer, intent(out) :: stat
       real(dp) :: rnorm, incr, fscale, uscale, fmag, fext_mag, wd, wl, wc, h
+      real(dp) :: t_a      !< event-split steps: the start of the stretch being solved
+      integer :: turned    !< event-split steps: a link unloaded at the stretch's start
       integer :: n
       logical :: ok, converged
       character(len=256) :: msg
+      !> A switch within SPLIT_MIN·h of a stretch's end is not a sub-step's end: a sub-step τ
+      !> that short carries the rounding of u into its velocity as ~2ε|u|/τ (3.7e-7 m/s at
+      !> τ = 6e-11 s, |u| = 5 cm: the order-2 error it was to remove, and more). A contact's
+      !> switch there is put on that end (its jump acts up to SPLIT_MIN·h early or late: a
+      !> velocity error ≤ 1e-4·h·ΔF/m, below the O(h²) of the step); a link's kink there is
+      !> already on a boundary (an error second order in the distance).
+      real(dp), parameter :: SPLIT_MIN = 1.0e-4_dp
 
       stat = MARTELLO_OK
       n = self%n; h = self%h
@@ -143,96 +161,267 @@ contains
 
    contains
 
-      !> The event-split step (docs/integrators.md): where a Kelvin contact's δ changes sign
-      !> over the step just solved, the crossing τ is located from the start of the step on the
-      !> quadratic δ + δ̇τ + ½δ̈τ² (the start is on the smooth branch up to the crossing:
-      !> O(h³) in time), and the step is re-taken as two Newmark sub-steps [t0, t0 + τ] and
-      !> [t0 + τ, t]. At the boundary the contact force jumps to its other branch's value
-      !> (onset: kδ + cδ̇, clipped as the law says; separation: 0) in the internal force, the
-      !> committed contact force and the acceleration (M Δa = −ΔF): the jump falls on a sub-step
-      !> boundary, so each sub-step integrates a smooth force. False: no crossing, the step
-      !> stands as solved.
+      !> The event-split step (docs/integrators.md, event-split steps). The switches of the
+      !> piecewise-smooth laws — a Kelvin contact's onset and separation (its force jumps by
+      !> cδ̇), its cut-off and re-engagement when clipped, a linear contact's onset and
+      !> separation, a bilinear link's yield and unloading (the slope of the force jumps) —
+      !> are looked for in the stretch just solved (first_switch). At the first, τ from the
+      !> stretch's start, the stretch is re-taken as a sub-step [t_a, t_a + τ] with the laws on
+      !> the start's branches (the left limit: a contact held on its branch; a bilinear link
+      !> reaches its yield line at the end to O(h³) under the return map, and is put on it),
+      !> the contact force takes its new branch's value at the boundary (boundary_jump: the
+      !> right limit), and the rest [t_a + τ, t] is solved and looked at again, up to
+      !> MAX_SPLITS switches a step. Each sub-step then integrates a smooth force. A contact's
+      !> switch within SPLIT_MIN·h of a stretch end is put on that end (the jump at the start,
+      !> or at the end after a sub-step over the whole stretch); a link's is already on a
+      !> boundary. False: no switch, the step stands as solved.
       logical function split_step() result(split)
-         real(dp), parameter :: SPLIT_MIN = 1.0e-6_dp
-         integer :: j, ia, ib, first, branch
-         real(dp) :: tau, tj, d0, r0, q0, d1, h_full, fplus, dfd, dfv
-         logical :: ok2
+         integer, parameter :: MAX_SPLITS = 8
+         integer :: k, first, branch, kind
+         real(dp) :: tau, h_full, h_left
+         logical :: pending
          split = .false.
-         tau = h; first = 0
-         do j = 1, m%ncontact
-            if (.not. self%ms%is_penalty(j) .or. m%con_law(j) /= LAW_KELVIN) cycle
-            ia = m%con_a(j); ib = m%con_b(j)
-            d0 = self%un(ia) - self%un(ib) - m%con_gap(j)
-            ! clipped Kelvin separates at its cut-off, F = 0 on both sides of δ = 0: no jump
-            if (d0 > 0.0_dp .and. m%con_par(P_CLIP, j) > 0.5_dp) cycle
-            d1 = self%u(ia) - self%u(ib) - m%con_gap(j)
-            r0 = self%vn(ia) - self%vn(ib); q0 = self%an(ia) - self%an(ib)
-            ! the start's quadratic crosses inside the step (the solved step may not: the
-            ! chatter rule can have held the contact open), or the solved step changes sign
-            tj = first_root(d0, r0, q0)
-            if (tj >= h) then
-               if ((d0 > 0.0_dp) .eqv. (d1 > 0.0_dp)) cycle
-               tj = free_side_crossing(d0, r0, q0, 0.0_dp, h)
-            end if
-            if (tj > 0.0_dp .and. tj < tau) then
-               tau = tj; first = j
-            end if
-         end do
-         ! a crossing within SPLIT_MIN·h of a step end is left in the step: its jump then
-         ! acts over at most SPLIT_MIN·h (an error SPLIT_MIN·h·ΔF/m, far below the O(h²) of the
-         ! step), where a sub-step that short would leave Newton only rounding to work with
-         if (first == 0 .or. tau <= SPLIT_MIN*h .or. h - tau <= SPLIT_MIN*h) return
-         split = .true.
+         pending = .true.                ! the solved stretch is not committed
          h_full = h
-         self%us = self%un; self%vs = self%vn; self%as = self%an
-         ! sub-step 1, [t0, t0 + τ]: on the start's branch up to its end, whatever the sign of
-         ! δ there (δ = 0 to the step's O(h³)): the left limit of the force
-         call set_step(tau)
-         self%ms%forced_off = .false.
-         branch = self%ms%con_branch(first)
-         ia = m%con_a(first); ib = m%con_b(first)
-         self%ms%con_branch(first) = merge(CONTACT_ON, CONTACT_OPEN, &
-                                           self%us(ia) - self%us(ib) - m%con_gap(first) > 0.0_dp)
-         call external_forces(m, self%mrow, self%t0 + tau, self%fext)
-         fext_mag = maxval(abs(self%fext))
-         call newton_step(converged)
-         if (.not. converged) return
-         call commit_works()
-         self%ms%con_branch(first) = branch
-         ! the jump of the crossing contact's force at the boundary, to its other branch
-         d0 = self%u(ia) - self%u(ib) - m%con_gap(first)
-         r0 = self%v(ia) - self%v(ib)
-         fplus = 0.0_dp
-         if (self%us(ia) - self%us(ib) - m%con_gap(first) <= 0.0_dp) &   ! an onset
-            call contact_force(LAW_KELVIN, m%con_par(1, first), m%con_mstar(first), &
-                               max(d0, tiny(1.0_dp)), r0, r0, fplus, dfd, dfv)
-         self%ms%con_on(first) = fplus /= 0.0_dp
-         self%jump = 0.0_dp
-         self%jump(ia) = -(fplus - self%ms%con_f(first)); self%jump(ib) = fplus - self%ms%con_f(first)
-         self%fint(ia) = self%fint(ia) - self%jump(ia); self%fint(ib) = self%fint(ib) - self%jump(ib)
-         self%fint(0) = 0.0_dp
-         self%ms%con_f(first) = fplus
-         call solve_free_mass(m, self%fixed_nodes, self%mband, self%jump, ok2)
-         if (.not. ok2) then
-            call stepper_fail(o, MARTELLO_ERR_SINGULAR, t, 'singular mass at an event-split boundary', stat)
-            return
-         end if
-         self%a = self%a + self%jump
-         ! sub-step 2, [t0 + τ, t]: from the boundary state on the other branch
-         self%un = self%u; self%vn = self%v; self%an = self%a
-         self%fint_n = self%fint; self%fext_n = self%fext
-         call mass_times(m, self%an, self%man)
-         call set_step(h_full - tau)
-         call external_forces(m, self%mrow, t, self%fext)
-         fext_mag = maxval(abs(self%fext))
-         call newton_step(converged)
-         if (.not. converged) return
-         call commit_works()
+         t_a = self%t0                   ! the stretch [t_a, t] of length h
+         turned = 0
+         do k = 1, MAX_SPLITS
+            call first_switch(first, tau, kind)
+            if (first == 0) exit
+            if (.not. split) then
+               self%us = self%un; self%vs = self%vn; self%as = self%an
+               split = .true.
+            end if
+            if (tau == 0.0_dp) then
+               ! a contact's switch at the stretch's start: the jump there, the stretch again
+               self%u = self%un; self%v = self%vn; self%a = self%an; self%fint = self%fint_n
+               if (.not. boundary_jump(first, kind)) return
+               self%an = self%a; self%fint_n = self%fint
+               call solve_stretch(t_a, h)
+               if (.not. converged) return
+               cycle
+            end if
+            ! the sub-step to the switch, a contact held on the start's branch up to its end
+            ! (whatever the sign of its switch there, 0 to the step's O(h³))
+            self%ms%forced_off = .false.
+            if (first > 0) then
+               branch = self%ms%con_branch(first)
+               self%ms%con_branch(first) = HELD(kind)
+            end if
+            h_left = h
+            call set_step(tau)
+            call external_forces(m, self%mrow, t_a + tau, self%fext)
+            fext_mag = maxval(abs(self%fext))
+            call newton_step(converged)
+            if (first > 0) self%ms%con_branch(first) = branch
+            if (.not. converged) return
+            call commit_works()
+            pending = .false.
+            if (first > 0) then
+               if (.not. boundary_jump(first, kind)) return
+            else if (kind /= 0) then
+               ! a yield: the boundary is on the yield line (the sub-step's end is on it to
+               ! O(h³), either side): the committed force is put on it, so the rest of the
+               ! step starts on the line, not an O(h³) short of it
+               associate (j => -first)
+                  self%ms%link_fc(j) = m%link_par(L_HARDENING, j)*m%link_par(L_STIFF, j)* &
+                                       self%ms%link_u(j) + kind*(1.0_dp - &
+                                       m%link_par(L_HARDENING, j))*m%link_par(L_YIELD, j)
+               end associate
+            end if
+            ! an unloading: the link has turned at the boundary (located to O(h²) in time, its
+            ! du̇ may still point outward there): the rest of the step starts it elastic
+            turned = 0
+            if (first < 0 .and. kind == 0) turned = -first
+            if (tau >= h_left) exit                 ! the switch is on the step's end
+            ! the rest of the step, from the boundary
+            self%un = self%u; self%vn = self%v; self%an = self%a
+            self%fint_n = self%fint; self%fext_n = self%fext
+            call solve_stretch(t_a + tau, h_left - tau)
+            if (.not. converged) return
+            pending = .true.
+         end do
+         if (.not. split) return
+         if (pending) call commit_works()
          ! the step as the strategy and the observer know it: [t0, t]
          self%un = self%us; self%vn = self%vs; self%an = self%as
          call set_step(h_full)
          call contact_state(self, m)
       end function split_step
+
+      !> Solve the stretch [ta, t] of length hh from the state (un, vn, an) (uncommitted)
+      subroutine solve_stretch(ta, hh)
+         real(dp), intent(in) :: ta, hh
+         t_a = ta
+         call mass_times(m, self%an, self%man)
+         call set_step(hh)
+         call external_forces(m, self%mrow, t, self%fext)
+         fext_mag = maxval(abs(self%fext))
+         self%ms%forced_off = .false.
+         call newton_step(converged)
+      end subroutine solve_stretch
+
+      !> The first switch of the stretch just solved, from its start (un, vn, an; the laws
+      !> committed there) to its solved end (u, v), on the branches committed at the start:
+      !> first = j > 0 for contact j, with kind its switch (SW_ONSET from open, SW_SEPARATION
+      !> from closed, a clipped Kelvin's SW_CUT where kδ + cδ̇ turns tensile, SW_REENGAGE
+      !> where it turns compressive again while δ > 0 and SW_CUT_SEPARATION where it
+      !> separates from its cut-off state, with F = 0 on both sides), −j for bilinear link j, with
+      !> kind = ±1 for a yield onto the upper or lower line and 0 for unloading; 0 if none.
+      !> Each switch g (> 0: the branch is left) is followed on the start's quadratic
+      !> g + ġτ + ½g̈τ² (without the jerk where g holds a rate: unloading −du̇, the Kelvin
+      !> force kδ + cδ̇), and a sign change of the solved end is a switch where the quadratic
+      !> has none (chatter rule, or the return map past its surface). tau: from the stretch's
+      !> start (0 and h: a contact's switch within SPLIT_MIN·h of that end).
+      subroutine first_switch(first, tau, kind)
+         integer, intent(out) :: first, kind
+         real(dp), intent(out) :: tau
+         integer :: j, ia, ib, sw, kj
+         real(dp) :: sg, d0, r0, q0, d1, r1, tj, k, rho, r, fp, c0, round, kap
+         first = 0; tau = huge(1.0_dp); kind = 0
+         do j = 1, m%ncontact
+            if (.not. self%ms%is_penalty(j) .or. .not. kinked_law(j)) cycle
+            ia = m%con_a(j); ib = m%con_b(j)
+            d0 = self%un(ia) - self%un(ib) - m%con_gap(j); d1 = self%u(ia) - self%u(ib) - m%con_gap(j)
+            r0 = self%vn(ia) - self%vn(ib); r1 = self%v(ia) - self%v(ib)
+            q0 = self%an(ia) - self%an(ib)
+            if (.not. self%ms%con_on(j)) then
+               kj = SW_ONSET; sg = 1.0_dp                  ! g = δ
+            else if (.not. clipped(j)) then
+               kj = SW_SEPARATION; sg = -1.0_dp            ! g = −δ
+            else
+               ! cut off (no force while δ > 0): it separates at δ = 0 with F = 0 on both sides,
+               ! a switch without a jump that makes a later closing an onset
+               if (.not. (self%ms%con_f(j) > 0.0_dp)) then
+                  tj = switch_time(-d0, -r0, -q0, -d1, .true.)
+                  if (tj < tau) then
+                     tau = tj; first = j; kind = SW_CUT_SEPARATION
+                  end if
+               end if
+               ! the clipped Kelvin force over k, δ + κδ̇: −(it) while it pushes, +(it) while cut
+               kap = m%con_par(P_DAMPING, j)/m%con_par(P_STIFF, j)
+               kj = merge(SW_CUT, SW_REENGAGE, self%ms%con_f(j) > 0.0_dp)
+               sg = merge(-1.0_dp, 1.0_dp, kj == SW_CUT)
+               d0 = d0 + kap*r0; d1 = d1 + kap*r1; r0 = r0 + kap*q0
+            end if
+            tj = switch_time(sg*d0, sg*r0, sg*q0, sg*d1, .true.)
+            if (tj < tau) then
+               tau = tj; first = j; kind = kj
+            end if
+         end do
+         do j = 1, m%nlink
+            if (m%link_kind(j) /= LINK_BILINEAR) cycle
+            ia = m%link_a(j); ib = m%link_b(j)
+            k = m%link_par(L_STIFF, j); rho = m%link_par(L_HARDENING, j)
+            if (rho >= 1.0_dp) cycle
+            r = (1.0_dp - rho)*m%link_par(L_YIELD, j)
+            r0 = self%vn(ia) - self%vn(ib); q0 = self%an(ia) - self%an(ib)
+            ! the branch committed: on a yield line (to the rounding of the return map's clamp)
+            ! while loading outward, else in the elastic band
+            fp = self%ms%link_fc(j) - rho*k*self%ms%link_u(j)
+            round = 64.0_dp*epsilon(1.0_dp)*(abs(self%ms%link_fc(j)) + rho*k*abs(self%ms%link_u(j)) + r)
+            sw = 0
+            if (fp >= r - round .and. r0 > 0.0_dp) sw = 1
+            if (fp <= -(r - round) .and. r0 < 0.0_dp) sw = -1
+            if (j == turned) sw = 0
+            if (sw /= 0) then
+               ! unloading: g = ∓du̇
+               tj = switch_time(-sw*r0, -sw*q0, 0.0_dp, -sw*(self%v(ia) - self%v(ib)), .false.)
+               if (tj < tau) then
+                  tau = tj; first = -j; kind = 0
+               end if
+               cycle
+            end if
+            ! yield: g = ±(f_n + k(du − u_n) − ρk du) − (1 − ρ)F_y, in force units
+            c0 = self%ms%link_fc(j) - k*self%ms%link_u(j)
+            d0 = self%un(ia) - self%un(ib); d1 = self%u(ia) - self%u(ib)
+            do sw = 1, -1, -2
+               tj = switch_time(sw*(c0 + (1.0_dp - rho)*k*d0) - r, sw*(1.0_dp - rho)*k*r0, &
+                                sw*(1.0_dp - rho)*k*q0, sw*(c0 + (1.0_dp - rho)*k*d1) - r, .false.)
+               if (tj < tau) then
+                  tau = tj; first = -j; kind = sw
+               end if
+            end do
+         end do
+      end subroutine first_switch
+
+      !> When g (≤ 0 at the stretch's start: a value past 0 there is a switch just taken, to
+      !> the O(h³) of its location) first becomes > 0 in the stretch [0, h]: on the start's
+      !> quadratic g0 + g1 τ + ½g2 τ², or at the crossing of the solved end g_end > 0 located
+      !> on the free side; huge if never. ends: a switch within SPLIT_MIN·h of an end is put
+      !> on that end (0 or h); otherwise it is no switch of the stretch (huge).
+      real(dp) function switch_time(g0, g1, g2, g_end, ends) result(tau)
+         real(dp), intent(in) :: g0, g1, g2, g_end
+         logical, intent(in) :: ends
+         real(dp) :: g
+         g = min(g0, 0.0_dp)
+         if (g == 0.0_dp .and. (g1 > 0.0_dp .or. (g1 == 0.0_dp .and. g2 > 0.0_dp))) then
+            tau = 0.0_dp
+         else
+            tau = first_root(g, g1, g2)
+            if (tau >= h) then
+               tau = huge(1.0_dp)
+               if (g_end > 0.0_dp) tau = free_side_crossing(g, g1, g2, 0.0_dp, h)
+            end if
+         end if
+         if (tau > h) return
+         if (tau <= SPLIT_MIN*h) then
+            tau = merge(0.0_dp, huge(1.0_dp), ends)
+         else if (h - tau <= SPLIT_MIN*h) then
+            tau = merge(h, huge(1.0_dp), ends)
+         end if
+      end function switch_time
+
+      !> The force of contact j just past its onset at the current end state (δ ≥ 0 to the
+      !> step's accuracy: Kelvin kδ + cδ̇, clipped as the law says; linear kδ, ≈ 0).
+      real(dp) function onset_force(j) result(fplus)
+         integer, intent(in) :: j
+         real(dp) :: d, r, dfd, dfv
+         d = self%u(m%con_a(j)) - self%u(m%con_b(j)) - m%con_gap(j)
+         r = self%v(m%con_a(j)) - self%v(m%con_b(j))
+         call contact_force(m%con_law(j), m%con_par(1, j), m%con_mstar(j), max(d, tiny(1.0_dp)), &
+                            r, r, fplus, dfd, dfv)
+      end function onset_force
+
+      !> The contact laws whose force is not smooth at δ = 0: Kelvin (it jumps by cδ̇) and
+      !> linear (its slope jumps by k); the Hertz and Hunt–Crossley family rise as δ^n, n > 1.
+      pure logical function kinked_law(j)
+         integer, intent(in) :: j
+         kinked_law = m%con_law(j) == LAW_KELVIN .or. m%con_law(j) == LAW_LINEAR
+      end function kinked_law
+
+      pure logical function clipped(j)
+         integer, intent(in) :: j
+         clipped = m%con_law(j) == LAW_KELVIN .and. m%con_par(P_CLIP, j) > 0.5_dp
+      end function clipped
+
+      !> Contact j takes its new branch at the current end state, a boundary of the smooth
+      !> stretches (switch kind of first_switch): the force of that branch (an onset or a
+      !> re-engagement: the law's; a separation or a cut-off: 0) in the internal force, the
+      !> committed contact force and the acceleration (M Δa = −ΔF), and con_on (in contact,
+      !> δ > 0, for the phases) but for the separations. False (with the failure handed over)
+      !> if M is singular.
+      logical function boundary_jump(j, kind) result(ok)
+         integer, intent(in) :: j, kind
+         integer :: ia, ib
+         real(dp) :: fplus
+         ia = m%con_a(j); ib = m%con_b(j)
+         fplus = 0.0_dp
+         if (kind == SW_ONSET .or. kind == SW_REENGAGE) fplus = max(onset_force(j), 0.0_dp)
+         self%ms%con_on(j) = kind /= SW_SEPARATION .and. kind /= SW_CUT_SEPARATION
+         self%jump = 0.0_dp
+         self%jump(ia) = -(fplus - self%ms%con_f(j)); self%jump(ib) = fplus - self%ms%con_f(j)
+         self%fint(ia) = self%fint(ia) - self%jump(ia); self%fint(ib) = self%fint(ib) - self%jump(ib)
+         self%fint(0) = 0.0_dp
+         self%ms%con_f(j) = fplus
+         call solve_free_mass(m, self%fixed_nodes, self%mband, self%jump, ok)
+         if (.not. ok) then
+            call stepper_fail(o, MARTELLO_ERR_SINGULAR, t, 'singular mass at an event-split boundary', stat)
+            return
+         end if
+         self%a = self%a + self%jump
+         self%tangent_valid = .false.
+      end function boundary_jump
 
       !> The first root τ in (0, h) of d + rτ + ½qτ² (h if none)
       real(dp) function first_root(d, r, q) result(tau)
@@ -429,7 +618,7 @@ contains
                   return
                end if
                if (it >= 2) then
-                  call line_search()
+                  call line_search(flips, was_on)
                else
                   u(1:n) = u(1:n) + du
                end if
@@ -440,9 +629,16 @@ contains
       !> Backtracking on ‖r‖∞ once plain Newton has taken two steps without converging: laws
       !> whose tangent is unbounded at first touch (Jankowski: ∂F/∂δ ~ δ^{−3/4}) or that switch
       !> branch inside a step make full steps overshoot; halving restores a decrease.
-      subroutine line_search()
+      !> A full step rejected while it would close or open a contact counts as a flip of it
+      !> (the chatter rule): where the step's solution sits on a jump of the force (a Kelvin
+      !> contact whose δ = 0 falls on the step's end: the force cδ̇ on one side of the
+      !> rounding of δ, none on the other), halving approaches the jump from one side without
+      !> ever flipping, and Newton would stall there instead of holding the contact open.
+      subroutine line_search(flips, was_on)
+         integer, intent(inout) :: flips(:)
+         logical, intent(in) :: was_on(:)
          real(dp) :: lam, r0
-         integer :: k
+         integer :: k, i
          r0 = rnorm
          self%work(1:n) = self%u(1:n)
          lam = 1.0_dp
@@ -450,6 +646,12 @@ contains
             self%u(1:n) = self%work(1:n) + lam*self%du
             call evaluate(.false.)       ! the residual alone
             if (rnorm < r0) return
+            if (k == 1) then
+               do i = 1, m%ncontact
+                  if ((self%ms%con_pen_trial(i) > 0.0_dp .and. .not. self%ms%forced_off(i)) &
+                      .neqv. was_on(i)) flips(i) = flips(i) + 1
+               end do
+            end if
             lam = 0.5_dp*lam
          end do
       end subroutine line_search

@@ -8,7 +8,11 @@ module martello_observer
    use martello_kinds, only: dp, i8
    use martello_status
    use martello_model, only: model_t
-   use martello_assembly, only: mech_state_t, kinetic_energy, recoverable_energy, mass_times
+   use martello_assembly, only: mech_state_t, kinetic_energy, recoverable_energy, mass_times, &
+      load_breakpoint
+   use martello_links, only: link_force, LINK_SPRING, LINK_BAR, LINK_BILINEAR, LINK_DASHPOT, &
+      LINK_FLUID_DAMPER, L_STIFF
+   use martello_contact_laws, only: contact_force, LAW_LINEAR, LAW_KELVIN, P_STIFF, P_DAMPING
    use martello_integrator_settings, only: integrator_settings_t, integrator_name
    use martello_run_quantities
    use martello_registry, only: INTEGRATORS
@@ -21,6 +25,9 @@ module martello_observer
       observer_work, observer_open_phase, observer_close_phase, observer_add_impact, &
       observer_penalty_phases, observer_fail, observer_fail_nonfinite, observer_finish, &
       free_side_crossing, progress_callback, observer_extremum, observer_recorded, &
+      observer_peak, observer_peak_value, peak_items, observer_link_step_extremum, &
+      observer_link_step_peaks, &
+      PEAK_V, PEAK_A, PEAK_PEN, PEAK_FORCE, PEAK_LINK_FORCE, PEAK_LINK_DU, &
       NCOUNTERS, C_STEPS, C_REJECTED, C_NEWTON, C_RESIDUALS, C_FACTORIZATIONS, C_EVENTS, &
       C_JACOBIANS, C_ROOT_EVALS, C_CHATTER, NENERGY, E_KINETIC, E_RECOVERABLE, E_INPUT, E_DAMPING, &
       E_PLASTIC, E_CONTACT, E_BALANCE, E_INITIAL, E_IMPACT, NEVENT, EV_T_ON, EV_T_OFF, &
@@ -36,19 +43,16 @@ module martello_observer
       integer :: nevents = 0
       integer, allocatable :: ev_contact(:)
       real(dp), allocatable :: ev(:, :)
-      ! peaks over every accepted step
+      ! peaks over every accepted step and located inside the steps (docs/results.md): the
+      ! adaptive methods hand theirs (observer_extremum, observer_peak), the fixed-step ones
+      ! are located on each step's polynomial (track)
       real(dp), allocatable :: u_max(:), u_min(:), v_absmax(:), a_absmax(:)
-      !> the largest local maximum of u, interpolated between steps (u_peak at t_peak); the
-      !> step maxima above are O(h) in time, these are O(h²)
+      !> the largest local maximum of u (u_peak at t_peak)
       real(dp), allocatable :: u_peak(:), t_peak(:)
-      !> the largest |u| and its time: at the steps, at the located extrema (observer_extremum)
-      !> and, for the fixed-step methods, at the root of v of the step's cubic Hermite on
-      !> (u, v) at both ends (hermite_extremum; docs/results.md)
+      !> the largest |u| and its time
       real(dp), allocatable :: u_absmax(:), t_absmax(:)
-      !> the method locates the extrema of u inside its steps (observer_extremum): u_peak is
-      !> its largest located maximum, not an interpolation
-      logical :: located_extrema = .false.
-      !> a fixed-step method: |u| is also located on each step's cubic Hermite (hermite_extremum)
+      !> a fixed-step method: the extrema of u and v are located on each step's cubic Hermite
+      !> (hermite_extremum, hermite_v_extremum)
       logical :: fixed_steps = .false.
       real(dp), allocatable :: pen_max(:), force_max(:)
       !> per link: max |force| and max |elongation| (storey shear and drift of a frame)
@@ -93,6 +97,30 @@ module martello_observer
       real(dp), allocatable :: work(:)          !< scratch (0:n): M v
       !> a C integrator's accelerations (0:n), contact penetrations and forces
       real(dp), allocatable :: acc(:), c_pen(:), c_force(:)
+      !> the fixed-step method's states lie on one smooth motion between the phase changes
+      !> (not Moreau–Jean's velocity jumps): the peaks of a, δ, the contact and link forces
+      !> and elongations are located on its steps (track)
+      logical :: smooth_steps = .false.
+      !> per node (0:n): the time of the last phase change (onset, separation, impact) of a
+      !> contact at it; the chatter resolutions at the previous sample (the jumps of the
+      !> forces a located peak of |a| must not straddle)
+      real(dp), allocatable :: node_change(:)
+      integer, allocatable :: con_nodes(:, :)
+      integer(i8) :: chatter_prev = 0_i8
+      !> per contact: its force and force rate at the previous sample, while in contact there;
+      !> the linear and Kelvin laws' k and c, contiguous (read at every step of a chain)
+      real(dp), allocatable :: c_prev_f(:), c_prev_fr(:), c_k(:), c_c(:)
+      !> the peak of |a| on fixed steps (a_parabolas): a sample k that raised it waits two
+      !> samples for the parabola through k − 1, k, k + 1 and the smoothness test with k + 2.
+      !> Per node: a at k − 1, k, k + 1 and the sample k of its latest candidate (a_gen);
+      !> the candidates of the last two samples (pend1: k = the last, pend2: the one before),
+      !> with the time and the chatter count of their sample k − 1
+      real(dp), allocatable :: a_m1(:), a_0(:), a_p1(:)
+      integer(i8), allocatable :: a_gen(:)
+      integer, allocatable :: pend1(:), pend2(:)
+      integer :: npend1 = 0, npend2 = 0
+      real(dp) :: pend1_t0 = 0.0_dp, pend2_t0 = 0.0_dp
+      integer(i8) :: pend1_stamp = 0_i8, pend2_stamp = 0_i8
    end type observer_t
 
    !> The caller's progress callback (martello_run_set_progress): the simulated time, t_end,
@@ -171,7 +199,9 @@ contains
                 o%u_absmax(n_nodes), o%t_absmax(n_nodes), &
                 o%link_du_absmax(n_links), o%prev_u(n_nodes), o%prev_v(n_nodes), &
                 o%prev_a(n_nodes), o%work(0:n_nodes), o%acc(0:n_nodes), o%c_pen(n_contacts), &
-                o%c_force(n_contacts), o%ph_open(n_contacts), &
+                o%c_force(n_contacts), o%ph_open(n_contacts), o%c_prev_f(n_contacts), &
+                o%c_prev_fr(n_contacts), o%a_m1(n_nodes), o%a_0(n_nodes), o%a_p1(n_nodes), &
+                o%a_gen(n_nodes), o%pend1(n_nodes), o%pend2(n_nodes), &
                 o%ph_t(n_contacts), o%ph_v(n_contacts), o%ph_pen(n_contacts), o%ph_f(n_contacts), &
                 stat=st2)
       if (st /= 0 .or. st2 /= 0) then
@@ -190,6 +220,7 @@ contains
       o%u_max = -huge(1.0_dp); o%u_min = huge(1.0_dp); o%v_absmax = 0.0_dp
       o%a_absmax = 0.0_dp; o%pen_max = -huge(1.0_dp); o%force_max = 0.0_dp; o%impacts = 0
       o%ph_open = .false.
+      o%c_prev_f = 0.0_dp; o%c_prev_fr = 0.0_dp; o%a_gen = -10_i8
    end subroutine observer_init
 
    !> The state at t = 0, before its first sample: the initial energies the balance starts
@@ -206,6 +237,10 @@ contains
       real(dp), intent(in) :: ke_aMa
       real(dp) :: e_kin
       integer :: c
+      o%con_nodes = reshape([(m%con_a(c), m%con_b(c), c = 1, m%ncontact)], [2, m%ncontact])
+      o%c_k = m%con_par(P_STIFF, 1:m%ncontact)
+      o%c_c = merge(m%con_par(P_DAMPING, 1:m%ncontact), 0.0_dp, m%con_law(1:m%ncontact) == LAW_KELVIN)
+      allocate (o%node_change(0:m%n), source=-huge(1.0_dp))
       do c = 1, m%ncontact
          if (ms%con_on(c)) call observer_open_phase(o, c, 0.0_dp, v(m%con_a(c)) - v(m%con_b(c)))
       end do
@@ -296,7 +331,8 @@ contains
          if (.not. o%ph_open(c)) cycle
          o%ph_pen(c) = max(o%ph_pen(c), pen(c)); o%ph_f(c) = max(o%ph_f(c), force(c))
       end do
-      call track(o, t, u(1:), v(1:), a(1:), pen, force, link_f, link_du, u_prev, v_prev, a_prev)
+      call track(o, m, ms, t, u(1:), v(1:), a(1:), pen, force, link_f, link_du, u_prev, v_prev, &
+                 a_prev)
       if (due) then
          e_kin = kinetic_energy(m, v, o%work)
          kc = kinetic_correction(o, m, a)
@@ -449,6 +485,7 @@ contains
       o%ph_open(c) = .true.
       o%ph_t(c) = t_on; o%ph_v(c) = v_in; o%ph_pen(c) = 0.0_dp; o%ph_f(c) = 0.0_dp
       o%impacts(c) = o%impacts(c) + 1
+      call phase_change(o, c, t_on)
    end subroutine observer_open_phase
 
    !> Contact c ends its phase at t_off, leaving at v_out. pen, force: the contact's state at
@@ -463,7 +500,17 @@ contains
       if (present(force)) o%ph_f(c) = max(o%ph_f(c), force)
       call add_event(o, c, [o%ph_t(c), t_off, o%ph_v(c), v_out, o%ph_pen(c), o%ph_f(c)])
       o%ph_open(c) = .false.
+      call phase_change(o, c, t_off)
    end subroutine observer_close_phase
+
+   !> Contact c changed phase at t: its nodes' forces jump or kink there.
+   subroutine phase_change(o, c, t)
+      type(observer_t), intent(inout) :: o
+      integer, intent(in) :: c
+      real(dp), intent(in) :: t
+      if (.not. allocated(o%con_nodes)) return
+      o%node_change(o%con_nodes(:, c)) = max(o%node_change(o%con_nodes(:, c)), t)
+   end subroutine phase_change
 
    !> An instantaneous phase of contact c at t (an impact resolved by an impulse): approach
    !> and separation speeds, penetration and force (or impulse) at the impact.
@@ -473,6 +520,7 @@ contains
       real(dp), intent(in) :: t, v_in, v_out, pen, force
       call add_event(o, c, [t, t, v_in, v_out, pen, force])
       o%impacts(c) = o%impacts(c) + 1
+      call phase_change(o, c, t)
    end subroutine observer_add_impact
 
    !> Phases of the penalty contacts of a fixed step (t − h, t], from the committed state
@@ -615,24 +663,30 @@ contains
       r%ev_contact(r%nevents) = contact
    end subroutine add_event
 
-   !> Peaks over every accepted state: extremes of u, |v|, |a|, penetration and force, and
-   !> the largest local maximum of u interpolated between the previous and this state by
-   !> u + vτ + ½aτ², τ = −v/a (O(h²) in time where the step maxima are O(h)).
-   subroutine track(o, t, u, v, a, pen, force, link_f, link_du, u_prev, v_prev, a_prev)
+   !> Peaks over every accepted state: extremes of u, |v|, |a|, penetration and force; on the
+   !> steps of a fixed-step method also the extrema inside them (hermite_extremum: u max,
+   !> min, |u| and the largest local maximum u_peak; hermite_v_extremum; the parabola of |a|;
+   !> contact_step_peaks, observer_link_step_extremum; docs/results.md). The adaptive
+   !> methods hand theirs (observer_extremum, observer_peak).
+   subroutine track(o, m, ms, t, u, v, a, pen, force, link_f, link_du, u_prev, v_prev, a_prev)
       type(observer_t), intent(inout) :: o
+      type(model_t), intent(in) :: m
+      type(mech_state_t), intent(in) :: ms
       real(dp), intent(in) :: t, u(:), v(:), a(:), pen(:), force(:)
       real(dp), intent(in), optional :: link_f(:), link_du(:)
       real(dp), intent(in), optional :: u_prev(:), v_prev(:), a_prev(:)
       integer :: i
-      real(dp) :: tau, up, h
+      real(dp) :: h
+      logical :: stepped
       h = t - o%prev_t
+      stepped = o%smooth_steps .and. o%prev_t >= 0.0_dp .and. h > 0.0_dp
       if (present(u_prev)) then
+         if (stepped) call a_parabolas()
          call peaks(u_prev, v_prev, a_prev)
       else
          call peaks(o%prev_u, o%prev_v, o%prev_a)
          o%prev_u = u; o%prev_v = v; o%prev_a = a
       end if
-      o%prev_t = t
       ! the maxima are stored only when they change: a peak array is then read, not
       ! rewritten, at every step (these passes are a fair part of a chain step's memory traffic)
       do i = 1, size(pen)
@@ -645,19 +699,14 @@ contains
             call raise_to(o%link_du_absmax(i), abs(link_du(i)))
          end do
       end if
+      if (stepped .and. present(u_prev)) then
+         call contact_step_peaks(o, m, ms, o%prev_t, h, u_prev, v_prev, v, a, pen, force)
+         if (present(link_f)) call observer_link_step_peaks(o, m, ms, h, u_prev, v_prev, a_prev, &
+                                                            u, v, a, link_f)
+      end if
+      if (o%smooth_steps) o%chatter_prev = o%counters(C_CHATTER)
+      o%prev_t = t
    contains
-      !> x ← max(x, y), the NaN x starts from replaced without comparing it (an ordered
-      !> comparison with a NaN raises the invalid flag: a trap under -ffpe-trap=invalid)
-      subroutine raise_to(x, y)
-         real(dp), intent(inout) :: x
-         real(dp), intent(in) :: y
-         if (ieee_is_nan(x)) then
-            x = y
-         else if (x < y) then
-            x = y
-         end if
-      end subroutine raise_to
-
       subroutine peaks(un, vn, an)
          real(dp), intent(in) :: un(:), vn(:), an(:)
          associate (umax => o%u_max, umin => o%u_min, vmax => o%v_absmax, amax => o%a_absmax, &
@@ -666,40 +715,292 @@ contains
                if (u(i) > umax(i)) umax(i) = u(i)
                if (u(i) < umin(i)) umin(i) = u(i)
                if (abs(v(i)) > vmax(i)) vmax(i) = abs(v(i))
-               if (abs(a(i)) > amax(i)) amax(i) = abs(a(i))
+               if (abs(a(i)) > amax(i)) then
+                  amax(i) = abs(a(i))
+                  ! a new sampled peak of |a|: located on the parabola through this sample,
+                  ! the one before and the next (a_parabolas)
+                  if (stepped) then
+                     o%npend1 = o%npend1 + 1; o%pend1(o%npend1) = i
+                     o%a_m1(i) = an(i); o%a_0(i) = a(i); o%a_gen(i) = o%nsamples
+                  end if
+               end if
                call fold_absmax(o, i, t, u(i))
                if (o%fixed_steps .and. o%prev_t >= 0.0_dp .and. h > 0.0_dp) then
                   call hermite_extremum(o, i, o%prev_t, h, un(i), vn(i), an(i), u(i), v(i), a(i))
                   call hermite_v_extremum(vmax(i), h, vn(i), an(i), v(i), a(i))
-               end if
-               if (.not. o%located_extrema .and. o%prev_t >= 0.0_dp .and. vn(i) > 0.0_dp .and. &
-                   v(i) <= 0.0_dp) then
-                  if (an(i) < 0.0_dp) then
-                     tau = min(-vn(i)/an(i), h)
-                     up = un(i) + vn(i)*tau + 0.5_dp*an(i)*tau*tau
-                     if (up > upk(i)) then
-                        upk(i) = up; tpk(i) = o%prev_t + tau
-                     end if
+                  ! a maximum on the step's end
+                  if (vn(i) > 0.0_dp .and. v(i) == 0.0_dp .and. u(i) > upk(i)) then
+                     upk(i) = u(i); tpk(i) = t
                   end if
                end if
             end do
          end associate
       end subroutine peaks
+
+      !> The peak of |a| between the samples: a sample k that raised it (a candidate) is the
+      !> middle of the parabola through k − 1, k, k + 1, whose vertex (equal steps; inside
+      !> the middle step when the middle sample is the largest) is O(h³) in a, below the O(h²)
+      !> of the steps, if a is smooth there: no jump of the forces (a phase change of a
+      !> contact at the node, a chatter resolution, a kink of a load) from k − 1 to k + 2,
+      !> and no kink — the second differences at k and k + 1 agree to half their size (a slope
+      !> kink at the peak, as a bilinear spring's yield onto a flat line, makes them differ by
+      !> O(h); its vertex would overshoot by O(h)). Candidates of sample k are completed here
+      !> at k + 1 (a_p1) and decided at k + 2.
+      subroutine a_parabolas()
+         integer :: k, j
+         real(dp) :: ym, y0, yp, yq, d2, sg
+         logical :: smooth
+         if (o%npend2 > 0) then
+            smooth = o%counters(C_CHATTER) == o%pend2_stamp .and. load_breakpoint(m, o%pend2_t0) > t
+            do k = 1, o%npend2
+               j = o%pend2(k)
+               if (.not. smooth .or. o%a_gen(j) /= o%nsamples - 2 .or. o%node_change(j) > o%pend2_t0) cycle
+               sg = sign(1.0_dp, o%a_0(j))
+               ym = sg*o%a_m1(j); y0 = sg*o%a_0(j); yp = sg*o%a_p1(j); yq = sg*a(j)
+               d2 = ym - 2.0_dp*y0 + yp
+               if (.not. (y0 >= ym .and. y0 >= yp .and. d2 < 0.0_dp)) cycle
+               if (abs((y0 - 2.0_dp*yp + yq) - d2) > 0.5_dp*abs(d2)) cycle
+               o%a_absmax(j) = max(o%a_absmax(j), y0 - (yp - ym)**2/(8.0_dp*d2))
+            end do
+         end if
+         ! the last sample's candidates, completed with this one's a
+         do k = 1, o%npend1
+            j = o%pend1(k)
+            o%pend2(k) = j
+            if (o%a_gen(j) == o%nsamples - 1) o%a_p1(j) = a(j)
+         end do
+         o%npend2 = o%npend1; o%pend2_t0 = o%pend1_t0; o%pend2_stamp = o%pend1_stamp
+         o%npend1 = 0; o%pend1_t0 = o%prev_t; o%pend1_stamp = o%chatter_prev
+      end subroutine a_parabolas
    end subroutine track
+
+   !> x(i) of a node array on 1..n, 0 for the ground (i = 0)
+   pure real(dp) function nodal(x, i)
+      real(dp), intent(in) :: x(:)
+      integer, intent(in) :: i
+      nodal = 0.0_dp
+      if (i > 0) nodal = x(i)
+   end function nodal
+
+   !> x ← max(x, y), the NaN x starts from replaced without comparing it (an ordered
+   !> comparison with a NaN raises the invalid flag: a trap under -ffpe-trap=invalid)
+   pure subroutine raise_to(x, y)
+      real(dp), intent(inout) :: x
+      real(dp), intent(in) :: y
+      if (ieee_is_nan(x)) then
+         x = y
+      else if (x < y) then
+         x = y
+      end if
+   end subroutine raise_to
+
+   !> The peaks of the penalty contacts inside a fixed step [t0, t0 + h] from (un, vn) to
+   !> (v, a; δ in pen) (nodes 1..n), while the contact's phase spans the whole step: δ on the cubic
+   !> Hermite of (δ, δ̇) at both ends, the force on the cubic Hermite of (P, Ṗ) with
+   !> Ṗ = P_δ δ̇ + P_δ̇ δ̈ from the law's tangents (contact_force) where the law pushes at both
+   !> ends (a contact held open by the chatter rule, or a clipped Kelvin past its cut-off,
+   !> does not). O(h⁴) in the value where the law is smooth over the step (docs/results.md).
+   subroutine contact_step_peaks(o, m, ms, t0, h, un, vn, v, a, pen, force)
+      type(observer_t), intent(inout) :: o
+      type(model_t), intent(in) :: m
+      type(mech_state_t), intent(in) :: ms
+      real(dp), intent(in) :: t0, h, un(:), vn(:), v(:), a(:), pen(:), force(:)
+      integer :: c, ia, ib
+      real(dp) :: d0, r0, r1, q1, f, dfd, dfv, fr1
+      do c = 1, m%ncontact
+         if (.not. (pen(c) > 0.0_dp)) cycle
+         if (.not. ms%is_penalty(c)) cycle
+         ia = m%con_a(c); ib = m%con_b(c)
+         r1 = nodal(v, ia) - nodal(v, ib); q1 = nodal(a, ia) - nodal(a, ib)
+         ! the law's tangents (the linear and Kelvin ones in line: a chain's every step)
+         select case (m%con_law(c))
+         case (LAW_LINEAR, LAW_KELVIN)
+            fr1 = 0.0_dp
+            if (force(c) > 0.0_dp) fr1 = o%c_k(c)*r1 + o%c_c(c)*q1
+         case default
+            call contact_force(m%con_law(c), m%con_par(:, c), m%con_mstar(c), pen(c), r1, &
+                               ms%con_vin(c), f, dfd, dfv)
+            fr1 = dfd*r1 + dfv*q1
+         end select
+         d0 = nodal(un, ia) - nodal(un, ib) - m%con_gap(c)
+         if (d0 > 0.0_dp .and. o%ph_open(c) .and. o%ph_t(c) <= t0) then
+            r0 = nodal(vn, ia) - nodal(vn, ib)
+            call fold_hermite_max(h, d0, r0, pen(c), r1, o%pen_max(c), o%ph_pen(c))
+            if (o%c_prev_f(c) > 0.0_dp .and. force(c) > 0.0_dp) &
+               call fold_hermite_max(h, o%c_prev_f(c), o%c_prev_fr(c), force(c), fr1, &
+                                     o%force_max(c), o%ph_f(c))
+         end if
+         o%c_prev_f(c) = force(c); o%c_prev_fr(c) = fr1
+      end do
+   end subroutine contact_step_peaks
+
+   !> The largest value inside a step of the cubic Hermite of (q, q̇) at both ends (q0, r0 at
+   !> the start, q1, r1 at the end, a step of h) where the rate turns from > 0 to < 0, into
+   !> both running maxima x and y.
+   pure subroutine fold_hermite_max(h, q0, r0, q1, r1, x, y)
+      real(dp), intent(in) :: h, q0, r0, q1, r1
+      real(dp), intent(inout) :: x, y
+      real(dp) :: s(2), p(2)
+      integer :: k
+      if (.not. (r0 > 0.0_dp .and. r1 < 0.0_dp)) return
+      call cubic_hermite_extrema(h, q0, r0, q1, r1, s, p)
+      do k = 1, 2
+         if (.not. (s(k) > 0.0_dp .and. s(k) < 1.0_dp)) cycle
+         x = max(x, p(k)); y = max(y, p(k))
+      end do
+   end subroutine fold_hermite_max
+
+   !> The peaks of link j inside a fixed step of h, from the relative motion of its nodes at
+   !> both ends (du, du̇, dü) and its force f1 at the end (docs/results.md). The elongation on
+   !> the cubic Hermite of (du, du̇) where du̇ changes sign. The force of a spring, a bar or a
+   !> bilinear spring is monotone in du along a stretch where du is (its tangent is k or ρk
+   !> ≥ 0), so its extremum is at the one of du, du*: valued f1 + k(du* − du1), exact for
+   !> these piecewise-linear laws (after a turn the link unloads elastically, with k, up to
+   !> the step's end). A dashpot's or a fluid damper's force is monotone in du̇: its extremum
+   !> is at that of du̇, on the cubic Hermite of (du̇, dü) where dü changes sign, valued by
+   !> the law. The public door of the fused chain step, which tracks its link peaks itself.
+   subroutine observer_link_step_extremum(o, m, j, h, du0, dv0, da0, du1, dv1, da1, f1)
+      type(observer_t), intent(inout) :: o
+      type(model_t), intent(in) :: m
+      integer, intent(in) :: j
+      real(dp), intent(in) :: h, du0, dv0, da0, du1, dv1, da1, f1
+      real(dp) :: s(2), p(2), f, kt, ct, fnew
+      integer :: k
+      if (dv0*dv1 < 0.0_dp) then
+         call cubic_hermite_extrema(h, du0, dv0, du1, dv1, s, p)
+         do k = 1, 2
+            if (.not. (s(k) > 0.0_dp .and. s(k) < 1.0_dp)) cycle
+            call raise_to(o%link_du_absmax(j), abs(p(k)))
+            select case (m%link_kind(j))
+            case (LINK_SPRING, LINK_BAR, LINK_BILINEAR)
+               call raise_to(o%link_force_absmax(j), abs(f1 + m%link_par(L_STIFF, j)*(p(k) - du1)))
+            end select
+         end do
+      end if
+      select case (m%link_kind(j))
+      case (LINK_DASHPOT, LINK_FLUID_DAMPER)
+         if (.not. (da0*da1 < 0.0_dp)) return
+         call cubic_hermite_extrema(h, dv0, da0, dv1, da1, s, p)
+         do k = 1, 2
+            if (.not. (s(k) > 0.0_dp .and. s(k) < 1.0_dp)) cycle
+            call link_force(m%link_kind(j), m%link_par(:, j), du1, p(k), 0.0_dp, du1, f, kt, ct, &
+                            fnew)
+            call raise_to(o%link_force_absmax(j), abs(f))
+         end do
+      end select
+   end subroutine observer_link_step_extremum
+
+   !> The peaks of every link inside a fixed step of h from (un, vn, an) to (u, v, a) (nodes
+   !> 1..n; observer_link_step_extremum). f1: the link forces at the step's end; absent, the
+   !> law's for springs and bars and the committed ms%link_f for bilinear springs (what the
+   !> fused chain step keeps between its recorded samples; a damper's is not needed).
+   subroutine observer_link_step_peaks(o, m, ms, h, un, vn, an, u, v, a, f1)
+      type(observer_t), intent(inout) :: o
+      type(model_t), intent(in) :: m
+      type(mech_state_t), intent(in) :: ms
+      real(dp), intent(in) :: h, un(:), vn(:), an(:), u(:), v(:), a(:)
+      real(dp), intent(in), optional :: f1(:)
+      integer :: j, ia, ib
+      real(dp) :: du1, dv0, dv1, f
+      logical :: damper
+      do j = 1, m%nlink
+         ia = m%link_a(j); ib = m%link_b(j)
+         ! only a step where du̇ (or, for a damper, dü) changes sign holds a peak
+         dv0 = nodal(vn, ia) - nodal(vn, ib); dv1 = nodal(v, ia) - nodal(v, ib)
+         damper = m%link_kind(j) == LINK_DASHPOT .or. m%link_kind(j) == LINK_FLUID_DAMPER
+         if (.not. (dv0*dv1 < 0.0_dp)) then
+            if (.not. damper) cycle
+            if (.not. ((nodal(an, ia) - nodal(an, ib))*(nodal(a, ia) - nodal(a, ib)) < 0.0_dp)) cycle
+         end if
+         du1 = nodal(u, ia) - nodal(u, ib)
+         if (present(f1)) then
+            f = f1(j)
+         else if (m%link_kind(j) == LINK_BILINEAR) then
+            f = ms%link_f(j)
+         else
+            f = m%link_par(L_STIFF, j)*du1
+         end if
+         call observer_link_step_extremum(o, m, j, h, nodal(un, ia) - nodal(un, ib), dv0, &
+                                          nodal(an, ia) - nodal(an, ib), du1, dv1, &
+                                          nodal(a, ia) - nodal(a, ib), f)
+      end do
+   end subroutine observer_link_step_peaks
+
+   !> A peak of kind (PEAK_*) of item j (node, contact or link) located by the method inside
+   !> an accepted step, with value q (signed: |q| enters the node and link peaks; δ and the
+   !> contact force their maxima and those of the open phase).
+   subroutine observer_peak(o, kind, j, q)
+      type(observer_t), intent(inout) :: o
+      integer, intent(in) :: kind, j
+      real(dp), intent(in) :: q
+      select case (kind)
+      case (PEAK_V)
+         o%v_absmax(j) = max(o%v_absmax(j), abs(q))
+      case (PEAK_A)
+         o%a_absmax(j) = max(o%a_absmax(j), abs(q))
+      case (PEAK_PEN)
+         o%pen_max(j) = max(o%pen_max(j), q)
+         if (o%ph_open(j)) o%ph_pen(j) = max(o%ph_pen(j), q)
+      case (PEAK_FORCE)
+         o%force_max(j) = max(o%force_max(j), q)
+         if (o%ph_open(j)) o%ph_f(j) = max(o%ph_f(j), q)
+      case (PEAK_LINK_FORCE)
+         call raise_to(o%link_force_absmax(j), abs(q))
+      case (PEAK_LINK_DU)
+         call raise_to(o%link_du_absmax(j), abs(q))
+      end select
+   end subroutine observer_peak
+
+   !> The value a located peak of kind, j must exceed to change what is reported: the open
+   !> phase's maximum for δ and the contact force (the run's otherwise), the run's peak for
+   !> the others (|·|; 0 for a link not yet tracked).
+   real(dp) function observer_peak_value(o, kind, j) result(q)
+      type(observer_t), intent(in) :: o
+      integer, intent(in) :: kind, j
+      q = 0.0_dp
+      select case (kind)
+      case (PEAK_V)
+         q = o%v_absmax(j)
+      case (PEAK_A)
+         q = o%a_absmax(j)
+      case (PEAK_PEN)
+         q = o%pen_max(j)
+         if (o%ph_open(j)) q = o%ph_pen(j)
+      case (PEAK_FORCE)
+         q = o%force_max(j)
+         if (o%ph_open(j)) q = o%ph_f(j)
+      case (PEAK_LINK_FORCE)
+         if (.not. ieee_is_nan(o%link_force_absmax(j))) q = o%link_force_absmax(j)
+      case (PEAK_LINK_DU)
+         if (.not. ieee_is_nan(o%link_du_absmax(j))) q = o%link_du_absmax(j)
+      end select
+   end function observer_peak_value
+
+   !> The number of items of a peak kind (0 for an unknown kind).
+   pure integer function peak_items(o, kind) result(n)
+      type(observer_t), intent(in) :: o
+      integer, intent(in) :: kind
+      select case (kind)
+      case (PEAK_V, PEAK_A)
+         n = size(o%v_absmax)
+      case (PEAK_PEN, PEAK_FORCE)
+         n = size(o%pen_max)
+      case (PEAK_LINK_FORCE, PEAK_LINK_DU)
+         n = size(o%link_force_absmax)
+      case default
+         n = 0
+      end select
+   end function peak_items
 
    !> An extremum of node i's displacement located by the method inside an accepted step, at t
    !> with value u (the root of the node's velocity on the stepper's own solution,
    !> docs/run-layer.md): folded into u_max, u_min, and for a maximum (maximum = .true.) into
-   !> u_peak, t_peak. From the first call on, u_peak holds located maxima only.
+   !> u_peak, t_peak.
    subroutine observer_extremum(o, i, t, u, maximum)
       type(observer_t), intent(inout) :: o
       integer, intent(in) :: i
       real(dp), intent(in) :: t, u
       logical, intent(in) :: maximum
-      if (.not. o%located_extrema) then
-         o%located_extrema = .true.
-         o%u_peak = -huge(1.0_dp); o%t_peak = -1.0_dp
-      end if
       o%u_max(i) = max(o%u_max(i), u); o%u_min(i) = min(o%u_min(i), u)
       call fold_absmax(o, i, t, u)
       if (maximum .and. u > o%u_peak(i)) then
@@ -719,7 +1020,8 @@ contains
 
    !> The extremum of u inside a fixed step [t0, t0 + h], located on the cubic Hermite
    !> interpolant of (u, v) at both ends, p(s) = u0 H00 + h v0 H10 + u1 H01 + h v1 H11
-   !> (s = τ/h): the root of p'(s), a quadratic, where v changes sign inside the step.
+   !> (s = τ/h): the root of p'(s), a quadratic, where v changes sign inside the step; into
+   !> u_max, u_min, u_absmax and, a maximum, u_peak.
    !> Interpolation error O(h⁴) in u (O(h³) in the time of the extremum), below the
    !> O(h²) of the structural steps themselves (docs/results.md). A turn the step's
    !> accelerations do not support (v reversed by an impulse: no a of the turn's sign at
@@ -735,7 +1037,12 @@ contains
       if (v0 < 0.0_dp .and. max(a0, a1) <= 0.0_dp) return
       call cubic_hermite_extrema(h, u0, v0, u1, v1, s, p)
       do k = 1, 2
-         if (s(k) > 0.0_dp .and. s(k) < 1.0_dp) call fold_absmax(o, i, t0 + s(k)*h, p(k))
+         if (.not. (s(k) > 0.0_dp .and. s(k) < 1.0_dp)) cycle
+         call fold_absmax(o, i, t0 + s(k)*h, p(k))
+         o%u_max(i) = max(o%u_max(i), p(k)); o%u_min(i) = min(o%u_min(i), p(k))
+         if (v0 > 0.0_dp .and. p(k) > o%u_peak(i)) then      ! a local maximum
+            o%u_peak(i) = p(k); o%t_peak(i) = t0 + s(k)*h
+         end if
       end do
    end subroutine hermite_extremum
 

@@ -1,6 +1,7 @@
-"""What a run of the independent engine reports: peaks, final state, contact phases, link
-maxima, energies and a history, all read from the dense output of its pieces (extrema are
-refined on the interpolant, not taken at the steps)."""
+"""What a run of the independent engine reports: peaks (node u, |v|, |a|; link |force| and
+|elongation|; contact phase penetration and force), final state, contact phases, energies and
+a history, all read from the dense output of its pieces (extrema are refined on the
+interpolant, not taken at the steps)."""
 
 from __future__ import annotations
 
@@ -36,6 +37,15 @@ def _refine(f, a, b, sign):
     return max(cands, key=lambda p: sign * p[1])
 
 
+def _sample_absmax(at, rec, field_, key, x, where):
+    """rec[field_] ← the largest |x| of a piece's samples; where it is largest is kept in at
+    (the sample index and the piece) for the refinement on the interpolant."""
+    k = int(np.argmax(np.abs(x)))
+    if abs(x[k]) > rec[field_]:
+        rec[field_] = float(abs(x[k]))
+        at[key] = (k, where)
+
+
 class Quantities:
     """Element quantities as functions of the state in a piece's modes."""
 
@@ -43,6 +53,11 @@ class Quantities:
         self.run = run
         self.s = run.system
         self.m = run.model
+
+    def accelerations(self, ts, Y, md):
+        """The node accelerations (n × len(ts)) of the states Y at ts in the modes md."""
+        n = self.s.n
+        return np.array([self.s.rhs(t, Y[:, i], md)[n:2 * n] for i, t in enumerate(ts)]).T
 
     def contact(self, Y, md, j):
         s, c = self.s, self.m.contacts[j]
@@ -82,9 +97,11 @@ def summarise(run: Run, grid=None) -> dict:
     """The run's report (docs/independent-reference.md "What it reports")."""
     m, s, q = run.model, run.system, Quantities(run)
     n = s.n
-    nodes = {nm: {"u_max": -math.inf, "u_min": math.inf, "v_absmax": 0.0} for nm in m.names}
+    nodes = {nm: {"u_max": -math.inf, "u_min": math.inf, "v_absmax": 0.0, "a_absmax": 0.0}
+             for nm in m.names}
     links = {}
     link_at = {}
+    absmax_at = {}      # (kind, name) -> (value, (sol, ts, k, md)): |v|, |a|, |du| refined below
     phase_best = [[[0.0, None, 0.0, None] for _ in ph] for ph in run.phases]   # pen, t, force, t
     node_at = {}
     for (t0, t1, sol, steps, md) in run.pieces:
@@ -100,14 +117,17 @@ def summarise(run: Run, grid=None) -> dict:
             if u[k] < nodes[nm]["u_min"]:
                 nodes[nm]["u_min"] = float(u[k])
                 node_at[(nm, -1)] = (sol, ts, k, t0, t1)
-            nodes[nm]["v_absmax"] = max(nodes[nm]["v_absmax"], float(np.max(np.abs(v))))
+            _sample_absmax(absmax_at, nodes[nm], "v_absmax", ("v", nm), v, (sol, ts, md))
+        A = q.accelerations(ts, Y, md)
+        for i, nm in enumerate(m.names):
+            _sample_absmax(absmax_at, nodes[nm], "a_absmax", ("a", nm), A[i], (sol, ts, md))
         for name, du, f in q.links(Y, md):
             rec = links.setdefault(name, {"max_abs_force": 0.0, "max_abs_elongation": 0.0})
             k = int(np.argmax(np.abs(f)))
             if abs(f[k]) > rec["max_abs_force"]:
                 rec["max_abs_force"] = float(abs(f[k]))
                 link_at[name] = (sol, ts, k, t0, t1, md)
-            rec["max_abs_elongation"] = max(rec["max_abs_elongation"], float(np.max(np.abs(du))))
+            _sample_absmax(absmax_at, rec, "max_abs_elongation", ("du", name), du, (sol, ts, md))
         for j in range(len(m.contacts)):
             if not md.active[j]:
                 continue
@@ -130,6 +150,20 @@ def summarise(run: Run, grid=None) -> dict:
         nodes[nm]["t_max" if sign > 0 else "t_min"] = tt
     for nm, rec in nodes.items():
         rec["u_absmax"] = max(abs(rec["u_max"]), abs(rec["u_min"]))
+    for (kind, name), (k, (sol, ts, md)) in absmax_at.items():
+        def fabs(x, kind=kind, name=name, sol=sol, md=md):
+            Yx = sol(np.array([x]))
+            if kind == "v":
+                return abs(float(Yx[n + m.names.index(name)][0]))
+            if kind == "a":
+                return abs(float(q.accelerations(np.array([x]), Yx, md)[m.names.index(name)][0]))
+            return abs(float(next(du for nm_, du, _ in q.links(Yx, md) if nm_ == name)[0]))
+        _, val = _refine(fabs, ts[max(k - 1, 0)], ts[min(k + 1, len(ts) - 1)], 1.0)
+        if kind == "du":
+            links[name]["max_abs_elongation"] = max(val, links[name]["max_abs_elongation"])
+        else:
+            field_ = "v_absmax" if kind == "v" else "a_absmax"
+            nodes[name][field_] = max(val, nodes[name][field_])
     for name, (sol, ts, k, t0, t1, md) in link_at.items():
         def fabs(x, name=name, sol=sol, md=md):
             Yx = sol(np.array([x]))

@@ -68,6 +68,21 @@ def sdof_free_response(m, k, zeta, t, u0=0.0, v0=0.0) -> SDOFResponse:
     return SDOFResponse(x, v, acc)
 
 
+def sdof_free_velocity_peak(m, k, zeta, u0):
+    """(the largest |v|, its time) of the damped SDOF (zeta < 1) released from u0 at rest: the
+    first root of its acceleration in (0, pi/w_d) (brentq on the closed form)."""
+    from scipy.optimize import brentq
+    w02 = k / m
+    a = zeta * math.sqrt(w02)
+    wd = math.sqrt(w02 - a * a)
+
+    def acc(t):
+        return float(damped_state(np.array([t]), u0, 0.0, a, w02)[2][0])
+
+    t = brentq(acc, 1e-3 / wd, math.pi / wd, xtol=1e-16, rtol=1e-15)
+    return abs(float(damped_state(np.array([t]), u0, 0.0, a, w02)[1][0])), t
+
+
 def sdof_sine_ground_response(m, k, zeta, ag_amp, omega_g, t, u0=0.0, v0=0.0) -> SDOFResponse:
     """Exact relative response of m u'' + c u' + k u = -m u_g'' with u_g'' = A sin(Omega t),
     c = 2 zeta w m. This is the particular solution plus the homogeneous one that matches

@@ -12,6 +12,8 @@ from dataclasses import dataclass
 import numpy as np
 from scipy import integrate, optimize, special
 
+from .linear_sdof import damped_state
+
 _EPS = np.finfo(float).eps
 
 
@@ -82,6 +84,40 @@ def kelvin_clipped_restitution(xi):
     # exp(-xi th/nu) * cosh th overflows for huge xi; fold the exponentials together
     return 0.5 * (math.exp(th - xi * th / nu) * (xi / nu - 1.0)
                   - math.exp(-th - xi * th / nu) * (xi / nu + 1.0))
+
+
+@dataclass(frozen=True)
+class KelvinPeaks:
+    delta_max: float    #: the largest penetration
+    t_delta_max: float  #: its time from the onset
+    force_max: float    #: the largest force k delta + c delta'
+    t_force_max: float  #: its time from the onset
+
+
+def kelvin_impact_peaks(mstar, k, xi, v0) -> KelvinPeaks:
+    """P5, the unclipped Kelvin contact (k, c = 2 xi sqrt(k m*), xi < 1) entered at speed v0:
+    delta is the damped free response from (0, v0) (linear_sdof.damped_state), the force
+    F = k delta + c delta' = -m* delta''. The penetration peaks where delta' = 0, the force
+    where F' = m* (w^2 delta' + 2 xi w delta'') = 0 (F' = -m* delta''' and the equation of
+    motion): both are roots of closed-form functions in the first half period pi/w_d
+    (brentq). The force peaks inside the phase when its rate at the onset, v0 (k - c^2/m*),
+    is positive (xi < 1/2); else it is c v0 at the onset."""
+    w = math.sqrt(k / mstar)
+    a = xi * w
+    wd = w * math.sqrt(1.0 - xi * xi)
+
+    def state(t):
+        x, v, acc = damped_state(np.array([t]), 0.0, v0, a, w * w)
+        return float(x[0]), float(v[0]), float(acc[0])
+
+    t_d = optimize.brentq(lambda t: state(t)[1], 1e-3 / wd, math.pi / wd, xtol=1e-16,
+                          rtol=4 * _EPS)
+    c = 2.0 * xi * math.sqrt(k * mstar)
+    if k - c * c / mstar <= 0.0:
+        return KelvinPeaks(state(t_d)[0], t_d, c * v0, 0.0)
+    t_f = optimize.brentq(lambda t: w * w * state(t)[1] + 2.0 * a * state(t)[2], 0.0, t_d,
+                          xtol=1e-16, rtol=4 * _EPS)
+    return KelvinPeaks(state(t_d)[0], t_d, -mstar * state(t_f)[2], t_f)
 
 
 def linear_contact_time(mstar, k):
