@@ -162,9 +162,12 @@ contains
             s%con_vin_trial(j) = 0.0_dp
          else if (s%con_branch(j) == CONTACT_OPEN .or. s%con_branch(j) == CONTACT_CUT) then
             f = 0.0_dp; dfd = 0.0_dp; dfv = 0.0_dp
-            ! the onset speed a commit past the located onset keeps (as the whole law would)
+            ! the onset speed a commit past the located onset keeps: the rate there, the
+            ! relative speed at the instant of impact of the Hunt–Crossley family's
+            ! χ = a/δ̇⁽⁻⁾ (Hunt & Crossley 1975, Lankarani & Nikravesh 1990, Flores et al.
+            ! 2011; docs/problems.md P5), not the larger of it and the previous commit's
             s%con_vin_trial(j) = s%con_vin(j)
-            if (.not. s%con_on(j)) s%con_vin_trial(j) = max(s%con_rate(j), rate, ONSET_SPEED_FLOOR)
+            if (.not. s%con_on(j)) s%con_vin_trial(j) = max(rate, ONSET_SPEED_FLOOR)
          else if (pen > 0.0_dp .and. .not. s%forced_off(j)) then
             ! onset speed: the committed (start-of-step, free-side) rate, not the in-contact
             ! one — exact for a free impact, so the 1/v_in laws keep their order
