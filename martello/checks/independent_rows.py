@@ -18,8 +18,9 @@ from __future__ import annotations
 import copy
 import json
 import math
+from pathlib import Path
 
-from ..paths import REFERENCE_ROOT
+from ..paths import REFERENCE_ROOT, REPO
 from ..reference.store import physics_digest
 
 INDEPENDENT_ROOT = REFERENCE_ROOT / "independent"
@@ -30,16 +31,28 @@ SAFETY = 3.0          # the Richardson estimate is asymptotic; 3 covers a measur
 def find_independent(scene, root=INDEPENDENT_ROOT):
     """The stored independent reference of this scene's physics (nodes, links, contacts,
     loads: martello.reference.store.physics_digest, not the analysis settings) that the
-    catalogue uses, or None."""
+    catalogue uses, or None. A reference that names its `scenes` (paths from the repository
+    root) serves those files only: another scene of the same physics keeps its own evidence."""
     if not root.is_dir():
         return None
     digest = physics_digest(scene)
     for f in sorted(root.glob("*.json")):
         ref = json.loads(f.read_text())
         if ref.get("physics_sha256") == digest and ref.get("catalogue", True) and \
-                ref.get("t_end") == scene.analysis.get("t_end"):
+                ref.get("t_end") == scene.analysis.get("t_end") and _serves(ref, scene):
             return ref
     return None
+
+
+def _serves(ref, scene):
+    names = ref.get("scenes")
+    if not names:
+        return True
+    try:
+        here = Path(scene.source).resolve()
+    except (TypeError, OSError):
+        return False
+    return any(here == (REPO / n).resolve() for n in names)
 
 
 def _quantities(summary):
