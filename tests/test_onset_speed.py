@@ -4,6 +4,7 @@ P5). An event-locating integrator has that instant: the located onset. It used t
 the rate there and the rate at the start of the step that crossed it, so an approach slowed
 by another force took v_in from up to one free-flight step earlier (P7's Flores and Gonthier
 contacts differed from the independent engine by 5e-5 – 2e-3 in e from the third phase on).
+A fixed step has no located onset: it interpolates the rate to where δ crosses 0.
 
 Verification against the independent engine (martello.independent, its own laws and its own
 v_in at the located root), not a closed form: with a force acting before and during the
@@ -43,3 +44,20 @@ def test_hc_damping_takes_the_speed_at_the_located_onset(law, integrator):
         # the old v_in (one free-flight step early, ~0.01 s × 5 m/s² on 0.7 m/s) gave ~1e-3
         assert got["approach_speeds"][i] == pytest.approx(p["v_in"], abs=1e-8)
         assert got["restitution"][i] == pytest.approx(p["restitution"], abs=1e-8)
+
+
+@pytest.mark.parametrize("law", ["flores", "hunt-crossley"])
+def test_a_fixed_step_takes_the_speed_where_the_gap_closes(law):
+    # A fixed step does not locate the onset: v_in was the larger of the start-of-step and
+    # the end-of-step rate, off by |δ̈| θΔt where the spring slows the approach (δ̈ = −5 m/s²),
+    # which put e 1.2e-6 and 5.2e-7 off at Δt = 1e-6 and 5e-7 (Newmark, first order). The rate
+    # interpolated to where δ crosses 0 is second order in Δt: measured 1.5e-8 and 6e-9, so a
+    # bound of 5e-8 separates the two by an order of magnitude at both steps.
+    # the first impact (t = 0.052 s … 0.06 s)
+    ref = independent.solve(wall(law, "rk8pd")).contacts["wall"]["phases"][0]
+    for dt in (1e-6, 5e-7):
+        d = wall(law, "newmark")
+        d["analysis"] = {"type": "dynamic", "integrator": "newmark", "dt": dt, "t_end": 0.1}
+        got = run_full(from_dict(d))[0]["contacts"]["wall"]
+        assert got["impacts"] == 1
+        assert got["restitution"][0] == pytest.approx(ref["restitution"], abs=5e-8), dt
