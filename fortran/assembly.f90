@@ -167,14 +167,20 @@ contains
             s%con_vin_trial(j) = 0.0_dp
          else if (s%con_branch(j) == CONTACT_OPEN .or. s%con_branch(j) == CONTACT_CUT) then
             f = 0.0_dp; dfd = 0.0_dp; dfv = 0.0_dp
-            ! the onset speed a commit past the located onset keeps (as the whole law would)
+            ! the onset speed a commit past the located onset keeps: the rate there, the
+            ! relative speed at the instant of impact of the Hunt–Crossley family's
+            ! χ = a/δ̇⁽⁻⁾ (Hunt & Crossley 1975, Lankarani & Nikravesh 1990, Flores et al.
+            ! 2011; docs/problems.md P5), not the larger of it and the previous commit's
             s%con_vin_trial(j) = s%con_vin(j)
-            if (.not. s%con_on(j)) s%con_vin_trial(j) = max(s%con_rate(j), rate, ONSET_SPEED_FLOOR)
+            if (.not. s%con_on(j)) s%con_vin_trial(j) = max(rate, ONSET_SPEED_FLOOR)
          else if (pen > 0.0_dp .and. .not. s%forced_off(j)) then
-            ! onset speed: the committed (start-of-step, free-side) rate, not the in-contact
-            ! one — exact for a free impact, so the 1/v_in laws keep their order
+            ! onset speed of a step that closes the gap (the fixed steps): the rate where δ
+            ! crosses 0, interpolated between the committed (free-side) state and the trial
+            ! one — second order where either end alone is first order once the approach is
+            ! accelerated (the springs of P7's two oscillators), and exact for a free impact
+            ! to the contact's own O(h^(n+1)) pull on the rate after the touch
             vin = s%con_vin(j)
-            if (.not. s%con_on(j)) vin = max(s%con_rate(j), rate, ONSET_SPEED_FLOOR)
+            if (.not. s%con_on(j)) vin = onset_speed(s%con_pen(j), s%con_rate(j), pen, rate)
             s%con_vin_trial(j) = vin
             if (m%con_law(j) == LAW_LINEAR) then
                dfd = m%con_par(P_STIFF, j); dfv = 0.0_dp; f = dfd*pen
@@ -236,6 +242,21 @@ contains
          end if
       end subroutine stencil
    end subroutine internal_forces
+
+   !> The approach speed where δ crosses 0 between a committed state (δ0 < 0, rate r0) and a
+   !> trial one (δ1 > 0, rate r1), linear in the fraction δ0/(δ0 − δ1); a contact first seen
+   !> already closed or opening (grazing, a step that lands inside) takes the larger rate,
+   !> and never less than ONSET_SPEED_FLOOR (χ = a/v_in).
+   pure function onset_speed(d0, r0, d1, r1) result(v)
+      real(dp), intent(in) :: d0, r0, d1, r1
+      real(dp) :: v
+      if (d0 < 0.0_dp .and. d1 > d0) then
+         v = r0 + (r1 - r0)*(-d0/(d1 - d0))
+      else
+         v = max(r0, r1)
+      end if
+      v = max(v, ONSET_SPEED_FLOOR)
+   end function onset_speed
 
    !> Accept the trial state of the last internal_forces call; optionally return the
    !> trapezoidal work of the elements over the step just ended, split into damping links,

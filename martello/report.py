@@ -126,17 +126,23 @@ def coverage(rows):
     cells = {}
     for r in rows:
         key = (r.get("problem") or "-", r.get("laws", "-"), r.get("integrator", "-"))
-        c = cells.setdefault(key, {"kinds": set(), "digits": [], "n": 0, "ok": True})
+        c = cells.setdefault(key, {"kinds": set(), "digits": [], "n": 0, "ok": True, "files": {}})
         c["kinds"].add(r.get("evidence", "regression"))
         c["n"] += 1
         c["ok"] &= bool(r["passed"])
         if r.get("evidence") in VERIFICATION:
             c["digits"].append(r["digits"])
+        verified = c["files"].setdefault(r.get("file", "?"), False)
+        c["files"][r.get("file", "?")] = verified or r.get("evidence") in VERIFICATION
     out = []
     for (problem, laws, integ), c in sorted(cells.items()):
         kind = next((k for k in VERIFICATION if k in c["kinds"]), "regression only (self-consistent)")
+        # scenes of a verified cell whose own rows are regression only are named, so that a
+        # cell's state never speaks for a scene it does not cover
+        apart = sorted(Path(f).stem for f, v in c["files"].items() if not v) if kind in VERIFICATION else []
         out.append({"problem": problem, "law": laws, "integrator": integ, "evidence": kind,
                     "digits": min(c["digits"]) if c["digits"] else None, "rows": c["n"],
+                    "regression_only_scenes": apart,
                     "state": "verified" if c["ok"] and kind in VERIFICATION else
                     ("WRONG" if not c["ok"] else "self-consistent only")})
     return out
@@ -154,7 +160,10 @@ def coverage_markdown(rows):
              "|---|---|---|---|---|---|---|"]
     for c in cells:
         d = f"{c['digits']:.1f}" if c["digits"] is not None else "—"
-        lines.append(f"| {c['problem']} | {c['law']} | {c['integrator']} | {c['evidence']} | {d} | "
+        ev = c["evidence"]
+        if c["regression_only_scenes"]:
+            ev += "; regression only: " + ", ".join(f"`{n}`" for n in c["regression_only_scenes"])
+        lines.append(f"| {c['problem']} | {c['law']} | {c['integrator']} | {ev} | {d} | "
                      f"{c['rows']} | {c['state']} |")
     return "\n".join(lines)
 

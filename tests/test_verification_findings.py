@@ -157,3 +157,16 @@ def test_moreau_jean_penalty_restitution_is_that_of_its_own_velocities(law):
     tangent = p["stiffness"] if law == "linear" else 1.5 * p["stiffness"] * math.sqrt(closed["max_penetration"])
     omega_h = math.sqrt(tangent / mstar) * 1e-6
     assert abs(e[0] - closed["restitution"]) <= 5.0 * omega_h
+
+
+def test_a_verified_cell_names_its_regression_only_scenes():
+    # P7's Kelvin Newmark cell holds the verified event-split scenes and p7_two_oscillators
+    # (Newmark at Δt = 1e-4 without a split: regression rows only); the cell's state must not
+    # speak for the latter
+    from martello.report import coverage, coverage_markdown
+    base = {"problem": "P7", "laws": "kelvin", "integrator": "newmark", "passed": True, "digits": 4.7}
+    rows = [dict(base, evidence="independent reference", file="laws/p7_two_kelvin_newmark.toml"),
+            dict(base, evidence="regression", file="p7/p7_two_oscillators.toml")]
+    (cell,) = coverage(rows)
+    assert cell["state"] == "verified" and cell["regression_only_scenes"] == ["p7_two_oscillators"]
+    assert "regression only: `p7_two_oscillators`" in coverage_markdown(rows)

@@ -14,6 +14,7 @@ from ..oracles.p5_contact_laws import (HC_FACTORS, hc_max_penetration, hertz_imp
                                        hunt_crossley_realised_e, jankowski_realised_e,
                                        jankowski_xi, kelvin_clipped_restitution, kelvin_damping,
                                        kelvin_xi_from_e, linear_contact_time)
+from ..oracles.p4_wave_theory import penalty_rod_impact
 from ..oracles.p6_hysteresis import elastoplastic_impulse
 
 
@@ -48,6 +49,24 @@ def two_body_impact(law, m1, m2, v0, stiffness, restitution=None, exponent=None,
     else:
         raise ValueError(f"no closed form for law {law!r}")
     return out
+
+
+def penalty_rods(E, rho, A, LA, v0, eps, LB=None, wall=False):
+    """P4's penalty continuum for a scene's rods (docs/p4-bars.md): free rods of one bar
+    (c = √(E/ρ), Z = ρcA), A of length LA at v0 toward B of length LB ≥ LA at rest, or
+    toward a wall, joined by a linear spring eps (wave_theory.penalty_rod_impact). Adds to
+    its values the rods' mean velocities after the contact from its impulse I:
+    vA = v0 − I/(ρ A LA), vB = I/(ρ A LB); and the element-free scales T = 2 LA/c."""
+    c = math.sqrt(E / rho)
+    Z = rho * c * A
+    T = 2.0 * LA / c
+    T_B = None if (wall or LB is None) else 2.0 * LB / c
+    out = dict(penalty_rod_impact(Z, v0, eps, T, duration_B=T_B, wall=wall))
+    out["vA"] = v0 - out["impulse"] / (rho * A * LA)
+    if not wall:
+        out["vB"] = out["impulse"] / (rho * A * (LB if LB is not None else LA))
+    out["T"] = T
+    return {k: v for k, v in out.items() if v is not None}
 
 
 def elastoplastic_peak(m, k, uy, rho, v0):

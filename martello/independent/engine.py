@@ -103,6 +103,9 @@ class System:
         # the largest speed met so far: the scale of the round-off of a velocity switch
         # (a velocity is 0 at its own switch, so its current size says nothing)
         self.vscale = float(np.max(np.abs(m.v0))) if n else 0.0
+        # likewise the largest displacement met so far: a gap of 0 between two bodies at 0
+        # (a barrier touched at rest, docs/problems.md P9) gives its own g no size at the root
+        self.uscale = max([float(np.max(np.abs(m.u0))) if n else 0.0] + [abs(c.gap) for c in m.contacts])
 
     # --- elements ----------------------------------------------------------------------
     def ext(self, y):
@@ -202,7 +205,7 @@ class System:
         def g(y):
             uE, _ = sysm.ext(y)
             d = uE[sysm.ca[j]] - uE[sysm.cb[j]] - c.gap
-            return d, abs(uE[sysm.ca[j]]) + abs(uE[sysm.cb[j]]) + abs(c.gap)
+            return d, abs(uE[sysm.ca[j]]) + abs(uE[sysm.cb[j]]) + abs(c.gap) + sysm.uscale
 
         def gdot(y, acc):
             _, vE = sysm.ext(y)
@@ -459,12 +462,13 @@ def integrate(m: Model, method: str = "DOP853", rtol: float = 1e-11, atol_scale:
     while t < m.t_end:
         t_stop = next(s for s in stops if s > t)
         sws = switches(modes)
-        evs = []
+        evs, offs = [], []
         for s in sws:
             # a switch that starts at its own root (the reverse of the one just applied, or
             # a turning point) is armed past the round-off of g: its sign there is noise
             g0, mag0 = s.g(y)
             off = s.direction * AT_SWITCH * mag0 if abs(g0) <= AT_SWITCH * mag0 else 0.0
+            offs.append(off)
 
             def ev(tt, yy, s=s, off=off):
                 return s.g(yy)[0] - off
@@ -488,12 +492,15 @@ def integrate(m: Model, method: str = "DOP853", rtol: float = 1e-11, atol_scale:
             raise RuntimeError(f"independent engine: {method} failed at t = {sol.t[-1]}: {sol.message}")
         run.steps += len(sol.t) - 1
         sysm.vscale = max(sysm.vscale, float(np.max(np.abs(sol.y[n:2 * n]))))
+        sysm.uscale = max(sysm.uscale, float(np.max(np.abs(sol.y[:n]))))
         t_end_piece = float(sol.t[-1])
         forced = None
         if sol.status == 1:
             for k, s in enumerate(sws):
                 if len(sol.t_events[k]) and sol.t_events[k][-1] == t_end_piece:
                     forced = s
+                    if offs[k] != 0.0:
+                        t_end_piece = _unbiased_root(s, sol, t, t_end_piece)
                     break
         # a threshold passed between two steps and back: find it at the watched extrema
         missed = _missed_threshold(switches, sol, watch, len(sws), md, t, t_end_piece)
@@ -511,6 +518,24 @@ def integrate(m: Model, method: str = "DOP853", rtol: float = 1e-11, atol_scale:
     run.system = sysm
     run.impact_total = impact[0]
     return run
+
+
+def _unbiased_root(s, sol, t0, t1):
+    """The root g = 0 of a switch armed past its round-off band (located at g = ±band at t1):
+    the band is a guard against the noise of g at the piece's start, not a shift of the
+    switch, which would bias it by band/|ġ| (a separation of P9's Kelvin barrier 8e-12 s
+    late, 1e-9 in e). Brent on the dense output from the last time before t1 on the branch's
+    side; t1 if there is none (a root within the band of the start)."""
+    def g(x):
+        return s.g(sol.sol(x))[0]
+    if g(t1) * s.direction <= 0.0:
+        return t1                 # a band below the noise of g: t1 is the root to round-off
+    for lo in sol.t[::-1]:
+        if lo < t1 and g(lo) * s.direction < 0.0:
+            return brentq(g, lo, t1, xtol=4 * EPS * max(abs(t1), 1e-300), rtol=4 * EPS)
+    if t0 < t1 and g(t0) * s.direction < 0.0:
+        return brentq(g, t0, t1, xtol=4 * EPS * max(abs(t1), 1e-300), rtol=4 * EPS)
+    return t1
 
 
 def _element(m, sw):
