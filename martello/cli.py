@@ -46,9 +46,13 @@ def cmd_run(args):
     from .checks.measures import run_measured
     from .run import write_results
     from .run import check_budget
+    from .errors import ResultError
+    from .paths import check_output_folder
     s = load(catalogue.find(args.scene))   # a file, or a path in the catalogue
     for w in check_budget(s, force=args.force):     # steps and output size, before running
         print(f"warning: {w}", file=sys.stderr)
+    out = Path(args.output) if args.output else Path("out") / Path(args.scene).stem
+    check_output_folder(out, "summary.json", ResultError)   # refused before the run, not after it
     show = sys.stderr.isatty() if args.progress is None else args.progress
     line = ProgressLine(sys.stderr) if show else None
     try:
@@ -57,7 +61,6 @@ def cmd_run(args):
     finally:
         if line:
             line.close()
-    out = Path(args.output) if args.output else Path("out") / Path(args.scene).stem
     path = write_results(summary, out, history)
     for w in summary.get("warnings", []):
         print(f"warning: {w}", file=sys.stderr)

@@ -22,7 +22,7 @@ import numpy as np
 from .checks.verify import digits, lookup, oracle_values
 from .errors import MartelloError
 from .history import history_dict
-from .paths import MiB, UnreadableFile, read_input, write_text_atomic
+from .paths import MiB, UnreadableFile, check_regular, read_input, write_text_atomic
 from .metrics.from_history import summary_from_history
 from .metrics.score import COST_KEYS, history_errors, score
 from .reference.selection import reference_for_scene
@@ -127,7 +127,12 @@ def read_history(path, scene=None):
 
 def is_recorder_file(path):
     """True for a whitespace-separated numeric file without a header (an OpenSees recorder's
-    output), False for a CSV with a header row."""
+    output), False for a CSV with a header row. Only a regular file is opened (a FIFO would
+    block the sniffing for ever): anything else is left to read_history's error."""
+    try:
+        check_regular(path)
+    except UnreadableFile:
+        return False
     try:
         with open(path) as fh:
             for ln in fh:

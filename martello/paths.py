@@ -128,16 +128,11 @@ def write_text_atomic(path, text):
         raise
 
 
-@contextmanager
-def folder_replaced(outdir, marker, refuse):
-    """Fill a folder that replaces outdir whole, atomically: the block gets a temporary folder
-    beside outdir to write into; when it ends without an exception the temporary folder is
-    renamed into place (an earlier outdir, stale files included, goes), so outdir holds one
-    complete output or none; on an exception it is removed and outdir stays as it was.
-
-    outdir may exist only as a folder that is empty or holds the file `marker` (an earlier
-    output of the same kind); else, or if the folders cannot be made or renamed, refuse(text)
-    is raised (an exception class taking the one-line message)."""
+def check_output_folder(outdir, marker, refuse):
+    """What folder_replaced will demand of outdir, checked before the work that fills it (a
+    run of an hour must not end in "-o names a file"): outdir is absent, or a folder that is
+    empty or holds `marker`; its first existing ancestor is a folder we may write in.
+    Returns outdir made absolute; refuse(text) otherwise. Nothing is created."""
     outdir = Path(os.path.abspath(outdir))
     if not outdir.name:
         raise refuse(f"{outdir}: cannot be an output folder (give a folder to create)")
@@ -151,6 +146,28 @@ def folder_replaced(outdir, marker, refuse):
             raise refuse(f"{outdir}: holds files of something else ({shown}): the output "
                          "replaces its whole folder (give a new or empty folder, or an earlier "
                          "one of the same command)")
+    above = outdir.parent
+    while not (above.exists() or above.is_symlink()) and above != above.parent:
+        above = above.parent
+    if not above.is_dir():
+        raise refuse(f"{outdir}: cannot create the output folder: {above} is not a folder "
+                     "(give -o a path under a folder)")
+    if not os.access(above, os.W_OK | os.X_OK):
+        raise refuse(f"{outdir}: cannot create the output folder: {above} is not writable")
+    return outdir
+
+
+@contextmanager
+def folder_replaced(outdir, marker, refuse):
+    """Fill a folder that replaces outdir whole, atomically: the block gets a temporary folder
+    beside outdir to write into; when it ends without an exception the temporary folder is
+    renamed into place (an earlier outdir, stale files included, goes), so outdir holds one
+    complete output or none; on an exception it is removed and outdir stays as it was.
+
+    outdir may exist only as a folder that is empty or holds the file `marker` (an earlier
+    output of the same kind); else, or if the folders cannot be made or renamed, refuse(text)
+    is raised (an exception class taking the one-line message)."""
+    outdir = check_output_folder(outdir, marker, refuse)
     try:
         outdir.parent.mkdir(parents=True, exist_ok=True)
         tmp = Path(tempfile.mkdtemp(prefix=f".{outdir.name}.", suffix=".tmp", dir=outdir.parent))

@@ -140,12 +140,37 @@ def test_scene_path_that_is_a_fifo_is_not_opened(tmp_path):
     one_line_error(r, "scene.toml: (file): is a FIFO (named pipe), not a regular file")
 
 
+def test_compared_history_that_is_a_fifo_or_a_device_is_not_opened(tmp_path):
+    """`compare` sniffs a history (CSV or OpenSees recorder) before reading it: the sniffing
+    must not open a FIFO (it would block for ever) or read /dev/zero (no line ever ends)."""
+    fifo = tmp_path / "h.csv"
+    os.mkfifo(fifo)
+    r = martello("compare", fifo, "--against", P5, timeout=30)
+    one_line_error(r, "h.csv: is a FIFO (named pipe), not a regular file")
+    r = martello("compare", "/dev/zero", "--against", P5, timeout=30)
+    one_line_error(r, "/dev/zero: is a character device, not a regular file")
+
+
 def test_output_naming_a_file_is_refused(tmp_path):
     (tmp_path / "afile").write_text("mine\n")
     for out in ("afile", "afile/sub"):
         r = martello("run", P1, "-o", tmp_path / out)
         one_line_error(r, "afile")
         assert (tmp_path / "afile").read_text() == "mine\n"
+
+
+def test_output_naming_a_file_is_refused_before_a_long_run(tmp_path):
+    """A run of 7e7 Newmark steps (about a minute here) with -o under a file: refused at once,
+    before the run, not after it (the fuzz campaign's one hang of `run`)."""
+    (tmp_path / "afile").write_text("mine\n")
+    d = scene_dict("p2/p2_penalty_linear")
+    d["analysis"]["dt"] = 1e-8
+    d["analysis"]["output"] = {"every": 10 ** 9}
+    d.pop("check", None)
+    f = write(tmp_path / "s.toml", d)
+    r = martello("run", f, "-o", tmp_path / "afile" / "sub", "--force", cwd=tmp_path, timeout=20)
+    one_line_error(r, "afile is not a folder")
+    assert (tmp_path / "afile").read_text() == "mine\n"
 
 
 def test_output_folder_of_something_else_is_not_replaced(tmp_path):

@@ -50,7 +50,7 @@ from ..binding import native
 from ..errors import MartelloError, StudyError
 from ..history import history_dict
 from ..oracles.p2_bouncing import bouncing_oscillator_restitution
-from ..paths import OUTPUT_ROOT, REPO, folder_replaced
+from ..paths import OUTPUT_ROOT, REPO, check_output_folder, folder_replaced
 from ..reference.closed_form import kelvin_bounce_reference, two_body_kelvin_reference
 from ..scene.spec import ADAPTIVE, INTEGRATORS
 from .outcome import failed_rows, status_class
@@ -292,6 +292,7 @@ def point_spec(mp, method, xv, yv, ident):
 
 
 def run_atlas(atlas, outdir, jobs=0, plots=True, stream=sys.stderr):
+    check_output_folder(outdir, "atlas.csv", MartelloError)   # before hours of runs, not after
     t0 = time.perf_counter()
     specs, info = [], {}
     for mp in atlas["maps"]:
