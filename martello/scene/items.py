@@ -200,14 +200,9 @@ def _may_share(s, t):
     return _comparable(ls[0], lt[0]) and (_comparable(ls[1][::-1], lt[1][::-1]))
 
 
-class Names(Sequence):
-    """The names of one kind of item, segment by segment (module docstring)."""
-
-    def __init__(self, segments=()):
-        self.segments, self.offsets, self.size = [], [], 0
-        self.listed = {}                  # every listed name -> its first position
-        for seg in segments:
-            self.extend(seg)
+class _Segmented(Sequence):
+    """A sequence kept as consecutive segments (``segments``, their first positions
+    ``offsets``, ``size`` in all); ``_at(segment, j)`` gives the j-th entry of a segment."""
 
     def __len__(self):
         return self.size
@@ -223,7 +218,20 @@ class Names(Sequence):
             i += self.size
         if not 0 <= i < self.size:
             raise IndexError(i)
-        seg, j = self._segment(i)
+        return self._at(*self._segment(i))
+
+
+class Names(_Segmented):
+    """The names of one kind of item, segment by segment (module docstring)."""
+
+    def __init__(self, segments=()):
+        self.segments, self.offsets, self.size = [], [], 0
+        self.listed = {}                  # every listed name -> its first position
+        for seg in segments:
+            self.extend(seg)
+
+    @staticmethod
+    def _at(seg, j):
         return seg.name(j)
 
     def __iter__(self):
@@ -331,7 +339,7 @@ class NameIndex(Mapping):
         return len(self.names)
 
 
-class ItemTable(Sequence):
+class ItemTable(_Segmented):
     """Items of one kind, segment by segment: a segment is a list of dicts (listed) or an
     object with ``__len__`` and ``item(j)`` (generated; martello.scene.chain)."""
 
@@ -343,18 +351,8 @@ class ItemTable(Sequence):
             n += len(s)
         self.size, self.names = n, names
 
-    def __len__(self):
-        return self.size
-
-    def __getitem__(self, i):
-        if isinstance(i, slice):
-            return [self[j] for j in range(*i.indices(self.size))]
-        if i < 0:
-            i += self.size
-        if not 0 <= i < self.size:
-            raise IndexError(i)
-        k = bisect_right(self.offsets, i) - 1
-        s, j = self.segments[k], i - self.offsets[k]
+    @staticmethod
+    def _at(s, j):
         return s[j] if isinstance(s, list) else s.item(j)
 
     def __iter__(self):
