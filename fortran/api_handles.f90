@@ -7,7 +7,7 @@ module martello_api_handles
    use martello_run, only: run_t
    use martello_evaluator, only: evaluator_t
    use martello_observer, only: observer_t
-   use martello_status, only: out_of_memory, memory_message
+   use martello_status, only: out_of_memory, memory_message, FIX_SMALLER_SCENE
    implicit none
    private
    public :: get_model, get_run, get_eval, get_observer, copy_message, from_c_string
@@ -76,13 +76,22 @@ contains
 
    !> The out-of-memory line of the C integrators (c/martello_internal.h): the kernels'
    !> wording (martello_status memory_message), so that every allocation says it alike.
+   !> fix: NULL for FIX_SMALLER_SCENE.
    subroutine c_memory_message(what, bytes, fix, buf, buflen) bind(C, name='martello_memory_message')
-      character(kind=c_char), intent(in) :: what(*), fix(*)
+      character(kind=c_char), intent(in) :: what(*)
       real(c_double), value :: bytes
+      type(c_ptr), value :: fix
       integer(c_int), value :: buflen
       character(kind=c_char), intent(out) :: buf(*)
       integer, parameter :: MAXLEN = 256
-      call copy_message(memory_message(from_c_string(what, MAXLEN), bytes, from_c_string(fix, MAXLEN)), &
-                        buf, buflen)
+      character(kind=c_char), pointer :: cfix(:)
+      if (c_associated(fix)) then
+         call c_f_pointer(fix, cfix, [MAXLEN])
+         call copy_message(memory_message(from_c_string(what, MAXLEN), bytes, &
+                                          from_c_string(cfix, MAXLEN)), buf, buflen)
+      else
+         call copy_message(memory_message(from_c_string(what, MAXLEN), bytes, FIX_SMALLER_SCENE), &
+                           buf, buflen)
+      end if
    end subroutine c_memory_message
 end module martello_api_handles

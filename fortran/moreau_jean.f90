@@ -398,8 +398,8 @@ contains
       subroutine no_memory(what, bytes)
          character(len=*), intent(in) :: what
          real(dp), intent(in) :: bytes
-         write (msg, '(a,i0,a)') ' of ', self%na, ' active contacts'
-         call out_of_memory('Moreau-Jean: '//what//trim(msg), bytes, FIX_SMALLER_SCENE, stat, msg)
+         write (msg, '(a,i0,a)') ' of Moreau-Jean for ', self%na, ' active contacts'
+         call out_of_memory(what//trim(msg), bytes, FIX_SMALLER_SCENE, stat, msg)
          call observer_fail(o, MARTELLO_ERR_MEMORY, t_prev, msg, stat)
       end subroutine no_memory
 

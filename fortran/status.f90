@@ -65,13 +65,17 @@ contains
    end subroutine out_of_memory
 
    !> The one line of every allocation of the library that failed, Fortran and C alike:
-   !> what could not be allocated, how much, and what to change.
+   !> what could not be allocated, how much (bytes < 0: not known, an object GSL or SUNDIALS
+   !> allocates inside), and what to change.
    function memory_message(what, bytes, fix) result(line)
       character(len=*), intent(in) :: what, fix
       real(dp), intent(in) :: bytes
       character(len=:), allocatable :: line
       character(len=32) :: amount
-      if (bytes >= 1.0e9_dp) then
+      if (bytes < 0.0_dp) then
+         line = 'out of memory allocating '//what//': '//fix
+         return
+      else if (bytes >= 1.0e9_dp) then
          write (amount, '(f0.1,a)') bytes/1.0e9_dp, ' GB'
       else if (bytes >= 1.0e6_dp) then
          write (amount, '(f0.1,a)') bytes/1.0e6_dp, ' MB'
