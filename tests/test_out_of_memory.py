@@ -17,20 +17,18 @@ import re
 import resource
 import subprocess
 import sys
-from pathlib import Path
 
 import pytest
 
-ROOT = Path(__file__).resolve().parent.parent
 
 # The cap is the peak address space of the same command on a small scene (everything loaded;
 # measured in the test, as /proc/self/status VmPeak: 170 MB for the Release build on the
 # reference machine, both integrators) plus MARGIN_MB. The large scene (n = 12 000) needs
-# under 5 MB more than the small one before its first large array (model, observer and loader
-# arrays are O(n); its large run reached 300 MB of VmPeak in all, the failed request
-# included, against the 170 MB of the small one), and that array alone is 1.15 GB
-# (n² doubles: fast-nonlinear's K_L; the event-driven columns M⁻¹ B_jᵀ of n − 1 contacts):
-# more than twice MARGIN_MB. So the allocation that fails is that one, on any machine.
+# little more than the small one before its first large array: its loader, model and
+# observer arrays are O(n) (a whole Newmark run of it peaks at 176 MB against the small
+# scene's 170 MB, measured the same way), while that array alone is 1.15 GB (n² doubles:
+# fast-nonlinear's K_L; the event-driven columns M⁻¹ B_jᵀ of n − 1 contacts), more than twice
+# MARGIN_MB. So the allocation that fails is that one, on any machine.
 MARGIN_MB = 512
 N = 12_000
 
