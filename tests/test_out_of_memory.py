@@ -135,3 +135,18 @@ def test_the_c_integrators_and_the_kernels_say_it_alike():
     assert memory_message("x", 999) .startswith("out of memory allocating x (999 bytes): ")
     assert memory_message("the GSL driver", -1, "use less") == \
         "out of memory allocating the GSL driver: use less"
+
+
+def test_a_ground_motion_function_out_of_memory_says_the_same_line():
+    """c/ground_motion.c returns MARTELLO_ERR_MEMORY without a message (its public API has
+    none): the binding says the library's line for the record's workspace. A mapping check
+    (the status given, not memory taken away)."""
+    from martello.binding.ground_motion import check_status
+    from martello.binding.native import constant
+    from martello.errors import SolverError
+    with pytest.raises(SolverError) as e:
+        check_status(constant("MARTELLO_ERR_MEMORY"), "response spectrum", 4096)
+    assert str(e.value) == ("MARTELLO_ERR_MEMORY (-2): out of memory allocating the workspace of "
+                            "the response spectrum of a record of 4096 samples: use a shorter "
+                            "record (fewer samples)")
+    assert check_status(0, "response spectrum", 4096) == 0
