@@ -92,12 +92,26 @@ typedef struct {
   long long cnt[MARTELLO_NCOUNTERS];
   double e_impact;
   int rhs_status;                 /* why the RHS stopped GSL */
+  double alloc_bytes;             /* the size of the last allocation tried (ALLOC) */
   char msg[512];
 } ed_t;
 
 /* ---- helpers --------------------------------------------------------------------------- */
 
+/* An allocation failed: the library's out-of-memory line for what (for the run's n nodes
+ * and nc contacts) and bytes (< 0: allocated inside GSL, amount not known). */
+static int fail_memory(ed_t *w, const char *what, double bytes, double t) {
+  char of[192];
+  snprintf(of, sizeof of, "%s for a scene of %d nodes and %d contacts", what, w->n, w->nc);
+  martello_memory_message(of, bytes, NULL, w->msg, (int)sizeof w->msg);
+  return martello_observer_fail(w->obs, MARTELLO_ERR_MEMORY, t, w->msg);
+}
+
+/* The run fails with status at t, saying what; MARTELLO_ERR_MEMORY comes only from the
+ * impulse doors (their LCP solver's work arrays) and says so in the out-of-memory line. */
 static int fail(ed_t *w, int status, double t, const char *what) {
+  if (status == MARTELLO_ERR_MEMORY)
+    return fail_memory(w, "the work arrays of the event-driven LCP solver", -1.0, t);
   snprintf(w->msg, sizeof w->msg, "%s (t = %.9e s)", what, t);
   return martello_observer_fail(w->obs, status, t, w->msg);
 }
@@ -961,9 +975,13 @@ static void ed_free(ed_t *w) {
   if (w->ev) martello_eval_free(&w->ev);
 }
 
-/* p = calloc(count) (at least one element); true on success */
+/* p = calloc(count) (at least one element), its size kept in w->alloc_bytes for the
+ * out-of-memory line; true on success */
 #define ALLOC(p, count) \
-  ((p) = calloc((size_t)(count) > 0 ? (size_t)(count) : 1, sizeof *(p)), (p) != NULL)
+  (w->alloc_bytes = (double)((size_t)(count) > 0 ? (size_t)(count) : 1) * sizeof *(p), \
+   (p) = calloc((size_t)(count) > 0 ? (size_t)(count) : 1, sizeof *(p)), (p) != NULL)
+/* the out-of-memory line of the ALLOC that failed */
+#define FAIL_ALLOC() fail_memory(w, "an array of the event-driven state", w->alloc_bytes, 0.0)
 
 /* Everything the run needs, allocated once before the time loop. */
 static int ed_setup(ed_t *w) {
@@ -977,7 +995,7 @@ static int ed_setup(ed_t *w) {
         ALLOC(w->con_a, nc) && ALLOC(w->con_b, nc) && ALLOC(w->scheme, nc) &&
         ALLOC(w->is_pen, nc) &&
         ALLOC(w->uni, nc) && ALLOC(w->inert, nc)))
-    return MARTELLO_ERR_MEMORY;
+    return FAIL_ALLOC();
   /* three distinct outputs: the Fortran dummies are intent(out) and must not alias */
   st = martello_model_topology(w->model, &nn, &nc_read, w->mass, w->fixed, w->con_a, w->con_b,
                                w->scheme, w->gap, w->e, &ncoup);
@@ -1007,7 +1025,7 @@ static int ed_setup(ed_t *w) {
         ALLOC(w->wl, nc) && ALLOC(w->sl, nc) && ALLOC(w->el, nc) && ALLOC(w->tg, nc) &&
         ALLOC(w->hk, nc) && ALLOC(w->t_hold, nc) && ALLOC(w->t_impact, nc) &&
         ALLOC(w->flight, nc)))
-    return MARTELLO_ERR_MEMORY;
+    return FAIL_ALLOC();
   for (j = 0; j < nc; j++) w->t_impact[j] = -1.0;   /* no impact yet */
   st = martello_eval_create(w->model, &w->ev);
   if (st != MARTELLO_OK) return fail(w, st, 0.0, "event-driven: martello_eval_create failed");
@@ -1016,13 +1034,13 @@ static int ed_setup(ed_t *w) {
   if (!(ALLOC(w->el0, 4 * (nc + w->nl)) && ALLOC(w->el1, 4 * (nc + w->nl)) &&
         ALLOC(w->elc, 4 * (nc + w->nl)) && ALLOC(w->jk0, n) && ALLOC(w->jk1, n) &&
         ALLOC(w->fp, n)))
-    return MARTELLO_ERR_MEMORY;
+    return FAIL_ALLOC();
   /* every switching surface of the laws is an event: hold them on smooth branches */
   st = martello_eval_use_branches(w->ev, &w->nsw);
   if (st != MARTELLO_OK) return fail(w, st, 0.0, "event-driven: martello_eval_use_branches failed");
   if (!(ALLOC(w->sw_a, w->nsw) && ALLOC(w->sw_b, w->nsw) && ALLOC(w->sw_al, w->nsw) &&
         ALLOC(w->sw_be, w->nsw) && ALLOC(w->sw_ga, w->nsw)))
-    return MARTELLO_ERR_MEMORY;
+    return FAIL_ALLOC();
   if (w->nsw > 0 &&
       martello_eval_switches(w->ev, w->sw_a, w->sw_b, w->sw_al, w->sw_be, w->sw_ga) != MARTELLO_OK)
     return fail(w, MARTELLO_ERR_ARGUMENT, 0.0, "event-driven: martello_eval_switches failed");
@@ -1054,14 +1072,16 @@ static int ed_setup(ed_t *w) {
   if (w->h_max > 0.0) h0 = fmin(h0, w->h_max);
   w->drv = gsl_odeiv2_driver_alloc_scaled_new(&w->sys, T, h0, w->atol, w->rtol, 1.0, 0.0,
                                               w->scale_abs);
-  if (w->drv == NULL) return MARTELLO_ERR_MEMORY;
+  if (w->drv == NULL) return fail_memory(w, "the GSL driver of the event-driven run", -1.0, 0.0);
   if (w->kind == MARTELLO_INT_MSBDF) {
     w->rdrv = gsl_odeiv2_driver_alloc_scaled_new(&w->sys, gsl_odeiv2_step_rk4imp, h0, w->atol,
                                                  w->rtol, 1.0, 0.0, w->scale_abs);
-    if (w->rdrv == NULL) return MARTELLO_ERR_MEMORY;
+    if (w->rdrv == NULL)
+      return fail_memory(w, "the GSL restart driver of the event-driven run", -1.0, 0.0);
   } else {
     w->rstep = gsl_odeiv2_step_alloc(T, dim);
-    if (w->rstep == NULL) return MARTELLO_ERR_MEMORY;
+    if (w->rstep == NULL)
+      return fail_memory(w, "the GSL restart stepper of the event-driven run", -1.0, 0.0);
   }
   return MARTELLO_OK;
 }
@@ -1216,8 +1236,6 @@ int martello_event_driven_run(martello_model *model, martello_run *run) {
   st = martello_model_topology(model, &w.n, &w.nc, NULL, NULL, NULL, NULL, NULL, NULL, NULL, &nco);
   if (st != MARTELLO_OK) return st;
   st = ed_setup(&w);
-  if (st == MARTELLO_ERR_MEMORY)
-    martello_observer_fail(w.obs, st, 0.0, "event-driven: out of memory");
   if (st == MARTELLO_OK) st = ed_integrate(&w);
   martello_observer_add_counts(w.obs, w.cnt);
   if (st == MARTELLO_OK) martello_observer_finish(w.obs, w.t_end);

@@ -113,9 +113,15 @@ typedef struct {
 
 /* ---- small helpers ------------------------------------------------------------------ */
 
+static int fail_memory(ida_problem *P, const char *what, double bytes);
+
+/* The run fails with code at P->t_now, saying fmt; MARTELLO_ERR_MEMORY comes only from the
+ * impulse doors (their LCP solver's work arrays) and says so in the out-of-memory line. */
 static int fail(ida_problem *P, int code, const char *fmt, ...) {
   char buf[480];
   va_list ap;
+  if (code == MARTELLO_ERR_MEMORY)
+    return fail_memory(P, "the work arrays of the IDA LCP solver", -1.0);
   va_start(ap, fmt);
   vsnprintf(buf, sizeof buf, fmt, ap);
   va_end(ap);
@@ -758,10 +764,21 @@ static int boundary_events(ida_problem *P, void *mem, double t_last, double tret
 
 /* ---- set-up ----------------------------------------------------------------------------- */
 
-static void *take(size_t count, size_t size, int *ok) {
+/* calloc(count) (at least one element); on failure its size is kept in *failed (the
+ * first that failed), for the out-of-memory line */
+static void *take(size_t count, size_t size, double *failed) {
   void *p = calloc(count > 0 ? count : 1, size);
-  if (!p) *ok = 0;
+  if (!p && *failed == 0.0) *failed = (double)(count > 0 ? count : 1) * (double)size;
   return p;
+}
+
+/* An allocation failed: the library's out-of-memory line for what (for the run's n nodes
+ * and nc contacts) and bytes (< 0: allocated inside SUNDIALS, amount not known). */
+static int fail_memory(ida_problem *P, const char *what, double bytes) {
+  char of[192], line[480];
+  snprintf(of, sizeof of, "%s for a scene of %d nodes and %d contacts", what, P->n, P->nc);
+  martello_memory_message(of, bytes, NULL, line, (int)sizeof line);
+  return martello_observer_fail(P->obs, MARTELLO_ERR_MEMORY, P->t_now, line);
 }
 
 static void release(ida_problem *P) {
@@ -821,7 +838,8 @@ static int bandwidth(ida_problem *P, const double *u0, const double *v0, suninde
 }
 
 static int setup(ida_problem *P, martello_model *model, martello_run *run) {
-  int st, ok = 1, n, nc, ncp;
+  int st, n, nc, ncp;
+  double failed = 0.0;
   martello_settings s;
   P->model = model;
   P->run = run;
@@ -840,20 +858,20 @@ static int setup(ida_problem *P, martello_model *model, martello_run *run) {
   P->n = n;
   P->nc = nc;
   P->ncoupling = ncp;
-  P->mass = take((size_t)n, sizeof(double), &ok);
-  P->fixed = take((size_t)n, sizeof(int), &ok);
-  P->con_a = take((size_t)nc, sizeof(int), &ok);
-  P->con_b = take((size_t)nc, sizeof(int), &ok);
-  P->scheme = take((size_t)nc, sizeof(int), &ok);
-  P->gap = take((size_t)nc, sizeof(double), &ok);
-  P->rest = take((size_t)nc, sizeof(double), &ok);
-  if (!ok) return fail(P, MARTELLO_ERR_MEMORY, "IDA: out of memory");
+  P->mass = take((size_t)n, sizeof(double), &failed);
+  P->fixed = take((size_t)n, sizeof(int), &failed);
+  P->con_a = take((size_t)nc, sizeof(int), &failed);
+  P->con_b = take((size_t)nc, sizeof(int), &failed);
+  P->scheme = take((size_t)nc, sizeof(int), &failed);
+  P->gap = take((size_t)nc, sizeof(double), &failed);
+  P->rest = take((size_t)nc, sizeof(double), &failed);
+  if (failed > 0.0) return fail_memory(P, "an array of the IDA state", failed);
   if ((st = martello_model_topology(model, &n, &nc, P->mass, P->fixed, P->con_a, P->con_b,
                                     P->scheme, P->gap, P->rest, &ncp)) != MARTELLO_OK)
     return fail(P, st, "IDA: could not read the model");
-  P->rig = take((size_t)nc, sizeof(int), &ok);
-  P->rig_con = take((size_t)nc, sizeof(int), &ok);
-  if (!ok) return fail(P, MARTELLO_ERR_MEMORY, "IDA: out of memory");
+  P->rig = take((size_t)nc, sizeof(int), &failed);
+  P->rig_con = take((size_t)nc, sizeof(int), &failed);
+  if (failed > 0.0) return fail_memory(P, "an array of the IDA state", failed);
   P->nr = 0;
   for (int j = 0; j < nc; j++) {
     if (P->scheme[j] == MARTELLO_SCHEME_LAGRANGE || P->scheme[j] == MARTELLO_SCHEME_RESTITUTION) {
@@ -866,32 +884,32 @@ static int setup(ida_problem *P, martello_model *model, martello_run *run) {
     }
   }
   size_t nr = (size_t)P->nr, un = (size_t)n, ucn = (size_t)nc;
-  P->iu = take(un, sizeof(sunindextype), &ok);
-  P->iv = take(un, sizeof(sunindextype), &ok);
-  P->ip = take(nr, sizeof(sunindextype), &ok);
-  P->im = take(nr, sizeof(sunindextype), &ok);
-  P->closed = take(nr, sizeof(int), &ok);
-  P->opened = take(nr, sizeof(int), &ok);
-  P->was_closed = take(nr, sizeof(int), &ok);
-  P->hit = take(nr, sizeof(int), &ok);
-  P->cand = take(nr, sizeof(int), &ok);
-  P->q = take(nr, sizeof(double), &ok);
-  P->w0 = take(nr, sizeof(double), &ok);
-  P->dc = take(nr, sizeof(int), &ok);
-  P->cols = take(nr * un, sizeof(double), &ok);
-  P->aset = take(nr, sizeof(int), &ok);
-  P->lam = take(nr, sizeof(double), &ok);
-  P->rhs = take(nr, sizeof(double), &ok);
-  P->S = take(nr * nr, sizeof(double), &ok);
-  P->act = take(ucn, sizeof(int), &ok);
-  P->w_in = take(ucn, sizeof(double), &ok);
-  P->force = take(ucn, sizeof(double), &ok);
-  P->t_impact = take(nr, sizeof(double), &ok);
-  P->v_last = take(un, sizeof(double), &ok);
-  P->flight = take(nr, sizeof(double), &ok);
+  P->iu = take(un, sizeof(sunindextype), &failed);
+  P->iv = take(un, sizeof(sunindextype), &failed);
+  P->ip = take(nr, sizeof(sunindextype), &failed);
+  P->im = take(nr, sizeof(sunindextype), &failed);
+  P->closed = take(nr, sizeof(int), &failed);
+  P->opened = take(nr, sizeof(int), &failed);
+  P->was_closed = take(nr, sizeof(int), &failed);
+  P->hit = take(nr, sizeof(int), &failed);
+  P->cand = take(nr, sizeof(int), &failed);
+  P->q = take(nr, sizeof(double), &failed);
+  P->w0 = take(nr, sizeof(double), &failed);
+  P->dc = take(nr, sizeof(int), &failed);
+  P->cols = take(nr * un, sizeof(double), &failed);
+  P->aset = take(nr, sizeof(int), &failed);
+  P->lam = take(nr, sizeof(double), &failed);
+  P->rhs = take(nr, sizeof(double), &failed);
+  P->S = take(nr * nr, sizeof(double), &failed);
+  P->act = take(ucn, sizeof(int), &failed);
+  P->w_in = take(ucn, sizeof(double), &failed);
+  P->force = take(ucn, sizeof(double), &failed);
+  P->t_impact = take(nr, sizeof(double), &failed);
+  P->v_last = take(un, sizeof(double), &failed);
+  P->flight = take(nr, sizeof(double), &failed);
   double **work[] = {&P->u, &P->v, &P->a, &P->x, &P->uq, &P->vq, &P->fint, &P->fext, &P->mb};
-  for (size_t k = 0; k < sizeof work / sizeof work[0]; k++) *work[k] = take(un, sizeof(double), &ok);
-  if (!ok) return fail(P, MARTELLO_ERR_MEMORY, "IDA: out of memory");
+  for (size_t k = 0; k < sizeof work / sizeof work[0]; k++) *work[k] = take(un, sizeof(double), &failed);
+  if (failed > 0.0) return fail_memory(P, "an array of the IDA state", failed);
   /* layout: node i's (u, v), then the (P, mu) of the rigid contacts whose first node is i
    * (between the two nodes of a chain link: half-bandwidth 3, 5 with links) */
   sunindextype pos = 0;
@@ -917,19 +935,19 @@ static int setup(ida_problem *P, martello_model *model, martello_run *run) {
     const size_t ne = 4 * ((size_t)nc + (size_t)P->nl);
     double **el[] = {&P->el0, &P->el1, &P->elc};
     double **nd[] = {&P->pv0, &P->pa0, &P->pj0, &P->pv1, &P->pa1, &P->pj1, &P->ua, &P->va, &P->aa};
-    for (size_t k = 0; k < sizeof el / sizeof el[0]; k++) *el[k] = take(ne, sizeof(double), &ok);
-    for (size_t k = 0; k < sizeof nd / sizeof nd[0]; k++) *nd[k] = take((size_t)n, sizeof(double), &ok);
-    if (!ok) return fail(P, MARTELLO_ERR_MEMORY, "IDA: out of memory");
+    for (size_t k = 0; k < sizeof el / sizeof el[0]; k++) *el[k] = take(ne, sizeof(double), &failed);
+    for (size_t k = 0; k < sizeof nd / sizeof nd[0]; k++) *nd[k] = take((size_t)n, sizeof(double), &failed);
+    if (failed > 0.0) return fail_memory(P, "an array of the IDA state", failed);
   }
   /* every switching surface of the laws is a root: hold them on smooth branches */
   if ((st = martello_eval_use_branches(P->ev, &P->nsw)) != MARTELLO_OK)
     return fail(P, st, "IDA: martello_eval_use_branches failed");
-  P->sw_a = take((size_t)P->nsw, sizeof(int), &ok);
-  P->sw_b = take((size_t)P->nsw, sizeof(int), &ok);
-  P->sw_al = take((size_t)P->nsw, sizeof(double), &ok);
-  P->sw_be = take((size_t)P->nsw, sizeof(double), &ok);
-  P->sw_ga = take((size_t)P->nsw, sizeof(double), &ok);
-  if (!ok) return fail(P, MARTELLO_ERR_MEMORY, "IDA: out of memory");
+  P->sw_a = take((size_t)P->nsw, sizeof(int), &failed);
+  P->sw_b = take((size_t)P->nsw, sizeof(int), &failed);
+  P->sw_al = take((size_t)P->nsw, sizeof(double), &failed);
+  P->sw_be = take((size_t)P->nsw, sizeof(double), &failed);
+  P->sw_ga = take((size_t)P->nsw, sizeof(double), &failed);
+  if (failed > 0.0) return fail_memory(P, "an array of the IDA state", failed);
   if (P->nsw > 0 &&
       (st = martello_eval_switches(P->ev, P->sw_a, P->sw_b, P->sw_al, P->sw_be, P->sw_ga)) != MARTELLO_OK)
     return fail(P, st, "IDA: martello_eval_switches failed");
@@ -1129,7 +1147,7 @@ static int integrate(ida_problem *P, SUNContext sunctx, void **memp, N_Vector yy
 
   /* IDA: create, init, options (SUNDIALS lifecycle) */
   void *mem = IDACreate(sunctx);
-  if (!mem) return fail(P, MARTELLO_ERR_MEMORY, "IDACreate failed");
+  if (!mem) return fail_memory(P, "the IDA solver memory (IDACreate)", -1.0);
   *memp = mem;
   if ((st = check(P, IDASetErrHandlerFn(mem, error_handler, P), "IDASetErrHandlerFn"))) return st;
   if ((st = check(P, IDAInit(mem, residual, 0.0, yy, yp), "IDAInit"))) return st;
@@ -1144,9 +1162,9 @@ static int integrate(ida_problem *P, SUNContext sunctx, void **memp, N_Vector yy
   if ((st = check(P, IDASVtolerances(mem, P->rtol, id), "IDASVtolerances"))) return st;
   if ((st = check(P, IDASetUserData(mem, P), "IDASetUserData"))) return st;
   *Jp = banded ? SUNBandMatrix(P->N, bw, bw, sunctx) : SUNDenseMatrix(P->N, P->N, sunctx);
-  if (!*Jp) return fail(P, MARTELLO_ERR_MEMORY, "IDA: could not create the Jacobian matrix");
+  if (!*Jp) return fail_memory(P, "the IDA Jacobian matrix", -1.0);
   *LSp = banded ? SUNLinSol_Band(yy, *Jp, sunctx) : SUNLinSol_Dense(yy, *Jp, sunctx);
-  if (!*LSp) return fail(P, MARTELLO_ERR_MEMORY, "IDA: could not create the linear solver");
+  if (!*LSp) return fail_memory(P, "the IDA linear solver", -1.0);
   if ((st = check(P, IDASetLinearSolver(mem, *LSp, *Jp), "IDASetLinearSolver"))) return st;
   if (P->h_max > 0.0 && (st = check(P, IDASetMaxStep(mem, P->h_max), "IDASetMaxStep"))) return st;
   double h0;
@@ -1168,8 +1186,9 @@ static int integrate(ida_problem *P, SUNContext sunctx, void **memp, N_Vector yy
   for (int i = 0; i < n; i++) P->v_last[i] = N_VGetArrayPointer(yy)[P->iv[i]];
   double t_stop = next_stop(P, 0.0, t_out);
   if ((st = check(P, IDASetStopTime(mem, t_stop), "IDASetStopTime"))) return st;
-  int *found = calloc((size_t)(2 * P->nc + P->nsw + 1), sizeof(int));
-  if (!found) return fail(P, MARTELLO_ERR_MEMORY, "IDA: out of memory");
+  const size_t n_found = (size_t)(2 * P->nc + P->nsw + 1);
+  int *found = calloc(n_found, sizeof(int));
+  if (!found) return fail_memory(P, "the IDA root flags", (double)(n_found * sizeof(int)));
   long steps = 0;
   int same_time = 0;
   double t_prev_restart = -1.0;
@@ -1311,7 +1330,7 @@ int martello_ida_run(martello_model *model, martello_run *run) {
     ytmp = N_VNew_Serial(P->N, sunctx);
     P->ytd = N_VNew_Serial(P->N, sunctx);
     if (!yy || !yp || !id || !ytmp || !P->ytd)
-      st = fail(P, MARTELLO_ERR_MEMORY, "IDA: could not create the vectors");
+      st = fail_memory(P, "the IDA state vectors", -1.0);
   }
   /* a failed run keeps what it computed (the observer closed its open phases) */
   if (st == MARTELLO_OK) st = integrate(P, sunctx, &mem, yy, yp, id, ytmp, &J, &LS);

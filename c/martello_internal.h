@@ -9,6 +9,12 @@
 typedef struct martello_eval martello_eval;
 typedef struct martello_observer martello_observer;
 
+/* The library's one out-of-memory line (fortran/status.f90, docs/behaviour.md "When memory
+ * runs out"): what could not be allocated, how many bytes, and the fix (NULL: a smaller
+ * scene), into buf (NUL-terminated, truncated to buflen - 1 characters). */
+void martello_memory_message(const char *what, double bytes, const char *fix, char *buf,
+                             int buflen);
+
 /* Scene topology for impact laws. con_a/con_b are 0-based nodes, -1 = ground; fixed[i] is 0/1;
  * restitution[j] is the contact's e (or -1 if none given). Pass NULL for what you don't need. */
 int martello_model_topology(const martello_model *model, int *n, int *n_contacts, double *mass,

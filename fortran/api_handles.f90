@@ -7,6 +7,7 @@ module martello_api_handles
    use martello_run, only: run_t
    use martello_evaluator, only: evaluator_t
    use martello_observer, only: observer_t
+   use martello_status, only: out_of_memory, memory_message, FIX_SMALLER_SCENE
    implicit none
    private
    public :: get_model, get_run, get_eval, get_observer, copy_message, from_c_string
@@ -47,13 +48,16 @@ contains
       character(kind=c_char), intent(in) :: cstr(*)
       integer, intent(in) :: maxlen
       character(len=:), allocatable :: s
-      integer :: n
+      integer :: n, st
       n = 0
       do while (n < maxlen)
          if (cstr(n + 1) == c_null_char) exit
          n = n + 1
       end do
-      allocate (character(len=n) :: s)
+      ! a name of at most maxlen characters: no status to return from inside an expression
+      allocate (character(len=n) :: s, stat=st)
+      if (st /= 0) call out_of_memory('a name passed through the C API', real(n, c_double), &
+                                      'free memory in the calling program')
       s = transfer(cstr(1:n), s)
    end function from_c_string
 
@@ -69,4 +73,25 @@ contains
       end do
       buf(n + 1) = c_null_char
    end subroutine copy_message
+
+   !> The out-of-memory line of the C integrators (c/martello_internal.h): the kernels'
+   !> wording (martello_status memory_message), so that every allocation says it alike.
+   !> fix: NULL for FIX_SMALLER_SCENE.
+   subroutine c_memory_message(what, bytes, fix, buf, buflen) bind(C, name='martello_memory_message')
+      character(kind=c_char), intent(in) :: what(*)
+      real(c_double), value :: bytes
+      type(c_ptr), value :: fix
+      integer(c_int), value :: buflen
+      character(kind=c_char), intent(out) :: buf(*)
+      integer, parameter :: MAXLEN = 256
+      character(kind=c_char), pointer :: cfix(:)
+      if (c_associated(fix)) then
+         call c_f_pointer(fix, cfix, [MAXLEN])
+         call copy_message(memory_message(from_c_string(what, MAXLEN), bytes, &
+                                          from_c_string(cfix, MAXLEN)), buf, buflen)
+      else
+         call copy_message(memory_message(from_c_string(what, MAXLEN), bytes, FIX_SMALLER_SCENE), &
+                           buf, buflen)
+      end if
+   end subroutine c_memory_message
 end module martello_api_handles

@@ -125,12 +125,16 @@ contains
       c_impulse_accumulation = merge(1, 0, acc)
    end function c_impulse_accumulation
 
-   !> Contacts list[0..m) of the topology (a, b, col) in the module's terms.
-   pure function problem(m, list, a, b, col) result(pb)
+   !> Contacts list[0..m) of the topology (a, b, col) in the module's terms. Three integers
+   !> a contact, next to the m × m matrices the doors hold on the stack: no status to return
+   !> from inside an expression, so a failed allocation stops with the out-of-memory line.
+   function problem(m, list, a, b, col) result(pb)
       integer, intent(in) :: m
       integer(c_int), intent(in) :: list(*), a(*), b(*), col(*)
       type(problem_t) :: pb
-      allocate (pb%sa(m), pb%sb(m), pb%ic(m))
+      integer :: st
+      allocate (pb%sa(m), pb%sb(m), pb%ic(m), stat=st)
+      if (st /= 0) call out_of_memory('the impulse problem', 3*INT_BYTES*m, FIX_SMALLER_SCENE)
       pb%sa = max(a(list(1:m) + 1), -1) + 1
       pb%sb = max(b(list(1:m) + 1), -1) + 1
       pb%ic = col(list(1:m) + 1) + 1
@@ -156,6 +160,7 @@ contains
       select case (info)
       case (IMPULSE_OK); martello_status_of = MARTELLO_OK
       case (IMPULSE_INFEASIBLE, IMPULSE_SINGULAR); martello_status_of = MARTELLO_ERR_SINGULAR
+      case (IMPULSE_NO_MEMORY); martello_status_of = MARTELLO_ERR_MEMORY
       case default; martello_status_of = MARTELLO_ERR_NOT_CONVERGED
       end select
    end function martello_status_of

@@ -4,6 +4,7 @@
 !> at rest in the relative frame), so ground ends need no branches in the loops.
 module martello_assembly
    use martello_kinds, only: dp
+   use martello_status, only: MARTELLO_OK, out_of_memory, REAL_BYTES, INT_BYTES, FIX_SMALLER_SCENE
    use martello_model, only: model_t, SCHEME_PENALTY
    use martello_links, only: link_force, link_force_on_branch, BRANCH_FREE, bilinear_energy, LINK_SPRING, LINK_BAR, LINK_BILINEAR, &
       LINK_DASHPOT, LINK_FLUID_DAMPER, L_STIFF, L_DAMP, L_YIELD, L_HARDENING
@@ -57,21 +58,33 @@ module martello_assembly
 
 contains
 
-   subroutine mech_init(m, s, u, v)
+   !> The committed state of links and contacts at (u, v). stat, message: MARTELLO_ERR_MEMORY
+   !> and its line if the state cannot be allocated (absent: the process stops with it).
+   subroutine mech_init(m, s, u, v, stat, message)
       type(model_t), intent(in) :: m
       type(mech_state_t), intent(out) :: s
       real(dp), intent(in) :: u(0:), v(0:)
+      integer, intent(out), optional :: stat
+      character(len=*), intent(out), optional :: message
       real(dp), allocatable :: f(:)
-      integer :: j
+      integer :: j, st
+      if (present(stat)) stat = MARTELLO_OK
       allocate (s%link_fc(m%nlink), s%link_u(m%nlink), s%link_fc_trial(m%nlink), &
-                s%link_f(m%nlink), s%link_f_trial(m%nlink))
-      allocate (s%con_f(m%ncontact), s%con_f_trial(m%ncontact), s%con_pen(m%ncontact), &
+                s%link_f(m%nlink), s%link_f_trial(m%nlink), &
+                s%con_f(m%ncontact), s%con_f_trial(m%ncontact), s%con_pen(m%ncontact), &
                 s%con_pen_trial(m%ncontact), s%con_rate_trial(m%ncontact), s%con_rate(m%ncontact), &
                 s%con_on(m%ncontact), s%con_vin(m%ncontact), s%con_vin_trial(m%ncontact), &
-                s%is_penalty(m%ncontact))
+                s%is_penalty(m%ncontact), s%forced_off(m%ncontact), s%link_branch(m%nlink), &
+                s%con_branch(m%ncontact), s%blk_e(m%nblock), s%blk(m%nblock), f(0:m%n), stat=st)
+      if (st /= 0) then
+         call out_of_memory('the element states of the scene', &
+                            REAL_BYTES*(5.0_dp*m%nlink + 8.0_dp*m%ncontact + m%nblock + m%n + 1) &
+                            + INT_BYTES*(m%nlink + 4.0_dp*m%ncontact) &
+                            + storage_size(s%blk)/8*real(m%nblock, dp), FIX_SMALLER_SCENE, stat, message)
+         return
+      end if
       s%is_penalty = m%con_scheme(1:m%ncontact) == SCHEME_PENALTY
-      allocate (s%forced_off(m%ncontact)); s%forced_off = .false.
-      allocate (s%link_branch(m%nlink), s%con_branch(m%ncontact))
+      s%forced_off = .false.
       s%link_branch = BRANCH_FREE; s%con_branch = CONTACT_FREE
       ! The initial state is elastic and unloaded history: the committed force of a bilinear
       ! spring starts on its elastic line k·u0 (clamped into the band by the first step).
@@ -82,7 +95,6 @@ contains
              m%link_kind(j) == LINK_BILINEAR) s%link_fc(j) = m%link_par(L_STIFF, j)*s%link_u(j)
       end do
       s%con_on = .false.; s%con_vin = 0.0_dp; s%con_rate = 0.0_dp
-      allocate (s%blk_e(m%nblock), s%blk(m%nblock))
       do j = 1, m%nblock
          associate (nd => m%block(j)%node)
             s%blk(j)%f = matmul(m%block(j)%k, u(nd))
@@ -92,7 +104,6 @@ contains
          end associate
          s%blk_e(j) = block_energy(m, j, u)
       end do
-      allocate (f(0:m%n))
       call internal_forces(m, s, u, v, f)
       call mech_commit(m, s, u)
    end subroutine mech_init

@@ -7,6 +7,7 @@
 module martello_band_matrix
    use martello_kinds, only: dp
    use martello_lapack, only: dgbsv
+   use martello_status, only: MARTELLO_OK, out_of_memory, REAL_BYTES, INT_BYTES, FIX_SMALLER_SCENE
    implicit none
    private
    public :: band_t, band_init, band_zero, band_add, band_add_pair, band_pin, band_solve, &
@@ -22,11 +23,24 @@ module martello_band_matrix
 
 contains
 
-   subroutine band_init(b, n, kd)
+   !> An n × n band of half-bandwidth kd, zero. stat, message: as martello_status
+   !> out_of_memory if it cannot be allocated (absent: the process stops with its line).
+   subroutine band_init(b, n, kd, stat, message)
       type(band_t), intent(out) :: b
       integer, intent(in) :: n, kd
+      integer, intent(out), optional :: stat
+      character(len=*), intent(out), optional :: message
+      character(len=64) :: what
+      integer :: st
+      if (present(stat)) stat = MARTELLO_OK
       b%n = n; b%kd = kd
-      allocate (b%ab(3*kd + 1, n), b%ipiv(n), b%dl(n), b%d(n), b%du(n), b%rhs_copy(n))
+      allocate (b%ab(3*kd + 1, n), b%ipiv(n), b%dl(n), b%d(n), b%du(n), b%rhs_copy(n), stat=st)
+      if (st /= 0) then
+         write (what, '(a,i0,a,i0)') 'a band matrix of ', n, ' rows and half-bandwidth ', kd
+         call out_of_memory(trim(what), REAL_BYTES*(3.0_dp*kd + 5)*n + INT_BYTES*n, &
+                            FIX_SMALLER_SCENE, stat, message)
+         return
+      end if
       b%ab = 0.0_dp
    end subroutine band_init
 

@@ -37,15 +37,25 @@ contains
       integer :: n, info
       character(len=512) :: msg
       n = m%n
-      allocate (self%fint(0:n), self%fext(0:n), self%fext_n(0:n), self%work(0:n))
-      call band_init(self%mband, n, model_bandwidth(m))
+      allocate (self%fint(0:n), self%fext(0:n), self%fext_n(0:n), self%work(0:n), stat=stat)
+      if (stat /= 0) call out_of_memory('the force vectors of central difference', &
+                                        REAL_BYTES*4*(n + 1.0_dp), FIX_SMALLER_SCENE, stat, msg)
+      if (stat == MARTELLO_OK) call band_init(self%mband, n, model_bandwidth(m), stat, msg)
+      if (stat /= MARTELLO_OK) then
+         call observer_fail(o, MARTELLO_ERR_MEMORY, 0.0_dp, msg, stat)
+         return
+      end if
       call stepper_rest_start(self, m, s, self%mband, self%fint, self%fext, o, stat)
       if (stat /= MARTELLO_OK) return
       self%advice = 'the step is past the stability limit'
       ! Velocity Verlet conserves ½vᵀMv − (h²/8)aᵀMa exactly against trapezoidal work
       self%ke_aMa = 0.125_dp*self%h*self%h
 
-      call omega_max(m, o%omega_max, info)
+      call omega_max(m, o%omega_max, info, stat, msg)
+      if (stat /= MARTELLO_OK) then
+         call observer_fail(o, MARTELLO_ERR_MEMORY, 0.0_dp, msg, stat)
+         return
+      end if
       if (info /= 0 .and. s%check_stability) then
          write (msg, '(a,i0,a)') 'central difference: the stability limit could not be computed'// &
             ' (LAPACK dsbgvx info = ', info, '): the mass matrix is not positive definite'

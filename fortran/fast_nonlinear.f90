@@ -37,10 +37,17 @@ module martello_fast_nonlinear
    use martello_model, only: SCHEME_PENALTY
    use martello_model, only: model_bandwidth
    use martello_band_matrix, only: band_t, band_init, band_zero
+   use martello_stability, only: free_dofs
    use martello_observer, only: C_JACOBIANS
    implicit none
    private
    public :: fast_nonlinear_t, modal_step_coefficients
+
+   !> What to change when the dense modal arrays (nf × nf, nf free nodes) do not fit.
+   character(len=*), parameter :: FIX_DENSE = 'fast-nonlinear holds dense matrices of the'// &
+      ' free nodes squared: use fewer nodes, or an integrator with banded matrices (newmark, hht)'
+   !> newton_setup's info when its matrices cannot be allocated
+   integer, parameter :: NEWTON_NO_MEMORY = -1
 
    type, extends(stepper_t) :: fast_nonlinear_t
       integer :: nf = 0, max_iter = 30
@@ -75,25 +82,33 @@ contains
       integer :: n, nf, i, j, info, lwork
       integer, allocatable :: dof(:)
       real(dp), allocatable :: kl(:, :), cl(:, :), mm(:, :), work(:), x(:), y(:)
-      character(len=200) :: msg
+      character(len=256) :: msg
 
       stat = MARTELLO_OK
       n = m%n
       call stepper_start(self, m, s)
       self%advice = 'reduce dt (the pseudo-force iteration converges for small h^2 k/m)'
       self%max_iter = s%max_newton; self%tol = s%tol_residual
-      allocate (dof(0:n)); dof = 0; nf = 0
-      do i = 1, n
-         if (.not. m%fixed(i)) then
-            nf = nf + 1; dof(i) = nf
-         end if
-      end do
-      self%nf = nf
-      self%free = pack([(i, i = 1, n)], .not. m%fixed)
-      allocate (self%fint(0:n), self%fext(0:n), self%fext_n(0:n))
-      call band_init(self%kband, n, model_bandwidth(m))
-      call band_init(self%cband, n, model_bandwidth(m))
-      allocate (kl(nf, nf), cl(nf, nf), mm(nf, nf), x(0:n), y(0:n))
+      call free_dofs(m, dof, nf, stat, msg)
+      if (stat == MARTELLO_OK) then
+         self%nf = nf
+         self%free = pack([(i, i = 1, n)], .not. m%fixed)
+         ! the dense modal matrices (K_L, C_L, M and Φ: nf² each) and every per-mode array
+         allocate (self%fint(0:n), self%fext(0:n), self%fext_n(0:n), x(0:n), y(0:n), &
+                   kl(nf, nf), cl(nf, nf), mm(nf, nf), self%phi(nf, nf), self%w2(nf), self%c(nf), &
+                   self%e11(nf), self%e12(nf), self%e21(nf), self%e22(nf), self%g0q(nf), &
+                   self%g0v(nf), self%g1q(nf), self%g1v(nf), self%q(nf), self%qd(nf), self%qn(nf), &
+                   self%qdn(nf), self%p(nf), self%pn(nf), self%ptrial(nf), self%r(nf), &
+                   self%pbase(nf), self%dp(nf), work(1), stat=stat)
+         if (stat /= 0) call modal_memory('the modal matrices of fast-nonlinear', &
+                                          REAL_BYTES*(5*(n + 1.0_dp) + 4*real(nf, dp)**2 + 20.0_dp*nf + 1))
+      end if
+      if (stat == MARTELLO_OK) call band_init(self%kband, n, model_bandwidth(m), stat, msg)
+      if (stat == MARTELLO_OK) call band_init(self%cband, n, model_bandwidth(m), stat, msg)
+      if (stat /= MARTELLO_OK) then
+         call observer_fail(o, MARTELLO_ERR_MEMORY, 0.0_dp, msg, stat)
+         return
+      end if
       call linear_part(m, dof, kl, cl)
       ! M on the free DOFs, column by column (lumped diagonal and consistent couplings)
       do j = 1, nf
@@ -102,10 +117,15 @@ contains
          call mass_times(m, x, y)
          mm(:, j) = y(self%free)
       end do
-      allocate (self%w2(nf), self%phi(nf, nf), work(1))
       self%phi = kl
       call dsygv(1, 'V', 'U', nf, self%phi, nf, mm, nf, self%w2, work, -1, info)
-      lwork = max(1, int(work(1))); deallocate (work); allocate (work(lwork))
+      lwork = max(1, int(work(1))); deallocate (work)
+      allocate (work(lwork), stat=stat)
+      if (stat /= 0) then
+         call modal_memory('the workspace of the modes (LAPACK dsygv)', REAL_BYTES*lwork)
+         call observer_fail(o, MARTELLO_ERR_MEMORY, 0.0_dp, msg, stat)
+         return
+      end if
       if (nf > 0) call dsygv(1, 'V', 'U', nf, self%phi, nf, mm, nf, self%w2, work, lwork, info)
       o%counters(C_FACTORIZATIONS) = o%counters(C_FACTORIZATIONS) + 1_i8
       o%counters(C_MODES) = o%counters(C_MODES) + int(nf, i8)
@@ -119,26 +139,24 @@ contains
       ! eigenvalue below 0 is round-off of a zero mode (a node held by nonlinear elements only)
       self%w2 = max(self%w2, 0.0_dp)
       ! modal damping: the diagonal of Φᵀ C_L Φ (the rest stays in the pseudo-force)
-      allocate (self%c(nf))
       do i = 1, nf
          self%c(i) = dot_product(self%phi(:, i), matmul(cl, self%phi(:, i)))
       end do
-      allocate (self%e11(nf), self%e12(nf), self%e21(nf), self%e22(nf), self%g0q(nf), &
-                self%g0v(nf), self%g1q(nf), self%g1v(nf))
       do i = 1, nf
          call modal_step_coefficients(self%w2(i), self%c(i), self%h, self%e11(i), self%e12(i), &
                                       self%e21(i), self%e22(i), self%g0q(i), self%g0v(i), &
                                       self%g1q(i), self%g1v(i))
       end do
-      call newton_setup(self, m, dof, kl, cl, info)
-      if (info /= 0) then
+      call newton_setup(self, m, dof, kl, cl, info, msg)
+      if (info == NEWTON_NO_MEMORY) then
+         call observer_fail(o, MARTELLO_ERR_MEMORY, 0.0_dp, msg, stat)
+         return
+      else if (info /= 0) then
          call observer_fail(o, MARTELLO_ERR_SINGULAR, 0.0_dp, 'fast-nonlinear: the constant '// &
                             'part of the Newton matrix is singular (LAPACK dgetrf)', stat)
          return
       end if
       ! modal state at t = 0: q = Φᵀ M u, q̇ = Φᵀ M v (free DOFs)
-      allocate (self%q(nf), self%qd(nf), self%qn(nf), self%qdn(nf), self%p(nf), self%pn(nf), &
-                self%ptrial(nf), self%r(nf), self%pbase(nf), self%dp(nf))
       call mass_times(m, self%u, y)
       self%q = matmul(transpose(self%phi), y(self%free))
       call mass_times(m, self%v, y)
@@ -152,6 +170,14 @@ contains
       call contact_state(self, m)
 
    contains
+      !> msg: the out-of-memory line of the dense modal arrays, for nf free nodes
+      subroutine modal_memory(what, bytes)
+         character(len=*), intent(in) :: what
+         real(dp), intent(in) :: bytes
+         write (msg, '(a,i0,a)') ' for ', nf, ' free nodes'
+         call out_of_memory(what//trim(msg), bytes, FIX_DENSE, stat, msg)
+      end subroutine modal_memory
+
       subroutine modal_load(pp)
          real(dp), intent(out) :: pp(:)
          pp = matmul(transpose(self%phi), self%fext(self%free) - self%fint(self%free)) + &
@@ -162,14 +188,16 @@ contains
    !> The Newton matrix's constant part and the nonlinear DOFs (docs/integrators.md): S = the
    !> free DOFs of penalty contacts, fluid dampers and bilinear springs; J0 = −I − Coff·G1v
    !> with Coff = Φᵀ C_L Φ less its diagonal; W = J0⁻¹ Φ(S,:)ᵀ.
-   subroutine newton_setup(self, m, dof, kl, cl, info)
+   subroutine newton_setup(self, m, dof, kl, cl, info, msg)
       class(fast_nonlinear_t), intent(inout) :: self
       type(model_t), intent(in) :: m
       integer, intent(in) :: dof(0:)
       real(dp), intent(in) :: kl(:, :), cl(:, :)
-      integer, intent(out) :: info
+      integer, intent(out) :: info        !< NEWTON_NO_MEMORY (msg says what), or dgetrf's
+      character(len=*), intent(out) :: msg
       logical :: touched(self%nf)
       integer :: j, nf
+      character(len=96) :: what
       real(dp), allocatable :: coff(:, :)
       nf = self%nf
       touched = .false.
@@ -188,10 +216,17 @@ contains
          self%phis = self%phi(s, :)
          self%kls = kl(s, s); self%cls = cl(s, s)
          allocate (self%vt(ns, nf), self%small(ns, ns), self%dks(ns, ns), self%dcs(ns, ns), &
-                   self%ipiv_s(ns), self%y(nf), self%z(ns))
+                   self%ipiv_s(ns), self%y(nf), self%z(ns), self%j0(nf, nf), self%ipiv(nf), stat=info)
+         if (info /= 0) then
+            write (what, '(a,i0,a,i0,a)') 'the Newton matrices of fast-nonlinear for ', nf, &
+               ' free nodes, ', ns, ' of them nonlinear'
+            call out_of_memory(trim(what), REAL_BYTES*(real(ns, dp)*nf + 3*real(ns, dp)**2 + nf + ns &
+                               + real(nf, dp)**2) + INT_BYTES*(ns + nf), FIX_DENSE, info, msg)
+            info = NEWTON_NO_MEMORY
+            return
+         end if
       end associate
       coff = matmul(transpose(self%phi), matmul(cl, self%phi))
-      allocate (self%j0(nf, nf), self%ipiv(nf))
       do j = 1, nf
          coff(j, j) = 0.0_dp
          self%j0(:, j) = -coff(:, j)*self%g1v(j)

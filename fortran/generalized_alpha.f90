@@ -73,13 +73,20 @@ contains
       type(observer_t), intent(inout) :: o
       integer, intent(out) :: stat
       integer :: n
+      character(len=256) :: msg
       n = m%n
       self%kd = model_bandwidth(m)
       allocate (self%fint(0:n), self%fint_n(0:n), self%fext(0:n), self%fext_n(0:n), &
-                self%res(0:n), self%du(n), self%work(0:n), self%ma(0:n), self%man(0:n))
-      call band_init(self%jac, n, self%kd)
-      call band_init(self%mband, n, self%kd)
-      call band_init(self%cjac, n, self%kd)
+                self%res(0:n), self%du(n), self%work(0:n), self%ma(0:n), self%man(0:n), stat=stat)
+      if (stat /= 0) call out_of_memory('the force vectors of '//integrator_name(s%kind), &
+                                        REAL_BYTES*(8*(n + 1.0_dp) + n), FIX_SMALLER_SCENE, stat, msg)
+      if (stat == MARTELLO_OK) call band_init(self%jac, n, self%kd, stat, msg)
+      if (stat == MARTELLO_OK) call band_init(self%mband, n, self%kd, stat, msg)
+      if (stat == MARTELLO_OK) call band_init(self%cjac, n, self%kd, stat, msg)
+      if (stat /= MARTELLO_OK) then
+         call observer_fail(o, MARTELLO_ERR_MEMORY, 0.0_dp, msg, stat)
+         return
+      end if
       call stepper_rest_start(self, m, s, self%mband, self%fint, self%fext, o, stat)
       if (stat /= MARTELLO_OK) return
       self%advice = 'the step is past the stability limit'
@@ -92,7 +99,15 @@ contains
       self%event_split = logical(s%event_split) .and. (any(m%con_law == LAW_KELVIN) .or. &
                                                         any(m%con_law == LAW_LINEAR) .or. &
                                                         any(m%link_kind == LINK_BILINEAR))
-      if (self%event_split) allocate (self%us(0:n), self%vs(0:n), self%as(0:n), self%jump(0:n))
+      if (self%event_split) then
+         allocate (self%us(0:n), self%vs(0:n), self%as(0:n), self%jump(0:n), stat=stat)
+         if (stat /= 0) then
+            call out_of_memory('the event-split states of '//integrator_name(s%kind), &
+                               REAL_BYTES*4*(n + 1.0_dp), FIX_SMALLER_SCENE, stat, msg)
+            call observer_fail(o, MARTELLO_ERR_MEMORY, 0.0_dp, msg, stat)
+            return
+         end if
+      end if
       if (s%kind == INT_NEWMARK .and. 2.0_dp*self%beta < self%gamma) &
          call newmark_stability(self%beta, self%gamma, self%h, logical(s%check_stability), stat)
    contains
@@ -108,7 +123,11 @@ contains
          character(len=512) :: msg
          real(dp) :: limit
          limit = 1.0_dp/sqrt(0.5_dp*gamma - beta)
-         call omega_max(m, o%omega_max, info)
+         call omega_max(m, o%omega_max, info, stat, msg)
+         if (stat /= MARTELLO_OK) then
+            call observer_fail(o, MARTELLO_ERR_MEMORY, 0.0_dp, msg, stat)
+            return
+         end if
          if (info /= 0 .or. o%omega_max <= 0.0_dp) return
          o%dt_critical = limit/o%omega_max
          if (.not. check .or. h <= o%dt_critical) return

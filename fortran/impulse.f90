@@ -16,8 +16,8 @@ module martello_impulse
    private
    public :: contact_graph_t, contact_graph, delassus_columns, delassus_bandwidth, &
       delassus_diagonal_band, newton_impulses, contact_forces, apply_impulses, delassus_factor, &
-      project_factored, impulse_accumulation, LEMKE_MAX, IMPULSE_OK, IMPULSE_INFEASIBLE, &
-      IMPULSE_NOT_CONVERGED, IMPULSE_SINGULAR
+      project_factored, impulse_accumulation, lcp_work_reals, LEMKE_MAX, IMPULSE_OK, &
+      IMPULSE_INFEASIBLE, IMPULSE_NOT_CONVERGED, IMPULSE_SINGULAR, IMPULSE_NO_MEMORY
 
    !> Up to this many contacts an LCP is solved by Lemke on a dense W (finite, exact to
    !> round-off); beyond, by projected Gauss–Seidel with its direct finish on the band of W
@@ -34,6 +34,8 @@ module martello_impulse
    integer, parameter :: IMPULSE_INFEASIBLE = 1
    integer, parameter :: IMPULSE_NOT_CONVERGED = 2    !< pivot or sweep limit reached
    integer, parameter :: IMPULSE_SINGULAR = 3         !< W of the held set not positive definite
+   !> the solver's work arrays (at most lcp_work_reals(m) reals) could not be allocated
+   integer, parameter :: IMPULSE_NO_MEMORY = 4
 
    !> Which contacts touch each node: con(ptr(i):ptr(i+1)−1). Built once a run; it makes the
    !> band Delassus matrix of a diagonal A cost O(m) instead of O(m²).
@@ -43,10 +45,12 @@ module martello_impulse
 
 contains
    !> The node → contact adjacency of the contacts with use(k) true (sides 0 are left out).
-   pure subroutine contact_graph(n, sa, sb, use, g)
+   !> stat /= 0: g could not be allocated (n + 2 + 2m integers at most).
+   pure subroutine contact_graph(n, sa, sb, use, g, stat)
       integer, intent(in) :: n, sa(:), sb(:)
       logical, intent(in) :: use(:)
       type(contact_graph_t), intent(out) :: g
+      integer, intent(out) :: stat
       integer :: cnt(0:n), k
       cnt = 0
       do k = 1, size(sa)
@@ -54,7 +58,8 @@ contains
          cnt(sa(k)) = cnt(sa(k)) + 1
          cnt(sb(k)) = cnt(sb(k)) + 1
       end do
-      allocate (g%ptr(n + 2), g%con(max(1, sum(cnt(1:n)))))
+      allocate (g%ptr(n + 2), g%con(max(1, sum(cnt(1:n)))), stat=stat)
+      if (stat /= 0) return
       g%ptr(1) = 1
       do k = 1, n
          g%ptr(k + 1) = g%ptr(k) + cnt(k)
@@ -257,6 +262,14 @@ contains
 
    ! ---- the LCP solvers (docs/impulse.md §2) -----------------------------------------------
 
+   !> The most reals solve_lcp holds at once for m contacts (a dense W copied into a band of
+   !> 2m − 1 rows, and the polish's band of 3m − 2): what an IMPULSE_NO_MEMORY failure could
+   !> not get, at most.
+   pure real(dp) function lcp_work_reals(m)
+      integer, intent(in) :: m
+      lcp_work_reals = 5.0_dp*real(m, dp)**2
+   end function lcp_work_reals
+
    !> W z + q ≥ 0 ⊥ z ≥ 0 with W dense (w) or in band storage (wb, kw): Lemke on the dense W up
    !> to LEMKE_MAX contacts, PGS on the band beyond (a dense W is copied into a band of full
    !> width, a band W into a dense one for Lemke); z on entry is PGS's warm start.
@@ -267,18 +280,21 @@ contains
       real(dp), intent(in), optional :: w(:, :), wb(:, :)
       integer, intent(in), optional :: kw
       real(dp), allocatable :: wd(:, :), wbd(:, :)
-      integer :: m, i, j
+      integer :: m, i, j, st
       m = size(q)
+      info = IMPULSE_NO_MEMORY; iterations = 0
       if (present(w)) then
          if (m <= LEMKE_MAX) then
             call lemke(w(1:m, 1:m), q, z, iterations, info)
             return
          end if
-         allocate (wbd(2*m - 1, m))
+         allocate (wbd(2*m - 1, m), stat=st)
+         if (st /= 0) return
          forall (i = 1:m, j = 1:m) wbd(m + i - j, j) = w(i, j)
          call pgs(wbd, m - 1, q, z, PGS_TOL, PGS_MAX_SWEEPS, iterations, info)
       else if (m <= LEMKE_MAX) then
-         allocate (wd(m, m))
+         allocate (wd(m, m), stat=st)
+         if (st /= 0) return
          wd = 0.0_dp
          forall (j = 1:m, i = 1:m, abs(i - j) <= kw) wd(i, j) = wb(kw + 1 + i - j, j)
          call lemke(wd, q, z, iterations, info)
@@ -433,8 +449,8 @@ contains
          end do
          if (change <= tol*max(zmax, tiny(1.0_dp))) return
          if (sweeps == 8 .or. mod(sweeps, POLISH_EVERY) == 0 .or. change <= sqrt(tol)*zmax) then
-            call polish(wb, kw, q, z, tol, done)
-            if (done) return
+            call polish(wb, kw, q, z, tol, done, info)
+            if (done .or. info /= IMPULSE_OK) return
          end if
       end do
       sweeps = max_sweeps
@@ -446,11 +462,12 @@ contains
    !> indices with z_j < 0, add those off J with (Wz + q)_i < 0, repeat. Accepted when both
    !> sets are empty within tol (z is then the LCP solution to round-off); after MAX_ROUNDS
    !> rounds z is left unchanged and PGS carries on.
-   subroutine polish(wb, kw, q, z, tol, done)
+   subroutine polish(wb, kw, q, z, tol, done, stat)
       real(dp), intent(in) :: wb(:, :), q(:), tol
       integer, intent(in) :: kw
       real(dp), intent(inout) :: z(:)
       logical, intent(out) :: done
+      integer, intent(out) :: stat    !< IMPULSE_NO_MEMORY: its band could not be allocated
       integer, parameter :: MAX_ROUNDS = 8
       integer :: idx(size(q)), ipiv(size(q)), nj, i, j, k, l, n, info, round
       logical :: inj(size(q)), changed
@@ -460,7 +477,10 @@ contains
       done = .false.
       inj = z > 0.0_dp
       qscale = maxval(abs(q))
-      allocate (ab(3*kw + 1, n))
+      stat = IMPULSE_NO_MEMORY
+      allocate (ab(3*kw + 1, n), stat=info)
+      if (info /= 0) return
+      stat = IMPULSE_OK
       do round = 1, MAX_ROUNDS
          nj = 0
          do i = 1, n

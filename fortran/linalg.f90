@@ -4,7 +4,8 @@
 module martello_linalg
    use martello_kinds, only: dp
    use martello_lapack, only: dpotrf, dpotrs, dpocon, dsytrf, dsytrs, dsycon, dlansy
-   use martello_status, only: MARTELLO_OK, MARTELLO_ERR_SINGULAR, MARTELLO_ERR_LAPACK
+   use martello_status, only: MARTELLO_OK, MARTELLO_ERR_SINGULAR, MARTELLO_ERR_LAPACK, out_of_memory, &
+      REAL_BYTES, INT_BYTES, FIX_SMALLER_SCENE
    implicit none
    private
    public :: solve_spd, solve_symmetric_indefinite, lapack_status, tridiagonal_solve
@@ -55,7 +56,12 @@ contains
       rcond = 1.0_dp
       stat = MARTELLO_OK
       if (n == 0) return
-      allocate (work(3*n), iwork(n))
+      allocate (work(3*n), iwork(n), stat=stat)
+      if (stat /= 0) then
+         call out_of_memory('the workspace of a Cholesky solve', (3*REAL_BYTES + INT_BYTES)*n, &
+                            FIX_SMALLER_SCENE, stat, msg)
+         return
+      end if
       anorm = dlansy('1', 'U', n, a, n, work)
       call dpotrf('U', n, a, n, info)
       call lapack_status('dpotrf', info, stat, msg)
@@ -81,11 +87,19 @@ contains
       rcond = 1.0_dp
       stat = MARTELLO_OK
       if (n == 0) return
-      allocate (ipiv(n), iwork(n), work(2*n))
-      anorm = dlansy('1', 'U', n, a, n, work)
-      call dsytrf('U', n, a, n, ipiv, query, -1, info)
-      lwork = max(2*n, int(query(1)))
-      deallocate (work); allocate (work(lwork))
+      lwork = 2*n
+      allocate (ipiv(n), iwork(n), work(lwork), stat=stat)
+      if (stat == 0) then
+         anorm = dlansy('1', 'U', n, a, n, work)
+         call dsytrf('U', n, a, n, ipiv, query, -1, info)
+         lwork = max(2*n, int(query(1)))
+         deallocate (work); allocate (work(lwork), stat=stat)
+      end if
+      if (stat /= 0) then
+         call out_of_memory('the workspace of a symmetric indefinite solve', &
+                            REAL_BYTES*lwork + 2*INT_BYTES*n, FIX_SMALLER_SCENE, stat, msg)
+         return
+      end if
       call dsytrf('U', n, a, n, ipiv, work, lwork, info)
       call lapack_status('dsytrf', info, stat, msg)
       if (stat /= MARTELLO_OK) return

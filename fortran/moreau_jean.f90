@@ -39,7 +39,8 @@ module martello_moreau_jean
    use martello_integrator_settings, only: integrator_settings_t
    use martello_fixed_step, only: stepper_t, stepper_start, contact_state
    use martello_impulse, only: contact_graph_t, contact_graph, delassus_columns, &
-      delassus_bandwidth, delassus_diagonal_band, newton_impulses, IMPULSE_OK
+      delassus_bandwidth, delassus_diagonal_band, newton_impulses, lcp_work_reals, IMPULSE_OK, &
+      IMPULSE_NO_MEMORY
    use martello_linalg, only: lapack_status
    implicit none
    private
@@ -72,6 +73,7 @@ contains
       type(observer_t), intent(inout) :: o
       integer, intent(out) :: stat
       integer :: n, nc
+      character(len=256) :: msg
       stat = MARTELLO_OK
       call stepper_start(self, m, s)
       n = m%n; nc = m%ncontact
@@ -82,15 +84,25 @@ contains
       self%hth2 = self%hth*self%hth
       self%kd = model_bandwidth(m)
       allocate (self%fint(0:n), self%fint_n(0:n), self%fext(0:n), self%fext_n(0:n), &
-                self%rhs(0:n), self%work(0:n), self%ipiv(n))
-      allocate (self%e_con(nc), self%p(nc), self%p_prev(nc), self%ph_last(nc), self%sa(nc), &
-                self%sb(nc), self%act(nc), self%pos(nc), self%rigid(nc), self%movable(nc))
+                self%rhs(0:n), self%work(0:n), self%ipiv(n), &
+                self%e_con(nc), self%p(nc), self%p_prev(nc), self%ph_last(nc), self%sa(nc), &
+                self%sb(nc), self%act(nc), self%pos(nc), self%rigid(nc), self%movable(nc), stat=stat)
+      if (stat /= 0) call out_of_memory('the state of Moreau-Jean', REAL_BYTES*(6*(n + 1.0_dp) + &
+                                        4.0_dp*nc) + INT_BYTES*(n + 6.0_dp*nc), FIX_SMALLER_SCENE, stat, msg)
+      if (stat == MARTELLO_OK) call band_init(self%kband, n, self%kd, stat, msg)
+      if (stat == MARTELLO_OK) call band_init(self%cband, n, self%kd, stat, msg)
+      if (stat == MARTELLO_OK) call band_init(self%what, n, self%kd, stat, msg)
+      if (stat == MARTELLO_OK) then
+         call rigid_contact_sides(m, self%rigid, self%e_con, self%sa, self%sb, self%movable)
+         call contact_graph(n, self%sa, self%sb, self%movable, self%graph, stat)
+         if (stat /= 0) call out_of_memory('the contact graph of Moreau-Jean', &
+                                           INT_BYTES*(n + 2.0_dp + 2*nc), FIX_SMALLER_SCENE, stat, msg)
+      end if
+      if (stat /= MARTELLO_OK) then
+         call observer_fail(o, MARTELLO_ERR_MEMORY, 0.0_dp, msg, stat)
+         return
+      end if
       self%p = 0.0_dp; self%p_prev = 0.0_dp; self%ph_last = 0.0_dp
-      call band_init(self%kband, n, self%kd)
-      call band_init(self%cband, n, self%kd)
-      call band_init(self%what, n, self%kd)
-      call rigid_contact_sides(m, self%rigid, self%e_con, self%sa, self%sb, self%movable)
-      call contact_graph(n, self%sa, self%sb, self%movable, self%graph)
       self%kband%ab = 0.0_dp; self%cband%ab = 0.0_dp
       call internal_forces(m, self%ms, self%u, self%v, self%fint, self%kband%ab, 1.0_dp, 0.0_dp, &
                            self%cband%ab)
@@ -292,8 +304,11 @@ contains
             if (allocated(self%qlcp)) then
                if (size(self%qlcp) < na) deallocate (self%qlcp, self%zlcp, self%gref, self%eact)
             end if
-            if (.not. allocated(self%qlcp)) allocate (self%qlcp(nc), self%zlcp(nc), self%gref(nc), &
-                                                      self%eact(nc))
+            if (.not. allocated(self%qlcp)) then
+               allocate (self%qlcp(nc), self%zlcp(nc), self%gref(nc), self%eact(nc), stat=inf)
+               if (inf /= 0) call no_memory('the impulse problem', REAL_BYTES*4*nc)
+               if (inf /= 0) return
+            end if
             do ii = 1, na
                k = act(ii)
                self%qlcp(ii) = v(sb(k)) - v(sa(k))
@@ -304,7 +319,8 @@ contains
             if (kd == 0) then
                ! Ŵ diagonal: W banded in the active ordering (tridiagonal for a chain)
                kw = delassus_bandwidth(self%graph, sa, sb, act(1:na), pos)
-               call ensure_band(kw)
+               call ensure_band(kw, inf)
+               if (inf /= 0) return
                call delassus_diagonal_band(self%graph, sa, sb, act(1:na), pos, what%ab(1, :), kw, self%wb)
                call newton_impulses(self%qlcp(1:na), self%gref(1:na), self%eact(1:na), &
                                     self%zlcp(1:na), inf, iters, wb=self%wb, kw=kw)
@@ -313,7 +329,11 @@ contains
                if (allocated(self%zcol)) then
                   if (size(self%zcol, 2) < na) deallocate (self%zcol)
                end if
-               if (.not. allocated(self%zcol)) allocate (self%zcol(n, max(na, 1)))
+               if (.not. allocated(self%zcol)) then
+                  allocate (self%zcol(n, max(na, 1)), stat=inf)
+                  if (inf /= 0) call no_memory('the Delassus columns', REAL_BYTES*n*max(na, 1))
+                  if (inf /= 0) return
+               end if
                self%zcol(:, 1:na) = 0.0_dp
                do jj = 1, na
                   k = act(jj)
@@ -327,14 +347,18 @@ contains
                else
                   call dgbtrs('N', n, kd, kd, na, what%ab, size(what%ab, 1), self%ipiv, self%zcol, n, inf)
                end if
-               call ensure_dense()
+               call ensure_dense(inf)
+               if (inf /= 0) return
                call delassus_columns(sa(act(1:na)), sb(act(1:na)), self%zcol(:, 1:na), &
                                      self%wd_(1:na, 1:na))
                call newton_impulses(self%qlcp(1:na), self%gref(1:na), self%eact(1:na), &
                                     self%zlcp(1:na), inf, iters, w=self%wd_(1:na, 1:na))
             end if
             o%counters(C_NEWTON) = o%counters(C_NEWTON) + int(iters, i8)
-            if (inf /= IMPULSE_OK) then
+            if (inf == IMPULSE_NO_MEMORY) then
+               call no_memory('the work arrays of the LCP solver', REAL_BYTES*lcp_work_reals(na))
+               return
+            else if (inf /= IMPULSE_OK) then
                write (msg, '(a,i0,a,es12.5,a,i0,a)') 'Moreau-Jean: the impulse LCP on ', na, &
                   ' active contacts failed at t = ', t, ' s (', iters, &
                   ' iterations; redundant constraints or a contact between immobile sides?)'
@@ -347,20 +371,37 @@ contains
          end associate
       end subroutine impulses
 
-      subroutine ensure_band(k)
+      subroutine ensure_band(k, st)
          integer, intent(in) :: k
+         integer, intent(out) :: st
+         st = 0
          if (allocated(self%wb)) then
             if (size(self%wb, 1) < 2*k + 1 .or. size(self%wb, 2) < self%na) deallocate (self%wb)
          end if
-         if (.not. allocated(self%wb)) allocate (self%wb(2*k + 1, max(self%na, nc)))
+         if (allocated(self%wb)) return
+         allocate (self%wb(2*k + 1, max(self%na, nc)), stat=st)
+         if (st /= 0) call no_memory('the band Delassus matrix', REAL_BYTES*(2*k + 1.0_dp)*max(self%na, nc))
       end subroutine ensure_band
 
-      subroutine ensure_dense()
+      subroutine ensure_dense(st)
+         integer, intent(out) :: st
+         st = 0
          if (allocated(self%wd_)) then
             if (size(self%wd_, 1) < self%na) deallocate (self%wd_)
          end if
-         if (.not. allocated(self%wd_)) allocate (self%wd_(self%na, self%na))
+         if (allocated(self%wd_)) return
+         allocate (self%wd_(self%na, self%na), stat=st)
+         if (st /= 0) call no_memory('the Delassus matrix', REAL_BYTES*real(self%na, dp)**2)
       end subroutine ensure_dense
+
+      !> An allocation of the step failed: the run fails with the out-of-memory line.
+      subroutine no_memory(what, bytes)
+         character(len=*), intent(in) :: what
+         real(dp), intent(in) :: bytes
+         write (msg, '(a,i0,a)') ' of Moreau-Jean for ', self%na, ' active contacts'
+         call out_of_memory(what//trim(msg), bytes, FIX_SMALLER_SCENE, stat, msg)
+         call observer_fail(o, MARTELLO_ERR_MEMORY, t_prev, msg, stat)
+      end subroutine no_memory
 
       !> Contact phases of the rigid contacts (the penalty ones are the strategy's): a phase
       !> is a run of steps with p > 0; it starts at the instant t_k + (1−θ)h where the

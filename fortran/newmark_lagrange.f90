@@ -78,6 +78,7 @@ contains
       integer :: n, nc, i
       logical :: converged
       character(len=16) :: num
+      character(len=256) :: msg
       stat = MARTELLO_OK
       if (m%n > NL_MAX_NODES) then
          write (num, '(i0)') NL_MAX_NODES
@@ -93,11 +94,18 @@ contains
       self%max_newton = s%max_newton
       self%tol_residual = s%tol_residual; self%tol_increment = s%tol_increment
       allocate (self%fint(0:n), self%fint_n(0:n), self%fext(0:n), self%fext_n(0:n), &
-                self%ma(0:n), self%work(0:n), self%mdense(n, n))
-      allocate (self%e_con(nc), self%lam(nc), self%mstar(nc), self%sa(nc), self%sb(nc), &
-                self%rigid(nc), self%pers(nc), self%active(nc), self%movable(nc))
-      call band_init(self%kband, n, self%kd)
-      call band_init(self%cband, n, self%kd)
+                self%ma(0:n), self%work(0:n), self%mdense(n, n), &
+                self%e_con(nc), self%lam(nc), self%mstar(nc), self%sa(nc), self%sb(nc), &
+                self%rigid(nc), self%pers(nc), self%active(nc), self%movable(nc), stat=stat)
+      if (stat /= 0) call out_of_memory('the state of Newmark-Lagrange', REAL_BYTES*(6*(n + 1.0_dp) &
+                                        + real(n, dp)**2 + 3*nc) + INT_BYTES*6.0_dp*nc, &
+                                        FIX_SMALLER_SCENE, stat, msg)
+      if (stat == MARTELLO_OK) call band_init(self%kband, n, self%kd, stat, msg)
+      if (stat == MARTELLO_OK) call band_init(self%cband, n, self%kd, stat, msg)
+      if (stat /= MARTELLO_OK) then
+         call observer_fail(o, MARTELLO_ERR_MEMORY, 0.0_dp, msg, stat)
+         return
+      end if
       self%pers = .false.; self%lam = 0.0_dp
 
       ! dense mass matrix (lumped diagonal and consistent couplings), columns by M e_i
@@ -140,7 +148,14 @@ contains
                na = na + 1; idx(na) = j
             end if
          end do
-         allocate (kkt(n + na, n + na), rhs(n + na))
+         ok = .false.
+         allocate (kkt(n + na, n + na), rhs(n + na), stat=st)
+         if (st /= 0) then
+            call out_of_memory('the KKT system of Newmark-Lagrange', REAL_BYTES*(n + na + 1.0_dp)*(n + na), &
+                               FIX_SMALLER_SCENE, st, msg)
+            call observer_fail(o, MARTELLO_ERR_MEMORY, t, msg, stat)
+            return
+         end if
          kkt = 0.0_dp
          kkt(1:n, 1:n) = self%mdense
          rhs = 0.0_dp
@@ -150,7 +165,10 @@ contains
          call solve_symmetric_indefinite(kkt, rhs, rc, st, msg)
          o%counters(C_FACTORIZATIONS) = o%counters(C_FACTORIZATIONS) + 1_i8
          ok = st == MARTELLO_OK
-         if (.not. ok) then
+         if (st == MARTELLO_ERR_MEMORY) then
+            call observer_fail(o, st, t, msg, stat)
+            return
+         else if (.not. ok) then
             call observer_fail(o, st, t, 'Newmark-Lagrange: the mass matrix with the persistent'// &
                                ' contacts is singular ('//trim(msg)//')', stat)
             return
@@ -322,7 +340,14 @@ contains
                   na = na + 1; idx(na) = j
                end if
             end do
-            allocate (kkt(n + na, n + na), rhs(n + na))
+            ok = .false.
+            allocate (kkt(n + na, n + na), rhs(n + na), stat=st)
+            if (st /= 0) then
+               call out_of_memory('the KKT system of Newmark-Lagrange', &
+                                  REAL_BYTES*(n + na + 1.0_dp)*(n + na), FIX_SMALLER_SCENE, st, msg)
+               call observer_fail(o, MARTELLO_ERR_MEMORY, t_prev, msg, stat)
+               return
+            end if
             lam = 0.0_dp
             u(1:n) = un(1:n) + h*vn(1:n) + 0.5_dp*h*h*an(1:n)
             uscale = tiny(1.0_dp)
@@ -373,7 +398,10 @@ contains
                call solve_symmetric_indefinite(kkt, rhs, rc, st, msg)
                o%counters(C_FACTORIZATIONS) = o%counters(C_FACTORIZATIONS) + 1_i8
                o%counters(C_NEWTON) = o%counters(C_NEWTON) + 1_i8
-               if (st /= MARTELLO_OK) then
+               if (st == MARTELLO_ERR_MEMORY) then
+                  call observer_fail(o, st, t_prev, msg, stat)
+                  return
+               else if (st /= MARTELLO_OK) then
                   write (why, '(a,es12.5,a)') 'Newmark-Lagrange: singular KKT system at t = ', t, &
                      ' s ('//trim(msg)//')'
                   call observer_fail(o, st, t_prev, why, stat)

@@ -10,6 +10,7 @@ module martello_stability
    use martello_model, only: model_t, model_bandwidth, SCHEME_PENALTY
    use martello_links, only: LINK_SPRING, LINK_BAR, LINK_BILINEAR, L_STIFF
    use martello_contact_laws, only: LAW_LINEAR, LAW_KELVIN, P_STIFF
+   use martello_status, only: MARTELLO_OK, out_of_memory, REAL_BYTES, INT_BYTES, FIX_SMALLER_SCENE
    implicit none
    private
    public :: omega_max, free_dofs, mass_band
@@ -18,23 +19,32 @@ module martello_stability
 contains
 
    !> ω_max [rad/s]; info /= 0 if LAPACK failed (M not positive definite on the free DOFs).
-   subroutine omega_max(m, w_max, info)
+   !> stat, message: as martello_status out_of_memory if the bands cannot be allocated.
+   subroutine omega_max(m, w_max, info, stat, message)
       type(model_t), intent(in) :: m
       real(dp), intent(out) :: w_max
-      integer, intent(out) :: info
+      integer, intent(out) :: info, stat
+      character(len=*), intent(out) :: message
       integer :: kd, nf, j, nfound
       integer, allocatable :: dof(:), iwork(:), ifail(:)
       real(dp), allocatable :: ka(:, :), mb(:, :), w(:), work(:)
       real(dp) :: q(1, 1), z(1, 1)
 
       kd = max(model_bandwidth(m), 0)
-      call free_dofs(m, dof, nf)
       w_max = 0.0_dp; info = 0
-      if (nf == 0) return
+      call free_dofs(m, dof, nf, stat, message)
+      if (stat /= MARTELLO_OK .or. nf == 0) return
       ! upper band storage: A(i,j), i <= j, in ab(kd+1+i−j, j)
-      allocate (ka(kd + 1, nf), w(nf), work(7*nf), iwork(5*nf), ifail(nf))
+      allocate (ka(kd + 1, nf), w(nf), work(7*nf), iwork(5*nf), ifail(nf), stat=stat)
+      if (stat /= 0) then
+         call out_of_memory('the stiffness band of the stability limit', &
+                            REAL_BYTES*(kd + 9.0_dp)*nf + INT_BYTES*6.0_dp*nf, FIX_SMALLER_SCENE, &
+                            stat, message)
+         return
+      end if
       ka = 0.0_dp
-      call mass_band(m, dof, nf, kd, mb)
+      call mass_band(m, dof, nf, kd, mb, stat, message)
+      if (stat /= MARTELLO_OK) return
       do j = 1, m%nlink
          select case (m%link_kind(j))
          case (LINK_SPRING, LINK_BAR, LINK_BILINEAR)
@@ -80,13 +90,23 @@ contains
 
    !> M (lumped diagonal plus consistent couplings) on the free nodes, dof-numbered, in
    !> LAPACK's upper band storage: M(i,j), i <= j, in mb(kd+1+i−j, j). A coupling to a fixed
-   !> node drops out with that node's row and column.
-   pure subroutine mass_band(m, dof, nf, kd, mb)
+   !> node drops out with that node's row and column. stat, message: as martello_status
+   !> out_of_memory (absent: the process stops with its line).
+   subroutine mass_band(m, dof, nf, kd, mb, stat, message)
       type(model_t), intent(in) :: m
       integer, intent(in) :: dof(0:), nf, kd
       real(dp), allocatable, intent(out) :: mb(:, :)
+      integer, intent(out), optional :: stat
+      character(len=*), intent(out), optional :: message
       integer :: i, j, ia, ib
-      allocate (mb(kd + 1, nf)); mb = 0.0_dp
+      if (present(stat)) stat = MARTELLO_OK
+      allocate (mb(kd + 1, nf), stat=i)
+      if (i /= 0) then
+         call out_of_memory('the mass band', REAL_BYTES*(kd + 1.0_dp)*nf, FIX_SMALLER_SCENE, &
+                            stat, message)
+         return
+      end if
+      mb = 0.0_dp
       do i = 1, m%n
          if (dof(i) > 0) mb(kd + 1, dof(i)) = m%mass(i)
       end do
@@ -99,12 +119,23 @@ contains
    end subroutine mass_band
 
    !> Numbering of the free nodes: dof(i) in 1..nf, 0 for fixed nodes and ground (dof(0)).
-   pure subroutine free_dofs(m, dof, nf)
+   !> stat, message: as martello_status out_of_memory (absent: the process stops with its line).
+   subroutine free_dofs(m, dof, nf, stat, message)
       type(model_t), intent(in) :: m
       integer, allocatable, intent(out) :: dof(:)
       integer, intent(out) :: nf
+      integer, intent(out), optional :: stat
+      character(len=*), intent(out), optional :: message
       integer :: i
-      allocate (dof(0:m%n)); dof = 0; nf = 0
+      if (present(stat)) stat = MARTELLO_OK
+      nf = 0
+      allocate (dof(0:m%n), stat=i)
+      if (i /= 0) then
+         call out_of_memory('the numbering of the free nodes', INT_BYTES*(m%n + 1.0_dp), &
+                            FIX_SMALLER_SCENE, stat, message)
+         return
+      end if
+      dof = 0
       do i = 1, m%n
          if (.not. m%fixed(i)) then
             nf = nf + 1; dof(i) = nf

@@ -11,7 +11,7 @@ from functools import lru_cache
 import numpy as np
 
 from ..errors import MartelloError, SolverError
-from .native import lib, status_name
+from .native import constant, lib, memory_message, status_name
 
 _DOUBLE_P = np.ctypeslib.ndpointer(dtype=np.float64, flags="C_CONTIGUOUS")
 
@@ -43,8 +43,13 @@ def library():
     return L
 
 
-def check_status(status, what):
-    """Raise SolverError on a negative status; return the status otherwise."""
+def check_status(status, what, samples):
+    """Raise SolverError on a negative status (out of memory: the library's line for the
+    workspace of a record of that many samples, which FFTW and GSL allocate); return the
+    status otherwise."""
+    if status == constant("MARTELLO_ERR_MEMORY"):
+        what = memory_message(f"the workspace of the {what} of a record of {samples} samples",
+                              fix="use a shorter record (fewer samples)")
     if status < 0:
         raise SolverError(status, status_name(status), what)
     return status
@@ -55,7 +60,7 @@ def response_spectrum(accel, dt, zeta, periods):
     sd, psv, psa = np.empty(periods.size), np.empty(periods.size), np.empty(periods.size)
     check_status(library().martello_gm_response_spectrum(accel, accel.size, dt, zeta, periods,
                                                          periods.size, sd, psv, psa),
-                 "response spectrum")
+                 "response spectrum", accel.size)
     return sd, psv, psa
 
 
@@ -66,7 +71,7 @@ def fourier_amplitude(accel, dt):
     count = ctypes.c_int(nf)
     check_status(library().martello_gm_fourier_amplitude(accel, accel.size, dt, freq, amp,
                                                          ctypes.byref(count)),
-                 "Fourier amplitude spectrum")
+                 "Fourier amplitude spectrum", accel.size)
     return freq[:count.value], amp[:count.value]
 
 

@@ -97,6 +97,7 @@ def lib():
         "martello_run_set_link_outputs": (c_int, [_VOID_P, c_int, _INT_P]),
         "martello_run_link_peaks": (c_int, [_VOID_P, _DOUBLE_P, _DOUBLE_P]),
         "martello_run_abs_peaks": (c_int, [_VOID_P, _DOUBLE_P, _DOUBLE_P]),
+        "martello_memory_message": (None, [c_char_p, c_double, c_char_p, c_char_p, c_int]),
     }
     for name, (res, args) in protos.items():
         fn = getattr(L, name)
@@ -267,6 +268,16 @@ def library_versions():
 
 def status_name(status):
     return lib().martello_status_name(status).decode()
+
+
+def memory_message(what, nbytes=-1.0, fix=None):
+    """The library's one out-of-memory line (fortran/status.f90, docs/behaviour.md "When
+    memory runs out"): what could not be allocated, nbytes (< 0: not known) and fix (None: a
+    smaller scene)."""
+    buf = ctypes.create_string_buffer(512)
+    lib().martello_memory_message(what.encode(), float(nbytes), fix.encode() if fix else None,
+                                  buf, len(buf))
+    return buf.value.decode()
 
 
 def _f64(values, n=None):

@@ -129,7 +129,7 @@ def synthesize(target, *, duration=20.0, dt=0.01, seed=0, pga=None, zeta=0.05, e
         T, sa, pga, zeta, dt, n, e, t_min, t_max, band, max_iter, seed)
     converged = st == 0
     if not converged and st != constant("MARTELLO_ERR_NOT_CONVERGED"):
-        native_gm.check_status(st, "spectrum-compatible synthesis")
+        native_gm.check_status(st, "spectrum-compatible synthesis", n)
     accel.setflags(write=False)
     return SynthesisResult(accel=accel, dt=dt, seed=seed, iterations=iterations,
                            restarts=restarts, worst_deviation=deviation, converged=converged)
