@@ -224,6 +224,11 @@ int martello_run_set_outputs(martello_run *run, int n_nodes, const int *nodes, i
                              const int *contacts);
 /* Links whose force and elongation the history records (0-based; default none). */
 int martello_run_set_link_outputs(martello_run *run, int n_links, const int *links);
+/* Which contacts' phases martello_run_events lists (docs/results.md): every contact's while
+ * the model has at most max_contacts contacts (default 1000; < 0: always); past it, those of
+ * the output contacts (martello_run_set_outputs), and of every other contact its first and
+ * last phase alone (in that order), so a long pounding chain keeps two rows per contact. */
+int martello_run_set_phase_lists(martello_run *run, int max_contacts);
 /* ---- closed forms of catalogue problems (docs/c-api.md "Closed forms") ------------------
  * The closed form `name` at the n_par parameters par: out (4 values) receives its *n_out
  * values. MARTELLO_ERR_ARGUMENT for an unknown name, a wrong parameter count or parameters

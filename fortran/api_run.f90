@@ -87,6 +87,21 @@ contains
       c_run_set_link_outputs = MARTELLO_OK
    end function c_run_set_link_outputs
 
+   !> Every contact's phases are listed while the model has at most max_contacts contacts
+   !> (< 0: always); past it the output contacts' (martello_run_set_outputs), and the
+   !> others keep their first and last phase (docs/results.md).
+   integer(c_int) function c_run_set_phase_lists(handle, max_contacts) &
+      bind(C, name='martello_run_set_phase_lists')
+      type(c_ptr), value :: handle
+      integer(c_int), value :: max_contacts
+      type(run_t), pointer :: rp
+      rp => get_run(handle)
+      c_run_set_phase_lists = MARTELLO_ERR_ARGUMENT
+      if (.not. associated(rp)) return
+      rp%phase_lists = int(max_contacts)
+      c_run_set_phase_lists = MARTELLO_OK
+   end function c_run_set_phase_lists
+
    !> The progress callback of the run (c/martello.h martello_progress_fn), called with
    !> user about four times a second while it runs; a NULL callback removes it.
    integer(c_int) function c_run_set_progress(handle, callback, user) &

@@ -21,6 +21,8 @@ module martello_observer
       observer_work, observer_open_phase, observer_close_phase, observer_add_impact, &
       observer_penalty_phases, observer_fail, observer_fail_nonfinite, observer_finish, &
       free_side_crossing, progress_callback, observer_extremum, observer_recorded, &
+      observer_node_peaks, observer_contact_peaks, observer_phase_change, observer_energy_due, &
+      observer_phase_lists, &
       NCOUNTERS, C_STEPS, C_REJECTED, C_NEWTON, C_RESIDUALS, C_FACTORIZATIONS, C_EVENTS, &
       C_JACOBIANS, C_ROOT_EVALS, C_CHATTER, NENERGY, E_KINETIC, E_RECOVERABLE, E_INPUT, E_DAMPING, &
       E_PLASTIC, E_CONTACT, E_BALANCE, E_INITIAL, E_IMPACT, NEVENT, EV_T_ON, EV_T_OFF, &
@@ -87,11 +89,18 @@ module martello_observer
       ! open contact phases: onset time and speed, running maxima of δ and P
       logical, allocatable :: ph_open(:)
       real(dp), allocatable :: ph_t(:), ph_v(:), ph_pen(:), ph_f(:)
+      !> past observer_phase_lists' number of contacts, the events of a contact not listed in
+      !> full are its first and last phase: ph_row(c) is 0 before its first phase, the row
+      !> of its only phase (> 0), or −(the row of its last phase) once it has two; LISTED
+      !> for a contact whose every phase is kept. Not allocated: every phase is kept.
+      integer, allocatable :: ph_row(:)
       ! the previous accepted state, for the interpolated peaks when the method keeps none
+      ! (allocated at the first such sample)
       real(dp), allocatable :: prev_u(:), prev_v(:), prev_a(:)
       real(dp) :: prev_t = -1.0_dp
-      real(dp), allocatable :: work(:)          !< scratch (0:n): M v
-      !> a C integrator's accelerations (0:n), contact penetrations and forces
+      real(dp), allocatable :: work(:)          !< scratch (0:n): M v, at its first use
+      !> a C integrator's accelerations (0:n), contact penetrations and forces (allocated by
+      !> martello_observer_begin, martello_api_internal)
       real(dp), allocatable :: acc(:), c_pen(:), c_force(:)
    end type observer_t
 
@@ -118,6 +127,8 @@ module martello_observer
    real(dp), parameter :: CREATED_BOUND = 1.0e-2_dp
    !> History rows allocated at the start; it grows by doubling beyond (record).
    integer, parameter :: HIST_START = 4096
+   !> ph_row of a contact whose phases are all kept
+   integer, parameter :: LISTED = -huge(1)
 
    !> Samples of one observer_sample call: the grid point k as a default or a 64-bit integer.
    interface observer_sample
@@ -169,9 +180,7 @@ contains
                 o%pen_max(n_contacts), o%force_max(n_contacts), o%impacts(n_contacts), &
                 o%u_peak(n_nodes), o%t_peak(n_nodes), o%link_force_absmax(n_links), &
                 o%u_absmax(n_nodes), o%t_absmax(n_nodes), &
-                o%link_du_absmax(n_links), o%prev_u(n_nodes), o%prev_v(n_nodes), &
-                o%prev_a(n_nodes), o%work(0:n_nodes), o%acc(0:n_nodes), o%c_pen(n_contacts), &
-                o%c_force(n_contacts), o%ph_open(n_contacts), &
+                o%link_du_absmax(n_links), o%ph_open(n_contacts), &
                 o%ph_t(n_contacts), o%ph_v(n_contacts), o%ph_pen(n_contacts), o%ph_f(n_contacts), &
                 stat=st2)
       if (st /= 0 .or. st2 /= 0) then
@@ -196,7 +205,9 @@ contains
    !> from, and a phase opened at t = 0 for every penalty contact closed there. energy_interval: samples between energy evaluations (the strategy's choice: 16
    !> for cheap fixed steps, 1 for adaptive ones); advice ends a divergence message;
    !> ke_aMa: the method conserves ½vᵀMv − ke_aMa·aᵀMa (Verlet; 0 for the others).
-   subroutine observer_begin(o, m, ms, u, v, a, energy_interval, advice, ke_aMa)
+   !> energies = [kinetic, links, contacts]: a method that keeps its own element states (no
+   !> ms, the fused chain step) hands them, and has opened the phases at t = 0 itself.
+   subroutine observer_begin(o, m, ms, u, v, a, energy_interval, advice, ke_aMa, energies)
       type(observer_t), intent(inout) :: o
       type(model_t), intent(in) :: m
       type(mech_state_t), intent(in) :: ms
@@ -204,13 +215,19 @@ contains
       integer, intent(in) :: energy_interval
       character(len=*), intent(in) :: advice
       real(dp), intent(in) :: ke_aMa
+      real(dp), intent(in), optional :: energies(3)
       real(dp) :: e_kin
       integer :: c
-      do c = 1, m%ncontact
-         if (ms%con_on(c)) call observer_open_phase(o, c, 0.0_dp, v(m%con_a(c)) - v(m%con_b(c)))
-      end do
-      e_kin = kinetic_energy(m, v, o%work)
-      call recoverable_energy(m, ms, u, o%e_links0, o%e_cont0)
+      if (present(energies)) then
+         e_kin = energies(1); o%e_links0 = energies(2); o%e_cont0 = energies(3)
+      else
+         do c = 1, m%ncontact
+            if (ms%con_on(c)) call observer_open_phase(o, c, 0.0_dp, v(m%con_a(c)) - v(m%con_b(c)))
+         end do
+         call scratch(o, m%n)
+         e_kin = kinetic_energy(m, v, o%work)
+         call recoverable_energy(m, ms, u, o%e_links0, o%e_cont0)
+      end if
       o%e0 = e_kin + o%e_links0 + o%e_cont0
       o%ke_aMa = ke_aMa
       ! the balance starts from the method's conserved energy e0 − ke_corr
@@ -250,9 +267,17 @@ contains
       real(dp), intent(in) :: a(0:)
       kc = 0.0_dp
       if (o%ke_aMa == 0.0_dp) return
+      call scratch(o, m%n)
       call mass_times(m, a, o%work)
       kc = o%ke_aMa*dot_product(a(1:m%n), o%work(1:m%n))
    end function kinetic_correction
+
+   !> o%work (0:n), allocated at its first use.
+   subroutine scratch(o, n)
+      type(observer_t), intent(inout) :: o
+      integer, intent(in) :: n
+      if (.not. allocated(o%work)) allocate (o%work(0:n))
+   end subroutine scratch
 
    !> The recording cadence: t = 0, every every-th output grid point, and the last one.
    pure logical function recorded(o, k)
@@ -270,14 +295,30 @@ contains
       observer_recorded = recorded(o, k)
    end function observer_recorded
 
+   !> Whether the next sample, at grid point k, evaluates the energy terms: where recorded,
+   !> every energy_interval-th sample and once a work is not finite (a method that hands
+   !> its energies to observer_sample computes them then).
+   logical function observer_energy_due(o, k) result(due)
+      type(observer_t), intent(in) :: o
+      integer(i8), intent(in) :: k
+      due = recorded(o, k) .or. mod(o%nsamples + 1, int(o%energy_interval, i8)) == 0 .or. &
+            .not. ieee_is_finite(o%w_last + o%d_damp + o%d_links + o%d_contact + o%d_impact)
+   end function observer_energy_due
+
    !> An accepted state at t (once per accepted step and at t = 0, after the step's phase
    !> changes): phase maxima and peaks; the energy terms and the divergence test where
    !> recorded, every energy_interval-th sample and once a work is not finite; a history row
    !> where recorded. k: the grid point t = k·dt of the state, or −1. u, v, a on nodes 0:n;
    !> u_prev … the previous state if the method keeps it (saves a copy). stat:
    !> MARTELLO_ERR_DIVERGED, with the message, when the run must stop.
+   !> folded: the method has measured this state item by item in its own sweeps
+   !> (observer_node_peaks, observer_phase_change and observer_contact_peaks, the link
+   !> peaks: the fused chain step); pen, force (and link_f, link_du) then serve the history
+   !> row alone, and are
+   !> read only where recorded. energies = [kinetic, links, contacts] at this state, from
+   !> such a method where observer_energy_due (it keeps no ms).
    subroutine observer_sample_i8(o, m, ms, t, u, v, a, pen, force, k, stat, link_f, link_du, &
-                                 u_prev, v_prev, a_prev)
+                                 u_prev, v_prev, a_prev, folded, energies)
       type(observer_t), intent(inout) :: o
       type(model_t), intent(in) :: m
       type(mech_state_t), intent(in) :: ms
@@ -285,22 +326,34 @@ contains
       integer(i8), intent(in) :: k
       integer, intent(out) :: stat
       real(dp), intent(in), optional :: link_f(:), link_du(:), u_prev(:), v_prev(:), a_prev(:)
+      logical, intent(in), optional :: folded
+      real(dp), intent(in), optional :: energies(3)
       real(dp) :: e_kin, e_links, e_cont, kc
-      logical :: due
-      integer :: c
+      logical :: due, measured
       stat = MARTELLO_OK
+      due = observer_energy_due(o, k)
       o%nsamples = o%nsamples + 1
-      due = recorded(o, k) .or. mod(o%nsamples, int(o%energy_interval, i8)) == 0 .or. &
-            .not. ieee_is_finite(o%w_last + o%d_damp + o%d_links + o%d_contact + o%d_impact)
-      do c = 1, size(pen)
-         if (.not. o%ph_open(c)) cycle
-         o%ph_pen(c) = max(o%ph_pen(c), pen(c)); o%ph_f(c) = max(o%ph_f(c), force(c))
-      end do
-      call track(o, t, u(1:), v(1:), a(1:), pen, force, link_f, link_du, u_prev, v_prev, a_prev)
+      measured = .false.
+      if (present(folded)) measured = folded
+      if (measured) then
+         o%prev_t = t
+      else
+         call observer_contact_peaks(o%ph_open(1:size(pen)), pen, force, o%ph_pen(1:size(pen)), &
+                                     o%ph_f(1:size(pen)), o%pen_max(1:size(pen)), &
+                                     o%force_max(1:size(pen)))
+         if (.not. present(u_prev) .and. .not. allocated(o%prev_u)) &
+            allocate (o%prev_u(m%n), o%prev_v(m%n), o%prev_a(m%n))
+         call track(o, t, u(1:), v(1:), a(1:), link_f, link_du, u_prev, v_prev, a_prev)
+      end if
       if (due) then
-         e_kin = kinetic_energy(m, v, o%work)
+         if (present(energies)) then
+            e_kin = energies(1); e_links = energies(2); e_cont = energies(3)
+         else
+            call scratch(o, m%n)
+            e_kin = kinetic_energy(m, v, o%work)
+            call recoverable_energy(m, ms, u, e_links, e_cont)
+         end if
          kc = kinetic_correction(o, m, a)
-         call recoverable_energy(m, ms, u, e_links, e_cont)
          o%energy = energy_terms(o%e0, o%w_ext, e_kin, e_links, e_cont, o%e_links0, o%e_cont0, &
                                  o%d_damp, o%d_links, o%d_contact, o%d_impact, kc, o%ke_corr0)
          o%energy_balance_max = max(o%energy_balance_max, abs(o%energy(E_BALANCE)))
@@ -317,7 +370,7 @@ contains
 
    !> observer_sample with the grid point k as a default integer (the C door, k ≤ 2^31).
    subroutine observer_sample_i4(o, m, ms, t, u, v, a, pen, force, k, stat, link_f, link_du, &
-                                 u_prev, v_prev, a_prev)
+                                 u_prev, v_prev, a_prev, folded, energies)
       type(observer_t), intent(inout) :: o
       type(model_t), intent(in) :: m
       type(mech_state_t), intent(in) :: ms
@@ -325,8 +378,10 @@ contains
       integer, intent(in) :: k
       integer, intent(out) :: stat
       real(dp), intent(in), optional :: link_f(:), link_du(:), u_prev(:), v_prev(:), a_prev(:)
+      logical, intent(in), optional :: folded
+      real(dp), intent(in), optional :: energies(3)
       call observer_sample_i8(o, m, ms, t, u, v, a, pen, force, int(k, i8), stat, link_f, &
-                              link_du, u_prev, v_prev, a_prev)
+                              link_du, u_prev, v_prev, a_prev, folded, energies)
    end subroutine observer_sample_i4
 
    !> The budget and the caller, after every accepted sample: max_steps (every sample),
@@ -461,7 +516,7 @@ contains
       real(dp), intent(in), optional :: pen, force
       if (present(pen)) o%ph_pen(c) = max(o%ph_pen(c), pen)
       if (present(force)) o%ph_f(c) = max(o%ph_f(c), force)
-      call add_event(o, c, [o%ph_t(c), t_off, o%ph_v(c), v_out, o%ph_pen(c), o%ph_f(c)])
+      call keep_event(o, c, [o%ph_t(c), t_off, o%ph_v(c), v_out, o%ph_pen(c), o%ph_f(c)])
       o%ph_open(c) = .false.
    end subroutine observer_close_phase
 
@@ -471,7 +526,7 @@ contains
       type(observer_t), intent(inout) :: o
       integer, intent(in) :: c
       real(dp), intent(in) :: t, v_in, v_out, pen, force
-      call add_event(o, c, [t, t, v_in, v_out, pen, force])
+      call keep_event(o, c, [t, t, v_in, v_out, pen, force])
       o%impacts(c) = o%impacts(c) + 1
    end subroutine observer_add_impact
 
@@ -486,26 +541,53 @@ contains
       type(mech_state_t), intent(in) :: ms
       real(dp), intent(in) :: un(0:), vn(0:), an(0:), u(0:), v(0:), a(0:), t, h
       integer :: c, ia, ib
-      real(dp) :: d0, r0, q0, tau
       do c = 1, m%ncontact
          if (.not. ms%is_penalty(c)) cycle
          ia = m%con_a(c); ib = m%con_b(c)
-         if (.not. o%ph_open(c) .and. ms%con_on(c)) then
-            d0 = un(ia) - un(ib) - m%con_gap(c); r0 = vn(ia) - vn(ib); q0 = an(ia) - an(ib)
-            tau = free_side_crossing(d0, r0, q0, 0.0_dp, h)
-            call observer_open_phase(o, c, t - h + tau, r0 + q0*tau)
-            o%counters(C_EVENTS) = o%counters(C_EVENTS) + 1_i8
-         end if
-         if (o%ph_open(c)) then
-            o%ph_pen(c) = max(o%ph_pen(c), ms%con_pen(c)); o%ph_f(c) = max(o%ph_f(c), ms%con_f(c))
-            if (.not. ms%con_on(c)) then
-               d0 = u(ia) - u(ib) - m%con_gap(c); r0 = v(ia) - v(ib); q0 = a(ia) - a(ib)
-               tau = free_side_crossing(d0, r0, q0, -h, 0.0_dp)
-               call observer_close_phase(o, c, t + tau, r0 + q0*tau)
-            end if
-         end if
+         call penalty_phase(o, c, ms%con_on(c), ms%con_pen(c), ms%con_f(c), &
+                            un(ia) - un(ib) - m%con_gap(c), vn(ia) - vn(ib), an(ia) - an(ib), &
+                            u(ia) - u(ib) - m%con_gap(c), v(ia) - v(ib), a(ia) - a(ib), t, h)
       end do
    end subroutine observer_penalty_phases
+
+   !> observer_penalty_phases for one penalty contact c: in contact (on), δ and force at t;
+   !> δ, δ̇, δ̈ at the start of the step (d0, r0, q0) and at its end (d1, r1, q1).
+   subroutine penalty_phase(o, c, on, pen, force, d0, r0, q0, d1, r1, q1, t, h)
+      type(observer_t), intent(inout) :: o
+      integer, intent(in) :: c
+      logical, intent(in) :: on
+      real(dp), intent(in) :: pen, force, d0, r0, q0, d1, r1, q1, t, h
+      if (on .neqv. o%ph_open(c)) call observer_phase_change(o, c, on, pen, force, d0, r0, q0, &
+                                                             d1, r1, q1, t, h)
+      if (o%ph_open(c)) then
+         o%ph_pen(c) = max(o%ph_pen(c), pen); o%ph_f(c) = max(o%ph_f(c), force)
+      end if
+   end subroutine penalty_phase
+
+   !> Penalty contact c opens (on) or closes (not on) in the fixed step (t − h, t], its
+   !> phase being closed or open: a phase starts at the onset located on the free side of the
+   !> step by the quadratic δ + δ̇τ + ½δ̈τ² = 0 from the start (O(h³) in time, speed
+   !> extrapolated likewise; one event of the method), or ends, its maxima taken with the
+   !> contact's state at t (pen, force), at the separation located likewise back from the
+   !> end. d0, r0, q0 and d1, r1, q1: δ, δ̇, δ̈ at t − h and at t. A method that measures its
+   !> contacts in its own sweep (the fused chain step) calls this where on differs from
+   !> o%ph_open(c), then observer_contact_peaks.
+   subroutine observer_phase_change(o, c, on, pen, force, d0, r0, q0, d1, r1, q1, t, h)
+      type(observer_t), intent(inout) :: o
+      integer, intent(in) :: c
+      logical, intent(in) :: on
+      real(dp), intent(in) :: pen, force, d0, r0, q0, d1, r1, q1, t, h
+      real(dp) :: tau
+      if (on) then
+         tau = free_side_crossing(d0, r0, q0, 0.0_dp, h)
+         call observer_open_phase(o, c, t - h + tau, r0 + q0*tau)
+         o%counters(C_EVENTS) = o%counters(C_EVENTS) + 1_i8
+      else
+         o%ph_pen(c) = max(o%ph_pen(c), pen); o%ph_f(c) = max(o%ph_f(c), force)
+         tau = free_side_crossing(d1, r1, q1, -h, 0.0_dp)
+         call observer_close_phase(o, c, t + tau, r1 + q1*tau)
+      end if
+   end subroutine observer_phase_change
 
    !> Event location on the free side of a step: the first root of d + rate·τ + ½acc·τ² in
    !> [lo, hi] (O(h³) in time when the free motion is smooth); linear fallback, else hi.
@@ -598,6 +680,42 @@ contains
       r%hist(c + 1:c + NENERGY, k) = r%energy
    end subroutine record
 
+   !> Which contacts keep every phase (docs/results.md): all of them while the scene has at
+   !> most max_contacts contacts (max_contacts < 0: always); past it, the history's output
+   !> contacts, and the others their first and last phase alone (keep_event). After
+   !> observer_init.
+   subroutine observer_phase_lists(o, max_contacts)
+      type(observer_t), intent(inout) :: o
+      integer, intent(in) :: max_contacts
+      if (allocated(o%ph_row)) deallocate (o%ph_row)
+      if (max_contacts < 0 .or. size(o%ph_open) <= max_contacts) return
+      allocate (o%ph_row(size(o%ph_open)))
+      o%ph_row = 0
+      o%ph_row(o%out_contacts) = LISTED
+   end subroutine observer_phase_lists
+
+   !> A phase of contact c ends: an event row, or for a contact that keeps its first and
+   !> last phase alone (observer_phase_lists), its first row, then its last one, rewritten in
+   !> place (rows stay in time order per contact).
+   subroutine keep_event(o, c, values)
+      type(observer_t), intent(inout) :: o
+      integer, intent(in) :: c
+      real(dp), intent(in) :: values(NEVENT)
+      integer :: row
+      if (.not. allocated(o%ph_row)) then
+         call add_event(o, c, values); return
+      end if
+      row = o%ph_row(c)
+      if (row == LISTED) then
+         call add_event(o, c, values)
+      else if (row < 0) then
+         o%ev(:, -row) = values
+      else
+         call add_event(o, c, values)
+         o%ph_row(c) = merge(-o%nevents, o%nevents, row > 0)
+      end if
+   end subroutine keep_event
+
    subroutine add_event(r, contact, values)
       class(results_t), intent(inout) :: r
       integer, intent(in) :: contact
@@ -615,30 +733,25 @@ contains
       r%ev_contact(r%nevents) = contact
    end subroutine add_event
 
-   !> Peaks over every accepted state: extremes of u, |v|, |a|, penetration and force, and
-   !> the largest local maximum of u interpolated between the previous and this state by
-   !> u + vτ + ½aτ², τ = −v/a (O(h²) in time where the step maxima are O(h)).
-   subroutine track(o, t, u, v, a, pen, force, link_f, link_du, u_prev, v_prev, a_prev)
+   !> Peaks over every accepted state: the node peaks (observer_node_peaks) and, when the
+   !> link states are given, the link peaks.
+   subroutine track(o, t, u, v, a, link_f, link_du, u_prev, v_prev, a_prev)
       type(observer_t), intent(inout) :: o
-      real(dp), intent(in) :: t, u(:), v(:), a(:), pen(:), force(:)
+      real(dp), intent(in) :: t, u(:), v(:), a(:)
       real(dp), intent(in), optional :: link_f(:), link_du(:)
       real(dp), intent(in), optional :: u_prev(:), v_prev(:), a_prev(:)
       integer :: i
-      real(dp) :: tau, up, h
-      h = t - o%prev_t
       if (present(u_prev)) then
-         call peaks(u_prev, v_prev, a_prev)
+         call observer_node_peaks(t, o%prev_t, o%fixed_steps, o%located_extrema, u_prev, v_prev, &
+                                  a_prev, u, v, a, o%u_max, o%u_min, o%v_absmax, o%a_absmax, &
+                                  o%u_absmax, o%t_absmax, o%u_peak, o%t_peak)
       else
-         call peaks(o%prev_u, o%prev_v, o%prev_a)
+         call observer_node_peaks(t, o%prev_t, o%fixed_steps, o%located_extrema, o%prev_u, &
+                                  o%prev_v, o%prev_a, u, v, a, o%u_max, o%u_min, o%v_absmax, &
+                                  o%a_absmax, o%u_absmax, o%t_absmax, o%u_peak, o%t_peak)
          o%prev_u = u; o%prev_v = v; o%prev_a = a
       end if
       o%prev_t = t
-      ! the maxima are stored only when they change: a peak array is then read, not
-      ! rewritten, at every step (these passes are a fair part of a chain step's memory traffic)
-      do i = 1, size(pen)
-         if (pen(i) > o%pen_max(i)) o%pen_max(i) = pen(i)
-         if (force(i) > o%force_max(i)) o%force_max(i) = force(i)
-      end do
       if (present(link_f) .and. present(link_du)) then
          do i = 1, size(link_f)
             call raise_to(o%link_force_absmax(i), abs(link_f(i)))
@@ -657,35 +770,59 @@ contains
             x = y
          end if
       end subroutine raise_to
-
-      subroutine peaks(un, vn, an)
-         real(dp), intent(in) :: un(:), vn(:), an(:)
-         associate (umax => o%u_max, umin => o%u_min, vmax => o%v_absmax, amax => o%a_absmax, &
-                    upk => o%u_peak, tpk => o%t_peak)
-            do i = 1, size(u)
-               if (u(i) > umax(i)) umax(i) = u(i)
-               if (u(i) < umin(i)) umin(i) = u(i)
-               if (abs(v(i)) > vmax(i)) vmax(i) = abs(v(i))
-               if (abs(a(i)) > amax(i)) amax(i) = abs(a(i))
-               call fold_absmax(o, i, t, u(i))
-               if (o%fixed_steps .and. o%prev_t >= 0.0_dp .and. h > 0.0_dp) then
-                  call hermite_extremum(o, i, o%prev_t, h, un(i), vn(i), an(i), u(i), v(i), a(i))
-                  call hermite_v_extremum(vmax(i), h, vn(i), an(i), v(i), a(i))
-               end if
-               if (.not. o%located_extrema .and. o%prev_t >= 0.0_dp .and. vn(i) > 0.0_dp .and. &
-                   v(i) <= 0.0_dp) then
-                  if (an(i) < 0.0_dp) then
-                     tau = min(-vn(i)/an(i), h)
-                     up = un(i) + vn(i)*tau + 0.5_dp*an(i)*tau*tau
-                     if (up > upk(i)) then
-                        upk(i) = up; tpk(i) = o%prev_t + tau
-                     end if
-                  end if
-               end if
-            end do
-         end associate
-      end subroutine peaks
    end subroutine track
+
+   !> The peaks of a node at the accepted state (u, v, a) at t, the previous one (un, vn, an)
+   !> at the last sample's time t_prev (< 0: none): extremes of u, |v|, |a| (umax … amax),
+   !> the largest |u| and its time (uabs, tabs: at the state and, for a fixed-step method,
+   !> located on the step's cubic Hermite), and the largest local maximum of u (upk at tpk)
+   !> interpolated between the two states by u + vτ + ½aτ², τ = −v/a (O(h²) in time where the
+   !> step maxima are O(h)) unless the method locates its extrema. The maxima are stored only
+   !> when they change: a peak array is then read, not rewritten, at every step (a fair part
+   !> of a chain step's memory traffic). Elemental: track calls it on every node; a method
+   !> that measures its nodes in its own sweep (the fused chain step) node by node, on the
+   !> observer's arrays, before its folded observer_sample.
+   elemental subroutine observer_node_peaks(t, t_prev, fixed_steps, located, un, vn, an, u, v, &
+                                            a, umax, umin, vmax, amax, uabs, tabs, upk, tpk)
+      real(dp), intent(in) :: t, t_prev, un, vn, an, u, v, a
+      logical, intent(in) :: fixed_steps, located
+      real(dp), intent(inout) :: umax, umin, vmax, amax, uabs, tabs, upk, tpk
+      real(dp) :: tau, up, h
+      h = t - t_prev
+      if (u > umax) umax = u
+      if (u < umin) umin = u
+      if (abs(v) > vmax) vmax = abs(v)
+      if (abs(a) > amax) amax = abs(a)
+      call raise_absmax(uabs, tabs, t, u)
+      if (fixed_steps .and. t_prev >= 0.0_dp .and. h > 0.0_dp) then
+         call hermite_extremum(t_prev, h, un, vn, an, u, v, a, uabs, tabs)
+         call hermite_v_extremum(vmax, h, vn, an, v, a)
+      end if
+      if (.not. located .and. t_prev >= 0.0_dp .and. vn > 0.0_dp .and. v <= 0.0_dp) then
+         if (an < 0.0_dp) then
+            tau = min(-vn/an, h)
+            up = un + vn*tau + 0.5_dp*an*tau*tau
+            if (up > upk) then
+               upk = up; tpk = t_prev + tau
+            end if
+         end if
+      end if
+   end subroutine observer_node_peaks
+
+   !> The maxima of a contact at a sample: its largest δ and force (pen_max, force_max), and
+   !> those of its phase if open (ph_pen, ph_f). Elemental: observer_sample calls it on every
+   !> contact; a method that measures its contacts in its own sweep, contact by contact, on
+   !> the observer's arrays (after observer_phase_change where the contact opens or closes).
+   elemental subroutine observer_contact_peaks(open, pen, force, ph_pen, ph_f, pen_max, force_max)
+      logical, intent(in) :: open
+      real(dp), intent(in) :: pen, force
+      real(dp), intent(inout) :: ph_pen, ph_f, pen_max, force_max
+      if (open) then
+         ph_pen = max(ph_pen, pen); ph_f = max(ph_f, force)
+      end if
+      if (pen > pen_max) pen_max = pen
+      if (force > force_max) force_max = force
+   end subroutine observer_contact_peaks
 
    !> An extremum of node i's displacement located by the method inside an accepted step, at t
    !> with value u (the root of the node's velocity on the stepper's own solution,
@@ -701,21 +838,20 @@ contains
          o%u_peak = -huge(1.0_dp); o%t_peak = -1.0_dp
       end if
       o%u_max(i) = max(o%u_max(i), u); o%u_min(i) = min(o%u_min(i), u)
-      call fold_absmax(o, i, t, u)
+      call raise_absmax(o%u_absmax(i), o%t_absmax(i), t, u)
       if (maximum .and. u > o%u_peak(i)) then
          o%u_peak(i) = u; o%t_peak(i) = t
       end if
    end subroutine observer_extremum
 
-   !> u_absmax(i), t_absmax(i) ← |u|, t where |u| is larger
-   subroutine fold_absmax(o, i, t, u)
-      type(observer_t), intent(inout) :: o
-      integer, intent(in) :: i
+   !> uabs, tabs ← |u|, t where |u| is larger (a node's u_absmax, t_absmax)
+   elemental subroutine raise_absmax(uabs, tabs, t, u)
+      real(dp), intent(inout) :: uabs, tabs
       real(dp), intent(in) :: t, u
-      if (abs(u) > o%u_absmax(i)) then
-         o%u_absmax(i) = abs(u); o%t_absmax(i) = t
+      if (abs(u) > uabs) then
+         uabs = abs(u); tabs = t
       end if
-   end subroutine fold_absmax
+   end subroutine raise_absmax
 
    !> The extremum of u inside a fixed step [t0, t0 + h], located on the cubic Hermite
    !> interpolant of (u, v) at both ends, p(s) = u0 H00 + h v0 H10 + u1 H01 + h v1 H11
@@ -724,10 +860,9 @@ contains
    !> O(h²) of the structural steps themselves (docs/results.md). A turn the step's
    !> accelerations do not support (v reversed by an impulse: no a of the turn's sign at
    !> either end) is not a smooth extremum and is left to the step values.
-   subroutine hermite_extremum(o, i, t0, h, u0, v0, a0, u1, v1, a1)
-      type(observer_t), intent(inout) :: o
-      integer, intent(in) :: i
+   pure subroutine hermite_extremum(t0, h, u0, v0, a0, u1, v1, a1, uabs, tabs)
       real(dp), intent(in) :: t0, h, u0, v0, a0, u1, v1, a1
+      real(dp), intent(inout) :: uabs, tabs
       real(dp) :: s(2), p(2)
       integer :: k
       if (.not. (v0*v1 < 0.0_dp)) return
@@ -735,13 +870,13 @@ contains
       if (v0 < 0.0_dp .and. max(a0, a1) <= 0.0_dp) return
       call cubic_hermite_extrema(h, u0, v0, u1, v1, s, p)
       do k = 1, 2
-         if (s(k) > 0.0_dp .and. s(k) < 1.0_dp) call fold_absmax(o, i, t0 + s(k)*h, p(k))
+         if (s(k) > 0.0_dp .and. s(k) < 1.0_dp) call raise_absmax(uabs, tabs, t0 + s(k)*h, p(k))
       end do
    end subroutine hermite_extremum
 
    !> |v| at the extremum of v inside a fixed step, on the cubic Hermite of (v, a) at both
    !> ends, where a changes sign inside the step (O(h⁴) in v; docs/results.md): into vmax.
-   subroutine hermite_v_extremum(vmax, h, v0, a0, v1, a1)
+   pure subroutine hermite_v_extremum(vmax, h, v0, a0, v1, a1)
       real(dp), intent(inout) :: vmax
       real(dp), intent(in) :: h, v0, a0, v1, a1
       real(dp) :: s(2), p(2)

@@ -9,7 +9,7 @@ module martello_run
    use martello_integrator_settings
    use martello_effective_mass, only: effective_mass_prepare
    use martello_run_checks, only: check_schemes
-   use martello_observer, only: observer_t, observer_init
+   use martello_observer, only: observer_t, observer_init, observer_phase_lists
    use martello_fixed_step, only: run_fixed_step, stepper_t
    use martello_generalized_alpha, only: generalized_alpha_t
    use martello_central_difference, only: central_difference_t
@@ -20,7 +20,11 @@ module martello_run
    use martello_chain_newmark, only: chain_newmark_t, chain_fusable
    implicit none
    private
-   public :: run_t, run_dynamic
+   public :: run_t, run_dynamic, PHASE_LISTS
+
+   !> Contacts up to which every contact's phases are listed (docs/results.md); past it the
+   !> output contacts', the others keep their first and last phase
+   integer, parameter :: PHASE_LISTS = 1000
 
    !> Dispatched to the C integrators (c/event_driven.c, c/ida.c).
    interface
@@ -38,6 +42,9 @@ module martello_run
       type(integrator_settings_t) :: settings
       type(observer_t) :: results     !< what the run measured (martello_observer)
       integer, allocatable :: out_nodes(:), out_contacts(:), out_links(:)
+      !> every contact's phases are listed while the model has at most this many contacts
+      !> (< 0: always; martello_run_set_phase_lists)
+      integer :: phase_lists = PHASE_LISTS
       logical :: configured = .false., done = .false.
       !> the caller's progress callback and its argument (martello_run_set_progress)
       type(c_funptr) :: progress = c_null_funptr
@@ -74,6 +81,7 @@ contains
       call observer_init(rp%results, rp%settings, mp%n, mp%ncontact, rp%out_nodes, &
                          rp%out_contacts, cap, mp%nlink, rp%out_links, stat)
       rp%results%progress = rp%progress; rp%results%progress_user = rp%progress_user
+      call observer_phase_lists(rp%results, rp%phase_lists)
       if (stat == MARTELLO_OK) call check_schemes(mp, rp%settings%kind, rp%results%message, stat)
       if (stat == MARTELLO_OK) call effective_mass_prepare(mp, rp%results%message, stat)
       if (stat == MARTELLO_OK) then

@@ -95,6 +95,7 @@ def lib():
         "martello_run_peaks": (c_int, [_VOID_P] + [_DOUBLE_P] * 6 + [_INT_P] + [_DOUBLE_P] * 2),
         "martello_run_energy": (c_int, [_VOID_P, _DOUBLE_P, _DOUBLE_P]),
         "martello_run_set_link_outputs": (c_int, [_VOID_P, c_int, _INT_P]),
+        "martello_run_set_phase_lists": (c_int, [_VOID_P, c_int]),
         "martello_run_link_peaks": (c_int, [_VOID_P, _DOUBLE_P, _DOUBLE_P]),
         "martello_run_abs_peaks": (c_int, [_VOID_P, _DOUBLE_P, _DOUBLE_P]),
     }
@@ -459,6 +460,11 @@ class Run(_Handle):
     def set_link_outputs(self, links):
         l = np.ascontiguousarray(links, dtype=np.int32)
         self._check(lib().martello_run_set_link_outputs(self._h, l.size, l), "link outputs")
+
+    def set_phase_lists(self, max_contacts):
+        """Every contact's phases listed up to max_contacts contacts (< 0: always); past it the
+        output contacts', the others' first and last phase (c/martello.h)."""
+        self._check(lib().martello_run_set_phase_lists(self._h, int(max_contacts)), "phase lists")
 
     def link_peaks(self, n_links):
         f, du = np.zeros(max(n_links, 1)), np.zeros(max(n_links, 1))
