@@ -288,7 +288,7 @@ contains
       op => get_observer(handle)
       c_observer_extremum = MARTELLO_ERR_ARGUMENT
       if (.not. associated(op)) return
-      if (node < 0 .or. node >= size(op%u_max)) return
+      if (node < 0 .or. node >= op%n_nodes) return
       call observer_extremum(op, node + 1, t, u, maximum /= 0)
       c_observer_extremum = MARTELLO_OK
    end function c_observer_extremum

@@ -23,16 +23,22 @@ module martello_chain_newmark
    use, intrinsic :: iso_fortran_env, only: int8
    use martello_kinds, only: dp, i8
    use martello_status
-   use martello_model, only: model_t, model_bandwidth, SCHEME_PENALTY
+   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
+   use martello_model, only: model_t, model_bandwidth, SCHEME_PENALTY, model_link_index, &
+      model_contact_index, model_link_at, model_contact_at, model_expand_chains, model_nlinks, &
+      model_ncontacts
    use martello_links, only: LINK_SPRING, LINK_BAR, LINK_DASHPOT, LINK_BILINEAR, L_STIFF, L_DAMP, &
       L_YIELD, L_HARDENING, bilinear_return_map, bilinear_energy
    use martello_contact_laws, only: LAW_LINEAR, LAW_KELVIN, P_STIFF, P_DAMPING, P_CLIP, &
-      contact_elastic_energy
+      P_RESTITUTION, NPAR_CONTACT, contact_elastic_energy, damping_from_restitution
+   use martello_links, only: NPAR_LINK
+   use martello_effective_mass, only: pair_effective_mass, effective_mass_prepare
    use martello_assembly, only: external_forces, uniform_acceleration, internal_forces, mech_commit
    use martello_time_functions, only: tf_value
    use martello_observer, only: observer_t, observer_work, observer_begin, observer_sample, &
       observer_open_phase, observer_node_peaks, observer_phase_change, observer_contact_peaks, &
-      observer_energy_due, observer_recorded
+      observer_phase_peaks, observer_energy_due, observer_recorded, tracks, TRACK_NODE_PEAKS, &
+      TRACK_LINK_PEAKS, TRACK_CONTACT_PEAKS, TRACK_PHASES
    use martello_run_quantities, only: C_NEWTON, C_RESIDUALS, C_FACTORIZATIONS, C_JACOBIANS, C_FUSED
    use martello_integrator_settings, only: integrator_settings_t, INT_NEWMARK
    use martello_fixed_step, only: stepper_t
@@ -53,35 +59,47 @@ module martello_chain_newmark
 
    type, extends(stepper_t) :: chain_newmark_t
       type(integrator_settings_t) :: settings
+      !> Newmark: Δa = c_m Δu, Δv = c_v Δu; the iterate u = uₙ has a₀ = −c₁vₙ − c₂aₙ
       real(dp) :: beta = 0.25_dp, gamma = 0.5_dp, cm = 0.0_dp, cv = 0.0_dp, c1 = 0.0_dp, &
                   c2 = 0.0_dp
+      !> the masses, read at 1 + (i − 1)·sm: one value for every node (sm = 0) or each's
+      real(dp), allocatable :: mass(:)
+      integer :: sm = 1
       !> the linear links (springs, bars, dashpots) summed: of node i to ground (kg, cg,
       !> 1:n), of the pair (i, i+1) (kp, cp, 0:n with 0 and n zero; allocated if any)
       real(dp), allocatable :: kg(:), cg(:), kp(:), cp(:)
       logical :: pair_links = .false.
+      !> the links are those of the model's one chain on every node, dashpots included: kg and
+      !> cg are its k and c, read there (no copy)
+      logical :: chain_links = .false.
       !> the pair contact of (i, i+1), i < n: δ = s(u_i − u_{i+1}) − gap with s = ±1,
       !> force k δ (+ c δ̇ for Kelvin). Parameter arrays run from 0 and are read at i·stride:
       !> stride 0 when every pair has the same value (one value for the chain).
       logical :: pair_contacts = .false., kelvin = .false.
-      integer, allocatable :: pcon(:)           !< contact index of pair i (0: none)
+      !> contact index of pair i (0: none); pc0 ≥ 0: pair i has contact pc0 + i (pcon unused)
+      integer, allocatable :: pcon(:)
+      integer :: pc0 = -1
       real(dp), allocatable :: psgn(:), pgap(:), pk(:), pc(:)
       integer(int8), allocatable :: plaw(:)
       integer :: ss = 0, sg = 0, sk = 0, sc = 0, sl = 0
       !> pair contact branches: trial (of the last evaluation), committed, of the factors
       integer(int8), allocatable :: pbr(:), pbrc(:), pbrf(:)
-      !> the other elements, one by one: bilinear links (model link index, committed force
-      !> and elongation, trial, branch of the last evaluation and of the factors) and the
-      !> other contacts (model contact index, branches)
-      integer, allocatable :: bl(:), xc(:)
+      !> the other elements, one by one (of those added one by one: model_add_link and
+      !> model_add_contact): bilinear links (their index there, blo among all the model's
+      !> links; committed force and elongation, trial, branch of the last evaluation and of
+      !> the factors) and the other contacts (xg there, xc among all the contacts; branches)
+      integer, allocatable :: bl(:), blo(:), xg(:), xc(:)
       real(dp), allocatable :: bfc(:), bdu(:), bft(:), bdut(:)
       integer(int8), allocatable :: bbr(:), bbrf(:), xbr(:), xbrc(:), xbrf(:)
       !> their tangents on the factors' branches per node: J (diagonal, J(i, i+1)) and C_t
       real(dp), allocatable :: xjd(:), xjo(:), xcd(:), xco(:)
       logical :: others = .false.
       !> J = L D Lᵀ: reciprocal pivots rp(i) = 1/D_ii and g(i) = J(i, i+1)·rp(i) = L(i+1, i);
-      !> the forward-substituted right-hand side y; fe the nodal internal force at the last
-      !> evaluation minus the nodal forces (fnod, as applied)
-      real(dp), allocatable :: rp(:), g(:), y(:), fe(:), fnod(:)
+      !> fe the nodal internal force at the last evaluation minus the nodal forces (fnod, as
+      !> applied), which the forward sweeps overwrite, entry by entry as they read it, with the
+      !> forward-substituted right-hand side y, and the backward sweep, entry by entry after
+      !> reading y, with the internal force again: one array for both
+      real(dp), allocatable :: rp(:), g(:), fe(:), fnod(:)
       logical :: factored = .false.
       !> the link peaks, per node (links to ground: max |u_i|, |v_i|) and per pair (max |Δu|,
       !> |Δv|) over the samples: each link's follows from its parameter (link_peaks)
@@ -91,8 +109,10 @@ module martello_chain_newmark
       real(dp) :: mdu = 0.0_dp, acc_n = 0.0_dp, acc = 0.0_dp
       !> trapezoidal works of the last evaluation (dampers, other links, contacts)
       real(dp) :: wd = 0.0_dp, wl = 0.0_dp, wc = 0.0_dp
-      !> the general path, made at the first step handed to it
+      !> the general path, made at the first step handed to it, and the model with its chains
+      !> as links and contacts one by one, for it (when the model has chains)
       type(generalized_alpha_t), allocatable :: gen
+      type(model_t), allocatable :: gm
    contains
       procedure :: init => chain_init
       procedure :: step => chain_step
@@ -111,7 +131,8 @@ contains
    logical function chain_fusable(m, s) result(ok)
       type(model_t), intent(in) :: m
       type(integrator_settings_t), intent(in) :: s
-      integer :: j
+      integer :: j, q
+      logical, allocatable :: paired(:)
       ok = s%kind == INT_NEWMARK .and. logical(s%fused_chain) .and. 2.0_dp*s%beta >= s%gamma
       if (.not. ok) return
       ! stiffness blocks (frames) are not in the sweep's per-node parameters
@@ -126,6 +147,19 @@ contains
       do j = 1, m%ncontact
          if (m%con_scheme(j) /= SCHEME_PENALTY) ok = .false.
          if (m%con_law(j) /= LAW_LINEAR .and. m%con_law(j) /= LAW_KELVIN) ok = .false.
+      end do
+      ! a chain held per node: linear springs (its bilinear ones are taken one by one), and
+      ! contacts the sweep holds as pair contacts (one chain's to a pair)
+      allocate (paired(0:m%n)); paired = .false.
+      do q = 1, m%nchain
+         associate (ch => m%chain(q))
+            if (allocated(ch%fy)) ok = .false.
+            if (ch%ncontact == 0) cycle
+            if (ch%scheme /= SCHEME_PENALTY) ok = .false.
+            if (ch%law /= LAW_LINEAR .and. ch%law /= LAW_KELVIN) ok = .false.
+            if (any(paired(ch%first:ch%first + ch%n - 2))) ok = .false.
+            paired(ch%first:ch%first + ch%n - 2) = .true.
+         end associate
       end do
    end function chain_fusable
 
@@ -144,6 +178,8 @@ contains
       self%beta = s%beta; self%gamma = s%gamma
       self%cm = 1.0_dp/(s%beta*s%dt*s%dt); self%cv = s%gamma/(s%beta*s%dt)
       self%c1 = 1.0_dp/(s%beta*s%dt); self%c2 = (0.5_dp - s%beta)/s%beta
+      self%sm = merge(0, 1, all(m%mass == m%mass(1)))
+      self%mass = m%mass(1:merge(1, n, self%sm == 0))
       self%advice = 'the step is past the stability limit'
       self%measures_itself = .true.
       allocate (self%u(0:n), self%v(0:n), self%a(0:n), self%un(0:n), self%vn(0:n), self%an(0:n), &
@@ -152,14 +188,15 @@ contains
       self%u(1:n) = m%u0; self%v(1:n) = merge(0.0_dp, m%v0, m%fixed)
       self%fixed_nodes = pack([(i, i = 1, n)], m%fixed)
       call per_node(self, m)
+      call link_peak_arrays(self, m, tracks(o, TRACK_LINK_PEAKS))
       ! the bilinear springs start elastic, on k·Δu₀ (clamped into the band by the first
       ! step), as mech_init
       do i = 1, size(self%bl)
          self%bdu(i) = self%u(m%link_a(self%bl(i))) - self%u(m%link_b(self%bl(i)))
          self%bfc(i) = m%link_par(L_STIFF, self%bl(i))*self%bdu(i)
       end do
-      allocate (self%rp(n), self%g(0:n), self%y(0:n), self%fe(0:n), self%fnod(m%nforce))
-      self%rp = 0.0_dp; self%g = 0.0_dp; self%y = 0.0_dp; self%fnod = 0.0_dp
+      allocate (self%rp(n), self%g(0:n), self%fe(0:n), self%fnod(m%nforce))
+      self%rp = 0.0_dp; self%g = 0.0_dp; self%fe = 0.0_dp; self%fnod = 0.0_dp
       ! the elements at (u0, v0) with their whole laws: the evaluation at an iterate with no
       ! increment, works from (u0, v0) itself
       self%un = self%u; self%vn = self%v; self%a = 0.0_dp; self%an = 0.0_dp
@@ -184,11 +221,14 @@ contains
    subroutine per_node(self, m)
       class(chain_newmark_t), intent(inout) :: self
       type(model_t), intent(in) :: m
-      integer :: n, j, a, b, lo, nb, nx
-      real(dp) :: k, c
-      logical, allocatable :: first(:)
+      integer :: n, j, a, b, lo, nb, nx, q, i, c
+      real(dp) :: k, cd
+      logical, allocatable :: pair(:)
       n = m%n
-      allocate (self%kg(n), self%cg(n))
+      self%chain_links = m%nchain == 1 .and. m%nlink == 0
+      if (self%chain_links) self%chain_links = m%chain(1)%first == 1 .and. m%chain(1)%n == n .and. &
+                                               allocated(m%chain(1)%c)
+      allocate (self%kg(merge(0, n, self%chain_links)), self%cg(merge(0, n, self%chain_links)))
       self%kg = 0.0_dp; self%cg = 0.0_dp
       self%pair_links = .false.
       do j = 1, m%nlink
@@ -201,49 +241,75 @@ contains
       nb = 0
       do j = 1, m%nlink
          a = m%link_a(j); b = m%link_b(j)
-         k = 0.0_dp; c = 0.0_dp
+         k = 0.0_dp; cd = 0.0_dp
          select case (m%link_kind(j))
          case (LINK_SPRING, LINK_BAR)
             k = m%link_par(L_STIFF, j)
          case (LINK_DASHPOT)
-            c = m%link_par(L_DAMP, j)
+            cd = m%link_par(L_DAMP, j)
          case default
             nb = nb + 1; cycle
          end select
          if (a > 0 .and. b > 0) then
             lo = min(a, b)
-            self%kp(lo) = self%kp(lo) + k; self%cp(lo) = self%cp(lo) + c
+            self%kp(lo) = self%kp(lo) + k; self%cp(lo) = self%cp(lo) + cd
          else
-            self%kg(a + b) = self%kg(a + b) + k; self%cg(a + b) = self%cg(a + b) + c
+            self%kg(a + b) = self%kg(a + b) + k; self%cg(a + b) = self%cg(a + b) + cd
          end if
       end do
+      ! the chains' springs and dashpots (chain_fusable: linear)
+      do q = merge(m%nchain + 1, 1, self%chain_links), m%nchain
+         associate (ch => m%chain(q))
+            do i = 1, ch%n
+               j = ch%first + i - 1
+               self%kg(j) = self%kg(j) + ch%k(i)
+               if (allocated(ch%c)) self%cg(j) = self%cg(j) + ch%c(i)
+            end do
+         end associate
+      end do
       self%bl = pack([(j, j = 1, m%nlink)], m%link_kind(1:m%nlink) == LINK_BILINEAR)
+      self%blo = [(model_link_index(m, self%bl(j)), j = 1, nb)]
       allocate (self%bfc(nb), self%bdu(nb), self%bft(nb), self%bdut(nb), self%bbr(nb), &
                 self%bbrf(nb))
       self%bbr = B_ELASTIC; self%bbrf = B_ELASTIC
-      ! the pair contacts: the first contact between i and i + 1
-      allocate (self%pcon(0:n), first(m%ncontact)); self%pcon = 0; first = .false.
+      ! the pair contacts: the chains' (chain_fusable: one to a pair), then the first contact
+      ! added one by one between i and i + 1; numbered among all the model's contacts
+      allocate (self%pcon(0:n), pair(m%ncontact)); self%pcon = 0; pair = .false.
+      do q = 1, m%nchain
+         associate (ch => m%chain(q))
+            do i = 1, ch%ncontact
+               self%pcon(ch%first + i - 1) = ch%contact0 + i
+            end do
+         end associate
+      end do
       do j = 1, m%ncontact
          a = m%con_a(j); b = m%con_b(j)
          if (a == 0 .or. b == 0) cycle
          lo = min(a, b)
          if (self%pcon(lo) == 0) then
-            self%pcon(lo) = j; first(j) = .true.
+            self%pcon(lo) = model_contact_index(m, j); pair(j) = .true.
          end if
       end do
-      self%pair_contacts = any(first)
+      self%pair_contacts = any(self%pcon > 0)
       call pair_parameters(self, m)
+      if (n > 1) then
+         c = self%pcon(1)
+         if (c > 0 .and. all(self%pcon(1:n - 1) == [(c - 1 + j, j = 1, n - 1)])) self%pc0 = c - 1
+      end if
+      if (self%pc0 >= 0) then
+         deallocate (self%pcon); allocate (self%pcon(0:0)); self%pcon = 0
+      end if
       allocate (self%pbr(0:n), self%pbrc(0:n), self%pbrf(0:n))
       self%pbr = B_OFF; self%pbrc = B_OFF; self%pbrf = B_OFF
-      self%xc = pack([(j, j = 1, m%ncontact)], .not. first)
-      nx = size(self%xc)
+      self%xg = pack([(j, j = 1, m%ncontact)], .not. pair)
+      nx = size(self%xg)
+      self%xc = [(model_contact_index(m, self%xg(j)), j = 1, nx)]
       allocate (self%xbr(nx), self%xbrc(nx), self%xbrf(nx))
       self%xbr = B_OFF; self%xbrc = B_OFF; self%xbrf = B_OFF
       self%others = nb > 0 .or. nx > 0
       nx = merge(n, 0, self%others)
       allocate (self%xjd(0:nx), self%xjo(0:nx), self%xcd(0:nx), self%xco(0:nx))
       self%xjd = 0.0_dp; self%xjo = 0.0_dp; self%xcd = 0.0_dp; self%xco = 0.0_dp
-      call link_peak_arrays(self, m)
    end subroutine per_node
 
    !> The pair contacts' parameters: sign, gap, stiffness, damping and law, each one value for
@@ -251,8 +317,9 @@ contains
    subroutine pair_parameters(self, m)
       class(chain_newmark_t), intent(inout) :: self
       type(model_t), intent(in) :: m
-      integer :: n, i, j
+      integer :: n, i, j, a, b, scheme, claw
       real(dp), allocatable :: sgn(:), gap(:), k(:), c(:)
+      real(dp) :: par(NPAR_CONTACT), mstar
       integer(int8), allocatable :: law(:)
       logical :: every
       n = m%n
@@ -262,11 +329,20 @@ contains
       do i = 1, n - 1
          j = self%pcon(i)
          if (j == 0) cycle
-         sgn(i) = merge(1.0_dp, -1.0_dp, m%con_a(j) == i)
-         gap(i) = m%con_gap(j); k(i) = m%con_par(P_STIFF, j)
-         if (m%con_law(j) == LAW_KELVIN) then
-            c(i) = m%con_par(P_DAMPING, j)
-            law(i) = merge(K_KELVIN_CLIPPED, K_KELVIN, m%con_par(P_CLIP, j) > 0.5_dp)
+         call model_contact_at(m, j, a, b, gap(i), scheme, claw, par)
+         sgn(i) = merge(1.0_dp, -1.0_dp, a == i)
+         k(i) = par(P_STIFF)
+         if (claw == LAW_KELVIN) then
+            ! the damping of a target restitution, with the pair's m* (as
+            ! effective_mass_prepare gives the contacts added one by one)
+            c(i) = par(P_DAMPING)
+            if (par(P_RESTITUTION) >= 0.0_dp) then
+               mstar = pair_effective_mass(m, a, b)
+               c(i) = 0.0_dp
+               if (ieee_is_finite(mstar)) c(i) = damping_from_restitution(claw, &
+                                                                          par(P_RESTITUTION), par, mstar)
+            end if
+            law(i) = merge(K_KELVIN_CLIPPED, K_KELVIN, par(P_CLIP) > 0.5_dp)
          end if
       end do
       self%kelvin = any(law(1:n - 1) /= K_LINEAR)
@@ -296,12 +372,13 @@ contains
    end subroutine pair_parameters
 
    !> The per-node and per-pair maxima the link peaks need: only for the kinds the chain has.
-   subroutine link_peak_arrays(self, m)
+   subroutine link_peak_arrays(self, m, tracked)
       class(chain_newmark_t), intent(inout) :: self
       type(model_t), intent(in) :: m
+      logical, intent(in) :: tracked
       integer :: j, n
       logical :: ground, gdamp, pair, pdamp
-      n = m%n
+      n = merge(m%n, 0, tracked)
       ground = .false.; gdamp = .false.; pair = .false.; pdamp = .false.
       do j = 1, m%nlink
          if (m%link_kind(j) == LINK_BILINEAR) cycle
@@ -310,6 +387,10 @@ contains
          else
             ground = .true.; gdamp = gdamp .or. m%link_kind(j) == LINK_DASHPOT
          end if
+      end do
+      do j = 1, m%nchain
+         ground = .true.
+         if (allocated(m%chain(j)%c)) gdamp = gdamp .or. any(m%chain(j)%c > 0.0_dp)
       end do
       allocate (self%gumax(merge(n, 0, ground)), self%gvmax(merge(n, 0, gdamp)), &
                 self%pumax(merge(n, 0, pair)), self%pvmax(merge(n, 0, pdamp)))
@@ -344,7 +425,7 @@ contains
          o%counters(C_NEWTON) = o%counters(C_NEWTON) + 1_i8
       else
          ! no factors: the elements at u = u_n (a solve with zero factors is no increment)
-         self%rp = 0.0_dp; self%g = 0.0_dp; self%y = 0.0_dp
+         self%rp = 0.0_dp; self%g = 0.0_dp; self%fe = 0.0_dp
       end if
       call evaluate(self, m, .true., flipped)
       call nodal_forces(self, m, t)
@@ -400,34 +481,45 @@ contains
    subroutine linearised_sweep(self, m)
       class(chain_newmark_t), intent(inout) :: self
       type(model_t), intent(in) :: m
-      call forward_kernel(self%n, self%h, self%gamma, self%c1, self%c2, self%acc, &
-                          self%pair_links, self%kelvin, self%others, self%sc, self%vn, self%an, &
-                          m%mass, self%fe, self%g, self%cg, self%cp, self%pc, self%pbrf, &
-                          self%xcd, self%xco, self%y)
+      if (self%chain_links) then
+         call sweep(m%chain(1)%c)
+      else
+         call sweep(self%cg)
+      end if
       call pin_fixed(self)
+   contains
+      subroutine sweep(cg)
+         real(dp), intent(in) :: cg(:)
+         call forward_kernel(self%n, self%h, self%gamma, self%c1, self%c2, self%acc, &
+                             self%pair_links, self%kelvin, self%others, self%sc, self%vn, self%an, &
+                             self%sm, self%mass, self%fe, self%g, cg, self%cp, self%pc, self%pbrf, &
+                             self%xcd, self%xco)
+      end subroutine sweep
    end subroutine linearised_sweep
 
    !> linearised_sweep's loop on explicit-shape arrays (no descriptors, no aliasing: the
    !> compiler keeps everything in registers but the arrays).
-   subroutine forward_kernel(n, h, gm, c1, c2, acc, pl, kel, oth, sc, vn, an, mass, fe, g, cg, &
-                             cp, pc, brf, xcd, xco, y)
-      integer, intent(in) :: n, sc
+   subroutine forward_kernel(n, h, gm, c1, c2, acc, pl, kel, oth, sc, vn, an, sm, mass, fe, g, &
+                             cg, cp, pc, brf, xcd, xco)
+      integer, intent(in) :: n, sc, sm
       real(dp), intent(in) :: h, gm, c1, c2, acc
       logical, intent(in) :: pl, kel, oth
-      real(dp), intent(in) :: vn(0:n), an(0:n), mass(n), fe(0:n), g(0:n), cg(n), cp(0:*), &
-                              pc(0:*), xcd(0:*), xco(0:*)
+      real(dp), intent(in) :: vn(0:n), an(0:n), mass(*), g(0:n), cg(n), cp(0:*), pc(0:*), &
+                              xcd(0:*), xco(0:*)
       integer(int8), intent(in) :: brf(0:n)
-      real(dp), intent(out) :: y(0:n)
+      real(dp), intent(inout) :: fe(0:n)     !< in: the committed internal force; out: y
       integer :: i
-      real(dp) :: dvm, dv0, dvp, a0, ap, cdv, cd, co, com, ym
+      real(dp) :: dvm, dv0, dvp, a0, ap, cdv, cd, co, com, ym, g1
+      ! a₀ = −c₁vₙ − c₂aₙ and Δv₀ = v₀ − vₙ = h((1 − γ)aₙ + γa₀) of each node
+      g1 = 1.0_dp - gm
       dvm = 0.0_dp; com = 0.0_dp; ym = 0.0_dp
       a0 = -c1*vn(1) - c2*an(1)
-      dv0 = h*((1.0_dp - gm)*an(1) + gm*a0)
+      dv0 = h*(g1*an(1) + gm*a0)
       do i = 1, n
          ap = 0.0_dp; dvp = 0.0_dp
          if (i < n) then
             ap = -c1*vn(i + 1) - c2*an(i + 1)
-            dvp = h*((1.0_dp - gm)*an(i + 1) + gm*ap)
+            dvp = h*(g1*an(i + 1) + gm*ap)
          end if
          ! C_t(i, i) and C_t(i, i+1) on the factors' branches
          cd = cg(i); co = 0.0_dp
@@ -444,11 +536,11 @@ contains
             cd = cd + xcd(i); co = co + xco(i)
          end if
          cdv = cd*dv0 + com*dvm + co*dvp
-         ym = mass(i)*(acc - a0) - fe(i) - cdv - g(i - 1)*ym
-         y(i) = ym
+         ym = mass(1 + (i - 1)*sm)*(acc - a0) - fe(i) - cdv - g(i - 1)*ym
+         fe(i) = ym
          dvm = dv0; dv0 = dvp; a0 = ap; com = co
       end do
-      y(0) = 0.0_dp
+      fe(0) = 0.0_dp
    end subroutine forward_kernel
 
    !> The forward sweep of a Newton iterate after a branch change: the tangent on the current
@@ -464,29 +556,39 @@ contains
       self%pbrf = self%pbr; self%bbrf = self%bbr; self%xbrf = self%xbr
       o%counters(C_JACOBIANS) = o%counters(C_JACOBIANS) + 1_i8
       o%counters(C_FACTORIZATIONS) = o%counters(C_FACTORIZATIONS) + 1_i8
-      call refactor_kernel(self%n, self%cm, self%cv, self%acc, self%pair_links, &
-                           self%pair_contacts, self%others, self%sk, self%sc, self%a, m%mass, &
-                           m%fixed, self%fe, self%kg, self%cg, self%kp, self%cp, self%pk, &
-                           self%pc, self%pbr, self%xjd, self%xjo, self%rp, self%g, self%y, ok)
+      if (self%chain_links) then
+         call sweep(m%chain(1)%k, m%chain(1)%c)
+      else
+         call sweep(self%kg, self%cg)
+      end if
       self%factored = ok
+   contains
+      subroutine sweep(kg, cg)
+         real(dp), intent(in) :: kg(:), cg(:)
+         call refactor_kernel(self%n, self%cm, self%cv, self%acc, self%pair_links, &
+                              self%pair_contacts, self%others, self%sk, self%sc, self%a, self%sm, &
+                              self%mass, m%fixed, self%fe, kg, cg, self%kp, self%cp, self%pk, &
+                              self%pc, self%pbr, self%xjd, self%xjo, self%rp, self%g, ok)
+      end subroutine sweep
    end subroutine refactor_sweep
 
    !> refactor_sweep's loop on explicit-shape arrays.
-   subroutine refactor_kernel(n, cm, cv, acc, pl, pcs, oth, sk, sc, a, mass, fixed, fe, kg, cg, &
-                              kp, cp, pk, pc, br, xjd, xjo, rp, g, y, ok)
-      integer, intent(in) :: n, sk, sc
+   subroutine refactor_kernel(n, cm, cv, acc, pl, pcs, oth, sk, sc, a, sm, mass, fixed, fe, kg, &
+                              cg, kp, cp, pk, pc, br, xjd, xjo, rp, g, ok)
+      integer, intent(in) :: n, sk, sc, sm
       real(dp), intent(in) :: cm, cv, acc
       logical, intent(in) :: pl, pcs, oth, fixed(n)
-      real(dp), intent(in) :: a(0:n), mass(n), fe(0:n), kg(n), cg(n), kp(0:*), cp(0:*), pk(0:*), &
-                              pc(0:*), xjd(0:*), xjo(0:*)
+      real(dp), intent(in) :: a(0:n), mass(*), kg(n), cg(n), kp(0:*), cp(0:*), pk(0:*), pc(0:*), &
+                              xjd(0:*), xjo(0:*)
+      real(dp), intent(inout) :: fe(0:n)     !< in: the internal force at the iterate; out: y
       integer(int8), intent(in) :: br(0:n)
-      real(dp), intent(out) :: rp(n), g(0:n), y(0:n)
+      real(dp), intent(out) :: rp(n), g(0:n)
       logical, intent(out) :: ok
       integer :: i
       real(dp) :: p, jd, jo, jom, tp, tpm, ym, gm
       ok = .true.
       tpm = 0.0_dp; gm = 0.0_dp; ym = 0.0_dp; jom = 0.0_dp
-      g(0) = 0.0_dp; y(0) = 0.0_dp
+      g(0) = 0.0_dp
       do i = 1, n
          ! tp: the tangent of pair (i, i+1), K_t + c_v C_t
          tp = 0.0_dp
@@ -507,21 +609,21 @@ contains
             if (i < n) then
                if (fixed(i + 1)) jo = 0.0_dp
             end if
-            p = cm*mass(i) + jd - jom*gm
+            p = cm*mass(1 + (i - 1)*sm) + jd - jom*gm
          end if
          if (.not. (p > 0.0_dp)) ok = .false.
          rp(i) = 1.0_dp/p
          if (fixed(i)) then
             ym = 0.0_dp
          else
-            ym = mass(i)*(acc - a(i)) - fe(i) - gm*ym
+            ym = mass(1 + (i - 1)*sm)*(acc - a(i)) - fe(i) - gm*ym
          end if
          gm = jo*rp(i)
          g(i) = gm
-         y(i) = ym
+         fe(i) = ym
          tpm = tp; jom = jo
       end do
-      g(n) = 0.0_dp
+      g(n) = 0.0_dp; fe(0) = 0.0_dp
    end subroutine refactor_kernel
 
    !> Fixed rows carry no residual: their Δu is 0 (their column of the factors is 0, so no
@@ -530,7 +632,7 @@ contains
       class(chain_newmark_t), intent(inout) :: self
       integer :: k
       do k = 1, size(self%fixed_nodes)
-         self%y(self%fixed_nodes(k)) = 0.0_dp
+         self%fe(self%fixed_nodes(k)) = 0.0_dp
       end do
    end subroutine pin_fixed
 
@@ -547,51 +649,63 @@ contains
       logical, intent(in) :: from_start
       logical, intent(out) :: flipped
       real(dp) :: mdu
-      call back_kernel(self%n, from_start, self%pair_links, self%pair_contacts, self%kelvin, &
-                       self%ss, self%sg, self%sk, self%sc, self%sl, self%cm, self%cv, self%c1, &
-                       self%c2, self%h, self%gamma, self%rp, self%y, self%g, self%u, self%v, &
-                       self%a, self%un, self%vn, self%an, m%mass, self%fe, self%kg, self%cg, &
-                       self%kp, self%cp, self%psgn, self%pgap, self%pk, self%pc, self%plaw, &
-                       self%pbr, self%pbrc, self%pbrf, mdu, self%wd, self%wl, self%wc, flipped)
+      if (self%chain_links) then
+         call sweep(m%chain(1)%k, m%chain(1)%c)
+      else
+         call sweep(self%kg, self%cg)
+      end if
       self%mdu = self%mdu + mdu
       if (self%others) call others(self, m, flipped)
       self%fnod = 0.0_dp
+   contains
+      subroutine sweep(kg, cg)
+         real(dp), intent(in) :: kg(:), cg(:)
+         call back_kernel(self%n, from_start, self%pair_links, self%pair_contacts, self%kelvin, &
+                          self%ss, self%sg, self%sk, self%sc, self%sl, self%cm, self%cv, self%c1, &
+                          self%c2, self%h, self%gamma, self%rp, self%g, self%u, self%v, &
+                          self%a, self%un, self%vn, self%an, self%sm, self%mass, self%fe, kg, cg, &
+                          self%kp, self%cp, self%psgn, self%pgap, self%pk, self%pc, self%plaw, &
+                          self%pbr, self%pbrc, self%pbrf, mdu, self%wd, self%wl, self%wc, flipped)
+      end subroutine sweep
    end subroutine evaluate
 
    !> evaluate's sweep on explicit-shape arrays (no descriptors, no aliasing). The parameter
    !> arrays of the pair contacts are read at i·stride (stride 0: one value for the chain).
    subroutine back_kernel(n, from_start, pl, pcs, kel, ss, sg, sk, sc, sl, cm, cv, c1, c2, h, &
-                          gm, rp, y, g, u, v, a, un, vn, an, mass, fe, kg, cg, kp, cp, psgn, &
+                          gm, rp, g, u, v, a, un, vn, an, sm, mass, fe, kg, cg, kp, cp, psgn, &
                           pgap, pk, pc, plaw, pbr, pbrc, pbrf, mdu, wd, wl, wc, flip)
-      integer, intent(in) :: n, ss, sg, sk, sc, sl
+      integer, intent(in) :: n, ss, sg, sk, sc, sl, sm
       logical, intent(in) :: from_start, pl, pcs, kel
       real(dp), intent(in) :: cm, cv, c1, c2, h, gm
-      real(dp), intent(in) :: rp(n), y(0:n), g(0:n), un(0:n), vn(0:n), an(0:n), mass(n), kg(n), &
+      real(dp), intent(in) :: rp(n), g(0:n), un(0:n), vn(0:n), an(0:n), mass(*), kg(n), &
                               cg(n), kp(0:*), cp(0:*), psgn(0:*), pgap(0:*), pk(0:*), pc(0:*)
       integer(int8), intent(in) :: plaw(0:*), pbrc(0:n), pbrf(0:n)
-      real(dp), intent(inout) :: u(0:n), v(0:n), a(0:n), fe(0:n)
+      real(dp), intent(inout) :: u(0:n), v(0:n), a(0:n)
+      real(dp), intent(inout) :: fe(0:n)     !< in: y; out: the internal force
       integer(int8), intent(inout) :: pbr(0:n)
       real(dp), intent(out) :: mdu, wd, wl, wc
       logical, intent(out) :: flip
       integer :: i
       integer(int8) :: br, law
       real(dp) :: x, ui, vi, ai, uni, vni, u1, v1, un1, vn1, fi, f1, du, dun, fp, s, pen, penn, &
-                  f, fn, gp
+                  f, fn, gp, g1
+      g1 = 1.0_dp - gm
       mdu = 0.0_dp; wd = 0.0_dp; wl = 0.0_dp; wc = 0.0_dp; flip = .false.
       x = 0.0_dp; u1 = 0.0_dp; v1 = 0.0_dp; un1 = 0.0_dp; vn1 = 0.0_dp; f1 = 0.0_dp
       do i = n, 1, -1
-         x = rp(i)*y(i) - g(i)*x
+         x = rp(i)*fe(i) - g(i)*x
          uni = un(i); vni = vn(i)
          if (from_start) then
+            ! the Newmark a₀, v₀ of u = uₙ, as the general path's kinematics associate them
             ai = -c1*vni - c2*an(i)
-            vi = vni + h*((1.0_dp - gm)*an(i) + gm*ai) + cv*x
+            vi = vni + h*(g1*an(i) + gm*ai) + cv*x
             ai = ai + cm*x
             ui = uni + x
          else
             ui = u(i) + x; vi = v(i) + cv*x; ai = a(i) + cm*x
          end if
          u(i) = ui; v(i) = vi; a(i) = ai
-         mdu = mdu + mass(i)*x
+         mdu = mdu + mass(1 + (i - 1)*sm)*x
          ! the links of node i to ground
          fi = kg(i)*ui + cg(i)*vi
          wl = wl + 0.5_dp*kg(i)*(uni + ui)*(ui - uni)
@@ -667,8 +781,8 @@ contains
             self%bft(idx) = f; self%bdut(idx) = du
             fe(a) = fe(a) + f; fe(b) = fe(b) - f
          end do
-         do idx = 1, size(self%xc)
-            j = self%xc(idx); a = m%con_a(j); b = m%con_b(j)
+         do idx = 1, size(self%xg)
+            j = self%xg(idx); a = m%con_a(j); b = m%con_b(j)
             pen = u(a) - u(b) - m%con_gap(j)
             call contact_law(m, j, pen, v(a) - v(b), br, f)
             self%xbr(idx) = br
@@ -721,8 +835,8 @@ contains
          if (self%bbr(idx) /= B_ELASTIC) k = m%link_par(L_HARDENING, j)*k
          call stencil(m%link_a(j), m%link_b(j), k, 0.0_dp)
       end do
-      do idx = 1, size(self%xc)
-         j = self%xc(idx)
+      do idx = 1, size(self%xg)
+         j = self%xg(idx)
          if (self%xbr(idx) /= B_ON) cycle
          c = 0.0_dp
          if (m%con_law(j) == LAW_KELVIN) c = m%con_par(P_DAMPING, j)
@@ -755,57 +869,74 @@ contains
 
    !> A step the fused sweeps do not settle, taken by the general path from the same
    !> committed state (its chatter rule, line search and failure messages). Its stepper is
-   !> made at the first such step and handed the committed state each time: the element
-   !> states from ours (a contact we hold open has no force), f_ext at t_n.
+   !> made at the first such step (on the model with its chains as links and contacts one by
+   !> one: their numbers are those of all the model's items) and handed the committed state
+   !> each time: the element states from ours (a contact we hold open has no force), f_ext at
+   !> t_n.
    subroutine general_step(self, m, t, o, stat)
       class(chain_newmark_t), intent(inout) :: self
       type(model_t), intent(in) :: m
       real(dp), intent(in) :: t
       type(observer_t), intent(inout) :: o
       integer, intent(out) :: stat
-      integer(i8) :: saved(size(o%counters))
-      integer :: idx, j, i
       self%factored = .false.
-      if (.not. allocated(self%gen)) then
-         ! its start at t = 0 (a = M⁻¹(f_ext − f_int)) is overwritten below: not counted
-         allocate (self%gen)
-         saved = o%counters
-         call self%gen%init(m, self%settings, o, stat)
-         o%counters = saved
-         if (stat /= MARTELLO_OK) return
+      if (m%nchain > 0) then
+         if (.not. allocated(self%gm)) then
+            allocate (self%gm, source=m)
+            call model_expand_chains(self%gm)
+            call effective_mass_prepare(self%gm, o%message, stat)
+            if (stat /= MARTELLO_OK) return
+         end if
+         call take(self%gm)
+      else
+         call take(m)
       end if
-      associate (gen => self%gen, ms => self%gen%ms)
-         gen%un = self%un; gen%vn = self%vn; gen%an = self%an; gen%t0 = self%t0
-         do idx = 1, size(self%bl)
-            j = self%bl(idx)
-            ms%link_fc(j) = self%bfc(idx); ms%link_u(j) = self%bdu(idx)
-         end do
-         ms%forced_off = .false.
-         call internal_forces(m, ms, gen%un, gen%vn, gen%fint)
-         call mech_commit(m, ms, gen%un)
-         do i = 1, m%n - 1
-            if (self%pcon(i) > 0) call hold(self%pcon(i), self%pbrc(i))
-         end do
-         do idx = 1, size(self%xc)
-            call hold(self%xc(idx), self%xbrc(idx))
-         end do
-         call external_forces(m, gen%mrow, self%t0, gen%fext)
-         gen%tangent_valid = .false.
-         call gen%step(m, t, o, stat)
-         if (stat /= MARTELLO_OK) return
-         self%u = gen%u; self%v = gen%v; self%a = gen%a
-         do idx = 1, size(self%bl)
-            j = self%bl(idx)
-            self%bfc(idx) = ms%link_fc(j); self%bdu(idx) = ms%link_u(j)
-         end do
-         do i = 1, m%n - 1
-            if (self%pcon(i) > 0) self%pbrc(i) = branch_of(self%pcon(i))
-         end do
-         do idx = 1, size(self%xc)
-            self%xbrc(idx) = branch_of(self%xc(idx))
-         end do
-      end associate
    contains
+      subroutine take(gm)
+         type(model_t), intent(in) :: gm
+         integer(i8) :: saved(size(o%counters))
+         integer :: idx, j, i
+         if (.not. allocated(self%gen)) then
+            ! its start at t = 0 (a = M⁻¹(f_ext − f_int)) is overwritten below: not counted
+            allocate (self%gen)
+            saved = o%counters
+            call self%gen%init(gm, self%settings, o, stat)
+            o%counters = saved
+            if (stat /= MARTELLO_OK) return
+         end if
+         associate (gen => self%gen, ms => self%gen%ms)
+            gen%un = self%un; gen%vn = self%vn; gen%an = self%an; gen%t0 = self%t0
+            do idx = 1, size(self%blo)
+               j = self%blo(idx)
+               ms%link_fc(j) = self%bfc(idx); ms%link_u(j) = self%bdu(idx)
+            end do
+            ms%forced_off = .false.
+            call internal_forces(gm, ms, gen%un, gen%vn, gen%fint)
+            call mech_commit(gm, ms, gen%un)
+            do i = 1, m%n - 1
+               if (pair_contact(self, i) > 0) call hold(pair_contact(self, i), self%pbrc(i))
+            end do
+            do idx = 1, size(self%xc)
+               call hold(self%xc(idx), self%xbrc(idx))
+            end do
+            call external_forces(gm, gen%mrow, self%t0, gen%fext)
+            gen%tangent_valid = .false.
+            call gen%step(gm, t, o, stat)
+            if (stat /= MARTELLO_OK) return
+            self%u = gen%u; self%v = gen%v; self%a = gen%a
+            do idx = 1, size(self%blo)
+               j = self%blo(idx)
+               self%bfc(idx) = ms%link_fc(j); self%bdu(idx) = ms%link_u(j)
+            end do
+            do i = 1, m%n - 1
+               if (pair_contact(self, i) > 0) self%pbrc(i) = branch_of(pair_contact(self, i))
+            end do
+            do idx = 1, size(self%xc)
+               self%xbrc(idx) = branch_of(self%xc(idx))
+            end do
+         end associate
+      end subroutine take
+
       !> contact j committed off here is off there (no force)
       subroutine hold(j, br)
          integer, intent(in) :: j
@@ -814,14 +945,18 @@ contains
          self%gen%ms%con_on(j) = .false.; self%gen%ms%con_f(j) = 0.0_dp
       end subroutine hold
 
-      !> our branch of contact j from the general path's committed state
+      !> our branch of contact j from the general path's committed state: clipped where the
+      !> Kelvin law's cut-off holds its force at 0
       integer(int8) function branch_of(j) result(br)
          integer, intent(in) :: j
+         integer :: a, b, scheme, law
+         real(dp) :: gap, par(NPAR_CONTACT)
          br = B_OFF
          if (.not. self%gen%ms%con_on(j)) return
          br = B_ON
-         if (m%con_law(j) == LAW_KELVIN .and. m%con_par(P_CLIP, j) > 0.5_dp .and. &
-             self%gen%ms%con_f(j) == 0.0_dp) br = B_CLIPPED
+         call model_contact_at(m, j, a, b, gap, scheme, law, par)
+         if (law == LAW_KELVIN .and. par(P_CLIP) > 0.5_dp .and. self%gen%ms%con_f(j) == 0.0_dp) &
+            br = B_CLIPPED
       end function branch_of
    end subroutine general_step
 
@@ -834,14 +969,13 @@ contains
       integer, intent(in) :: energy_interval
       integer :: i, idx, j
       do i = 1, self%n - 1
-         j = self%pcon(i)
-         if (j == 0) cycle
-         if (self%pbrc(i) /= B_OFF) call observer_open_phase(o, j, 0.0_dp, &
-                                                             self%v(m%con_a(j)) - self%v(m%con_b(j)))
+         if (pair_contact(self, i) == 0 .or. self%pbrc(i) == B_OFF) cycle
+         call observer_open_phase(o, pair_contact(self, i), 0.0_dp, &
+                                  self%psgn(i*self%ss)*(self%v(i) - self%v(i + 1)))
       end do
-      do idx = 1, size(self%xc)
-         j = self%xc(idx)
-         if (self%xbrc(idx) /= B_OFF) call observer_open_phase(o, j, 0.0_dp, &
+      do idx = 1, size(self%xg)
+         j = self%xg(idx)
+         if (self%xbrc(idx) /= B_OFF) call observer_open_phase(o, self%xc(idx), 0.0_dp, &
                                                                self%v(m%con_a(j)) - self%v(m%con_b(j)))
       end do
       call observer_begin(o, m, self%ms, self%u, self%v, self%a, energy_interval, self%advice, &
@@ -886,11 +1020,13 @@ contains
       type(observer_t), intent(inout) :: o
       real(dp), intent(in) :: t, h
       call measure_kernel(self%n, t, h, o%prev_t, o%fixed_steps, o%located_extrema, &
+                          tracks(o, TRACK_NODE_PEAKS), tracks(o, TRACK_CONTACT_PEAKS), &
+                          tracks(o, TRACK_PHASES), &
                           size(self%gumax) > 0, size(self%gvmax) > 0, size(self%pumax) > 0, &
                           size(self%pvmax) > 0, self%pair_contacts, self%kelvin, self%ss, &
                           self%sg, self%sk, self%sc, self%sl, self%u, self%v, self%a, self%un, &
                           self%vn, self%an, self%psgn, self%pgap, self%pk, self%pc, self%plaw, &
-                          self%pbrc, self%pcon, o%u_max, o%u_min, o%v_absmax, o%a_absmax, &
+                          self%pbrc, self%pc0, self%pcon, o%u_max, o%u_min, o%v_absmax, o%a_absmax, &
                           o%u_absmax, o%t_absmax, o%u_peak, o%t_peak, self%gumax, self%gvmax, &
                           self%pumax, self%pvmax, o%pen_max, o%force_max, o)
    end subroutine measure_nodes
@@ -898,29 +1034,32 @@ contains
    !> measure_nodes' loop on explicit-shape arrays. The observer's per-node and per-contact
    !> maxima come in as arrays (observer_node_peaks, observer_contact_peaks); o itself is
    !> touched only where a phase opens or closes, and for the open-phase maxima
-   !> (observer_phase_change reads and writes none of the arrays passed apart).
-   subroutine measure_kernel(n, t, h, t_prev, fixed_steps, located, gu, gv, pu, pv, pcs, kel, &
+   !> (observer_phase_change reads and writes none of the arrays passed apart). nodes,
+   !> contacts, phases: what the run tracks.
+   subroutine measure_kernel(n, t, h, t_prev, fixed_steps, located, nodes, contacts, phases, &
+                             gu, gv, pu, pv, pcs, kel, &
                              ss, sg, sk, sc, sl, u, v, a, un, vn, an, psgn, pgap, pk, pc, plaw, &
-                             br, pcon, umax, umin, vmax, amax, uabs, tabs, upk, tpk, gumax, &
+                             br, pc0, pcon, umax, umin, vmax, amax, uabs, tabs, upk, tpk, gumax, &
                              gvmax, pumax, pvmax, pen_max, force_max, o)
       integer, intent(in) :: n, ss, sg, sk, sc, sl
       real(dp), intent(in) :: t, h, t_prev
-      logical, intent(in) :: fixed_steps, located, gu, gv, pu, pv, pcs, kel
+      logical, intent(in) :: fixed_steps, located, nodes, contacts, phases, gu, gv, pu, pv, &
+                             pcs, kel
       real(dp), intent(in) :: u(0:n), v(0:n), a(0:n), un(0:n), vn(0:n), an(0:n), psgn(0:*), &
                               pgap(0:*), pk(0:*), pc(0:*)
       integer(int8), intent(in) :: plaw(0:*), br(0:n)
-      integer, intent(in) :: pcon(0:n)
-      real(dp), intent(inout) :: umax(n), umin(n), vmax(n), amax(n), uabs(n), tabs(n), upk(n), &
-                                 tpk(n), gumax(*), gvmax(*), pumax(*), pvmax(*), pen_max(*), &
+      integer, intent(in) :: pc0, pcon(0:*)
+      real(dp), intent(inout) :: umax(*), umin(*), vmax(*), amax(*), uabs(*), tabs(*), upk(*), &
+                                 tpk(*), gumax(*), gvmax(*), pumax(*), pvmax(*), pen_max(*), &
                                  force_max(*)
       type(observer_t), intent(inout) :: o
       integer :: i, p, c
       real(dp) :: s, gp, pen, f, d0, r0, q0, r1, q1
       logical :: on
       do i = 1, n
-         call observer_node_peaks(t, t_prev, fixed_steps, located, un(i), vn(i), an(i), u(i), &
-                                  v(i), a(i), umax(i), umin(i), vmax(i), amax(i), uabs(i), &
-                                  tabs(i), upk(i), tpk(i))
+         if (nodes) call observer_node_peaks(t, t_prev, fixed_steps, located, un(i), vn(i), an(i), &
+                                             u(i), v(i), a(i), umax(i), umin(i), vmax(i), amax(i), &
+                                             uabs(i), tabs(i), upk(i), tpk(i))
          if (gu) gumax(i) = max(gumax(i), abs(u(i)))
          if (gv) gvmax(i) = max(gvmax(i), abs(v(i)))
          if (i == 1) cycle
@@ -929,8 +1068,12 @@ contains
          if (pu) pumax(p) = max(pumax(p), abs(u(p) - u(i)))
          if (pv) pvmax(p) = max(pvmax(p), abs(v(p) - v(i)))
          if (.not. pcs) cycle
-         c = pcon(p)
-         if (c == 0) cycle
+         if (pc0 >= 0) then
+            c = pc0 + p
+         else
+            c = pcon(p)
+            if (c == 0) cycle
+         end if
          s = psgn(p*ss); gp = pgap(p*sg)
          pen = s*(u(p) - u(i)) - gp
          f = 0.0_dp
@@ -946,8 +1089,8 @@ contains
             r1 = s*(v(p) - v(i)); q1 = s*(a(p) - a(i))
             call observer_phase_change(o, c, on, pen, f, d0, r0, q0, pen, r1, q1, t, h)
          end if
-         call observer_contact_peaks(o%ph_open(c), pen, f, o%ph_pen(c), o%ph_f(c), pen_max(c), &
-                                     force_max(c))
+         if (phases) call observer_phase_peaks(o%ph_open(c), pen, f, o%ph_pen(c), o%ph_f(c))
+         if (contacts) call observer_contact_peaks(pen, f, pen_max(c), force_max(c))
       end do
    end subroutine measure_kernel
 
@@ -957,24 +1100,27 @@ contains
       type(model_t), intent(in) :: m
       type(observer_t), intent(inout) :: o
       real(dp), intent(in) :: t, h
-      integer :: idx, j, a, b
+      integer :: idx, j, a, b, c
       real(dp) :: pen, f, r1
       integer(int8) :: br
       associate (u => self%u, v => self%v, acc => self%a, un => self%un, vn => self%vn, &
                  an => self%an, gap => m%con_gap)
-         do idx = 1, size(self%xc)
-            j = self%xc(idx); a = m%con_a(j); b = m%con_b(j)
+         do idx = 1, size(self%xg)
+            j = self%xg(idx); a = m%con_a(j); b = m%con_b(j); c = self%xc(idx)
             pen = u(a) - u(b) - gap(j); r1 = v(a) - v(b)
             call contact_law(m, j, pen, r1, br, f, self%xbrc(idx))
-            if (h > 0.0_dp .and. ((self%xbrc(idx) /= B_OFF) .neqv. o%ph_open(j))) &
-               call observer_phase_change(o, j, self%xbrc(idx) /= B_OFF, pen, f, &
+            if (h > 0.0_dp .and. ((self%xbrc(idx) /= B_OFF) .neqv. o%ph_open(c))) &
+               call observer_phase_change(o, c, self%xbrc(idx) /= B_OFF, pen, f, &
                                           un(a) - un(b) - gap(j), vn(a) - vn(b), an(a) - an(b), &
                                           pen, r1, acc(a) - acc(b), t, h)
-            call observer_contact_peaks(o%ph_open(j), pen, f, o%ph_pen(j), o%ph_f(j), &
-                                        o%pen_max(j), o%force_max(j))
+            if (tracks(o, TRACK_PHASES)) &
+               call observer_phase_peaks(o%ph_open(c), pen, f, o%ph_pen(c), o%ph_f(c))
+            if (tracks(o, TRACK_CONTACT_PEAKS)) &
+               call observer_contact_peaks(pen, f, o%pen_max(c), o%force_max(c))
          end do
-         do idx = 1, size(self%bl)
-            j = self%bl(idx)
+         if (.not. tracks(o, TRACK_LINK_PEAKS)) return
+         do idx = 1, size(self%blo)
+            j = self%blo(idx)
             call raise_to(o%link_force_absmax(j), abs(self%bfc(idx)))
             call raise_to(o%link_du_absmax(j), abs(self%bdu(idx)))
          end do
@@ -1000,8 +1146,9 @@ contains
       class(chain_newmark_t), intent(inout) :: self
       type(model_t), intent(in) :: m
       type(observer_t), intent(inout) :: o
-      integer :: j, a, b
+      integer :: j, a, b, q, i, idx
       real(dp) :: umax, vmax
+      if (.not. tracks(o, TRACK_LINK_PEAKS)) return
       do j = 1, m%nlink
          a = m%link_a(j); b = m%link_b(j)
          select case (m%link_kind(j))
@@ -1009,6 +1156,7 @@ contains
          case default
             cycle
          end select
+         vmax = 0.0_dp
          if (a > 0 .and. b > 0) then
             umax = self%pumax(min(a, b))
             if (m%link_kind(j) == LINK_DASHPOT) vmax = self%pvmax(min(a, b))
@@ -1016,12 +1164,30 @@ contains
             umax = self%gumax(a + b)
             if (m%link_kind(j) == LINK_DASHPOT) vmax = self%gvmax(a + b)
          end if
-         o%link_du_absmax(j) = umax
+         idx = model_link_index(m, j)
+         o%link_du_absmax(idx) = umax
          if (m%link_kind(j) == LINK_DASHPOT) then
-            o%link_force_absmax(j) = abs(m%link_par(L_DAMP, j))*vmax
+            o%link_force_absmax(idx) = abs(m%link_par(L_DAMP, j))*vmax
          else
-            o%link_force_absmax(j) = abs(m%link_par(L_STIFF, j))*umax
+            o%link_force_absmax(idx) = abs(m%link_par(L_STIFF, j))*umax
          end if
+      end do
+      ! a chain's: the spring, then (where c > 0) the dashpot of each node
+      do q = 1, m%nchain
+         associate (ch => m%chain(q))
+            idx = ch%link0
+            do i = 1, ch%n
+               j = ch%first + i - 1
+               idx = idx + 1
+               o%link_du_absmax(idx) = self%gumax(j)
+               o%link_force_absmax(idx) = abs(ch%k(i))*self%gumax(j)
+               if (.not. allocated(ch%c)) cycle
+               if (.not. (ch%c(i) > 0.0_dp)) cycle
+               idx = idx + 1
+               o%link_du_absmax(idx) = self%gumax(j)
+               o%link_force_absmax(idx) = ch%c(i)*self%gvmax(j)
+            end do
+         end associate
       end do
    end subroutine link_peaks
 
@@ -1031,25 +1197,43 @@ contains
       type(model_t), intent(in) :: m
       integer, intent(in) :: which(:)
       real(dp), allocatable, intent(inout) :: pen(:), force(:)
-      integer :: idx, j, i, a, b
-      integer(int8) :: br, brk
+      integer :: idx, j, i, a, b, scheme, law
+      integer(int8) :: br
+      real(dp) :: gap, par(NPAR_CONTACT), rate
       deallocate (pen, force)
-      allocate (pen(m%ncontact), force(m%ncontact))
+      allocate (pen(model_ncontacts(m)), force(model_ncontacts(m)))
       pen = 0.0_dp; force = 0.0_dp
       do idx = 1, size(which)
-         j = which(idx); a = m%con_a(j); b = m%con_b(j)
-         pen(j) = self%u(a) - self%u(b) - m%con_gap(j)
+         j = which(idx)
+         call model_contact_at(m, j, a, b, gap, scheme, law, par)
+         pen(j) = self%u(a) - self%u(b) - gap
+         rate = self%v(a) - self%v(b)
          ! its committed branch: a pair contact's or another's
          br = B_OFF
          i = min(a, b)
          if (a > 0 .and. b > 0) then
-            if (self%pcon(i) == j) br = self%pbrc(i)
+            if (pair_contact(self, i) == j) br = self%pbrc(i)
          end if
          do i = 1, size(self%xc)
             if (self%xc(i) == j) br = self%xbrc(i)
          end do
-         call contact_law(m, j, pen(j), self%v(a) - self%v(b), brk, force(j), br)
+         force(j) = 0.0_dp
+         if (br == B_ON) force(j) = par(P_STIFF)*pen(j)
+         if (br == B_ON .and. law == LAW_KELVIN) force(j) = force(j) + kelvin_damping(j)*rate
       end do
+   contains
+      !> the damping the sweep gives contact j
+      real(dp) function kelvin_damping(j) result(c)
+         integer, intent(in) :: j
+         integer :: q
+         c = 0.0_dp
+         do q = 1, self%n - 1
+            if (pair_contact(self, q) == j) c = self%pc(q*self%sc)
+         end do
+         do q = 1, size(self%xc)
+            if (self%xc(q) == j) c = m%con_par(P_DAMPING, self%xg(q))
+         end do
+      end function kelvin_damping
    end subroutine contact_states
 
    !> Force and elongation of the links which (0 elsewhere): the history's columns.
@@ -1058,21 +1242,23 @@ contains
       type(model_t), intent(in) :: m
       integer, intent(in) :: which(:)
       real(dp), allocatable, intent(out) :: lf(:), ld(:)
-      integer :: idx, j, a, b, q
-      allocate (lf(m%nlink), ld(m%nlink))
+      integer :: idx, j, a, b, q, kind
+      real(dp) :: par(NPAR_LINK)
+      allocate (lf(model_nlinks(m)), ld(model_nlinks(m)))
       lf = 0.0_dp; ld = 0.0_dp
       do idx = 1, size(which)
-         j = which(idx); a = m%link_a(j); b = m%link_b(j)
+         j = which(idx)
+         call model_link_at(m, j, kind, a, b, par)
          ld(j) = self%u(a) - self%u(b)
-         select case (m%link_kind(j))
+         select case (kind)
          case (LINK_DASHPOT)
-            lf(j) = m%link_par(L_DAMP, j)*(self%v(a) - self%v(b))
+            lf(j) = par(L_DAMP)*(self%v(a) - self%v(b))
          case (LINK_BILINEAR)
-            do q = 1, size(self%bl)
-               if (self%bl(q) == j) lf(j) = self%bfc(q)
+            do q = 1, size(self%blo)
+               if (self%blo(q) == j) lf(j) = self%bfc(q)
             end do
          case default
-            lf(j) = m%link_par(L_STIFF, j)*ld(j)
+            lf(j) = par(L_STIFF)*ld(j)
          end select
       end do
    end subroutine link_states
@@ -1091,7 +1277,11 @@ contains
       associate (u => self%u, v => self%v)
          do i = 1, n
             e(1) = e(1) + 0.5_dp*m%mass(i)*v(i)*v(i)
-            e(2) = e(2) + 0.5_dp*self%kg(i)*u(i)*u(i)
+            if (self%chain_links) then
+               e(2) = e(2) + 0.5_dp*m%chain(1)%k(i)*u(i)*u(i)
+            else
+               e(2) = e(2) + 0.5_dp*self%kg(i)*u(i)*u(i)
+            end if
          end do
          if (self%pair_links) then
             do i = 1, n - 1
@@ -1106,17 +1296,29 @@ contains
             e(2) = e(2) + eb
          end do
          do i = 1, n - 1
-            if (self%pcon(i) == 0) cycle
+            if (pair_contact(self, i) == 0) cycle
             pen = self%psgn(i*self%ss)*(u(i) - u(i + 1)) - self%pgap(i*self%sg)
             if (pen > 0.0_dp) e(3) = e(3) + 0.5_dp*self%pk(i*self%sk)*pen*pen
          end do
-         do idx = 1, size(self%xc)
-            j = self%xc(idx)
+         do idx = 1, size(self%xg)
+            j = self%xg(idx)
             pen = u(m%con_a(j)) - u(m%con_b(j)) - m%con_gap(j)
             e(3) = e(3) + contact_elastic_energy(m%con_law(j), m%con_par(:, j), max(pen, 0.0_dp))
          end do
       end associate
    end function energies
+
+   !> The contact of pair (i, i+1) among all the model's contacts (0: none).
+   pure integer function pair_contact(self, i) result(c)
+      class(chain_newmark_t), intent(in) :: self
+      integer, intent(in) :: i
+      if (self%pc0 >= 0) then
+         c = 0
+         if (i >= 1 .and. i < self%n) c = self%pc0 + i
+      else
+         c = self%pcon(i)
+      end if
+   end function pair_contact
 
    subroutine swap(x, y)
       real(dp), allocatable, intent(inout) :: x(:), y(:)

@@ -11,7 +11,8 @@ module martello_observer
    use martello_assembly, only: mech_state_t, kinetic_energy, recoverable_energy, mass_times
    use martello_integrator_settings, only: integrator_settings_t, integrator_name
    use martello_run_quantities
-   use martello_registry, only: INTEGRATORS
+   use martello_registry, only: INTEGRATORS, TRACK_NODE_PEAKS, TRACK_LINK_PEAKS, &
+      TRACK_CONTACT_PEAKS, TRACK_PHASES, TRACK_ALL
    use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan, ieee_is_finite, ieee_is_nan
    use, intrinsic :: iso_c_binding, only: c_funptr, c_ptr, c_null_funptr, c_null_ptr, &
       c_associated, c_f_procpointer, c_int, c_double, c_long_long
@@ -22,13 +23,19 @@ module martello_observer
       observer_penalty_phases, observer_fail, observer_fail_nonfinite, observer_finish, &
       free_side_crossing, progress_callback, observer_extremum, observer_recorded, &
       observer_node_peaks, observer_contact_peaks, observer_phase_change, observer_energy_due, &
-      observer_phase_lists, &
+      observer_phase_lists, tracks, TRACK_NODE_PEAKS, TRACK_LINK_PEAKS, TRACK_CONTACT_PEAKS, &
+      TRACK_PHASES, TRACK_ALL, observer_phase_peaks, &
       NCOUNTERS, C_STEPS, C_REJECTED, C_NEWTON, C_RESIDUALS, C_FACTORIZATIONS, C_EVENTS, &
       C_JACOBIANS, C_ROOT_EVALS, C_CHATTER, NENERGY, E_KINETIC, E_RECOVERABLE, E_INPUT, E_DAMPING, &
       E_PLASTIC, E_CONTACT, E_BALANCE, E_INITIAL, E_IMPACT, NEVENT, EV_T_ON, EV_T_OFF, &
       EV_V_IN, EV_V_OUT, EV_MAX_PEN, EV_MAX_FORCE
 
    type :: results_t
+      !> what the run tracks (TRACK_* bits, martello_run_set_tracking): the arrays of what it
+      !> does not track have no entries (the accessors give NaN), its phases no rows;
+      !> impacts are always counted
+      integer :: tracking = TRACK_ALL
+      integer :: n_nodes = 0, n_contacts = 0, n_links = 0
       ! history: hist(:, k) = [t, (u, v, a of each output node), (δ, P of each output
       ! contact), (force, elongation of each output link), energy(1:NENERGY)]
       integer :: ncol = 0, nrec = 0
@@ -145,17 +152,25 @@ contains
    !> before it starts (every integrator takes at least one step per grid point);
    !> stat = MARTELLO_ERR_LIMIT, or MARTELLO_ERR_MEMORY if the arrays cannot be allocated.
    subroutine observer_init(o, s, n_nodes, n_contacts, out_nodes, out_contacts, capacity, &
-                            n_links, out_links, stat)
+                            n_links, out_links, stat, tracking)
       type(observer_t), intent(inout) :: o
       type(integrator_settings_t), intent(in) :: s
       integer, intent(in) :: n_nodes, n_contacts, out_nodes(:), out_contacts(:), capacity, &
                              n_links, out_links(:)
       integer, intent(out), optional :: stat
+      integer, intent(in), optional :: tracking
       type(observer_t) :: fresh
       real(dp) :: steps
-      integer :: st, st2
+      integer :: st, st2, nn, nl, ncp, nph
       o = fresh        ! every field at its default, every array deallocated
       if (present(stat)) stat = MARTELLO_OK
+      if (present(tracking)) o%tracking = tracking
+      o%n_nodes = n_nodes; o%n_contacts = n_contacts; o%n_links = n_links
+      ! the arrays of what the run does not track have no entries
+      nn = merge(n_nodes, 0, tracks(o, TRACK_NODE_PEAKS))
+      nl = merge(n_links, 0, tracks(o, TRACK_LINK_PEAKS))
+      ncp = merge(n_contacts, 0, tracks(o, TRACK_CONTACT_PEAKS))
+      nph = merge(n_contacts, 0, tracks(o, TRACK_PHASES))
       o%kind = s%kind
       if (s%kind >= 1 .and. s%kind <= size(INTEGRATORS)) o%fixed_steps = .not. INTEGRATORS(s%kind)%adaptive
       o%every = max(s%every, 1); o%divergence_factor = s%divergence_factor
@@ -176,12 +191,12 @@ contains
       o%ncol = 1 + 3*size(out_nodes) + 2*size(out_contacts) + 2*size(out_links) + NENERGY
       allocate (o%hist(o%ncol, max(min(capacity, HIST_START), 2)), o%ev(NEVENT, 16), o%ev_contact(16), &
                 stat=st)
-      allocate (o%u_max(n_nodes), o%u_min(n_nodes), o%v_absmax(n_nodes), o%a_absmax(n_nodes), &
-                o%pen_max(n_contacts), o%force_max(n_contacts), o%impacts(n_contacts), &
-                o%u_peak(n_nodes), o%t_peak(n_nodes), o%link_force_absmax(n_links), &
-                o%u_absmax(n_nodes), o%t_absmax(n_nodes), &
-                o%link_du_absmax(n_links), o%ph_open(n_contacts), &
-                o%ph_t(n_contacts), o%ph_v(n_contacts), o%ph_pen(n_contacts), o%ph_f(n_contacts), &
+      allocate (o%u_max(nn), o%u_min(nn), o%v_absmax(nn), o%a_absmax(nn), &
+                o%pen_max(ncp), o%force_max(ncp), o%impacts(n_contacts), &
+                o%u_peak(nn), o%t_peak(nn), o%link_force_absmax(nl), &
+                o%u_absmax(nn), o%t_absmax(nn), &
+                o%link_du_absmax(nl), o%ph_open(n_contacts), &
+                o%ph_t(nph), o%ph_v(nph), o%ph_pen(nph), o%ph_f(nph), &
                 stat=st2)
       if (st /= 0 .or. st2 /= 0) then
          write (o%message, '(a,i0,a,i0,a)') 'out of memory allocating the results of a run of ', &
@@ -338,11 +353,13 @@ contains
       if (measured) then
          o%prev_t = t
       else
-         call observer_contact_peaks(o%ph_open(1:size(pen)), pen, force, o%ph_pen(1:size(pen)), &
-                                     o%ph_f(1:size(pen)), o%pen_max(1:size(pen)), &
-                                     o%force_max(1:size(pen)))
-         if (.not. present(u_prev) .and. .not. allocated(o%prev_u)) &
-            allocate (o%prev_u(m%n), o%prev_v(m%n), o%prev_a(m%n))
+         if (tracks(o, TRACK_PHASES)) &
+            call observer_phase_peaks(o%ph_open(1:size(pen)), pen, force, o%ph_pen(1:size(pen)), &
+                                      o%ph_f(1:size(pen)))
+         if (tracks(o, TRACK_CONTACT_PEAKS)) &
+            call observer_contact_peaks(pen, force, o%pen_max(1:size(pen)), o%force_max(1:size(pen)))
+         if (.not. present(u_prev) .and. .not. allocated(o%prev_u) .and. &
+             tracks(o, TRACK_NODE_PEAKS)) allocate (o%prev_u(m%n), o%prev_v(m%n), o%prev_a(m%n))
          call track(o, t, u(1:), v(1:), a(1:), link_f, link_du, u_prev, v_prev, a_prev)
       end if
       if (due) then
@@ -502,8 +519,9 @@ contains
       integer, intent(in) :: c
       real(dp), intent(in) :: t_on, v_in
       o%ph_open(c) = .true.
-      o%ph_t(c) = t_on; o%ph_v(c) = v_in; o%ph_pen(c) = 0.0_dp; o%ph_f(c) = 0.0_dp
       o%impacts(c) = o%impacts(c) + 1
+      if (.not. tracks(o, TRACK_PHASES)) return
+      o%ph_t(c) = t_on; o%ph_v(c) = v_in; o%ph_pen(c) = 0.0_dp; o%ph_f(c) = 0.0_dp
    end subroutine observer_open_phase
 
    !> Contact c ends its phase at t_off, leaving at v_out. pen, force: the contact's state at
@@ -514,10 +532,11 @@ contains
       integer, intent(in) :: c
       real(dp), intent(in) :: t_off, v_out
       real(dp), intent(in), optional :: pen, force
+      o%ph_open(c) = .false.
+      if (.not. tracks(o, TRACK_PHASES)) return
       if (present(pen)) o%ph_pen(c) = max(o%ph_pen(c), pen)
       if (present(force)) o%ph_f(c) = max(o%ph_f(c), force)
       call keep_event(o, c, [o%ph_t(c), t_off, o%ph_v(c), v_out, o%ph_pen(c), o%ph_f(c)])
-      o%ph_open(c) = .false.
    end subroutine observer_close_phase
 
    !> An instantaneous phase of contact c at t (an impact resolved by an impulse): approach
@@ -526,7 +545,7 @@ contains
       type(observer_t), intent(inout) :: o
       integer, intent(in) :: c
       real(dp), intent(in) :: t, v_in, v_out, pen, force
-      call keep_event(o, c, [t, t, v_in, v_out, pen, force])
+      if (tracks(o, TRACK_PHASES)) call keep_event(o, c, [t, t, v_in, v_out, pen, force])
       o%impacts(c) = o%impacts(c) + 1
    end subroutine observer_add_impact
 
@@ -559,9 +578,8 @@ contains
       real(dp), intent(in) :: pen, force, d0, r0, q0, d1, r1, q1, t, h
       if (on .neqv. o%ph_open(c)) call observer_phase_change(o, c, on, pen, force, d0, r0, q0, &
                                                              d1, r1, q1, t, h)
-      if (o%ph_open(c)) then
-         o%ph_pen(c) = max(o%ph_pen(c), pen); o%ph_f(c) = max(o%ph_f(c), force)
-      end if
+      if (tracks(o, TRACK_PHASES)) call observer_phase_peaks(o%ph_open(c), pen, force, o%ph_pen(c), &
+                                                            o%ph_f(c))
    end subroutine penalty_phase
 
    !> Penalty contact c opens (on) or closes (not on) in the fixed step (t − h, t], its
@@ -583,9 +601,8 @@ contains
          call observer_open_phase(o, c, t - h + tau, r0 + q0*tau)
          o%counters(C_EVENTS) = o%counters(C_EVENTS) + 1_i8
       else
-         o%ph_pen(c) = max(o%ph_pen(c), pen); o%ph_f(c) = max(o%ph_f(c), force)
          tau = free_side_crossing(d1, r1, q1, -h, 0.0_dp)
-         call observer_close_phase(o, c, t + tau, r1 + q1*tau)
+         call observer_close_phase(o, c, t + tau, r1 + q1*tau, pen, force)
       end if
    end subroutine observer_phase_change
 
@@ -741,7 +758,9 @@ contains
       real(dp), intent(in), optional :: link_f(:), link_du(:)
       real(dp), intent(in), optional :: u_prev(:), v_prev(:), a_prev(:)
       integer :: i
-      if (present(u_prev)) then
+      if (.not. tracks(o, TRACK_NODE_PEAKS)) then
+         ! nothing of the nodes
+      else if (present(u_prev)) then
          call observer_node_peaks(t, o%prev_t, o%fixed_steps, o%located_extrema, u_prev, v_prev, &
                                   a_prev, u, v, a, o%u_max, o%u_min, o%v_absmax, o%a_absmax, &
                                   o%u_absmax, o%t_absmax, o%u_peak, o%t_peak)
@@ -752,7 +771,7 @@ contains
          o%prev_u = u; o%prev_v = v; o%prev_a = a
       end if
       o%prev_t = t
-      if (present(link_f) .and. present(link_du)) then
+      if (present(link_f) .and. present(link_du) .and. tracks(o, TRACK_LINK_PEAKS)) then
          do i = 1, size(link_f)
             call raise_to(o%link_force_absmax(i), abs(link_f(i)))
             call raise_to(o%link_du_absmax(i), abs(link_du(i)))
@@ -809,20 +828,33 @@ contains
       end if
    end subroutine observer_node_peaks
 
-   !> The maxima of a contact at a sample: its largest δ and force (pen_max, force_max), and
-   !> those of its phase if open (ph_pen, ph_f). Elemental: observer_sample calls it on every
-   !> contact; a method that measures its contacts in its own sweep, contact by contact, on
-   !> the observer's arrays (after observer_phase_change where the contact opens or closes).
-   elemental subroutine observer_contact_peaks(open, pen, force, ph_pen, ph_f, pen_max, force_max)
-      logical, intent(in) :: open
+   !> The maxima of a contact at a sample: its largest δ and force (pen_max, force_max).
+   !> Elemental: observer_sample calls it on every contact; a method that measures its
+   !> contacts in its own sweep, contact by contact, on the observer's arrays.
+   elemental subroutine observer_contact_peaks(pen, force, pen_max, force_max)
       real(dp), intent(in) :: pen, force
-      real(dp), intent(inout) :: ph_pen, ph_f, pen_max, force_max
-      if (open) then
-         ph_pen = max(ph_pen, pen); ph_f = max(ph_f, force)
-      end if
+      real(dp), intent(inout) :: pen_max, force_max
       if (pen > pen_max) pen_max = pen
       if (force > force_max) force_max = force
    end subroutine observer_contact_peaks
+
+   !> The maxima of a contact's phase if open (ph_pen, ph_f) at a sample: as
+   !> observer_contact_peaks (after observer_phase_change where the contact opens or closes).
+   elemental subroutine observer_phase_peaks(open, pen, force, ph_pen, ph_f)
+      logical, intent(in) :: open
+      real(dp), intent(in) :: pen, force
+      real(dp), intent(inout) :: ph_pen, ph_f
+      if (open) then
+         ph_pen = max(ph_pen, pen); ph_f = max(ph_f, force)
+      end if
+   end subroutine observer_phase_peaks
+
+   !> Whether the run tracks what (a TRACK_* bit).
+   pure logical function tracks(r, what)
+      class(results_t), intent(in) :: r
+      integer, intent(in) :: what
+      tracks = iand(r%tracking, what) == what
+   end function tracks
 
    !> An extremum of node i's displacement located by the method inside an accepted step, at t
    !> with value u (the root of the node's velocity on the stepper's own solution,
@@ -833,6 +865,7 @@ contains
       integer, intent(in) :: i
       real(dp), intent(in) :: t, u
       logical, intent(in) :: maximum
+      if (.not. tracks(o, TRACK_NODE_PEAKS)) return
       if (.not. o%located_extrema) then
          o%located_extrema = .true.
          o%u_peak = -huge(1.0_dp); o%t_peak = -1.0_dp

@@ -1,15 +1,18 @@
 /* The benchmark chain of benchmarks/perf/chain_vs_opensees.py built and run through the C API
  * alone (docs/performance.md "The library alone"): no Python, so the time and the memory are
- * the library's. The model is the one the front end builds from the scene's [[chain]] (node
- * b_i with a spring and a dashpot to ground, links in the order spring, dashpot of b_1, of
- * b_2 ...; contact b_i-b_{i+1}), by the bulk doors (docs/c-api.md "Building a large model").
+ * the library's. The model is the scene's [[chain]]: node b_i with a spring and a dashpot to
+ * ground (links numbered spring, dashpot of b_1, of b_2 ...), contact b_i-b_{i+1}; held per
+ * node by martello_model_add_chain, or with --items as links and contacts by the bulk doors
+ * (docs/c-api.md "Chains", "Building a large model").
  *
- *     chain_native N STEPS [--full-phases]
+ *     chain_native N STEPS [--items] [--full-phases] [--track WHAT]
  *
  * prints one JSON line: the wall seconds of martello_dynamic_run (its set-up included), the
  * resident memory (VmRSS) before the model, after it is built and after the run, the peak
- * (VmHWM), the counters and a checksum of the peaks (to compare two builds). --full-phases
- * asks for every contact's phase list (martello_run_set_phase_lists). */
+ * (VmHWM), the counters and a checksum of the peaks (to compare two builds or the two doors).
+ * --full-phases asks for every contact's phase list (martello_run_set_phase_lists); --track
+ * keeps only WHAT, a comma-separated list of node_peaks, link_peaks, contact_peaks, phases
+ * (martello_run_set_tracking; default all). */
 #include <malloc.h>
 #include <math.h>
 #include <stdio.h>
@@ -56,14 +59,30 @@ int main(int argc, char **argv) {
     return 2;
   }
   int n = atoi(argv[1]), steps = atoi(argv[2]);
-  int full = argc > 3 && strcmp(argv[3], "--full-phases") == 0;
+  int full = 0, items = 0, track = MARTELLO_TRACK_ALL;
+  for (int a = 3; a < argc; ++a) {
+    if (strcmp(argv[a], "--full-phases") == 0) full = 1;
+    else if (strcmp(argv[a], "--items") == 0) items = 1;
+    else if (strcmp(argv[a], "--track") == 0 && a + 1 < argc) {
+      const char *w = argv[++a];
+      track = 0;
+      if (strstr(w, "node_peaks")) track |= MARTELLO_TRACK_NODE_PEAKS;
+      if (strstr(w, "link_peaks")) track |= MARTELLO_TRACK_LINK_PEAKS;
+      if (strstr(w, "contact_peaks")) track |= MARTELLO_TRACK_CONTACT_PEAKS;
+      if (strstr(w, "phases")) track |= MARTELLO_TRACK_PHASES;
+    } else {
+      fprintf(stderr, "chain_native: unknown option %s\n", argv[a]);
+      return 2;
+    }
+  }
   /* every block of 64 kB or more its own mapping, returned when freed: the resident memory
    * is then what is allocated (glibc's adaptive threshold would keep this driver's freed
    * input arrays resident and count them as the library's) */
   mallopt(M_MMAP_THRESHOLD, 64 * 1024);
   double rss0 = proc_status("VmRSS");
   martello_model *m = NULL;
-  check(martello_model_create(n, 2 * n, n - 1, 0, 0, &m), "model_create", NULL, NULL);
+  check(martello_model_create(n, items ? 2 * n : 0, items ? n - 1 : 0, 0, 0, &m), "model_create",
+        NULL, NULL);
   {
     double *mass = malloc(n * sizeof *mass), *zero = calloc(n, sizeof *zero);
     int *fixed = calloc(n, sizeof *fixed);
@@ -71,7 +90,19 @@ int main(int argc, char **argv) {
     check(martello_model_set_nodes(m, n, mass, zero, zero, fixed), "set_nodes", m, NULL);
     free(mass); free(zero); free(fixed);
   }
-  {
+  if (!items) {
+    double *k = malloc(n * sizeof *k), *c = malloc(n * sizeof *c), *gap = malloc(n * sizeof *gap);
+    double par[MARTELLO_NPAR_CONTACT] = {0};
+    for (int i = 0; i < n; ++i) {
+      k[i] = i % 2 == 0 ? K1 : K2;
+      c[i] = 2.0 * ZETA * sqrt(k[i] * M);
+      gap[i] = GAP;
+    }
+    par[MARTELLO_P_STIFF] = EPS; par[MARTELLO_P_EXPONENT] = 1.0; par[MARTELLO_P_RESTITUTION] = -1.0;
+    check(martello_model_add_chain(m, 0, n, k, c, NULL, NULL, gap, MARTELLO_SCHEME_PENALTY,
+                                   MARTELLO_LAW_LINEAR, par), "add_chain", m, NULL);
+    free(k); free(c); free(gap);
+  } else {
     int *kind = malloc(2 * n * sizeof *kind), *a = malloc(2 * n * sizeof *a),
         *b = malloc(2 * n * sizeof *b);
     double *par = calloc((size_t)2 * n * MARTELLO_NPAR_LINK, sizeof *par);
@@ -86,7 +117,7 @@ int main(int argc, char **argv) {
     check(martello_model_add_links(m, 2 * n, kind, a, b, par), "add_links", m, NULL);
     free(kind); free(a); free(b); free(par);
   }
-  if (n > 1) {
+  if (items && n > 1) {
     int nc = n - 1;
     int *a = malloc(nc * sizeof *a), *b = malloc(nc * sizeof *b), *scheme = malloc(nc * sizeof *scheme),
         *law = malloc(nc * sizeof *law);
@@ -116,7 +147,8 @@ int main(int argc, char **argv) {
   check(martello_run_set_settings(r, &s), "set_settings", NULL, r);
   int out_nodes[2] = {0, n - 1};
   check(martello_run_set_outputs(r, 2, out_nodes, 0, NULL), "set_outputs", NULL, r);
-  if (full) check(martello_run_set_phase_lists(r, -1, 0, NULL), "set_phase_lists", NULL, r);
+  if (full) check(martello_run_set_phase_lists(r, -1), "set_phase_lists", NULL, r);
+  check(martello_run_set_tracking(r, track), "set_tracking", NULL, r);
   double t0 = now();
   check(martello_dynamic_run(m, r), "dynamic_run", NULL, r);
   double wall = now() - t0;
@@ -136,15 +168,18 @@ int main(int argc, char **argv) {
   long long impacts = 0;
   for (int i = 0; i < n; ++i) checksum += fmax(u_max[i], -u_min[i]);
   for (int i = 0; i < n - 1; ++i) impacts += imp[i];
+  char sum[40];
+  if (checksum != checksum) snprintf(sum, sizeof sum, "null");   /* node peaks not tracked */
+  else snprintf(sum, sizeof sum, "%.17g", checksum);
   printf("{\"n\": %d, \"steps\": %lld, \"wall_s\": %.6f, \"ns_per_dof_step\": %.3f, "
          "\"rss_start\": %.0f, \"rss_model\": %.0f, \"rss_run\": %.0f, \"rss_peak\": %.0f, "
          "\"model_B_per_dof\": %.1f, \"peak_B_per_dof\": %.1f, \"newton\": %lld, "
          "\"factorizations\": %lld, \"fused\": %lld, \"events\": %d, \"impacts\": %lld, "
-         "\"sum_absmax_u\": %.17g}\n",
+         "\"sum_absmax_u\": %s, \"tracking\": %d}\n",
          n, cnt[MARTELLO_COUNTER_STEPS], wall, wall / ((double)n * steps) * 1e9, rss0, rss_model,
          rss_run, hwm, (rss_model - rss0) / n, (hwm - rss0) / n,
          cnt[MARTELLO_COUNTER_NEWTON_ITERATIONS], cnt[MARTELLO_COUNTER_FACTORIZATIONS],
-         cnt[MARTELLO_COUNTER_FUSED_CHAIN_STEPS], nev, impacts, checksum);
+         cnt[MARTELLO_COUNTER_FUSED_CHAIN_STEPS], nev, impacts, sum, track);
   free(u_max); free(u_min); free(v); free(acc); free(upk); free(tpk); free(pen); free(force_max); free(imp);
   martello_run_free(&r);
   martello_model_free(&m);
