@@ -6,7 +6,7 @@ module martello_api_results
    use martello_kinds, only: dp
    use martello_status
    use martello_observer, only: NCOUNTERS, NENERGY, NEVENT, tracks, TRACK_NODE_PEAKS, &
-      TRACK_LINK_PEAKS, TRACK_CONTACT_PEAKS
+      TRACK_LINK_PEAKS, TRACK_CONTACT_PEAKS, observer_events
    use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan
    use martello_run, only: run_t
    use martello_api_handles, only: get_run
@@ -50,18 +50,25 @@ contains
       type(run_t), pointer :: rp
       integer(c_int), pointer :: ic(:)
       real(c_double), pointer :: vals(:, :)
+      integer :: nev
       rp => get_run(handle)
       n = 0
       c_run_events = MARTELLO_ERR_ARGUMENT
       if (.not. associated(rp)) return
-      n = rp%results%nevents
-      if (c_associated(contacts) .and. n > 0) then
-         call c_f_pointer(contacts, ic, [n])
-         ic = rp%results%ev_contact(1:n) - 1
+      if (.not. allocated(rp%results%ev)) then
+         c_run_events = MARTELLO_OK; return
       end if
-      if (c_associated(values) .and. n > 0) then
-         call c_f_pointer(values, vals, [NEVENT, n])
-         vals = rp%results%ev(:, 1:n)
+      call observer_events(rp%results, nev)
+      n = nev
+      if (nev > 0 .and. c_associated(contacts) .and. c_associated(values)) then
+         call c_f_pointer(contacts, ic, [nev]); call c_f_pointer(values, vals, [NEVENT, nev])
+         call observer_events(rp%results, nev, ic, vals)
+      else if (nev > 0 .and. c_associated(contacts)) then
+         call c_f_pointer(contacts, ic, [nev])
+         call observer_events(rp%results, nev, contact=ic)
+      else if (nev > 0 .and. c_associated(values)) then
+         call c_f_pointer(values, vals, [NEVENT, nev])
+         call observer_events(rp%results, nev, values=vals)
       end if
       c_run_events = MARTELLO_OK
    end function c_run_events

@@ -489,7 +489,7 @@ contains
       call pin_fixed(self)
    contains
       subroutine sweep(cg)
-         real(dp), intent(in) :: cg(:)
+         real(dp), intent(in), contiguous :: cg(:)
          call forward_kernel(self%n, self%h, self%gamma, self%c1, self%c2, self%acc, &
                              self%pair_links, self%kelvin, self%others, self%sc, self%vn, self%an, &
                              self%sm, self%mass, self%fe, self%g, cg, self%cp, self%pc, self%pbrf, &
@@ -564,7 +564,7 @@ contains
       self%factored = ok
    contains
       subroutine sweep(kg, cg)
-         real(dp), intent(in) :: kg(:), cg(:)
+         real(dp), intent(in), contiguous :: kg(:), cg(:)
          call refactor_kernel(self%n, self%cm, self%cv, self%acc, self%pair_links, &
                               self%pair_contacts, self%others, self%sk, self%sc, self%a, self%sm, &
                               self%mass, m%fixed, self%fe, kg, cg, self%kp, self%cp, self%pk, &
@@ -659,7 +659,7 @@ contains
       self%fnod = 0.0_dp
    contains
       subroutine sweep(kg, cg)
-         real(dp), intent(in) :: kg(:), cg(:)
+         real(dp), intent(in), contiguous :: kg(:), cg(:)
          call back_kernel(self%n, from_start, self%pair_links, self%pair_contacts, self%kelvin, &
                           self%ss, self%sg, self%sk, self%sc, self%sl, self%cm, self%cv, self%c1, &
                           self%c2, self%h, self%gamma, self%rp, self%g, self%u, self%v, &
@@ -688,7 +688,7 @@ contains
       integer :: i
       integer(int8) :: br, law
       real(dp) :: x, ui, vi, ai, uni, vni, u1, v1, un1, vn1, fi, f1, du, dun, fp, s, pen, penn, &
-                  f, fn, gp, g1
+                  f, fn, gp, g1, k, c, hd
       g1 = 1.0_dp - gm
       mdu = 0.0_dp; wd = 0.0_dp; wl = 0.0_dp; wc = 0.0_dp; flip = .false.
       x = 0.0_dp; u1 = 0.0_dp; v1 = 0.0_dp; un1 = 0.0_dp; vn1 = 0.0_dp; f1 = 0.0_dp
@@ -707,9 +707,10 @@ contains
          u(i) = ui; v(i) = vi; a(i) = ai
          mdu = mdu + mass(1 + (i - 1)*sm)*x
          ! the links of node i to ground
-         fi = kg(i)*ui + cg(i)*vi
-         wl = wl + 0.5_dp*kg(i)*(uni + ui)*(ui - uni)
-         wd = wd + 0.5_dp*cg(i)*(vni + vi)*(ui - uni)
+         k = kg(i); c = cg(i); hd = 0.5_dp*(ui - uni)
+         fi = k*ui + c*vi
+         wl = wl + k*(uni + ui)*hd
+         wd = wd + c*(vni + vi)*hd
          if (i < n) then
             ! the pair (i, i+1): node i+1 is known
             du = ui - u1; dun = uni - un1
@@ -1054,20 +1055,36 @@ contains
                                  force_max(*)
       type(observer_t), intent(inout) :: o
       integer :: i, p, c
-      real(dp) :: s, gp, pen, f, d0, r0, q0, r1, q1
-      logical :: on
+      real(dp) :: s, gp, pen, f, d0, r0, q0, r1, q1, tt, tp, hh, x
+      logical :: on, fs, loc, step
+      ! the scalars as locals: o, which a phase change writes, holds t_prev (the compiler
+      ! would read it again after every call)
+      tt = t; tp = t_prev; hh = h; fs = fixed_steps; loc = located; step = h > 0.0_dp
       do i = 1, n
-         if (nodes) call observer_node_peaks(t, t_prev, fixed_steps, located, un(i), vn(i), an(i), &
-                                             u(i), v(i), a(i), umax(i), umin(i), vmax(i), amax(i), &
-                                             uabs(i), tabs(i), upk(i), tpk(i))
-         if (gu) gumax(i) = max(gumax(i), abs(u(i)))
-         if (gv) gvmax(i) = max(gvmax(i), abs(v(i)))
+         if (nodes) call observer_node_peaks(tt, tp, fs, loc, un(i), vn(i), an(i), u(i), v(i), &
+                                             a(i), umax(i), umin(i), vmax(i), amax(i), uabs(i), &
+                                             tabs(i), upk(i), tpk(i))
+         ! the maxima stored only when they change (read, not rewritten, at every step)
+         if (gu) then
+            x = abs(u(i)); if (x > gumax(i)) gumax(i) = x
+         end if
+         if (gv) then
+            x = abs(v(i)); if (x > gvmax(i)) gvmax(i) = x
+         end if
          if (i == 1) cycle
          ! the pair (i − 1, i)
          p = i - 1
-         if (pu) pumax(p) = max(pumax(p), abs(u(p) - u(i)))
-         if (pv) pvmax(p) = max(pvmax(p), abs(v(p) - v(i)))
-         if (.not. pcs) cycle
+         if (pu) then
+            x = abs(u(p) - u(i)); if (x > pumax(p)) pumax(p) = x
+         end if
+         if (pv) then
+            x = abs(v(p) - v(i)); if (x > pvmax(p)) pvmax(p) = x
+         end if
+      end do
+      if (.not. pcs) return
+      ! the pair contacts, in a loop of their own (fewer arrays at a time: no registers spilt)
+      do p = 1, n - 1
+         i = p + 1
          if (pc0 >= 0) then
             c = pc0 + p
          else
@@ -1084,10 +1101,10 @@ contains
             end if
          end if
          on = br(p) /= B_OFF
-         if (h > 0.0_dp .and. (on .neqv. o%ph_open(c))) then
+         if (step .and. (on .neqv. o%ph_open(c))) then
             d0 = s*(un(p) - un(i)) - gp; r0 = s*(vn(p) - vn(i)); q0 = s*(an(p) - an(i))
             r1 = s*(v(p) - v(i)); q1 = s*(a(p) - a(i))
-            call observer_phase_change(o, c, on, pen, f, d0, r0, q0, pen, r1, q1, t, h)
+            call observer_phase_change(o, c, on, pen, f, d0, r0, q0, pen, r1, q1, tt, hh)
          end if
          if (phases) call observer_phase_peaks(o%ph_open(c), pen, f, o%ph_pen(c), o%ph_f(c))
          if (contacts) call observer_contact_peaks(pen, f, pen_max(c), force_max(c))

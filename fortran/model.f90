@@ -412,7 +412,6 @@ contains
       end if
       kind = merge(LINK_BILINEAR, LINK_SPRING, present(fy))
       do i = 1, n
-         write (num, '(i0)') i - 1
          lp = 0.0_dp; lp(L_STIFF) = k(i)
          if (present(fy)) then
             lp(L_YIELD) = fy(i); lp(L_HARDENING) = rho(i)
@@ -425,6 +424,7 @@ contains
          if (stat == MARTELLO_OK .and. present(gap) .and. i < n) &
             call check_contact(m, first + i - 1, first + i, gap(i), scheme, law, par, stat)
          if (stat /= MARTELLO_OK) then
+            write (num, '(i0)') i - 1
             m%errmsg = 'chain entry '//trim(num)//': '//trim(m%errmsg); return
          end if
       end do

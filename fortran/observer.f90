@@ -23,7 +23,7 @@ module martello_observer
       observer_penalty_phases, observer_fail, observer_fail_nonfinite, observer_finish, &
       free_side_crossing, progress_callback, observer_extremum, observer_recorded, &
       observer_node_peaks, observer_contact_peaks, observer_phase_change, observer_energy_due, &
-      observer_phase_lists, tracks, TRACK_NODE_PEAKS, TRACK_LINK_PEAKS, TRACK_CONTACT_PEAKS, &
+      observer_phase_lists, observer_events, tracks, TRACK_NODE_PEAKS, TRACK_LINK_PEAKS, TRACK_CONTACT_PEAKS, &
       TRACK_PHASES, TRACK_ALL, observer_phase_peaks, &
       NCOUNTERS, C_STEPS, C_REJECTED, C_NEWTON, C_RESIDUALS, C_FACTORIZATIONS, C_EVENTS, &
       C_JACOBIANS, C_ROOT_EVALS, C_CHATTER, NENERGY, E_KINETIC, E_RECOVERABLE, E_INPUT, E_DAMPING, &
@@ -96,11 +96,13 @@ module martello_observer
       ! open contact phases: onset time and speed, running maxima of δ and P
       logical, allocatable :: ph_open(:)
       real(dp), allocatable :: ph_t(:), ph_v(:), ph_pen(:), ph_f(:)
-      !> past observer_phase_lists' number of contacts, the events of a contact not listed in
-      !> full are its first and last phase: ph_row(c) is 0 before its first phase, the row
-      !> of its only phase (> 0), or −(the row of its last phase) once it has two; LISTED
-      !> for a contact whose every phase is kept. Not allocated: every phase is kept.
-      integer, allocatable :: ph_row(:)
+      !> past observer_phase_lists' number of contacts, a contact not listed in full keeps its
+      !> first and last phase alone, outside the event table: ph_kept(c) is how many of them
+      !> it has (0, 1, 2), LISTED for a contact whose every phase is a row. The first is
+      !> ev_first(:, c); the last is ph_t, ph_toff, ph_v, ph_vout, ph_pen, ph_f (the open
+      !> phase's state, which a closed phase leaves there). Not allocated: every phase is a row.
+      integer, allocatable :: ph_kept(:)
+      real(dp), allocatable :: ev_first(:, :), ph_toff(:), ph_vout(:)
       ! the previous accepted state, for the interpolated peaks when the method keeps none
       ! (allocated at the first such sample)
       real(dp), allocatable :: prev_u(:), prev_v(:), prev_a(:)
@@ -134,7 +136,7 @@ module martello_observer
    real(dp), parameter :: CREATED_BOUND = 1.0e-2_dp
    !> History rows allocated at the start; it grows by doubling beyond (record).
    integer, parameter :: HIST_START = 4096
-   !> ph_row of a contact whose phases are all kept
+   !> ph_kept of a contact whose phases are all rows
    integer, parameter :: LISTED = -huge(1)
 
    !> Samples of one observer_sample call: the grid point k as a default or a 64-bit integer.
@@ -704,34 +706,63 @@ contains
    subroutine observer_phase_lists(o, max_contacts)
       type(observer_t), intent(inout) :: o
       integer, intent(in) :: max_contacts
-      if (allocated(o%ph_row)) deallocate (o%ph_row)
-      if (max_contacts < 0 .or. size(o%ph_open) <= max_contacts) return
-      allocate (o%ph_row(size(o%ph_open)))
-      o%ph_row = 0
-      o%ph_row(o%out_contacts) = LISTED
+      integer :: nc
+      if (allocated(o%ph_kept)) deallocate (o%ph_kept, o%ev_first, o%ph_toff, o%ph_vout)
+      nc = size(o%ph_open)
+      if (max_contacts < 0 .or. nc <= max_contacts .or. .not. tracks(o, TRACK_PHASES)) return
+      allocate (o%ph_kept(nc), o%ev_first(NEVENT, nc), o%ph_toff(nc), o%ph_vout(nc))
+      o%ph_kept = 0
+      o%ph_kept(o%out_contacts) = LISTED
    end subroutine observer_phase_lists
 
    !> A phase of contact c ends: an event row, or for a contact that keeps its first and
-   !> last phase alone (observer_phase_lists), its first row, then its last one, rewritten in
-   !> place (rows stay in time order per contact).
+   !> last phase alone (observer_phase_lists), its first phase, then its last one, in place.
    subroutine keep_event(o, c, values)
       type(observer_t), intent(inout) :: o
       integer, intent(in) :: c
       real(dp), intent(in) :: values(NEVENT)
-      integer :: row
-      if (.not. allocated(o%ph_row)) then
+      if (.not. allocated(o%ph_kept)) then
          call add_event(o, c, values); return
       end if
-      row = o%ph_row(c)
-      if (row == LISTED) then
+      select case (o%ph_kept(c))
+      case (LISTED)
          call add_event(o, c, values)
-      else if (row < 0) then
-         o%ev(:, -row) = values
-      else
-         call add_event(o, c, values)
-         o%ph_row(c) = merge(-o%nevents, o%nevents, row > 0)
-      end if
+      case (0)
+         o%ev_first(:, c) = values; o%ph_kept(c) = 1
+      case default
+         o%ph_t(c) = values(EV_T_ON); o%ph_toff(c) = values(EV_T_OFF)
+         o%ph_v(c) = values(EV_V_IN); o%ph_vout(c) = values(EV_V_OUT)
+         o%ph_pen(c) = values(EV_MAX_PEN); o%ph_f(c) = values(EV_MAX_FORCE)
+         o%ph_kept(c) = 2
+      end select
    end subroutine keep_event
+
+   !> The contact phases a finished run lists (martello_run_events): the rows of the event
+   !> table, then the first and last phase of each contact that keeps them alone
+   !> (observer_phase_lists). n: their number; contact (0-based) and values filled when
+   !> present.
+   subroutine observer_events(o, n, contact, values)
+      type(observer_t), intent(in) :: o
+      integer, intent(out) :: n
+      integer, intent(out), optional :: contact(:)
+      real(dp), intent(out), optional :: values(:, :)
+      integer :: c
+      n = o%nevents
+      if (present(contact)) contact(1:n) = o%ev_contact(1:n) - 1
+      if (present(values)) values(:, 1:n) = o%ev(:, 1:n)
+      if (.not. allocated(o%ph_kept)) return
+      do c = 1, size(o%ph_kept)
+         if (o%ph_kept(c) == LISTED .or. o%ph_kept(c) == 0) cycle
+         n = n + 1
+         if (present(contact)) contact(n) = c - 1
+         if (present(values)) values(:, n) = o%ev_first(:, c)
+         if (o%ph_kept(c) < 2) cycle
+         n = n + 1
+         if (present(contact)) contact(n) = c - 1
+         if (present(values)) values(:, n) = [o%ph_t(c), o%ph_toff(c), o%ph_v(c), o%ph_vout(c), &
+                                              o%ph_pen(c), o%ph_f(c)]
+      end do
+   end subroutine observer_events
 
    subroutine add_event(r, contact, values)
       class(results_t), intent(inout) :: r
