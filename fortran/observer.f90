@@ -22,9 +22,9 @@ module martello_observer
       observer_work, observer_open_phase, observer_close_phase, observer_add_impact, &
       observer_penalty_phases, observer_fail, observer_fail_nonfinite, observer_finish, &
       free_side_crossing, progress_callback, observer_extremum, observer_recorded, &
-      observer_node_peaks, observer_contact_peaks, observer_phase_change, observer_energy_due, &
-      observer_phase_lists, observer_events, tracks, TRACK_NODE_PEAKS, TRACK_LINK_PEAKS, TRACK_CONTACT_PEAKS, &
-      TRACK_PHASES, TRACK_ALL, observer_phase_peaks, &
+      observer_node_peaks, observer_contact_peaks, observer_phase_peaks, observer_phase_change, &
+      observer_energy_due, observer_phase_lists, observer_events, tracks, TRACK_NODE_PEAKS, &
+      TRACK_LINK_PEAKS, TRACK_CONTACT_PEAKS, TRACK_PHASES, TRACK_ALL, &
       NCOUNTERS, C_STEPS, C_REJECTED, C_NEWTON, C_RESIDUALS, C_FACTORIZATIONS, C_EVENTS, &
       C_JACOBIANS, C_ROOT_EVALS, C_CHATTER, NENERGY, E_KINETIC, E_RECOVERABLE, E_INPUT, E_DAMPING, &
       E_PLASTIC, E_CONTACT, E_BALANCE, E_INITIAL, E_IMPACT, NEVENT, EV_T_ON, EV_T_OFF, &
@@ -329,11 +329,11 @@ contains
    !> u_prev … the previous state if the method keeps it (saves a copy). stat:
    !> MARTELLO_ERR_DIVERGED, with the message, when the run must stop.
    !> folded: the method has measured this state item by item in its own sweeps
-   !> (observer_node_peaks, observer_phase_change and observer_contact_peaks, the link
-   !> peaks: the fused chain step); pen, force (and link_f, link_du) then serve the history
-   !> row alone, and are
-   !> read only where recorded. energies = [kinetic, links, contacts] at this state, from
-   !> such a method where observer_energy_due (it keeps no ms).
+   !> (observer_node_peaks, observer_phase_change, observer_phase_peaks,
+   !> observer_contact_peaks, the link peaks: the fused chain step); pen, force (and link_f,
+   !> link_du) then serve the history row alone, and are read only where recorded.
+   !> energies = [kinetic, links, contacts] at this state, from such a method where
+   !> observer_energy_due (it keeps no ms).
    subroutine observer_sample_i8(o, m, ms, t, u, v, a, pen, force, k, stat, link_f, link_du, &
                                  u_prev, v_prev, a_prev, folded, energies)
       type(observer_t), intent(inout) :: o

@@ -21,6 +21,7 @@ from martello.errors import SolverError
 from martello.run import run_full
 from martello.scene.catalogue import scene_files
 from martello.scene.loader import from_dict, load
+from tests.test_bulk_model import leaves
 
 
 def chain_tables(data):
@@ -73,14 +74,6 @@ def build_with_chain_door(chains):
             m.set_ground_acceleration(*run_module._function_args(scene.ground, scene.source))
         return m
     return build
-
-
-def leaves(d, pre=""):
-    if isinstance(d, dict):
-        return {k: v for key, sub in d.items() for k, v in leaves(sub, f"{pre}/{key}").items()}
-    if isinstance(d, list):
-        return {k: v for i, sub in enumerate(d) for k, v in leaves(sub, f"{pre}/{i}").items()}
-    return {pre: d}
 
 
 def assert_same_bits(data, monkeypatch):
