@@ -37,7 +37,7 @@ module martello_chain_newmark
    use martello_time_functions, only: tf_value
    use martello_observer, only: observer_t, observer_work, observer_begin, observer_sample, &
       observer_open_phase, observer_node_peaks, observer_phase_change, observer_contact_peaks, &
-      observer_phase_peaks, observer_energy_due, observer_recorded, tracks, TRACK_NODE_PEAKS, &
+      observer_phase_peaks, observer_energy_due, observer_recorded, tracks, TRACK_NODE_PEAKS, TRACK_ALL, &
       TRACK_LINK_PEAKS, TRACK_CONTACT_PEAKS, TRACK_PHASES
    use martello_run_quantities, only: C_NEWTON, C_RESIDUALS, C_FACTORIZATIONS, C_JACOBIANS, C_FUSED
    use martello_integrator_settings, only: integrator_settings_t, INT_NEWMARK
@@ -114,6 +114,7 @@ module martello_chain_newmark
       type(generalized_alpha_t), allocatable :: gen
       type(model_t), allocatable :: gm
    contains
+      procedure :: from_chain_of_one_kind
       procedure :: init => chain_init
       procedure :: step => chain_step
       procedure :: begin_step => chain_begin_step
@@ -490,10 +491,18 @@ contains
    contains
       subroutine sweep(cg)
          real(dp), intent(in), contiguous :: cg(:)
-         call forward_kernel(self%n, self%h, self%gamma, self%c1, self%c2, self%acc, &
-                             self%pair_links, self%kelvin, self%others, self%sc, self%vn, self%an, &
-                             self%sm, self%mass, self%fe, self%g, cg, self%cp, self%pc, self%pbrf, &
-                             self%xcd, self%xco)
+         if (.not. (self%pair_links .or. self%kelvin .or. self%others) .and. &
+             self%from_chain_of_one_kind()) then
+            ! the usual chain, with these as constants (back_kernel's call says why)
+            call forward_kernel(self%n, self%h, self%gamma, self%c1, self%c2, self%acc, .false., &
+                                .false., .false., 0, self%vn, self%an, 0, self%mass, self%fe, &
+                                self%g, cg, self%cp, self%pc, self%pbrf, self%xcd, self%xco)
+         else
+            call forward_kernel(self%n, self%h, self%gamma, self%c1, self%c2, self%acc, &
+                                self%pair_links, self%kelvin, self%others, self%sc, self%vn, &
+                                self%an, self%sm, self%mass, self%fe, self%g, cg, self%cp, &
+                                self%pc, self%pbrf, self%xcd, self%xco)
+         end if
       end subroutine sweep
    end subroutine linearised_sweep
 
@@ -501,9 +510,9 @@ contains
    !> compiler keeps everything in registers but the arrays).
    subroutine forward_kernel(n, h, gm, c1, c2, acc, pl, kel, oth, sc, vn, an, sm, mass, fe, g, &
                              cg, cp, pc, brf, xcd, xco)
-      integer, intent(in) :: n, sc, sm
-      real(dp), intent(in) :: h, gm, c1, c2, acc
-      logical, intent(in) :: pl, kel, oth
+      integer, intent(in), value :: n, sc, sm
+      real(dp), intent(in), value :: h, gm, c1, c2, acc
+      logical, intent(in), value :: pl, kel, oth
       real(dp), intent(in) :: vn(0:n), an(0:n), mass(*), g(0:n), cg(n), cp(0:*), pc(0:*), &
                               xcd(0:*), xco(0:*)
       integer(int8), intent(in) :: brf(0:n)
@@ -660,12 +669,26 @@ contains
    contains
       subroutine sweep(kg, cg)
          real(dp), intent(in), contiguous :: kg(:), cg(:)
-         call back_kernel(self%n, from_start, self%pair_links, self%pair_contacts, self%kelvin, &
-                          self%ss, self%sg, self%sk, self%sc, self%sl, self%cm, self%cv, self%c1, &
-                          self%c2, self%h, self%gamma, self%rp, self%g, self%u, self%v, &
-                          self%a, self%un, self%vn, self%an, self%sm, self%mass, self%fe, kg, cg, &
-                          self%kp, self%cp, self%psgn, self%pgap, self%pk, self%pc, self%plaw, &
-                          self%pbr, self%pbrc, self%pbrf, mdu, self%wd, self%wl, self%wc, flipped)
+         if (.not. (self%pair_links .or. self%kelvin) .and. self%pair_contacts .and. &
+             self%from_chain_of_one_kind()) then
+            ! the usual chain (springs and dashpots to ground, one linear contact law and gap
+            ! for every pair, one mass): the same kernel with these as constants, which the
+            ! compiler specialises (no branches on them, the parameters read once)
+            call back_kernel(self%n, from_start, .false., .true., .false., 0, 0, 0, 0, 0, &
+                             self%cm, self%cv, self%c1, self%c2, self%h, self%gamma, self%rp, &
+                             self%g, self%u, self%v, self%a, self%un, self%vn, self%an, 0, &
+                             self%mass, self%fe, kg, cg, self%kp, self%cp, self%psgn, self%pgap, &
+                             self%pk, self%pc, self%plaw, self%pbr, self%pbrc, self%pbrf, mdu, &
+                             self%wd, self%wl, self%wc, flipped)
+         else
+            call back_kernel(self%n, from_start, self%pair_links, self%pair_contacts, self%kelvin, &
+                             self%ss, self%sg, self%sk, self%sc, self%sl, self%cm, self%cv, &
+                             self%c1, self%c2, self%h, self%gamma, self%rp, self%g, self%u, &
+                             self%v, self%a, self%un, self%vn, self%an, self%sm, self%mass, &
+                             self%fe, kg, cg, self%kp, self%cp, self%psgn, self%pgap, self%pk, &
+                             self%pc, self%plaw, self%pbr, self%pbrc, self%pbrf, mdu, self%wd, &
+                             self%wl, self%wc, flipped)
+         end if
       end subroutine sweep
    end subroutine evaluate
 
@@ -674,9 +697,9 @@ contains
    subroutine back_kernel(n, from_start, pl, pcs, kel, ss, sg, sk, sc, sl, cm, cv, c1, c2, h, &
                           gm, rp, g, u, v, a, un, vn, an, sm, mass, fe, kg, cg, kp, cp, psgn, &
                           pgap, pk, pc, plaw, pbr, pbrc, pbrf, mdu, wd, wl, wc, flip)
-      integer, intent(in) :: n, ss, sg, sk, sc, sl, sm
-      logical, intent(in) :: from_start, pl, pcs, kel
-      real(dp), intent(in) :: cm, cv, c1, c2, h, gm
+      integer, intent(in), value :: n, ss, sg, sk, sc, sl, sm
+      logical, intent(in), value :: from_start, pl, pcs, kel
+      real(dp), intent(in), value :: cm, cv, c1, c2, h, gm
       real(dp), intent(in) :: rp(n), g(0:n), un(0:n), vn(0:n), an(0:n), mass(*), kg(n), &
                               cg(n), kp(0:*), cp(0:*), psgn(0:*), pgap(0:*), pk(0:*), pc(0:*)
       integer(int8), intent(in) :: plaw(0:*), pbrc(0:n), pbrf(0:n)
@@ -1020,16 +1043,30 @@ contains
       class(chain_newmark_t), intent(inout) :: self
       type(observer_t), intent(inout) :: o
       real(dp), intent(in) :: t, h
-      call measure_kernel(self%n, t, h, o%prev_t, o%fixed_steps, o%located_extrema, &
-                          tracks(o, TRACK_NODE_PEAKS), tracks(o, TRACK_CONTACT_PEAKS), &
-                          tracks(o, TRACK_PHASES), &
-                          size(self%gumax) > 0, size(self%gvmax) > 0, size(self%pumax) > 0, &
-                          size(self%pvmax) > 0, self%pair_contacts, self%kelvin, self%ss, &
-                          self%sg, self%sk, self%sc, self%sl, self%u, self%v, self%a, self%un, &
-                          self%vn, self%an, self%psgn, self%pgap, self%pk, self%pc, self%plaw, &
-                          self%pbrc, self%pc0, self%pcon, o%u_max, o%u_min, o%v_absmax, o%a_absmax, &
-                          o%u_absmax, o%t_absmax, o%u_peak, o%t_peak, self%gumax, self%gvmax, &
-                          self%pumax, self%pvmax, o%pen_max, o%force_max, o)
+      if (.not. self%kelvin .and. self%pair_contacts .and. self%from_chain_of_one_kind() .and. &
+          o%fixed_steps .and. .not. o%located_extrema .and. o%tracking == TRACK_ALL .and. &
+          size(self%pumax) == 0 .and. size(self%pvmax) == 0) then
+         ! the usual chain, every result tracked, with these as constants (back_kernel's call
+         ! says why)
+         call measure_kernel(self%n, t, h, o%prev_t, .true., .false., .true., .true., .true., &
+                             size(self%gumax) > 0, size(self%gvmax) > 0, .false., .false., .true., &
+                             .false., 0, 0, 0, 0, 0, self%u, self%v, self%a, self%un, self%vn, &
+                             self%an, self%psgn, self%pgap, self%pk, self%pc, self%plaw, &
+                             self%pbrc, self%pc0, self%pcon, o%u_max, o%u_min, o%v_absmax, &
+                             o%a_absmax, o%u_absmax, o%t_absmax, o%u_peak, o%t_peak, self%gumax, &
+                             self%gvmax, self%pumax, self%pvmax, o%pen_max, o%force_max, o)
+      else
+         call measure_kernel(self%n, t, h, o%prev_t, o%fixed_steps, o%located_extrema, &
+                             tracks(o, TRACK_NODE_PEAKS), tracks(o, TRACK_CONTACT_PEAKS), &
+                             tracks(o, TRACK_PHASES), size(self%gumax) > 0, size(self%gvmax) > 0, &
+                             size(self%pumax) > 0, size(self%pvmax) > 0, self%pair_contacts, &
+                             self%kelvin, self%ss, self%sg, self%sk, self%sc, self%sl, self%u, &
+                             self%v, self%a, self%un, self%vn, self%an, self%psgn, self%pgap, &
+                             self%pk, self%pc, self%plaw, self%pbrc, self%pc0, self%pcon, o%u_max, &
+                             o%u_min, o%v_absmax, o%a_absmax, o%u_absmax, o%t_absmax, o%u_peak, &
+                             o%t_peak, self%gumax, self%gvmax, self%pumax, self%pvmax, o%pen_max, &
+                             o%force_max, o)
+      end if
    end subroutine measure_nodes
 
    !> measure_nodes' loop on explicit-shape arrays. The observer's per-node and per-contact
@@ -1042,14 +1079,15 @@ contains
                              ss, sg, sk, sc, sl, u, v, a, un, vn, an, psgn, pgap, pk, pc, plaw, &
                              br, pc0, pcon, umax, umin, vmax, amax, uabs, tabs, upk, tpk, gumax, &
                              gvmax, pumax, pvmax, pen_max, force_max, o)
-      integer, intent(in) :: n, ss, sg, sk, sc, sl
-      real(dp), intent(in) :: t, h, t_prev
-      logical, intent(in) :: fixed_steps, located, nodes, contacts, phases, gu, gv, pu, pv, &
-                             pcs, kel
+      integer, intent(in), value :: n, ss, sg, sk, sc, sl
+      real(dp), intent(in), value :: t, h, t_prev
+      logical, intent(in), value :: fixed_steps, located, nodes, contacts, phases, gu, gv, pu, &
+                                    pv, pcs, kel
       real(dp), intent(in) :: u(0:n), v(0:n), a(0:n), un(0:n), vn(0:n), an(0:n), psgn(0:*), &
                               pgap(0:*), pk(0:*), pc(0:*)
       integer(int8), intent(in) :: plaw(0:*), br(0:n)
-      integer, intent(in) :: pc0, pcon(0:*)
+      integer, intent(in), value :: pc0
+      integer, intent(in) :: pcon(0:*)
       real(dp), intent(inout) :: umax(*), umin(*), vmax(*), amax(*), uabs(*), tabs(*), upk(*), &
                                  tpk(*), gumax(*), gvmax(*), pumax(*), pvmax(*), pen_max(*), &
                                  force_max(*)
@@ -1324,6 +1362,14 @@ contains
          end do
       end associate
    end function energies
+
+   !> Every pair contact shares its sign, gap, stiffness and law, and every node its mass
+   !> (stride 0 for all): the usual [[chain]].
+   pure logical function from_chain_of_one_kind(self) result(one)
+      class(chain_newmark_t), intent(in) :: self
+      one = self%ss == 0 .and. self%sg == 0 .and. self%sk == 0 .and. self%sc == 0 .and. &
+            self%sl == 0 .and. self%sm == 0
+   end function from_chain_of_one_kind
 
    !> The contact of pair (i, i+1) among all the model's contacts (0: none).
    pure integer function pair_contact(self, i) result(c)
