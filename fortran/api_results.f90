@@ -5,7 +5,9 @@ module martello_api_results
    use, intrinsic :: iso_c_binding
    use martello_kinds, only: dp
    use martello_status
-   use martello_observer, only: NCOUNTERS, NENERGY, NEVENT
+   use martello_observer, only: NCOUNTERS, NENERGY, NEVENT, tracks, TRACK_NODE_PEAKS, &
+      TRACK_LINK_PEAKS, TRACK_CONTACT_PEAKS, observer_events
+   use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan
    use martello_run, only: run_t
    use martello_api_handles, only: get_run
    implicit none
@@ -48,18 +50,25 @@ contains
       type(run_t), pointer :: rp
       integer(c_int), pointer :: ic(:)
       real(c_double), pointer :: vals(:, :)
+      integer :: nev
       rp => get_run(handle)
       n = 0
       c_run_events = MARTELLO_ERR_ARGUMENT
       if (.not. associated(rp)) return
-      n = rp%results%nevents
-      if (c_associated(contacts) .and. n > 0) then
-         call c_f_pointer(contacts, ic, [n])
-         ic = rp%results%ev_contact(1:n) - 1
+      if (.not. allocated(rp%results%ev)) then
+         c_run_events = MARTELLO_OK; return
       end if
-      if (c_associated(values) .and. n > 0) then
-         call c_f_pointer(values, vals, [NEVENT, n])
-         vals = rp%results%ev(:, 1:n)
+      call observer_events(rp%results, nev)
+      n = nev
+      if (nev > 0 .and. c_associated(contacts) .and. c_associated(values)) then
+         call c_f_pointer(contacts, ic, [nev]); call c_f_pointer(values, vals, [NEVENT, nev])
+         call observer_events(rp%results, nev, ic, vals)
+      else if (nev > 0 .and. c_associated(contacts)) then
+         call c_f_pointer(contacts, ic, [nev])
+         call observer_events(rp%results, nev, contact=ic)
+      else if (nev > 0 .and. c_associated(values)) then
+         call c_f_pointer(values, vals, [NEVENT, nev])
+         call observer_events(rp%results, nev, values=vals)
       end if
       c_run_events = MARTELLO_OK
    end function c_run_events
@@ -85,16 +94,28 @@ contains
       integer(c_int), intent(out) :: impacts(*)
       type(run_t), pointer :: rp
       integer :: n, nc
+      real(dp) :: nan
       rp => get_run(handle)
       c_run_peaks = MARTELLO_ERR_ARGUMENT
       if (.not. associated(rp)) return
       if (.not. allocated(rp%results%u_max)) return
-      n = size(rp%results%u_max); nc = size(rp%results%pen_max)
-      u_max(1:n) = rp%results%u_max; u_min(1:n) = rp%results%u_min
-      v_absmax(1:n) = rp%results%v_absmax; a_absmax(1:n) = rp%results%a_absmax
-      pen_max(1:nc) = rp%results%pen_max; force_max(1:nc) = rp%results%force_max
+      n = rp%results%n_nodes; nc = rp%results%n_contacts
+      nan = ieee_value(1.0_dp, ieee_quiet_nan)
+      ! what the run did not track: NaN (martello_run_set_tracking)
+      if (tracks(rp%results, TRACK_NODE_PEAKS)) then
+         u_max(1:n) = rp%results%u_max; u_min(1:n) = rp%results%u_min
+         v_absmax(1:n) = rp%results%v_absmax; a_absmax(1:n) = rp%results%a_absmax
+         u_peak(1:n) = rp%results%u_peak; t_peak(1:n) = rp%results%t_peak
+      else
+         u_max(1:n) = nan; u_min(1:n) = nan; v_absmax(1:n) = nan; a_absmax(1:n) = nan
+         u_peak(1:n) = nan; t_peak(1:n) = nan
+      end if
+      if (tracks(rp%results, TRACK_CONTACT_PEAKS)) then
+         pen_max(1:nc) = rp%results%pen_max; force_max(1:nc) = rp%results%force_max
+      else
+         pen_max(1:nc) = nan; force_max(1:nc) = nan
+      end if
       impacts(1:nc) = rp%results%impacts
-      u_peak(1:n) = rp%results%u_peak; t_peak(1:n) = rp%results%t_peak
       c_run_peaks = MARTELLO_OK
    end function c_run_peaks
 
@@ -108,8 +129,12 @@ contains
       c_run_abs_peaks = MARTELLO_ERR_ARGUMENT
       if (.not. associated(rp)) return
       if (.not. allocated(rp%results%u_absmax)) return
-      n = size(rp%results%u_absmax)
-      u_absmax(1:n) = rp%results%u_absmax; t_absmax(1:n) = rp%results%t_absmax
+      n = rp%results%n_nodes
+      if (tracks(rp%results, TRACK_NODE_PEAKS)) then
+         u_absmax(1:n) = rp%results%u_absmax; t_absmax(1:n) = rp%results%t_absmax
+      else
+         u_absmax(1:n) = ieee_value(1.0_dp, ieee_quiet_nan); t_absmax(1:n) = u_absmax(1:n)
+      end if
       c_run_abs_peaks = MARTELLO_OK
    end function c_run_abs_peaks
 
@@ -138,8 +163,12 @@ contains
       c_run_link_peaks = MARTELLO_ERR_ARGUMENT
       if (.not. associated(rp)) return
       if (.not. allocated(rp%results%link_force_absmax)) return
-      nl = size(rp%results%link_force_absmax)
-      fmax(1:nl) = rp%results%link_force_absmax; dumax(1:nl) = rp%results%link_du_absmax
+      nl = rp%results%n_links
+      if (tracks(rp%results, TRACK_LINK_PEAKS)) then
+         fmax(1:nl) = rp%results%link_force_absmax; dumax(1:nl) = rp%results%link_du_absmax
+      else
+         fmax(1:nl) = ieee_value(1.0_dp, ieee_quiet_nan); dumax(1:nl) = fmax(1:nl)
+      end if
       c_run_link_peaks = MARTELLO_OK
    end function c_run_link_peaks
 end module martello_api_results

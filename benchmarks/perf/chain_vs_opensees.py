@@ -21,8 +21,17 @@ OpenSeesPy runs in its own environment (default out/bench-venv, created with pip
 the comparison is skipped with a message if that fails). The machine is shared: the load
 average is printed with every figure.
 
+--library measures the library alone instead: benchmarks/perf/chain_native.c (compiled here
+against build/libmartello.so) builds the same chain through the C API, as a chain held per node
+(martello_model_add_chain) or with --items as links and contacts, runs it and reports the
+library's clock around martello_dynamic_run, the process' CPU time, and its resident memory per
+DOF: the model once built, and the peak of the run over the memory before the model; --track
+keeps only what it lists (martello_run_set_tracking).
+
     .venv/bin/python benchmarks/perf/chain_vs_opensees.py [--n 1000 10000 100000]
         [--steps 8000] [--repeats 3] [--out out/perf] [--opensees-max-n 10000]
+    .venv/bin/python benchmarks/perf/chain_vs_opensees.py --library [--items]
+        [--track node_peaks,contact_peaks] --n 1000 10000 100000 1000000 --steps 8000
 """
 
 import argparse
@@ -190,6 +199,51 @@ def load():
     return os.getloadavg()[0]
 
 
+def library_alone(a, out):
+    """The chain through the C API alone (chain_native.c): per n, the median of the repeats
+    of the library's ns per DOF-step (its clock and the process' CPU time), the model's and
+    the run's resident bytes per DOF, and the cost exponent of the time loop in n."""
+    exe = out / "chain_native"
+    lib = ROOT / "build"
+    subprocess.run(["cc", "-O2", "-I", str(ROOT / "c"), "-I", str(lib / "include"),
+                    str(Path(__file__).with_name("chain_native.c")), "-o", str(exe),
+                    f"-L{lib}", "-lmartello", f"-Wl,-rpath,{lib}", "-lm"], check=True)
+    opts = (["--items"] if a.items else []) + (["--track", a.track] if a.track is not None else [])
+    print(f"the library alone ({'links and contacts' if a.items else 'a chain held per node'}; "
+          f"tracking {a.track or 'all'}); {os.cpu_count()} cores")
+    print(f"{'n':>8} {'steps':>5} {'ns/DOF-step':>11} {'CPU ns':>7} {'model B/DOF':>11} "
+          f"{'peak B/DOF':>10} {'Newton/step':>11} {'fused':>6} {'load':>5}")
+    rows = []
+    for n in a.n:
+        runs, loads = [], []
+        for _ in range(a.repeats):
+            loads.append(load())
+            r = run_child([str(exe), n, a.steps, *opts])
+            r.update(json.loads(r["out"]))
+            runs.append(r)
+        dofsteps = n * a.steps
+        row = {"n": n, "steps": a.steps, "load": statistics.median(loads),
+               "ns_per_dof_step": statistics.median(r["wall_s"] for r in runs) / dofsteps * 1e9,
+               "cpu_ns_per_dof_step": statistics.median(r["cpu"] for r in runs) / dofsteps * 1e9,
+               "model_bytes_per_dof": statistics.median(r["model_B_per_dof"] for r in runs),
+               "peak_bytes_per_dof": statistics.median(r["peak_B_per_dof"] for r in runs),
+               "newton_per_step": runs[-1]["newton"] / a.steps, "fused": runs[-1]["fused"],
+               "wall_s": [r["wall_s"] for r in runs]}
+        rows.append(row)
+        print(f"{n:>8} {a.steps:>5} {row['ns_per_dof_step']:>11.1f} {row['cpu_ns_per_dof_step']:>7.1f} "
+              f"{row['model_bytes_per_dof']:>11.0f} {row['peak_bytes_per_dof']:>10.0f} "
+              f"{row['newton_per_step']:>11.3f} {row['fused']:>6} {row['load']:>5.2f}", flush=True)
+    if len(rows) >= 2:
+        xs = [math.log(r["n"]) for r in rows]
+        ys = [math.log(r["ns_per_dof_step"] * r["n"]) for r in rows]
+        mx, my = sum(xs) / len(xs), sum(ys) / len(ys)
+        slope = sum((x - mx) * (y - my) for x, y in zip(xs, ys)) / sum((x - mx) ** 2 for x in xs)
+        print(f"cost exponent (library time loop ~ n^p, n = {rows[0]['n']} ... {rows[-1]['n']}): "
+              f"p = {slope:.3f}")
+    (out / "chain_library.json").write_text(json.dumps({"rows": rows}, indent=1))
+    print(f"results: {out / 'chain_library.json'}")
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--n", type=int, nargs="+", default=[1000, 10000, 100000])
@@ -200,6 +254,12 @@ def main():
     ap.add_argument("--opensees-max-n", type=int, default=10000,
                     help="largest n OpenSees runs (it takes ~2 µs per DOF-step)")
     ap.add_argument("--skip-pounding", action="store_true")
+    ap.add_argument("--library", action="store_true",
+                    help="the library alone through the C API (benchmarks/perf/chain_native.c)")
+    ap.add_argument("--items", action="store_true",
+                    help="--library: the chain as links and contacts, not held per node")
+    ap.add_argument("--track", help="--library: what the run keeps (node_peaks,link_peaks,"
+                                    "contact_peaks,phases; default all)")
     ap.add_argument("--opensees-one", nargs=4, help=argparse.SUPPRESS)
     a = ap.parse_args()
     if a.opensees_one:
@@ -208,6 +268,9 @@ def main():
         return
     out = Path(a.out)
     out.mkdir(parents=True, exist_ok=True)
+    if a.library:
+        library_alone(a, out)
+        return
     py = opensees_python(a.opensees_python)
     sys.path.insert(0, str(ROOT))
     from martello.binding import native

@@ -67,6 +67,8 @@ def lib():
         "martello_model_add_contacts": (c_int, [_VOID_P, c_int, _INT_P, _INT_P, _DOUBLE_P, _INT_P,
                                                 _INT_P, _DOUBLE_P]),
         "martello_model_add_mass_coupling": (c_int, [_VOID_P, c_int, c_int, c_double]),
+        "martello_model_add_chain": (c_int, [_VOID_P, c_int, c_int] + [_VOID_P] * 5
+                                     + [c_int, c_int, _VOID_P]),
         "martello_model_add_stiffness_block": (c_int, [_VOID_P, c_int, _INT_P, _DOUBLE_P,
                                                        _DOUBLE_P]),
         "martello_model_set_gravity": (c_int, [_VOID_P, c_double]),
@@ -95,6 +97,8 @@ def lib():
         "martello_run_peaks": (c_int, [_VOID_P] + [_DOUBLE_P] * 6 + [_INT_P] + [_DOUBLE_P] * 2),
         "martello_run_energy": (c_int, [_VOID_P, _DOUBLE_P, _DOUBLE_P]),
         "martello_run_set_link_outputs": (c_int, [_VOID_P, c_int, _INT_P]),
+        "martello_run_set_phase_lists": (c_int, [_VOID_P, c_int]),
+        "martello_run_set_tracking": (c_int, [_VOID_P, c_int]),
         "martello_run_link_peaks": (c_int, [_VOID_P, _DOUBLE_P, _DOUBLE_P]),
         "martello_run_abs_peaks": (c_int, [_VOID_P, _DOUBLE_P, _DOUBLE_P]),
     }
@@ -383,6 +387,29 @@ class Model(_Handle):
             _f64_rows(par, n, constant("NPAR_CONTACT"))), "contacts")
         self.n_contacts += n
 
+    def add_chain(self, first, k, c=None, fy=None, hardening=None, gap=None, scheme=0, law=0,
+                  par=None):
+        """A chain held per node (docs/c-api.md "Chains"): nodes first … first + len(k) − 1
+        (0-based), each with a spring k to ground (bilinear with fy, hardening), a dashpot c
+        where c > 0, and contacts between neighbours through gap (len(k) − 1 values) with one
+        scheme, law and parameter row par."""
+        k = _f64(k)
+        n = len(k)
+        keep = [k]
+
+        def ptr(x, size):
+            if x is None:
+                return None
+            arr = _f64(x, size)
+            keep.append(arr)
+            return arr.ctypes.data
+        args = [ptr(c, n), ptr(fy, n), ptr(hardening, n), ptr(gap, n - 1)]
+        row = ptr(par, constant("NPAR_CONTACT")) if gap is not None else None
+        self.check(lib().martello_model_add_chain(self._h, first, n, k.ctypes.data, *args,
+                                                  scheme, law, row), "chain")
+        if gap is not None:
+            self.n_contacts += n - 1
+
     def add_mass_coupling(self, a, b, value):
         self.check(lib().martello_model_add_mass_coupling(self._h, a, b, value), "mass coupling")
 
@@ -459,6 +486,19 @@ class Run(_Handle):
     def set_link_outputs(self, links):
         l = np.ascontiguousarray(links, dtype=np.int32)
         self._check(lib().martello_run_set_link_outputs(self._h, l.size, l), "link outputs")
+
+    def set_phase_lists(self, max_contacts):
+        """Every contact's phases listed up to max_contacts contacts (< 0: always); past it the
+        output contacts', the others' first and last phase (c/martello.h)."""
+        self._check(lib().martello_run_set_phase_lists(self._h, int(max_contacts)), "phase lists")
+
+    def set_tracking(self, *what):
+        """Track only what is named (rows of the registry's table "tracking": "node_peaks",
+        "link_peaks", "contact_peaks", "phases"); the rest reads NaN, or no phase rows."""
+        flags = 0
+        for w in what:
+            flags |= value("tracking", w)
+        self._check(lib().martello_run_set_tracking(self._h, flags), "tracking")
 
     def link_peaks(self, n_links):
         f, du = np.zeros(max(n_links, 1)), np.zeros(max(n_links, 1))
