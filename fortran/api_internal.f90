@@ -64,8 +64,7 @@ contains
       mp => get_model(handle)
       c_model_initial_state = MARTELLO_ERR_ARGUMENT
       if (.not. associated(mp)) return
-      u0(1:mp%n) = mp%u0
-      v0(1:mp%n) = merge(0.0_dp, mp%v0, mp%fixed)
+      call model_initial_state(mp, u0(1:mp%n), v0(1:mp%n))
       c_model_initial_state = MARTELLO_OK
    end function c_model_initial_state
 

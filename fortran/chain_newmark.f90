@@ -25,6 +25,7 @@ module martello_chain_newmark
    use martello_status
    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
    use martello_model, only: model_t, model_bandwidth, SCHEME_PENALTY, model_link_index, &
+      model_initial_state, &
       model_contact_index, model_link_at, model_contact_at, model_expand_chains, model_nlinks, &
       model_ncontacts
    use martello_links, only: LINK_SPRING, LINK_BAR, LINK_DASHPOT, LINK_BILINEAR, L_STIFF, L_DAMP, &
@@ -96,12 +97,15 @@ module martello_chain_newmark
       !> their tangents on the factors' branches per node: J (diagonal, J(i, i+1)) and C_t
       real(dp), allocatable :: xjd(:), xjo(:), xcd(:), xco(:)
       logical :: others = .false.
-      !> J = L D Lᵀ: reciprocal pivots rp(i) = 1/D_ii and g(i) = J(i, i+1)·rp(i) = L(i+1, i);
-      !> fe the nodal internal force at the last evaluation minus the nodal forces (fnod, as
-      !> applied), which the forward sweeps overwrite, entry by entry as they read it, with the
-      !> forward-substituted right-hand side y, and the backward sweep, entry by entry after
-      !> reading y, with the internal force again: one array for both
-      real(dp), allocatable :: rp(:), g(:), fe(:), fnod(:)
+      !> J = L D Lᵀ: reciprocal pivots rp(i) = 1/D_ii (L(i+1, i) = J(i, i+1)·rp(i) is computed
+      !> again where a sweep needs it, coupling: no array of it); fe the nodal internal force
+      !> at the last evaluation minus the nodal forces (fnod, as applied), which the forward
+      !> sweeps overwrite, entry by entry as they read it, with the forward-substituted
+      !> right-hand side y, and the backward sweep, entry by entry after reading y, with the
+      !> internal force again: one array for both
+      real(dp), allocatable :: rp(:), fe(:), fnod(:)
+      !> a node is fixed (its row and column of J are the identity's)
+      logical :: any_fixed = .false.
       logical :: factored = .false.
       !> the link peaks, per node (links to ground: max |u_i|, |v_i|) and per pair (max |Δu|,
       !> |Δv|) over the samples: each link's follows from its parameter (link_peaks)
@@ -188,7 +192,7 @@ contains
       allocate (self%u(0:n), self%v(0:n), self%a(0:n), self%un(0:n), self%vn(0:n), self%an(0:n), &
                 self%pen(0), self%force(0))
       self%u(0) = 0.0_dp; self%v(0) = 0.0_dp
-      self%u(1:n) = m%u0; self%v(1:n) = merge(0.0_dp, m%v0, m%fixed)
+      call model_initial_state(m, self%u(1:n), self%v(1:n))
       self%fixed_nodes = pack([(i, i = 1, n)], m%fixed)
       call per_node(self, m)
       call link_peak_arrays(self, m, tracks(o, TRACK_LINK_PEAKS))
@@ -198,8 +202,9 @@ contains
          self%bdu(i) = self%u(m%link_a(self%bl(i))) - self%u(m%link_b(self%bl(i)))
          self%bfc(i) = m%link_par(L_STIFF, self%bl(i))*self%bdu(i)
       end do
-      allocate (self%rp(n), self%g(0:n), self%fe(0:n), self%fnod(m%nforce))
-      self%rp = 0.0_dp; self%g = 0.0_dp; self%fe = 0.0_dp; self%fnod = 0.0_dp
+      allocate (self%rp(n), self%fe(0:n), self%fnod(m%nforce))
+      self%rp = 0.0_dp; self%fe = 0.0_dp; self%fnod = 0.0_dp
+      self%any_fixed = size(self%fixed_nodes) > 0
       ! the elements at (u0, v0) with their whole laws: the evaluation at an iterate with no
       ! increment, works from (u0, v0) itself
       self%un = self%u; self%vn = self%v; self%a = 0.0_dp; self%an = 0.0_dp
@@ -428,7 +433,7 @@ contains
          o%counters(C_NEWTON) = o%counters(C_NEWTON) + 1_i8
       else
          ! no factors: the elements at u = u_n (a solve with zero factors is no increment)
-         self%rp = 0.0_dp; self%g = 0.0_dp; self%fe = 0.0_dp
+         self%rp = 0.0_dp; self%fe = 0.0_dp
       end if
       call evaluate(self, m, .true., flipped)
       call nodal_forces(self, m, t)
@@ -496,34 +501,38 @@ contains
          if (.not. (self%pair_links .or. self%kelvin .or. self%others) .and. &
              self%from_chain_of_one_kind()) then
             ! the usual chain, with these as constants (back_kernel's call says why)
-            call forward_kernel(self%n, self%h, self%gamma, self%c1, self%c2, self%acc, .false., &
-                                .false., .false., 0, self%vn, self%an, 0, self%mass, self%fe, &
-                                self%g, cg, self%cp, self%pc, self%pbrf, self%xcd, self%xco)
+            call forward_kernel(self%n, self%h, self%gamma, self%c1, self%c2, self%cv, self%acc, &
+                                .false., .false., .false., self%pair_contacts, .false., 0, 0, &
+                                self%vn, self%an, 0, self%mass, self%fe, self%rp, cg, self%kp, &
+                                self%cp, self%pk, self%pc, self%pbrf, self%xcd, self%xco, &
+                                self%xjo, m%fixed)
          else
-            call forward_kernel(self%n, self%h, self%gamma, self%c1, self%c2, self%acc, &
-                                self%pair_links, self%kelvin, self%others, self%sc, self%vn, &
-                                self%an, self%sm, self%mass, self%fe, self%g, cg, self%cp, &
-                                self%pc, self%pbrf, self%xcd, self%xco)
+            call forward_kernel(self%n, self%h, self%gamma, self%c1, self%c2, self%cv, self%acc, &
+                                self%pair_links, self%kelvin, self%others, self%pair_contacts, &
+                                self%any_fixed, self%sk, self%sc, self%vn, self%an, self%sm, &
+                                self%mass, self%fe, self%rp, cg, self%kp, self%cp, self%pk, &
+                                self%pc, self%pbrf, self%xcd, self%xco, self%xjo, m%fixed)
          end if
       end subroutine sweep
    end subroutine linearised_sweep
 
    !> linearised_sweep's loop on explicit-shape arrays (no descriptors, no aliasing: the
    !> compiler keeps everything in registers but the arrays).
-   subroutine forward_kernel(n, h, gm, c1, c2, acc, pl, kel, oth, sc, vn, an, sm, mass, fe, g, &
-                             cg, cp, pc, brf, xcd, xco)
-      integer, intent(in), value :: n, sc, sm
-      real(dp), intent(in), value :: h, gm, c1, c2, acc
-      logical, intent(in), value :: pl, kel, oth
-      real(dp), intent(in) :: vn(0:n), an(0:n), mass(*), g(0:n), cg(n), cp(0:*), pc(0:*), &
-                              xcd(0:*), xco(0:*)
+   subroutine forward_kernel(n, h, gm, c1, c2, cv, acc, pl, kel, oth, pcs, fx, sk, sc, vn, an, &
+                             sm, mass, fe, rp, cg, kp, cp, pk, pc, brf, xcd, xco, xjo, fixed)
+      integer, intent(in), value :: n, sk, sc, sm
+      real(dp), intent(in), value :: h, gm, c1, c2, cv, acc
+      logical, intent(in), value :: pl, kel, oth, pcs, fx
+      real(dp), intent(in) :: vn(0:n), an(0:n), mass(*), rp(n), cg(n), kp(0:*), cp(0:*), &
+                              pk(0:*), pc(0:*), xcd(0:*), xco(0:*), xjo(0:*)
       integer(int8), intent(in) :: brf(0:n)
+      logical, intent(in) :: fixed(n)
       real(dp), intent(inout) :: fe(0:n)     !< in: the committed internal force; out: y
       integer :: i
-      real(dp) :: dvm, dv0, dvp, a0, ap, cdv, cd, co, com, ym, g1
+      real(dp) :: dvm, dv0, dvp, a0, ap, cdv, cd, co, com, ym, g1, lm
       ! a₀ = −c₁vₙ − c₂aₙ and Δv₀ = v₀ − vₙ = h((1 − γ)aₙ + γa₀) of each node
       g1 = 1.0_dp - gm
-      dvm = 0.0_dp; com = 0.0_dp; ym = 0.0_dp
+      dvm = 0.0_dp; com = 0.0_dp; ym = 0.0_dp; lm = 0.0_dp
       a0 = -c1*vn(1) - c2*an(1)
       dv0 = h*(g1*an(1) + gm*a0)
       do i = 1, n
@@ -547,9 +556,12 @@ contains
             cd = cd + xcd(i); co = co + xco(i)
          end if
          cdv = cd*dv0 + com*dvm + co*dvp
-         ym = mass(1 + (i - 1)*sm)*(acc - a0) - fe(i) - cdv - g(i - 1)*ym
+         ym = mass(1 + (i - 1)*sm)*(acc - a0) - fe(i) - cdv - lm*ym
          fe(i) = ym
          dvm = dv0; dv0 = dvp; a0 = ap; com = co
+         ! L(i+1, i) for the next node
+         if (i < n) lm = coupling(i, cv, pl, pcs, oth, fx, sk, sc, kp, cp, pk, pc, brf, xjo, &
+                                  fixed)*rp(i)
       end do
       fe(0) = 0.0_dp
    end subroutine forward_kernel
@@ -579,13 +591,13 @@ contains
          call refactor_kernel(self%n, self%cm, self%cv, self%acc, self%pair_links, &
                               self%pair_contacts, self%others, self%sk, self%sc, self%a, self%sm, &
                               self%mass, m%fixed, self%fe, kg, cg, self%kp, self%cp, self%pk, &
-                              self%pc, self%pbr, self%xjd, self%xjo, self%rp, self%g, ok)
+                              self%pc, self%pbr, self%xjd, self%xjo, self%rp, ok)
       end subroutine sweep
    end subroutine refactor_sweep
 
    !> refactor_sweep's loop on explicit-shape arrays.
    subroutine refactor_kernel(n, cm, cv, acc, pl, pcs, oth, sk, sc, a, sm, mass, fixed, fe, kg, &
-                              cg, kp, cp, pk, pc, br, xjd, xjo, rp, g, ok)
+                              cg, kp, cp, pk, pc, br, xjd, xjo, rp, ok)
       integer, intent(in) :: n, sk, sc, sm
       real(dp), intent(in) :: cm, cv, acc
       logical, intent(in) :: pl, pcs, oth, fixed(n)
@@ -593,13 +605,12 @@ contains
                               xjd(0:*), xjo(0:*)
       real(dp), intent(inout) :: fe(0:n)     !< in: the internal force at the iterate; out: y
       integer(int8), intent(in) :: br(0:n)
-      real(dp), intent(out) :: rp(n), g(0:n)
+      real(dp), intent(out) :: rp(n)
       logical, intent(out) :: ok
       integer :: i
       real(dp) :: p, jd, jo, jom, tp, tpm, ym, gm
       ok = .true.
       tpm = 0.0_dp; gm = 0.0_dp; ym = 0.0_dp; jom = 0.0_dp
-      g(0) = 0.0_dp
       do i = 1, n
          ! tp: the tangent of pair (i, i+1), K_t + c_v C_t
          tp = 0.0_dp
@@ -610,16 +621,13 @@ contains
             end if
          end if
          jd = kg(i) + cv*cg(i) + tpm + tp
-         jo = -tp
-         if (oth) then
-            jd = jd + xjd(i); jo = jo + xjo(i)
-         end if
+         if (oth) jd = jd + xjd(i)
+         ! J(i, i+1) as the sweeps compute it again (coupling)
+         jo = 0.0_dp
+         if (i < n) jo = coupling(i, cv, pl, pcs, oth, .true., sk, sc, kp, cp, pk, pc, br, xjo, fixed)
          if (fixed(i)) then
-            p = 1.0_dp; jo = 0.0_dp
+            p = 1.0_dp
          else
-            if (i < n) then
-               if (fixed(i + 1)) jo = 0.0_dp
-            end if
             p = cm*mass(1 + (i - 1)*sm) + jd - jom*gm
          end if
          if (.not. (p > 0.0_dp)) ok = .false.
@@ -630,12 +638,35 @@ contains
             ym = mass(1 + (i - 1)*sm)*(acc - a(i)) - fe(i) - gm*ym
          end if
          gm = jo*rp(i)
-         g(i) = gm
          fe(i) = ym
          tpm = tp; jom = jo
       end do
-      g(n) = 0.0_dp; fe(0) = 0.0_dp
+      fe(0) = 0.0_dp
    end subroutine refactor_kernel
+
+   !> J(i, i+1), i < n, of the factors made on the branches brf: −(K_t + c_v C_t) of the pair
+   !> (i, i+1) (its summed links, its contact where on), plus the other elements' (xjo), 0 at
+   !> a fixed row or column (fx: some node is fixed). L(i+1, i) = J(i, i+1)·rp(i): the sweeps
+   !> compute it again from the branch bytes rather than read it from an array (8 B per node
+   !> less to keep, and to stream at every step), to the same bits as the factorisation.
+   pure real(dp) function coupling(i, cv, pl, pcs, oth, fx, sk, sc, kp, cp, pk, pc, brf, xjo, &
+                                   fixed) result(jo)
+      integer, intent(in) :: i, sk, sc
+      real(dp), intent(in) :: cv, kp(0:*), cp(0:*), pk(0:*), pc(0:*), xjo(0:*)
+      logical, intent(in) :: pl, pcs, oth, fx, fixed(*)
+      integer(int8), intent(in) :: brf(0:*)
+      real(dp) :: tp
+      tp = 0.0_dp
+      if (pl) tp = kp(i) + cv*cp(i)
+      if (pcs) then
+         if (brf(i) == B_ON) tp = tp + (pk(i*sk) + cv*pc(i*sc))
+      end if
+      jo = -tp
+      if (oth) jo = jo + xjo(i)
+      if (fx) then
+         if (fixed(i) .or. fixed(i + 1)) jo = 0.0_dp
+      end if
+   end function coupling
 
    !> Fixed rows carry no residual: their Δu is 0 (their column of the factors is 0, so no
    !> other row depends on their entry of y).
@@ -676,34 +707,36 @@ contains
             ! the usual chain (springs and dashpots to ground, one linear contact law and gap
             ! for every pair, one mass): the same kernel with these as constants, which the
             ! compiler specialises (no branches on them, the parameters read once)
-            call back_kernel(self%n, from_start, .false., .true., .false., 0, 0, 0, 0, 0, &
-                             self%cm, self%cv, self%c1, self%c2, self%h, self%gamma, self%rp, &
-                             self%g, self%u, self%v, self%a, self%un, self%vn, self%an, 0, &
+            call back_kernel(self%n, from_start, .false., .true., .false., .false., .false., 0, 0, &
+                             0, 0, 0, self%cm, self%cv, self%c1, self%c2, self%h, self%gamma, &
+                             self%rp, self%u, self%v, self%a, self%un, self%vn, self%an, 0, &
                              self%mass, self%fe, kg, cg, self%kp, self%cp, self%psgn, self%pgap, &
-                             self%pk, self%pc, self%plaw, self%pbr, self%pbrc, self%pbrf, mdu, &
-                             self%wd, self%wl, self%wc, flipped)
+                             self%pk, self%pc, self%plaw, self%pbr, self%pbrc, self%pbrf, &
+                             self%xjo, m%fixed, mdu, self%wd, self%wl, self%wc, flipped)
          else
             call back_kernel(self%n, from_start, self%pair_links, self%pair_contacts, self%kelvin, &
-                             self%ss, self%sg, self%sk, self%sc, self%sl, self%cm, self%cv, &
-                             self%c1, self%c2, self%h, self%gamma, self%rp, self%g, self%u, &
-                             self%v, self%a, self%un, self%vn, self%an, self%sm, self%mass, &
-                             self%fe, kg, cg, self%kp, self%cp, self%psgn, self%pgap, self%pk, &
-                             self%pc, self%plaw, self%pbr, self%pbrc, self%pbrf, mdu, self%wd, &
-                             self%wl, self%wc, flipped)
+                             self%others, self%any_fixed, self%ss, self%sg, self%sk, self%sc, &
+                             self%sl, self%cm, self%cv, self%c1, self%c2, self%h, self%gamma, &
+                             self%rp, self%u, self%v, self%a, self%un, self%vn, self%an, self%sm, &
+                             self%mass, self%fe, kg, cg, self%kp, self%cp, self%psgn, self%pgap, &
+                             self%pk, self%pc, self%plaw, self%pbr, self%pbrc, self%pbrf, &
+                             self%xjo, m%fixed, mdu, self%wd, self%wl, self%wc, flipped)
          end if
       end subroutine sweep
    end subroutine evaluate
 
    !> evaluate's sweep on explicit-shape arrays (no descriptors, no aliasing). The parameter
    !> arrays of the pair contacts are read at i·stride (stride 0: one value for the chain).
-   subroutine back_kernel(n, from_start, pl, pcs, kel, ss, sg, sk, sc, sl, cm, cv, c1, c2, h, &
-                          gm, rp, g, u, v, a, un, vn, an, sm, mass, fe, kg, cg, kp, cp, psgn, &
-                          pgap, pk, pc, plaw, pbr, pbrc, pbrf, mdu, wd, wl, wc, flip)
+   subroutine back_kernel(n, from_start, pl, pcs, kel, oth, fx, ss, sg, sk, sc, sl, cm, cv, c1, &
+                          c2, h, gm, rp, u, v, a, un, vn, an, sm, mass, fe, kg, cg, kp, cp, psgn, &
+                          pgap, pk, pc, plaw, pbr, pbrc, pbrf, xjo, fixed, mdu, wd, wl, wc, flip)
       integer, intent(in), value :: n, ss, sg, sk, sc, sl, sm
-      logical, intent(in), value :: from_start, pl, pcs, kel
+      logical, intent(in), value :: from_start, pl, pcs, kel, oth, fx
       real(dp), intent(in), value :: cm, cv, c1, c2, h, gm
-      real(dp), intent(in) :: rp(n), g(0:n), un(0:n), vn(0:n), an(0:n), mass(*), kg(n), &
-                              cg(n), kp(0:*), cp(0:*), psgn(0:*), pgap(0:*), pk(0:*), pc(0:*)
+      real(dp), intent(in) :: rp(n), un(0:n), vn(0:n), an(0:n), mass(*), kg(n), &
+                              cg(n), kp(0:*), cp(0:*), psgn(0:*), pgap(0:*), pk(0:*), pc(0:*), &
+                              xjo(0:*)
+      logical, intent(in) :: fixed(n)
       integer(int8), intent(in) :: plaw(0:*), pbrc(0:n), pbrf(0:n)
       real(dp), intent(inout) :: u(0:n), v(0:n), a(0:n)
       real(dp), intent(inout) :: fe(0:n)     !< in: y; out: the internal force
@@ -713,12 +746,16 @@ contains
       integer :: i
       integer(int8) :: br, law
       real(dp) :: x, ui, vi, ai, uni, vni, u1, v1, un1, vn1, fi, f1, du, dun, fp, s, pen, penn, &
-                  f, fn, gp, g1, k, c, hd
+                  f, fn, gp, g1, k, c, hd, lx
       g1 = 1.0_dp - gm
       mdu = 0.0_dp; wd = 0.0_dp; wl = 0.0_dp; wc = 0.0_dp; flip = .false.
       x = 0.0_dp; u1 = 0.0_dp; v1 = 0.0_dp; un1 = 0.0_dp; vn1 = 0.0_dp; f1 = 0.0_dp
       do i = n, 1, -1
-         x = rp(i)*fe(i) - g(i)*x
+         ! Δu(i) = D⁻¹y(i) − L(i+1, i)·Δu(i+1)
+         lx = 0.0_dp
+         if (i < n) lx = coupling(i, cv, pl, pcs, oth, fx, sk, sc, kp, cp, pk, pc, pbrf, xjo, &
+                                  fixed)*rp(i)*x
+         x = rp(i)*fe(i) - lx
          uni = un(i); vni = vn(i)
          if (from_start) then
             ! the Newmark a₀, v₀ of u = uₙ, as the general path's kinematics associate them

@@ -8,7 +8,7 @@
 module martello_fixed_step
    use martello_kinds, only: dp, i8
    use martello_status
-   use martello_model, only: model_t
+   use martello_model, only: model_t, model_initial_state
    use martello_assembly, only: mech_state_t, mech_init, mass_times, assemble_mass, internal_forces, &
       external_forces, mech_commit
    use martello_band_matrix, only: band_t, band_zero, band_pin, band_solve
@@ -180,7 +180,7 @@ contains
       allocate (self%u(0:n), self%v(0:n), self%a(0:n), self%un(0:n), self%vn(0:n), &
                 self%an(0:n), self%mrow(0:n), self%pen(m%ncontact), self%force(m%ncontact))
       self%u(0) = 0.0_dp; self%v(0) = 0.0_dp; self%a = 0.0_dp
-      self%u(1:n) = m%u0; self%v(1:n) = merge(0.0_dp, m%v0, m%fixed)
+      call model_initial_state(m, self%u(1:n), self%v(1:n))
       self%pen = 0.0_dp; self%force = 0.0_dp
       self%fixed_nodes = pack([(j, j = 1, n)], m%fixed)
       self%un = 1.0_dp; self%un(0) = 0.0_dp

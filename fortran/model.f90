@@ -15,6 +15,7 @@ module martello_model
    implicit none
    private
    public :: model_t, model_init, model_set_node, model_add_link, model_add_contact, &
+      model_initial_state, model_u0, &
       model_add_mass_coupling, model_add_nodal_force, model_set_ground_acceleration, &
       model_add_stiffness_block, stiffness_block_t, model_bandwidth, rigid_contact_sides, &
       SCHEME_PENALTY, SCHEME_LAGRANGE, SCHEME_AUGMENTED, &
@@ -50,7 +51,10 @@ module martello_model
 
    type :: model_t
       integer :: n = 0
-      real(dp), allocatable :: mass(:), u0(:), v0(:)
+      real(dp), allocatable :: mass(:)
+      !> the initial displacements and velocities: no entries while every one is 0 (a large
+      !> chain from rest keeps 16 B per node less); read them through model_initial_state
+      real(dp), allocatable :: u0(:), v0(:)
       logical, allocatable :: fixed(:)
       ! links
       integer :: nlink = 0
@@ -111,8 +115,8 @@ contains
          return
       end if
       m%n = n
-      allocate (m%mass(n), m%u0(n), m%v0(n), m%fixed(n))
-      m%mass = -1.0_dp; m%u0 = 0.0_dp; m%v0 = 0.0_dp; m%fixed = .false.
+      allocate (m%mass(n), m%u0(0), m%v0(0), m%fixed(n))
+      m%mass = -1.0_dp; m%fixed = .false.
       allocate (m%link_kind(max_links), m%link_a(max_links), m%link_b(max_links), &
                 m%link_par(NPAR_LINK, max_links))
       allocate (m%con_a(max_contacts), m%con_b(max_contacts), m%con_scheme(max_contacts), &
@@ -147,8 +151,38 @@ contains
          call fail(m, stat, 'set_node: mass must be > 0 for a free node (>= 0 for a fixed one)')
          return
       end if
-      m%mass(i) = mass; m%u0(i) = u0; m%v0(i) = v0; m%fixed(i) = fixed
+      m%mass(i) = mass; m%fixed(i) = fixed
+      call set_initial(m%u0, i, u0); call set_initial(m%v0, i, v0)
+   contains
+      !> x(i) ← value, x made whole (zeros) by the first value that is not +0
+      subroutine set_initial(x, i, value)
+         real(dp), allocatable, intent(inout) :: x(:)
+         integer, intent(in) :: i
+         real(dp), intent(in) :: value
+         if (size(x) == 0) then
+            if (value == 0.0_dp .and. sign(1.0_dp, value) > 0.0_dp) return
+            deallocate (x); allocate (x(m%n), source=0.0_dp)
+         end if
+         x(i) = value
+      end subroutine set_initial
    end subroutine model_set_node
+
+   !> The state at t = 0 (nodes 1..n): u(i) = u0 of node i, v(i) its v0 (0 for a fixed node).
+   pure subroutine model_initial_state(m, u, v)
+      type(model_t), intent(in) :: m
+      real(dp), intent(out) :: u(:), v(:)
+      u = 0.0_dp; v = 0.0_dp
+      if (size(m%u0) > 0) u = m%u0
+      if (size(m%v0) > 0) v = merge(0.0_dp, m%v0, m%fixed)
+   end subroutine model_initial_state
+
+   !> u0 of node i (0 where none was given).
+   pure real(dp) function model_u0(m, i) result(u0)
+      type(model_t), intent(in) :: m
+      integer, intent(in) :: i
+      u0 = 0.0_dp
+      if (size(m%u0) > 0) u0 = m%u0(i)
+   end function model_u0
 
    subroutine model_add_link(m, kind, a, b, par, stat)
       type(model_t), intent(inout) :: m
