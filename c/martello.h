@@ -277,20 +277,22 @@ int martello_run_events(const martello_run *run, int *n, int *contacts, double *
 /* counters indexed by MARTELLO_COUNTER_* (chatter resolutions: steps where a contact was
  * held open, see docs/integrators.md) */
 int martello_run_counters(const martello_run *run, long long counters[MARTELLO_NCOUNTERS]);
-/* Per node: extremes over the steps, and the largest local maximum of u interpolated between
- * steps (u_peak at t_peak; t_peak = -1 if u never turned back); per contact: max
- * penetration, max force and the number of contact phases. */
+/* Per node: extremes over the steps, and the largest local maximum of u (u_peak at t_peak;
+ * t_peak = -1 if u never turned back); per contact: max penetration, max force and the number
+ * of contact phases; every peak located inside the steps (docs/results.md). Any output may be
+ * NULL: not written. What the run does not track is NaN (martello_run_set_tracking). */
 int martello_run_peaks(const martello_run *run, double *u_max, double *u_min, double *v_absmax,
                        double *a_absmax, double *pen_max, double *force_max, int *impacts,
                        double *u_peak, double *t_peak);
 /* Per node: the largest |u| and its time t_absmax: at the steps, at the extrema the adaptive
- * integrators locate, and on each fixed step's cubic Hermite on (u, v) (docs/results.md). */
+ * integrators locate, and on each fixed step's cubic Hermite on (u, v) (docs/results.md).
+ * NULL: not written. */
 int martello_run_abs_peaks(const martello_run *run, double *u_absmax, double *t_absmax);
 /* energy indexed by MARTELLO_ENERGY_*; extra = {max |balance|, omega_max, dt_crit
  * (explicit), time reached} */
 int martello_run_energy(const martello_run *run, double energy[MARTELLO_NENERGY], double extra[4]);
 /* Per link: max |force| and max |elongation| over the run (NaN if the integrator does not
- * report link states). */
+ * report link states, or the run does not track them). NULL: not written. */
 int martello_run_link_peaks(const martello_run *run, double *force_absmax, double *elongation_absmax);
 
 #ifdef __cplusplus

@@ -86,57 +86,65 @@ contains
       c_run_counters = MARTELLO_OK
    end function c_run_counters
 
+   !> Per node and contact (c/martello.h): each output may be NULL (not written); what the
+   !> run did not track is NaN (martello_run_set_tracking).
    integer(c_int) function c_run_peaks(handle, u_max, u_min, v_absmax, a_absmax, pen_max, &
                                        force_max, impacts, u_peak, t_peak) bind(C, name='martello_run_peaks')
-      type(c_ptr), value :: handle
-      real(c_double), intent(out) :: u_max(*), u_min(*), v_absmax(*), a_absmax(*), pen_max(*), &
-                                     force_max(*), u_peak(*), t_peak(*)
-      integer(c_int), intent(out) :: impacts(*)
+      type(c_ptr), value :: handle, u_max, u_min, v_absmax, a_absmax, pen_max, force_max, &
+                            impacts, u_peak, t_peak
       type(run_t), pointer :: rp
-      integer :: n, nc
-      real(dp) :: nan
+      integer(c_int), pointer :: ip(:)
       rp => get_run(handle)
       c_run_peaks = MARTELLO_ERR_ARGUMENT
       if (.not. associated(rp)) return
       if (.not. allocated(rp%results%u_max)) return
-      n = rp%results%n_nodes; nc = rp%results%n_contacts
-      nan = ieee_value(1.0_dp, ieee_quiet_nan)
-      ! what the run did not track: NaN (martello_run_set_tracking)
-      if (tracks(rp%results, TRACK_NODE_PEAKS)) then
-         u_max(1:n) = rp%results%u_max; u_min(1:n) = rp%results%u_min
-         v_absmax(1:n) = rp%results%v_absmax; a_absmax(1:n) = rp%results%a_absmax
-         u_peak(1:n) = rp%results%u_peak; t_peak(1:n) = rp%results%t_peak
-      else
-         u_max(1:n) = nan; u_min(1:n) = nan; v_absmax(1:n) = nan; a_absmax(1:n) = nan
-         u_peak(1:n) = nan; t_peak(1:n) = nan
-      end if
-      if (tracks(rp%results, TRACK_CONTACT_PEAKS)) then
-         pen_max(1:nc) = rp%results%pen_max; force_max(1:nc) = rp%results%force_max
-      else
-         pen_max(1:nc) = nan; force_max(1:nc) = nan
-      end if
-      impacts(1:nc) = rp%results%impacts
+      associate (r => rp%results)
+         call put(u_max, r%u_max, r%n_nodes, tracks(r, TRACK_NODE_PEAKS))
+         call put(u_min, r%u_min, r%n_nodes, tracks(r, TRACK_NODE_PEAKS))
+         call put(v_absmax, r%v_absmax, r%n_nodes, tracks(r, TRACK_NODE_PEAKS))
+         call put(a_absmax, r%a_absmax, r%n_nodes, tracks(r, TRACK_NODE_PEAKS))
+         call put(u_peak, r%u_peak, r%n_nodes, tracks(r, TRACK_NODE_PEAKS))
+         call put(t_peak, r%t_peak, r%n_nodes, tracks(r, TRACK_NODE_PEAKS))
+         call put(pen_max, r%pen_max, r%n_contacts, tracks(r, TRACK_CONTACT_PEAKS))
+         call put(force_max, r%force_max, r%n_contacts, tracks(r, TRACK_CONTACT_PEAKS))
+         if (c_associated(impacts)) then
+            call c_f_pointer(impacts, ip, [r%n_contacts]); ip = r%impacts
+         end if
+      end associate
       c_run_peaks = MARTELLO_OK
    end function c_run_peaks
 
-   !> Per node: the largest |u| and its time (docs/results.md, u_absmax)
+   !> Per node: the largest |u| and its time (docs/results.md, u_absmax); NULL: not written.
    integer(c_int) function c_run_abs_peaks(handle, u_absmax, t_absmax) bind(C, name='martello_run_abs_peaks')
-      type(c_ptr), value :: handle
-      real(c_double), intent(out) :: u_absmax(*), t_absmax(*)
+      type(c_ptr), value :: handle, u_absmax, t_absmax
       type(run_t), pointer :: rp
-      integer :: n
       rp => get_run(handle)
       c_run_abs_peaks = MARTELLO_ERR_ARGUMENT
       if (.not. associated(rp)) return
       if (.not. allocated(rp%results%u_absmax)) return
-      n = rp%results%n_nodes
-      if (tracks(rp%results, TRACK_NODE_PEAKS)) then
-         u_absmax(1:n) = rp%results%u_absmax; t_absmax(1:n) = rp%results%t_absmax
-      else
-         u_absmax(1:n) = ieee_value(1.0_dp, ieee_quiet_nan); t_absmax(1:n) = u_absmax(1:n)
-      end if
+      associate (r => rp%results)
+         call put(u_absmax, r%u_absmax, r%n_nodes, tracks(r, TRACK_NODE_PEAKS))
+         call put(t_absmax, r%t_absmax, r%n_nodes, tracks(r, TRACK_NODE_PEAKS))
+      end associate
       c_run_abs_peaks = MARTELLO_OK
    end function c_run_abs_peaks
+
+   !> The n values of a result array at the C pointer out unless NULL: src if tracked, else
+   !> NaN.
+   subroutine put(out, src, n, tracked)
+      type(c_ptr), intent(in) :: out
+      real(dp), intent(in) :: src(:)
+      integer, intent(in) :: n
+      logical, intent(in) :: tracked
+      real(c_double), pointer :: x(:)
+      if (.not. c_associated(out)) return
+      call c_f_pointer(out, x, [n])
+      if (tracked) then
+         x = src(1:n)
+      else
+         x = ieee_value(1.0_dp, ieee_quiet_nan)
+      end if
+   end subroutine put
 
    !> energy[9] = {kinetic, recoverable, input, damping, plastic, contact, balance, initial,
    !> impact}; extra[4] = {max |balance| over the run, omega_max, dt_crit, t reached}
@@ -153,22 +161,19 @@ contains
       c_run_energy = MARTELLO_OK
    end function c_run_energy
 
-   !> Per link: max |force| and max |elongation| over the run (NaN if not tracked).
+   !> Per link: max |force| and max |elongation| over the run (NaN if not tracked); NULL: not
+   !> written.
    integer(c_int) function c_run_link_peaks(handle, fmax, dumax) bind(C, name='martello_run_link_peaks')
-      type(c_ptr), value :: handle
-      real(c_double), intent(out) :: fmax(*), dumax(*)
+      type(c_ptr), value :: handle, fmax, dumax
       type(run_t), pointer :: rp
-      integer :: nl
       rp => get_run(handle)
       c_run_link_peaks = MARTELLO_ERR_ARGUMENT
       if (.not. associated(rp)) return
       if (.not. allocated(rp%results%link_force_absmax)) return
-      nl = rp%results%n_links
-      if (tracks(rp%results, TRACK_LINK_PEAKS)) then
-         fmax(1:nl) = rp%results%link_force_absmax; dumax(1:nl) = rp%results%link_du_absmax
-      else
-         fmax(1:nl) = ieee_value(1.0_dp, ieee_quiet_nan); dumax(1:nl) = fmax(1:nl)
-      end if
+      associate (r => rp%results)
+         call put(fmax, r%link_force_absmax, r%n_links, tracks(r, TRACK_LINK_PEAKS))
+         call put(dumax, r%link_du_absmax, r%n_links, tracks(r, TRACK_LINK_PEAKS))
+      end associate
       c_run_link_peaks = MARTELLO_OK
    end function c_run_link_peaks
 end module martello_api_results

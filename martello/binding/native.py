@@ -94,13 +94,13 @@ def lib():
         "martello_run_history": (c_int, [_VOID_P, _DOUBLE_P]),
         "martello_run_events": (c_int, [_VOID_P, ctypes.POINTER(c_int), _VOID_P, _VOID_P]),
         "martello_run_counters": (c_int, [_VOID_P, np.ctypeslib.ndpointer(dtype=np.int64, flags="C_CONTIGUOUS")]),
-        "martello_run_peaks": (c_int, [_VOID_P] + [_DOUBLE_P] * 6 + [_INT_P] + [_DOUBLE_P] * 2),
+        "martello_run_peaks": (c_int, [_VOID_P] * 10),
         "martello_run_energy": (c_int, [_VOID_P, _DOUBLE_P, _DOUBLE_P]),
         "martello_run_set_link_outputs": (c_int, [_VOID_P, c_int, _INT_P]),
         "martello_run_set_phase_lists": (c_int, [_VOID_P, c_int]),
         "martello_run_set_tracking": (c_int, [_VOID_P, c_int]),
-        "martello_run_link_peaks": (c_int, [_VOID_P, _DOUBLE_P, _DOUBLE_P]),
-        "martello_run_abs_peaks": (c_int, [_VOID_P, _DOUBLE_P, _DOUBLE_P]),
+        "martello_run_link_peaks": (c_int, [_VOID_P] * 3),
+        "martello_run_abs_peaks": (c_int, [_VOID_P] * 3),
     }
     for name, (res, args) in protos.items():
         fn = getattr(L, name)
@@ -502,7 +502,7 @@ class Run(_Handle):
 
     def link_peaks(self, n_links):
         f, du = np.zeros(max(n_links, 1)), np.zeros(max(n_links, 1))
-        lib().martello_run_link_peaks(self._h, f, du)
+        lib().martello_run_link_peaks(self._h, f.ctypes.data, du.ctypes.data)
         return f[:n_links], du[:n_links]
 
     def execute(self, model):
@@ -543,19 +543,23 @@ class Run(_Handle):
         lib().martello_run_counters(self._h, c)
         return dict(zip(counter_names(), map(int, c)))
 
-    def peaks(self, n_nodes, n_contacts):
-        arrays = [np.zeros(max(n_nodes, 1)) for _ in range(4)] + \
-                 [np.zeros(max(n_contacts, 1)) for _ in range(2)]
-        impacts = np.zeros(max(n_contacts, 1), dtype=np.int32)
-        peak = [np.zeros(max(n_nodes, 1)) for _ in range(2)]
-        lib().martello_run_peaks(self._h, *arrays, impacts, *peak)
-        names = ("u_max", "u_min", "v_absmax", "a_absmax", "pen_max", "force_max")
-        out = {k: a[: (n_nodes if i < 4 else n_contacts)] for i, (k, a) in enumerate(zip(names, arrays))}
-        out["impacts"] = impacts[:n_contacts]
-        out["u_peak"], out["t_peak"] = peak[0][:n_nodes], peak[1][:n_nodes]
-        absmax = [np.zeros(max(n_nodes, 1)) for _ in range(2)]
-        lib().martello_run_abs_peaks(self._h, *absmax)
-        out["u_absmax"], out["t_absmax"] = absmax[0][:n_nodes], absmax[1][:n_nodes]
+    def peaks(self, n_nodes, n_contacts, nodes=True, contacts=True):
+        """The node peaks (nodes=False: none copied out) and the contact maxima (contacts=False:
+        none), with every contact's number of phases, as a dict of arrays."""
+        def out_array(n, wanted, dtype=np.float64):
+            return np.zeros(max(n, 1), dtype) if wanted else None
+        names = ("u_max", "u_min", "v_absmax", "a_absmax", "pen_max", "force_max", "impacts",
+                 "u_peak", "t_peak")
+        arrays = [out_array(n_nodes, nodes) for _ in range(4)] + \
+                 [out_array(n_contacts, contacts) for _ in range(2)] + \
+                 [out_array(n_contacts, True, np.int32)] + [out_array(n_nodes, nodes) for _ in range(2)]
+        lib().martello_run_peaks(self._h, *(None if a is None else a.ctypes.data for a in arrays))
+        out = {k: a[: (n_contacts if 4 <= i <= 6 else n_nodes)]
+               for i, (k, a) in enumerate(zip(names, arrays)) if a is not None}
+        if nodes:
+            absmax = [np.zeros(max(n_nodes, 1)) for _ in range(2)]
+            lib().martello_run_abs_peaks(self._h, absmax[0].ctypes.data, absmax[1].ctypes.data)
+            out["u_absmax"], out["t_absmax"] = absmax[0][:n_nodes], absmax[1][:n_nodes]
         return out
 
     def energy(self):
