@@ -1,5 +1,6 @@
-"""The chain door (martello_model_add_chain, docs/c-api.md "Chains") against the same chain added
-link by link and contact by contact.
+"""The chain door (martello_model_add_chain, docs/c-api.md "Chains"), through which the front end
+hands the library every [[chain]] (martello.run.build_model), against the same chain added
+link by link and contact by contact by the bulk doors.
 
 Kind of evidence: an identity of the method, not a verification. A chain held per node is the
 model its links and contacts make one by one (numbered as the scene's [[chain]] expansion
@@ -10,6 +11,7 @@ The catalogue's [[chain]] scenes, and chains made here for what they lack (linea
 long chain, a clipped Kelvin law, items added one by one around a chain, bilinear springs,
 integrators other than Newmark)."""
 
+import functools
 import tomllib
 
 import numpy as np
@@ -24,62 +26,19 @@ from martello.scene.loader import from_dict, load
 from tests.test_bulk_model import leaves
 
 
-def chain_tables(data):
-    return [(c["prefix"], c["n"]) for c in data.get("chain", [])]
-
-
-def build_with_chain_door(chains):
-    """A build_model that adds the scene's [[chain]] items by martello_model_add_chain and the
-    rest by the bulk doors, in the order the expansion numbers them (the items written one by
-    one first, then each chain)."""
-    def build(scene):
-        names = {lk["name"] for lk in scene.links}
-        in_chain_links, in_chain_contacts, door = set(), set(), []
-        for p, n in chains:
-            first = scene.index[f"{p}1"]
-            links = {lk["name"]: lk for lk in scene.links}
-            springs = [links[f"{p}{i + 1}.spring"] for i in range(n)]
-            k = [lk["k"] for lk in springs]
-            bil = springs[0]["type"] == "bilinear"
-            c = [links[f"{p}{i + 1}.damper"]["c"] if f"{p}{i + 1}.damper" in names else 0.0
-                 for i in range(n)]
-            in_chain_links |= {f"{p}{i + 1}.spring" for i in range(n)}
-            in_chain_links |= {f"{p}{i + 1}.damper" for i in range(n)}
-            contacts = [c_ for c_ in scene.contacts
-                        if c_["name"] in {f"{p}{i + 1}-{p}{i + 2}" for i in range(n - 1)}]
-            in_chain_contacts |= {c_["name"] for c_ in contacts}
-            door.append(dict(first=first, k=k, c=c if any(x > 0 for x in c) else None,
-                             fy=[lk["fy"] for lk in springs] if bil else None,
-                             hardening=[lk["hardening"] for lk in springs] if bil else None,
-                             contacts=contacts))
-        links = [lk for lk in scene.links if lk["name"] not in in_chain_links]
-        contacts = [c_ for c_ in scene.contacts if c_["name"] not in in_chain_contacts]
-        m = native.Model(len(scene.nodes), len(links), len(contacts), len(scene.forces),
-                         len(scene.couplings))
-        m.set_nodes(*run_module.node_arrays(scene.nodes))
-        if links:
-            m.add_links(*run_module.link_arrays(links))
-        if contacts:
-            m.add_contacts(*run_module.contact_arrays(contacts))
-        for d in door:
-            kw = {}
-            if d["contacts"]:
-                _, _, gap, scheme, law, par = run_module.contact_arrays(d["contacts"])
-                kw = dict(gap=gap, scheme=int(scheme[0]), law=int(law[0]), par=par[0])
-            m.add_chain(d["first"], d["k"], c=d["c"], fy=d["fy"], hardening=d["hardening"], **kw)
-        m.set_gravity(scene.gravity)
-        for f in scene.forces:
-            m.add_nodal_force(f["node"], *run_module._function_args(f["function"], scene.source))
-        if scene.ground is not None:
-            m.set_ground_acceleration(*run_module._function_args(scene.ground, scene.source))
-        return m
-    return build
-
-
 def assert_same_bits(data, monkeypatch):
-    items, hist = run_full(from_dict(data))
-    monkeypatch.setattr(run_module, "build_model", build_with_chain_door(chain_tables(data)))
+    """The scene run as the front end builds it (each [[chain]] through the chain door) and
+    with its chains' links and contacts added by the bulk doors: every number of summary and
+    history equal."""
+    doors = []
+    add_chain = native.Model.add_chain
+    monkeypatch.setattr(native.Model, "add_chain",
+                        lambda self, *a, **kw: doors.append(a[0]) or add_chain(self, *a, **kw))
     door, door_hist = run_full(from_dict(data))
+    assert len(doors) == len(data.get("chain", []))           # the door took every chain
+    monkeypatch.setattr(run_module, "build_model",
+                        functools.partial(run_module.build_model, chain_door=False))
+    items, hist = run_full(from_dict(data))
     monkeypatch.undo()
     skip = ("cost", "provenance")
     a = leaves({k: v for k, v in items.items() if k not in skip})
@@ -186,3 +145,31 @@ def test_a_bad_chain_entry_is_named():
             m.add_chain(0, [1.0] * 4, gap=[float("inf"), 0.0, 0.0], scheme=pen, law=lin, par=par)
         with pytest.raises(SolverError, match=r"add_chain: its nodes first \.\.\. first \+ n - 1"):
             m.add_chain(2, [1.0] * 3)
+
+
+def test_a_chain_between_written_links_and_a_rod_keeps_every_number(monkeypatch):
+    # the front end's order (martello.run.build_model): the links written before the
+    # generators, every listed contact, the chain's items at its call, then a rod's bars; a
+    # rod's end pounds the chain's first node, a link joins its other end to the chain's last
+    d = pounding(n=5)
+    d["bar"] = [{"name": "R", "L": 0.5, "elements": 4, "E": 2.0e5, "A": 1.0e-4, "rho": 800.0,
+                 "mass": "lumped", "v0": 0.3}]
+    d["link"] = [{"name": "tie", "type": "spring", "a": "R.right", "b": "b5", "k": 20.0}]
+    d["contact"] = [{"name": "hit", "a": "R.left", "b": "b1", "gap": 0.005, "scheme": "penalty",
+                     "law": "linear", "stiffness": 5e3}]
+    d["analysis"]["output"]["links"] = ["tie", "b2.spring", "R.e1"]
+    d["analysis"]["output"]["contacts"] = ["hit", "b1-b2"]
+    r = assert_same_bits(d, monkeypatch)
+    assert r["contacts"]["hit"]["impacts"] > 0 and r["contacts"]["b1-b2"]["impacts"] > 0
+
+
+def test_a_rod_after_a_chain_keeps_its_numbers_without_written_links(monkeypatch):
+    # no link written in the file: the scene numbers the chain's links first, then the rod's
+    d = pounding(n=4)
+    d["bar"] = [{"name": "R", "L": 0.5, "elements": 3, "E": 2.0e5, "A": 1.0e-4, "rho": 800.0,
+                 "mass": "lumped", "v0": 0.3}]
+    d["contact"] = [{"name": "hit", "a": "R.left", "b": "b1", "gap": 0.005, "scheme": "penalty",
+                     "law": "linear", "stiffness": 5e3}]
+    d["analysis"]["output"]["links"] = ["b2.spring", "R.e1"]
+    r = assert_same_bits(d, monkeypatch)
+    assert r["contacts"]["hit"]["impacts"] > 0

@@ -48,8 +48,9 @@ ROOT = Path(__file__).resolve().parents[2]
 M, K1, K2, ZETA, GAP, EPS, AMP, OMEGA, DT = 1.0, 100.0, 400.0, 0.05, 0.01, 1.0e5, 3.0, 8.0, 1e-3
 
 
-def scene_toml(n, steps, dt=DT, every=None):
-    """The chain as a martello scene ([[chain]]); records two nodes, every 1000th step."""
+def scene_toml(n, steps, dt=DT, every=None, track=None):
+    """The chain as a martello scene ([[chain]]); records two nodes, every 1000th step; track:
+    what the run keeps (analysis.output.track; None: the scene's default, docs/results.md)."""
     ks = ", ".join("100.0" if i % 2 == 0 else "400.0" for i in range(n))
     every = every or max(1, min(steps, 1000))
     return f"""title = "chain of {n} pounding oscillators (linear contacts)"
@@ -75,7 +76,7 @@ t_end = {steps * dt!r}
 every = {every}
 nodes = ["b1", "b{n}"]
 contacts = []
-"""
+""" + (f"track = {json.dumps(list(track))}\n" if track is not None else "")
 
 
 def opensees_one(n, steps, dt, out):
@@ -151,7 +152,9 @@ def martello_once(scene, out):
     import numpy as np
     from martello.results import read_summary         # summary.json, and a large scene's arrays
     s = read_summary(out)
-    if "arrays" in s:
+    if "node_peaks" not in s["tracked"]:
+        absmax = None                   # not tracked (a large scene's default)
+    elif "arrays" in s:
         absmax = np.maximum(np.abs(s["arrays"].column("nodes", "u_max")),
                             np.abs(s["arrays"].column("nodes", "u_min"))).tolist()
     else:
@@ -258,8 +261,9 @@ def main():
                     help="the library alone through the C API (benchmarks/perf/chain_native.c)")
     ap.add_argument("--items", action="store_true",
                     help="--library: the chain as links and contacts, not held per node")
-    ap.add_argument("--track", help="--library: what the run keeps (node_peaks,link_peaks,"
-                                    "contact_peaks,phases; default all)")
+    ap.add_argument("--track", help="what the run keeps (node_peaks,link_peaks,contact_peaks,"
+                                    "phases,all; default: --library all, else the scene's "
+                                    "default and node_peaks where OpenSees runs)")
     ap.add_argument("--opensees-one", nargs=4, help=argparse.SUPPRESS)
     a = ap.parse_args()
     if a.opensees_one:
@@ -288,10 +292,13 @@ def main():
         d = out / f"n{n}"
         d.mkdir(exist_ok=True)
         scene = d / "scene.toml"
-        scene.write_text(scene_toml(n, a.steps))
+        with_os = py is not None and n <= a.opensees_max_n
+        track = a.track.split(",") if a.track else None
+        if with_os:         # the two codes' peak |u| compared
+            track = sorted(set(track or ["contact_peaks"]) | {"node_peaks"})
+        scene.write_text(scene_toml(n, a.steps, track=track))
         mr, orr = [], []
         loads = []
-        with_os = py is not None and n <= a.opensees_max_n
         for rep in range(a.repeats):
             loads.append(load())
             order = ("m", "o") if rep % 2 == 0 else ("o", "m")
