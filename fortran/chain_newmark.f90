@@ -37,7 +37,8 @@ module martello_chain_newmark
    use martello_assembly, only: external_forces, uniform_acceleration, internal_forces, mech_commit
    use martello_time_functions, only: tf_value
    use martello_observer, only: observer_t, observer_work, observer_begin, observer_sample, &
-      observer_open_phase, observer_node_peaks, observer_phase_change, observer_contact_peaks, &
+      observer_open_phase, observer_node_samples, observer_node_turns, &
+      observer_node_step_extrema, observer_phase_change, observer_contact_peaks, &
       observer_phase_peaks, observer_energy_due, observer_recorded, tracks, TRACK_NODE_PEAKS, TRACK_ALL, &
       TRACK_LINK_PEAKS, TRACK_CONTACT_PEAKS, TRACK_PHASES, observer_a_parabolas, &
       observer_a_candidate, observer_contact_step_peaks, observer_step_absmax, &
@@ -1149,30 +1150,40 @@ contains
       integer(i8) :: sample
       real(dp) :: s, gp, pen, f, d0, r0, q0, r1, q1, tt, tp, hh, hl, x, du, dv, dvn, f0, &
                   fr0, fr1, kp, cp
-      logical :: on, fs, loc, step, raised, spans
+      logical :: on, fs, loc, step, raised, was, turns
       ! the scalars as locals: o, which a phase change writes, holds t_prev (the compiler
       ! would read it again after every call)
       tt = t; tp = t_prev; hh = h; fs = fixed_steps; loc = located; step = h > 0.0_dp
       hl = t - t_prev                    ! the step the extrema are located on
       sample = o%nsamples + 1            ! this sample's number (observer_sample counts it)
       do i = 1, n
+         ! the node's v or a changes sign in the step (rare): its extrema inside it
+         turns = .false.
+         if (loc) turns = observer_node_turns(vn(i), an(i), v(i), a(i))
          if (nodes) then
-            call observer_node_peaks(tt, tp, fs, un(i), vn(i), an(i), u(i), v(i), a(i), umax(i), &
-                                     umin(i), vmax(i), amax(i), uabs(i), tabs(i), upk(i), tpk(i), &
-                                     raised)
+            ! observer_node_peaks in its parts: the samples' in line, the extrema inside the
+            ! step where the node turns (fs: a fixed step, as loc)
+            call observer_node_samples(tt, u(i), v(i), a(i), umax(i), umin(i), vmax(i), amax(i), &
+                                       uabs(i), tabs(i), raised)
+            if (turns .and. fs) call observer_node_step_extrema(tt, tp, un(i), vn(i), an(i), u(i), &
+                                                                v(i), a(i), umax(i), umin(i), &
+                                                                vmax(i), uabs(i), tabs(i), upk(i), &
+                                                                tpk(i))
             if (raised .and. loc) call observer_a_candidate(o, i, an(i), a(i), sample)
          end if
          ! the maxima stored only when they change (read, not rewritten, at every step)
          if (gu) then
             x = abs(u(i))
-            if (loc .and. vn(i)*v(i) < 0.0_dp) x = max(x, observer_step_absmax(hl, un(i), vn(i), &
-                                                                              u(i), v(i)))
+            if (turns) then
+               if (vn(i)*v(i) < 0.0_dp) x = max(x, observer_step_absmax(hl, un(i), vn(i), u(i), v(i)))
+            end if
             if (x > gumax(i)) gumax(i) = x
          end if
          if (gv) then
             x = abs(v(i))
-            if (loc .and. an(i)*a(i) < 0.0_dp) x = max(x, observer_step_absmax(hl, vn(i), an(i), &
-                                                                              v(i), a(i)))
+            if (turns) then
+               if (an(i)*a(i) < 0.0_dp) x = max(x, observer_step_absmax(hl, vn(i), an(i), v(i), a(i)))
+            end if
             if (x > gvmax(i)) gvmax(i) = x
          end if
          if (i == 1) cycle
@@ -1217,13 +1228,13 @@ contains
             end if
          end if
          on = br(p) /= B_OFF
-         if (loc .and. (contacts .or. phases)) then
+         was = o%ph_open(c)
+         if (on .and. was .and. loc .and. (contacts .or. phases)) then
             ! a phase over the whole step (open before this step's change and still): its
             ! maxima inside the step; the force and its rate at the start as the previous
             ! sample had them (the law at the committed state there)
-            spans = on .and. o%ph_open(c)
             d0 = s*(un(p) - un(i)) - gp
-            if (spans .and. d0 > 0.0_dp .and. pen > 0.0_dp) then
+            if (d0 > 0.0_dp .and. pen > 0.0_dp) then
                r0 = s*(vn(p) - vn(i)); q0 = s*(an(p) - an(i))
                r1 = s*(v(p) - v(i)); q1 = s*(a(p) - a(i))
                f0 = kp*d0
@@ -1234,15 +1245,16 @@ contains
                fr0 = 0.0_dp; fr1 = 0.0_dp
                if (f0 > 0.0_dp) fr0 = kp*r0 + cp*q0
                if (f > 0.0_dp) fr1 = kp*r1 + cp*q1
-               call observer_contact_step_peaks(o, c, spans, hl, d0, r0, f0, fr0, pen, r1, f, fr1)
+               call observer_contact_step_peaks(o, c, .true., hl, d0, r0, f0, fr0, pen, r1, f, fr1)
             end if
          end if
-         if (step .and. (on .neqv. o%ph_open(c))) then
+         if (step .and. (on .neqv. was)) then
             d0 = s*(un(p) - un(i)) - gp; r0 = s*(vn(p) - vn(i)); q0 = s*(an(p) - an(i))
             r1 = s*(v(p) - v(i)); q1 = s*(a(p) - a(i))
             call observer_phase_change(o, c, on, pen, f, d0, r0, q0, pen, r1, q1, tt, hh, [p, i])
          end if
-         if (phases) call observer_phase_peaks(o%ph_open(c), pen, f, o%ph_pen(c), o%ph_f(c))
+         ! the phase is open now where the contact is (a step's change, or at t = 0 the start's)
+         if (phases) call observer_phase_peaks(on, pen, f, o%ph_pen(c), o%ph_f(c))
          if (contacts) call observer_contact_peaks(pen, f, pen_max(c), force_max(c))
       end do
    end subroutine measure_kernel

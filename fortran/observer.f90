@@ -32,7 +32,8 @@ module martello_observer
       TRACK_LINK_PEAKS, TRACK_CONTACT_PEAKS, TRACK_PHASES, TRACK_ALL, &
       observer_peak, observer_peak_value, peak_items, observer_link_step_extremum, &
       observer_step_max, observer_step_absmax, observer_a_parabolas, observer_a_candidate, &
-      observer_contact_step_peaks, raise_to, PEAK_V, PEAK_A, PEAK_PEN, PEAK_FORCE, PEAK_LINK_FORCE, PEAK_LINK_DU, &
+      observer_contact_step_peaks, raise_to, observer_node_samples, observer_node_turns, &
+      observer_node_step_extrema, PEAK_V, PEAK_A, PEAK_PEN, PEAK_FORCE, PEAK_LINK_FORCE, PEAK_LINK_DU, &
       NCOUNTERS, C_STEPS, C_REJECTED, C_NEWTON, C_RESIDUALS, C_FACTORIZATIONS, C_EVENTS, &
       C_JACOBIANS, C_ROOT_EVALS, C_CHATTER, NENERGY, E_KINETIC, E_RECOVERABLE, E_INPUT, E_DAMPING, &
       E_PLASTIC, E_CONTACT, E_BALANCE, E_INITIAL, E_IMPACT, NEVENT, EV_T_ON, EV_T_OFF, &
@@ -1167,25 +1168,57 @@ contains
       logical, intent(in) :: fixed_steps
       real(dp), intent(inout) :: umax, umin, vmax, amax, uabs, tabs, upk, tpk
       logical, intent(out) :: raised
-      real(dp) :: h
-      h = t - t_prev
+      call observer_node_samples(t, u, v, a, umax, umin, vmax, amax, uabs, tabs, raised)
+      if (.not. fixed_steps) return
+      if (observer_node_turns(vn, an, v, a)) &
+         call observer_node_step_extrema(t, t_prev, un, vn, an, u, v, a, umax, umin, vmax, uabs, &
+                                         tabs, upk, tpk)
+   end subroutine observer_node_peaks
+
+   !> observer_node_peaks at the state: extremes of u, |v|, |a| and the largest |u| at t;
+   !> raised: the state raised amax. (The method that measures itself calls the three parts of
+   !> observer_node_peaks, so that this, the part of every node and step, is compiled into
+   !> its loop.)
+   elemental subroutine observer_node_samples(t, u, v, a, umax, umin, vmax, amax, uabs, tabs, &
+                                              raised)
+      real(dp), intent(in) :: t, u, v, a
+      real(dp), intent(inout) :: umax, umin, vmax, amax, uabs, tabs
+      logical, intent(out) :: raised
       if (u > umax) umax = u
       if (u < umin) umin = u
       if (abs(v) > vmax) vmax = abs(v)
       raised = abs(a) > amax
       if (raised) amax = abs(a)
       call raise_absmax(uabs, tabs, t, u)
-      if (fixed_steps .and. t_prev >= 0.0_dp .and. h > 0.0_dp) then
-         call hermite_extremum(t_prev, h, un, vn, an, u, v, a, umax, umin, uabs, tabs, upk, tpk)
-         ! |v| at the extremum of v, on the cubic Hermite of (v, a) where a changes sign
-         ! (O(h⁴) in v; docs/results.md)
-         vmax = max(vmax, observer_step_absmax(h, vn, an, v, a))
-         ! a maximum on the step's end
-         if (vn > 0.0_dp .and. v == 0.0_dp .and. u > upk) then
-            upk = u; tpk = t
-         end if
+   end subroutine observer_node_samples
+
+   !> Whether a fixed step from (vn, an) to (v, a) can hold an extremum of u (v changes sign,
+   !> or reaches 0 from above) or of v (a changes sign): most steps of most nodes hold none.
+   elemental logical function observer_node_turns(vn, an, v, a) result(turns)
+      real(dp), intent(in) :: vn, an, v, a
+      turns = vn*v < 0.0_dp .or. an*a < 0.0_dp .or. (vn > 0.0_dp .and. v == 0.0_dp)
+   end function observer_node_turns
+
+   !> observer_node_peaks inside a fixed step from the state (un, vn, an) at t_prev to
+   !> (u, v, a) at t where observer_node_turns (t_prev < 0: no step yet): the extrema of u
+   !> and v on the step's cubic Hermite (hermite_extremum, observer_step_absmax), and a maximum
+   !> of u on the step's end.
+   elemental subroutine observer_node_step_extrema(t, t_prev, un, vn, an, u, v, a, umax, umin, &
+                                                   vmax, uabs, tabs, upk, tpk)
+      real(dp), intent(in) :: t, t_prev, un, vn, an, u, v, a
+      real(dp), intent(inout) :: umax, umin, vmax, uabs, tabs, upk, tpk
+      real(dp) :: h
+      h = t - t_prev
+      if (.not. (t_prev >= 0.0_dp .and. h > 0.0_dp)) return
+      call hermite_extremum(t_prev, h, un, vn, an, u, v, a, umax, umin, uabs, tabs, upk, tpk)
+      ! |v| at the extremum of v, on the cubic Hermite of (v, a) where a changes sign
+      ! (O(h⁴) in v; docs/results.md)
+      vmax = max(vmax, observer_step_absmax(h, vn, an, v, a))
+      ! a maximum on the step's end
+      if (vn > 0.0_dp .and. v == 0.0_dp .and. u > upk) then
+         upk = u; tpk = t
       end if
-   end subroutine observer_node_peaks
+   end subroutine observer_node_step_extrema
 
    !> The maxima of a contact at a sample: its largest δ and force (pen_max, force_max).
    !> Elemental: observer_sample calls it on every contact; a method that measures its
