@@ -20,9 +20,8 @@ from .compatibility import COMPATIBLE
 from ..paths import MiB, UnreadableFile, check_regular, read_input
 from .fields import (ANY, MAX_DEPTH, NONNEG, POSITIVE, check_fields, choice, finite_everywhere,
                      kind_ok)
-from ..results import ARRAY_ITEMS
 from .spec import (ALL_SPECIFIC, ANALYSIS_TYPES, CONTACT_COMMON, CONTACT_SCHEMES,
-                   FIXED_EXPONENT, FUNCTION_TYPES, GROUND, INTEGRATOR_KEYS,
+                   ARRAY_ITEMS, FIXED_EXPONENT, FUNCTION_TYPES, GROUND, INTEGRATOR_KEYS,
                    INTEGRATORS, LARGE_SCENE_TRACKS, LAWS, LINK_COMMON, LINK_TYPES,
                    NEWMARK_PRESETS, NODE_KEYS, OUTPUT_KEYS, SCHEMES, TOP_KEYS, TRACKABLE)
 

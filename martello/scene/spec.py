@@ -122,6 +122,10 @@ OUTPUT_KEYS = {"every": _setting("int", "every"), "nodes": ("list", False, None,
 # (docs/performance.md). A smaller scene tracks everything its summary lists.
 TRACKABLE = tuple(n for n in native.names("tracking") if n != "all")
 LARGE_SCENE_TRACKS = ("contact_peaks",)
+# A scene with more nodes, links and contacts than this, together, is large: it has its
+# per-item results written as arrays (martello.results; 1e4 items made a summary.json of
+# ~5 MB; 1e6 of ~1 GB) and tracks LARGE_SCENE_TRACKS by default.
+ARRAY_ITEMS = 10_000
 # The analysis keys of one integrator or a group: the settings it reads beyond those every
 # integrator reads (the library's table "reads"); Newmark also takes a preset.
 _READ_BY_ALL = set.intersection(*(native.settings_read(i) for i in INTEGRATORS))
