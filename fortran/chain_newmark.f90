@@ -1157,9 +1157,10 @@ contains
       hl = t - t_prev                    ! the step the extrema are located on
       sample = o%nsamples + 1            ! this sample's number (observer_sample counts it)
       do i = 1, n
-         ! the node's v or a changes sign in the step (rare): its extrema inside it
+         ! the node's v or a changes sign in the step (rare): its extrema inside it (read
+         ! only where a node's peaks are tracked: vn, an are not read for nothing)
          turns = .false.
-         if (loc) turns = observer_node_turns(vn(i), an(i), v(i), a(i))
+         if (loc .and. (nodes .or. gu .or. gv)) turns = observer_node_turns(vn(i), an(i), v(i), a(i))
          if (nodes) then
             ! observer_node_peaks in its parts: the samples' in line, the extrema inside the
             ! step where the node turns (fs: a fixed step, as loc)
