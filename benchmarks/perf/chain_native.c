@@ -55,7 +55,7 @@ static double now(void) {
 
 int main(int argc, char **argv) {
   if (argc < 3) {
-    fprintf(stderr, "usage: chain_native N STEPS [--full-phases]\n");
+    fprintf(stderr, "usage: chain_native N STEPS [--items] [--full-phases] [--track WHAT]\n");
     return 2;
   }
   int n = atoi(argv[1]), steps = atoi(argv[2]);
