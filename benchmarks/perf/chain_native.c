@@ -11,8 +11,8 @@
  * resident memory (VmRSS) before the model, after it is built and after the run, the peak
  * (VmHWM), the counters and a checksum of the peaks (to compare two builds or the two doors).
  * --full-phases asks for every contact's phase list (martello_run_set_phase_lists); --track
- * keeps only WHAT, a comma-separated list of node_peaks, link_peaks, contact_peaks, phases
- * (martello_run_set_tracking; default all). */
+ * keeps only WHAT, a comma-separated list of node_peaks, link_peaks, contact_peaks, phases,
+ * all, or none (martello_run_set_tracking; default all). */
 #include <malloc.h>
 #include <math.h>
 #include <stdio.h>
@@ -64,12 +64,24 @@ int main(int argc, char **argv) {
     if (strcmp(argv[a], "--full-phases") == 0) full = 1;
     else if (strcmp(argv[a], "--items") == 0) items = 1;
     else if (strcmp(argv[a], "--track") == 0 && a + 1 < argc) {
-      const char *w = argv[++a];
+      /* a comma-separated list of the library's names (table "tracking"), or none */
+      static const char *names[] = {"node_peaks", "link_peaks", "contact_peaks", "phases", "all"};
+      static const int flags[] = {MARTELLO_TRACK_NODE_PEAKS, MARTELLO_TRACK_LINK_PEAKS,
+                                  MARTELLO_TRACK_CONTACT_PEAKS, MARTELLO_TRACK_PHASES,
+                                  MARTELLO_TRACK_ALL};
+      char list[256];
+      snprintf(list, sizeof list, "%s", argv[++a]);
       track = 0;
-      if (strstr(w, "node_peaks")) track |= MARTELLO_TRACK_NODE_PEAKS;
-      if (strstr(w, "link_peaks")) track |= MARTELLO_TRACK_LINK_PEAKS;
-      if (strstr(w, "contact_peaks")) track |= MARTELLO_TRACK_CONTACT_PEAKS;
-      if (strstr(w, "phases")) track |= MARTELLO_TRACK_PHASES;
+      for (char *w = strtok(list, ","); w; w = strtok(NULL, ",")) {
+        int k = 0;
+        while (k < 5 && strcmp(w, names[k]) != 0) ++k;
+        if (k == 5 && strcmp(w, "none") != 0) {
+          fprintf(stderr, "chain_native: --track: unknown name %s (use node_peaks, link_peaks, "
+                          "contact_peaks, phases, all or none)\n", w);
+          return 2;
+        }
+        if (k < 5) track |= flags[k];
+      }
     } else {
       fprintf(stderr, "chain_native: unknown option %s\n", argv[a]);
       return 2;
