@@ -107,6 +107,19 @@ int martello_model_add_link(martello_model *model, int kind, int a, int b,
 int martello_model_add_contact(martello_model *model, int a, int b, double gap, int scheme,
                                int law, const double par[MARTELLO_NPAR_CONTACT]);
 int martello_model_add_mass_coupling(martello_model *model, int a, int b, double value);
+/* A chain held per node (docs/c-api.md "Chains"): nodes first ... first + n - 1 (0-based, set
+ * by set_node(s)), node i with a spring k[i] to ground (a bilinear spring when fy and
+ * hardening are given), a dashpot c[i] to ground where c[i] > 0 (c NULL: none), and nodes i,
+ * i + 1 in contact through gap[i] (n - 1 values; NULL: no contacts) with one scheme, law and
+ * par[MARTELLO_NPAR_CONTACT] for all. Its links and contacts are numbered as if added by
+ * add_links and add_contacts at this call (the spring, then the dashpot, of each node), and
+ * checked as those check them (the message names the chain entry); the model holds them as
+ * these arrays, O(1) values per node, not as links and contacts: the fused chain step reads
+ * them so; any other method gets them one by one when it runs. They need no capacity at
+ * martello_model_create. */
+int martello_model_add_chain(martello_model *model, int first, int n, const double *k,
+                             const double *c, const double *fy, const double *hardening,
+                             const double *gap, int scheme, int law, const double *par);
 /* Bulk doors for large models: n entries in one call, each checked exactly as by
  * martello_model_set_node / _add_link / _add_contact, in order (so the model is the one the
  * one-entry calls build). Nodes 0..n-1 are set from mass[i], u0[i], v0[i], fixed[i];
@@ -224,6 +237,18 @@ int martello_run_set_outputs(martello_run *run, int n_nodes, const int *nodes, i
                              const int *contacts);
 /* Links whose force and elongation the history records (0-based; default none). */
 int martello_run_set_link_outputs(martello_run *run, int n_links, const int *links);
+/* Which contacts' phases martello_run_events lists (docs/results.md): every contact's while
+ * the model has at most max_contacts contacts (default 1000; < 0: always); past it, those of
+ * the output contacts (martello_run_set_outputs), and of every other contact its first and
+ * last phase alone (in that order), so a long pounding chain keeps two rows per contact. */
+int martello_run_set_phase_lists(martello_run *run, int max_contacts);
+/* What a run tracks (the registry's table "tracking"), an OR of MARTELLO_TRACK_*; default
+ * MARTELLO_TRACK_ALL. What it does not track costs no memory: martello_run_peaks,
+ * _abs_peaks and _link_peaks give NaN for it, martello_run_events no rows; the number of
+ * phases of each contact (impacts) is always counted. */
+enum { MARTELLO_TRACK_NODE_PEAKS = 1, MARTELLO_TRACK_LINK_PEAKS = 2,
+       MARTELLO_TRACK_CONTACT_PEAKS = 4, MARTELLO_TRACK_PHASES = 8, MARTELLO_TRACK_ALL = 15 };
+int martello_run_set_tracking(martello_run *run, int what);
 /* ---- closed forms of catalogue problems (docs/c-api.md "Closed forms") ------------------
  * The closed form `name` at the n_par parameters par: out (4 values) receives its *n_out
  * values. MARTELLO_ERR_ARGUMENT for an unknown name, a wrong parameter count or parameters
@@ -252,20 +277,22 @@ int martello_run_events(const martello_run *run, int *n, int *contacts, double *
 /* counters indexed by MARTELLO_COUNTER_* (chatter resolutions: steps where a contact was
  * held open, see docs/integrators.md) */
 int martello_run_counters(const martello_run *run, long long counters[MARTELLO_NCOUNTERS]);
-/* Per node: extremes over the steps, and the largest local maximum of u interpolated between
- * steps (u_peak at t_peak; t_peak = -1 if u never turned back); per contact: max
- * penetration, max force and the number of contact phases. */
+/* Per node: extremes over the steps, and the largest local maximum of u (u_peak at t_peak;
+ * t_peak = -1 if u never turned back); per contact: max penetration, max force and the number
+ * of contact phases; every peak located inside the steps (docs/results.md). Any output may be
+ * NULL: not written. What the run does not track is NaN (martello_run_set_tracking). */
 int martello_run_peaks(const martello_run *run, double *u_max, double *u_min, double *v_absmax,
                        double *a_absmax, double *pen_max, double *force_max, int *impacts,
                        double *u_peak, double *t_peak);
 /* Per node: the largest |u| and its time t_absmax: at the steps, at the extrema the adaptive
- * integrators locate, and on each fixed step's cubic Hermite on (u, v) (docs/results.md). */
+ * integrators locate, and on each fixed step's cubic Hermite on (u, v) (docs/results.md).
+ * NULL: not written. */
 int martello_run_abs_peaks(const martello_run *run, double *u_absmax, double *t_absmax);
 /* energy indexed by MARTELLO_ENERGY_*; extra = {max |balance|, omega_max, dt_crit
  * (explicit), time reached} */
 int martello_run_energy(const martello_run *run, double energy[MARTELLO_NENERGY], double extra[4]);
 /* Per link: max |force| and max |elongation| over the run (NaN if the integrator does not
- * report link states). */
+ * report link states, or the run does not track them). NULL: not written. */
 int martello_run_link_peaks(const martello_run *run, double *force_absmax, double *elongation_absmax);
 
 #ifdef __cplusplus

@@ -64,8 +64,7 @@ contains
       mp => get_model(handle)
       c_model_initial_state = MARTELLO_ERR_ARGUMENT
       if (.not. associated(mp)) return
-      u0(1:mp%n) = mp%u0
-      v0(1:mp%n) = merge(0.0_dp, mp%v0, mp%fixed)
+      call model_initial_state(mp, u0(1:mp%n), v0(1:mp%n))
       c_model_initial_state = MARTELLO_OK
    end function c_model_initial_state
 
@@ -279,6 +278,9 @@ contains
       c_observer_begin = MARTELLO_ERR_ARGUMENT
       if (.not. (associated(op) .and. associated(ep))) return
       call evaluator_load(ep, u(1:ep%m%n), v(1:ep%m%n))
+      ! the observer's arrays for the C integrators' states (a fixed-step run needs none)
+      if (.not. allocated(op%acc)) allocate (op%acc(0:ep%m%n), op%c_pen(ep%m%ncontact), &
+                                            op%c_force(ep%m%ncontact))
       ! the C integrators conserve ½vᵀMv itself (no Verlet correction): a = 0 serves
       op%acc = 0.0_dp
       call observer_begin(op, ep%m, ep%ms, ep%u, ep%v, op%acc, 1, c_string(advice), 0.0_dp)
@@ -321,7 +323,7 @@ contains
       op => get_observer(handle)
       c_observer_extremum = MARTELLO_ERR_ARGUMENT
       if (.not. associated(op)) return
-      if (node < 0 .or. node >= size(op%u_max)) return
+      if (node < 0 .or. node >= op%n_nodes) return
       call observer_extremum(op, node + 1, t, u, maximum /= 0)
       c_observer_extremum = MARTELLO_OK
    end function c_observer_extremum

@@ -159,6 +159,38 @@ contains
       c_model_add_contacts = stat
    end function c_model_add_contacts
 
+   !> A chain held per node (docs/c-api.md "Chains"): first 0-based; k required; c, fy,
+   !> hardening, gap and par may be NULL (no dashpots, linear springs, no contacts).
+   integer(c_int) function c_model_add_chain(handle, first, n, k, c, fy, hardening, gap, scheme, &
+                                             law, par) bind(C, name='martello_model_add_chain')
+      type(c_ptr), value :: handle, k, c, fy, hardening, gap, par
+      integer(c_int), value :: first, n, scheme, law
+      type(model_t), pointer :: mp
+      real(c_double), pointer :: pk(:), pc(:), pf(:), ph(:), pg(:), pp(:)
+      real(dp) :: row(NPAR_CONTACT)
+      integer :: stat
+      mp => get_model(handle)
+      c_model_add_chain = MARTELLO_ERR_ARGUMENT
+      if (.not. associated(mp)) return
+      if (n < 1 .or. .not. c_associated(k) .or. (c_associated(gap) .and. .not. c_associated(par))) then
+         mp%errmsg = 'add_chain: need n >= 1, the springs k, and par with the gaps'; return
+      end if
+      call c_f_pointer(k, pk, [n])
+      row = 0.0_dp
+      if (c_associated(par)) then
+         call c_f_pointer(par, pp, [NPAR_CONTACT]); row = pp
+      end if
+      pc => null(); pf => null(); ph => null(); pg => null()
+      if (c_associated(c)) call c_f_pointer(c, pc, [n])
+      if (c_associated(fy)) call c_f_pointer(fy, pf, [n])
+      if (c_associated(hardening)) call c_f_pointer(hardening, ph, [n])
+      if (c_associated(gap)) call c_f_pointer(gap, pg, [max(n - 1, 1)])
+      ! a disassociated pointer is an absent optional argument
+      call model_add_chain(mp, int(first) + 1, int(n), pk, pc, pf, ph, pg, int(scheme), &
+                           int(law), row, stat)
+      c_model_add_chain = stat
+   end function c_model_add_chain
+
    !> Prefix the model's message with the failing bulk entry's 0-based index.
    subroutine name_entry(mp, i)
       type(model_t), intent(inout) :: mp
@@ -268,6 +300,7 @@ contains
          mp%errmsg = 'effective_masses: every node must be set (set_node) first'
          c_model_effective_masses = MARTELLO_ERR_STATE; return
       end if
+      call model_expand_chains(mp)
       call contact_effective_masses(mp, mstar(1:mp%ncontact), mp%errmsg, stat)
       c_model_effective_masses = stat
    end function c_model_effective_masses
@@ -306,6 +339,7 @@ contains
          c_static_solve = MARTELLO_ERR_STATE; return
       end if
       mp%errmsg = ''
+      call model_expand_chains(mp)
       call static_solve(mp, tol, int(max_iter), r, stat)
       n = mp%n; nc = mp%ncontact
       if (allocated(r%u)) then

@@ -5,7 +5,9 @@ module martello_api_results
    use, intrinsic :: iso_c_binding
    use martello_kinds, only: dp
    use martello_status
-   use martello_observer, only: NCOUNTERS, NENERGY, NEVENT
+   use martello_observer, only: NCOUNTERS, NENERGY, NEVENT, tracks, TRACK_NODE_PEAKS, &
+      TRACK_LINK_PEAKS, TRACK_CONTACT_PEAKS, observer_events
+   use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan
    use martello_run, only: run_t
    use martello_api_handles, only: get_run
    implicit none
@@ -48,18 +50,25 @@ contains
       type(run_t), pointer :: rp
       integer(c_int), pointer :: ic(:)
       real(c_double), pointer :: vals(:, :)
+      integer :: nev
       rp => get_run(handle)
       n = 0
       c_run_events = MARTELLO_ERR_ARGUMENT
       if (.not. associated(rp)) return
-      n = rp%results%nevents
-      if (c_associated(contacts) .and. n > 0) then
-         call c_f_pointer(contacts, ic, [n])
-         ic = rp%results%ev_contact(1:n) - 1
+      if (.not. allocated(rp%results%ev)) then
+         c_run_events = MARTELLO_OK; return
       end if
-      if (c_associated(values) .and. n > 0) then
-         call c_f_pointer(values, vals, [NEVENT, n])
-         vals = rp%results%ev(:, 1:n)
+      call observer_events(rp%results, nev)
+      n = nev
+      if (nev > 0 .and. c_associated(contacts) .and. c_associated(values)) then
+         call c_f_pointer(contacts, ic, [nev]); call c_f_pointer(values, vals, [NEVENT, nev])
+         call observer_events(rp%results, nev, ic, vals)
+      else if (nev > 0 .and. c_associated(contacts)) then
+         call c_f_pointer(contacts, ic, [nev])
+         call observer_events(rp%results, nev, contact=ic)
+      else if (nev > 0 .and. c_associated(values)) then
+         call c_f_pointer(values, vals, [NEVENT, nev])
+         call observer_events(rp%results, nev, values=vals)
       end if
       c_run_events = MARTELLO_OK
    end function c_run_events
@@ -77,41 +86,65 @@ contains
       c_run_counters = MARTELLO_OK
    end function c_run_counters
 
+   !> Per node and contact (c/martello.h): each output may be NULL (not written); what the
+   !> run did not track is NaN (martello_run_set_tracking).
    integer(c_int) function c_run_peaks(handle, u_max, u_min, v_absmax, a_absmax, pen_max, &
                                        force_max, impacts, u_peak, t_peak) bind(C, name='martello_run_peaks')
-      type(c_ptr), value :: handle
-      real(c_double), intent(out) :: u_max(*), u_min(*), v_absmax(*), a_absmax(*), pen_max(*), &
-                                     force_max(*), u_peak(*), t_peak(*)
-      integer(c_int), intent(out) :: impacts(*)
+      type(c_ptr), value :: handle, u_max, u_min, v_absmax, a_absmax, pen_max, force_max, &
+                            impacts, u_peak, t_peak
       type(run_t), pointer :: rp
-      integer :: n, nc
+      integer(c_int), pointer :: ip(:)
       rp => get_run(handle)
       c_run_peaks = MARTELLO_ERR_ARGUMENT
       if (.not. associated(rp)) return
       if (.not. allocated(rp%results%u_max)) return
-      n = size(rp%results%u_max); nc = size(rp%results%pen_max)
-      u_max(1:n) = rp%results%u_max; u_min(1:n) = rp%results%u_min
-      v_absmax(1:n) = rp%results%v_absmax; a_absmax(1:n) = rp%results%a_absmax
-      pen_max(1:nc) = rp%results%pen_max; force_max(1:nc) = rp%results%force_max
-      impacts(1:nc) = rp%results%impacts
-      u_peak(1:n) = rp%results%u_peak; t_peak(1:n) = rp%results%t_peak
+      associate (r => rp%results)
+         call put(u_max, r%u_max, r%n_nodes, tracks(r, TRACK_NODE_PEAKS))
+         call put(u_min, r%u_min, r%n_nodes, tracks(r, TRACK_NODE_PEAKS))
+         call put(v_absmax, r%v_absmax, r%n_nodes, tracks(r, TRACK_NODE_PEAKS))
+         call put(a_absmax, r%a_absmax, r%n_nodes, tracks(r, TRACK_NODE_PEAKS))
+         call put(u_peak, r%u_peak, r%n_nodes, tracks(r, TRACK_NODE_PEAKS))
+         call put(t_peak, r%t_peak, r%n_nodes, tracks(r, TRACK_NODE_PEAKS))
+         call put(pen_max, r%pen_max, r%n_contacts, tracks(r, TRACK_CONTACT_PEAKS))
+         call put(force_max, r%force_max, r%n_contacts, tracks(r, TRACK_CONTACT_PEAKS))
+         if (c_associated(impacts)) then
+            call c_f_pointer(impacts, ip, [r%n_contacts]); ip = r%impacts
+         end if
+      end associate
       c_run_peaks = MARTELLO_OK
    end function c_run_peaks
 
-   !> Per node: the largest |u| and its time (docs/results.md, u_absmax)
+   !> Per node: the largest |u| and its time (docs/results.md, u_absmax); NULL: not written.
    integer(c_int) function c_run_abs_peaks(handle, u_absmax, t_absmax) bind(C, name='martello_run_abs_peaks')
-      type(c_ptr), value :: handle
-      real(c_double), intent(out) :: u_absmax(*), t_absmax(*)
+      type(c_ptr), value :: handle, u_absmax, t_absmax
       type(run_t), pointer :: rp
-      integer :: n
       rp => get_run(handle)
       c_run_abs_peaks = MARTELLO_ERR_ARGUMENT
       if (.not. associated(rp)) return
       if (.not. allocated(rp%results%u_absmax)) return
-      n = size(rp%results%u_absmax)
-      u_absmax(1:n) = rp%results%u_absmax; t_absmax(1:n) = rp%results%t_absmax
+      associate (r => rp%results)
+         call put(u_absmax, r%u_absmax, r%n_nodes, tracks(r, TRACK_NODE_PEAKS))
+         call put(t_absmax, r%t_absmax, r%n_nodes, tracks(r, TRACK_NODE_PEAKS))
+      end associate
       c_run_abs_peaks = MARTELLO_OK
    end function c_run_abs_peaks
+
+   !> The n values of a result array at the C pointer out unless NULL: src if tracked, else
+   !> NaN.
+   subroutine put(out, src, n, tracked)
+      type(c_ptr), intent(in) :: out
+      real(dp), intent(in) :: src(:)
+      integer, intent(in) :: n
+      logical, intent(in) :: tracked
+      real(c_double), pointer :: x(:)
+      if (.not. c_associated(out)) return
+      call c_f_pointer(out, x, [n])
+      if (tracked) then
+         x = src(1:n)
+      else
+         x = ieee_value(1.0_dp, ieee_quiet_nan)
+      end if
+   end subroutine put
 
    !> energy[9] = {kinetic, recoverable, input, damping, plastic, contact, balance, initial,
    !> impact}; extra[4] = {max |balance| over the run, omega_max, dt_crit, t reached}
@@ -128,18 +161,19 @@ contains
       c_run_energy = MARTELLO_OK
    end function c_run_energy
 
-   !> Per link: max |force| and max |elongation| over the run (NaN if not tracked).
+   !> Per link: max |force| and max |elongation| over the run (NaN if not tracked); NULL: not
+   !> written.
    integer(c_int) function c_run_link_peaks(handle, fmax, dumax) bind(C, name='martello_run_link_peaks')
-      type(c_ptr), value :: handle
-      real(c_double), intent(out) :: fmax(*), dumax(*)
+      type(c_ptr), value :: handle, fmax, dumax
       type(run_t), pointer :: rp
-      integer :: nl
       rp => get_run(handle)
       c_run_link_peaks = MARTELLO_ERR_ARGUMENT
       if (.not. associated(rp)) return
       if (.not. allocated(rp%results%link_force_absmax)) return
-      nl = size(rp%results%link_force_absmax)
-      fmax(1:nl) = rp%results%link_force_absmax; dumax(1:nl) = rp%results%link_du_absmax
+      associate (r => rp%results)
+         call put(fmax, r%link_force_absmax, r%n_links, tracks(r, TRACK_LINK_PEAKS))
+         call put(dumax, r%link_du_absmax, r%n_links, tracks(r, TRACK_LINK_PEAKS))
+      end associate
       c_run_link_peaks = MARTELLO_OK
    end function c_run_link_peaks
 end module martello_api_results

@@ -6,6 +6,7 @@ module martello_api_run
    use martello_model, only: model_t
    use martello_integrator_settings, only: integrator_settings_t, settings_default, settings_check
    use martello_run, only: run_t, run_dynamic
+   use martello_observer, only: TRACK_ALL
    use martello_api_handles, only: get_model, get_run, copy_message
    implicit none
    private
@@ -86,6 +87,36 @@ contains
       rp%out_links = links(1:nl) + 1
       c_run_set_link_outputs = MARTELLO_OK
    end function c_run_set_link_outputs
+
+   !> Every contact's phases are listed while the model has at most max_contacts contacts
+   !> (< 0: always); past it the output contacts' (martello_run_set_outputs), and the
+   !> others keep their first and last phase (docs/results.md).
+   integer(c_int) function c_run_set_phase_lists(handle, max_contacts) &
+      bind(C, name='martello_run_set_phase_lists')
+      type(c_ptr), value :: handle
+      integer(c_int), value :: max_contacts
+      type(run_t), pointer :: rp
+      rp => get_run(handle)
+      c_run_set_phase_lists = MARTELLO_ERR_ARGUMENT
+      if (.not. associated(rp)) return
+      rp%phase_lists = int(max_contacts)
+      c_run_set_phase_lists = MARTELLO_OK
+   end function c_run_set_phase_lists
+
+   !> What the run tracks: an OR of MARTELLO_TRACK_* (default MARTELLO_TRACK_ALL).
+   integer(c_int) function c_run_set_tracking(handle, what) bind(C, name='martello_run_set_tracking')
+      type(c_ptr), value :: handle
+      integer(c_int), value :: what
+      type(run_t), pointer :: rp
+      rp => get_run(handle)
+      c_run_set_tracking = MARTELLO_ERR_ARGUMENT
+      if (.not. associated(rp)) return
+      if (what < 0 .or. iand(int(what), not(TRACK_ALL)) /= 0) then
+         rp%results%message = 'set_tracking: an OR of MARTELLO_TRACK_* flags is needed'; return
+      end if
+      rp%tracking = int(what)
+      c_run_set_tracking = MARTELLO_OK
+   end function c_run_set_tracking
 
    !> The progress callback of the run (c/martello.h martello_progress_fn), called with
    !> user about four times a second while it runs; a NULL callback removes it.

@@ -19,7 +19,7 @@ module martello_effective_mass
    use martello_lapack, only: dpbtrf, dpbtrs
    implicit none
    private
-   public :: contact_effective_masses, effective_mass_prepare
+   public :: contact_effective_masses, effective_mass_prepare, pair_effective_mass
 
 contains
 
@@ -61,15 +61,7 @@ contains
          if (ia == 0 .and. ib == 0) then
             mstar(c) = ieee_value(1.0_dp, ieee_positive_inf)
          else if (.not. (coupled(m%con_a(c)) .or. coupled(m%con_b(c)))) then
-            if (ia == 0) then
-               mstar(c) = m%mass(m%con_b(c))
-            else if (ib == 0) then
-               mstar(c) = m%mass(m%con_a(c))
-            else
-               associate (ma => m%mass(m%con_a(c)), mbb => m%mass(m%con_b(c)))
-                  mstar(c) = ma*mbb/(ma + mbb)
-               end associate
-            end if
+            mstar(c) = pair_effective_mass(m, m%con_a(c), m%con_b(c))
          else
             x = 0.0_dp
             if (ia > 0) x(ia) = 1.0_dp
@@ -82,6 +74,29 @@ contains
          end if
       end do
    end subroutine contact_effective_masses
+
+   !> m* of a contact between nodes a and b (0: ground) with no mass coupling at either:
+   !> m_a m_b/(m_a + m_b), the moving side's mass against ground or a fixed node, +inf if
+   !> neither side moves.
+   pure real(dp) function pair_effective_mass(m, a, b) result(mstar)
+      type(model_t), intent(in) :: m
+      integer, intent(in) :: a, b
+      logical :: ma_moves, mb_moves
+      ma_moves = .false.; mb_moves = .false.
+      if (a > 0) ma_moves = .not. m%fixed(a)
+      if (b > 0) mb_moves = .not. m%fixed(b)
+      if (.not. (ma_moves .or. mb_moves)) then
+         mstar = ieee_value(1.0_dp, ieee_positive_inf)
+      else if (.not. ma_moves) then
+         mstar = m%mass(b)
+      else if (.not. mb_moves) then
+         mstar = m%mass(a)
+      else
+         associate (ma => m%mass(a), mbb => m%mass(b))
+            mstar = ma*mbb/(ma + mbb)
+         end associate
+      end if
+   end function pair_effective_mass
 
    !> What a run needs from the whole model: m%con_mstar, and the damping of every penalty
    !> contact given a target restitution, by its law's published formula. Called once the

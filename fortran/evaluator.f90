@@ -4,7 +4,7 @@
 !> steps. It wraps the same assembly code as the structural integrators.
 module martello_evaluator
    use martello_kinds, only: dp
-   use martello_model, only: model_t, model_bandwidth
+   use martello_model, only: model_t, model_bandwidth, model_initial_state, model_u0
    use martello_assembly
    use martello_band_matrix
    use martello_switching, only: switch_count, switching_choose, switching_functions
@@ -37,7 +37,7 @@ contains
       ev%work = 1.0_dp; ev%work(0) = 0.0_dp
       call mass_times(m, ev%work, ev%mrow)
       ev%u = 0.0_dp; ev%v = 0.0_dp
-      ev%u(1:n) = m%u0; ev%v(1:n) = merge(0.0_dp, m%v0, m%fixed)
+      call model_initial_state(m, ev%u(1:n), ev%v(1:n))
       call mech_init(m, ev%ms, ev%u, ev%v)
       call band_init(ev%mband, n, model_bandwidth(m))
       ev%fixed_nodes = pack([(j, j = 1, n)], m%fixed)
@@ -47,8 +47,10 @@ contains
    subroutine evaluator_load(ev, u, v)
       type(evaluator_t), intent(inout) :: ev
       real(dp), intent(in) :: u(:), v(:)
+      integer :: j
       ev%u(1:) = u; ev%v(1:) = v
-      ev%u(ev%fixed_nodes) = ev%m%u0(ev%fixed_nodes); ev%v(ev%fixed_nodes) = 0.0_dp
+      ev%u(ev%fixed_nodes) = [(model_u0(ev%m, ev%fixed_nodes(j)), j = 1, size(ev%fixed_nodes))]
+      ev%v(ev%fixed_nodes) = 0.0_dp
    end subroutine evaluator_load
 
    !> fint and fext (length n) at (t, u, v); links from the committed state.

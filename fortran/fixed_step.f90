@@ -8,15 +8,14 @@
 module martello_fixed_step
    use martello_kinds, only: dp, i8
    use martello_status
-   use martello_model, only: model_t
+   use martello_model, only: model_t, model_initial_state
    use martello_assembly, only: mech_state_t, mech_init, mass_times, assemble_mass, internal_forces, &
       external_forces, mech_commit
    use martello_band_matrix, only: band_t, band_zero, band_pin, band_solve
    use martello_integrator_settings, only: integrator_settings_t
    use martello_run_checks, only: check_run_settings
    use martello_observer, only: observer_t, observer_begin, observer_sample, observer_fail, &
-      observer_penalty_phases, observer_finish, observer_recorded, observer_link_step_peaks, &
-      C_STEPS, C_FACTORIZATIONS
+      observer_penalty_phases, observer_finish, C_STEPS, C_FACTORIZATIONS
    implicit none
    private
    public :: run_fixed_step, stepper_t, stepper_start, stepper_rest_start, solve_free_mass, &
@@ -44,9 +43,10 @@ module martello_fixed_step
       !> the energy the method conserves is ½vᵀMv − ke_aMa·aᵀMa (h²/8 for velocity Verlet,
       !> 0 for the others): the observer's kinetic energy in the balance
       real(dp) :: ke_aMa = 0.0_dp
-      !> the method tracks the link peaks (o%link_force_absmax, o%link_du_absmax) itself and
-      !> builds ms%link_f, ms%link_u only for the recorded samples (link_states)
-      logical :: own_link_peaks = .false.
+      !> the method measures its states itself, item by item in its own sweeps (the fused
+      !> chain step): its measure_start and measure hand them to the observer, phases
+      !> included (the strategy's observer_penalty_phases is then not called)
+      logical :: measures_itself = .false.
       !> the method's velocity jumps from v_k to v_{k+1} inside the step (Moreau–Jean: the
       !> positions are q_k + h((1−θ)v_k + θv_{k+1})): a penalty phase then starts at v_k of
       !> the step it opens in and ends at v_{k+1} of the step it closes in, the velocities
@@ -59,9 +59,10 @@ module martello_fixed_step
       !> (un, vn, an) ← (u, v, a) before a step: copies; a method that writes every entry of
       !> u, v, a before reading it may swap the buffers instead
       procedure :: begin_step => stepper_begin_step
-      !> ms%link_f, ms%link_u at the committed state, for a method that keeps them only
-      !> where they are read (own_link_peaks): before a recorded sample
-      procedure :: link_states => stepper_link_states
+      !> the observer's start (observer_begin), and the sample of the state at grid point k
+      !> (observer_sample); a method that measures itself overrides both
+      procedure :: measure_start => stepper_measure_start
+      procedure :: measure => stepper_measure
    end type stepper_t
 
    abstract interface
@@ -112,9 +113,9 @@ contains
       ! the other methods' states lie on a smooth motion between phase changes: their peaks
       ! are located inside the steps (docs/results.md)
       o%smooth_steps = .not. stp%velocity_jump_phases
-      call observer_begin(o, m, stp%ms, stp%u, stp%v, stp%a, ENERGY_CHECK, stp%advice, stp%ke_aMa)
+      call stp%measure_start(m, o, ENERGY_CHECK)
       t = 0.0_dp
-      call sample(0_i8)
+      call stp%measure(m, o, t, 0_i8, stat)
       if (stat /= MARTELLO_OK) return
 
       do k = 1_i8, o%n_grid      ! 64-bit: more than 2^31 steps are counted, not wrapped
@@ -124,43 +125,42 @@ contains
          call stp%step(m, t, o, stat)
          if (stat /= MARTELLO_OK) return
          o%counters(C_STEPS) = o%counters(C_STEPS) + 1_i8
-         if (stp%velocity_jump_phases) then
+         if (stp%measures_itself) then
+            ! its phases are handed over with its sample (measure)
+         else if (stp%velocity_jump_phases) then
             call observer_penalty_phases(o, m, stp%ms, stp%un, stp%vn, no_acc, stp%u, stp%v, no_acc, &
                                          t, stp%h)
          else
             call observer_penalty_phases(o, m, stp%ms, stp%un, stp%vn, stp%an, stp%u, stp%v, stp%a, &
                                          t, stp%h)
          end if
-         call sample(k)
+         call stp%measure(m, o, t, k, stat)
          if (stat /= MARTELLO_OK) return
       end do
       call observer_finish(o, t)
-
-   contains
-
-      !> The state at t_k; the previous one is the stepper's own (un, vn, an): no copy.
-      subroutine sample(kk)
-         integer(i8), intent(in) :: kk
-         if (stp%own_link_peaks .and. .not. observer_recorded(o, kk)) then
-            call observer_sample(o, m, stp%ms, t, stp%u, stp%v, stp%a, stp%pen, stp%force, kk, &
-                                 stat, u_prev=stp%un(1:), v_prev=stp%vn(1:), a_prev=stp%an(1:))
-            ! its link peaks inside the step (a pass of its own: the fused step could locate
-            ! them in its element loop, where du, du̇ are at hand)
-            if (kk > 0) call observer_link_step_peaks(o, m, stp%ms, stp%h, stp%un(1:), stp%vn(1:), &
-                                                      stp%an(1:), stp%u(1:), stp%v(1:), stp%a(1:))
-            return
-         end if
-         if (stp%own_link_peaks) call stp%link_states(m)
-         call observer_sample(o, m, stp%ms, t, stp%u, stp%v, stp%a, stp%pen, stp%force, kk, stat, &
-                              stp%ms%link_f, stp%ms%link_u, stp%un(1:), stp%vn(1:), stp%an(1:))
-      end subroutine sample
    end subroutine run_fixed_step
 
-   !> Nothing to build: the steppers keep ms%link_f, ms%link_u committed at every step.
-   subroutine stepper_link_states(self, m)
+   !> The observer's start: the state at t = 0 and the energy evaluation cadence.
+   subroutine stepper_measure_start(self, m, o, energy_interval)
       class(stepper_t), intent(inout) :: self
       type(model_t), intent(in) :: m
-   end subroutine stepper_link_states
+      type(observer_t), intent(inout) :: o
+      integer, intent(in) :: energy_interval
+      call observer_begin(o, m, self%ms, self%u, self%v, self%a, energy_interval, self%advice, &
+                          self%ke_aMa)
+   end subroutine stepper_measure_start
+
+   !> The state at t = t_k; the previous one is the stepper's own (un, vn, an): no copy.
+   subroutine stepper_measure(self, m, o, t, k, stat)
+      class(stepper_t), intent(inout) :: self
+      type(model_t), intent(in) :: m
+      type(observer_t), intent(inout) :: o
+      real(dp), intent(in) :: t
+      integer(i8), intent(in) :: k
+      integer, intent(out) :: stat
+      call observer_sample(o, m, self%ms, t, self%u, self%v, self%a, self%pen, self%force, k, stat, &
+                           self%ms%link_f, self%ms%link_u, self%un(1:), self%vn(1:), self%an(1:))
+   end subroutine stepper_measure
 
    !> The start of a step: the committed state becomes (un, vn, an).
    subroutine stepper_begin_step(self)
@@ -180,7 +180,7 @@ contains
       allocate (self%u(0:n), self%v(0:n), self%a(0:n), self%un(0:n), self%vn(0:n), &
                 self%an(0:n), self%mrow(0:n), self%pen(m%ncontact), self%force(m%ncontact))
       self%u(0) = 0.0_dp; self%v(0) = 0.0_dp; self%a = 0.0_dp
-      self%u(1:n) = m%u0; self%v(1:n) = merge(0.0_dp, m%v0, m%fixed)
+      call model_initial_state(m, self%u(1:n), self%v(1:n))
       self%pen = 0.0_dp; self%force = 0.0_dp
       self%fixed_nodes = pack([(j, j = 1, n)], m%fixed)
       self%un = 1.0_dp; self%un(0) = 0.0_dp

@@ -7,17 +7,21 @@ module martello_model
    use martello_status, only: MARTELLO_OK, MARTELLO_ERR_ARGUMENT
    use martello_time_functions, only: time_function_t, tf_is_known, TF_TABLE, NPAR_TF
    use martello_contact_laws, only: NPAR_CONTACT, law_is_known, P_RESTITUTION, P_CLIP
-   use martello_links, only: NPAR_LINK, link_is_known
+   use martello_links, only: NPAR_LINK, link_is_known, LINK_SPRING, LINK_DASHPOT, LINK_BILINEAR, &
+      L_STIFF, L_DAMP, L_YIELD, L_HARDENING
    use martello_registry, only: SCHEME_PENALTY, SCHEME_LAGRANGE, SCHEME_AUGMENTED, &
       SCHEME_RESTITUTION, registry_name
    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
    implicit none
    private
    public :: model_t, model_init, model_set_node, model_add_link, model_add_contact, &
+      model_initial_state, model_u0, &
       model_add_mass_coupling, model_add_nodal_force, model_set_ground_acceleration, &
       model_add_stiffness_block, stiffness_block_t, model_bandwidth, rigid_contact_sides, &
       SCHEME_PENALTY, SCHEME_LAGRANGE, SCHEME_AUGMENTED, &
-      SCHEME_RESTITUTION, scheme_name
+      SCHEME_RESTITUTION, scheme_name, chain_t, model_add_chain, model_expand_chains, &
+      model_nlinks, model_ncontacts, model_link_index, model_contact_index, model_contact_at, &
+      model_link_at
 
    !> Symmetric stiffness and damping matrices between a set of nodes (a statically condensed
    !> structure, e.g. a planar frame on its lateral DOFs, docs/problems.md P10): internal
@@ -29,9 +33,28 @@ module martello_model
       logical :: damped = .false.     !< c /= 0
    end type stiffness_block_t
 
+   !> A chain added whole (model_add_chain, docs/c-api.md "Chains"): nodes first … first + n − 1,
+   !> node i with a spring k(i) to ground (bilinear with fy(i), rho(i) when given) and, where
+   !> c(i) > 0, a dashpot c(i); nodes i and i + 1 in contact through gap(i), one scheme, law
+   !> and parameter row for all. Held per node (the methods that take a chain as a whole read
+   !> these arrays); its links and contacts are the items numbered link0 + 1 … and
+   !> contact0 + 1 … (spring then dashpot of each node, in order), made one by one only by
+   !> model_expand_chains, for the methods that take items one by one. glink, gcontact: the
+   !> items added one by one before it.
+   type :: chain_t
+      integer :: first = 0, n = 0, nlink = 0, ncontact = 0
+      integer :: link0 = 0, contact0 = 0, glink = 0, gcontact = 0
+      real(dp), allocatable :: k(:), c(:), fy(:), rho(:), gap(:)
+      integer :: scheme = 0, law = 0
+      real(dp) :: par(NPAR_CONTACT) = 0.0_dp
+   end type chain_t
+
    type :: model_t
       integer :: n = 0
-      real(dp), allocatable :: mass(:), u0(:), v0(:)
+      real(dp), allocatable :: mass(:)
+      !> the initial displacements and velocities: no entries while every one is 0 (a large
+      !> chain from rest keeps 16 B per node less); read them through model_initial_state
+      real(dp), allocatable :: u0(:), v0(:)
       logical, allocatable :: fixed(:)
       ! links
       integer :: nlink = 0
@@ -51,6 +74,10 @@ module martello_model
       ! stiffness blocks (no capacity at model_create: the array grows)
       integer :: nblock = 0
       type(stiffness_block_t), allocatable :: block(:)
+      !> chains held per node (model_add_chain; the array grows); nlink and ncontact above
+      !> count the items added one by one (model_nlinks, model_ncontacts: all of them)
+      integer :: nchain = 0
+      type(chain_t), allocatable :: chain(:)
       ! loads: gravity is an acceleration along +u acting on M; ground acceleration loads −M·1·ü_g
       real(dp) :: gravity = 0.0_dp
       integer :: nforce = 0
@@ -88,8 +115,8 @@ contains
          return
       end if
       m%n = n
-      allocate (m%mass(n), m%u0(n), m%v0(n), m%fixed(n))
-      m%mass = -1.0_dp; m%u0 = 0.0_dp; m%v0 = 0.0_dp; m%fixed = .false.
+      allocate (m%mass(n), m%u0(0), m%v0(0), m%fixed(n))
+      m%mass = -1.0_dp; m%fixed = .false.
       allocate (m%link_kind(max_links), m%link_a(max_links), m%link_b(max_links), &
                 m%link_par(NPAR_LINK, max_links))
       allocate (m%con_a(max_contacts), m%con_b(max_contacts), m%con_scheme(max_contacts), &
@@ -124,8 +151,38 @@ contains
          call fail(m, stat, 'set_node: mass must be > 0 for a free node (>= 0 for a fixed one)')
          return
       end if
-      m%mass(i) = mass; m%u0(i) = u0; m%v0(i) = v0; m%fixed(i) = fixed
+      m%mass(i) = mass; m%fixed(i) = fixed
+      call set_initial(m%u0, i, u0); call set_initial(m%v0, i, v0)
+   contains
+      !> x(i) ← value, x made whole (zeros) by the first value that is not +0
+      subroutine set_initial(x, i, value)
+         real(dp), allocatable, intent(inout) :: x(:)
+         integer, intent(in) :: i
+         real(dp), intent(in) :: value
+         if (size(x) == 0) then
+            if (value == 0.0_dp .and. sign(1.0_dp, value) > 0.0_dp) return
+            deallocate (x); allocate (x(m%n), source=0.0_dp)
+         end if
+         x(i) = value
+      end subroutine set_initial
    end subroutine model_set_node
+
+   !> The state at t = 0 (nodes 1..n): u(i) = u0 of node i, v(i) its v0 (0 for a fixed node).
+   pure subroutine model_initial_state(m, u, v)
+      type(model_t), intent(in) :: m
+      real(dp), intent(out) :: u(:), v(:)
+      u = 0.0_dp; v = 0.0_dp
+      if (size(m%u0) > 0) u = m%u0
+      if (size(m%v0) > 0) v = merge(0.0_dp, m%v0, m%fixed)
+   end subroutine model_initial_state
+
+   !> u0 of node i (0 where none was given).
+   pure real(dp) function model_u0(m, i) result(u0)
+      type(model_t), intent(in) :: m
+      integer, intent(in) :: i
+      u0 = 0.0_dp
+      if (size(m%u0) > 0) u0 = m%u0(i)
+   end function model_u0
 
    subroutine model_add_link(m, kind, a, b, par, stat)
       type(model_t), intent(inout) :: m
@@ -136,6 +193,20 @@ contains
       if (m%nlink >= size(m%link_kind)) then
          call fail(m, stat, 'add_link: more links than declared at model_create'); return
       end if
+      call check_link(m, kind, a, b, par, stat)
+      if (stat /= MARTELLO_OK) return
+      m%nlink = m%nlink + 1
+      m%link_kind(m%nlink) = kind; m%link_a(m%nlink) = a; m%link_b(m%nlink) = b
+      m%link_par(:, m%nlink) = par
+   end subroutine model_add_link
+
+   !> What add_link checks of one link (its nodes, kind and parameters).
+   subroutine check_link(m, kind, a, b, par, stat)
+      type(model_t), intent(inout) :: m
+      integer, intent(in) :: kind, a, b
+      real(dp), intent(in) :: par(NPAR_LINK)
+      integer, intent(out) :: stat
+      stat = MARTELLO_OK
       if (.not. link_is_known(kind)) then
          call fail(m, stat, 'add_link: unknown link kind'); return
       end if
@@ -145,10 +216,7 @@ contains
       if (.not. all(ieee_is_finite(par))) then
          call fail(m, stat, 'add_link: parameters must be finite'); return
       end if
-      m%nlink = m%nlink + 1
-      m%link_kind(m%nlink) = kind; m%link_a(m%nlink) = a; m%link_b(m%nlink) = b
-      m%link_par(:, m%nlink) = par
-   end subroutine model_add_link
+   end subroutine check_link
 
    subroutine model_add_contact(m, a, b, gap, scheme, law, par, stat)
       type(model_t), intent(inout) :: m
@@ -159,6 +227,22 @@ contains
       if (m%ncontact >= size(m%con_a)) then
          call fail(m, stat, 'add_contact: more contacts than declared at model_create'); return
       end if
+      call check_contact(m, a, b, gap, scheme, law, par, stat)
+      if (stat /= MARTELLO_OK) return
+      m%ncontact = m%ncontact + 1
+      m%con_a(m%ncontact) = a; m%con_b(m%ncontact) = b; m%con_gap(m%ncontact) = gap
+      m%con_scheme(m%ncontact) = scheme; m%con_law(m%ncontact) = law
+      m%con_par(:, m%ncontact) = par
+      m%con_mstar(m%ncontact) = 0.0_dp
+   end subroutine model_add_contact
+
+   !> What add_contact checks of one contact (its nodes, scheme, law and parameters).
+   subroutine check_contact(m, a, b, gap, scheme, law, par, stat)
+      type(model_t), intent(inout) :: m
+      integer, intent(in) :: a, b, scheme, law
+      real(dp), intent(in) :: gap, par(NPAR_CONTACT)
+      integer, intent(out) :: stat
+      stat = MARTELLO_OK
       if (.not. (node_ok(m, a, .true.) .and. node_ok(m, b, .true.)) .or. a == b) then
          call fail(m, stat, 'add_contact: nodes out of range, or both sides on the same node')
          return
@@ -181,12 +265,7 @@ contains
             call fail(m, stat, 'add_contact: target restitution must lie in [0, 1]'); return
          end if
       end if
-      m%ncontact = m%ncontact + 1
-      m%con_a(m%ncontact) = a; m%con_b(m%ncontact) = b; m%con_gap(m%ncontact) = gap
-      m%con_scheme(m%ncontact) = scheme; m%con_law(m%ncontact) = law
-      m%con_par(:, m%ncontact) = par
-      m%con_mstar(m%ncontact) = 0.0_dp
-   end subroutine model_add_contact
+   end subroutine check_contact
 
    subroutine model_add_mass_coupling(m, a, b, value, stat)
       type(model_t), intent(inout) :: m
@@ -334,7 +413,260 @@ contains
       do j = 1, m%nblock
          kd = max(kd, maxval(m%block(j)%node) - minval(m%block(j)%node))
       end do
+      do j = 1, m%nchain
+         if (m%chain(j)%ncontact > 0) kd = max(kd, 1)
+      end do
    end function model_bandwidth
+
+   !> Add a chain (chain_t) on nodes first … first + n − 1: k(n) the springs to ground; c(n)
+   !> the dashpots (0: none; absent: none), fy(n), rho(n) the bilinear springs' yield force
+   !> and hardening (absent: linear springs); gap(n − 1) the contacts between neighbours
+   !> (absent: none) with scheme, law and par. Every link and contact is checked as add_link
+   !> and add_contact check it; the first bad one stops the call, and the message names it
+   !> (`chain entry i`, 0-based node of the chain). Items added one by one and chains are
+   !> numbered in the order of the calls.
+   subroutine model_add_chain(m, first, n, k, c, fy, rho, gap, scheme, law, par, stat)
+      type(model_t), intent(inout) :: m
+      integer, intent(in) :: first, n, scheme, law
+      real(dp), intent(in) :: k(:), par(NPAR_CONTACT)
+      real(dp), intent(in), optional :: c(:), fy(:), rho(:), gap(:)
+      integer, intent(out) :: stat
+      type(chain_t), allocatable :: grown(:)
+      real(dp) :: lp(NPAR_LINK)
+      integer :: i, kind
+      character(len=24) :: num
+      stat = MARTELLO_OK
+      if (n < 1 .or. first < 1 .or. first + n - 1 > m%n) then
+         call fail(m, stat, 'add_chain: its nodes first ... first + n - 1 must be nodes of the model'//&
+                   ' (n >= 1)'); return
+      end if
+      if (present(fy) .neqv. present(rho)) then
+         call fail(m, stat, 'add_chain: give both fy and hardening (bilinear springs) or neither')
+         return
+      end if
+      kind = merge(LINK_BILINEAR, LINK_SPRING, present(fy))
+      do i = 1, n
+         lp = 0.0_dp; lp(L_STIFF) = k(i)
+         if (present(fy)) then
+            lp(L_YIELD) = fy(i); lp(L_HARDENING) = rho(i)
+         end if
+         call check_link(m, kind, first + i - 1, 0, lp, stat)
+         if (stat == MARTELLO_OK .and. present(c)) then
+            if (.not. (c(i) >= 0.0_dp .and. ieee_is_finite(c(i)))) &
+               call fail(m, stat, 'add_chain: dashpot c must be finite and >= 0 (0: none)')
+         end if
+         if (stat == MARTELLO_OK .and. present(gap) .and. i < n) &
+            call check_contact(m, first + i - 1, first + i, gap(i), scheme, law, par, stat)
+         if (stat /= MARTELLO_OK) then
+            write (num, '(i0)') i - 1
+            m%errmsg = 'chain entry '//trim(num)//': '//trim(m%errmsg); return
+         end if
+      end do
+      allocate (grown(m%nchain + 1))
+      if (m%nchain > 0) grown(1:m%nchain) = m%chain
+      associate (ch => grown(m%nchain + 1))
+         ch%first = first; ch%n = n
+         ch%glink = m%nlink; ch%gcontact = m%ncontact
+         ch%link0 = model_nlinks(m); ch%contact0 = model_ncontacts(m)
+         ch%k = k(1:n)
+         ch%nlink = n
+         if (present(c)) then
+            ch%c = c(1:n); ch%nlink = n + count(c(1:n) > 0.0_dp)
+         end if
+         if (present(fy)) then
+            ch%fy = fy(1:n); ch%rho = rho(1:n)
+         end if
+         if (present(gap) .and. n > 1) then
+            ch%gap = gap(1:n - 1); ch%ncontact = n - 1
+         end if
+         ch%scheme = scheme; ch%law = law; ch%par = par
+      end associate
+      call move_alloc(grown, m%chain)
+      m%nchain = m%nchain + 1
+   end subroutine model_add_chain
+
+   !> Links of the model: added one by one and in chains.
+   pure integer function model_nlinks(m) result(nl)
+      type(model_t), intent(in) :: m
+      integer :: j
+      nl = m%nlink
+      do j = 1, m%nchain
+         nl = nl + m%chain(j)%nlink
+      end do
+   end function model_nlinks
+
+   !> Contacts of the model: added one by one and in chains.
+   pure integer function model_ncontacts(m) result(nc)
+      type(model_t), intent(in) :: m
+      integer :: j
+      nc = m%ncontact
+      do j = 1, m%nchain
+         nc = nc + m%chain(j)%ncontact
+      end do
+   end function model_ncontacts
+
+   !> The number of link j added one by one among all the model's links.
+   pure integer function model_link_index(m, j) result(idx)
+      type(model_t), intent(in) :: m
+      integer, intent(in) :: j
+      integer :: q
+      idx = j
+      do q = 1, m%nchain
+         if (m%chain(q)%glink < j) idx = idx + m%chain(q)%nlink
+      end do
+   end function model_link_index
+
+   !> The number of contact j added one by one among all the model's contacts.
+   pure integer function model_contact_index(m, j) result(idx)
+      type(model_t), intent(in) :: m
+      integer, intent(in) :: j
+      integer :: q
+      idx = j
+      do q = 1, m%nchain
+         if (m%chain(q)%gcontact < j) idx = idx + m%chain(q)%ncontact
+      end do
+   end function model_contact_index
+
+   !> Link number j of all the model's links (one by one or in a chain): kind, nodes and
+   !> parameters.
+   pure subroutine model_link_at(m, j, kind, a, b, par)
+      type(model_t), intent(in) :: m
+      integer, intent(in) :: j
+      integer, intent(out) :: kind, a, b
+      real(dp), intent(out) :: par(NPAR_LINK)
+      integer :: q, i, pos, g
+      g = j
+      do q = 1, m%nchain
+         associate (ch => m%chain(q))
+            if (j > ch%link0 .and. j <= ch%link0 + ch%nlink) then
+               ! the spring, then (where c > 0) the dashpot of each node, in order
+               pos = ch%link0
+               do i = 1, ch%n
+                  par = 0.0_dp; a = ch%first + i - 1; b = 0
+                  pos = pos + 1
+                  if (pos == j) then
+                     kind = LINK_SPRING; par(L_STIFF) = ch%k(i)
+                     if (allocated(ch%fy)) then
+                        kind = LINK_BILINEAR; par(L_YIELD) = ch%fy(i); par(L_HARDENING) = ch%rho(i)
+                     end if
+                     return
+                  end if
+                  if (allocated(ch%c)) then
+                     if (ch%c(i) > 0.0_dp) pos = pos + 1
+                     if (pos == j) then
+                        kind = LINK_DASHPOT; par(L_DAMP) = ch%c(i); return
+                     end if
+                  end if
+               end do
+            end if
+            ! one added one by one after this chain: its number among those
+            if (ch%link0 < j) g = g - ch%nlink
+         end associate
+      end do
+      kind = m%link_kind(g); a = m%link_a(g); b = m%link_b(g); par = m%link_par(:, g)
+   end subroutine model_link_at
+
+   !> Contact number j of all the model's contacts (one by one or in a chain): nodes, gap,
+   !> scheme, law and parameters.
+   pure subroutine model_contact_at(m, j, a, b, gap, scheme, law, par)
+      type(model_t), intent(in) :: m
+      integer, intent(in) :: j
+      integer, intent(out) :: a, b, scheme, law
+      real(dp), intent(out) :: gap, par(NPAR_CONTACT)
+      integer :: q, g
+      g = j
+      do q = 1, m%nchain
+         associate (ch => m%chain(q))
+            if (j > ch%contact0 .and. j <= ch%contact0 + ch%ncontact) then
+               a = ch%first + (j - ch%contact0) - 1; b = a + 1; gap = ch%gap(j - ch%contact0)
+               scheme = ch%scheme; law = ch%law; par = ch%par
+               return
+            end if
+            ! one added one by one after this chain: its number among those
+            if (ch%contact0 < j) g = g - ch%ncontact
+         end associate
+      end do
+      a = m%con_a(g); b = m%con_b(g); gap = m%con_gap(g); scheme = m%con_scheme(g)
+      law = m%con_law(g); par = m%con_par(:, g)
+   end subroutine model_contact_at
+
+   !> The chains as links and contacts one by one, numbered as model_add_chain says, for the
+   !> methods that take items one by one (a run's integrator, the static solve); the free
+   !> capacity of model_create is kept.
+   subroutine model_expand_chains(m)
+      type(model_t), intent(inout) :: m
+      integer :: nl, nc, free_l, free_c, q, i, g, pos
+      integer, allocatable :: lk(:), la(:), lb(:), ca(:), cb(:), cs(:), cl(:)
+      real(dp), allocatable :: lpar(:, :), cg(:), cpar(:, :), cm(:)
+      if (m%nchain == 0) return
+      nl = model_nlinks(m); nc = model_ncontacts(m)
+      free_l = size(m%link_kind) - m%nlink; free_c = size(m%con_a) - m%ncontact
+      allocate (lk(nl + free_l), la(nl + free_l), lb(nl + free_l), lpar(NPAR_LINK, nl + free_l))
+      allocate (ca(nc + free_c), cb(nc + free_c), cs(nc + free_c), cl(nc + free_c), &
+                cg(nc + free_c), cm(nc + free_c), cpar(NPAR_CONTACT, nc + free_c))
+      cm = 0.0_dp
+      ! in the order of the calls: the items added one by one before each chain, the chain
+      pos = 0; g = 0
+      do q = 1, m%nchain
+         associate (ch => m%chain(q))
+            do while (g < ch%glink)
+               g = g + 1; pos = pos + 1
+               lk(pos) = m%link_kind(g); la(pos) = m%link_a(g); lb(pos) = m%link_b(g)
+               lpar(:, pos) = m%link_par(:, g)
+            end do
+            do i = 1, ch%n
+               pos = pos + 1
+               la(pos) = ch%first + i - 1; lb(pos) = 0; lpar(:, pos) = 0.0_dp
+               lk(pos) = LINK_SPRING; lpar(L_STIFF, pos) = ch%k(i)
+               if (allocated(ch%fy)) then
+                  lk(pos) = LINK_BILINEAR; lpar(L_YIELD, pos) = ch%fy(i)
+                  lpar(L_HARDENING, pos) = ch%rho(i)
+               end if
+               if (.not. allocated(ch%c)) cycle
+               if (.not. (ch%c(i) > 0.0_dp)) cycle
+               pos = pos + 1
+               la(pos) = ch%first + i - 1; lb(pos) = 0; lpar(:, pos) = 0.0_dp
+               lk(pos) = LINK_DASHPOT; lpar(L_DAMP, pos) = ch%c(i)
+            end do
+         end associate
+      end do
+      do while (g < m%nlink)
+         g = g + 1; pos = pos + 1
+         lk(pos) = m%link_kind(g); la(pos) = m%link_a(g); lb(pos) = m%link_b(g)
+         lpar(:, pos) = m%link_par(:, g)
+      end do
+      pos = 0; g = 0
+      do q = 1, m%nchain
+         associate (ch => m%chain(q))
+            do while (g < ch%gcontact)
+               g = g + 1; pos = pos + 1
+               call copy_contact(g, pos)
+            end do
+            do i = 1, ch%ncontact
+               pos = pos + 1
+               ca(pos) = ch%first + i - 1; cb(pos) = ch%first + i; cg(pos) = ch%gap(i)
+               cs(pos) = ch%scheme; cl(pos) = ch%law; cpar(:, pos) = ch%par
+            end do
+         end associate
+      end do
+      do while (g < m%ncontact)
+         g = g + 1; pos = pos + 1
+         call copy_contact(g, pos)
+      end do
+      call move_alloc(lk, m%link_kind); call move_alloc(la, m%link_a)
+      call move_alloc(lb, m%link_b); call move_alloc(lpar, m%link_par)
+      call move_alloc(ca, m%con_a); call move_alloc(cb, m%con_b); call move_alloc(cs, m%con_scheme)
+      call move_alloc(cl, m%con_law); call move_alloc(cg, m%con_gap)
+      call move_alloc(cpar, m%con_par); call move_alloc(cm, m%con_mstar)
+      m%nlink = nl; m%ncontact = nc
+      deallocate (m%chain); m%nchain = 0
+   contains
+      subroutine copy_contact(from, to)
+         integer, intent(in) :: from, to
+         ca(to) = m%con_a(from); cb(to) = m%con_b(from); cg(to) = m%con_gap(from)
+         cs(to) = m%con_scheme(from); cl(to) = m%con_law(from); cpar(:, to) = m%con_par(:, from)
+      end subroutine copy_contact
+   end subroutine model_expand_chains
    !> For the impulse-level integrators: which contacts are rigid (restitution or Lagrange,
    !> solved by complementarity), their restitution (Lagrange without one: 0, plastic), and
    !> their moving sides — a side on ground or on a fixed node does not move, so its column of

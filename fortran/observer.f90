@@ -5,17 +5,19 @@
 !> increments and the phase changes they locate. results_t is what a finished run exposes
 !> (martello_api_results); observer_t adds the working state of the measurement.
 module martello_observer
+   use, intrinsic :: iso_fortran_env, only: int8
    use martello_kinds, only: dp, i8
    use martello_status
    use martello_model, only: model_t
    use martello_assembly, only: mech_state_t, kinetic_energy, recoverable_energy, mass_times, &
       load_breakpoint
    use martello_links, only: link_force, LINK_SPRING, LINK_BAR, LINK_BILINEAR, LINK_DASHPOT, &
-      LINK_FLUID_DAMPER, L_STIFF
+      LINK_FLUID_DAMPER, L_STIFF, NPAR_LINK
    use martello_contact_laws, only: contact_force, LAW_LINEAR, LAW_KELVIN, P_STIFF, P_DAMPING
    use martello_integrator_settings, only: integrator_settings_t, integrator_name
    use martello_run_quantities
-   use martello_registry, only: INTEGRATORS
+   use martello_registry, only: INTEGRATORS, TRACK_NODE_PEAKS, TRACK_LINK_PEAKS, &
+      TRACK_CONTACT_PEAKS, TRACK_PHASES, TRACK_ALL
    use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan, ieee_is_finite, ieee_is_nan
    use, intrinsic :: iso_c_binding, only: c_funptr, c_ptr, c_null_funptr, c_null_ptr, &
       c_associated, c_f_procpointer, c_int, c_double, c_long_long
@@ -25,15 +27,24 @@ module martello_observer
       observer_work, observer_open_phase, observer_close_phase, observer_add_impact, &
       observer_penalty_phases, observer_fail, observer_fail_nonfinite, observer_finish, &
       free_side_crossing, progress_callback, observer_extremum, observer_recorded, &
+      observer_node_peaks, observer_contact_peaks, observer_phase_peaks, observer_phase_change, &
+      observer_energy_due, observer_phase_lists, observer_events, tracks, TRACK_NODE_PEAKS, &
+      TRACK_LINK_PEAKS, TRACK_CONTACT_PEAKS, TRACK_PHASES, TRACK_ALL, &
       observer_peak, observer_peak_value, peak_items, observer_link_step_extremum, &
-      observer_link_step_peaks, &
-      PEAK_V, PEAK_A, PEAK_PEN, PEAK_FORCE, PEAK_LINK_FORCE, PEAK_LINK_DU, &
+      observer_step_max, observer_step_absmax, observer_a_parabolas, observer_a_candidate, &
+      observer_contact_step_peaks, raise_to, observer_node_samples, observer_node_turns, &
+      observer_node_step_extrema, PEAK_V, PEAK_A, PEAK_PEN, PEAK_FORCE, PEAK_LINK_FORCE, PEAK_LINK_DU, &
       NCOUNTERS, C_STEPS, C_REJECTED, C_NEWTON, C_RESIDUALS, C_FACTORIZATIONS, C_EVENTS, &
       C_JACOBIANS, C_ROOT_EVALS, C_CHATTER, NENERGY, E_KINETIC, E_RECOVERABLE, E_INPUT, E_DAMPING, &
       E_PLASTIC, E_CONTACT, E_BALANCE, E_INITIAL, E_IMPACT, NEVENT, EV_T_ON, EV_T_OFF, &
       EV_V_IN, EV_V_OUT, EV_MAX_PEN, EV_MAX_FORCE
 
    type :: results_t
+      !> what the run tracks (TRACK_* bits, martello_run_set_tracking): the arrays of what it
+      !> does not track have no entries (the accessors give NaN), its phases no rows;
+      !> impacts are always counted
+      integer :: tracking = TRACK_ALL
+      integer :: n_nodes = 0, n_contacts = 0, n_links = 0
       ! history: hist(:, k) = [t, (u, v, a of each output node), (δ, P of each output
       ! contact), (force, elongation of each output link), energy(1:NENERGY)]
       integer :: ncol = 0, nrec = 0
@@ -45,14 +56,14 @@ module martello_observer
       real(dp), allocatable :: ev(:, :)
       ! peaks over every accepted step and located inside the steps (docs/results.md): the
       ! adaptive methods hand theirs (observer_extremum, observer_peak), the fixed-step ones
-      ! are located on each step's polynomial (track)
+      ! are located on each step's polynomial (observer_node_peaks and the step routines)
       real(dp), allocatable :: u_max(:), u_min(:), v_absmax(:), a_absmax(:)
       !> the largest local maximum of u (u_peak at t_peak)
       real(dp), allocatable :: u_peak(:), t_peak(:)
       !> the largest |u| and its time
       real(dp), allocatable :: u_absmax(:), t_absmax(:)
       !> a fixed-step method: the extrema of u and v are located on each step's cubic Hermite
-      !> (hermite_extremum, hermite_v_extremum)
+      !> (hermite_extremum, observer_step_absmax)
       logical :: fixed_steps = .false.
       real(dp), allocatable :: pen_max(:), force_max(:)
       !> per link: max |force| and max |elongation| (storey shear and drift of a frame)
@@ -91,32 +102,42 @@ module martello_observer
       ! open contact phases: onset time and speed, running maxima of δ and P
       logical, allocatable :: ph_open(:)
       real(dp), allocatable :: ph_t(:), ph_v(:), ph_pen(:), ph_f(:)
-      ! the previous accepted state, for the interpolated peaks when the method keeps none
-      real(dp), allocatable :: prev_u(:), prev_v(:), prev_a(:)
+      !> past observer_phase_lists' number of contacts, a contact not listed in full keeps its
+      !> first and last phase alone, outside the event table: ph_kept(c) is how many of them
+      !> it has (0, 1, 2), LISTED for a contact whose every phase is a row. The first is
+      !> ev_first(:, c); the last is ph_t, ph_toff, ph_v, ph_vout, ph_pen, ph_f (the open
+      !> phase's state, which a closed phase leaves there). Not allocated: every phase is a row.
+      integer, allocatable :: ph_kept(:)
+      real(dp), allocatable :: ev_first(:, :), ph_toff(:), ph_vout(:)
+      !> the time of the previous sample (< 0: none yet)
       real(dp) :: prev_t = -1.0_dp
-      real(dp), allocatable :: work(:)          !< scratch (0:n): M v
-      !> a C integrator's accelerations (0:n), contact penetrations and forces
+      real(dp), allocatable :: work(:)          !< scratch (0:n): M v, at its first use
+      !> a C integrator's accelerations (0:n), contact penetrations and forces (allocated by
+      !> martello_observer_begin, martello_api_internal)
       real(dp), allocatable :: acc(:), c_pen(:), c_force(:)
       !> the fixed-step method's states lie on one smooth motion between the phase changes
       !> (not Moreau–Jean's velocity jumps): the peaks of a, δ, the contact and link forces
-      !> and elongations are located on its steps (track)
+      !> and elongations are located on its steps
       logical :: smooth_steps = .false.
       !> per node (0:n): the time of the last phase change (onset, separation, impact) of a
       !> contact at it; the chatter resolutions at the previous sample (the jumps of the
-      !> forces a located peak of |a| must not straddle)
+      !> forces a located peak of |a| must not straddle). con_nodes: each contact's nodes,
+      !> for the phase changes the method does not name them at (the fused chain step does)
       real(dp), allocatable :: node_change(:)
       integer, allocatable :: con_nodes(:, :)
       integer(i8) :: chatter_prev = 0_i8
-      !> per contact: its force and force rate at the previous sample, while in contact there;
-      !> the linear and Kelvin laws' k and c, contiguous (read at every step of a chain)
-      real(dp), allocatable :: c_prev_f(:), c_prev_fr(:), c_k(:), c_c(:)
-      !> the peak of |a| on fixed steps (a_parabolas): a sample k that raised it waits two
-      !> samples for the parabola through k − 1, k, k + 1 and the smoothness test with k + 2.
-      !> Per node: a at k − 1, k, k + 1 and the sample k of its latest candidate (a_gen);
-      !> the candidates of the last two samples (pend1: k = the last, pend2: the one before),
-      !> with the time and the chatter count of their sample k − 1
+      !> per contact, for the general fixed-step path: its force and force rate at the
+      !> previous sample (the fused chain step computes them again from its previous state)
+      real(dp), allocatable :: c_prev_f(:), c_prev_fr(:)
+      !> the peak of |a| on fixed steps (observer_a_parabolas): a sample k that raised it
+      !> waits two samples for the parabola through k − 1, k, k + 1 and the smoothness test
+      !> with k + 2. Per node: a at k − 1, k, k + 1 and the sample k of its latest candidate
+      !> modulo 256 (a_gen; the lists name the candidates of the last three samples at most,
+      !> so no two stamps in use are equal); the candidates of the last two samples (pend1:
+      !> k = the last, pend2: the one before), with the time and the chatter count of their
+      !> sample k − 1
       real(dp), allocatable :: a_m1(:), a_0(:), a_p1(:)
-      integer(i8), allocatable :: a_gen(:)
+      integer(int8), allocatable :: a_gen(:)
       integer, allocatable :: pend1(:), pend2(:)
       integer :: npend1 = 0, npend2 = 0
       real(dp) :: pend1_t0 = 0.0_dp, pend2_t0 = 0.0_dp
@@ -146,6 +167,8 @@ module martello_observer
    real(dp), parameter :: CREATED_BOUND = 1.0e-2_dp
    !> History rows allocated at the start; it grows by doubling beyond (record).
    integer, parameter :: HIST_START = 4096
+   !> ph_kept of a contact whose phases are all rows
+   integer, parameter :: LISTED = -huge(1)
 
    !> Samples of one observer_sample call: the grid point k as a default or a 64-bit integer.
    interface observer_sample
@@ -162,17 +185,25 @@ contains
    !> before it starts (every integrator takes at least one step per grid point);
    !> stat = MARTELLO_ERR_LIMIT, or MARTELLO_ERR_MEMORY if the arrays cannot be allocated.
    subroutine observer_init(o, s, n_nodes, n_contacts, out_nodes, out_contacts, capacity, &
-                            n_links, out_links, stat)
+                            n_links, out_links, stat, tracking)
       type(observer_t), intent(inout) :: o
       type(integrator_settings_t), intent(in) :: s
       integer, intent(in) :: n_nodes, n_contacts, out_nodes(:), out_contacts(:), capacity, &
                              n_links, out_links(:)
       integer, intent(out), optional :: stat
+      integer, intent(in), optional :: tracking
       type(observer_t) :: fresh
       real(dp) :: steps
-      integer :: st, st2
+      integer :: st, st2, nn, nl, ncp, nph
       o = fresh        ! every field at its default, every array deallocated
       if (present(stat)) stat = MARTELLO_OK
+      if (present(tracking)) o%tracking = tracking
+      o%n_nodes = n_nodes; o%n_contacts = n_contacts; o%n_links = n_links
+      ! the arrays of what the run does not track have no entries
+      nn = merge(n_nodes, 0, tracks(o, TRACK_NODE_PEAKS))
+      nl = merge(n_links, 0, tracks(o, TRACK_LINK_PEAKS))
+      ncp = merge(n_contacts, 0, tracks(o, TRACK_CONTACT_PEAKS))
+      nph = merge(n_contacts, 0, tracks(o, TRACK_PHASES))
       o%kind = s%kind
       if (s%kind >= 1 .and. s%kind <= size(INTEGRATORS)) o%fixed_steps = .not. INTEGRATORS(s%kind)%adaptive
       o%every = max(s%every, 1); o%divergence_factor = s%divergence_factor
@@ -193,16 +224,12 @@ contains
       o%ncol = 1 + 3*size(out_nodes) + 2*size(out_contacts) + 2*size(out_links) + NENERGY
       allocate (o%hist(o%ncol, max(min(capacity, HIST_START), 2)), o%ev(NEVENT, 16), o%ev_contact(16), &
                 stat=st)
-      allocate (o%u_max(n_nodes), o%u_min(n_nodes), o%v_absmax(n_nodes), o%a_absmax(n_nodes), &
-                o%pen_max(n_contacts), o%force_max(n_contacts), o%impacts(n_contacts), &
-                o%u_peak(n_nodes), o%t_peak(n_nodes), o%link_force_absmax(n_links), &
-                o%u_absmax(n_nodes), o%t_absmax(n_nodes), &
-                o%link_du_absmax(n_links), o%prev_u(n_nodes), o%prev_v(n_nodes), &
-                o%prev_a(n_nodes), o%work(0:n_nodes), o%acc(0:n_nodes), o%c_pen(n_contacts), &
-                o%c_force(n_contacts), o%ph_open(n_contacts), o%c_prev_f(n_contacts), &
-                o%c_prev_fr(n_contacts), o%a_m1(n_nodes), o%a_0(n_nodes), o%a_p1(n_nodes), &
-                o%a_gen(n_nodes), o%pend1(n_nodes), o%pend2(n_nodes), &
-                o%ph_t(n_contacts), o%ph_v(n_contacts), o%ph_pen(n_contacts), o%ph_f(n_contacts), &
+      allocate (o%u_max(nn), o%u_min(nn), o%v_absmax(nn), o%a_absmax(nn), &
+                o%pen_max(ncp), o%force_max(ncp), o%impacts(n_contacts), &
+                o%u_peak(nn), o%t_peak(nn), o%link_force_absmax(nl), &
+                o%u_absmax(nn), o%t_absmax(nn), &
+                o%link_du_absmax(nl), o%ph_open(n_contacts), &
+                o%ph_t(nph), o%ph_v(nph), o%ph_pen(nph), o%ph_f(nph), &
                 stat=st2)
       if (st /= 0 .or. st2 /= 0) then
          write (o%message, '(a,i0,a,i0,a)') 'out of memory allocating the results of a run of ', &
@@ -220,14 +247,15 @@ contains
       o%u_max = -huge(1.0_dp); o%u_min = huge(1.0_dp); o%v_absmax = 0.0_dp
       o%a_absmax = 0.0_dp; o%pen_max = -huge(1.0_dp); o%force_max = 0.0_dp; o%impacts = 0
       o%ph_open = .false.
-      o%c_prev_f = 0.0_dp; o%c_prev_fr = 0.0_dp; o%a_gen = -10_i8
    end subroutine observer_init
 
    !> The state at t = 0, before its first sample: the initial energies the balance starts
    !> from, and a phase opened at t = 0 for every penalty contact closed there. energy_interval: samples between energy evaluations (the strategy's choice: 16
    !> for cheap fixed steps, 1 for adaptive ones); advice ends a divergence message;
    !> ke_aMa: the method conserves ½vᵀMv − ke_aMa·aᵀMa (Verlet; 0 for the others).
-   subroutine observer_begin(o, m, ms, u, v, a, energy_interval, advice, ke_aMa)
+   !> energies = [kinetic, links, contacts]: a method that keeps its own element states (no
+   !> ms, the fused chain step) hands them, and has opened the phases at t = 0 itself.
+   subroutine observer_begin(o, m, ms, u, v, a, energy_interval, advice, ke_aMa, energies)
       type(observer_t), intent(inout) :: o
       type(model_t), intent(in) :: m
       type(mech_state_t), intent(in) :: ms
@@ -235,17 +263,28 @@ contains
       integer, intent(in) :: energy_interval
       character(len=*), intent(in) :: advice
       real(dp), intent(in) :: ke_aMa
+      real(dp), intent(in), optional :: energies(3)
       real(dp) :: e_kin
-      integer :: c
-      o%con_nodes = reshape([(m%con_a(c), m%con_b(c), c = 1, m%ncontact)], [2, m%ncontact])
-      o%c_k = m%con_par(P_STIFF, 1:m%ncontact)
-      o%c_c = merge(m%con_par(P_DAMPING, 1:m%ncontact), 0.0_dp, m%con_law(1:m%ncontact) == LAW_KELVIN)
-      allocate (o%node_change(0:m%n), source=-huge(1.0_dp))
-      do c = 1, m%ncontact
-         if (ms%con_on(c)) call observer_open_phase(o, c, 0.0_dp, v(m%con_a(c)) - v(m%con_b(c)))
-      end do
-      e_kin = kinetic_energy(m, v, o%work)
-      call recoverable_energy(m, ms, u, o%e_links0, o%e_cont0)
+      integer :: c, st
+      call located_peak_state(o, m%n, present(energies), st)
+      if (st /= 0) error stop 'martello: out of memory allocating the located peaks of a run'
+      if (present(energies)) then
+         e_kin = energies(1); o%e_links0 = energies(2); o%e_cont0 = energies(3)
+      else
+         if (o%smooth_steps) then
+            o%con_nodes = reshape([(m%con_a(c), m%con_b(c), c = 1, m%ncontact)], [2, m%ncontact])
+         end if
+         do c = 1, m%ncontact
+            if (ms%con_on(c)) call observer_open_phase(o, c, 0.0_dp, v(m%con_a(c)) - v(m%con_b(c)))
+            ! the force and its rate the first step's located peaks start from
+            if (allocated(o%c_prev_f)) &
+               call contact_force_rate(m, ms, c, v(m%con_a(c)) - v(m%con_b(c)), &
+                                       a(m%con_a(c)) - a(m%con_b(c)), o%c_prev_f(c), o%c_prev_fr(c))
+         end do
+         call scratch(o, m%n)
+         e_kin = kinetic_energy(m, v, o%work)
+         call recoverable_energy(m, ms, u, o%e_links0, o%e_cont0)
+      end if
       o%e0 = e_kin + o%e_links0 + o%e_cont0
       o%ke_aMa = ke_aMa
       ! the balance starts from the method's conserved energy e0 − ke_corr
@@ -253,6 +292,29 @@ contains
       o%energy_interval = max(energy_interval, 1)
       o%advice = advice
    end subroutine observer_begin
+
+   !> The working state of the located peaks of a smooth fixed-step method (smooth_steps):
+   !> the phase change times per node and the candidates of |a| where node peaks are
+   !> tracked, and, for a method that measures through observer_sample (not folded: the
+   !> general path), the contact forces and rates at the previous sample where a contact
+   !> peak or phase is tracked.
+   subroutine located_peak_state(o, n, folded, st)
+      type(observer_t), intent(inout) :: o
+      integer, intent(in) :: n
+      logical, intent(in) :: folded
+      integer, intent(out) :: st
+      integer :: nn, nc
+      st = 0
+      if (.not. o%smooth_steps) return
+      nn = merge(n, 0, tracks(o, TRACK_NODE_PEAKS))
+      allocate (o%node_change(0:nn), o%a_m1(nn), o%a_0(nn), o%a_p1(nn), o%a_gen(nn), &
+                o%pend1(nn), o%pend2(nn), stat=st)
+      if (st /= 0) return
+      o%node_change = -huge(1.0_dp)
+      if (folded .or. .not. (tracks(o, TRACK_CONTACT_PEAKS) .or. tracks(o, TRACK_PHASES))) return
+      nc = size(o%ph_open)
+      allocate (o%c_prev_f(nc), o%c_prev_fr(nc), source=0.0_dp, stat=st)
+   end subroutine located_peak_state
 
    !> Work increments of one step [J]: external, of the dampers, of the other links and of
    !> the penalty contacts (a fixed step: mech_commit's trapezoidal works), and the kinetic
@@ -285,9 +347,17 @@ contains
       real(dp), intent(in) :: a(0:)
       kc = 0.0_dp
       if (o%ke_aMa == 0.0_dp) return
+      call scratch(o, m%n)
       call mass_times(m, a, o%work)
       kc = o%ke_aMa*dot_product(a(1:m%n), o%work(1:m%n))
    end function kinetic_correction
+
+   !> o%work (0:n), allocated at its first use.
+   subroutine scratch(o, n)
+      type(observer_t), intent(inout) :: o
+      integer, intent(in) :: n
+      if (.not. allocated(o%work)) allocate (o%work(0:n))
+   end subroutine scratch
 
    !> The recording cadence: t = 0, every every-th output grid point, and the last one.
    pure logical function recorded(o, k)
@@ -305,14 +375,32 @@ contains
       observer_recorded = recorded(o, k)
    end function observer_recorded
 
+   !> Whether the next sample, at grid point k, evaluates the energy terms: where recorded,
+   !> every energy_interval-th sample and once a work is not finite (a method that hands
+   !> its energies to observer_sample computes them then).
+   logical function observer_energy_due(o, k) result(due)
+      type(observer_t), intent(in) :: o
+      integer(i8), intent(in) :: k
+      due = recorded(o, k) .or. mod(o%nsamples + 1, int(o%energy_interval, i8)) == 0 .or. &
+            .not. ieee_is_finite(o%w_last + o%d_damp + o%d_links + o%d_contact + o%d_impact)
+   end function observer_energy_due
+
    !> An accepted state at t (once per accepted step and at t = 0, after the step's phase
    !> changes): phase maxima and peaks; the energy terms and the divergence test where
    !> recorded, every energy_interval-th sample and once a work is not finite; a history row
    !> where recorded. k: the grid point t = k·dt of the state, or −1. u, v, a on nodes 0:n;
    !> u_prev … the previous state if the method keeps it (saves a copy). stat:
    !> MARTELLO_ERR_DIVERGED, with the message, when the run must stop.
+   !> folded: the method has measured this state item by item in its own sweeps, the
+   !> extrema inside the step included (observer_a_parabolas, observer_node_peaks,
+   !> observer_a_candidate, observer_contact_step_peaks, observer_phase_change,
+   !> observer_phase_peaks, observer_contact_peaks, the link peaks: the fused chain step);
+   !> pen, force (and link_f, link_du) then serve the history row alone, and are read only
+   !> where recorded.
+   !> energies = [kinetic, links, contacts] at this state, from such a method where
+   !> observer_energy_due (it keeps no ms).
    subroutine observer_sample_i8(o, m, ms, t, u, v, a, pen, force, k, stat, link_f, link_du, &
-                                 u_prev, v_prev, a_prev)
+                                 u_prev, v_prev, a_prev, folded, energies)
       type(observer_t), intent(inout) :: o
       type(model_t), intent(in) :: m
       type(mech_state_t), intent(in) :: ms
@@ -320,23 +408,35 @@ contains
       integer(i8), intent(in) :: k
       integer, intent(out) :: stat
       real(dp), intent(in), optional :: link_f(:), link_du(:), u_prev(:), v_prev(:), a_prev(:)
+      logical, intent(in), optional :: folded
+      real(dp), intent(in), optional :: energies(3)
       real(dp) :: e_kin, e_links, e_cont, kc
-      logical :: due
-      integer :: c
+      logical :: due, measured
       stat = MARTELLO_OK
+      due = observer_energy_due(o, k)
       o%nsamples = o%nsamples + 1
-      due = recorded(o, k) .or. mod(o%nsamples, int(o%energy_interval, i8)) == 0 .or. &
-            .not. ieee_is_finite(o%w_last + o%d_damp + o%d_links + o%d_contact + o%d_impact)
-      do c = 1, size(pen)
-         if (.not. o%ph_open(c)) cycle
-         o%ph_pen(c) = max(o%ph_pen(c), pen(c)); o%ph_f(c) = max(o%ph_f(c), force(c))
-      end do
-      call track(o, m, ms, t, u(1:), v(1:), a(1:), pen, force, link_f, link_du, u_prev, v_prev, &
-                 a_prev)
+      measured = .false.
+      if (present(folded)) measured = folded
+      if (.not. measured) then
+         if (tracks(o, TRACK_PHASES)) &
+            call observer_phase_peaks(o%ph_open(1:size(pen)), pen, force, o%ph_pen(1:size(pen)), &
+                                      o%ph_f(1:size(pen)))
+         if (tracks(o, TRACK_CONTACT_PEAKS)) &
+            call observer_contact_peaks(pen, force, o%pen_max(1:size(pen)), o%force_max(1:size(pen)))
+         call track(o, m, t, u(1:), v(1:), a(1:), link_f, link_du, u_prev, v_prev, a_prev)
+      end if
+      ! the next step's start
+      if (o%smooth_steps) o%chatter_prev = o%counters(C_CHATTER)
+      o%prev_t = t
       if (due) then
-         e_kin = kinetic_energy(m, v, o%work)
+         if (present(energies)) then
+            e_kin = energies(1); e_links = energies(2); e_cont = energies(3)
+         else
+            call scratch(o, m%n)
+            e_kin = kinetic_energy(m, v, o%work)
+            call recoverable_energy(m, ms, u, e_links, e_cont)
+         end if
          kc = kinetic_correction(o, m, a)
-         call recoverable_energy(m, ms, u, e_links, e_cont)
          o%energy = energy_terms(o%e0, o%w_ext, e_kin, e_links, e_cont, o%e_links0, o%e_cont0, &
                                  o%d_damp, o%d_links, o%d_contact, o%d_impact, kc, o%ke_corr0)
          o%energy_balance_max = max(o%energy_balance_max, abs(o%energy(E_BALANCE)))
@@ -353,7 +453,7 @@ contains
 
    !> observer_sample with the grid point k as a default integer (the C door, k ≤ 2^31).
    subroutine observer_sample_i4(o, m, ms, t, u, v, a, pen, force, k, stat, link_f, link_du, &
-                                 u_prev, v_prev, a_prev)
+                                 u_prev, v_prev, a_prev, folded, energies)
       type(observer_t), intent(inout) :: o
       type(model_t), intent(in) :: m
       type(mech_state_t), intent(in) :: ms
@@ -361,8 +461,10 @@ contains
       integer, intent(in) :: k
       integer, intent(out) :: stat
       real(dp), intent(in), optional :: link_f(:), link_du(:), u_prev(:), v_prev(:), a_prev(:)
+      logical, intent(in), optional :: folded
+      real(dp), intent(in), optional :: energies(3)
       call observer_sample_i8(o, m, ms, t, u, v, a, pen, force, int(k, i8), stat, link_f, &
-                              link_du, u_prev, v_prev, a_prev)
+                              link_du, u_prev, v_prev, a_prev, folded, energies)
    end subroutine observer_sample_i4
 
    !> The budget and the caller, after every accepted sample: max_steps (every sample),
@@ -483,9 +585,10 @@ contains
       integer, intent(in) :: c
       real(dp), intent(in) :: t_on, v_in
       o%ph_open(c) = .true.
-      o%ph_t(c) = t_on; o%ph_v(c) = v_in; o%ph_pen(c) = 0.0_dp; o%ph_f(c) = 0.0_dp
       o%impacts(c) = o%impacts(c) + 1
       call phase_change(o, c, t_on)
+      if (.not. tracks(o, TRACK_PHASES)) return
+      o%ph_t(c) = t_on; o%ph_v(c) = v_in; o%ph_pen(c) = 0.0_dp; o%ph_f(c) = 0.0_dp
    end subroutine observer_open_phase
 
    !> Contact c ends its phase at t_off, leaving at v_out. pen, force: the contact's state at
@@ -496,21 +599,13 @@ contains
       integer, intent(in) :: c
       real(dp), intent(in) :: t_off, v_out
       real(dp), intent(in), optional :: pen, force
-      if (present(pen)) o%ph_pen(c) = max(o%ph_pen(c), pen)
-      if (present(force)) o%ph_f(c) = max(o%ph_f(c), force)
-      call add_event(o, c, [o%ph_t(c), t_off, o%ph_v(c), v_out, o%ph_pen(c), o%ph_f(c)])
       o%ph_open(c) = .false.
       call phase_change(o, c, t_off)
+      if (.not. tracks(o, TRACK_PHASES)) return
+      if (present(pen)) o%ph_pen(c) = max(o%ph_pen(c), pen)
+      if (present(force)) o%ph_f(c) = max(o%ph_f(c), force)
+      call keep_event(o, c, [o%ph_t(c), t_off, o%ph_v(c), v_out, o%ph_pen(c), o%ph_f(c)])
    end subroutine observer_close_phase
-
-   !> Contact c changed phase at t: its nodes' forces jump or kink there.
-   subroutine phase_change(o, c, t)
-      type(observer_t), intent(inout) :: o
-      integer, intent(in) :: c
-      real(dp), intent(in) :: t
-      if (.not. allocated(o%con_nodes)) return
-      o%node_change(o%con_nodes(:, c)) = max(o%node_change(o%con_nodes(:, c)), t)
-   end subroutine phase_change
 
    !> An instantaneous phase of contact c at t (an impact resolved by an impulse): approach
    !> and separation speeds, penetration and force (or impulse) at the impact.
@@ -518,42 +613,145 @@ contains
       type(observer_t), intent(inout) :: o
       integer, intent(in) :: c
       real(dp), intent(in) :: t, v_in, v_out, pen, force
-      call add_event(o, c, [t, t, v_in, v_out, pen, force])
+      if (tracks(o, TRACK_PHASES)) call keep_event(o, c, [t, t, v_in, v_out, pen, force])
       o%impacts(c) = o%impacts(c) + 1
       call phase_change(o, c, t)
    end subroutine observer_add_impact
+
+   !> Contact c changed phase at t: its nodes' forces jump or kink there (node_change, read
+   !> by observer_a_parabolas). nodes: the contact's, where the method names them (the
+   !> fused chain step keeps no table of them); else con_nodes.
+   subroutine phase_change(o, c, t, nodes)
+      type(observer_t), intent(inout) :: o
+      integer, intent(in) :: c
+      real(dp), intent(in) :: t
+      integer, intent(in), optional :: nodes(2)
+      integer :: k, j
+      if (.not. allocated(o%node_change)) return
+      if (size(o%node_change) < 2) return           ! node peaks not tracked
+      do k = 1, 2
+         if (present(nodes)) then
+            j = nodes(k)
+         else if (allocated(o%con_nodes)) then
+            j = o%con_nodes(k, c)
+         else
+            return
+         end if
+         o%node_change(j) = max(o%node_change(j), t)
+      end do
+   end subroutine phase_change
 
    !> Phases of the penalty contacts of a fixed step (t − h, t], from the committed state
    !> ms: a contact that closed starts a phase at the onset located on the free side of the
    !> step by the quadratic δ + δ̇τ + ½δ̈τ² = 0 from the start (O(h³) in time, speed
    !> extrapolated likewise; one event of the method); one that opened ends it at the
    !> separation located likewise back from the end. un … the state at t − h, u … at t.
+   !> On a smooth method's step (smooth_steps), a phase spanning the step also has its
+   !> maxima located inside it (observer_step_max).
    subroutine observer_penalty_phases(o, m, ms, un, vn, an, u, v, a, t, h)
       type(observer_t), intent(inout) :: o
       type(model_t), intent(in) :: m
       type(mech_state_t), intent(in) :: ms
       real(dp), intent(in) :: un(0:), vn(0:), an(0:), u(0:), v(0:), a(0:), t, h
       integer :: c, ia, ib
-      real(dp) :: d0, r0, q0, tau
+      real(dp) :: f, fr
+      logical :: located
+      located = allocated(o%c_prev_f) .and. o%prev_t >= 0.0_dp .and. t > o%prev_t
       do c = 1, m%ncontact
          if (.not. ms%is_penalty(c)) cycle
          ia = m%con_a(c); ib = m%con_b(c)
-         if (.not. o%ph_open(c) .and. ms%con_on(c)) then
-            d0 = un(ia) - un(ib) - m%con_gap(c); r0 = vn(ia) - vn(ib); q0 = an(ia) - an(ib)
-            tau = free_side_crossing(d0, r0, q0, 0.0_dp, h)
-            call observer_open_phase(o, c, t - h + tau, r0 + q0*tau)
-            o%counters(C_EVENTS) = o%counters(C_EVENTS) + 1_i8
+         if (located) then
+            call contact_force_rate(m, ms, c, v(ia) - v(ib), a(ia) - a(ib), f, fr)
+            call observer_contact_step_peaks(o, c, o%ph_open(c) .and. ms%con_on(c), t - o%prev_t, &
+                                       un(ia) - un(ib) - m%con_gap(c), vn(ia) - vn(ib), &
+                                       o%c_prev_f(c), o%c_prev_fr(c), ms%con_pen(c), &
+                                       v(ia) - v(ib), f, fr)
+            o%c_prev_f(c) = f; o%c_prev_fr(c) = fr
          end if
-         if (o%ph_open(c)) then
-            o%ph_pen(c) = max(o%ph_pen(c), ms%con_pen(c)); o%ph_f(c) = max(o%ph_f(c), ms%con_f(c))
-            if (.not. ms%con_on(c)) then
-               d0 = u(ia) - u(ib) - m%con_gap(c); r0 = v(ia) - v(ib); q0 = a(ia) - a(ib)
-               tau = free_side_crossing(d0, r0, q0, -h, 0.0_dp)
-               call observer_close_phase(o, c, t + tau, r0 + q0*tau)
-            end if
-         end if
+         if (ms%con_on(c) .neqv. o%ph_open(c)) &
+            call observer_phase_change(o, c, ms%con_on(c), ms%con_pen(c), ms%con_f(c), &
+                                       un(ia) - un(ib) - m%con_gap(c), vn(ia) - vn(ib), &
+                                       an(ia) - an(ib), u(ia) - u(ib) - m%con_gap(c), v(ia) - v(ib), &
+                                       a(ia) - a(ib), t, h)
+         if (tracks(o, TRACK_PHASES)) call observer_phase_peaks(o%ph_open(c), ms%con_pen(c), &
+                                                               ms%con_f(c), o%ph_pen(c), o%ph_f(c))
       end do
    end subroutine observer_penalty_phases
+
+   !> The force f of penalty contact c of the committed state ms and its rate
+   !> Ṗ = P_δ δ̇ + P_δ̇ δ̈ from the law's tangents (the linear and Kelvin laws in line), at
+   !> the rates r = δ̇, q = δ̈ (0 where the contact does not push).
+   subroutine contact_force_rate(m, ms, c, r, q, f, fr)
+      type(model_t), intent(in) :: m
+      type(mech_state_t), intent(in) :: ms
+      integer, intent(in) :: c
+      real(dp), intent(in) :: r, q
+      real(dp), intent(out) :: f, fr
+      real(dp) :: fl, dfd, dfv
+      f = ms%con_f(c); fr = 0.0_dp
+      if (.not. (f > 0.0_dp .and. ms%con_pen(c) > 0.0_dp)) return
+      select case (m%con_law(c))
+      case (LAW_LINEAR)
+         fr = m%con_par(P_STIFF, c)*r
+      case (LAW_KELVIN)
+         fr = m%con_par(P_STIFF, c)*r + m%con_par(P_DAMPING, c)*q
+      case default
+         call contact_force(m%con_law(c), m%con_par(:, c), m%con_mstar(c), ms%con_pen(c), r, &
+                            ms%con_vin(c), fl, dfd, dfv)
+         fr = dfd*r + dfv*q
+      end select
+   end subroutine contact_force_rate
+
+   !> The maxima of penalty contact c located inside a smooth fixed step of h (the one
+   !> procedure of the general path and the fused chain step), while its phase spans the
+   !> step (spans: open at both ends, the phase change of the step not yet handed over) and
+   !> δ > 0 at both ends: δ on the cubic Hermite of (δ, δ̇) from (d0, r0) to (d1, r1), the
+   !> force on that of (P, Ṗ) from (f0, fr0) to (f1, fr1) where the law pushes at both ends
+   !> (a clipped Kelvin past its cut-off, or a contact the chatter rule holds open, does
+   !> not). O(h⁴) in the value where the law is smooth over the step (docs/results.md).
+   !> Into the run's and the phase's maxima, as tracked.
+   subroutine observer_contact_step_peaks(o, c, spans, h, d0, r0, f0, fr0, d1, r1, f1, fr1)
+      type(observer_t), intent(inout) :: o
+      integer, intent(in) :: c
+      logical, intent(in) :: spans
+      real(dp), intent(in) :: h, d0, r0, f0, fr0, d1, r1, f1, fr1
+      real(dp) :: dm, fm
+      if (.not. (spans .and. d0 > 0.0_dp .and. d1 > 0.0_dp)) return
+      dm = observer_step_max(h, d0, r0, d1, r1)
+      fm = -huge(1.0_dp)
+      if (f0 > 0.0_dp .and. f1 > 0.0_dp) fm = observer_step_max(h, f0, fr0, f1, fr1)
+      if (tracks(o, TRACK_CONTACT_PEAKS)) call observer_contact_peaks(dm, fm, o%pen_max(c), &
+                                                                      o%force_max(c))
+      if (tracks(o, TRACK_PHASES)) call observer_phase_peaks(.true., dm, fm, o%ph_pen(c), o%ph_f(c))
+   end subroutine observer_contact_step_peaks
+
+   !> Penalty contact c opens (on) or closes (not on) in the fixed step (t − h, t], its
+   !> phase being closed or open: a phase starts at the onset located on the free side of the
+   !> step by the quadratic δ + δ̇τ + ½δ̈τ² = 0 from the start (O(h³) in time, speed
+   !> extrapolated likewise; one event of the method), or ends, its maxima taken with the
+   !> contact's state at t (pen, force), at the separation located likewise back from the
+   !> end. d0, r0, q0 and d1, r1, q1: δ, δ̇, δ̈ at t − h and at t. A method that measures its
+   !> contacts in its own sweep (the fused chain step) calls this where on differs from
+   !> o%ph_open(c) (after observer_contact_step_peaks), then observer_phase_peaks and
+   !> observer_contact_peaks; nodes: the contact's, which it names (phase_change).
+   subroutine observer_phase_change(o, c, on, pen, force, d0, r0, q0, d1, r1, q1, t, h, nodes)
+      type(observer_t), intent(inout) :: o
+      integer, intent(in) :: c
+      logical, intent(in) :: on
+      real(dp), intent(in) :: pen, force, d0, r0, q0, d1, r1, q1, t, h
+      integer, intent(in), optional :: nodes(2)
+      real(dp) :: tau
+      if (on) then
+         tau = free_side_crossing(d0, r0, q0, 0.0_dp, h)
+         call observer_open_phase(o, c, t - h + tau, r0 + q0*tau)
+         o%counters(C_EVENTS) = o%counters(C_EVENTS) + 1_i8
+         if (present(nodes)) call phase_change(o, c, t - h + tau, nodes)
+      else
+         tau = free_side_crossing(d1, r1, q1, -h, 0.0_dp)
+         call observer_close_phase(o, c, t + tau, r1 + q1*tau, pen, force)
+         if (present(nodes)) call phase_change(o, c, t + tau, nodes)
+      end if
+   end subroutine observer_phase_change
 
    !> Event location on the free side of a step: the first root of d + rate·τ + ½acc·τ² in
    !> [lo, hi] (O(h³) in time when the free motion is smooth); linear fallback, else hi.
@@ -646,6 +844,71 @@ contains
       r%hist(c + 1:c + NENERGY, k) = r%energy
    end subroutine record
 
+   !> Which contacts keep every phase (docs/results.md): all of them while the scene has at
+   !> most max_contacts contacts (max_contacts < 0: always); past it, the history's output
+   !> contacts, and the others their first and last phase alone (keep_event). After
+   !> observer_init.
+   subroutine observer_phase_lists(o, max_contacts)
+      type(observer_t), intent(inout) :: o
+      integer, intent(in) :: max_contacts
+      integer :: nc
+      if (allocated(o%ph_kept)) deallocate (o%ph_kept, o%ev_first, o%ph_toff, o%ph_vout)
+      nc = size(o%ph_open)
+      if (max_contacts < 0 .or. nc <= max_contacts .or. .not. tracks(o, TRACK_PHASES)) return
+      allocate (o%ph_kept(nc), o%ev_first(NEVENT, nc), o%ph_toff(nc), o%ph_vout(nc))
+      o%ph_kept = 0
+      o%ph_kept(o%out_contacts) = LISTED
+   end subroutine observer_phase_lists
+
+   !> A phase of contact c ends: an event row, or for a contact that keeps its first and
+   !> last phase alone (observer_phase_lists), its first phase, then its last one, in place.
+   subroutine keep_event(o, c, values)
+      type(observer_t), intent(inout) :: o
+      integer, intent(in) :: c
+      real(dp), intent(in) :: values(NEVENT)
+      if (.not. allocated(o%ph_kept)) then
+         call add_event(o, c, values); return
+      end if
+      select case (o%ph_kept(c))
+      case (LISTED)
+         call add_event(o, c, values)
+      case (0)
+         o%ev_first(:, c) = values; o%ph_kept(c) = 1
+      case default
+         o%ph_t(c) = values(EV_T_ON); o%ph_toff(c) = values(EV_T_OFF)
+         o%ph_v(c) = values(EV_V_IN); o%ph_vout(c) = values(EV_V_OUT)
+         o%ph_pen(c) = values(EV_MAX_PEN); o%ph_f(c) = values(EV_MAX_FORCE)
+         o%ph_kept(c) = 2
+      end select
+   end subroutine keep_event
+
+   !> The contact phases a finished run lists (martello_run_events): the rows of the event
+   !> table, then the first and last phase of each contact that keeps them alone
+   !> (observer_phase_lists). n: their number; contact (0-based) and values filled when
+   !> present.
+   subroutine observer_events(o, n, contact, values)
+      type(observer_t), intent(in) :: o
+      integer, intent(out) :: n
+      integer, intent(out), optional :: contact(:)
+      real(dp), intent(out), optional :: values(:, :)
+      integer :: c
+      n = o%nevents
+      if (present(contact)) contact(1:n) = o%ev_contact(1:n) - 1
+      if (present(values)) values(:, 1:n) = o%ev(:, 1:n)
+      if (.not. allocated(o%ph_kept)) return
+      do c = 1, size(o%ph_kept)
+         if (o%ph_kept(c) == LISTED .or. o%ph_kept(c) == 0) cycle
+         n = n + 1
+         if (present(contact)) contact(n) = c - 1
+         if (present(values)) values(:, n) = o%ev_first(:, c)
+         if (o%ph_kept(c) < 2) cycle
+         n = n + 1
+         if (present(contact)) contact(n) = c - 1
+         if (present(values)) values(:, n) = [o%ph_t(c), o%ph_toff(c), o%ph_v(c), o%ph_vout(c), &
+                                              o%ph_pen(c), o%ph_f(c)]
+      end do
+   end subroutine observer_events
+
    subroutine add_event(r, contact, values)
       class(results_t), intent(inout) :: r
       integer, intent(in) :: contact
@@ -663,115 +926,49 @@ contains
       r%ev_contact(r%nevents) = contact
    end subroutine add_event
 
-   !> Peaks over every accepted state: extremes of u, |v|, |a|, penetration and force; on the
-   !> steps of a fixed-step method also the extrema inside them (hermite_extremum: u max,
-   !> min, |u| and the largest local maximum u_peak; hermite_v_extremum; the parabola of |a|;
-   !> contact_step_peaks, observer_link_step_extremum; docs/results.md). The adaptive
-   !> methods hand theirs (observer_extremum, observer_peak).
-   subroutine track(o, m, ms, t, u, v, a, pen, force, link_f, link_du, u_prev, v_prev, a_prev)
+   !> Peaks over every accepted state (after the step's phase changes): the node peaks
+   !> (observer_node_peaks) and, when the link states are given, the link peaks; on the
+   !> steps of a fixed-step method given the previous state (u_prev …) also the extrema inside
+   !> them: of u and v on every fixed step, of |a| (observer_a_parabolas) and of the links
+   !> (link_step_peaks) on a smooth one (docs/results.md). The contact maxima inside the
+   !> steps are observer_penalty_phases'. The adaptive methods hand theirs
+   !> (observer_extremum, observer_peak).
+   subroutine track(o, m, t, u, v, a, link_f, link_du, u_prev, v_prev, a_prev)
       type(observer_t), intent(inout) :: o
       type(model_t), intent(in) :: m
-      type(mech_state_t), intent(in) :: ms
-      real(dp), intent(in) :: t, u(:), v(:), a(:), pen(:), force(:)
+      real(dp), intent(in) :: t, u(:), v(:), a(:)
       real(dp), intent(in), optional :: link_f(:), link_du(:)
       real(dp), intent(in), optional :: u_prev(:), v_prev(:), a_prev(:)
       integer :: i
-      real(dp) :: h
-      logical :: stepped
-      h = t - o%prev_t
-      stepped = o%smooth_steps .and. o%prev_t >= 0.0_dp .and. h > 0.0_dp
-      if (present(u_prev)) then
-         if (stepped) call a_parabolas()
-         call peaks(u_prev, v_prev, a_prev)
+      logical :: stepped, raised
+      stepped = o%smooth_steps .and. o%prev_t >= 0.0_dp .and. t > o%prev_t .and. present(u_prev)
+      if (.not. tracks(o, TRACK_NODE_PEAKS)) then
+         ! nothing of the nodes
+      else if (present(u_prev)) then
+         if (stepped) call observer_a_parabolas(o, m, t, a, o%nsamples)
+         do i = 1, size(u)
+            call observer_node_peaks(t, o%prev_t, o%fixed_steps, u_prev(i), v_prev(i), a_prev(i), &
+                                     u(i), v(i), a(i), o%u_max(i), o%u_min(i), o%v_absmax(i), &
+                                     o%a_absmax(i), o%u_absmax(i), o%t_absmax(i), o%u_peak(i), &
+                                     o%t_peak(i), raised)
+            if (raised .and. stepped) call observer_a_candidate(o, i, a_prev(i), a(i), o%nsamples)
+         end do
       else
-         call peaks(o%prev_u, o%prev_v, o%prev_a)
-         o%prev_u = u; o%prev_v = v; o%prev_a = a
+         ! no previous state (an adaptive method, which locates its own): the samples alone
+         do i = 1, size(u)
+            call observer_node_peaks(t, -1.0_dp, .false., u(i), v(i), a(i), u(i), v(i), a(i), &
+                                     o%u_max(i), o%u_min(i), o%v_absmax(i), o%a_absmax(i), &
+                                     o%u_absmax(i), o%t_absmax(i), o%u_peak(i), o%t_peak(i), raised)
+         end do
       end if
-      ! the maxima are stored only when they change: a peak array is then read, not
-      ! rewritten, at every step (these passes are a fair part of a chain step's memory traffic)
-      do i = 1, size(pen)
-         if (pen(i) > o%pen_max(i)) o%pen_max(i) = pen(i)
-         if (force(i) > o%force_max(i)) o%force_max(i) = force(i)
-      end do
-      if (present(link_f) .and. present(link_du)) then
+      if (present(link_f) .and. present(link_du) .and. tracks(o, TRACK_LINK_PEAKS)) then
          do i = 1, size(link_f)
             call raise_to(o%link_force_absmax(i), abs(link_f(i)))
             call raise_to(o%link_du_absmax(i), abs(link_du(i)))
          end do
+         if (stepped) call link_step_peaks(o, m, t - o%prev_t, u_prev, v_prev, a_prev, u, v, a, &
+                                           link_f)
       end if
-      if (stepped .and. present(u_prev)) then
-         call contact_step_peaks(o, m, ms, o%prev_t, h, u_prev, v_prev, v, a, pen, force)
-         if (present(link_f)) call observer_link_step_peaks(o, m, ms, h, u_prev, v_prev, a_prev, &
-                                                            u, v, a, link_f)
-      end if
-      if (o%smooth_steps) o%chatter_prev = o%counters(C_CHATTER)
-      o%prev_t = t
-   contains
-      subroutine peaks(un, vn, an)
-         real(dp), intent(in) :: un(:), vn(:), an(:)
-         associate (umax => o%u_max, umin => o%u_min, vmax => o%v_absmax, amax => o%a_absmax, &
-                    upk => o%u_peak, tpk => o%t_peak)
-            do i = 1, size(u)
-               if (u(i) > umax(i)) umax(i) = u(i)
-               if (u(i) < umin(i)) umin(i) = u(i)
-               if (abs(v(i)) > vmax(i)) vmax(i) = abs(v(i))
-               if (abs(a(i)) > amax(i)) then
-                  amax(i) = abs(a(i))
-                  ! a new sampled peak of |a|: located on the parabola through this sample,
-                  ! the one before and the next (a_parabolas)
-                  if (stepped) then
-                     o%npend1 = o%npend1 + 1; o%pend1(o%npend1) = i
-                     o%a_m1(i) = an(i); o%a_0(i) = a(i); o%a_gen(i) = o%nsamples
-                  end if
-               end if
-               call fold_absmax(o, i, t, u(i))
-               if (o%fixed_steps .and. o%prev_t >= 0.0_dp .and. h > 0.0_dp) then
-                  call hermite_extremum(o, i, o%prev_t, h, un(i), vn(i), an(i), u(i), v(i), a(i))
-                  call hermite_v_extremum(vmax(i), h, vn(i), an(i), v(i), a(i))
-                  ! a maximum on the step's end
-                  if (vn(i) > 0.0_dp .and. v(i) == 0.0_dp .and. u(i) > upk(i)) then
-                     upk(i) = u(i); tpk(i) = t
-                  end if
-               end if
-            end do
-         end associate
-      end subroutine peaks
-
-      !> The peak of |a| between the samples: a sample k that raised it (a candidate) is the
-      !> middle of the parabola through k − 1, k, k + 1, whose vertex (equal steps; inside
-      !> the middle step when the middle sample is the largest) is O(h³) in a, below the O(h²)
-      !> of the steps, if a is smooth there: no jump of the forces (a phase change of a
-      !> contact at the node, a chatter resolution, a kink of a load) from k − 1 to k + 2,
-      !> and no kink — the second differences at k and k + 1 agree to half their size (a slope
-      !> kink at the peak, as a bilinear spring's yield onto a flat line, makes them differ by
-      !> O(h); its vertex would overshoot by O(h)). Candidates of sample k are completed here
-      !> at k + 1 (a_p1) and decided at k + 2.
-      subroutine a_parabolas()
-         integer :: k, j
-         real(dp) :: ym, y0, yp, yq, d2, sg
-         logical :: smooth
-         if (o%npend2 > 0) then
-            smooth = o%counters(C_CHATTER) == o%pend2_stamp .and. load_breakpoint(m, o%pend2_t0) > t
-            do k = 1, o%npend2
-               j = o%pend2(k)
-               if (.not. smooth .or. o%a_gen(j) /= o%nsamples - 2 .or. o%node_change(j) > o%pend2_t0) cycle
-               sg = sign(1.0_dp, o%a_0(j))
-               ym = sg*o%a_m1(j); y0 = sg*o%a_0(j); yp = sg*o%a_p1(j); yq = sg*a(j)
-               d2 = ym - 2.0_dp*y0 + yp
-               if (.not. (y0 >= ym .and. y0 >= yp .and. d2 < 0.0_dp)) cycle
-               if (abs((y0 - 2.0_dp*yp + yq) - d2) > 0.5_dp*abs(d2)) cycle
-               o%a_absmax(j) = max(o%a_absmax(j), y0 - (yp - ym)**2/(8.0_dp*d2))
-            end do
-         end if
-         ! the last sample's candidates, completed with this one's a
-         do k = 1, o%npend1
-            j = o%pend1(k)
-            o%pend2(k) = j
-            if (o%a_gen(j) == o%nsamples - 1) o%a_p1(j) = a(j)
-         end do
-         o%npend2 = o%npend1; o%pend2_t0 = o%pend1_t0; o%pend2_stamp = o%pend1_stamp
-         o%npend1 = 0; o%pend1_t0 = o%prev_t; o%pend1_stamp = o%chatter_prev
-      end subroutine a_parabolas
    end subroutine track
 
    !> x(i) of a node array on 1..n, 0 for the ground (i = 0)
@@ -784,7 +981,7 @@ contains
 
    !> x ← max(x, y), the NaN x starts from replaced without comparing it (an ordered
    !> comparison with a NaN raises the invalid flag: a trap under -ffpe-trap=invalid)
-   pure subroutine raise_to(x, y)
+   elemental subroutine raise_to(x, y)
       real(dp), intent(inout) :: x
       real(dp), intent(in) :: y
       if (ieee_is_nan(x)) then
@@ -794,199 +991,330 @@ contains
       end if
    end subroutine raise_to
 
-   !> The peaks of the penalty contacts inside a fixed step [t0, t0 + h] from (un, vn) to
-   !> (v, a; δ in pen) (nodes 1..n), while the contact's phase spans the whole step: δ on the cubic
-   !> Hermite of (δ, δ̇) at both ends, the force on the cubic Hermite of (P, Ṗ) with
-   !> Ṗ = P_δ δ̇ + P_δ̇ δ̈ from the law's tangents (contact_force) where the law pushes at both
-   !> ends (a contact held open by the chatter rule, or a clipped Kelvin past its cut-off,
-   !> does not). O(h⁴) in the value where the law is smooth over the step (docs/results.md).
-   subroutine contact_step_peaks(o, m, ms, t0, h, un, vn, v, a, pen, force)
+   !> The peaks of every link inside a smooth fixed step of h from (un, vn, an) to (u, v, a)
+   !> (nodes 1..n), f1 the link forces at its end (observer_link_step_extremum): only a step
+   !> where du̇ (or, for a damper, dü) changes sign holds one.
+   subroutine link_step_peaks(o, m, h, un, vn, an, u, v, a, f1)
       type(observer_t), intent(inout) :: o
       type(model_t), intent(in) :: m
-      type(mech_state_t), intent(in) :: ms
-      real(dp), intent(in) :: t0, h, un(:), vn(:), v(:), a(:), pen(:), force(:)
-      integer :: c, ia, ib
-      real(dp) :: d0, r0, r1, q1, f, dfd, dfv, fr1
-      do c = 1, m%ncontact
-         if (.not. (pen(c) > 0.0_dp)) cycle
-         if (.not. ms%is_penalty(c)) cycle
-         ia = m%con_a(c); ib = m%con_b(c)
-         r1 = nodal(v, ia) - nodal(v, ib); q1 = nodal(a, ia) - nodal(a, ib)
-         ! the law's tangents (the linear and Kelvin ones in line: a chain's every step)
-         select case (m%con_law(c))
-         case (LAW_LINEAR, LAW_KELVIN)
-            fr1 = 0.0_dp
-            if (force(c) > 0.0_dp) fr1 = o%c_k(c)*r1 + o%c_c(c)*q1
-         case default
-            call contact_force(m%con_law(c), m%con_par(:, c), m%con_mstar(c), pen(c), r1, &
-                               ms%con_vin(c), f, dfd, dfv)
-            fr1 = dfd*r1 + dfv*q1
-         end select
-         d0 = nodal(un, ia) - nodal(un, ib) - m%con_gap(c)
-         if (d0 > 0.0_dp .and. o%ph_open(c) .and. o%ph_t(c) <= t0) then
-            r0 = nodal(vn, ia) - nodal(vn, ib)
-            call fold_hermite_max(h, d0, r0, pen(c), r1, o%pen_max(c), o%ph_pen(c))
-            if (o%c_prev_f(c) > 0.0_dp .and. force(c) > 0.0_dp) &
-               call fold_hermite_max(h, o%c_prev_f(c), o%c_prev_fr(c), force(c), fr1, &
-                                     o%force_max(c), o%ph_f(c))
+      real(dp), intent(in) :: h, un(:), vn(:), an(:), u(:), v(:), a(:), f1(:)
+      integer :: j, ia, ib
+      real(dp) :: dv0, dv1, da0, da1
+      logical :: damper
+      do j = 1, m%nlink
+         ia = m%link_a(j); ib = m%link_b(j)
+         dv0 = nodal(vn, ia) - nodal(vn, ib); dv1 = nodal(v, ia) - nodal(v, ib)
+         damper = m%link_kind(j) == LINK_DASHPOT .or. m%link_kind(j) == LINK_FLUID_DAMPER
+         da0 = 0.0_dp; da1 = 0.0_dp
+         if (damper) then
+            da0 = nodal(an, ia) - nodal(an, ib); da1 = nodal(a, ia) - nodal(a, ib)
          end if
-         o%c_prev_f(c) = force(c); o%c_prev_fr(c) = fr1
+         if (.not. (dv0*dv1 < 0.0_dp .or. da0*da1 < 0.0_dp)) cycle
+         call observer_link_step_extremum(m%link_kind(j), m%link_par(:, j), h, &
+                                          nodal(un, ia) - nodal(un, ib), dv0, da0, &
+                                          nodal(u, ia) - nodal(u, ib), dv1, da1, f1(j), &
+                                          o%link_force_absmax(j), o%link_du_absmax(j))
       end do
-   end subroutine contact_step_peaks
+   end subroutine link_step_peaks
 
-   !> The largest value inside a step of the cubic Hermite of (q, q̇) at both ends (q0, r0 at
-   !> the start, q1, r1 at the end, a step of h) where the rate turns from > 0 to < 0, into
-   !> both running maxima x and y.
-   pure subroutine fold_hermite_max(h, q0, r0, q1, r1, x, y)
-      real(dp), intent(in) :: h, q0, r0, q1, r1
-      real(dp), intent(inout) :: x, y
-      real(dp) :: s(2), p(2)
-      integer :: k
-      if (.not. (r0 > 0.0_dp .and. r1 < 0.0_dp)) return
-      call cubic_hermite_extrema(h, q0, r0, q1, r1, s, p)
-      do k = 1, 2
-         if (.not. (s(k) > 0.0_dp .and. s(k) < 1.0_dp)) cycle
-         x = max(x, p(k)); y = max(y, p(k))
-      end do
-   end subroutine fold_hermite_max
-
-   !> The peaks of link j inside a fixed step of h, from the relative motion of its nodes at
-   !> both ends (du, du̇, dü) and its force f1 at the end (docs/results.md). The elongation on
-   !> the cubic Hermite of (du, du̇) where du̇ changes sign. The force of a spring, a bar or a
-   !> bilinear spring is monotone in du along a stretch where du is (its tangent is k or ρk
-   !> ≥ 0), so its extremum is at the one of du, du*: valued f1 + k(du* − du1), exact for
-   !> these piecewise-linear laws (after a turn the link unloads elastically, with k, up to
-   !> the step's end). A dashpot's or a fluid damper's force is monotone in du̇: its extremum
-   !> is at that of du̇, on the cubic Hermite of (du̇, dü) where dü changes sign, valued by
-   !> the law. The public door of the fused chain step, which tracks its link peaks itself.
-   subroutine observer_link_step_extremum(o, m, j, h, du0, dv0, da0, du1, dv1, da1, f1)
-      type(observer_t), intent(inout) :: o
-      type(model_t), intent(in) :: m
-      integer, intent(in) :: j
-      real(dp), intent(in) :: h, du0, dv0, da0, du1, dv1, da1, f1
+   !> The peaks of a link (kind, its parameters par) inside a smooth fixed step of h, from
+   !> the relative motion of its nodes at both ends (du, du̇, dü) and its force f1 at the end
+   !> (docs/results.md), into its running maxima of |force| (fmax) and |elongation| (dmax).
+   !> The elongation on the cubic Hermite of (du, du̇) where du̇ changes sign. The force of a
+   !> spring, a bar or a bilinear spring is monotone in du along a stretch where du is (its
+   !> tangent is k or ρk ≥ 0), so its extremum is at the one of du, du*: valued by the law,
+   !> k du* for a spring or a bar, f1 + k(du* − du1) for a bilinear spring (after a turn it
+   !> unloads elastically, with k, up to the step's end; exact for these piecewise-linear
+   !> laws). A dashpot's or a fluid damper's force is monotone in du̇: its extremum is at
+   !> that of du̇, on the cubic Hermite of (du̇, dü) where dü changes sign, valued by the law.
+   !> The general path calls it for every link, the fused chain step for its bilinear ones
+   !> (its linear ones: observer_step_absmax per node and pair, the same numbers).
+   pure subroutine observer_link_step_extremum(kind, par, h, du0, dv0, da0, du1, dv1, da1, f1, &
+                                               fmax, dmax)
+      integer, intent(in) :: kind
+      real(dp), intent(in) :: par(NPAR_LINK), h, du0, dv0, da0, du1, dv1, da1, f1
+      real(dp), intent(inout) :: fmax, dmax
       real(dp) :: s(2), p(2), f, kt, ct, fnew
       integer :: k
       if (dv0*dv1 < 0.0_dp) then
          call cubic_hermite_extrema(h, du0, dv0, du1, dv1, s, p)
          do k = 1, 2
             if (.not. (s(k) > 0.0_dp .and. s(k) < 1.0_dp)) cycle
-            call raise_to(o%link_du_absmax(j), abs(p(k)))
-            select case (m%link_kind(j))
-            case (LINK_SPRING, LINK_BAR, LINK_BILINEAR)
-               call raise_to(o%link_force_absmax(j), abs(f1 + m%link_par(L_STIFF, j)*(p(k) - du1)))
+            call raise_to(dmax, abs(p(k)))
+            select case (kind)
+            case (LINK_SPRING, LINK_BAR)
+               call raise_to(fmax, abs(par(L_STIFF)*p(k)))
+            case (LINK_BILINEAR)
+               call raise_to(fmax, abs(f1 + par(L_STIFF)*(p(k) - du1)))
             end select
          end do
       end if
-      select case (m%link_kind(j))
+      select case (kind)
       case (LINK_DASHPOT, LINK_FLUID_DAMPER)
          if (.not. (da0*da1 < 0.0_dp)) return
          call cubic_hermite_extrema(h, dv0, da0, dv1, da1, s, p)
          do k = 1, 2
             if (.not. (s(k) > 0.0_dp .and. s(k) < 1.0_dp)) cycle
-            call link_force(m%link_kind(j), m%link_par(:, j), du1, p(k), 0.0_dp, du1, f, kt, ct, &
-                            fnew)
-            call raise_to(o%link_force_absmax(j), abs(f))
+            call link_force(kind, par, du1, p(k), 0.0_dp, du1, f, kt, ct, fnew)
+            call raise_to(fmax, abs(f))
          end do
       end select
    end subroutine observer_link_step_extremum
 
-   !> The peaks of every link inside a fixed step of h from (un, vn, an) to (u, v, a) (nodes
-   !> 1..n; observer_link_step_extremum). f1: the link forces at the step's end; absent, the
-   !> law's for springs and bars and the committed ms%link_f for bilinear springs (what the
-   !> fused chain step keeps between its recorded samples; a damper's is not needed).
-   subroutine observer_link_step_peaks(o, m, ms, h, un, vn, an, u, v, a, f1)
+   !> The largest value inside a step of h of the cubic Hermite of (q, q̇) at both ends (q0,
+   !> r0 at the start, q1, r1 at the end) where the rate turns from > 0 to < 0; −huge where
+   !> none (a contact's δ and force: observer_contact_step_peaks).
+   elemental real(dp) function observer_step_max(h, q0, r0, q1, r1) result(x)
+      real(dp), intent(in) :: h, q0, r0, q1, r1
+      real(dp) :: s(2), p(2)
+      integer :: k
+      x = -huge(1.0_dp)
+      if (.not. (r0 > 0.0_dp .and. r1 < 0.0_dp)) return
+      call cubic_hermite_extrema(h, q0, r0, q1, r1, s, p)
+      do k = 1, 2
+         if (s(k) > 0.0_dp .and. s(k) < 1.0_dp) x = max(x, p(k))
+      end do
+   end function observer_step_max
+
+   !> The largest |value| inside a step of h of the cubic Hermite of (q, q̇) at both ends
+   !> where the rate changes sign; 0 where none (a link's elongation, a dashpot's rate: the
+   !> fused chain step's per node and pair maxima, as observer_link_step_extremum).
+   elemental real(dp) function observer_step_absmax(h, q0, r0, q1, r1) result(x)
+      real(dp), intent(in) :: h, q0, r0, q1, r1
+      real(dp) :: s(2), p(2)
+      integer :: k
+      x = 0.0_dp
+      if (.not. (r0*r1 < 0.0_dp)) return
+      call cubic_hermite_extrema(h, q0, r0, q1, r1, s, p)
+      do k = 1, 2
+         if (s(k) > 0.0_dp .and. s(k) < 1.0_dp) x = max(x, abs(p(k)))
+      end do
+   end function observer_step_absmax
+
+   !> The peak of |a| between the samples of a smooth fixed-step method, at sample number
+   !> sample (t, a on nodes 1..n; before the sample's candidates, observer_a_candidate): a
+   !> sample k that raised it (a candidate) is the middle of the parabola through k − 1, k,
+   !> k + 1, whose vertex (equal steps; inside the middle step when the middle sample is the
+   !> largest) is O(h³) in a, below the O(h²) of the steps, if a is smooth there: no jump of
+   !> the forces (a phase change of a contact at the node, a chatter resolution, a kink of a
+   !> load) from k − 1 to k + 2, and no kink — the second differences at k and k + 1 agree to
+   !> half their size (a slope kink at the peak, as a bilinear spring's yield onto a flat
+   !> line, makes them differ by O(h); its vertex would overshoot by O(h)). Candidates of
+   !> sample k are completed here at k + 1 (a_p1) and decided at k + 2.
+   subroutine observer_a_parabolas(o, m, t, a, sample)
       type(observer_t), intent(inout) :: o
       type(model_t), intent(in) :: m
-      type(mech_state_t), intent(in) :: ms
-      real(dp), intent(in) :: h, un(:), vn(:), an(:), u(:), v(:), a(:)
-      real(dp), intent(in), optional :: f1(:)
-      integer :: j, ia, ib
-      real(dp) :: du1, dv0, dv1, f
-      logical :: damper
-      do j = 1, m%nlink
-         ia = m%link_a(j); ib = m%link_b(j)
-         ! only a step where du̇ (or, for a damper, dü) changes sign holds a peak
-         dv0 = nodal(vn, ia) - nodal(vn, ib); dv1 = nodal(v, ia) - nodal(v, ib)
-         damper = m%link_kind(j) == LINK_DASHPOT .or. m%link_kind(j) == LINK_FLUID_DAMPER
-         if (.not. (dv0*dv1 < 0.0_dp)) then
-            if (.not. damper) cycle
-            if (.not. ((nodal(an, ia) - nodal(an, ib))*(nodal(a, ia) - nodal(a, ib)) < 0.0_dp)) cycle
-         end if
-         du1 = nodal(u, ia) - nodal(u, ib)
-         if (present(f1)) then
-            f = f1(j)
-         else if (m%link_kind(j) == LINK_BILINEAR) then
-            f = ms%link_f(j)
-         else
-            f = m%link_par(L_STIFF, j)*du1
-         end if
-         call observer_link_step_extremum(o, m, j, h, nodal(un, ia) - nodal(un, ib), dv0, &
-                                          nodal(an, ia) - nodal(an, ib), du1, dv1, &
-                                          nodal(a, ia) - nodal(a, ib), f)
+      real(dp), intent(in) :: t, a(:)
+      integer(i8), intent(in) :: sample
+      integer :: k, j
+      integer(int8) :: s2, s1
+      real(dp) :: ym, y0, yp, yq, d2, sg
+      logical :: smooth
+      s2 = stamp(sample - 2); s1 = stamp(sample - 1)
+      if (o%npend2 > 0) then
+         smooth = o%counters(C_CHATTER) == o%pend2_stamp .and. load_breakpoint(m, o%pend2_t0) > t
+         do k = 1, o%npend2
+            j = o%pend2(k)
+            if (.not. smooth .or. o%a_gen(j) /= s2 .or. o%node_change(j) > o%pend2_t0) cycle
+            sg = sign(1.0_dp, o%a_0(j))
+            ym = sg*o%a_m1(j); y0 = sg*o%a_0(j); yp = sg*o%a_p1(j); yq = sg*a(j)
+            d2 = ym - 2.0_dp*y0 + yp
+            if (.not. (y0 >= ym .and. y0 >= yp .and. d2 < 0.0_dp)) cycle
+            if (abs((y0 - 2.0_dp*yp + yq) - d2) > 0.5_dp*abs(d2)) cycle
+            o%a_absmax(j) = max(o%a_absmax(j), y0 - (yp - ym)**2/(8.0_dp*d2))
+         end do
+      end if
+      ! the last sample's candidates, completed with this one's a
+      do k = 1, o%npend1
+         j = o%pend1(k)
+         o%pend2(k) = j
+         if (o%a_gen(j) == s1) o%a_p1(j) = a(j)
       end do
-   end subroutine observer_link_step_peaks
+      o%npend2 = o%npend1; o%pend2_t0 = o%pend1_t0; o%pend2_stamp = o%pend1_stamp
+      o%npend1 = 0; o%pend1_t0 = o%prev_t; o%pend1_stamp = o%chatter_prev
+   end subroutine observer_a_parabolas
+
+   !> Node j raised its sampled peak of |a| at sample number sample of a smooth fixed-step
+   !> method (observer_node_peaks' raised), from a_prev at the sample before to a_now: a
+   !> candidate of observer_a_parabolas.
+   subroutine observer_a_candidate(o, j, a_prev, a_now, sample)
+      type(observer_t), intent(inout) :: o
+      integer, intent(in) :: j
+      real(dp), intent(in) :: a_prev, a_now
+      integer(i8), intent(in) :: sample
+      o%npend1 = o%npend1 + 1; o%pend1(o%npend1) = j
+      o%a_m1(j) = a_prev; o%a_0(j) = a_now; o%a_gen(j) = stamp(sample)
+   end subroutine observer_a_candidate
+
+   !> A sample number modulo 256, as a_gen keeps it
+   pure integer(int8) function stamp(sample)
+      integer(i8), intent(in) :: sample
+      stamp = int(modulo(sample, 256_i8) - 128_i8, int8)
+   end function stamp
+
+   !> The peaks of a node at the accepted state (u, v, a) at t, the previous one (un, vn, an)
+   !> at the last sample's time t_prev (< 0: none): extremes of u, |v|, |a| (umax … amax) and
+   !> the largest |u| and its time (uabs, tabs) at the state; for a fixed-step method also
+   !> the extrema of u and v located on the step's cubic Hermite (into the same and into the
+   !> largest local maximum of u, upk at tpk: hermite_extremum, observer_step_absmax). raised:
+   !> the state raised amax (a candidate of observer_a_parabolas on a smooth method). The
+   !> maxima are stored only when they change: a peak array is then read, not rewritten, at
+   !> every step (a fair part of a chain step's memory traffic). Elemental: track calls it
+   !> on every node; a method that measures its nodes in its own sweep (the fused chain step)
+   !> node by node, on the observer's arrays, before its folded observer_sample.
+   elemental subroutine observer_node_peaks(t, t_prev, fixed_steps, un, vn, an, u, v, a, umax, &
+                                            umin, vmax, amax, uabs, tabs, upk, tpk, raised)
+      real(dp), intent(in) :: t, t_prev, un, vn, an, u, v, a
+      logical, intent(in) :: fixed_steps
+      real(dp), intent(inout) :: umax, umin, vmax, amax, uabs, tabs, upk, tpk
+      logical, intent(out) :: raised
+      call observer_node_samples(t, u, v, a, umax, umin, vmax, amax, uabs, tabs, raised)
+      if (.not. fixed_steps) return
+      if (observer_node_turns(vn, an, v, a)) &
+         call observer_node_step_extrema(t, t_prev, un, vn, an, u, v, a, umax, umin, vmax, uabs, &
+                                         tabs, upk, tpk)
+   end subroutine observer_node_peaks
+
+   !> observer_node_peaks at the state: extremes of u, |v|, |a| and the largest |u| at t;
+   !> raised: the state raised amax. (The method that measures itself calls the three parts of
+   !> observer_node_peaks, so that this, the part of every node and step, is compiled into
+   !> its loop.)
+   elemental subroutine observer_node_samples(t, u, v, a, umax, umin, vmax, amax, uabs, tabs, &
+                                              raised)
+      real(dp), intent(in) :: t, u, v, a
+      real(dp), intent(inout) :: umax, umin, vmax, amax, uabs, tabs
+      logical, intent(out) :: raised
+      if (u > umax) umax = u
+      if (u < umin) umin = u
+      if (abs(v) > vmax) vmax = abs(v)
+      raised = abs(a) > amax
+      if (raised) amax = abs(a)
+      call raise_absmax(uabs, tabs, t, u)
+   end subroutine observer_node_samples
+
+   !> Whether a fixed step from (vn, an) to (v, a) can hold an extremum of u (v changes sign,
+   !> or reaches 0 from above) or of v (a changes sign): most steps of most nodes hold none.
+   elemental logical function observer_node_turns(vn, an, v, a) result(turns)
+      real(dp), intent(in) :: vn, an, v, a
+      turns = vn*v < 0.0_dp .or. an*a < 0.0_dp .or. (vn > 0.0_dp .and. v == 0.0_dp)
+   end function observer_node_turns
+
+   !> observer_node_peaks inside a fixed step from the state (un, vn, an) at t_prev to
+   !> (u, v, a) at t where observer_node_turns (t_prev < 0: no step yet): the extrema of u
+   !> and v on the step's cubic Hermite (hermite_extremum, observer_step_absmax), and a maximum
+   !> of u on the step's end.
+   elemental subroutine observer_node_step_extrema(t, t_prev, un, vn, an, u, v, a, umax, umin, &
+                                                   vmax, uabs, tabs, upk, tpk)
+      real(dp), intent(in) :: t, t_prev, un, vn, an, u, v, a
+      real(dp), intent(inout) :: umax, umin, vmax, uabs, tabs, upk, tpk
+      real(dp) :: h
+      h = t - t_prev
+      if (.not. (t_prev >= 0.0_dp .and. h > 0.0_dp)) return
+      call hermite_extremum(t_prev, h, un, vn, an, u, v, a, umax, umin, uabs, tabs, upk, tpk)
+      ! |v| at the extremum of v, on the cubic Hermite of (v, a) where a changes sign
+      ! (O(h⁴) in v; docs/results.md)
+      vmax = max(vmax, observer_step_absmax(h, vn, an, v, a))
+      ! a maximum on the step's end
+      if (vn > 0.0_dp .and. v == 0.0_dp .and. u > upk) then
+         upk = u; tpk = t
+      end if
+   end subroutine observer_node_step_extrema
+
+   !> The maxima of a contact at a sample: its largest δ and force (pen_max, force_max).
+   !> Elemental: observer_sample calls it on every contact; a method that measures its
+   !> contacts in its own sweep, contact by contact, on the observer's arrays.
+   elemental subroutine observer_contact_peaks(pen, force, pen_max, force_max)
+      real(dp), intent(in) :: pen, force
+      real(dp), intent(inout) :: pen_max, force_max
+      if (pen > pen_max) pen_max = pen
+      if (force > force_max) force_max = force
+   end subroutine observer_contact_peaks
+
+   !> The maxima of a contact's phase if open (ph_pen, ph_f) at a sample: as
+   !> observer_contact_peaks (after observer_phase_change where the contact opens or closes).
+   elemental subroutine observer_phase_peaks(open, pen, force, ph_pen, ph_f)
+      logical, intent(in) :: open
+      real(dp), intent(in) :: pen, force
+      real(dp), intent(inout) :: ph_pen, ph_f
+      if (open) then
+         ph_pen = max(ph_pen, pen); ph_f = max(ph_f, force)
+      end if
+   end subroutine observer_phase_peaks
+
+   !> Whether the run tracks what (a TRACK_* bit).
+   pure logical function tracks(r, what)
+      class(results_t), intent(in) :: r
+      integer, intent(in) :: what
+      tracks = iand(r%tracking, what) == what
+   end function tracks
 
    !> A peak of kind (PEAK_*) of item j (node, contact or link) located by the method inside
    !> an accepted step, with value q (signed: |q| enters the node and link peaks; δ and the
-   !> contact force their maxima and those of the open phase).
+   !> contact force their maxima and those of the open phase), into what the run tracks.
    subroutine observer_peak(o, kind, j, q)
       type(observer_t), intent(inout) :: o
       integer, intent(in) :: kind, j
       real(dp), intent(in) :: q
       select case (kind)
       case (PEAK_V)
-         o%v_absmax(j) = max(o%v_absmax(j), abs(q))
+         if (tracks(o, TRACK_NODE_PEAKS)) o%v_absmax(j) = max(o%v_absmax(j), abs(q))
       case (PEAK_A)
-         o%a_absmax(j) = max(o%a_absmax(j), abs(q))
+         if (tracks(o, TRACK_NODE_PEAKS)) o%a_absmax(j) = max(o%a_absmax(j), abs(q))
       case (PEAK_PEN)
-         o%pen_max(j) = max(o%pen_max(j), q)
-         if (o%ph_open(j)) o%ph_pen(j) = max(o%ph_pen(j), q)
+         if (tracks(o, TRACK_CONTACT_PEAKS)) o%pen_max(j) = max(o%pen_max(j), q)
+         if (tracks(o, TRACK_PHASES) .and. o%ph_open(j)) o%ph_pen(j) = max(o%ph_pen(j), q)
       case (PEAK_FORCE)
-         o%force_max(j) = max(o%force_max(j), q)
-         if (o%ph_open(j)) o%ph_f(j) = max(o%ph_f(j), q)
+         if (tracks(o, TRACK_CONTACT_PEAKS)) o%force_max(j) = max(o%force_max(j), q)
+         if (tracks(o, TRACK_PHASES) .and. o%ph_open(j)) o%ph_f(j) = max(o%ph_f(j), q)
       case (PEAK_LINK_FORCE)
-         call raise_to(o%link_force_absmax(j), abs(q))
+         if (tracks(o, TRACK_LINK_PEAKS)) call raise_to(o%link_force_absmax(j), abs(q))
       case (PEAK_LINK_DU)
-         call raise_to(o%link_du_absmax(j), abs(q))
+         if (tracks(o, TRACK_LINK_PEAKS)) call raise_to(o%link_du_absmax(j), abs(q))
       end select
    end subroutine observer_peak
 
    !> The value a located peak of kind, j must exceed to change what is reported: the open
    !> phase's maximum for δ and the contact force (the run's otherwise), the run's peak for
-   !> the others (|·|; 0 for a link not yet tracked).
+   !> the others (|·|; 0 for a link not yet tracked); huge where the run tracks none of it.
    real(dp) function observer_peak_value(o, kind, j) result(q)
       type(observer_t), intent(in) :: o
       integer, intent(in) :: kind, j
-      q = 0.0_dp
+      q = huge(1.0_dp)
       select case (kind)
       case (PEAK_V)
-         q = o%v_absmax(j)
+         if (tracks(o, TRACK_NODE_PEAKS)) q = o%v_absmax(j)
       case (PEAK_A)
-         q = o%a_absmax(j)
+         if (tracks(o, TRACK_NODE_PEAKS)) q = o%a_absmax(j)
       case (PEAK_PEN)
-         q = o%pen_max(j)
-         if (o%ph_open(j)) q = o%ph_pen(j)
+         if (tracks(o, TRACK_CONTACT_PEAKS)) q = o%pen_max(j)
+         if (tracks(o, TRACK_PHASES) .and. o%ph_open(j)) q = o%ph_pen(j)
       case (PEAK_FORCE)
-         q = o%force_max(j)
-         if (o%ph_open(j)) q = o%ph_f(j)
+         if (tracks(o, TRACK_CONTACT_PEAKS)) q = o%force_max(j)
+         if (tracks(o, TRACK_PHASES) .and. o%ph_open(j)) q = o%ph_f(j)
       case (PEAK_LINK_FORCE)
-         if (.not. ieee_is_nan(o%link_force_absmax(j))) q = o%link_force_absmax(j)
+         if (tracks(o, TRACK_LINK_PEAKS)) q = nan_as_zero(o%link_force_absmax(j))
       case (PEAK_LINK_DU)
-         if (.not. ieee_is_nan(o%link_du_absmax(j))) q = o%link_du_absmax(j)
+         if (tracks(o, TRACK_LINK_PEAKS)) q = nan_as_zero(o%link_du_absmax(j))
       end select
+   contains
+      pure real(dp) function nan_as_zero(x)
+         real(dp), intent(in) :: x
+         nan_as_zero = 0.0_dp
+         if (.not. ieee_is_nan(x)) nan_as_zero = x
+      end function nan_as_zero
    end function observer_peak_value
 
-   !> The number of items of a peak kind (0 for an unknown kind).
+   !> The number of items of a peak kind (0 for an unknown kind), tracked or not.
    pure integer function peak_items(o, kind) result(n)
       type(observer_t), intent(in) :: o
       integer, intent(in) :: kind
       select case (kind)
       case (PEAK_V, PEAK_A)
-         n = size(o%v_absmax)
+         n = o%n_nodes
       case (PEAK_PEN, PEAK_FORCE)
-         n = size(o%pen_max)
+         n = o%n_contacts
       case (PEAK_LINK_FORCE, PEAK_LINK_DU)
-         n = size(o%link_force_absmax)
+         n = o%n_links
       case default
          n = 0
       end select
@@ -1001,35 +1329,35 @@ contains
       integer, intent(in) :: i
       real(dp), intent(in) :: t, u
       logical, intent(in) :: maximum
+      if (.not. tracks(o, TRACK_NODE_PEAKS)) return
       o%u_max(i) = max(o%u_max(i), u); o%u_min(i) = min(o%u_min(i), u)
-      call fold_absmax(o, i, t, u)
+      call raise_absmax(o%u_absmax(i), o%t_absmax(i), t, u)
       if (maximum .and. u > o%u_peak(i)) then
          o%u_peak(i) = u; o%t_peak(i) = t
       end if
    end subroutine observer_extremum
 
-   !> u_absmax(i), t_absmax(i) ← |u|, t where |u| is larger
-   subroutine fold_absmax(o, i, t, u)
-      type(observer_t), intent(inout) :: o
-      integer, intent(in) :: i
+   !> uabs, tabs ← |u|, t where |u| is larger (a node's u_absmax, t_absmax)
+   elemental subroutine raise_absmax(uabs, tabs, t, u)
+      real(dp), intent(inout) :: uabs, tabs
       real(dp), intent(in) :: t, u
-      if (abs(u) > o%u_absmax(i)) then
-         o%u_absmax(i) = abs(u); o%t_absmax(i) = t
+      if (abs(u) > uabs) then
+         uabs = abs(u); tabs = t
       end if
-   end subroutine fold_absmax
+   end subroutine raise_absmax
 
    !> The extremum of u inside a fixed step [t0, t0 + h], located on the cubic Hermite
    !> interpolant of (u, v) at both ends, p(s) = u0 H00 + h v0 H10 + u1 H01 + h v1 H11
    !> (s = τ/h): the root of p'(s), a quadratic, where v changes sign inside the step; into
-   !> u_max, u_min, u_absmax and, a maximum, u_peak.
+   !> umax, umin, uabs (tabs) and, a maximum, upk (tpk).
    !> Interpolation error O(h⁴) in u (O(h³) in the time of the extremum), below the
    !> O(h²) of the structural steps themselves (docs/results.md). A turn the step's
    !> accelerations do not support (v reversed by an impulse: no a of the turn's sign at
    !> either end) is not a smooth extremum and is left to the step values.
-   subroutine hermite_extremum(o, i, t0, h, u0, v0, a0, u1, v1, a1)
-      type(observer_t), intent(inout) :: o
-      integer, intent(in) :: i
+   pure subroutine hermite_extremum(t0, h, u0, v0, a0, u1, v1, a1, umax, umin, uabs, tabs, upk, &
+                                    tpk)
       real(dp), intent(in) :: t0, h, u0, v0, a0, u1, v1, a1
+      real(dp), intent(inout) :: umax, umin, uabs, tabs, upk, tpk
       real(dp) :: s(2), p(2)
       integer :: k
       if (.not. (v0*v1 < 0.0_dp)) return
@@ -1038,27 +1366,13 @@ contains
       call cubic_hermite_extrema(h, u0, v0, u1, v1, s, p)
       do k = 1, 2
          if (.not. (s(k) > 0.0_dp .and. s(k) < 1.0_dp)) cycle
-         call fold_absmax(o, i, t0 + s(k)*h, p(k))
-         o%u_max(i) = max(o%u_max(i), p(k)); o%u_min(i) = min(o%u_min(i), p(k))
-         if (v0 > 0.0_dp .and. p(k) > o%u_peak(i)) then      ! a local maximum
-            o%u_peak(i) = p(k); o%t_peak(i) = t0 + s(k)*h
+         call raise_absmax(uabs, tabs, t0 + s(k)*h, p(k))
+         umax = max(umax, p(k)); umin = min(umin, p(k))
+         if (v0 > 0.0_dp .and. p(k) > upk) then      ! a local maximum
+            upk = p(k); tpk = t0 + s(k)*h
          end if
       end do
    end subroutine hermite_extremum
-
-   !> |v| at the extremum of v inside a fixed step, on the cubic Hermite of (v, a) at both
-   !> ends, where a changes sign inside the step (O(h⁴) in v; docs/results.md): into vmax.
-   subroutine hermite_v_extremum(vmax, h, v0, a0, v1, a1)
-      real(dp), intent(inout) :: vmax
-      real(dp), intent(in) :: h, v0, a0, v1, a1
-      real(dp) :: s(2), p(2)
-      integer :: k
-      if (.not. (a0*a1 < 0.0_dp)) return
-      call cubic_hermite_extrema(h, v0, a0, v1, a1, s, p)
-      do k = 1, 2
-         if (s(k) > 0.0_dp .and. s(k) < 1.0_dp) vmax = max(vmax, abs(p(k)))
-      end do
-   end subroutine hermite_v_extremum
 
    !> The stationary points s (in units of h; outside (0, 1) if none) and values p of the
    !> cubic Hermite interpolant of y with derivative d at both ends of a step of length h.

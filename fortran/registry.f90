@@ -36,9 +36,14 @@ module martello_registry
       S_ATOL, S_THETA, S_EVENT_TOL, S_H_MAX, S_FUSED_CHAIN, S_MAX_STEPS, S_MAX_WALL, S_EVENT_SPLIT, SETTINGS, &
       INTEGRATORS, setting_t, integrator_t, &
       registry_shape, registry_column, registry_row, registry_find, registry_name, &
-      NAME_LEN, TEXT_LEN, MAX_COLS, T_DOUBLE, T_INT, T_BOOL
+      NAME_LEN, TEXT_LEN, MAX_COLS, T_DOUBLE, T_INT, T_BOOL, TRACK_NODE_PEAKS, TRACK_LINK_PEAKS, &
+      TRACK_CONTACT_PEAKS, TRACK_PHASES, TRACK_ALL
 
    integer, parameter :: NAME_LEN = 32, TEXT_LEN = 160
+
+   ! What a run tracks (martello_run_set_tracking): bits of one number.
+   integer, parameter :: TRACK_NODE_PEAKS = 1, TRACK_LINK_PEAKS = 2, TRACK_CONTACT_PEAKS = 4, &
+                         TRACK_PHASES = 8, TRACK_ALL = 15
 
    ! Contact schemes (values frozen: the C API and scene files use them).
    integer, parameter :: SCHEME_PENALTY = 1, SCHEME_LAGRANGE = 2, SCHEME_AUGMENTED = 3, &
@@ -196,6 +201,16 @@ module martello_registry
       named_t('initial', E_INITIAL - 1, 'mechanical energy at t = 0 [J]'), &
       named_t('impact', E_IMPACT - 1, 'lost in impacts (restitution, Lagrange) [J]')]
 
+   type(named_t), parameter :: TRACKING(*) = [ &
+      named_t('node_peaks', TRACK_NODE_PEAKS, 'every node''s peaks (martello_run_peaks,'// &
+              ' martello_run_abs_peaks)'), &
+      named_t('link_peaks', TRACK_LINK_PEAKS, 'every link''s largest force and elongation'// &
+              ' (martello_run_link_peaks)'), &
+      named_t('contact_peaks', TRACK_CONTACT_PEAKS, 'every contact''s max penetration and force'), &
+      named_t('phases', TRACK_PHASES, 'the contact phases (martello_run_events,'// &
+              ' martello_run_set_phase_lists)'), &
+      named_t('all', TRACK_ALL, 'all of them (the default)')]
+
    type(named_t), parameter :: EVENT_FIELDS(*) = [ &
       named_t('t_on', EV_T_ON - 1, 'onset of the contact phase [s]'), &
       named_t('t_off', EV_T_OFF - 1, 'separation [s] (-1: still closed at the end)'), &
@@ -327,7 +342,8 @@ module martello_registry
       named_t('contact_parameters', 0, 'MARTELLO_P_'), named_t('link_parameters', 0, 'MARTELLO_L_'), &
       named_t('counters', 0, 'MARTELLO_COUNTER_'), named_t('energy', 0, 'MARTELLO_ENERGY_'), &
       named_t('events', 0, 'MARTELLO_EVENT_'), named_t('constants', 0, 'MARTELLO_'), &
-      named_t('history', 0, ''), named_t('history_per', 0, '')]
+      named_t('history', 0, ''), named_t('history_per', 0, ''), &
+      named_t('tracking', 0, 'MARTELLO_TRACK_')]
 
 contains
 
@@ -356,6 +372,7 @@ contains
       case ('counters'); rows = size(COUNTERS)
       case ('energy'); rows = size(ENERGY_TERMS)
       case ('events'); rows = size(EVENT_FIELDS)
+      case ('tracking'); rows = size(TRACKING)
       case ('constants'); rows = size(CONSTANTS)
       case ('history'); rows = size(HISTORY)
       case ('history_per'); rows = size(HISTORY_PER)
@@ -497,6 +514,7 @@ contains
       case ('counters'); t = COUNTERS
       case ('energy'); t = ENERGY_TERMS
       case ('events'); t = EVENT_FIELDS
+      case ('tracking'); t = TRACKING
       case ('constants'); t = CONSTANTS
       case ('history'); t = HISTORY
       case ('history_per'); t = HISTORY_PER

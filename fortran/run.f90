@@ -5,11 +5,11 @@ module martello_run
    use, intrinsic :: iso_c_binding, only: c_int, c_ptr, c_loc, c_funptr, c_null_funptr, c_null_ptr
    use martello_kinds, only: dp
    use martello_status
-   use martello_model, only: model_t
+   use martello_model, only: model_t, model_nlinks, model_ncontacts, model_expand_chains
    use martello_integrator_settings
    use martello_effective_mass, only: effective_mass_prepare
    use martello_run_checks, only: check_schemes
-   use martello_observer, only: observer_t, observer_init
+   use martello_observer, only: observer_t, observer_init, observer_phase_lists, TRACK_ALL
    use martello_fixed_step, only: run_fixed_step, stepper_t
    use martello_generalized_alpha, only: generalized_alpha_t
    use martello_central_difference, only: central_difference_t
@@ -20,7 +20,11 @@ module martello_run
    use martello_chain_newmark, only: chain_newmark_t, chain_fusable
    implicit none
    private
-   public :: run_t, run_dynamic
+   public :: run_t, run_dynamic, PHASE_LISTS
+
+   !> Contacts up to which every contact's phases are listed (docs/results.md); past it the
+   !> output contacts', the others keep their first and last phase
+   integer, parameter :: PHASE_LISTS = 1000
 
    !> Dispatched to the C integrators (c/event_driven.c, c/ida.c).
    interface
@@ -38,6 +42,11 @@ module martello_run
       type(integrator_settings_t) :: settings
       type(observer_t) :: results     !< what the run measured (martello_observer)
       integer, allocatable :: out_nodes(:), out_contacts(:), out_links(:)
+      !> every contact's phases are listed while the model has at most this many contacts
+      !> (< 0: always; martello_run_set_phase_lists)
+      integer :: phase_lists = PHASE_LISTS
+      !> what the run tracks (TRACK_* bits; martello_run_set_tracking)
+      integer :: tracking = TRACK_ALL
       logical :: configured = .false., done = .false.
       !> the caller's progress callback and its argument (martello_run_set_progress)
       type(c_funptr) :: progress = c_null_funptr
@@ -54,32 +63,42 @@ contains
       type(model_t), pointer, intent(in) :: mp
       type(run_t), pointer, intent(in) :: rp
       integer, intent(out) :: stat
-      integer :: cap
+      integer :: cap, nl, nc
+      logical :: fused
       class(stepper_t), allocatable :: stepper
       stat = MARTELLO_ERR_ARGUMENT
       if (.not. rp%configured) then
          rp%results%message = 'dynamic_run: call martello_run_set_settings first'
          stat = MARTELLO_ERR_STATE; return
       end if
+      nl = model_nlinks(mp); nc = model_ncontacts(mp)
       if (any(rp%out_nodes < 1 .or. rp%out_nodes > mp%n) .or. &
-          any(rp%out_contacts < 1 .or. rp%out_contacts > mp%ncontact)) then
+          any(rp%out_contacts < 1 .or. rp%out_contacts > nc)) then
          rp%results%message = 'dynamic_run: an output node or contact is out of range'; return
       end if
-      if (any(rp%out_links < 1 .or. rp%out_links > mp%nlink)) then
+      if (any(rp%out_links < 1 .or. rp%out_links > nl)) then
          rp%results%message = 'dynamic_run: an output link is out of range'; return
       end if
       ! the rows a fixed step records; the history starts at most at HIST_START rows of
       ! them and grows as needed (observer record)
       cap = int(min(rp%settings%t_end/rp%settings%dt/rp%settings%every + 3.0_dp, 1.0e7_dp))
-      call observer_init(rp%results, rp%settings, mp%n, mp%ncontact, rp%out_nodes, &
-                         rp%out_contacts, cap, mp%nlink, rp%out_links, stat)
+      call observer_init(rp%results, rp%settings, mp%n, nc, rp%out_nodes, &
+                         rp%out_contacts, cap, nl, rp%out_links, stat, rp%tracking)
       rp%results%progress = rp%progress; rp%results%progress_user = rp%progress_user
+      call observer_phase_lists(rp%results, rp%phase_lists)
+      ! the chains held per node stay so for the fused chain step, which takes them whole;
+      ! every other method takes their links and contacts one by one
+      fused = chain_fusable(mp, rp%settings) .and. .not. logical(rp%settings%event_split)
+      if (.not. fused .and. mp%nchain > 0) then
+         call model_expand_chains(mp)
+         fused = chain_fusable(mp, rp%settings) .and. .not. logical(rp%settings%event_split)
+      end if
       if (stat == MARTELLO_OK) call check_schemes(mp, rp%settings%kind, rp%results%message, stat)
       if (stat == MARTELLO_OK) call effective_mass_prepare(mp, rp%results%message, stat)
       if (stat == MARTELLO_OK) then
          select case (rp%settings%kind)
          case (INT_NEWMARK, INT_HHT, INT_GENERALIZED_ALPHA)
-            if (chain_fusable(mp, rp%settings) .and. .not. logical(rp%settings%event_split)) then
+            if (fused) then
                allocate (chain_newmark_t :: stepper)
             else
                allocate (generalized_alpha_t :: stepper)

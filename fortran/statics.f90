@@ -11,7 +11,7 @@ module martello_statics
    use martello_kinds, only: dp
    use martello_status
    use martello_model, only: model_t, SCHEME_PENALTY, SCHEME_LAGRANGE, SCHEME_AUGMENTED, &
-      SCHEME_RESTITUTION
+      SCHEME_RESTITUTION, model_u0
    use martello_contact_laws, only: LAW_LINEAR, P_STIFF
    use martello_links, only: LINK_SPRING, LINK_BAR, LINK_DASHPOT, LINK_FLUID_DAMPER, L_STIFF
    use martello_linalg, only: solve_spd, solve_symmetric_indefinite
@@ -68,7 +68,7 @@ contains
             nf = nf + 1; dof(i) = nf
          end if
       end do
-      r%u = merge(m%u0, 0.0_dp, m%fixed)
+      r%u = [(merge(model_u0(m, i), 0.0_dp, m%fixed(i)), i = 1, n)]
 
       ! Elastic stiffness and loads on the free DOFs (fixed displacements moved to the rhs).
       allocate (kfree(nf, nf), fext(nf)); kfree = 0.0_dp; fext = 0.0_dp

@@ -26,11 +26,9 @@ import numpy as np
 
 from .errors import ResultError
 from .scene.items import Names
+from .scene.spec import ARRAY_ITEMS
 
 ARRAYS_FILE = "results.npz"
-# A scene with more nodes, links and contacts than this, together, has its per-item results
-# written as arrays (1e4 items made a summary.json of ~5 MB; 1e6 of ~1 GB).
-ARRAY_ITEMS = 10_000
 
 KINDS = ("nodes", "links", "contacts")
 # The fields of a contact's first and last phase (docs/results.md, "Contacts").

@@ -16,6 +16,7 @@ from .errors import RecordError, ResultError, SceneError
 from .paths import folder_replaced
 from .results import (ARRAYS_FILE, PHASE_FIELDS, ItemArrays, is_large)
 from .scene.bars import RodElements, RodNodes
+from .scene.chain import ChainContacts, ChainLinks
 from .scene.items import ItemTable, Listed, Names
 
 # The names a link's type, a contact's scheme and law take (the library's tables); results
@@ -129,9 +130,10 @@ def segments(table):
 CHUNK = 1 << 16
 
 
-def link_chunks(links):
-    """(kind, a, b, par) arrays of the scene's links, in order, a chunk at a time."""
-    for seg in segments(links):
+def link_chunks(segs):
+    """(kind, a, b, par) arrays of links (segments of the scene's link table), in order, a
+    chunk at a time."""
+    for seg in segs:
         if isinstance(seg, list):
             if seg:
                 yield link_arrays(seg)
@@ -169,10 +171,11 @@ def link_chunks(links):
             yield kind, a, np.full(m, -1, np.int32), par
 
 
-def contact_chunks(contacts):
-    """(a, b, gap, scheme, law, par) arrays of the scene's contacts, in order, a chunk at a
-    time; a chain's contacts share one row of parameters, its template's."""
-    for seg in segments(contacts):
+def contact_chunks(segs):
+    """(a, b, gap, scheme, law, par) arrays of contacts (segments of the scene's contact
+    table), in order, a chunk at a time; a chain's contacts share one row of parameters, its
+    template's."""
+    for seg in segs:
         if isinstance(seg, list):
             if seg:
                 yield contact_arrays(seg)
@@ -216,16 +219,39 @@ def _function_args(fn, source="<scene>"):
     raise AssertionError(kind)
 
 
-def build_model(scene):
-    """A native Model holding the scene (the caller frees it, or uses a with-block)."""
-    m = native.Model(len(scene.nodes), len(scene.links), len(scene.contacts), len(scene.forces),
-                     len(scene.couplings))
+def build_model(scene, chain_door=True):
+    """A native Model holding the scene (the caller frees it, or uses a with-block).
+
+    Each [[chain]] goes to the library whole (martello_model_add_chain: the model keeps its
+    arrays, the fused chain step reads them as they are), the other items by the bulk doors, so
+    that every item has the number the scene gives it: every listed contact first (the scene
+    numbers the chains' contacts after them), then the link segments in order, a chain's at
+    its call (its springs and dashpots, then its contacts: numbered as if added one by one
+    there, docs/c-api.md "Chains"). chain_door=False adds the chains' items by the bulk doors
+    instead: the same model, run to the same bits (tests/test_chain_door.py)."""
+    link_segs, contact_segs = segments(scene.links), segments(scene.contacts)
+    door = chain_door and any(isinstance(seg, ChainLinks) for seg in link_segs)
+    if door:
+        contact_segs = [seg for seg in contact_segs if not isinstance(seg, ChainContacts)]
+    # no capacity for the chains' items: the model keeps them as the chains' arrays
+    m = native.Model(len(scene.nodes),
+                     sum(len(seg) for seg in link_segs if not (door and isinstance(seg, ChainLinks))),
+                     sum(map(len, contact_segs)), len(scene.forces), len(scene.couplings))
     # one call per array, or per chunk of a generator's (docs/c-api.md, "Building a large model")
     m.set_nodes(*node_arrays(scene.nodes))
-    for chunk in link_chunks(scene.links):
-        m.add_links(*chunk)
-    for chunk in contact_chunks(scene.contacts):
+    if not door:
+        for chunk in link_chunks(link_segs):
+            m.add_links(*chunk)
+    for chunk in contact_chunks(contact_segs):
         m.add_contacts(*chunk)
+    # the link segments in order: a chain's at its call (after every listed contact, which
+    # the scene numbers before the chains' contacts)
+    for seg in link_segs if door else ():
+        if isinstance(seg, ChainLinks):
+            add_chain(m, seg.block)
+        else:
+            for chunk in link_chunks([seg]):
+                m.add_links(*chunk)
     for seg in segments(scene.couplings):
         if isinstance(seg, list):
             for mc in seg:
@@ -241,6 +267,22 @@ def build_model(scene):
     if scene.ground is not None:
         m.set_ground_acceleration(*_function_args(scene.ground, scene.source))
     return m
+
+
+def add_chain(model, b):
+    """One [[chain]] (a ChainBlock) through the chain door: its arrays as they are, the
+    dashpot coefficients per oscillator (0 where it has none), its contacts' one row of
+    parameters (its template's)."""
+    c = None
+    if len(b.dampers):
+        c = np.zeros(b.n)
+        c[b.dampers] = b.c
+    kw = {}
+    if b.n_contacts:
+        _, _, _, scheme, law, row = contact_arrays([b.template])
+        kw = dict(gap=b.gap, scheme=int(scheme[0]), law=int(law[0]), par=row[0])
+    model.add_chain(b.node0, b.k, c=c, fy=b.fy, hardening=b.hardening if b.fy is not None else None,
+                    **kw)
 
 
 def provenance(scene):
@@ -315,21 +357,28 @@ def _dynamic(scene, model, raise_on_failure=True):
         r.set_outputs(out_nodes, out_contacts)
         out_links = [names_of(scene.links).index(n) for n in an["output"]["links"]]
         r.set_link_outputs(out_links)
+        # only what the summary and results list (docs/results.md): the library allocates
+        # nothing for the rest
+        tracked = an["output"]["track"]
+        r.set_tracking(*tracked)
         t0 = time.perf_counter()
         st = r.execute(model) if raise_on_failure else r.status_of(model)
         wall = time.perf_counter() - t0
         hist = r.history()
         ev_contacts, ev = r.events()
-        peaks = r.peaks(len(scene.nodes), len(scene.contacts))
+        # the results of what it tracked alone (a large scene's untracked columns would be
+        # arrays of NaN as large as the run's state)
+        peaks = r.peaks(len(scene.nodes), len(scene.contacts), "node_peaks" in tracked,
+                        "contact_peaks" in tracked)
         energy, extra = r.energy()
-        link_f, link_du = r.link_peaks(len(scene.links))
+        link_f, link_du = r.link_peaks(len(scene.links)) if "link_peaks" in tracked else (None, None)
         counters = r.counters()
         message = r.message()
 
     columns = native.history_columns(an["output"]["nodes"], an["output"]["contacts"],
                                      an["output"]["links"])
     col = {name: i for i, name in enumerate(columns)}
-    arrays = item_arrays(scene, peaks, link_f, link_du, ev,
+    arrays = item_arrays(scene, tracked, peaks, link_f, link_du, ev,
                          *phase_rows(ev_contacts, len(scene.contacts)))
     # a large scene: the items named in output in summary.json, all of them as arrays
     # (docs/results.md, "Results as arrays"); a small one: every item in summary.json
@@ -343,6 +392,8 @@ def _dynamic(scene, model, raise_on_failure=True):
                                v_final=float(hist[-1, col[f"v:{name}"]]))
     contacts = arrays.entries("contacts", pick("contacts", out_contacts))
     every_phase = len(scene.contacts) <= PHASE_LISTS or set(an["output"]["contacts"])
+    if "phases" not in tracked:
+        every_phase = set()                  # no phase kept: none listed
     if every_phase is True:
         # the events grouped by contact once (each contact's rows in the table's order)
         order = np.argsort(ev_contacts, kind="stable")
@@ -355,7 +406,7 @@ def _dynamic(scene, model, raise_on_failure=True):
             continue       # a scene of many contacts: the first and last phase (docs/results.md)
         mine = ev[rows_of(arrays.names["contacts"].position(name))]
         closed = mine[mine[:, 1] >= 0]
-        del e["first_phase"], e["last_phase"]
+        e.pop("first_phase"), e.pop("last_phase")
         e.update({
             "impact_times": [float(x) for x in mine[:, 0]],
             "separation_times": [float(x) if x >= 0 else None for x in mine[:, 1]],
@@ -404,6 +455,7 @@ def _dynamic(scene, model, raise_on_failure=True):
         "message": message,
         "warnings": warnings,
         "t_reached": extra["t_reached"],
+        "tracked": list(tracked),
         "nodes": nodes, "contacts": contacts, "energy": energy,
         "links": arrays.entries("links", pick("links", out_links)),
         **({"arrays": arrays} if large else {}),
@@ -434,27 +486,31 @@ def phase_rows(ev_contacts, n_contacts):
     return first, last
 
 
-def item_arrays(scene, peaks, link_f, link_du, ev, first, last):
+def item_arrays(scene, tracked, peaks, link_f, link_du, ev, first, last):
     """The per-item results of a dynamic run as columns (martello.results.ItemArrays) from
     the library's arrays: peaks (martello_run_peaks), link peaks, and the event table ev with
-    each contact's first and last row of it (phase_rows)."""
+    each contact's first and last row of it (phase_rows); the columns of what the run did not
+    track (spec.TRACKABLE) left out."""
     f64 = lambda x: np.asarray(x, np.float64)             # noqa: E731
-    t_peak = f64(peaks["t_peak"])
-    has_peak = t_peak >= 0                                  # else: no local maximum of u
-    nodes = {k: f64(peaks[k]) for k in NODE_PEAKS}
-    nodes["u_peak"] = np.where(has_peak, f64(peaks["u_peak"]), np.nan)
-    nodes["t_peak"] = np.where(has_peak, t_peak, np.nan)
-    f, du = f64(link_f), f64(link_du)
-    links = {"type": _codes(scene.links, "type", LINK_KINDS),
-             "max_abs_force": np.where(np.isfinite(f), f, np.nan),   # null: not reported
-             "max_abs_elongation": np.where(np.isfinite(du), du, np.nan)}
-    pen = f64(peaks["pen_max"])
-    contacts = {"scheme": _codes(scene.contacts, "scheme", SCHEMES),
-                "law": _codes(scene.contacts, "law", LAWS),
-                "max_penetration": np.where(0.0 > pen, 0.0, pen),   # max(pen, 0), NaN kept
-                "max_force": f64(peaks["force_max"]),
-                "impacts": np.asarray(peaks["impacts"]).astype(np.int64)}
-    for p, rows in (("first", first), ("last", last)):
+    nodes, links, contacts = {}, {"type": _codes(scene.links, "type", LINK_KINDS)}, {
+        "scheme": _codes(scene.contacts, "scheme", SCHEMES),
+        "law": _codes(scene.contacts, "law", LAWS)}
+    if "node_peaks" in tracked:
+        t_peak = f64(peaks["t_peak"])
+        has_peak = t_peak >= 0                              # else: no local maximum of u
+        nodes = {k: f64(peaks[k]) for k in NODE_PEAKS}
+        nodes["u_peak"] = np.where(has_peak, f64(peaks["u_peak"]), np.nan)
+        nodes["t_peak"] = np.where(has_peak, t_peak, np.nan)
+    if "link_peaks" in tracked:
+        f, du = f64(link_f), f64(link_du)
+        links["max_abs_force"] = np.where(np.isfinite(f), f, np.nan)     # null: not reported
+        links["max_abs_elongation"] = np.where(np.isfinite(du), du, np.nan)
+    if "contact_peaks" in tracked:
+        pen = f64(peaks["pen_max"])
+        contacts["max_penetration"] = np.where(0.0 > pen, 0.0, pen)     # max(pen, 0), NaN kept
+        contacts["max_force"] = f64(peaks["force_max"])
+    contacts["impacts"] = np.asarray(peaks["impacts"]).astype(np.int64)
+    for p, rows in (("first", first), ("last", last)) if "phases" in tracked else ():
         has = rows >= 0
         phase = _phases(ev, rows[has], has)
         for k, field in enumerate(PHASE_FIELDS):

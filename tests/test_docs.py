@@ -21,7 +21,7 @@ from tests.docs_tables import DOCS, ROOT, parse_table, registry_tables, read_tab
 REGISTRY = {"integrators", "schemes", "laws", "link-kinds", "compatibility",
             "integrator-parameters", "counters", "energy-terms", "history-columns",
             "status-codes", "families", "setting-types", "contact-parameters",
-            "link-parameters", "time-functions", "events", "constants"}
+            "link-parameters", "time-functions", "events", "constants", "tracking"}
 
 
 # --- reading the source text ---------------------------------------------------------------
@@ -348,6 +348,7 @@ REGISTRY_DOCS = {
     "link_parameters": "link-parameters", "time_functions": "time-functions",
     "counters": "counters", "energy": "energy-terms", "events": "events",
     "constants": "constants", "history": "history-columns", "history_per": "history-columns",
+    "tracking": "tracking",
     "tables": None,   # the list of tables itself: docs/c-api.md's overview
 }
 
@@ -368,7 +369,8 @@ def test_every_registry_table_is_documented():
 @pytest.mark.parametrize("table,label", [
     ("families", "families"), ("setting_types", "setting-types"),
     ("contact_parameters", "contact-parameters"), ("link_parameters", "link-parameters"),
-    ("time_functions", "time-functions"), ("events", "events"), ("constants", "constants")])
+    ("time_functions", "time-functions"), ("events", "events"), ("constants", "constants"),
+    ("tracking", "tracking")])
 def test_c_api_tables_are_the_registry(table, label):
     native = _registry()
     prefix = {r.name: r.text for r in native.registry("tables")}[table]

@@ -11,7 +11,7 @@ import pytest
 
 from martello import results
 from martello.checks.verify import lookup
-from martello.errors import ResultError
+from martello.errors import ResultError, SceneError
 from martello.run import run, run_full, write_results
 from martello.scene.loader import from_dict
 
@@ -45,8 +45,12 @@ def test_a_large_scene_lists_the_phases_of_the_named_contacts_only():
     assert last["approach_speed"] == full["approach_speeds"][-1]
 
 
-def big_chain(n=3400):
-    """n + 2n + (n - 1) items: past the 10 000 of docs/results.md for n = 3400."""
+def big_chain(n=3400, track=("all",)):
+    """n + 2n + (n - 1) items: past the 10 000 of docs/results.md for n = 3400; every result
+    tracked unless track says (None: the large scene's default)."""
+    output = {"every": 100, "nodes": ["b7"], "contacts": ["b7-b8"], "links": ["b7.spring"]}
+    if track is not None:
+        output["track"] = list(track)
     return from_dict({
         "chain": [{"prefix": "b", "n": n, "mass": 1.0,
                    "k": [100.0 if i % 2 == 0 else 400.0 for i in range(n)],
@@ -54,8 +58,7 @@ def big_chain(n=3400):
                    "gap": 0.001, "contact": {"scheme": "penalty", "law": "linear", "stiffness": 1e5}}],
         "loads": {"ground_acceleration": {"type": "sine", "amplitude": 3.0, "omega": 8.0}},
         "analysis": {"type": "dynamic", "integrator": "newmark", "dt": 1e-3, "t_end": 0.5,
-                     "output": {"every": 100, "nodes": ["b7"], "contacts": ["b7-b8"],
-                                "links": ["b7.spring"]}}})
+                     "output": output}})
 
 
 def test_a_large_scene_writes_its_items_as_arrays_and_names_those_of_output(tmp_path, monkeypatch):
@@ -92,6 +95,36 @@ def test_a_large_scene_writes_its_items_as_arrays_and_names_those_of_output(tmp_
     assert lookup(back, "nodes.b3000.u_max") == full["nodes"]["b3000"]["u_max"]
     assert lookup(back, "links.b3000.damper.max_abs_force") == \
         full["links"]["b3000.damper"]["max_abs_force"]
+
+
+def test_a_large_scene_tracks_its_contact_maxima_unless_output_track_says(tmp_path):
+    """Identity of the method: what a large scene tracks by default (docs/results.md, "What a
+    large scene tracks") is written bit for bit as a run that tracks everything writes it, the
+    rest is absent (no column, no key); output.track asks for more."""
+    everything = run(big_chain())
+    s, history = run_full(big_chain(track=None))
+    assert s["tracked"] == ["contact_peaks"] and everything["tracked"] == \
+        ["node_peaks", "link_peaks", "contact_peaks", "phases"]
+    write_results(s, tmp_path / "run", history)
+    back = results.read_summary(tmp_path / "run")
+    arrays, full = back["arrays"], everything["arrays"]
+    assert arrays["nodes"]["columns"] == [] and arrays["links"]["columns"] == ["type"]
+    assert arrays["contacts"]["columns"] == ["scheme", "law", "max_penetration", "max_force",
+                                             "impacts"]
+    for column in arrays["contacts"]["columns"]:
+        assert np.array_equal(arrays.column("contacts", column), full.column("contacts", column))
+    assert arrays.column("contacts", "impacts").sum() > 0          # the chain pounds
+    assert set(back["nodes"]["b7"]) == {"u_final", "v_final"}
+    assert "impact_times" not in back["contacts"]["b7-b8"] and "first_phase" not in back["contacts"]["b7-b8"]
+    assert set(back["links"]["b7.spring"]) == {"type"}
+    some = run(big_chain(track=("node_peaks", "phases")))
+    assert some["tracked"] == ["node_peaks", "phases"]
+    assert "max_penetration" not in some["arrays"]["contacts"]["columns"]
+    assert np.array_equal(some["arrays"].column("nodes", "a_absmax"), full.column("nodes", "a_absmax"))
+    assert some["contacts"]["b7-b8"]["impact_times"] == everything["contacts"]["b7-b8"]["impact_times"]
+    with pytest.raises(SceneError, match=r"analysis\.output\.track\[0\]: unknown value 'peaks' "
+                                         r"\(valid: node_peaks, link_peaks, contact_peaks, phases, all\)"):
+        big_chain(track=("peaks",))
 
 
 def test_a_large_scene_with_a_value_that_is_not_finite_writes_nothing(tmp_path):

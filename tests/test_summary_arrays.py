@@ -13,6 +13,7 @@ from types import SimpleNamespace
 import numpy as np
 
 from martello.run import item_arrays, phase_rows
+from martello.scene.spec import TRACKABLE
 
 RNG = np.random.default_rng(7)
 SPECIAL = np.array([np.nan, np.inf, -np.inf, -0.0, 0.0, 1e-300, -1.5])
@@ -54,7 +55,7 @@ def arrays_of(n_nodes=0, n_links=0, n_contacts=0, n_events=0):
     ev[RNG.random(n_events) < 0.3, 1] = -1.0                      # open phases
     order = np.argsort(ev_contacts, kind="stable")
     bounds = np.searchsorted(ev_contacts[order], np.arange(n_contacts + 1))
-    arrays = item_arrays(scene, peaks, f, du, ev, *phase_rows(ev_contacts, n_contacts))
+    arrays = item_arrays(scene, TRACKABLE, peaks, f, du, ev, *phase_rows(ev_contacts, n_contacts))
     return scene, peaks, f, du, ev, order, bounds, arrays
 
 

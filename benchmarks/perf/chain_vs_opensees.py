@@ -13,7 +13,10 @@ figure is the median of the repeats. Reported per n: the time loop in ns per DOF
 (martello: the library's own clock around its time loop, `cost.wall_time_s`; OpenSees: the
 clock around `analyze`), their ratio, the whole process (martello: `martello run` from scene
 file to summary.json written), peak RSS per DOF, the Python share of martello's process, and
-the agreement of the two codes on every node's peak |u|. Then the cost exponent in n (least
+the agreement of the two codes on every node's peak |u| (martello locates each peak inside
+its step, docs/results.md, OpenSees' EnvelopeNode takes the samples: martello's is the larger
+by the located excess, and below OpenSees' nowhere by more than round-off, the samples being
+the same solution's; both are printed). Then the cost exponent in n (least
 squares on log t against log n), a STREAM-like triad (benchmarks/perf/triad.c) for the memory
 floor, and P7's two oscillators with the linear contact, whole process against whole process.
 
@@ -21,8 +24,17 @@ OpenSeesPy runs in its own environment (default out/bench-venv, created with pip
 the comparison is skipped with a message if that fails). The machine is shared: the load
 average is printed with every figure.
 
+--library measures the library alone instead: benchmarks/perf/chain_native.c (compiled here
+against build/libmartello.so) builds the same chain through the C API, as a chain held per node
+(martello_model_add_chain) or with --items as links and contacts, runs it and reports the
+library's clock around martello_dynamic_run, the process' CPU time, and its resident memory per
+DOF: the model once built, and the peak of the run over the memory before the model; --track
+keeps only what it lists (martello_run_set_tracking).
+
     .venv/bin/python benchmarks/perf/chain_vs_opensees.py [--n 1000 10000 100000]
         [--steps 8000] [--repeats 3] [--out out/perf] [--opensees-max-n 10000]
+    .venv/bin/python benchmarks/perf/chain_vs_opensees.py --library [--items]
+        [--track node_peaks,contact_peaks] --n 1000 10000 100000 1000000 --steps 8000
 """
 
 import argparse
@@ -39,8 +51,9 @@ ROOT = Path(__file__).resolve().parents[2]
 M, K1, K2, ZETA, GAP, EPS, AMP, OMEGA, DT = 1.0, 100.0, 400.0, 0.05, 0.01, 1.0e5, 3.0, 8.0, 1e-3
 
 
-def scene_toml(n, steps, dt=DT, every=None):
-    """The chain as a martello scene ([[chain]]); records two nodes, every 1000th step."""
+def scene_toml(n, steps, dt=DT, every=None, track=None):
+    """The chain as a martello scene ([[chain]]); records two nodes, every 1000th step; track:
+    what the run keeps (analysis.output.track; None: the scene's default, docs/results.md)."""
     ks = ", ".join("100.0" if i % 2 == 0 else "400.0" for i in range(n))
     every = every or max(1, min(steps, 1000))
     return f"""title = "chain of {n} pounding oscillators (linear contacts)"
@@ -66,7 +79,7 @@ t_end = {steps * dt!r}
 every = {every}
 nodes = ["b1", "b{n}"]
 contacts = []
-"""
+""" + (f"track = {json.dumps(list(track))}\n" if track is not None else "")
 
 
 def opensees_one(n, steps, dt, out):
@@ -122,6 +135,14 @@ def opensees_one(n, steps, dt, out):
                       "absmax": rows[2] if len(rows) >= 3 else None}))
 
 
+def peak_agreement(martello, opensees):
+    """The largest relative difference of the two codes' peak |u| over the nodes, and the
+    largest amount, relative, by which martello's (located inside the steps) is below
+    OpenSees' (the largest sample): round-off where both solve the same equations."""
+    rel = [(x - y) / max(abs(y), 1e-300) for x, y in zip(martello, opensees)]
+    return max(abs(d) for d in rel), max(-d for d in rel)
+
+
 def run_child(cmd):
     """cmd in a child process, measured by a wrapper that reports its own rusage."""
     wrapper = ("import json, os, resource, subprocess, sys, time\n"
@@ -142,7 +163,9 @@ def martello_once(scene, out):
     import numpy as np
     from martello.results import read_summary         # summary.json, and a large scene's arrays
     s = read_summary(out)
-    if "arrays" in s:
+    if "node_peaks" not in s["tracked"]:
+        absmax = None                   # not tracked (a large scene's default)
+    elif "arrays" in s:
         absmax = np.maximum(np.abs(s["arrays"].column("nodes", "u_max")),
                             np.abs(s["arrays"].column("nodes", "u_min"))).tolist()
     else:
@@ -190,6 +213,51 @@ def load():
     return os.getloadavg()[0]
 
 
+def library_alone(a, out):
+    """The chain through the C API alone (chain_native.c): per n, the median of the repeats
+    of the library's ns per DOF-step (its clock and the process' CPU time), the model's and
+    the run's resident bytes per DOF, and the cost exponent of the time loop in n."""
+    exe = out / "chain_native"
+    lib = ROOT / "build"
+    subprocess.run(["cc", "-O2", "-I", str(ROOT / "c"), "-I", str(lib / "include"),
+                    str(Path(__file__).with_name("chain_native.c")), "-o", str(exe),
+                    f"-L{lib}", "-lmartello", f"-Wl,-rpath,{lib}", "-lm"], check=True)
+    opts = (["--items"] if a.items else []) + (["--track", a.track] if a.track is not None else [])
+    print(f"the library alone ({'links and contacts' if a.items else 'a chain held per node'}; "
+          f"tracking {a.track or 'all'}); {os.cpu_count()} cores")
+    print(f"{'n':>8} {'steps':>5} {'ns/DOF-step':>11} {'CPU ns':>7} {'model B/DOF':>11} "
+          f"{'peak B/DOF':>10} {'Newton/step':>11} {'fused':>6} {'load':>5}")
+    rows = []
+    for n in a.n:
+        runs, loads = [], []
+        for _ in range(a.repeats):
+            loads.append(load())
+            r = run_child([str(exe), n, a.steps, *opts])
+            r.update(json.loads(r["out"]))
+            runs.append(r)
+        dofsteps = n * a.steps
+        row = {"n": n, "steps": a.steps, "load": statistics.median(loads),
+               "ns_per_dof_step": statistics.median(r["wall_s"] for r in runs) / dofsteps * 1e9,
+               "cpu_ns_per_dof_step": statistics.median(r["cpu"] for r in runs) / dofsteps * 1e9,
+               "model_bytes_per_dof": statistics.median(r["model_B_per_dof"] for r in runs),
+               "peak_bytes_per_dof": statistics.median(r["peak_B_per_dof"] for r in runs),
+               "newton_per_step": runs[-1]["newton"] / a.steps, "fused": runs[-1]["fused"],
+               "wall_s": [r["wall_s"] for r in runs]}
+        rows.append(row)
+        print(f"{n:>8} {a.steps:>5} {row['ns_per_dof_step']:>11.1f} {row['cpu_ns_per_dof_step']:>7.1f} "
+              f"{row['model_bytes_per_dof']:>11.0f} {row['peak_bytes_per_dof']:>10.0f} "
+              f"{row['newton_per_step']:>11.3f} {row['fused']:>6} {row['load']:>5.2f}", flush=True)
+    if len(rows) >= 2:
+        xs = [math.log(r["n"]) for r in rows]
+        ys = [math.log(r["ns_per_dof_step"] * r["n"]) for r in rows]
+        mx, my = sum(xs) / len(xs), sum(ys) / len(ys)
+        slope = sum((x - mx) * (y - my) for x, y in zip(xs, ys)) / sum((x - mx) ** 2 for x in xs)
+        print(f"cost exponent (library time loop ~ n^p, n = {rows[0]['n']} ... {rows[-1]['n']}): "
+              f"p = {slope:.3f}")
+    (out / "chain_library.json").write_text(json.dumps({"rows": rows}, indent=1))
+    print(f"results: {out / 'chain_library.json'}")
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--n", type=int, nargs="+", default=[1000, 10000, 100000])
@@ -200,6 +268,13 @@ def main():
     ap.add_argument("--opensees-max-n", type=int, default=10000,
                     help="largest n OpenSees runs (it takes ~2 µs per DOF-step)")
     ap.add_argument("--skip-pounding", action="store_true")
+    ap.add_argument("--library", action="store_true",
+                    help="the library alone through the C API (benchmarks/perf/chain_native.c)")
+    ap.add_argument("--items", action="store_true",
+                    help="--library: the chain as links and contacts, not held per node")
+    ap.add_argument("--track", help="what the run keeps (node_peaks,link_peaks,contact_peaks,"
+                                    "phases,all; default: --library all, else the scene's "
+                                    "default and node_peaks where OpenSees runs)")
     ap.add_argument("--opensees-one", nargs=4, help=argparse.SUPPRESS)
     a = ap.parse_args()
     if a.opensees_one:
@@ -208,6 +283,9 @@ def main():
         return
     out = Path(a.out)
     out.mkdir(parents=True, exist_ok=True)
+    if a.library:
+        library_alone(a, out)
+        return
     py = opensees_python(a.opensees_python)
     sys.path.insert(0, str(ROOT))
     from martello.binding import native
@@ -219,16 +297,19 @@ def main():
     rows = []
     hdr = (f"{'n':>8} {'steps':>5} {'martello ns':>11} {'OpenSees ns':>11} {'ratio':>6} "
            f"{'m. process s':>12} {'py share':>8} {'m. B/DOF':>9} {'OS B/DOF':>9} "
-           f"{'peak |u| rel':>12} {'load':>5}")
+           f"{'peak |u| rel':>12} {'m. below':>9} {'load':>5}")
     print(hdr)
     for n in a.n:
         d = out / f"n{n}"
         d.mkdir(exist_ok=True)
         scene = d / "scene.toml"
-        scene.write_text(scene_toml(n, a.steps))
+        with_os = py is not None and n <= a.opensees_max_n
+        track = a.track.split(",") if a.track else None
+        if with_os:         # the two codes' peak |u| compared
+            track = sorted(set(track or ["contact_peaks"]) | {"node_peaks"})
+        scene.write_text(scene_toml(n, a.steps, track=track))
         mr, orr = [], []
         loads = []
-        with_os = py is not None and n <= a.opensees_max_n
         for rep in range(a.repeats):
             loads.append(load())
             order = ("m", "o") if rep % 2 == 0 else ("o", "m")
@@ -247,20 +328,20 @@ def main():
                "martello_peak_rss_bytes_per_dof": m_rss, "python_share": share,
                "fused_steps": mr[-1]["fused"], "load": statistics.median(loads),
                "martello_native_s": [r["native"] for r in mr]}
-        o_ns = o_rss = agree = ratio = None
+        o_ns = o_rss = agree = below = ratio = None
         if orr:
             o_ns = statistics.median(r["loop_s"] for r in orr) / dofsteps * 1e9
             o_rss = statistics.median(r["rss"] for r in orr) / n
             ratio = o_ns / m_ns
             om = orr[-1]["absmax"]
-            agree = max(abs(x - y) / max(abs(y), 1e-300) for x, y in zip(mr[-1]["absmax"], om))
+            agree, below = peak_agreement(mr[-1]["absmax"], om)
             row.update(opensees_ns_per_dof_step=o_ns, ratio=ratio, opensees_peak_rss_bytes_per_dof=o_rss,
-                       peak_u_max_rel_diff=agree, opensees_loop_s=[r["loop_s"] for r in orr])
+                       peak_u_max_rel_diff=agree, peak_u_martello_below=below, opensees_loop_s=[r["loop_s"] for r in orr])
         rows.append(row)
         f = lambda x, fmt: format(x, fmt) if x is not None else "-"
         print(f"{n:>8} {a.steps:>5} {m_ns:>11.1f} {f(o_ns, '11.1f'):>11} {f(ratio, '6.1f'):>6} "
               f"{m_wall:>12.2f} {share:>8.1%} {m_rss:>9.0f} {f(o_rss, '9.0f'):>9} "
-              f"{f(agree, '12.1e'):>12} {row['load']:>5.2f}", flush=True)
+              f"{f(agree, '12.1e'):>12} {f(below, '9.1e'):>9} {row['load']:>5.2f}", flush=True)
     big = [r for r in rows if r["n"] >= 1000]
     if len(big) >= 2:
         xs = [math.log(r["n"]) for r in big]
@@ -285,7 +366,7 @@ def pounding(py, out, repeats, rows):
     d.mkdir(exist_ok=True)
     scene = d / "scene.toml"
     scene.write_text(scene_toml(2, 40000, dt=1e-4, every=10))
-    mw, ow, agree = [], [], None
+    mw, ow, agree, below = [], [], None, None
     for rep in range(repeats):
         for who in (("m", "o") if rep % 2 == 0 else ("o", "m")):
             if who == "m":
@@ -296,14 +377,15 @@ def pounding(py, out, repeats, rows):
                 r = run_child([py, __file__, "--opensees-one", 2, 40000, 1e-4, d / "opensees"])
                 ow.append(r["wall"])
                 om = json.loads(r["out"].strip().splitlines()[-1])["absmax"]
-                agree = max(abs(x - y) / abs(y) for x, y in zip(mr["absmax"], om))
+                agree, below = peak_agreement(mr["absmax"], om)
     line = (f"P7 two oscillators, linear contact, Newmark dt = 1e-4 s, 40000 steps: whole process "
             f"martello {statistics.median(mw):.3f} s")
     if ow:
-        line += f", OpenSeesPy {statistics.median(ow):.3f} s; peak |u| agree to {agree:.1e}"
+        line += (f", OpenSeesPy {statistics.median(ow):.3f} s; peak |u| agree to {agree:.1e}, "
+                 f"martello's below OpenSees' by at most {below:.1e}")
     print(line + f" (load {load():.2f})")
     rows.append({"pounding_martello_process_s": mw, "pounding_opensees_process_s": ow,
-                 "pounding_peak_u_rel_diff": agree})
+                 "pounding_peak_u_rel_diff": agree, "pounding_peak_u_martello_below": below})
 
 
 if __name__ == "__main__":

@@ -67,6 +67,8 @@ def lib():
         "martello_model_add_contacts": (c_int, [_VOID_P, c_int, _INT_P, _INT_P, _DOUBLE_P, _INT_P,
                                                 _INT_P, _DOUBLE_P]),
         "martello_model_add_mass_coupling": (c_int, [_VOID_P, c_int, c_int, c_double]),
+        "martello_model_add_chain": (c_int, [_VOID_P, c_int, c_int] + [_VOID_P] * 5
+                                     + [c_int, c_int, _VOID_P]),
         "martello_model_add_stiffness_block": (c_int, [_VOID_P, c_int, _INT_P, _DOUBLE_P,
                                                        _DOUBLE_P]),
         "martello_model_set_gravity": (c_int, [_VOID_P, c_double]),
@@ -92,11 +94,13 @@ def lib():
         "martello_run_history": (c_int, [_VOID_P, _DOUBLE_P]),
         "martello_run_events": (c_int, [_VOID_P, ctypes.POINTER(c_int), _VOID_P, _VOID_P]),
         "martello_run_counters": (c_int, [_VOID_P, np.ctypeslib.ndpointer(dtype=np.int64, flags="C_CONTIGUOUS")]),
-        "martello_run_peaks": (c_int, [_VOID_P] + [_DOUBLE_P] * 6 + [_INT_P] + [_DOUBLE_P] * 2),
+        "martello_run_peaks": (c_int, [_VOID_P] * 10),
         "martello_run_energy": (c_int, [_VOID_P, _DOUBLE_P, _DOUBLE_P]),
         "martello_run_set_link_outputs": (c_int, [_VOID_P, c_int, _INT_P]),
-        "martello_run_link_peaks": (c_int, [_VOID_P, _DOUBLE_P, _DOUBLE_P]),
-        "martello_run_abs_peaks": (c_int, [_VOID_P, _DOUBLE_P, _DOUBLE_P]),
+        "martello_run_set_phase_lists": (c_int, [_VOID_P, c_int]),
+        "martello_run_set_tracking": (c_int, [_VOID_P, c_int]),
+        "martello_run_link_peaks": (c_int, [_VOID_P] * 3),
+        "martello_run_abs_peaks": (c_int, [_VOID_P] * 3),
         "martello_memory_message": (None, [c_char_p, c_double, c_char_p, c_char_p, c_int]),
     }
     for name, (res, args) in protos.items():
@@ -394,6 +398,29 @@ class Model(_Handle):
             _f64_rows(par, n, constant("NPAR_CONTACT"))), "contacts")
         self.n_contacts += n
 
+    def add_chain(self, first, k, c=None, fy=None, hardening=None, gap=None, scheme=0, law=0,
+                  par=None):
+        """A chain held per node (docs/c-api.md "Chains"): nodes first … first + len(k) − 1
+        (0-based), each with a spring k to ground (bilinear with fy, hardening), a dashpot c
+        where c > 0, and contacts between neighbours through gap (len(k) − 1 values) with one
+        scheme, law and parameter row par."""
+        k = _f64(k)
+        n = len(k)
+        keep = [k]
+
+        def ptr(x, size):
+            if x is None:
+                return None
+            arr = _f64(x, size)
+            keep.append(arr)
+            return arr.ctypes.data
+        args = [ptr(c, n), ptr(fy, n), ptr(hardening, n), ptr(gap, n - 1)]
+        row = ptr(par, constant("NPAR_CONTACT")) if gap is not None else None
+        self.check(lib().martello_model_add_chain(self._h, first, n, k.ctypes.data, *args,
+                                                  scheme, law, row), "chain")
+        if gap is not None:
+            self.n_contacts += n - 1
+
     def add_mass_coupling(self, a, b, value):
         self.check(lib().martello_model_add_mass_coupling(self._h, a, b, value), "mass coupling")
 
@@ -471,9 +498,22 @@ class Run(_Handle):
         l = np.ascontiguousarray(links, dtype=np.int32)
         self._check(lib().martello_run_set_link_outputs(self._h, l.size, l), "link outputs")
 
+    def set_phase_lists(self, max_contacts):
+        """Every contact's phases listed up to max_contacts contacts (< 0: always); past it the
+        output contacts', the others' first and last phase (c/martello.h)."""
+        self._check(lib().martello_run_set_phase_lists(self._h, int(max_contacts)), "phase lists")
+
+    def set_tracking(self, *what):
+        """Track only what is named (rows of the registry's table "tracking": "node_peaks",
+        "link_peaks", "contact_peaks", "phases"); the rest reads NaN, or no phase rows."""
+        flags = 0
+        for w in what:
+            flags |= value("tracking", w)
+        self._check(lib().martello_run_set_tracking(self._h, flags), "tracking")
+
     def link_peaks(self, n_links):
         f, du = np.zeros(max(n_links, 1)), np.zeros(max(n_links, 1))
-        lib().martello_run_link_peaks(self._h, f, du)
+        lib().martello_run_link_peaks(self._h, f.ctypes.data, du.ctypes.data)
         return f[:n_links], du[:n_links]
 
     def execute(self, model):
@@ -514,19 +554,23 @@ class Run(_Handle):
         lib().martello_run_counters(self._h, c)
         return dict(zip(counter_names(), map(int, c)))
 
-    def peaks(self, n_nodes, n_contacts):
-        arrays = [np.zeros(max(n_nodes, 1)) for _ in range(4)] + \
-                 [np.zeros(max(n_contacts, 1)) for _ in range(2)]
-        impacts = np.zeros(max(n_contacts, 1), dtype=np.int32)
-        peak = [np.zeros(max(n_nodes, 1)) for _ in range(2)]
-        lib().martello_run_peaks(self._h, *arrays, impacts, *peak)
-        names = ("u_max", "u_min", "v_absmax", "a_absmax", "pen_max", "force_max")
-        out = {k: a[: (n_nodes if i < 4 else n_contacts)] for i, (k, a) in enumerate(zip(names, arrays))}
-        out["impacts"] = impacts[:n_contacts]
-        out["u_peak"], out["t_peak"] = peak[0][:n_nodes], peak[1][:n_nodes]
-        absmax = [np.zeros(max(n_nodes, 1)) for _ in range(2)]
-        lib().martello_run_abs_peaks(self._h, *absmax)
-        out["u_absmax"], out["t_absmax"] = absmax[0][:n_nodes], absmax[1][:n_nodes]
+    def peaks(self, n_nodes, n_contacts, nodes=True, contacts=True):
+        """The node peaks (nodes=False: none copied out) and the contact maxima (contacts=False:
+        none), with every contact's number of phases, as a dict of arrays."""
+        def out_array(n, wanted, dtype=np.float64):
+            return np.zeros(max(n, 1), dtype) if wanted else None
+        names = ("u_max", "u_min", "v_absmax", "a_absmax", "pen_max", "force_max", "impacts",
+                 "u_peak", "t_peak")
+        arrays = [out_array(n_nodes, nodes) for _ in range(4)] + \
+                 [out_array(n_contacts, contacts) for _ in range(2)] + \
+                 [out_array(n_contacts, True, np.int32)] + [out_array(n_nodes, nodes) for _ in range(2)]
+        lib().martello_run_peaks(self._h, *(None if a is None else a.ctypes.data for a in arrays))
+        out = {k: a[: (n_contacts if 4 <= i <= 6 else n_nodes)]
+               for i, (k, a) in enumerate(zip(names, arrays)) if a is not None}
+        if nodes:
+            absmax = [np.zeros(max(n_nodes, 1)) for _ in range(2)]
+            lib().martello_run_abs_peaks(self._h, absmax[0].ctypes.data, absmax[1].ctypes.data)
+            out["u_absmax"], out["t_absmax"] = absmax[0][:n_nodes], absmax[1][:n_nodes]
         return out
 
     def energy(self):

@@ -21,9 +21,9 @@ from ..paths import MiB, UnreadableFile, check_regular, read_input
 from .fields import (ANY, MAX_DEPTH, NONNEG, POSITIVE, check_fields, choice, finite_everywhere,
                      kind_ok)
 from .spec import (ALL_SPECIFIC, ANALYSIS_TYPES, CONTACT_COMMON, CONTACT_SCHEMES,
-                   FIXED_EXPONENT, FUNCTION_TYPES, GROUND, INTEGRATOR_KEYS,
-                   INTEGRATORS, LAWS, LINK_COMMON, LINK_TYPES, NEWMARK_PRESETS, NODE_KEYS,
-                   OUTPUT_KEYS, SCHEMES, TOP_KEYS)
+                   ARRAY_ITEMS, FIXED_EXPONENT, FUNCTION_TYPES, GROUND, INTEGRATOR_KEYS,
+                   INTEGRATORS, LARGE_SCENE_TRACKS, LAWS, LINK_COMMON, LINK_TYPES,
+                   NEWMARK_PRESETS, NODE_KEYS, OUTPUT_KEYS, SCHEMES, TOP_KEYS, TRACKABLE)
 
 
 @dataclass
@@ -465,7 +465,20 @@ def _dynamic_analysis(src, raw, an, index, contacts, links):
         if nm not in link_names:
             raise SceneError(src, f"analysis.output.links[{i}]", f"names no link {nm!r}",
                              "use link names of this scene (links without a name are link<i>)")
+    out["track"] = _tracked(src, out["track"], len(index) + len(links) + len(contacts) > ARRAY_ITEMS)
     an["output"] = out
+
+
+def _tracked(src, given, large):
+    """What the run tracks (spec.TRACKABLE, in that order): output.track's names ("all": every
+    one), or by default everything, a large scene's LARGE_SCENE_TRACKS."""
+    if given is None:
+        return list(LARGE_SCENE_TRACKS if large else TRACKABLE)
+    for i, nm in enumerate(given):
+        if nm not in TRACKABLE and nm != "all":
+            raise SceneError(src, f"analysis.output.track[{i}]", f"unknown value {nm!r}",
+                             "valid: " + ", ".join(TRACKABLE + ("all",)))
+    return [nm for nm in TRACKABLE if nm in given or "all" in given]
 
 
 def _ground_stiffness(links):

@@ -113,7 +113,19 @@ ANALYSIS_TYPES = {
                 "output": ("table", False, None, None)},
 }
 OUTPUT_KEYS = {"every": _setting("int", "every"), "nodes": ("list", False, None, None),
-               "contacts": ("list", False, None, None), "links": ("list", False, None, [])}
+               "contacts": ("list", False, None, None), "links": ("list", False, None, []),
+               "track": ("list", False, None, None)}
+# What a run can track (the library's table "tracking", docs/c-api.md "What a run tracks"),
+# and what a scene whose per-item results are written as arrays (docs/results.md "Results as
+# arrays") tracks unless output.track says: the contact maxima (and every contact's number of
+# phases, always counted), which keep a chain of 1e6 nodes within 200 B per node
+# (docs/performance.md). A smaller scene tracks everything its summary lists.
+TRACKABLE = tuple(n for n in native.names("tracking") if n != "all")
+LARGE_SCENE_TRACKS = ("contact_peaks",)
+# A scene with more nodes, links and contacts than this, together, is large: it has its
+# per-item results written as arrays (martello.results; 1e4 items made a summary.json of
+# ~5 MB; 1e6 of ~1 GB) and tracks LARGE_SCENE_TRACKS by default.
+ARRAY_ITEMS = 10_000
 # The analysis keys of one integrator or a group: the settings it reads beyond those every
 # integrator reads (the library's table "reads"); Newmark also takes a preset.
 _READ_BY_ALL = set.intersection(*(native.settings_read(i) for i in INTEGRATORS))
