@@ -4,6 +4,8 @@
  * nodes), contact arrays length n_contacts; contacts are 0-based. */
 #ifndef MARTELLO_INTERNAL_H
 #define MARTELLO_INTERNAL_H
+#include <stdint.h>
+
 #include "martello.h"
 
 typedef struct martello_eval martello_eval;
@@ -14,6 +16,13 @@ typedef struct martello_observer martello_observer;
  * scene), into buf (NUL-terminated, truncated to buflen - 1 characters). */
 void martello_memory_message(const char *what, double bytes, const char *fix, char *buf,
                              int buflen);
+
+/* history.csv (c/csv_writer.c, docs/results.md): header, a newline, then rows × cols doubles
+ * (row-major) as %.17g, commas between, a newline after each row. 0, or an errno value
+ * (EINVAL for a bad argument); a partial file may remain on failure (the caller writes into a
+ * folder it discards then). */
+int martello_write_csv(const char *path, const char *header, const double *data, int64_t rows,
+                       int cols);
 
 /* Scene topology for impact laws. con_a/con_b are 0-based nodes, -1 = ground; fixed[i] is 0/1;
  * restitution[j] is the contact's e (or -1 if none given). Pass NULL for what you don't need. */

@@ -226,9 +226,9 @@ def compare(history, against):
     if isinstance(history, Result):
         if not history.columns:
             raise MartelloError("compare: a static run has no history to compare")
+        from .run import write_history
         with tempfile.TemporaryDirectory() as tmp:
             path = Path(tmp) / "history.csv"
-            np.savetxt(path, history.data, delimiter=",", header=",".join(history.columns),
-                       comments="", fmt="%.17g")
+            write_history(path, history.columns, history.data)
             return _compare_history(path, against)
     return _compare_history(history, against)

@@ -102,6 +102,7 @@ def lib():
         "martello_run_link_peaks": (c_int, [_VOID_P] * 3),
         "martello_run_abs_peaks": (c_int, [_VOID_P] * 3),
         "martello_memory_message": (None, [c_char_p, c_double, c_char_p, c_char_p, c_int]),
+        "martello_write_csv": (c_int, [c_char_p, c_char_p, _DOUBLE_P, ctypes.c_int64, c_int]),
     }
     for name, (res, args) in protos.items():
         fn = getattr(L, name)
@@ -282,6 +283,19 @@ def memory_message(what, nbytes=-1.0, fix=None):
     lib().martello_memory_message(what.encode(), float(nbytes), fix.encode() if fix else None,
                                   buf, len(buf))
     return buf.value.decode()
+
+
+def write_csv(path, columns, data):
+    """history.csv (docs/results.md): the header of columns, then each row of data (a 2D
+    array, one column per name) as %.17g, written by the library (c/csv_writer.c). OSError
+    naming the path if it cannot be written."""
+    a = np.ascontiguousarray(data, dtype=np.float64)
+    if a.ndim != 2 or a.shape[1] != len(columns):
+        raise ValueError(f"history of shape {a.shape} for {len(columns)} columns")
+    err = lib().martello_write_csv(os.fsencode(path), ",".join(columns).encode(), a,
+                                   a.shape[0], a.shape[1])
+    if err:
+        raise OSError(err, os.strerror(err), str(path))
 
 
 def _f64(values, n=None):
