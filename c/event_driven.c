@@ -1028,6 +1028,11 @@ static int ed_setup(ed_t *w) {
     return FAIL_ALLOC();
   for (j = 0; j < nc; j++) w->t_impact[j] = -1.0;   /* no impact yet */
   st = martello_eval_create(w->model, &w->ev);
+  /* out of memory: the model's message is the line (martello_eval_create) */
+  if (st == MARTELLO_ERR_MEMORY) {
+    martello_model_message(w->model, w->msg, (int)sizeof w->msg);
+    return martello_observer_fail(w->obs, st, 0.0, w->msg);
+  }
   if (st != MARTELLO_OK) return fail(w, st, 0.0, "event-driven: martello_eval_create failed");
   st = martello_eval_link_count(w->ev, &w->nl);
   if (st != MARTELLO_OK) return fail(w, st, 0.0, "event-driven: martello_eval_link_count failed");
@@ -1135,6 +1140,7 @@ static int ed_integrate(ed_t *w) {
     }
   }
   st = martello_observer_begin(w->obs, w->ev, w->y, w->y + n, "tighten rtol and atol");
+  if (st == MARTELLO_ERR_MEMORY) return st; /* the observer failed the run with its line */
   if (st != MARTELLO_OK) return fail(w, st, 0.0, "event-driven: martello_observer_begin failed");
   st = process_events(w, 0.0);
   if (st == MARTELLO_OK) st = commit(w, 0.0, w->y + 2 * n);

@@ -927,8 +927,12 @@ static int setup(ida_problem *P, martello_model *model, martello_run *run) {
   }
   P->N = pos;
   for (int r = 0; r < P->nr; r++) P->t_impact[r] = -1.0;   /* no impact yet */
-  if ((st = martello_eval_create(model, &P->ev)) != MARTELLO_OK)
-    return fail(P, st, "IDA: could not create the force evaluator");
+  if ((st = martello_eval_create(model, &P->ev)) == MARTELLO_ERR_MEMORY) {
+    char line[480]; /* the model's message is the line (martello_eval_create) */
+    martello_model_message(model, line, (int)sizeof line);
+    return martello_observer_fail(P->obs, st, P->t_now, line);
+  }
+  if (st != MARTELLO_OK) return fail(P, st, "IDA: could not create the force evaluator");
   if ((st = martello_eval_link_count(P->ev, &P->nl)) != MARTELLO_OK)
     return fail(P, st, "IDA: martello_eval_link_count failed");
   {
@@ -1142,7 +1146,8 @@ static int integrate(ida_problem *P, SUNContext sunctx, void **memp, N_Vector yy
     }
   }
   if ((st = martello_observer_begin(P->obs, P->ev, u0, v0, "tighten rtol and atol")) != MARTELLO_OK)
-    return fail(P, st, "IDA: martello_observer_begin failed");
+    /* out of memory: the observer failed the run with its line */
+    return st == MARTELLO_ERR_MEMORY ? st : fail(P, st, "IDA: martello_observer_begin failed");
   if ((st = prepare_restart(P, 0.0, u0, v0, yy, yp)) != MARTELLO_OK) return st;
 
   /* IDA: create, init, options (SUNDIALS lifecycle) */

@@ -73,12 +73,19 @@ contains
       type(c_ptr), intent(out) :: handle
       type(model_t), pointer :: mp
       type(evaluator_t), pointer :: ep
+      integer :: st
       handle = c_null_ptr
       mp => get_model(mhandle)
       c_eval_create = MARTELLO_ERR_ARGUMENT
       if (.not. associated(mp)) return
-      allocate (ep)
-      call evaluator_init(ep, mp)
+      allocate (ep, stat=st)
+      if (st /= 0) then
+         c_eval_create = MARTELLO_ERR_MEMORY; return
+      end if
+      call evaluator_init(ep, mp, st)
+      if (st /= MARTELLO_OK) then
+         deallocate (ep); c_eval_create = st; return
+      end if
       handle = c_loc(ep)
       c_eval_create = MARTELLO_OK
    end function c_eval_create
@@ -274,17 +281,27 @@ contains
       character(kind=c_char), intent(in) :: advice(*)
       type(observer_t), pointer :: op
       type(evaluator_t), pointer :: ep
+      integer :: st
       op => get_observer(handle); ep => get_eval(ehandle)
       c_observer_begin = MARTELLO_ERR_ARGUMENT
       if (.not. (associated(op) .and. associated(ep))) return
       call evaluator_load(ep, u(1:ep%m%n), v(1:ep%m%n))
       ! the observer's arrays for the C integrators' states (a fixed-step run needs none)
+      st = 0
       if (.not. allocated(op%acc)) allocate (op%acc(0:ep%m%n), op%c_pen(ep%m%ncontact), &
-                                            op%c_force(ep%m%ncontact))
-      ! the C integrators conserve ½vᵀMv itself (no Verlet correction): a = 0 serves
-      op%acc = 0.0_dp
-      call observer_begin(op, ep%m, ep%ms, ep%u, ep%v, op%acc, 1, c_string(advice), 0.0_dp)
-      c_observer_begin = MARTELLO_OK
+                                            op%c_force(ep%m%ncontact), stat=st)
+      if (st /= 0) then
+         call out_of_memory('the states of the results of a run', &
+                            REAL_BYTES*(ep%m%n + 1.0_dp + 2.0_dp*ep%m%ncontact), FIX_SMALLER_SCENE, &
+                            st, op%message)
+      else
+         ! the C integrators conserve ½vᵀMv itself (no Verlet correction): a = 0 serves
+         op%acc = 0.0_dp
+         call observer_begin(op, ep%m, ep%ms, ep%u, ep%v, op%acc, 1, c_string(advice), 0.0_dp, st)
+      end if
+      ! a failure is the observer's (its message set): the run ends with it
+      if (st /= MARTELLO_OK) call observer_failed(op, 0.0_dp, st)
+      c_observer_begin = st
    end function c_observer_begin
 
    integer(c_int) function c_observer_sample(handle, ehandle, t, u, v, a, force, k) &
@@ -472,11 +489,13 @@ contains
    function c_string(cs) result(fs)
       character(kind=c_char), intent(in) :: cs(*)
       character(len=:), allocatable :: fs
-      integer :: i
+      integer :: i, st
       do i = 1, 512
          if (cs(i) == c_null_char) exit
       end do
-      allocate (character(len=i - 1) :: fs)
+      allocate (character(len=i - 1) :: fs, stat=st)
+      ! at most 512 bytes, and no status to return: the process' one line (out_of_memory)
+      if (st /= 0) call out_of_memory('a message passed through the C API', 512.0_dp, FIX_SMALLER_SCENE)
       fs = transfer(cs(1:i - 1), fs)
    end function c_string
 end module martello_api_internal

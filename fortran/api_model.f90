@@ -232,7 +232,13 @@ contains
          if (associated(mp)) mp%errmsg = 'add_stiffness_block: need n >= 1'
          return
       end if
-      allocate (cm(n, n)); cm = 0.0_dp
+      allocate (cm(n, n), stat=stat)
+      if (stat /= 0) then
+         call out_of_memory('the damping of a stiffness block', REAL_BYTES*n*real(n, dp), &
+                            FIX_SMALLER_SCENE, stat, mp%errmsg)
+         c_model_add_stiffness_block = stat; return
+      end if
+      cm = 0.0_dp
       if (c_associated(c)) then
          call c_f_pointer(c, cp, [n*n])
          cm = reshape(cp, [int(n), int(n)])
@@ -300,8 +306,8 @@ contains
          mp%errmsg = 'effective_masses: every node must be set (set_node) first'
          c_model_effective_masses = MARTELLO_ERR_STATE; return
       end if
-      call model_expand_chains(mp)
-      call contact_effective_masses(mp, mstar(1:mp%ncontact), mp%errmsg, stat)
+      call model_expand_chains(mp, stat, mp%errmsg)
+      if (stat == MARTELLO_OK) call contact_effective_masses(mp, mstar(1:mp%ncontact), mp%errmsg, stat)
       c_model_effective_masses = stat
    end function c_model_effective_masses
 
@@ -339,8 +345,8 @@ contains
          c_static_solve = MARTELLO_ERR_STATE; return
       end if
       mp%errmsg = ''
-      call model_expand_chains(mp)
-      call static_solve(mp, tol, int(max_iter), r, stat)
+      call model_expand_chains(mp, stat, mp%errmsg)
+      if (stat == MARTELLO_OK) call static_solve(mp, tol, int(max_iter), r, stat)
       n = mp%n; nc = mp%ncontact
       if (allocated(r%u)) then
          u(1:n) = r%u; force(1:nc) = r%force; penetration(1:nc) = r%penetration

@@ -36,7 +36,7 @@ module martello_chain_newmark
    use martello_effective_mass, only: pair_effective_mass, effective_mass_prepare
    use martello_assembly, only: external_forces, uniform_acceleration, internal_forces, mech_commit
    use martello_time_functions, only: tf_value
-   use martello_observer, only: observer_t, observer_work, observer_begin, observer_sample, &
+   use martello_observer, only: observer_t, observer_fail, observer_failed, observer_work, observer_begin, observer_sample, &
       observer_open_phase, observer_node_samples, observer_node_turns, &
       observer_node_step_extrema, observer_phase_change, observer_contact_peaks, &
       observer_phase_peaks, observer_energy_due, observer_recorded, tracks, TRACK_NODE_PEAKS, TRACK_ALL, &
@@ -158,7 +158,13 @@ contains
       end do
       ! a chain held per node: linear springs (its bilinear ones are taken one by one), and
       ! contacts the sweep holds as pair contacts (one chain's to a pair)
-      allocate (paired(0:m%n)); paired = .false.
+      ! a scene whose few bytes per node cannot be had is not fused (the general path then
+      ! reports its own out-of-memory line)
+      allocate (paired(0:m%n), stat=j)
+      if (j /= 0) then
+         ok = .false.; return
+      end if
+      paired = .false.
       do q = 1, m%nchain
          associate (ch => m%chain(q))
             if (allocated(ch%fy)) ok = .false.
@@ -178,8 +184,10 @@ contains
       type(integrator_settings_t), intent(in) :: s
       type(observer_t), intent(inout) :: o
       integer, intent(out) :: stat
-      integer :: n, i
+      integer :: n, i, st
       logical :: flipped
+      character(len=16) :: num
+      character(len=512) :: msg
       stat = MARTELLO_OK
       n = m%n
       self%n = n; self%nc = m%ncontact; self%h = s%dt; self%settings = s
@@ -187,23 +195,31 @@ contains
       self%cm = 1.0_dp/(s%beta*s%dt*s%dt); self%cv = s%gamma/(s%beta*s%dt)
       self%c1 = 1.0_dp/(s%beta*s%dt); self%c2 = (0.5_dp - s%beta)/s%beta
       self%sm = merge(0, 1, all(m%mass == m%mass(1)))
-      self%mass = m%mass(1:merge(1, n, self%sm == 0))
       self%advice = 'the step is past the stability limit'
       self%measures_itself = .true.
-      allocate (self%u(0:n), self%v(0:n), self%a(0:n), self%un(0:n), self%vn(0:n), self%an(0:n), &
-                self%pen(0), self%force(0))
+      ! st: every allocation of the per-node state (stat > 0 if one failed)
+      allocate (self%mass(merge(1, n, self%sm == 0)), self%fixed_nodes(count(m%fixed)), &
+                self%u(0:n), self%v(0:n), self%a(0:n), self%un(0:n), self%vn(0:n), self%an(0:n), &
+                self%pen(0), self%force(0), self%rp(n), self%fe(0:n), self%fnod(m%nforce), stat=st)
+      if (st == 0) call per_node(self, m, st)
+      if (st == 0) call link_peak_arrays(self, m, tracks(o, TRACK_LINK_PEAKS), st)
+      if (st /= 0) then
+         write (num, '(i0)') n
+         call out_of_memory('the per-node state of the fused chain step for '//trim(num)//' nodes', &
+                            -1.0_dp, FIX_SMALLER_SCENE, stat, msg)
+         call observer_fail(o, MARTELLO_ERR_MEMORY, 0.0_dp, msg, stat)
+         return
+      end if
+      self%mass = m%mass(1:size(self%mass))
       self%u(0) = 0.0_dp; self%v(0) = 0.0_dp
       call model_initial_state(m, self%u(1:n), self%v(1:n))
       self%fixed_nodes = pack([(i, i = 1, n)], m%fixed)
-      call per_node(self, m)
-      call link_peak_arrays(self, m, tracks(o, TRACK_LINK_PEAKS))
       ! the bilinear springs start elastic, on k·Δu₀ (clamped into the band by the first
       ! step), as mech_init
       do i = 1, size(self%bl)
          self%bdu(i) = self%u(m%link_a(self%bl(i))) - self%u(m%link_b(self%bl(i)))
          self%bfc(i) = m%link_par(L_STIFF, self%bl(i))*self%bdu(i)
       end do
-      allocate (self%rp(n), self%fe(0:n), self%fnod(m%nforce))
       self%rp = 0.0_dp; self%fe = 0.0_dp; self%fnod = 0.0_dp
       self%any_fixed = size(self%fixed_nodes) > 0
       ! the elements at (u0, v0) with their whole laws: the evaluation at an iterate with no
@@ -227,9 +243,11 @@ contains
    !> The chain per node from the model's links and contacts (chain_fusable holds): the
    !> linear links summed per node and per pair, the first contact of each pair in the pair
    !> arrays (one value for the chain where all pairs share it), the rest one by one.
-   subroutine per_node(self, m)
+   !> st > 0: an allocation failed (the state is then incomplete).
+   subroutine per_node(self, m, st)
       class(chain_newmark_t), intent(inout) :: self
       type(model_t), intent(in) :: m
+      integer, intent(out) :: st
       integer :: n, j, a, b, lo, nb, nx, q, i, c
       real(dp) :: k, cd
       logical, allocatable :: pair(:)
@@ -237,7 +255,10 @@ contains
       self%chain_links = m%nchain == 1 .and. m%nlink == 0
       if (self%chain_links) self%chain_links = m%chain(1)%first == 1 .and. m%chain(1)%n == n .and. &
                                                allocated(m%chain(1)%c)
-      allocate (self%kg(merge(0, n, self%chain_links)), self%cg(merge(0, n, self%chain_links)))
+      allocate (self%kg(merge(0, n, self%chain_links)), self%cg(merge(0, n, self%chain_links)), &
+                self%pcon(0:n), pair(m%ncontact), self%pbr(0:n), self%pbrc(0:n), self%pbrf(0:n), &
+                stat=st)
+      if (st /= 0) return
       self%kg = 0.0_dp; self%cg = 0.0_dp
       self%pair_links = .false.
       do j = 1, m%nlink
@@ -245,7 +266,9 @@ contains
          if (m%link_kind(j) /= LINK_BILINEAR .and. a > 0 .and. b > 0) self%pair_links = .true.
       end do
       ! unused ones hold one entry: the kernels take them as arrays
-      allocate (self%kp(0:merge(n, 0, self%pair_links)), self%cp(0:merge(n, 0, self%pair_links)))
+      allocate (self%kp(0:merge(n, 0, self%pair_links)), self%cp(0:merge(n, 0, self%pair_links)), &
+                stat=st)
+      if (st /= 0) return
       self%kp = 0.0_dp; self%cp = 0.0_dp
       nb = 0
       do j = 1, m%nlink
@@ -279,11 +302,12 @@ contains
       self%bl = pack([(j, j = 1, m%nlink)], m%link_kind(1:m%nlink) == LINK_BILINEAR)
       self%blo = [(model_link_index(m, self%bl(j)), j = 1, nb)]
       allocate (self%bfc(nb), self%bdu(nb), self%bft(nb), self%bdut(nb), self%bbr(nb), &
-                self%bbrf(nb))
+                self%bbrf(nb), stat=st)
+      if (st /= 0) return
       self%bbr = B_ELASTIC; self%bbrf = B_ELASTIC
       ! the pair contacts: the chains' (chain_fusable: one to a pair), then the first contact
       ! added one by one between i and i + 1; numbered among all the model's contacts
-      allocate (self%pcon(0:n), pair(m%ncontact)); self%pcon = 0; pair = .false.
+      self%pcon = 0; pair = .false.
       do q = 1, m%nchain
          associate (ch => m%chain(q))
             do i = 1, ch%ncontact
@@ -300,39 +324,43 @@ contains
          end if
       end do
       self%pair_contacts = any(self%pcon > 0)
-      call pair_parameters(self, m)
+      call pair_parameters(self, m, st)
+      if (st /= 0) return
       if (n > 1) then
          c = self%pcon(1)
          if (c > 0 .and. all(self%pcon(1:n - 1) == [(c - 1 + j, j = 1, n - 1)])) self%pc0 = c - 1
       end if
       if (self%pc0 >= 0) then
-         deallocate (self%pcon); allocate (self%pcon(0:0)); self%pcon = 0
+         deallocate (self%pcon); allocate (self%pcon(0:0), stat=st); self%pcon = 0
       end if
-      allocate (self%pbr(0:n), self%pbrc(0:n), self%pbrf(0:n))
       self%pbr = B_OFF; self%pbrc = B_OFF; self%pbrf = B_OFF
       self%xg = pack([(j, j = 1, m%ncontact)], .not. pair)
       nx = size(self%xg)
       self%xc = [(model_contact_index(m, self%xg(j)), j = 1, nx)]
-      allocate (self%xbr(nx), self%xbrc(nx), self%xbrf(nx))
+      allocate (self%xbr(nx), self%xbrc(nx), self%xbrf(nx), stat=st)
+      if (st /= 0) return
       self%xbr = B_OFF; self%xbrc = B_OFF; self%xbrf = B_OFF
       self%others = nb > 0 .or. nx > 0
       nx = merge(n, 0, self%others)
-      allocate (self%xjd(0:nx), self%xjo(0:nx), self%xcd(0:nx), self%xco(0:nx))
+      allocate (self%xjd(0:nx), self%xjo(0:nx), self%xcd(0:nx), self%xco(0:nx), stat=st)
+      if (st /= 0) return
       self%xjd = 0.0_dp; self%xjo = 0.0_dp; self%xcd = 0.0_dp; self%xco = 0.0_dp
    end subroutine per_node
 
    !> The pair contacts' parameters: sign, gap, stiffness, damping and law, each one value for
    !> the chain (stride 0) where every pair has a contact and they share it.
-   subroutine pair_parameters(self, m)
+   subroutine pair_parameters(self, m, st)
       class(chain_newmark_t), intent(inout) :: self
       type(model_t), intent(in) :: m
+      integer, intent(out) :: st
       integer :: n, i, j, a, b, scheme, claw
       real(dp), allocatable :: sgn(:), gap(:), k(:), c(:)
       real(dp) :: par(NPAR_CONTACT), mstar
       integer(int8), allocatable :: law(:)
       logical :: every
       n = m%n
-      allocate (sgn(0:n), gap(0:n), k(0:n), c(0:n), law(0:n))
+      allocate (sgn(0:n), gap(0:n), k(0:n), c(0:n), law(0:n), stat=st)
+      if (st /= 0) return
       ! a pair without a contact: a gap no motion closes
       sgn = 1.0_dp; gap = huge(1.0_dp); k = 0.0_dp; c = 0.0_dp; law = K_LINEAR
       do i = 1, n - 1
@@ -357,11 +385,12 @@ contains
       self%kelvin = any(law(1:n - 1) /= K_LINEAR)
       every = n > 1 .and. all(self%pcon(1:n - 1) > 0)
       call one_or_all(sgn, self%psgn, self%ss)
-      call one_or_all(gap, self%pgap, self%sg)
-      call one_or_all(k, self%pk, self%sk)
-      call one_or_all(c, self%pc, self%sc)
+      if (st == 0) call one_or_all(gap, self%pgap, self%sg)
+      if (st == 0) call one_or_all(k, self%pk, self%sk)
+      if (st == 0) call one_or_all(c, self%pc, self%sc)
+      if (st /= 0) return
       if (every .and. all(law(1:n - 1) == law(1))) then
-         allocate (self%plaw(0:0)); self%plaw(0) = law(1); self%sl = 0
+         allocate (self%plaw(0:0), stat=st); self%plaw(0) = law(1); self%sl = 0
       else
          call move_alloc(law, self%plaw); self%sl = 1
       end if
@@ -373,18 +402,21 @@ contains
          real(dp), allocatable, intent(out) :: to(:)
          integer, intent(out) :: stride
          if (every .and. all(x(1:n - 1) == x(1))) then
-            allocate (to(0:0)); to(0) = x(1); stride = 0
+            allocate (to(0:0), stat=st); if (st /= 0) return
+            to(0) = x(1); stride = 0
          else
-            allocate (to(0:n)); to(0:n) = x; stride = 1
+            allocate (to(0:n), stat=st); if (st /= 0) return
+            to(0:n) = x; stride = 1
          end if
       end subroutine one_or_all
    end subroutine pair_parameters
 
    !> The per-node and per-pair maxima the link peaks need: only for the kinds the chain has.
-   subroutine link_peak_arrays(self, m, tracked)
+   subroutine link_peak_arrays(self, m, tracked, st)
       class(chain_newmark_t), intent(inout) :: self
       type(model_t), intent(in) :: m
       logical, intent(in) :: tracked
+      integer, intent(out) :: st
       integer :: j, n
       logical :: ground, gdamp, pair, pdamp
       n = merge(m%n, 0, tracked)
@@ -402,7 +434,8 @@ contains
          if (allocated(m%chain(j)%c)) gdamp = gdamp .or. any(m%chain(j)%c > 0.0_dp)
       end do
       allocate (self%gumax(merge(n, 0, ground)), self%gvmax(merge(n, 0, gdamp)), &
-                self%pumax(merge(n, 0, pair)), self%pvmax(merge(n, 0, pdamp)))
+                self%pumax(merge(n, 0, pair)), self%pvmax(merge(n, 0, pdamp)), stat=st)
+      if (st /= 0) return
       self%gumax = 0.0_dp; self%gvmax = 0.0_dp; self%pumax = 0.0_dp; self%pvmax = 0.0_dp
    end subroutine link_peak_arrays
 
@@ -946,8 +979,16 @@ contains
       self%factored = .false.
       if (m%nchain > 0) then
          if (.not. allocated(self%gm)) then
-            allocate (self%gm, source=m)
-            call model_expand_chains(self%gm)
+            allocate (self%gm, source=m, stat=stat)
+            if (stat /= 0) then
+               call out_of_memory('a copy of the model for the general path of the fused chain step', &
+                                  -1.0_dp, FIX_SMALLER_SCENE, stat, o%message)
+            else
+               call model_expand_chains(self%gm, stat, o%message)
+            end if
+            if (stat /= MARTELLO_OK) then
+               call observer_failed(o, t, stat); return
+            end if
             call effective_mass_prepare(self%gm, o%message, stat)
             if (stat /= MARTELLO_OK) return
          end if
@@ -962,7 +1003,12 @@ contains
          integer :: idx, j, i
          if (.not. allocated(self%gen)) then
             ! its start at t = 0 (a = M⁻¹(f_ext − f_int)) is overwritten below: not counted
-            allocate (self%gen)
+            allocate (self%gen, stat=stat)
+            if (stat /= 0) then
+               call out_of_memory('the general path of the fused chain step', -1.0_dp, &
+                                  FIX_SMALLER_SCENE, stat, o%message)
+               call observer_failed(o, t, stat); return
+            end if
             saved = o%counters
             call self%gen%init(gm, self%settings, o, stat)
             o%counters = saved
@@ -1026,11 +1072,12 @@ contains
 
    !> The observer's start: the phases of the contacts closed at t = 0 and the energies
    !> there.
-   subroutine chain_measure_start(self, m, o, energy_interval)
+   subroutine chain_measure_start(self, m, o, energy_interval, stat)
       class(chain_newmark_t), intent(inout) :: self
       type(model_t), intent(in) :: m
       type(observer_t), intent(inout) :: o
       integer, intent(in) :: energy_interval
+      integer, intent(out) :: stat
       integer :: i, idx, j
       do i = 1, self%n - 1
          if (pair_contact(self, i) == 0 .or. self%pbrc(i) == B_OFF) cycle
@@ -1043,7 +1090,8 @@ contains
                                                                self%v(m%con_a(j)) - self%v(m%con_b(j)))
       end do
       call observer_begin(o, m, self%ms, self%u, self%v, self%a, energy_interval, self%advice, &
-                          0.0_dp, energies=energies(self, m))
+                          0.0_dp, stat, energies=energies(self, m))
+      if (stat /= MARTELLO_OK) call observer_failed(o, 0.0_dp, stat)
    end subroutine chain_measure_start
 
    !> The committed state at t = t_k measured item by item: every node's peaks, every
@@ -1067,10 +1115,17 @@ contains
       call measure_nodes(self, m, o, t, h)
       call measure_others(self, m, o, t, h)
       rec = observer_recorded(o, k)
-      allocate (pen(0), force(0))
-      if (rec .and. size(o%out_contacts) > 0) call contact_states(self, m, o%out_contacts, pen, force)
+      allocate (pen(0), force(0), stat=stat)
+      if (stat == 0 .and. rec .and. size(o%out_contacts) > 0) &
+         call contact_states(self, m, o%out_contacts, pen, force, stat)
       if (rec) call link_peaks(self, m, o)
-      if (rec .and. size(o%out_links) > 0) call link_states(self, m, o%out_links, lf, ld)
+      if (stat == 0 .and. rec .and. size(o%out_links) > 0) call link_states(self, m, o%out_links, lf, ld, stat)
+      if (stat /= 0) then
+         call out_of_memory('the recorded contact and link states of the fused chain step', &
+                            REAL_BYTES*2*(model_ncontacts(m) + real(model_nlinks(m), dp)), &
+                            FIX_SMALLER_SCENE, stat, o%message)
+         call observer_failed(o, t, stat); return
+      end if
       if (observer_energy_due(o, k)) e = energies(self, m)
       call observer_sample(o, m, self%ms, t, self%u, self%v, self%a, pen, force, k, stat, lf, ld, &
                            folded=.true., energies=e)
@@ -1367,16 +1422,18 @@ contains
    end subroutine link_peaks
 
    !> δ and force of the contacts which (0 elsewhere): the history's columns.
-   subroutine contact_states(self, m, which, pen, force)
+   subroutine contact_states(self, m, which, pen, force, st)
       class(chain_newmark_t), intent(inout) :: self
       type(model_t), intent(in) :: m
       integer, intent(in) :: which(:)
       real(dp), allocatable, intent(inout) :: pen(:), force(:)
+      integer, intent(out) :: st
       integer :: idx, j, i, a, b, scheme, law
       integer(int8) :: br
       real(dp) :: gap, par(NPAR_CONTACT), rate
       deallocate (pen, force)
-      allocate (pen(model_ncontacts(m)), force(model_ncontacts(m)))
+      allocate (pen(model_ncontacts(m)), force(model_ncontacts(m)), stat=st)
+      if (st /= 0) return
       pen = 0.0_dp; force = 0.0_dp
       do idx = 1, size(which)
          j = which(idx)
@@ -1412,14 +1469,16 @@ contains
    end subroutine contact_states
 
    !> Force and elongation of the links which (0 elsewhere): the history's columns.
-   subroutine link_states(self, m, which, lf, ld)
+   subroutine link_states(self, m, which, lf, ld, st)
       class(chain_newmark_t), intent(inout) :: self
       type(model_t), intent(in) :: m
       integer, intent(in) :: which(:)
       real(dp), allocatable, intent(out) :: lf(:), ld(:)
+      integer, intent(out) :: st
       integer :: idx, j, a, b, q, kind
       real(dp) :: par(NPAR_LINK)
-      allocate (lf(model_nlinks(m)), ld(model_nlinks(m)))
+      allocate (lf(model_nlinks(m)), ld(model_nlinks(m)), stat=st)
+      if (st /= 0) return
       lf = 0.0_dp; ld = 0.0_dp
       do idx = 1, size(which)
          j = which(idx)

@@ -36,9 +36,16 @@ contains
       logical, allocatable :: coupled(:)
       real(dp), allocatable :: mb(:, :), x(:)
       integer :: nf, kd, c, j, ia, ib, info
-      stat = MARTELLO_OK
-      call free_dofs(m, dof, nf)
-      allocate (coupled(0:m%n)); coupled = .false.
+      call free_dofs(m, dof, nf, stat, message)
+      if (stat /= MARTELLO_OK) return
+      allocate (coupled(0:m%n), stat=stat)
+      if (stat /= 0) then
+         call out_of_memory('the coupled nodes of the effective masses', &
+                            storage_size(coupled)/8*(m%n + 1.0_dp), &
+                            FIX_SMALLER_SCENE, stat, message)
+         return
+      end if
+      coupled = .false.
       do j = 1, m%ncoupling
          if (dof(m%mc_a(j)) > 0 .and. dof(m%mc_b(j)) > 0) then
             coupled(m%mc_a(j)) = .true.; coupled(m%mc_b(j)) = .true.
@@ -46,7 +53,8 @@ contains
       end do
       kd = max(model_bandwidth(m), 0)
       if (any(coupled)) then
-         call mass_band(m, dof, nf, kd, mb)
+         call mass_band(m, dof, nf, kd, mb, stat, message)
+         if (stat /= MARTELLO_OK) return
          call dpbtrf('U', nf, kd, mb, kd + 1, info)
          if (info /= 0) then
             stat = MARTELLO_ERR_ARGUMENT
@@ -54,7 +62,12 @@ contains
                ' definite: a coupling is larger than the masses it joins allow'
             return
          end if
-         allocate (x(nf))
+         allocate (x(nf), stat=stat)
+         if (stat /= 0) then
+            call out_of_memory('a column of the inverse mass', REAL_BYTES*nf, FIX_SMALLER_SCENE, &
+                               stat, message)
+            return
+         end if
       end if
       do c = 1, m%ncontact
          ia = dof(m%con_a(c)); ib = dof(m%con_b(c))   ! 0: ground or a fixed node

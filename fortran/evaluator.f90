@@ -4,6 +4,7 @@
 !> steps. It wraps the same assembly code as the structural integrators.
 module martello_evaluator
    use martello_kinds, only: dp
+   use martello_status
    use martello_model, only: model_t, model_bandwidth, model_initial_state, model_u0
    use martello_assembly
    use martello_band_matrix
@@ -27,19 +28,28 @@ module martello_evaluator
 
 contains
 
-   subroutine evaluator_init(ev, m)
+   !> stat: MARTELLO_ERR_MEMORY (the model's message its line) if its arrays cannot be
+   !> allocated.
+   subroutine evaluator_init(ev, m, stat)
       type(evaluator_t), intent(inout) :: ev
-      type(model_t), intent(in), target :: m
+      type(model_t), intent(inout), target :: m
+      integer, intent(out) :: stat
       integer :: n, j
       ev%m => m
       n = m%n
-      allocate (ev%mrow(0:n), ev%u(0:n), ev%v(0:n), ev%f(0:n), ev%fext(0:n), ev%work(0:n))
+      allocate (ev%mrow(0:n), ev%u(0:n), ev%v(0:n), ev%f(0:n), ev%fext(0:n), ev%work(0:n), &
+                ev%fixed_nodes(count(m%fixed)), stat=stat)
+      if (stat /= 0) then
+         call out_of_memory('the force evaluator', REAL_BYTES*6*(n + 1.0_dp) &
+                            + INT_BYTES*count(m%fixed), FIX_SMALLER_SCENE, stat, m%errmsg)
+         return
+      end if
       ev%work = 1.0_dp; ev%work(0) = 0.0_dp
       call mass_times(m, ev%work, ev%mrow)
       ev%u = 0.0_dp; ev%v = 0.0_dp
       call model_initial_state(m, ev%u(1:n), ev%v(1:n))
-      call mech_init(m, ev%ms, ev%u, ev%v)
-      call band_init(ev%mband, n, model_bandwidth(m))
+      call mech_init(m, ev%ms, ev%u, ev%v, stat, m%errmsg)
+      if (stat == MARTELLO_OK) call band_init(ev%mband, n, model_bandwidth(m), stat, m%errmsg)
       ev%fixed_nodes = pack([(j, j = 1, n)], m%fixed)
    end subroutine evaluator_init
 

@@ -86,7 +86,8 @@ contains
 
       stat = MARTELLO_OK
       n = m%n
-      call stepper_start(self, m, s)
+      call stepper_start(self, m, s, o, stat)
+      if (stat /= MARTELLO_OK) return
       self%advice = 'reduce dt (the pseudo-force iteration converges for small h^2 k/m)'
       self%max_iter = s%max_newton; self%tol = s%tol_residual
       call free_dofs(m, dof, nf, stat, msg)

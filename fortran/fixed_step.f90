@@ -12,9 +12,9 @@ module martello_fixed_step
    use martello_assembly, only: mech_state_t, mech_init, mass_times, assemble_mass, internal_forces, &
       external_forces, mech_commit
    use martello_band_matrix, only: band_t, band_zero, band_pin, band_solve
-   use martello_integrator_settings, only: integrator_settings_t
+   use martello_integrator_settings, only: integrator_settings_t, integrator_name
    use martello_run_checks, only: check_run_settings
-   use martello_observer, only: observer_t, observer_begin, observer_sample, observer_fail, &
+   use martello_observer, only: observer_t, observer_begin, observer_sample, observer_fail, observer_failed, &
       observer_penalty_phases, observer_finish, C_STEPS, C_FACTORIZATIONS
    implicit none
    private
@@ -59,7 +59,8 @@ module martello_fixed_step
       !> (un, vn, an) ← (u, v, a) before a step: copies; a method that writes every entry of
       !> u, v, a before reading it may swap the buffers instead
       procedure :: begin_step => stepper_begin_step
-      !> the observer's start (observer_begin), and the sample of the state at grid point k
+      !> the observer's start (observer_begin: stat = MARTELLO_ERR_MEMORY, the run failed, if
+      !> its arrays cannot be allocated), and the sample of the state at grid point k
       !> (observer_sample); a method that measures itself overrides both
       procedure :: measure_start => stepper_measure_start
       procedure :: measure => stepper_measure
@@ -109,11 +110,20 @@ contains
       call stp%init(m, s, o, stat)
       if (stat /= MARTELLO_OK) return
       ! velocity-jump phases: located and valued with the end velocities (no acceleration)
-      if (stp%velocity_jump_phases) allocate (no_acc(0:stp%n), source=0.0_dp)
+      if (stp%velocity_jump_phases) then
+         allocate (no_acc(0:stp%n), source=0.0_dp, stat=stat)
+         if (stat /= 0) then
+            call out_of_memory('the zero acceleration of the velocity-jump phases', &
+                               REAL_BYTES*(stp%n + 1.0_dp), FIX_SMALLER_SCENE, stat, o%message)
+            call observer_failed(o, 0.0_dp, stat)
+            return
+         end if
+      end if
       ! the other methods' states lie on a smooth motion between phase changes: their peaks
       ! are located inside the steps (docs/results.md)
       o%smooth_steps = .not. stp%velocity_jump_phases
-      call stp%measure_start(m, o, ENERGY_CHECK)
+      call stp%measure_start(m, o, ENERGY_CHECK, stat)
+      if (stat /= MARTELLO_OK) return
       t = 0.0_dp
       call stp%measure(m, o, t, 0_i8, stat)
       if (stat /= MARTELLO_OK) return
@@ -141,13 +151,15 @@ contains
    end subroutine run_fixed_step
 
    !> The observer's start: the state at t = 0 and the energy evaluation cadence.
-   subroutine stepper_measure_start(self, m, o, energy_interval)
+   subroutine stepper_measure_start(self, m, o, energy_interval, stat)
       class(stepper_t), intent(inout) :: self
       type(model_t), intent(in) :: m
       type(observer_t), intent(inout) :: o
       integer, intent(in) :: energy_interval
+      integer, intent(out) :: stat
       call observer_begin(o, m, self%ms, self%u, self%v, self%a, energy_interval, self%advice, &
-                          self%ke_aMa)
+                          self%ke_aMa, stat)
+      if (stat /= MARTELLO_OK) call observer_failed(o, 0.0_dp, stat)
    end subroutine stepper_measure_start
 
    !> The state at t = t_k; the previous one is the stepper's own (un, vn, an): no copy.
@@ -169,23 +181,43 @@ contains
    end subroutine stepper_begin_step
 
    !> The common start of every stepper: sizes, the initial state (fixed nodes at rest), M·1
-   !> and the committed link and contact states at t = 0.
-   subroutine stepper_start(self, m, s)
+   !> and the committed link and contact states at t = 0. stat = MARTELLO_ERR_MEMORY, the run
+   !> failed (observer_fail), if they cannot be allocated.
+   subroutine stepper_start(self, m, s, o, stat)
       class(stepper_t), intent(inout) :: self
       type(model_t), intent(in) :: m
       type(integrator_settings_t), intent(in) :: s
-      integer :: n, j
+      type(observer_t), intent(inout) :: o
+      integer, intent(out) :: stat
+      integer :: n, j, k
+      character(len=512) :: msg
       n = m%n
       self%n = n; self%nc = m%ncontact; self%h = s%dt
       allocate (self%u(0:n), self%v(0:n), self%a(0:n), self%un(0:n), self%vn(0:n), &
-                self%an(0:n), self%mrow(0:n), self%pen(m%ncontact), self%force(m%ncontact))
+                self%an(0:n), self%mrow(0:n), self%pen(m%ncontact), self%force(m%ncontact), &
+                self%fixed_nodes(count(m%fixed)), stat=stat)
+      if (stat /= 0) then
+         call out_of_memory('the state of '//integrator_name(s%kind), &
+                            REAL_BYTES*(7*(n + 1.0_dp) + 2.0_dp*m%ncontact) &
+                            + INT_BYTES*count(m%fixed), FIX_SMALLER_SCENE, stat, msg)
+         call observer_fail(o, MARTELLO_ERR_MEMORY, 0.0_dp, msg, stat)
+         return
+      end if
       self%u(0) = 0.0_dp; self%v(0) = 0.0_dp; self%a = 0.0_dp
       call model_initial_state(m, self%u(1:n), self%v(1:n))
       self%pen = 0.0_dp; self%force = 0.0_dp
-      self%fixed_nodes = pack([(j, j = 1, n)], m%fixed)
+      k = 0
+      do j = 1, n
+         if (.not. m%fixed(j)) cycle
+         k = k + 1; self%fixed_nodes(k) = j
+      end do
       self%un = 1.0_dp; self%un(0) = 0.0_dp
       call mass_times(m, self%un, self%mrow)
-      call mech_init(m, self%ms, self%u, self%v)
+      call mech_init(m, self%ms, self%u, self%v, stat, msg)
+      if (stat /= MARTELLO_OK) then
+         call observer_fail(o, MARTELLO_ERR_MEMORY, 0.0_dp, msg, stat)
+         return
+      end if
       self%un = self%u; self%vn = self%v; self%an = self%a
    end subroutine stepper_start
 
@@ -200,8 +232,8 @@ contains
       type(observer_t), intent(inout) :: o
       integer, intent(out) :: stat
       logical :: ok
-      stat = MARTELLO_OK
-      call stepper_start(self, m, s)
+      call stepper_start(self, m, s, o, stat)
+      if (stat /= MARTELLO_OK) return
       call internal_forces(m, self%ms, self%u, self%v, fint)
       call external_forces(m, self%mrow, 0.0_dp, fext)
       self%a = fext - fint

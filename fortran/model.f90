@@ -4,7 +4,8 @@
 !> whole model (the contacts' effective masses) is martello_effective_mass's.
 module martello_model
    use martello_kinds, only: dp
-   use martello_status, only: MARTELLO_OK, MARTELLO_ERR_ARGUMENT
+   use martello_status, only: MARTELLO_OK, MARTELLO_ERR_ARGUMENT, out_of_memory, REAL_BYTES, &
+      INT_BYTES, FIX_SMALLER_SCENE
    use martello_time_functions, only: time_function_t, tf_is_known, TF_TABLE, NPAR_TF
    use martello_contact_laws, only: NPAR_CONTACT, law_is_known, P_RESTITUTION, P_CLIP
    use martello_links, only: NPAR_LINK, link_is_known, LINK_SPRING, LINK_DASHPOT, LINK_BILINEAR, &
@@ -109,21 +110,33 @@ contains
       type(model_t), intent(inout) :: m
       integer, intent(in) :: n, max_links, max_contacts, max_forces, max_couplings
       integer, intent(out) :: stat
+      character(len=128) :: what
       stat = MARTELLO_OK
       if (n < 1 .or. min(max_links, max_contacts, max_forces, max_couplings) < 0) then
          call fail(m, stat, 'model_create: need n_nodes >= 1 and non-negative capacities')
          return
       end if
       m%n = n
-      allocate (m%mass(n), m%u0(0), m%v0(0), m%fixed(n))
-      m%mass = -1.0_dp; m%fixed = .false.
-      allocate (m%link_kind(max_links), m%link_a(max_links), m%link_b(max_links), &
-                m%link_par(NPAR_LINK, max_links))
-      allocate (m%con_a(max_contacts), m%con_b(max_contacts), m%con_scheme(max_contacts), &
+      allocate (m%mass(n), m%u0(0), m%v0(0), m%fixed(n), &
+                m%link_kind(max_links), m%link_a(max_links), m%link_b(max_links), &
+                m%link_par(NPAR_LINK, max_links), &
+                m%con_a(max_contacts), m%con_b(max_contacts), m%con_scheme(max_contacts), &
                 m%con_law(max_contacts), m%con_gap(max_contacts), &
-                m%con_par(NPAR_CONTACT, max_contacts), m%con_mstar(max_contacts))
-      allocate (m%force_node(max_forces), m%force_fn(max_forces))
-      allocate (m%mc_a(max_couplings), m%mc_b(max_couplings), m%mc_value(max_couplings))
+                m%con_par(NPAR_CONTACT, max_contacts), m%con_mstar(max_contacts), &
+                m%force_node(max_forces), m%force_fn(max_forces), &
+                m%mc_a(max_couplings), m%mc_b(max_couplings), m%mc_value(max_couplings), stat=stat)
+      if (stat /= 0) then
+         write (what, '(a,i0,a,i0,a,i0,a)') 'a model of ', n, ' nodes, ', max_links, ' links and ', &
+            max_contacts, ' contacts'
+         call out_of_memory(trim(what), REAL_BYTES*(real(n, dp) + NPAR_LINK*real(max_links, dp) &
+                            + (NPAR_CONTACT + 2.0_dp)*max_contacts + max_couplings) &
+                            + INT_BYTES*(2.0_dp*n + 3.0_dp*max_links + 4.0_dp*max_contacts &
+                            + max_forces + 2.0_dp*max_couplings) &
+                            + storage_size(m%force_fn)/8*real(max_forces, dp), &
+                            FIX_SMALLER_SCENE, stat, m%errmsg)
+         return
+      end if
+      m%mass = -1.0_dp; m%fixed = .false.
    end subroutine model_init
 
    logical function node_ok(m, i, ground_allowed)
@@ -296,6 +309,7 @@ contains
       integer, intent(out) :: stat
       type(stiffness_block_t), allocatable :: grown(:)
       integer :: i, nb
+      character(len=64) :: what
       stat = MARTELLO_OK
       nb = size(node)
       if (nb < 1 .or. size(k, 1) /= nb .or. size(k, 2) /= nb .or. size(c, 1) /= nb .or. &
@@ -324,7 +338,15 @@ contains
             return
          end if
       end do
-      allocate (grown(m%nblock + 1))
+      allocate (grown(m%nblock + 1), stat=stat)
+      if (stat == 0) allocate (grown(m%nblock + 1)%node(nb), grown(m%nblock + 1)%k(nb, nb), &
+                               grown(m%nblock + 1)%c(nb, nb), stat=stat)
+      if (stat /= 0) then
+         write (what, '(a,i0,a)') 'a stiffness block of ', nb, ' nodes'
+         call out_of_memory(trim(what), 2*REAL_BYTES*nb*real(nb, dp) + INT_BYTES*nb, &
+                            FIX_SMALLER_SCENE, stat, m%errmsg)
+         return
+      end if
       do i = 1, m%nblock
          call move_alloc(m%block(i)%node, grown(i)%node)
          call move_alloc(m%block(i)%k, grown(i)%k)
@@ -432,6 +454,7 @@ contains
       real(dp), intent(in), optional :: c(:), fy(:), rho(:), gap(:)
       integer, intent(out) :: stat
       type(chain_t), allocatable :: grown(:)
+      type(chain_t) :: new
       real(dp) :: lp(NPAR_LINK)
       integer :: i, kind
       character(len=24) :: num
@@ -462,27 +485,54 @@ contains
             m%errmsg = 'chain entry '//trim(num)//': '//trim(m%errmsg); return
          end if
       end do
-      allocate (grown(m%nchain + 1))
-      if (m%nchain > 0) grown(1:m%nchain) = m%chain
-      associate (ch => grown(m%nchain + 1))
-         ch%first = first; ch%n = n
-         ch%glink = m%nlink; ch%gcontact = m%ncontact
-         ch%link0 = model_nlinks(m); ch%contact0 = model_ncontacts(m)
-         ch%k = k(1:n)
-         ch%nlink = n
-         if (present(c)) then
-            ch%c = c(1:n); ch%nlink = n + count(c(1:n) > 0.0_dp)
-         end if
-         if (present(fy)) then
-            ch%fy = fy(1:n); ch%rho = rho(1:n)
-         end if
-         if (present(gap) .and. n > 1) then
-            ch%gap = gap(1:n - 1); ch%ncontact = n - 1
-         end if
-         ch%scheme = scheme; ch%law = law; ch%par = par
-      end associate
+      ! the new chain's arrays and the grown list allocated before anything moves: a failure
+      ! leaves the model as it was
+      allocate (new%k(n), stat=stat)
+      if (stat == 0 .and. present(c)) allocate (new%c(n), stat=stat)
+      if (stat == 0 .and. present(fy)) allocate (new%fy(n), new%rho(n), stat=stat)
+      if (stat == 0 .and. present(gap) .and. n > 1) allocate (new%gap(n - 1), stat=stat)
+      if (stat == 0) allocate (grown(m%nchain + 1), stat=stat)
+      if (stat /= 0) then
+         write (num, '(i0)') n
+         call out_of_memory('a chain of '//trim(num)//' nodes', REAL_BYTES*n*(1 + merge(1, 0, present(c)) &
+                            + merge(2, 0, present(fy)) + merge(1, 0, present(gap))), &
+                            FIX_SMALLER_SCENE, stat, m%errmsg)
+         return
+      end if
+      new%first = first; new%n = n
+      new%glink = m%nlink; new%gcontact = m%ncontact
+      new%link0 = model_nlinks(m); new%contact0 = model_ncontacts(m)
+      new%k = k(1:n)
+      new%nlink = n
+      if (present(c)) then
+         new%c = c(1:n); new%nlink = n + count(c(1:n) > 0.0_dp)
+      end if
+      if (present(fy)) then
+         new%fy = fy(1:n); new%rho = rho(1:n)
+      end if
+      if (present(gap) .and. n > 1) then
+         new%gap = gap(1:n - 1); new%ncontact = n - 1
+      end if
+      new%scheme = scheme; new%law = law; new%par = par
+      do i = 1, m%nchain
+         call move_chain(m%chain(i), grown(i))
+      end do
+      call move_chain(new, grown(m%nchain + 1))
       call move_alloc(grown, m%chain)
       m%nchain = m%nchain + 1
+   contains
+      !> to ← from, the arrays moved, not copied
+      subroutine move_chain(from, to)
+         type(chain_t), intent(inout) :: from
+         type(chain_t), intent(inout) :: to
+         to%first = from%first; to%n = from%n; to%nlink = from%nlink; to%ncontact = from%ncontact
+         to%link0 = from%link0; to%contact0 = from%contact0
+         to%glink = from%glink; to%gcontact = from%gcontact
+         to%scheme = from%scheme; to%law = from%law; to%par = from%par
+         call move_alloc(from%k, to%k); call move_alloc(from%c, to%c)
+         call move_alloc(from%fy, to%fy); call move_alloc(from%rho, to%rho)
+         call move_alloc(from%gap, to%gap)
+      end subroutine move_chain
    end subroutine model_add_chain
 
    !> Links of the model: added one by one and in chains.
@@ -593,17 +643,32 @@ contains
    !> The chains as links and contacts one by one, numbered as model_add_chain says, for the
    !> methods that take items one by one (a run's integrator, the static solve); the free
    !> capacity of model_create is kept.
-   subroutine model_expand_chains(m)
+   !> stat, message: as martello_status out_of_memory if they cannot be allocated (the model
+   !> is left as it was).
+   subroutine model_expand_chains(m, stat, message)
       type(model_t), intent(inout) :: m
+      integer, intent(out) :: stat
+      character(len=*), intent(inout) :: message
       integer :: nl, nc, free_l, free_c, q, i, g, pos
       integer, allocatable :: lk(:), la(:), lb(:), ca(:), cb(:), cs(:), cl(:)
       real(dp), allocatable :: lpar(:, :), cg(:), cpar(:, :), cm(:)
+      character(len=96) :: what
+      stat = MARTELLO_OK
       if (m%nchain == 0) return
       nl = model_nlinks(m); nc = model_ncontacts(m)
       free_l = size(m%link_kind) - m%nlink; free_c = size(m%con_a) - m%ncontact
-      allocate (lk(nl + free_l), la(nl + free_l), lb(nl + free_l), lpar(NPAR_LINK, nl + free_l))
-      allocate (ca(nc + free_c), cb(nc + free_c), cs(nc + free_c), cl(nc + free_c), &
-                cg(nc + free_c), cm(nc + free_c), cpar(NPAR_CONTACT, nc + free_c))
+      allocate (lk(nl + free_l), la(nl + free_l), lb(nl + free_l), lpar(NPAR_LINK, nl + free_l), &
+                ca(nc + free_c), cb(nc + free_c), cs(nc + free_c), cl(nc + free_c), &
+                cg(nc + free_c), cm(nc + free_c), cpar(NPAR_CONTACT, nc + free_c), stat=stat)
+      if (stat /= 0) then
+         write (what, '(a,i0,a,i0,a)') 'the chains as ', nl + free_l, ' links and ', nc + free_c, &
+            ' contacts one by one'
+         call out_of_memory(trim(what), REAL_BYTES*(NPAR_LINK*real(nl + free_l, dp) &
+                            + (NPAR_CONTACT + 2.0_dp)*(nc + free_c)) &
+                            + INT_BYTES*(3.0_dp*(nl + free_l) + 4.0_dp*(nc + free_c)), &
+                            FIX_SMALLER_SCENE, stat, message)
+         return
+      end if
       cm = 0.0_dp
       ! in the order of the calls: the items added one by one before each chain, the chain
       pos = 0; g = 0

@@ -75,7 +75,8 @@ contains
       integer :: n, nc
       character(len=256) :: msg
       stat = MARTELLO_OK
-      call stepper_start(self, m, s)
+      call stepper_start(self, m, s, o, stat)
+      if (stat /= MARTELLO_OK) return
       n = m%n; nc = m%ncontact
       self%advice = 'the linearised smooth forces need a smaller step'
       self%velocity_jump_phases = .true.   ! penalty phases valued with v_k, v_{k+1}

@@ -87,7 +87,8 @@ contains
                             ' (P2, P5): at most '//trim(num)//' nodes; use moreau-jean for chains', stat)
          return
       end if
-      call stepper_start(self, m, s)
+      call stepper_start(self, m, s, o, stat)
+      if (stat /= MARTELLO_OK) return
       n = m%n; nc = m%ncontact
       self%advice = 'reduce dt'
       self%kd = model_bandwidth(m)

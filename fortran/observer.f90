@@ -23,7 +23,7 @@ module martello_observer
       c_associated, c_f_procpointer, c_int, c_double, c_long_long
    implicit none
    private
-   public :: results_t, observer_t, observer_init, observer_begin, observer_sample, &
+   public :: results_t, observer_t, observer_init, observer_begin, observer_sample, observer_failed, &
       observer_work, observer_open_phase, observer_close_phase, observer_add_impact, &
       observer_penalty_phases, observer_fail, observer_fail_nonfinite, observer_finish, &
       free_side_crossing, progress_callback, observer_extremum, observer_recorded, &
@@ -48,6 +48,9 @@ module martello_observer
       ! history: hist(:, k) = [t, (u, v, a of each output node), (δ, P of each output
       ! contact), (force, elongation of each output link), energy(1:NENERGY)]
       integer :: ncol = 0, nrec = 0
+      !> a failure met where no status could be returned (the event table could not grow):
+      !> the next history row returns it (record), the last grid point's at the latest
+      integer :: deferred_stat = MARTELLO_OK
       real(dp), allocatable :: hist(:, :)
       integer, allocatable :: out_nodes(:), out_contacts(:), out_links(:)
       ! events: one per contact phase
@@ -111,7 +114,7 @@ module martello_observer
       real(dp), allocatable :: ev_first(:, :), ph_toff(:), ph_vout(:)
       !> the time of the previous sample (< 0: none yet)
       real(dp) :: prev_t = -1.0_dp
-      real(dp), allocatable :: work(:)          !< scratch (0:n): M v, at its first use
+      real(dp), allocatable :: work(:)          !< scratch (0:n): M v (observer_begin)
       !> a C integrator's accelerations (0:n), contact penetrations and forces (allocated by
       !> martello_observer_begin, martello_api_internal)
       real(dp), allocatable :: acc(:), c_pen(:), c_force(:)
@@ -167,6 +170,10 @@ module martello_observer
    real(dp), parameter :: CREATED_BOUND = 1.0e-2_dp
    !> History rows allocated at the start; it grows by doubling beyond (record).
    integer, parameter :: HIST_START = 4096
+   !> The fix of the out-of-memory line for the history and the phase list of a run.
+   character(len=*), parameter :: FIX_RECORD_LESS = &
+      'record less (output.every, output.nodes, output.contacts)', &
+      FIX_FEWER_PHASES = 'track fewer contact phases (analysis.output.track) or use a smaller scene'
    !> ph_kept of a contact whose phases are all rows
    integer, parameter :: LISTED = -huge(1)
 
@@ -190,13 +197,14 @@ contains
       type(integrator_settings_t), intent(in) :: s
       integer, intent(in) :: n_nodes, n_contacts, out_nodes(:), out_contacts(:), capacity, &
                              n_links, out_links(:)
-      integer, intent(out), optional :: stat
+      integer, intent(out) :: stat
       integer, intent(in), optional :: tracking
       type(observer_t) :: fresh
       real(dp) :: steps
-      integer :: st, st2, nn, nl, ncp, nph
+      integer :: st, nn, nl, ncp, nph, rows
+      character(len=96) :: what
       o = fresh        ! every field at its default, every array deallocated
-      if (present(stat)) stat = MARTELLO_OK
+      stat = MARTELLO_OK
       if (present(tracking)) o%tracking = tracking
       o%n_nodes = n_nodes; o%n_contacts = n_contacts; o%n_links = n_links
       ! the arrays of what the run does not track have no entries
@@ -216,28 +224,36 @@ contains
          write (o%message, '(a,a,es10.3,a,es10.3,a)') integrator_name(o%kind), ': the run needs at least ', &
             steps, ' steps (t_end/dt), more than max_steps = ', o%max_steps, &
             ': raise dt, shorten t_end or raise max_steps'
-         if (present(stat)) stat = MARTELLO_ERR_LIMIT
+         stat = MARTELLO_ERR_LIMIT
          steps = 1.0_dp
       end if
       o%n_grid = ceiling(steps, i8)
       o%out_nodes = out_nodes; o%out_contacts = out_contacts; o%out_links = out_links
       o%ncol = 1 + 3*size(out_nodes) + 2*size(out_contacts) + 2*size(out_links) + NENERGY
-      allocate (o%hist(o%ncol, max(min(capacity, HIST_START), 2)), o%ev(NEVENT, 16), o%ev_contact(16), &
-                stat=st)
-      allocate (o%u_max(nn), o%u_min(nn), o%v_absmax(nn), o%a_absmax(nn), &
+      rows = max(min(capacity, HIST_START), 2)
+      allocate (o%hist(o%ncol, rows), stat=st)
+      if (st /= 0) then
+         write (what, '(a,i0,a,i0,a)') 'the history of a run (', rows, ' rows of ', o%ncol, ' columns)'
+         call out_of_memory(trim(what), REAL_BYTES*o%ncol*real(rows, dp), FIX_RECORD_LESS, stat, &
+                            o%message)
+         return
+      end if
+      allocate (o%ev(NEVENT, 16), o%ev_contact(16), &
+                o%u_max(nn), o%u_min(nn), o%v_absmax(nn), o%a_absmax(nn), &
                 o%pen_max(ncp), o%force_max(ncp), o%impacts(n_contacts), &
                 o%u_peak(nn), o%t_peak(nn), o%link_force_absmax(nl), &
                 o%u_absmax(nn), o%t_absmax(nn), &
                 o%link_du_absmax(nl), o%ph_open(n_contacts), &
                 o%ph_t(nph), o%ph_v(nph), o%ph_pen(nph), o%ph_f(nph), &
-                stat=st2)
-      if (st /= 0 .or. st2 /= 0) then
-         write (o%message, '(a,i0,a,i0,a)') 'out of memory allocating the results of a run of ', &
-            n_nodes, ' nodes and ', n_contacts, ' contacts'
-         if (present(stat)) stat = MARTELLO_ERR_MEMORY
-         if (st2 /= 0) error stop 'martello: out of memory allocating the results of a run'
-         if (.not. allocated(o%hist)) allocate (o%hist(o%ncol, 2))
-         if (.not. allocated(o%ev)) allocate (o%ev(NEVENT, 16), o%ev_contact(16))
+                stat=st)
+      if (st /= 0) then
+         write (what, '(a,i0,a,i0,a,i0,a)') 'the results of a run of ', n_nodes, ' nodes, ', &
+            n_contacts, ' contacts and ', n_links, ' links'
+         call out_of_memory(trim(what), REAL_BYTES*(10.0_dp*nn + 2.0_dp*ncp + 4.0_dp*nph &
+                            + 2.0_dp*nl + NEVENT*16) + INT_BYTES*(n_contacts + 16.0_dp) &
+                            + storage_size(o%ph_open)/8*real(n_contacts, dp), FIX_SMALLER_SCENE, &
+                            stat, o%message)
+         return
       end if
       ! NaN until a state is tracked (a run that fails before its first step)
       o%link_force_absmax = ieee_value(1.0_dp, ieee_quiet_nan)
@@ -255,7 +271,9 @@ contains
    !> ke_aMa: the method conserves ½vᵀMv − ke_aMa·aᵀMa (Verlet; 0 for the others).
    !> energies = [kinetic, links, contacts]: a method that keeps its own element states (no
    !> ms, the fused chain step) hands them, and has opened the phases at t = 0 itself.
-   subroutine observer_begin(o, m, ms, u, v, a, energy_interval, advice, ke_aMa, energies)
+   !> The observer's working arrays are allocated here, none later: stat =
+   !> MARTELLO_ERR_MEMORY (o%message its line) if they cannot be.
+   subroutine observer_begin(o, m, ms, u, v, a, energy_interval, advice, ke_aMa, stat, energies)
       type(observer_t), intent(inout) :: o
       type(model_t), intent(in) :: m
       type(mech_state_t), intent(in) :: ms
@@ -263,11 +281,22 @@ contains
       integer, intent(in) :: energy_interval
       character(len=*), intent(in) :: advice
       real(dp), intent(in) :: ke_aMa
+      integer, intent(out) :: stat
       real(dp), intent(in), optional :: energies(3)
       real(dp) :: e_kin
-      integer :: c, st
-      call located_peak_state(o, m%n, present(energies), st)
-      if (st /= 0) error stop 'martello: out of memory allocating the located peaks of a run'
+      integer :: c
+      character(len=64) :: what
+      call located_peak_state(o, m%n, present(energies), stat)
+      ! the scratch vector of the energies this observer evaluates itself (kinetic_correction:
+      ! ke_aMa /= 0)
+      if (stat == 0 .and. .not. allocated(o%work) .and. (.not. present(energies) .or. ke_aMa /= 0.0_dp)) &
+         allocate (o%work(0:m%n), stat=stat)
+      if (stat /= 0) then
+         write (what, '(a,i0,a)') 'the working state of the results of a run of ', m%n, ' nodes'
+         call out_of_memory(trim(what), REAL_BYTES*(8.0_dp*m%n + 2.0_dp*size(o%ph_open) + 2), &
+                            FIX_SMALLER_SCENE, stat, o%message)
+         return
+      end if
       if (present(energies)) then
          e_kin = energies(1); o%e_links0 = energies(2); o%e_cont0 = energies(3)
       else
@@ -281,7 +310,6 @@ contains
                call contact_force_rate(m, ms, c, v(m%con_a(c)) - v(m%con_b(c)), &
                                        a(m%con_a(c)) - a(m%con_b(c)), o%c_prev_f(c), o%c_prev_fr(c))
          end do
-         call scratch(o, m%n)
          e_kin = kinetic_energy(m, v, o%work)
          call recoverable_energy(m, ms, u, o%e_links0, o%e_cont0)
       end if
@@ -347,17 +375,9 @@ contains
       real(dp), intent(in) :: a(0:)
       kc = 0.0_dp
       if (o%ke_aMa == 0.0_dp) return
-      call scratch(o, m%n)
       call mass_times(m, a, o%work)
       kc = o%ke_aMa*dot_product(a(1:m%n), o%work(1:m%n))
    end function kinetic_correction
-
-   !> o%work (0:n), allocated at its first use.
-   subroutine scratch(o, n)
-      type(observer_t), intent(inout) :: o
-      integer, intent(in) :: n
-      if (.not. allocated(o%work)) allocate (o%work(0:n))
-   end subroutine scratch
 
    !> The recording cadence: t = 0, every every-th output grid point, and the last one.
    pure logical function recorded(o, k)
@@ -432,7 +452,6 @@ contains
          if (present(energies)) then
             e_kin = energies(1); e_links = energies(2); e_cont = energies(3)
          else
-            call scratch(o, m%n)
             e_kin = kinetic_energy(m, v, o%work)
             call recoverable_energy(m, ms, u, e_links, e_cont)
          end if
@@ -566,6 +585,18 @@ contains
       stat = code
       call observer_finish(o, t_reached)
    end subroutine observer_fail
+
+   !> The run failed at t with code, o%message already saying why (memory running out): the
+   !> observer's failure path, as every other failure takes it.
+   subroutine observer_failed(o, t, code)
+      type(observer_t), intent(inout) :: o
+      real(dp), intent(in) :: t
+      integer, intent(inout) :: code
+      character(len=len(o%message)) :: msg
+      integer :: failed
+      msg = o%message; failed = code
+      call observer_fail(o, failed, t, msg, code)
+   end subroutine observer_failed
 
    !> The run stops at t_reached (the end, or a failure): phases still open become events
    !> with t_off = −1.
@@ -813,14 +844,17 @@ contains
       integer, intent(out) :: stat
       real(dp), allocatable :: tmp(:, :)
       integer :: k, c, nn, nc, nl, st
-      stat = MARTELLO_OK
+      character(len=96) :: what
+      stat = r%deferred_stat
+      if (stat /= MARTELLO_OK) return
       if (r%nrec == size(r%hist, 2)) then
          allocate (tmp(r%ncol, 2*size(r%hist, 2)), stat=st)
          if (st /= 0) then
-            write (r%message, '(a,i0,a,i0,a)') 'out of memory growing the history to ', &
-               2*size(r%hist, 2), ' rows of ', r%ncol, ' columns: record less (output.every,'// &
-               ' output.nodes, output.contacts)'
-            stat = MARTELLO_ERR_MEMORY; return
+            write (what, '(a,i0,a,i0,a)') 'the history of a run grown to ', 2*size(r%hist, 2), &
+               ' rows of ', r%ncol, ' columns'
+            call out_of_memory(trim(what), REAL_BYTES*r%ncol*2.0_dp*size(r%hist, 2), &
+                               FIX_RECORD_LESS, stat, r%message)
+            return
          end if
          tmp(:, 1:r%nrec) = r%hist(:, 1:r%nrec)
          call move_alloc(tmp, r%hist)
@@ -848,14 +882,23 @@ contains
    !> most max_contacts contacts (max_contacts < 0: always); past it, the history's output
    !> contacts, and the others their first and last phase alone (keep_event). After
    !> observer_init.
-   subroutine observer_phase_lists(o, max_contacts)
+   subroutine observer_phase_lists(o, max_contacts, stat)
       type(observer_t), intent(inout) :: o
       integer, intent(in) :: max_contacts
+      integer, intent(out) :: stat
       integer :: nc
+      character(len=64) :: what
+      stat = MARTELLO_OK
       if (allocated(o%ph_kept)) deallocate (o%ph_kept, o%ev_first, o%ph_toff, o%ph_vout)
       nc = size(o%ph_open)
       if (max_contacts < 0 .or. nc <= max_contacts .or. .not. tracks(o, TRACK_PHASES)) return
-      allocate (o%ph_kept(nc), o%ev_first(NEVENT, nc), o%ph_toff(nc), o%ph_vout(nc))
+      allocate (o%ph_kept(nc), o%ev_first(NEVENT, nc), o%ph_toff(nc), o%ph_vout(nc), stat=stat)
+      if (stat /= 0) then
+         write (what, '(a,i0,a)') 'the first and last phases of ', nc, ' contacts'
+         call out_of_memory(trim(what), ((NEVENT + 2)*REAL_BYTES + INT_BYTES)*real(nc, dp), &
+                            FIX_FEWER_PHASES, stat, o%message)
+         return
+      end if
       o%ph_kept = 0
       o%ph_kept(o%out_contacts) = LISTED
    end subroutine observer_phase_lists
@@ -915,8 +958,18 @@ contains
       real(dp), intent(in) :: values(NEVENT)
       real(dp), allocatable :: tmp(:, :)
       integer, allocatable :: itmp(:)
+      integer :: st
+      character(len=64) :: what
       if (r%nevents == size(r%ev, 2)) then
-         allocate (tmp(NEVENT, 2*size(r%ev, 2)), itmp(2*size(r%ev, 2)))
+         allocate (tmp(NEVENT, 2*size(r%ev, 2)), itmp(2*size(r%ev, 2)), stat=st)
+         if (st /= 0) then
+            ! the phase is lost; the run fails at its next history row (deferred_stat)
+            write (what, '(a,i0,a)') 'the contact phases of a run grown to ', 2*size(r%ev, 2), ' rows'
+            if (r%deferred_stat == MARTELLO_OK) &
+               call out_of_memory(trim(what), (NEVENT*REAL_BYTES + INT_BYTES)*2.0_dp*size(r%ev, 2), &
+                                  FIX_FEWER_PHASES, r%deferred_stat, r%message)
+            return
+         end if
          tmp(:, 1:r%nevents) = r%ev(:, 1:r%nevents)
          itmp(1:r%nevents) = r%ev_contact(1:r%nevents)
          call move_alloc(tmp, r%ev); call move_alloc(itmp, r%ev_contact)

@@ -63,7 +63,7 @@ contains
       type(model_t), pointer, intent(in) :: mp
       type(run_t), pointer, intent(in) :: rp
       integer, intent(out) :: stat
-      integer :: cap, nl, nc
+      integer :: cap, nl, nc, st
       logical :: fused
       class(stepper_t), allocatable :: stepper
       stat = MARTELLO_ERR_ARGUMENT
@@ -85,37 +85,41 @@ contains
       call observer_init(rp%results, rp%settings, mp%n, nc, rp%out_nodes, &
                          rp%out_contacts, cap, nl, rp%out_links, stat, rp%tracking)
       rp%results%progress = rp%progress; rp%results%progress_user = rp%progress_user
-      call observer_phase_lists(rp%results, rp%phase_lists)
+      if (stat == MARTELLO_OK) call observer_phase_lists(rp%results, rp%phase_lists, stat)
       ! the chains held per node stay so for the fused chain step, which takes them whole;
       ! every other method takes their links and contacts one by one
       fused = chain_fusable(mp, rp%settings) .and. .not. logical(rp%settings%event_split)
-      if (.not. fused .and. mp%nchain > 0) then
-         call model_expand_chains(mp)
+      if (stat == MARTELLO_OK .and. .not. fused .and. mp%nchain > 0) then
+         call model_expand_chains(mp, stat, rp%results%message)
          fused = chain_fusable(mp, rp%settings) .and. .not. logical(rp%settings%event_split)
       end if
       if (stat == MARTELLO_OK) call check_schemes(mp, rp%settings%kind, rp%results%message, stat)
       if (stat == MARTELLO_OK) call effective_mass_prepare(mp, rp%results%message, stat)
       if (stat == MARTELLO_OK) then
+         ! st: the stepper's allocation (a few hundred bytes: its arrays come at its init)
+         st = 0
          select case (rp%settings%kind)
          case (INT_NEWMARK, INT_HHT, INT_GENERALIZED_ALPHA)
             if (fused) then
-               allocate (chain_newmark_t :: stepper)
+               allocate (chain_newmark_t :: stepper, stat=st)
             else
-               allocate (generalized_alpha_t :: stepper)
+               allocate (generalized_alpha_t :: stepper, stat=st)
             end if
          case (INT_CENTRAL_DIFFERENCE)
-            allocate (central_difference_t :: stepper)
+            allocate (central_difference_t :: stepper, stat=st)
          case (INT_MOREAU_JEAN)
-            allocate (moreau_jean_t :: stepper)
+            allocate (moreau_jean_t :: stepper, stat=st)
          case (INT_NEWMARK_LAGRANGE)
-            allocate (newmark_lagrange_t :: stepper)
+            allocate (newmark_lagrange_t :: stepper, stat=st)
          case (INT_FAST_NONLINEAR)
-            allocate (fast_nonlinear_t :: stepper)
+            allocate (fast_nonlinear_t :: stepper, stat=st)
          case (INT_RKF45, INT_RK8PD, INT_MSBDF)
             stat = c_event_driven_run(c_loc(mp), c_loc(rp))
          case (INT_IDA)
             stat = c_ida_run(c_loc(mp), c_loc(rp))
          end select
+         if (st /= 0) call out_of_memory('the state of the integrator', -1.0_dp, FIX_SMALLER_SCENE, &
+                                         stat, rp%results%message)
          if (allocated(stepper)) call run_fixed_step(mp, rp%settings, rp%results, stepper, stat)
       end if
       rp%done = .true.

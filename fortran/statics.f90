@@ -36,6 +36,9 @@ module martello_statics
    !> Round-off allowance in the activation/release tests (in units of ε_mach × scale):
    !> without it, a grazing contact (m g = k h exactly) can flip forever on the last bit.
    real(dp), parameter :: ROUNDOFF = 64.0_dp*epsilon(1.0_dp)
+   !> The fix of the out-of-memory line for the dense matrices of the static solve.
+   character(len=*), parameter :: FIX_DENSE = &
+      'the static solve uses dense matrices (n^2 doubles for n free nodes): use fewer nodes'
 
 contains
 
@@ -54,7 +57,12 @@ contains
       logical :: any_aug, changed
 
       n = m%n; nc = m%ncontact
-      allocate (r%u(n), r%force(nc), r%penetration(nc), r%active(nc))
+      allocate (r%u(n), r%force(nc), r%penetration(nc), r%active(nc), dof(0:n), stat=stat)
+      if (stat /= 0) then
+         call no_memory('the results of the static solve', REAL_BYTES*(n + 2.0_dp*nc) &
+                        + INT_BYTES*(2.0_dp*nc + n + 1), FIX_SMALLER_SCENE)
+         return
+      end if
       r%force = 0.0_dp; r%penetration = 0.0_dp; r%active = .false.
       stat = MARTELLO_OK
 
@@ -62,16 +70,22 @@ contains
       if (stat /= MARTELLO_OK) return
 
       ! Free-DOF numbering: fixed nodes keep u = u0 and leave the system.
-      allocate (dof(0:n)); dof = 0; nf = 0
+      dof = 0; nf = 0
       do i = 1, n
+         r%u(i) = merge(model_u0(m, i), 0.0_dp, m%fixed(i))
          if (.not. m%fixed(i)) then
             nf = nf + 1; dof(i) = nf
          end if
       end do
-      r%u = [(merge(model_u0(m, i), 0.0_dp, m%fixed(i)), i = 1, n)]
 
       ! Elastic stiffness and loads on the free DOFs (fixed displacements moved to the rhs).
-      allocate (kfree(nf, nf), fext(nf)); kfree = 0.0_dp; fext = 0.0_dp
+      allocate (kfree(nf, nf), fext(nf), stat=stat)
+      if (stat /= 0) then
+         call no_memory('the stiffness matrix of the static solve'//of_size(nf, 0), &
+                        REAL_BYTES*(nf + 1.0_dp)*nf, FIX_DENSE)
+         return
+      end if
+      kfree = 0.0_dp; fext = 0.0_dp
       do i = 1, n
          if (dof(i) > 0) fext(dof(i)) = m%gravity*m%mass(i)
       end do
@@ -102,7 +116,12 @@ contains
       end if
 
       any_aug = any(m%con_scheme(1:nc) == SCHEME_AUGMENTED)
-      allocate (act(nc), act_new(nc), p_shift(nc), p_new(nc), lag_row(nc))
+      allocate (act(nc), act_new(nc), p_shift(nc), p_new(nc), lag_row(nc), stat=stat)
+      if (stat /= 0) then
+         call no_memory('the active set of the static solve'//of_size(nf, nc), &
+                        (2*REAL_BYTES + 3*INT_BYTES)*nc, FIX_SMALLER_SCENE)
+         return
+      end if
       act = .false.; p_shift = 0.0_dp
 
       do outer = 1, max_iter
@@ -148,6 +167,13 @@ contains
       call assess_digits()
 
    contains
+
+      !> An allocation failed: stat = MARTELLO_ERR_MEMORY and its line in the model's message.
+      subroutine no_memory(what, bytes, fix)
+         character(len=*), intent(in) :: what, fix
+         real(dp), intent(in) :: bytes
+         call out_of_memory(what, bytes, fix, stat, m%errmsg)
+      end subroutine no_memory
 
       !> K(a,a) += s, K(b,b) += s, K(a,b) −= s for free ends; known displacements to the rhs.
       subroutine add_pair(kmat, f, dof, u, a, b, s)
@@ -202,7 +228,12 @@ contains
          end do
          dim = nf + nlag
          if (allocated(sys)) deallocate (sys, rhs)
-         allocate (sys(dim, dim), rhs(dim))
+         allocate (sys(dim, dim), rhs(dim), stat=st)
+         if (st /= 0) then
+            call out_of_memory('the system of the static solve'//of_size(nf, nlag), &
+                               REAL_BYTES*(dim + 1.0_dp)*dim, FIX_DENSE, st, m%errmsg)
+            return
+         end if
          sys = 0.0_dp; rhs = 0.0_dp
          sys(1:nf, 1:nf) = kfree; rhs(1:nf) = fext
          do j = 1, nc
@@ -300,8 +331,15 @@ contains
       !> K + εBBᵀ: that matrix's condition (dpocon, reported too) grows like ε/k and a primal
       !> penalty code loses log10(1 + ε/k) digits — and so does u, which cannot resolve δ.
       subroutine assess_digits()
-         real(dp) :: lost, ratio, kd, pen_rc, dummy(max(nf, 1)), kpen(nf, nf)
+         real(dp) :: lost, ratio, kd, pen_rc
+         real(dp), allocatable :: dummy(:), kpen(:, :)
          integer :: k, st, ia, ib
+         allocate (dummy(max(nf, 1)), kpen(nf, nf), stat=st)
+         if (st /= 0) then
+            call no_memory('the penalised stiffness of the static solve'//of_size(nf, 0), &
+                           REAL_BYTES*(nf + 1.0_dp)*nf, FIX_DENSE)
+            return
+         end if
          lost = 16.0_dp
          if (r%rcond > 0.0_dp) lost = log10(1.0_dp/r%rcond)
          r%penalty_ratio = 0.0_dp
@@ -325,6 +363,11 @@ contains
          if (r%penalty_ratio > 0.0_dp .and. nf > 0) then
             dummy = 0.0_dp
             call solve_spd(kpen, dummy(1:nf), pen_rc, st, m%errmsg)
+            ! a matrix that is not positive definite has condition 0; memory running out is
+            ! the solve's failure, not a condition number
+            if (st == MARTELLO_ERR_MEMORY) then
+               stat = st; return
+            end if
             r%penalised_rcond = merge(pen_rc, 0.0_dp, st == MARTELLO_OK)
             m%errmsg = ''
             lost = max(lost, log10(1.0_dp + r%penalty_ratio))
@@ -341,6 +384,16 @@ contains
       end subroutine assess_digits
 
    end subroutine static_solve
+
+   !> ' for nf free nodes' (and nc contacts) in the out-of-memory lines of the static solve.
+   function of_size(nf, nc) result(text)
+      integer, intent(in) :: nf, nc
+      character(len=:), allocatable :: text
+      character(len=64) :: buf
+      write (buf, '(a,i0,a)') ' for ', nf, ' free nodes'
+      if (nc > 0) write (buf, '(a,a,i0,a)') trim(buf), ' and ', nc, ' contacts'
+      text = trim(buf)
+   end function of_size
 
    subroutine check_supported(m, stat)
       type(model_t), intent(inout) :: m

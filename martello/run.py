@@ -704,8 +704,9 @@ def output_estimate(scene):
 
 
 def _size(b):
-    return next(f"{b / d:.3g} {u}" for d, u in ((1e9, "GB"), (1e6, "MB"), (1e3, "kB"), (0, ""))
-                if b >= d or not d).strip()
+    # the last unit takes what the others leave (below 1 kB: bytes, no unit)
+    return next(f"{b / d:.3g} {u}" for d, u in ((1e9, "GB"), (1e6, "MB"), (1e3, "kB"), (1, ""))
+                if b >= d or d == 1).strip()
 
 
 def _g(x):

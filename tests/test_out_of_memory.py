@@ -150,3 +150,60 @@ def test_a_ground_motion_function_out_of_memory_says_the_same_line():
                             "the response spectrum of a record of 4096 samples: use a shorter "
                             "record (fewer samples)")
     assert check_status(0, "response spectrum", 4096) == 0
+
+
+# The library call a test takes memory away from: the run is martello itself, in a process
+# whose address space is capped right before that call at what the process holds then
+# (VmSize, /proc/self/status: measured, not guessed) plus AT_CALL_MB, far less than the
+# arrays the call needs, and given back when it returns, so the front end writes its line.
+AT_CALL_MB = 1
+CAPPED_CALL = ("import resource, sys\nimport martello.binding.native as native\n"
+               "name = sys.argv[1]\nlib = native.lib()\nreal = getattr(lib, name)\n"
+               "def capped(*args):\n"
+               "    size = [l for l in open('/proc/self/status') if l.startswith('VmSize:')][0]\n"
+               "    cap = int(size.split()[1]) * 1024 + " + str(AT_CALL_MB) + " * 2**20\n"
+               "    hard = resource.getrlimit(resource.RLIMIT_AS)[1]\n"
+               "    resource.setrlimit(resource.RLIMIT_AS, (cap, hard))\n"
+               "    try:\n        return real(*args)\n"
+               "    finally:\n        resource.setrlimit(resource.RLIMIT_AS, (hard, hard))\n"
+               "setattr(lib, name, capped)\n"
+               "from martello.cli import main\nsys.exit(main(sys.argv[2:]))\n")
+
+
+@pytest.mark.parametrize("call, analysis, n, expected", [
+    # fortran/model.f90 model_add_chain: the chain's k and gap, 2 n doubles (16 MB)
+    ("martello_model_add_chain", "", 1_000_000,
+     r"out of memory allocating a chain of 1000000 nodes \(16\.0 MB\): use a smaller scene"),
+    # fortran/statics.f90: the dense stiffness of the free nodes, (n + 1) n doubles (80 MB)
+    ("martello_static_solve", 'type = "static"', 3_000,
+     r"out of memory allocating the stiffness matrix of the static solve for 3000 free nodes "
+     r"\(72\.0 MB\): the static solve uses dense matrices"),
+    # fortran/observer.f90 observer_init: the history's first 4096 rows of 1 + 3 n + 2 (n − 1)
+    # + NENERGY columns (every node and contact recorded)
+    ("martello_dynamic_run", "history", 20_000,
+     r"out of memory allocating the history of a run \(4096 rows of 1000\d\d columns\) "
+     r"\(3\.3 GB\): record less"),
+])
+def test_the_door_the_static_solve_and_the_observer_out_of_memory(tmp_path, call, analysis, n, expected):
+    body = scene(n, "newmark", "gap = 0.01\ncontact = { scheme = \"penalty\", law = \"linear\", stiffness = 1.0e5 }")
+    if analysis == 'type = "static"':
+        body = body.replace('type = "dynamic"\nintegrator = "newmark"\ndt = 1.0e-3\nt_end = 1.0e-3\n',
+                            'type = "static"\n').split("[analysis.output]")[0]
+    if analysis == "history":
+        body = body.replace("t_end = 1.0e-3", "t_end = 5.0").replace(
+            'nodes = ["s1"]\ncontacts = []', f"nodes = {[f's{i}' for i in range(1, n + 1)]}\n"
+            f"contacts = {[f's{i}-s{i + 1}' for i in range(1, n)]}".replace("'", '"'))
+    path = tmp_path / "scene.toml"
+    path.write_text(body)
+    out = tmp_path / "out"
+    r = subprocess.run([sys.executable, "-c", CAPPED_CALL, call, "run", path, "-o", out, "--force"],
+                       cwd=tmp_path,
+                       capture_output=True, text=True, timeout=600, stdin=subprocess.DEVNULL)
+    # the front end's estimate of what a run writes comes first (a warning, not a failure)
+    lines = [ln for ln in r.stderr.splitlines() if not re.fullmatch(ASAN_REFUSED, ln)
+             and not ln.startswith("warning: the run will write up to about")]
+    assert r.returncode == 1, r.stderr[-2000:]
+    assert len(lines) == 1, r.stderr[-2000:]
+    assert re.fullmatch(r"martello: error: MARTELLO_ERR_MEMORY \(-2\): .*" + expected + r".*", lines[0]), lines[0]
+    assert r.stdout == ""
+    assert not out.exists() or not any(out.iterdir())
