@@ -168,26 +168,23 @@ def from_dict(data, source="<scene>", base_dir=Path("."), digest=None):
         raise SceneError(src, "node", "missing", "a scene needs at least one [[node]]")
     w = len(written["node"])
     node_segments = _segments(raw_nodes[:w], generated, raw_nodes[w:])
-    node_names, pos = Names(), 0
-    for seg in node_segments:
-        if not isinstance(seg, list):
-            _place(src, "node", seg, pos, node_names)
-            pos += len(seg)
-            continue
-        for i, tab in enumerate(seg, start=pos):
-            where = f"node[{i}]"
-            n = check_fields(src, tab, where, NODE_KEYS)
-            if n["name"] == GROUND:
-                raise SceneError(src, f"{where}.name", "'ground' is reserved", "choose another name")
-            if node_names.add(n["name"]) >= 0:
-                raise SceneError(src, f"{where}.name", f"duplicate name {n['name']!r}", "names must be unique")
-            if n["fixed"]:
-                if n["mass"] < 0:
-                    raise SceneError(src, f"{where}.mass", f"invalid value {n['mass']!r}", "must be >= 0 for a fixed node")
-            elif not n["mass"] > 0:
-                raise SceneError(src, f"{where}.mass", f"invalid value {n['mass']!r}", "must be > 0 (or set fixed = true)")
-            seg[i - pos] = n
-        pos += len(seg)
+    node_names = Names()
+
+    def node(i, tab):
+        where = f"node[{i}]"
+        n = check_fields(src, tab, where, NODE_KEYS)
+        if n["name"] == GROUND:
+            raise SceneError(src, f"{where}.name", "'ground' is reserved", "choose another name")
+        if node_names.add(n["name"]) >= 0:
+            raise SceneError(src, f"{where}.name", f"duplicate name {n['name']!r}", "names must be unique")
+        if n["fixed"]:
+            if n["mass"] < 0:
+                raise SceneError(src, f"{where}.mass", f"invalid value {n['mass']!r}", "must be >= 0 for a fixed node")
+        elif not n["mass"] > 0:
+            raise SceneError(src, f"{where}.mass", f"invalid value {n['mass']!r}", "must be > 0 (or set fixed = true)")
+        return n
+
+    _check_segments(src, "node", node_segments, node_names, node)
     nodes = ItemTable(node_segments, node_names)
     index = NameIndex(node_names)
 
@@ -213,30 +210,27 @@ def from_dict(data, source="<scene>", base_dir=Path("."), digest=None):
     w = len(written["link"])
     link_segments = _segments(raw_links[:w], [ChainLinks(b) for b in chains] + rods["link"],
                               raw_links[w:])
-    link_names, pos = Names(), 0
-    for seg in link_segments:
-        if not isinstance(seg, list):
-            _place(src, "link", seg, pos, link_names)
-            pos += len(seg)
-            continue
-        for i, tab in enumerate(seg, start=pos):
-            where = f"link[{i}]"
-            if not isinstance(tab, dict) or "type" not in tab:
-                raise SceneError(src, f"{where}.type", "missing", "valid: " + ", ".join(LINK_TYPES))
-            kind = choice(src, f"{where}.type", tab["type"], list(LINK_TYPES))
-            spec = dict(LINK_COMMON, **LINK_TYPES[kind])
-            lk = check_fields(src, tab, where, spec)
-            lk["a"], lk["b"] = node_ref(f"{where}.a", lk["a"]), node_ref(f"{where}.b", lk["b"])
-            if lk["a"] == lk["b"]:
-                raise SceneError(src, f"{where}.b", "connects a node to itself", "name two different nodes")
-            lk["name"] = lk["name"] or f"link{i}"
-            if link_names.add(lk["name"]) >= 0:
-                raise SceneError(src, f"{where}.name", f"duplicate name {lk['name']!r}", "names must be unique")
-            if kind == "dashpot" and (lk["c"] is None) == (lk["zeta"] is None):
-                raise SceneError(src, where, "needs exactly one of c or zeta",
-                                 "c = damping [N s/m], or zeta = damping ratio of a node-to-ground oscillator")
-            seg[i - pos] = lk
-        pos += len(seg)
+    link_names = Names()
+
+    def link(i, tab):
+        where = f"link[{i}]"
+        if not isinstance(tab, dict) or "type" not in tab:
+            raise SceneError(src, f"{where}.type", "missing", "valid: " + ", ".join(LINK_TYPES))
+        kind = choice(src, f"{where}.type", tab["type"], list(LINK_TYPES))
+        spec = dict(LINK_COMMON, **LINK_TYPES[kind])
+        lk = check_fields(src, tab, where, spec)
+        lk["a"], lk["b"] = node_ref(f"{where}.a", lk["a"]), node_ref(f"{where}.b", lk["b"])
+        if lk["a"] == lk["b"]:
+            raise SceneError(src, f"{where}.b", "connects a node to itself", "name two different nodes")
+        lk["name"] = lk["name"] or f"link{i}"
+        if link_names.add(lk["name"]) >= 0:
+            raise SceneError(src, f"{where}.name", f"duplicate name {lk['name']!r}", "names must be unique")
+        if kind == "dashpot" and (lk["c"] is None) == (lk["zeta"] is None):
+            raise SceneError(src, where, "needs exactly one of c or zeta",
+                             "c = damping [N s/m], or zeta = damping ratio of a node-to-ground oscillator")
+        return lk
+
+    _check_segments(src, "link", link_segments, link_names, link)
     links = ItemTable(link_segments, link_names)
 
     # contacts: those written, then each chain's (one contact table each, validated once as
@@ -345,6 +339,19 @@ def _segments(listed, generated, after=()):
     """The segments of an item table: the listed dicts (copied: validation replaces them),
     the generated segments, then the listed dicts that follow them."""
     return [list(listed)] + list(generated) + [list(after)]
+
+
+def _check_segments(src, kind, segments, names, check):
+    """Every segment of an item table in order: a listed one's entries replaced by
+    check(position, table) (which adds their names), a generated one placed (_place)."""
+    pos = 0
+    for seg in segments:
+        if isinstance(seg, list):
+            for i, tab in enumerate(seg, start=pos):
+                seg[i - pos] = check(i, tab)
+        else:
+            _place(src, kind, seg, pos, names)
+        pos += len(seg)
 
 
 def _place(src, kind, seg, pos, names):
