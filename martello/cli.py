@@ -356,7 +356,7 @@ def main(argv=None):
                        "in the script's header and docs/opensees.md.")
     p.add_argument("scene", help="scene file (TOML), or a path in the catalogue")
     p.add_argument("--to", default="opensees", help="the other code (default and only: opensees)")
-    p.add_argument("-o", "--output", required=True, help="folder for model.py (replaced whole)")
+    p.add_argument("-o", "--output", type=_path, required=True, help="folder for model.py (replaced whole)")
     p.add_argument("--tcl", action="store_true", help="also write model.tcl for OpenSees' Tcl interpreter")
     p.add_argument("--integrator", help="override the scene's integrator (newmark, hht, "
                    "generalized-alpha, central-difference)")
