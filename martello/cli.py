@@ -385,7 +385,7 @@ def main(argv=None):
                        "tolerance kinds, provenance) and DIR/<id>.md (its page), plus index.json and "
                        "README.md, versioned with martello.")
     p.add_argument("scenes", nargs="*", help="scene files (default: the catalogue)")
-    p.add_argument("-o", "--output", required=True, help="folder of the set (replaced whole)")
+    p.add_argument("-o", "--output", type=_path, required=True, help="folder of the set (replaced whole)")
     p.add_argument("--run", action="store_true", help="also run each scene and add martello's own "
                    "values as regression tolerances")
     p.set_defaults(func=cmd_testset)
