@@ -145,6 +145,11 @@ def cmd_export(args):
     return export.main(args)
 
 
+def cmd_testset(args):
+    from . import testset
+    return testset.main(args)
+
+
 def _print_version(args):
     print(f"martello {native.version()} ({native.library_versions()})")
     return 0
@@ -335,6 +340,18 @@ def main(argv=None):
     p.add_argument("--tol", type=float, help="NormDispIncr tolerance in m (default: the scene's "
                    "tol_increment x 0.1 m)")
     p.set_defaults(func=cmd_export)
+
+    p = sub.add_parser("testset", help="write the pounding test set: a JSON file and a page per problem",
+                       description="Write the machine-readable pounding test set (docs/testset.md): for "
+                       "every catalogue scene with a closed-form [check], DIR/<id>.json (the model in "
+                       "neutral terms, parameters and units, reference values with trusted digits, "
+                       "tolerance kinds, provenance) and DIR/<id>.md (its page), plus index.json and "
+                       "README.md, versioned with martello.")
+    p.add_argument("scenes", nargs="*", help="scene files (default: the catalogue)")
+    p.add_argument("-o", "--output", required=True, help="folder of the set (replaced whole)")
+    p.add_argument("--run", action="store_true", help="also run each scene and add martello's own "
+                   "values as regression tolerances")
+    p.set_defaults(func=cmd_testset)
 
     p = sub.add_parser("version", help="versions of martello and the libraries it links")
     p.set_defaults(func=_print_version)
