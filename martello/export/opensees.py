@@ -129,8 +129,9 @@ class _Builder:
                         "the static problems have closed forms of their own")
         if an["integrator"] not in NEWMARK_FAMILY:
             self.refuse(f"analysis.integrator = {an['integrator']}",
-                        "OpenSees has no event-driven, DAE, Moreau–Jean or modal (fast "
-                        "nonlinear) integrator; its transient integrators are the Newmark family",
+                        "OpenSees' transient integrators are the Newmark family: it has no "
+                        "event-driven, ODE or DAE (GSL, CVODE, ARKODE, IDA), Moreau–Jean or modal "
+                        "(fast nonlinear) integrator",
                         "give --integrator newmark, hht, generalized-alpha or central-difference "
                         "and --dt")
         if s.couplings:
