@@ -140,8 +140,9 @@ def measure(rows, out, only=None, cap=MAX_NODE_STEPS, refine=1):
     from martello.scene import catalogue
     from martello.scene.loader import load
     res = []
+    wanted = [w for w in (only or "").split(",") if w]
     todo = [(rel, problem, integ, dt / 2 ** k, mats, k) for rel, problem, status, integ, dt, mats, _ in rows
-            if status == "as is" and not (only and only not in rel) for k in range(refine)]
+            if status == "as is" and (not wanted or any(w in rel for w in wanted)) for k in range(refine)]
     for rel, problem, integ, dt, mats, k in todo:
         scene = catalogue.ROOT / rel
         s = load(scene)
@@ -220,7 +221,7 @@ def _replace(text, begin, end, block):
 def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("-o", "--output", default="out/opensees-scorecard")
-    ap.add_argument("--only", help="measure only scenes whose path contains this text")
+    ap.add_argument("--only", help="measure only scenes whose path contains one of these texts (comma-separated)")
     ap.add_argument("--docs", action="store_true", help=f"regenerate {DOC.relative_to(ROOT)}")
     ap.add_argument("--check", action="store_true", help="check the committed doc's deterministic part")
     ap.add_argument("--deterministic", action="store_true", help="regenerate only the doc's deterministic "
