@@ -359,3 +359,16 @@ def test_bad_buildings_are_refused_with_the_field():
     # a mechanism is a floor of a single pinned column (no lateral stiffness)
     with pytest.raises(SceneError, match="positive definite|singular"):
         from_dict(scene(building(grid_x=[0.0], grid_y=[0.0], base="pinned", model="frame")))
+
+
+def test_the_independent_engine_reads_frame_joint_masses():
+    """[[frame]]'s per-joint masses reach the independent engine's model as given (its own
+    reading of the scene, martello.independent)."""
+    from martello.independent.scene import load_model
+    masses = [[1.25e4, 2.5e4, 1.25e4], [1.0e4, 2.0e4, 1.0e4]]
+    d = {"frame": [{"prefix": "P", "storeys": 2, "bays": 2, "storey_height": 3.0, "bay_width": 5.0,
+                    "column": {"E": E, "A": 0.15, "I": 3e-3}, "beam": {"E": E, "A": 0.15, "I": 3e-3},
+                    "mass": masses, "mass_model": "joints"}],
+         "analysis": {"type": "dynamic", "integrator": "newmark", "dt": 1e-3, "t_end": 0.1}}
+    model = load_model(d)
+    assert list(model.mass) == [m for row in masses for m in row]
