@@ -62,7 +62,11 @@ typedef struct {
   /* scene (martello_model_topology) */
   int n, nc, nr, ncoupling;
   double *mass, *gap, *rest;
-  int *fixed, *con_a, *con_b, *scheme;
+  int *fixed, *scheme;
+  /* the elements' rows (martello_model_elements): elem all of them, con the contacts' */
+  int *el_first, *el_node;
+  double *el_coef;
+  martello_rows elem, con;
   int *rig;      /* contact -> rigid index, or -1 (penalty) */
   int *rig_con;  /* rigid index -> contact */
   /* layout of y */
@@ -85,7 +89,7 @@ typedef struct {
   int cols_ready, *dc;
   /* the switches of the laws' branches (martello_eval_switches), refreshed at every commit:
    * roots 2 nc .. 2 nc + nsw - 1 */
-  int nsw, *sw_a, *sw_b;
+  int nsw, *sw_el;
   double *sw_al, *sw_be, *sw_ga;
   martello_accumulation acc; /* the accumulation rule's phases (c/accumulation.c) */
   /* the release roots: the closed set at the last restart (its rigid contacts lc[0..mc), their
@@ -134,15 +138,14 @@ static int fail(ida_problem *P, int code, const char *fmt, ...) {
 }
 
 
-static double node_u(int i, const double *u) { return i < 0 ? 0.0 : u[i]; }
-
-/* delta = (u_a - u_b) - gap, in the kernels' order of operations (fortran/evaluator.f90). */
+/* delta = G_j u - gap (u_a - u_b - gap for a node pair), in the kernels' order of operations
+ * (fortran/element_rows.f90). */
 static double penetration(const ida_problem *P, int j, const double *u) {
-  return (node_u(P->con_a[j], u) - node_u(P->con_b[j], u)) - P->gap[j];
+  return martello_rows_dot(&P->con, j, u) - P->gap[j];
 }
 
 static double pen_rate(const ida_problem *P, int j, const double *v) {
-  return node_u(P->con_a[j], v) - node_u(P->con_b[j], v);
+  return martello_rows_dot(&P->con, j, v);
 }
 
 static void gather(const ida_problem *P, const double *y, double *u, double *v) {
@@ -157,9 +160,7 @@ static void apply_B(const ida_problem *P, const double *lam, double *x) {
   memset(x, 0, sizeof(double) * (size_t)P->n);
   for (int r = 0; r < P->nr; r++) {
     if (!P->closed[r] || lam[r] == 0.0) continue;
-    int j = P->rig_con[r];
-    if (P->con_a[j] >= 0) x[P->con_a[j]] += lam[r];
-    if (P->con_b[j] >= 0) x[P->con_b[j]] -= lam[r];
+    martello_rows_axpy(&P->con, P->rig_con[r], lam[r], x);
   }
 }
 
@@ -167,9 +168,7 @@ static double dot_B(const ida_problem *P, int j, const double *x) { return pen_r
 
 /* Gap within which a rigid contact touches (see POSITION_TOL_FACTOR). */
 static double position_tol(const ida_problem *P, int j, const double *u) {
-  double s = fabs(P->gap[j]);
-  s = fmax(s, fabs(node_u(P->con_a[j], u)));
-  s = fmax(s, fabs(node_u(P->con_b[j], u)));
+  double s = fmax(fabs(P->gap[j]), martello_rows_max(&P->con, j, u));
   return POSITION_TOL_FACTOR * (P->rtol * s + P->atol);
 }
 
@@ -180,19 +179,23 @@ static double speed_tol(const ida_problem *P, const double *v) {
 }
 
 /* Move contact j strictly to side sgn (+1: delta > 0, -1: delta < 0) by the smallest shift of
- * one free node: the kernels decide a penalty law's regime by the sign of delta, so a restart
- * exactly at delta = 0 would not know on which side it is. */
+ * one free node (its row's first term on a free node): the kernels decide a penalty law's
+ * regime by the sign of delta, so a restart exactly at delta = 0 would not know on which side
+ * it is. */
 static void nudge(ida_problem *P, int j, int sgn, double *u) {
-  int a = P->con_a[j], b = P->con_b[j];
-  int node = (a >= 0 && !P->fixed[a]) ? a : ((b >= 0 && !P->fixed[b]) ? b : -1);
+  int node = -1;
+  double c = 0.0;
+  for (int k = P->con.first[j]; k < P->con.first[j + 1] && node < 0; k++)
+    if (!P->fixed[P->con.node[k]] && P->con.coef[k] != 0.0) {
+      node = P->con.node[k];
+      c = P->con.coef[k];
+    }
   if (node < 0) return;
-  double dir = node == a ? 1.0 : -1.0;
-  double eta = 4.0 * DBL_EPSILON *
-               (fabs(P->gap[j]) + fabs(node_u(a, u)) + fabs(node_u(b, u))) + DBL_MIN;
+  double eta = 4.0 * DBL_EPSILON * (fabs(P->gap[j]) + martello_rows_abs(&P->con, j, u)) + DBL_MIN;
   for (int k = 0; k < 80; k++) {
     double d = penetration(P, j, u);
     if (sgn * d > 0.0) return;
-    u[node] += dir * sgn * (fabs(d) + eta);
+    u[node] += sgn * (fabs(d) + eta) / c;
     eta *= 2.0;
   }
 }
@@ -204,8 +207,7 @@ static int impulse_columns(ida_problem *P) {
     int j = P->rig_con[r], st;
     double *c = P->cols + (size_t)r * (size_t)P->n;
     memset(c, 0, sizeof(double) * (size_t)P->n);
-    if (P->con_a[j] >= 0) c[P->con_a[j]] -= 1.0;
-    if (P->con_b[j] >= 0) c[P->con_b[j]] += 1.0;
+    martello_rows_axpy(&P->con, j, -1.0, c);       /* B_j^T = -G_j^T */
     if ((st = martello_eval_solve_mass(P->ev, c)) != MARTELLO_OK) return st;
   }
   P->cols_ready = 1;
@@ -218,7 +220,7 @@ static void door_list(ida_problem *P, int m) {
 }
 
 /* The impulse door's topology arguments (c/martello_internal.h): sides, columns in cols. */
-#define TOPOLOGY(P) (P)->con_a, (P)->con_b, (P)->rig, (P)->cols
+#define TOPOLOGY(P) &(P)->con, (P)->rig, (P)->cols
 
 static int closed_set(ida_problem *P) {
   int m = 0;
@@ -276,7 +278,7 @@ static int residual(realtype t, N_Vector yy, N_Vector yp, N_Vector rr, void *dat
 static int commit(ida_problem *P, const double *u, const double *v) {
   int st = martello_eval_commit(P->ev, u, v);
   if (st == MARTELLO_OK && P->nsw > 0)
-    st = martello_eval_switches(P->ev, P->sw_a, P->sw_b, P->sw_al, P->sw_be, P->sw_ga);
+    st = martello_eval_switches(P->ev, P->sw_el, P->sw_al, P->sw_be, P->sw_ga);
   return st;
 }
 
@@ -301,10 +303,10 @@ static int closed_set_roots(ida_problem *P, const double *u, const double *v) {
   P->mc = 0;
   for (int r = 0; r < P->nr; r++)
     if (P->closed[r]) {
-      int j = P->rig_con[r], a = P->con_a[j], b = P->con_b[j];
+      int j = P->rig_con[r];
       double fs = fabs(P->lam[r]);
-      if (a >= 0) fs += P->mass[a] * fabs(P->a[a]);
-      if (b >= 0) fs += P->mass[b] * fabs(P->a[b]);
+      for (int k = P->con.first[j]; k < P->con.first[j + 1]; k++)
+        fs += fabs(P->con.coef[k]) * P->mass[P->con.node[k]] * fabs(P->a[P->con.node[k]]);
       P->lamtol[r] = 1e3 * DBL_EPSILON * fs;
       P->lc[P->mc] = r;
       P->dlc[P->mc++] = j;
@@ -336,9 +338,10 @@ static int roots(realtype t, N_Vector yy, N_Vector yp, realtype *g, void *data) 
     }
   }
   for (int s = 0; s < P->nsw; s++) {
-    const int a = P->sw_a[s], b = P->sw_b[s];
-    g[2 * P->nc + s] = P->sw_al[s] * (node_u(a, P->uq) - node_u(b, P->uq)) +
-                       P->sw_be[s] * (node_u(a, P->vq) - node_u(b, P->vq)) + P->sw_ga[s];
+    const int e = P->sw_el[s];
+    const double du = e >= 0 ? martello_rows_dot(&P->elem, e, P->uq) : 0.0;
+    const double dv = e >= 0 ? martello_rows_dot(&P->elem, e, P->vq) : 0.0;
+    g[2 * P->nc + s] = P->sw_al[s] * du + P->sw_be[s] * dv + P->sw_ga[s];
   }
   return 0;
 }
@@ -508,7 +511,7 @@ static int rigid_impacts(ida_problem *P, double t, double *u, double *v) {
     double an = dot_B(P, j, P->a), rebound = fmax(-pen_rate(P, j, v), 0.0);
     double e = P->rest[j] >= 0.0 ? P->rest[j] : 0.0;
     double v_res = POSITION_TOL_FACTOR *
-                   (P->rtol * (fabs(node_u(P->con_a[j], v)) + fabs(node_u(P->con_b[j], v))) + P->atol);
+                   (P->rtol * martello_rows_abs(&P->con, j, v) + P->atol);
     double da = 0.0;
     for (int l = 0; l < mc; l++) an -= P->S[k + ma * l] * P->w0[l];
     if (rebound > 0.0 && an > 0.0) {
@@ -787,7 +790,7 @@ static int boundary_events(ida_problem *P, void *mem, double t_last, double tret
     double d = penetration(P, j, P->u), w = pen_rate(P, j, P->v);
     /* on the surface within round-off of the gap, or of the time */
     double on = 64.0 * DBL_EPSILON *
-                (fabs(node_u(P->con_a[j], P->u)) + fabs(node_u(P->con_b[j], P->u)) + fabs(P->gap[j]) +
+                (martello_rows_abs(&P->con, j, P->u) + fabs(P->gap[j]) +
                  fabs(w) * (fabs(tret) + fabs(h_last)));
     /* ... and moving across it faster than the integration error of a rate: two bodies
      * that travel together at zero gap are not a new event */
@@ -836,11 +839,11 @@ static int fail_memory(ida_problem *P, const char *what, double bytes) {
 }
 
 static void release(ida_problem *P) {
-  void *all[] = {P->mass, P->gap, P->rest, P->fixed, P->con_a, P->con_b, P->scheme, P->rig,
+  void *all[] = {P->mass, P->gap, P->rest, P->fixed, P->el_first, P->el_node, P->el_coef, P->scheme, P->rig,
                  P->rig_con, P->iu, P->iv, P->ip, P->im, P->closed, P->act,
                  P->opened, P->was_closed, P->hit, P->cand, P->q, P->w0, P->w_in, P->u, P->v, P->a, P->x, P->uq, P->vq, P->fint, P->fext,
                  P->force, P->lam, P->S, P->rhs, P->mb, P->cols, P->dc, P->aset,
-                 P->sw_a, P->sw_b, P->sw_al, P->sw_be, P->sw_ga, P->w_out, P->lc, P->dlc, P->Wc, P->ar, P->lr, P->lamtol,
+                 P->sw_el, P->sw_al, P->sw_be, P->sw_ga, P->w_out, P->lc, P->dlc, P->Wc, P->ar, P->lr, P->lamtol,
                  P->v_last, P->el0, P->el1, P->elc, P->pv0, P->pa0, P->pj0, P->pv1, P->pa1,
                  P->pj1, P->ua, P->va, P->aa};
   for (size_t k = 0; k < sizeof all / sizeof all[0]; k++) free(all[k]);
@@ -868,9 +871,12 @@ static int bandwidth(ida_problem *P, const double *u0, const double *v0, suninde
     up[k] = u0[k];
     vp[k] = v0[k];
   }
-  for (int j = 0; j < P->nc; j++)
-    if (P->con_a[j] >= 0 && P->con_b[j] >= 0 && P->rig[j] < 0)
-      dnode = abs(P->con_a[j] - P->con_b[j]) > dnode ? abs(P->con_a[j] - P->con_b[j]) : dnode;
+  for (int j = 0; j < P->nc; j++) {
+    if (P->rig[j] >= 0) continue;
+    for (int p = P->con.first[j]; p < P->con.first[j + 1]; p++)
+      for (int q = P->con.first[j]; q < P->con.first[j + 1]; q++)
+        dnode = abs(P->con.node[p] - P->con.node[q]) > dnode ? abs(P->con.node[p] - P->con.node[q]) : dnode;
+  }
   sunindextype b = 1;
 #define WIDEN(p, q) do { sunindextype d_ = (p) > (q) ? (p) - (q) : (q) - (p); if (d_ > b) b = d_; } while (0)
   for (int i = 0; i < n; i++)
@@ -880,11 +886,10 @@ static int bandwidth(ida_problem *P, const double *u0, const double *v0, suninde
       WIDEN(P->iv[i], P->iv[k]);
     }
   for (int r = 0; r < P->nr; r++) {
-    int j = P->rig_con[r], ends[2] = {P->con_a[j], P->con_b[j]};
-    for (int e = 0; e < 2; e++) {
-      if (ends[e] < 0) continue;
-      WIDEN(P->ip[r], P->iv[ends[e]]);
-      WIDEN(P->im[r], P->iu[ends[e]]);
+    int j = P->rig_con[r];
+    for (int k = P->con.first[j]; k < P->con.first[j + 1]; k++) {
+      WIDEN(P->ip[r], P->iv[P->con.node[k]]);
+      WIDEN(P->im[r], P->iu[P->con.node[k]]);
     }
   }
 #undef WIDEN
@@ -907,7 +912,7 @@ static int setup(ida_problem *P, martello_model *model, martello_run *run) {
   P->every = s.every;
   P->out_dt = s.dt * s.every;
   P->dt = s.dt;
-  if ((st = martello_model_topology(model, &n, &nc, NULL, NULL, NULL, NULL, NULL, NULL, NULL,
+  if ((st = martello_model_topology(model, &n, &nc, NULL, NULL, NULL, NULL, NULL,
                                     &ncp)) != MARTELLO_OK)
     return fail(P, st, "IDA: could not read the model");
   P->n = n;
@@ -915,15 +920,28 @@ static int setup(ida_problem *P, martello_model *model, martello_run *run) {
   P->ncoupling = ncp;
   P->mass = take((size_t)n, sizeof(double), &failed);
   P->fixed = take((size_t)n, sizeof(int), &failed);
-  P->con_a = take((size_t)nc, sizeof(int), &failed);
-  P->con_b = take((size_t)nc, sizeof(int), &failed);
   P->scheme = take((size_t)nc, sizeof(int), &failed);
   P->gap = take((size_t)nc, sizeof(double), &failed);
   P->rest = take((size_t)nc, sizeof(double), &failed);
   if (failed > 0.0) return fail_memory(P, "an array of the IDA state", failed);
-  if ((st = martello_model_topology(model, &n, &nc, P->mass, P->fixed, P->con_a, P->con_b,
-                                    P->scheme, P->gap, P->rest, &ncp)) != MARTELLO_OK)
+  if ((st = martello_model_topology(model, &n, &nc, P->mass, P->fixed, P->scheme, P->gap,
+                                    P->rest, &ncp)) != MARTELLO_OK)
     return fail(P, st, "IDA: could not read the model");
+  {
+    int nl_rows, nterms;
+    if ((st = martello_model_elements(model, &nl_rows, &nterms, NULL, NULL, NULL)) != MARTELLO_OK)
+      return fail(P, st, "IDA: could not read the model");
+    P->el_first = take((size_t)(nl_rows + nc + 1), sizeof(int), &failed);
+    P->el_node = take((size_t)nterms, sizeof(int), &failed);
+    P->el_coef = take((size_t)nterms, sizeof(double), &failed);
+    if (failed > 0.0) return fail_memory(P, "an array of the IDA state", failed);
+    if ((st = martello_model_elements(model, &nl_rows, &nterms, P->el_first, P->el_node,
+                                      P->el_coef)) != MARTELLO_OK)
+      return fail(P, st, "IDA: could not read the model");
+    P->elem.first = P->el_first; P->elem.node = P->el_node; P->elem.coef = P->el_coef;
+    P->con = P->elem;
+    P->con.first = P->el_first + nl_rows;
+  }
   P->rig = take((size_t)nc, sizeof(int), &failed);
   P->rig_con = take((size_t)nc, sizeof(int), &failed);
   if (failed > 0.0) return fail_memory(P, "an array of the IDA state", failed);
@@ -977,8 +995,9 @@ static int setup(ida_problem *P, martello_model *model, martello_run *run) {
     P->iu[i] = pos++;
     P->iv[i] = pos++;
     for (int r = 0; r < P->nr; r++) {
-      int j = P->rig_con[r], a = P->con_a[j], b = P->con_b[j];
-      int first = (a >= 0 && b >= 0) ? (a < b ? a : b) : (a > b ? a : b);
+      int j = P->rig_con[r], first = n;
+      for (int k = P->con.first[j]; k < P->con.first[j + 1]; k++)
+        first = P->con.node[k] < first ? P->con.node[k] : first;
       if (first == i) {
         P->ip[r] = pos++;
         P->im[r] = pos++;
@@ -1007,14 +1026,13 @@ static int setup(ida_problem *P, martello_model *model, martello_run *run) {
   /* every switching surface of the laws is a root: hold them on smooth branches */
   if ((st = martello_eval_use_branches(P->ev, &P->nsw)) != MARTELLO_OK)
     return fail(P, st, "IDA: martello_eval_use_branches failed");
-  P->sw_a = take((size_t)P->nsw, sizeof(int), &failed);
-  P->sw_b = take((size_t)P->nsw, sizeof(int), &failed);
+  P->sw_el = take((size_t)P->nsw, sizeof(int), &failed);
   P->sw_al = take((size_t)P->nsw, sizeof(double), &failed);
   P->sw_be = take((size_t)P->nsw, sizeof(double), &failed);
   P->sw_ga = take((size_t)P->nsw, sizeof(double), &failed);
   if (failed > 0.0) return fail_memory(P, "an array of the IDA state", failed);
   if (P->nsw > 0 &&
-      (st = martello_eval_switches(P->ev, P->sw_a, P->sw_b, P->sw_al, P->sw_be, P->sw_ga)) != MARTELLO_OK)
+      (st = martello_eval_switches(P->ev, P->sw_el, P->sw_al, P->sw_be, P->sw_ga)) != MARTELLO_OK)
     return fail(P, st, "IDA: martello_eval_switches failed");
   return MARTELLO_OK;
 }

@@ -61,12 +61,16 @@ typedef struct {
   int n, nc, nsw, nl, kd, lumped;
   sunindextype N;
   double *mass;
-  int *fixed, *con_a, *con_b;
+  int *fixed;
+  /* the elements' rows (martello_model_elements): elem all of them, con the contacts' */
+  int *el_first, *el_node;
+  double *el_coef;
+  martello_rows elem, con;
   double *gap;
   int *act;
   double *u, *v, *a, *uq, *vq, *fint, *fext, *kb, *cb, *v_last;
   double *force;           /* the forces of rigid contacts for the sample: none here, all 0 */
-  int *sw_a, *sw_b;
+  int *sw_el;
   double *sw_al, *sw_be, *sw_ga;
   /* located peaks (c/located_peaks.c), as on IDA */
   int start_rates;
@@ -103,14 +107,12 @@ static int fail_memory(ode_problem *P, const char *what, double bytes) {
   return martello_observer_fail(P->obs, MARTELLO_ERR_MEMORY, P->t_now, line);
 }
 
-static double node_u(int i, const double *u) { return i < 0 ? 0.0 : u[i]; }
-
 static double penetration(const ode_problem *P, int j, const double *u) {
-  return (node_u(P->con_a[j], u) - node_u(P->con_b[j], u)) - P->gap[j];
+  return martello_rows_dot(&P->con, j, u) - P->gap[j];
 }
 
 static double pen_rate(const ode_problem *P, int j, const double *v) {
-  return node_u(P->con_a[j], v) - node_u(P->con_b[j], v);
+  return martello_rows_dot(&P->con, j, v);
 }
 
 static void gather(const ode_problem *P, const double *y, double *u, double *v) {
@@ -123,16 +125,19 @@ static void gather(const ode_problem *P, const double *y, double *u, double *v) 
 /* Move contact j strictly to side sgn by the smallest shift of one free node (the kernels
  * decide a penalty law's regime by the sign of delta; c/ida.c's nudge). */
 static void nudge(ode_problem *P, int j, int sgn, double *u) {
-  int a = P->con_a[j], b = P->con_b[j];
-  int node = (a >= 0 && !P->fixed[a]) ? a : ((b >= 0 && !P->fixed[b]) ? b : -1);
+  int node = -1;
+  double c = 0.0;
+  for (int k = P->con.first[j]; k < P->con.first[j + 1] && node < 0; k++)
+    if (!P->fixed[P->con.node[k]] && P->con.coef[k] != 0.0) {
+      node = P->con.node[k];
+      c = P->con.coef[k];
+    }
   if (node < 0) return;
-  double dir = node == a ? 1.0 : -1.0;
-  double eta = 4.0 * DBL_EPSILON *
-               (fabs(P->gap[j]) + fabs(node_u(a, u)) + fabs(node_u(b, u))) + DBL_MIN;
+  double eta = 4.0 * DBL_EPSILON * (fabs(P->gap[j]) + martello_rows_abs(&P->con, j, u)) + DBL_MIN;
   for (int k = 0; k < 80; k++) {
     double d = penetration(P, j, u);
     if (sgn * d > 0.0) return;
-    u[node] += dir * sgn * (fabs(d) + eta);
+    u[node] += sgn * (fabs(d) + eta) / c;
     eta *= 2.0;
   }
 }
@@ -300,9 +305,10 @@ static int roots(realtype t, N_Vector yy, realtype *g, void *data) {
     g[2 * j + 1] = pen_rate(P, j, P->vq);
   }
   for (int s = 0; s < P->nsw; s++) {
-    const int a = P->sw_a[s], b = P->sw_b[s];
-    g[2 * P->nc + s] = P->sw_al[s] * (node_u(a, P->uq) - node_u(b, P->uq)) +
-                       P->sw_be[s] * (node_u(a, P->vq) - node_u(b, P->vq)) + P->sw_ga[s];
+    const int e = P->sw_el[s];
+    const double du = e >= 0 ? martello_rows_dot(&P->elem, e, P->uq) : 0.0;
+    const double dv = e >= 0 ? martello_rows_dot(&P->elem, e, P->vq) : 0.0;
+    g[2 * P->nc + s] = P->sw_al[s] * du + P->sw_be[s] * dv + P->sw_ga[s];
   }
   return 0;
 }
@@ -319,7 +325,7 @@ static void error_handler(int code, const char *module, const char *function, ch
 static int commit(ode_problem *P, const double *u, const double *v) {
   int st = martello_eval_commit(P->ev, u, v);
   if (st == MARTELLO_OK && P->nsw > 0)
-    st = martello_eval_switches(P->ev, P->sw_a, P->sw_b, P->sw_al, P->sw_be, P->sw_ga);
+    st = martello_eval_switches(P->ev, P->sw_el, P->sw_al, P->sw_be, P->sw_ga);
   return st == MARTELLO_OK ? st : fail(P, st, "%s: commit failed", P->name);
 }
 
@@ -539,7 +545,7 @@ static int boundary_events(ode_problem *P, double t_last, double tret, const dou
     int want = ACT_NONE, touching = martello_observer_in_phase(P->obs, j);
     double d = penetration(P, j, P->u), w = pen_rate(P, j, P->v);
     double on = 64.0 * DBL_EPSILON *
-                (fabs(node_u(P->con_a[j], P->u)) + fabs(node_u(P->con_b[j], P->u)) + fabs(P->gap[j]) +
+                (martello_rows_abs(&P->con, j, P->u) + fabs(P->gap[j]) +
                  fabs(w) * (fabs(tret) + fabs(h_last)));
     if (!touching && (d > 0.0 || (d >= -on && w > wtol))) want = ACT_ONSET;
     else if (touching && (d < 0.0 || (d <= on && w < -wtol))) want = ACT_SEPARATION;
@@ -593,8 +599,8 @@ static void *take(size_t count, size_t size, double *failed) {
 }
 
 static void release(ode_problem *P) {
-  void *all[] = {P->mass, P->force, P->fixed, P->con_a, P->con_b, P->gap, P->act, P->u, P->v, P->a,
-                 P->uq, P->vq, P->fint, P->fext, P->kb, P->cb, P->v_last, P->sw_a, P->sw_b,
+  void *all[] = {P->mass, P->force, P->fixed, P->el_first, P->el_node, P->el_coef, P->gap, P->act, P->u, P->v, P->a,
+                 P->uq, P->vq, P->fint, P->fext, P->kb, P->cb, P->v_last, P->sw_el,
                  P->sw_al, P->sw_be, P->sw_ga, P->el0, P->el1, P->elc, P->pv0, P->pa0,
                  P->pj0, P->pv1, P->pa1, P->pj1, P->ua, P->va, P->aa, P->jk};
   for (size_t k = 0; k < sizeof all / sizeof all[0]; k++) free(all[k]);
@@ -649,7 +655,7 @@ static int setup(ode_problem *P, martello_model *model, martello_run *run) {
   P->out_dt = s.dt * s.every;
   P->dt = s.dt;
   if ((st = choose_method(P, s.method)) != MARTELLO_OK) return st;
-  if ((st = martello_model_topology(model, &n, &nc, NULL, NULL, NULL, NULL, NULL, NULL, NULL,
+  if ((st = martello_model_topology(model, &n, &nc, NULL, NULL, NULL, NULL, NULL,
                                     &ncp)) != MARTELLO_OK)
     return fail(P, st, "%s: could not read the model", P->name);
   P->n = n;
@@ -658,8 +664,12 @@ static int setup(ode_problem *P, martello_model *model, martello_run *run) {
   size_t un = (size_t)n, ucn = (size_t)nc;
   P->mass = take(un, sizeof(double), &failed);
   P->fixed = take(un, sizeof(int), &failed);
-  P->con_a = take(ucn, sizeof(int), &failed);
-  P->con_b = take(ucn, sizeof(int), &failed);
+  int nl_rows = 0, nterms = 0;
+  if ((st = martello_model_elements(model, &nl_rows, &nterms, NULL, NULL, NULL)) != MARTELLO_OK)
+    return fail(P, st, "%s: could not read the model", P->name);
+  P->el_first = take((size_t)(nl_rows + nc + 1), sizeof(int), &failed);
+  P->el_node = take((size_t)nterms, sizeof(int), &failed);
+  P->el_coef = take((size_t)nterms, sizeof(double), &failed);
   P->gap = take(ucn, sizeof(double), &failed);
   P->act = take(ucn, sizeof(int), &failed);
   P->force = take(ucn, sizeof(double), &failed);
@@ -674,8 +684,12 @@ static int setup(ode_problem *P, martello_model *model, martello_run *run) {
     free(rest);
     return fail_memory(P, "an array of the ODE state", failed);
   }
-  st = martello_model_topology(model, &n, &nc, P->mass, P->fixed, P->con_a, P->con_b, scheme,
-                               P->gap, rest, &ncp);
+  st = martello_model_topology(model, &n, &nc, P->mass, P->fixed, scheme, P->gap, rest, &ncp);
+  if (st == MARTELLO_OK)
+    st = martello_model_elements(model, &nl_rows, &nterms, P->el_first, P->el_node, P->el_coef);
+  P->elem.first = P->el_first; P->elem.node = P->el_node; P->elem.coef = P->el_coef;
+  P->con = P->elem;
+  P->con.first = P->el_first + nl_rows;
   for (int j = 0; j < nc && st == MARTELLO_OK; j++)
     if (scheme[j] != MARTELLO_SCHEME_PENALTY)
       st = fail(P, MARTELLO_ERR_UNSUPPORTED,
@@ -703,14 +717,13 @@ static int setup(ode_problem *P, martello_model *model, martello_run *run) {
   }
   if ((st = martello_eval_use_branches(P->ev, &P->nsw)) != MARTELLO_OK)
     return fail(P, st, "%s: martello_eval_use_branches failed", P->name);
-  P->sw_a = take((size_t)P->nsw, sizeof(int), &failed);
-  P->sw_b = take((size_t)P->nsw, sizeof(int), &failed);
+  P->sw_el = take((size_t)P->nsw, sizeof(int), &failed);
   P->sw_al = take((size_t)P->nsw, sizeof(double), &failed);
   P->sw_be = take((size_t)P->nsw, sizeof(double), &failed);
   P->sw_ga = take((size_t)P->nsw, sizeof(double), &failed);
   if (failed > 0.0) return fail_memory(P, "an array of the ODE state", failed);
   if (P->nsw > 0 &&
-      (st = martello_eval_switches(P->ev, P->sw_a, P->sw_b, P->sw_al, P->sw_be, P->sw_ga)) != MARTELLO_OK)
+      (st = martello_eval_switches(P->ev, P->sw_el, P->sw_al, P->sw_be, P->sw_ga)) != MARTELLO_OK)
     return fail(P, st, "%s: martello_eval_switches failed", P->name);
   return MARTELLO_OK;
 }

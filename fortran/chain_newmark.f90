@@ -28,6 +28,7 @@ module martello_chain_newmark
       model_initial_state, &
       model_contact_index, model_link_at, model_contact_at, model_expand_chains, model_nlinks, &
       model_ncontacts, model_has_influence
+   use martello_element_rows, only: row_a, row_b, row_is_pair
    use martello_links, only: LINK_SPRING, LINK_BAR, LINK_DASHPOT, LINK_BILINEAR, L_STIFF, L_DAMP, &
       L_YIELD, L_HARDENING, bilinear_return_map, bilinear_energy
    use martello_contact_laws, only: LAW_LINEAR, LAW_KELVIN, P_STIFF, P_DAMPING, P_CLIP, &
@@ -152,8 +153,10 @@ contains
          case default
             ok = .false.
          end select
+         if (.not. row_is_pair(m%lnk, j)) ok = .false.   ! the sweep takes node pairs
       end do
       do j = 1, m%ncontact
+         if (.not. row_is_pair(m%con, j)) ok = .false.
          if (m%con_scheme(j) /= SCHEME_PENALTY) ok = .false.
          if (m%con_law(j) /= LAW_LINEAR .and. m%con_law(j) /= LAW_KELVIN) ok = .false.
       end do
@@ -218,7 +221,7 @@ contains
       ! the bilinear springs start elastic, on k·Δu₀ (clamped into the band by the first
       ! step), as mech_init
       do i = 1, size(self%bl)
-         self%bdu(i) = self%u(m%link_a(self%bl(i))) - self%u(m%link_b(self%bl(i)))
+         self%bdu(i) = self%u(row_a(m%lnk, self%bl(i))) - self%u(row_b(m%lnk, self%bl(i)))
          self%bfc(i) = m%link_par(L_STIFF, self%bl(i))*self%bdu(i)
       end do
       self%rp = 0.0_dp; self%fe = 0.0_dp; self%fnod = 0.0_dp
@@ -263,7 +266,7 @@ contains
       self%kg = 0.0_dp; self%cg = 0.0_dp
       self%pair_links = .false.
       do j = 1, m%nlink
-         a = m%link_a(j); b = m%link_b(j)
+         a = row_a(m%lnk, j); b = row_b(m%lnk, j)
          if (m%link_kind(j) /= LINK_BILINEAR .and. a > 0 .and. b > 0) self%pair_links = .true.
       end do
       ! unused ones hold one entry: the kernels take them as arrays
@@ -273,7 +276,7 @@ contains
       self%kp = 0.0_dp; self%cp = 0.0_dp
       nb = 0
       do j = 1, m%nlink
-         a = m%link_a(j); b = m%link_b(j)
+         a = row_a(m%lnk, j); b = row_b(m%lnk, j)
          k = 0.0_dp; cd = 0.0_dp
          select case (m%link_kind(j))
          case (LINK_SPRING, LINK_BAR)
@@ -317,7 +320,7 @@ contains
          end associate
       end do
       do j = 1, m%ncontact
-         a = m%con_a(j); b = m%con_b(j)
+         a = row_a(m%con, j); b = row_b(m%con, j)
          if (a == 0 .or. b == 0) cycle
          lo = min(a, b)
          if (self%pcon(lo) == 0) then
@@ -424,7 +427,7 @@ contains
       ground = .false.; gdamp = .false.; pair = .false.; pdamp = .false.
       do j = 1, m%nlink
          if (m%link_kind(j) == LINK_BILINEAR) cycle
-         if (m%link_a(j) > 0 .and. m%link_b(j) > 0) then
+         if (row_a(m%lnk, j) > 0 .and. row_b(m%lnk, j) > 0) then
             pair = .true.; pdamp = pdamp .or. m%link_kind(j) == LINK_DASHPOT
          else
             ground = .true.; gdamp = gdamp .or. m%link_kind(j) == LINK_DASHPOT
@@ -867,7 +870,7 @@ contains
                  par => m%link_par)
          do idx = 1, size(self%bl)
             ! the return map from the committed state
-            j = self%bl(idx); a = m%link_a(j); b = m%link_b(j)
+            j = self%bl(idx); a = row_a(m%lnk, j); b = row_b(m%lnk, j)
             du = u(a) - u(b)
             call bilinear_return_map(par(L_STIFF, j), par(L_YIELD, j), par(L_HARDENING, j), &
                                      self%bfc(idx), self%bdu(idx), du, f, kt, yielding)
@@ -880,7 +883,7 @@ contains
             fe(a) = fe(a) + f; fe(b) = fe(b) - f
          end do
          do idx = 1, size(self%xg)
-            j = self%xg(idx); a = m%con_a(j); b = m%con_b(j)
+            j = self%xg(idx); a = row_a(m%con, j); b = row_b(m%con, j)
             pen = u(a) - u(b) - m%con_gap(j)
             call contact_law(m, j, pen, v(a) - v(b), br, f)
             self%xbr(idx) = br
@@ -931,14 +934,14 @@ contains
          j = self%bl(idx)
          k = m%link_par(L_STIFF, j)
          if (self%bbr(idx) /= B_ELASTIC) k = m%link_par(L_HARDENING, j)*k
-         call stencil(m%link_a(j), m%link_b(j), k, 0.0_dp)
+         call stencil(row_a(m%lnk, j), row_b(m%lnk, j), k, 0.0_dp)
       end do
       do idx = 1, size(self%xg)
          j = self%xg(idx)
          if (self%xbr(idx) /= B_ON) cycle
          c = 0.0_dp
          if (m%con_law(j) == LAW_KELVIN) c = m%con_par(P_DAMPING, j)
-         call stencil(m%con_a(j), m%con_b(j), m%con_par(P_STIFF, j), c)
+         call stencil(row_a(m%con, j), row_b(m%con, j), m%con_par(P_STIFF, j), c)
       end do
       self%xjd(0) = 0.0_dp; self%xcd(0) = 0.0_dp
    contains
@@ -1088,7 +1091,7 @@ contains
       do idx = 1, size(self%xg)
          j = self%xg(idx)
          if (self%xbrc(idx) /= B_OFF) call observer_open_phase(o, self%xc(idx), 0.0_dp, &
-                                                               self%v(m%con_a(j)) - self%v(m%con_b(j)))
+                                                               self%v(row_a(m%con, j)) - self%v(row_b(m%con, j)))
       end do
       call observer_begin(o, m, self%ms, self%u, self%v, self%a, energy_interval, self%advice, &
                           0.0_dp, stat, energies=energies(self, m))
@@ -1332,7 +1335,7 @@ contains
       associate (u => self%u, v => self%v, acc => self%a, un => self%un, vn => self%vn, &
                  an => self%an, gap => m%con_gap)
          do idx = 1, size(self%xg)
-            j = self%xg(idx); a = m%con_a(j); b = m%con_b(j); c = self%xc(idx)
+            j = self%xg(idx); a = row_a(m%con, j); b = row_b(m%con, j); c = self%xc(idx)
             pen = u(a) - u(b) - gap(j); r1 = v(a) - v(b)
             call contact_law(m, j, pen, r1, br, f, self%xbrc(idx))
             d0 = un(a) - un(b) - gap(j)
@@ -1358,7 +1361,7 @@ contains
          end do
          if (.not. tracks(o, TRACK_LINK_PEAKS)) return
          do idx = 1, size(self%blo)
-            j = self%blo(idx); l = self%bl(idx); a = m%link_a(l); b = m%link_b(l)
+            j = self%blo(idx); l = self%bl(idx); a = row_a(m%lnk, l); b = row_b(m%lnk, l)
             call raise_to(o%link_force_absmax(j), abs(self%bfc(idx)))
             call raise_to(o%link_du_absmax(j), abs(self%bdu(idx)))
             if (located) call observer_link_step_extremum(LINK_BILINEAR, m%link_par(:, l), hl, &
@@ -1381,7 +1384,7 @@ contains
       real(dp) :: umax, vmax
       if (.not. tracks(o, TRACK_LINK_PEAKS)) return
       do j = 1, m%nlink
-         a = m%link_a(j); b = m%link_b(j)
+         a = row_a(m%lnk, j); b = row_b(m%lnk, j)
          select case (m%link_kind(j))
          case (LINK_SPRING, LINK_BAR, LINK_DASHPOT)
          case default
@@ -1537,7 +1540,7 @@ contains
          end do
          do idx = 1, size(self%xg)
             j = self%xg(idx)
-            pen = u(m%con_a(j)) - u(m%con_b(j)) - m%con_gap(j)
+            pen = u(row_a(m%con, j)) - u(row_b(m%con, j)) - m%con_gap(j)
             e(3) = e(3) + contact_elastic_energy(m%con_law(j), m%con_par(:, j), max(pen, 0.0_dp))
          end do
       end associate

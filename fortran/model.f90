@@ -12,14 +12,17 @@ module martello_model
       L_STIFF, L_DAMP, L_YIELD, L_HARDENING
    use martello_registry, only: SCHEME_PENALTY, SCHEME_LAGRANGE, SCHEME_AUGMENTED, &
       SCHEME_RESTITUTION, registry_name
+   use martello_element_rows, only: rows_t, rows_init, rows_append, rows_append_pair, row_span, &
+      row_pair, row_lo, row_hi, rows_move
    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
    implicit none
    private
    public :: model_t, model_init, model_set_node, model_add_link, model_add_contact, &
       model_initial_state, model_u0, &
       model_add_mass_coupling, model_add_nodal_force, model_set_ground_acceleration, &
+      model_add_link_row, model_add_contact_row, rigid_contacts, &
       model_set_influence, model_influence, model_has_influence, &
-      model_add_stiffness_block, stiffness_block_t, model_bandwidth, rigid_contact_sides, &
+      model_add_stiffness_block, stiffness_block_t, model_bandwidth, &
       SCHEME_PENALTY, SCHEME_LAGRANGE, SCHEME_AUGMENTED, &
       SCHEME_RESTITUTION, scheme_name, chain_t, model_add_chain, model_expand_chains, &
       model_nlinks, model_ncontacts, model_link_index, model_contact_index, model_contact_at, &
@@ -60,11 +63,17 @@ module martello_model
       logical, allocatable :: fixed(:)
       ! links
       integer :: nlink = 0
-      integer, allocatable :: link_kind(:), link_a(:), link_b(:)
+      integer, allocatable :: link_kind(:)
+      !> each link's row: its elongation Σ coef·u(node) (a node pair: u_a − u_b), its force f
+      !> on the nodes coef·f (martello_element_rows)
+      type(rows_t) :: lnk
       real(dp), allocatable :: link_par(:, :)           !< (NPAR_LINK, nlink)
-      ! contacts: penetration δ = (u_a − u_b) − gap, compressive force pushes a back, b forward
+      ! contacts: penetration δ = Σ coef·u(node) − gap over the contact's row (a node pair:
+      ! u_a − u_b − gap), a compressive force f acts on the nodes as coef·f (pushes a back, b
+      ! forward); rows between plan points of floors: docs/buildings.md
       integer :: ncontact = 0
-      integer, allocatable :: con_a(:), con_b(:), con_scheme(:), con_law(:)
+      type(rows_t) :: con
+      integer, allocatable :: con_scheme(:), con_law(:)
       real(dp), allocatable :: con_gap(:), con_par(:, :) !< (NPAR_CONTACT, ncontact)
       !> effective mass 1/(B M⁻¹ Bᵀ) of each contact (+inf if neither side moves), and the
       !> damping derived from a target restitution: set by effective_mass_prepare before a run
@@ -123,9 +132,9 @@ contains
       end if
       m%n = n
       allocate (m%mass(n), m%u0(0), m%v0(0), m%influence(0), m%fixed(n), &
-                m%link_kind(max_links), m%link_a(max_links), m%link_b(max_links), &
+                m%link_kind(max_links), &
                 m%link_par(NPAR_LINK, max_links), &
-                m%con_a(max_contacts), m%con_b(max_contacts), m%con_scheme(max_contacts), &
+                m%con_scheme(max_contacts), &
                 m%con_law(max_contacts), m%con_gap(max_contacts), &
                 m%con_par(NPAR_CONTACT, max_contacts), m%con_mstar(max_contacts), &
                 m%force_node(max_forces), m%force_fn(max_forces), &
@@ -138,6 +147,14 @@ contains
                             + INT_BYTES*(2.0_dp*n + 3.0_dp*max_links + 4.0_dp*max_contacts &
                             + max_forces + 2.0_dp*max_couplings) &
                             + storage_size(m%force_fn)/8*real(max_forces, dp), &
+                            FIX_SMALLER_SCENE, stat, m%errmsg)
+         return
+      end if
+      if (stat == 0) call rows_init(m%lnk, max_links, 2, stat)
+      if (stat == 0) call rows_init(m%con, max_contacts, 2, stat)
+      if (stat /= 0) then
+         call out_of_memory('the rows of the links and contacts', &
+                            (REAL_BYTES + INT_BYTES)*2.0_dp*(real(max_links, dp) + max_contacts), &
                             FIX_SMALLER_SCENE, stat, m%errmsg)
          return
       end if
@@ -250,10 +267,66 @@ contains
       end if
       call check_link(m, kind, a, b, par, stat)
       if (stat /= MARTELLO_OK) return
+      call rows_append_pair(m%lnk, a, b, stat)
+      if (stat /= 0) then
+         call out_of_memory('a link row', REAL_BYTES + INT_BYTES, FIX_SMALLER_SCENE, stat, m%errmsg)
+         return
+      end if
       m%nlink = m%nlink + 1
-      m%link_kind(m%nlink) = kind; m%link_a(m%nlink) = a; m%link_b(m%nlink) = b
+      m%link_kind(m%nlink) = kind
       m%link_par(:, m%nlink) = par
    end subroutine model_add_link
+
+   !> Add a link whose elongation is Σ coef(k)·u(node(k)) (node 0: the ground, left out): a
+   !> link between plan points of floors (docs/buildings.md), its force f acting as coef·f.
+   subroutine model_add_link_row(m, kind, node, coef, par, stat)
+      type(model_t), intent(inout) :: m
+      integer, intent(in) :: kind, node(:)
+      real(dp), intent(in) :: coef(:), par(NPAR_LINK)
+      integer, intent(out) :: stat
+      stat = MARTELLO_OK
+      if (m%nlink >= size(m%link_kind)) then
+         call fail(m, stat, 'add_link_row: more links than declared at model_create'); return
+      end if
+      call check_row(m, 'add_link_row', node, coef, stat)
+      if (stat == MARTELLO_OK) call check_link(m, kind, 0, -1, par, stat)
+      if (stat /= MARTELLO_OK) return
+      call rows_append(m%lnk, node, coef, stat)
+      if (stat /= 0) then
+         call out_of_memory('a link row', (REAL_BYTES + INT_BYTES)*size(node), FIX_SMALLER_SCENE, &
+                            stat, m%errmsg)
+         return
+      end if
+      m%nlink = m%nlink + 1
+      m%link_kind(m%nlink) = kind
+      m%link_par(:, m%nlink) = par
+   end subroutine model_add_link_row
+
+   !> What a row needs: nodes of the model or 0 (the ground), finite coefficients, at least
+   !> one term on a node.
+   subroutine check_row(m, what, node, coef, stat)
+      type(model_t), intent(inout) :: m
+      character(len=*), intent(in) :: what
+      integer, intent(in) :: node(:)
+      real(dp), intent(in) :: coef(:)
+      integer, intent(out) :: stat
+      integer :: k
+      stat = MARTELLO_OK
+      if (size(node) /= size(coef)) then
+         call fail(m, stat, what//': as many coefficients as nodes'); return
+      end if
+      do k = 1, size(node)
+         if (.not. node_ok(m, node(k), .true.)) then
+            call fail(m, stat, what//': node out of range'); return
+         end if
+      end do
+      if (.not. all(ieee_is_finite(coef))) then
+         call fail(m, stat, what//': coefficients must be finite'); return
+      end if
+      if (.not. any(node > 0 .and. coef /= 0.0_dp)) then
+         call fail(m, stat, what//': the row has no term on a node (it joins nothing that moves)')
+      end if
+   end subroutine check_row
 
    !> What add_link checks of one link (its nodes, kind and parameters).
    subroutine check_link(m, kind, a, b, par, stat)
@@ -265,8 +338,10 @@ contains
       if (.not. link_is_known(kind)) then
          call fail(m, stat, 'add_link: unknown link kind'); return
       end if
-      if (.not. (node_ok(m, a, .true.) .and. node_ok(m, b, .true.)) .or. a == b) then
-         call fail(m, stat, 'add_link: nodes out of range, or both ends on the same node'); return
+      if (b /= -1) then       ! b = −1: a row's link, its nodes checked by check_row
+         if (.not. (node_ok(m, a, .true.) .and. node_ok(m, b, .true.)) .or. a == b) then
+            call fail(m, stat, 'add_link: nodes out of range, or both ends on the same node'); return
+         end if
       end if
       if (.not. all(ieee_is_finite(par))) then
          call fail(m, stat, 'add_link: parameters must be finite'); return
@@ -279,28 +354,64 @@ contains
       real(dp), intent(in) :: gap, par(NPAR_CONTACT)
       integer, intent(out) :: stat
       stat = MARTELLO_OK
-      if (m%ncontact >= size(m%con_a)) then
+      if (m%ncontact >= size(m%con_scheme)) then
          call fail(m, stat, 'add_contact: more contacts than declared at model_create'); return
       end if
       call check_contact(m, a, b, gap, scheme, law, par, stat)
       if (stat /= MARTELLO_OK) return
+      call rows_append_pair(m%con, a, b, stat)
+      if (stat /= 0) then
+         call out_of_memory('a contact row', REAL_BYTES + INT_BYTES, FIX_SMALLER_SCENE, stat, m%errmsg)
+         return
+      end if
       m%ncontact = m%ncontact + 1
-      m%con_a(m%ncontact) = a; m%con_b(m%ncontact) = b; m%con_gap(m%ncontact) = gap
+      m%con_gap(m%ncontact) = gap
       m%con_scheme(m%ncontact) = scheme; m%con_law(m%ncontact) = law
       m%con_par(:, m%ncontact) = par
       m%con_mstar(m%ncontact) = 0.0_dp
    end subroutine model_add_contact
 
-   !> What add_contact checks of one contact (its nodes, scheme, law and parameters).
+   !> Add a contact whose penetration is Σ coef(k)·u(node(k)) − gap (node 0: the ground, left
+   !> out): a contact between plan points of floors (docs/buildings.md), its compressive force
+   !> f acting as coef·f on the nodes.
+   subroutine model_add_contact_row(m, node, coef, gap, scheme, law, par, stat)
+      type(model_t), intent(inout) :: m
+      integer, intent(in) :: node(:), scheme, law
+      real(dp), intent(in) :: coef(:), gap, par(NPAR_CONTACT)
+      integer, intent(out) :: stat
+      stat = MARTELLO_OK
+      if (m%ncontact >= size(m%con_scheme)) then
+         call fail(m, stat, 'add_contact_row: more contacts than declared at model_create'); return
+      end if
+      call check_row(m, 'add_contact_row', node, coef, stat)
+      if (stat == MARTELLO_OK) call check_contact(m, 0, -1, gap, scheme, law, par, stat)
+      if (stat /= MARTELLO_OK) return
+      call rows_append(m%con, node, coef, stat)
+      if (stat /= 0) then
+         call out_of_memory('a contact row', (REAL_BYTES + INT_BYTES)*size(node), FIX_SMALLER_SCENE, &
+                            stat, m%errmsg)
+         return
+      end if
+      m%ncontact = m%ncontact + 1
+      m%con_gap(m%ncontact) = gap
+      m%con_scheme(m%ncontact) = scheme; m%con_law(m%ncontact) = law
+      m%con_par(:, m%ncontact) = par
+      m%con_mstar(m%ncontact) = 0.0_dp
+   end subroutine model_add_contact_row
+
+   !> What add_contact checks of one contact (its nodes, scheme, law and parameters; b = −1:
+   !> a row's contact, its nodes checked by check_row).
    subroutine check_contact(m, a, b, gap, scheme, law, par, stat)
       type(model_t), intent(inout) :: m
       integer, intent(in) :: a, b, scheme, law
       real(dp), intent(in) :: gap, par(NPAR_CONTACT)
       integer, intent(out) :: stat
       stat = MARTELLO_OK
-      if (.not. (node_ok(m, a, .true.) .and. node_ok(m, b, .true.)) .or. a == b) then
-         call fail(m, stat, 'add_contact: nodes out of range, or both sides on the same node')
-         return
+      if (b /= -1) then
+         if (.not. (node_ok(m, a, .true.) .and. node_ok(m, b, .true.)) .or. a == b) then
+            call fail(m, stat, 'add_contact: nodes out of range, or both sides on the same node')
+            return
+         end if
       end if
       if (scheme < SCHEME_PENALTY .or. scheme > SCHEME_RESTITUTION) then
          call fail(m, stat, 'add_contact: unknown scheme'); return
@@ -466,10 +577,10 @@ contains
       integer :: j
       kd = 0
       do j = 1, m%nlink
-         if (m%link_a(j) > 0 .and. m%link_b(j) > 0) kd = max(kd, abs(m%link_a(j) - m%link_b(j)))
+         kd = max(kd, row_span(m%lnk, j))
       end do
       do j = 1, m%ncontact
-         if (m%con_a(j) > 0 .and. m%con_b(j) > 0) kd = max(kd, abs(m%con_a(j) - m%con_b(j)))
+         kd = max(kd, row_span(m%con, j))
       end do
       do j = 1, m%ncoupling
          kd = max(kd, abs(m%mc_a(j) - m%mc_b(j)))
@@ -655,7 +766,8 @@ contains
             if (ch%link0 < j) g = g - ch%nlink
          end associate
       end do
-      kind = m%link_kind(g); a = m%link_a(g); b = m%link_b(g); par = m%link_par(:, g)
+      kind = m%link_kind(g); par = m%link_par(:, g)
+      call row_pair(m%lnk, g, a, b)
    end subroutine model_link_at
 
    !> Contact number j of all the model's contacts (one by one or in a chain): nodes, gap,
@@ -678,7 +790,8 @@ contains
             if (ch%contact0 < j) g = g - ch%ncontact
          end associate
       end do
-      a = m%con_a(g); b = m%con_b(g); gap = m%con_gap(g); scheme = m%con_scheme(g)
+      call row_pair(m%con, g, a, b)
+      gap = m%con_gap(g); scheme = m%con_scheme(g)
       law = m%con_law(g); par = m%con_par(:, g)
    end subroutine model_contact_at
 
@@ -692,22 +805,26 @@ contains
       integer, intent(out) :: stat
       character(len=*), intent(inout) :: message
       integer :: nl, nc, free_l, free_c, q, i, g, pos
-      integer, allocatable :: lk(:), la(:), lb(:), ca(:), cb(:), cs(:), cl(:)
+      integer, allocatable :: lk(:), cs(:), cl(:)
       real(dp), allocatable :: lpar(:, :), cg(:), cpar(:, :), cm(:)
+      type(rows_t) :: lr, cr
       character(len=96) :: what
       stat = MARTELLO_OK
       if (m%nchain == 0) return
       nl = model_nlinks(m); nc = model_ncontacts(m)
-      free_l = size(m%link_kind) - m%nlink; free_c = size(m%con_a) - m%ncontact
-      allocate (lk(nl + free_l), la(nl + free_l), lb(nl + free_l), lpar(NPAR_LINK, nl + free_l), &
-                ca(nc + free_c), cb(nc + free_c), cs(nc + free_c), cl(nc + free_c), &
+      free_l = size(m%link_kind) - m%nlink; free_c = size(m%con_scheme) - m%ncontact
+      allocate (lk(nl + free_l), lpar(NPAR_LINK, nl + free_l), &
+                cs(nc + free_c), cl(nc + free_c), &
                 cg(nc + free_c), cm(nc + free_c), cpar(NPAR_CONTACT, nc + free_c), stat=stat)
+      if (stat == 0) call rows_init(lr, nl + free_l, 2, stat)
+      if (stat == 0) call rows_init(cr, nc + free_c, 2, stat)
       if (stat /= 0) then
          write (what, '(a,i0,a,i0,a)') 'the chains as ', nl + free_l, ' links and ', nc + free_c, &
             ' contacts one by one'
          call out_of_memory(trim(what), REAL_BYTES*(NPAR_LINK*real(nl + free_l, dp) &
                             + (NPAR_CONTACT + 2.0_dp)*(nc + free_c)) &
-                            + INT_BYTES*(3.0_dp*(nl + free_l) + 4.0_dp*(nc + free_c)), &
+                            + (REAL_BYTES + INT_BYTES)*2.0_dp*(nl + free_l + nc + free_c) &
+                            + INT_BYTES*(real(nl + free_l, dp) + 2.0_dp*(nc + free_c)), &
                             FIX_SMALLER_SCENE, stat, message)
          return
       end if
@@ -718,12 +835,13 @@ contains
          associate (ch => m%chain(q))
             do while (g < ch%glink)
                g = g + 1; pos = pos + 1
-               lk(pos) = m%link_kind(g); la(pos) = m%link_a(g); lb(pos) = m%link_b(g)
-               lpar(:, pos) = m%link_par(:, g)
+               call copy_link(g, pos)
+               if (stat /= 0) exit
             end do
             do i = 1, ch%n
                pos = pos + 1
-               la(pos) = ch%first + i - 1; lb(pos) = 0; lpar(:, pos) = 0.0_dp
+               call rows_append_pair(lr, ch%first + i - 1, 0, stat)
+               lpar(:, pos) = 0.0_dp
                lk(pos) = LINK_SPRING; lpar(L_STIFF, pos) = ch%k(i)
                if (allocated(ch%fy)) then
                   lk(pos) = LINK_BILINEAR; lpar(L_YIELD, pos) = ch%fy(i)
@@ -732,15 +850,15 @@ contains
                if (.not. allocated(ch%c)) cycle
                if (.not. (ch%c(i) > 0.0_dp)) cycle
                pos = pos + 1
-               la(pos) = ch%first + i - 1; lb(pos) = 0; lpar(:, pos) = 0.0_dp
+               call rows_append_pair(lr, ch%first + i - 1, 0, stat)
+               lpar(:, pos) = 0.0_dp
                lk(pos) = LINK_DASHPOT; lpar(L_DAMP, pos) = ch%c(i)
             end do
          end associate
       end do
       do while (g < m%nlink)
          g = g + 1; pos = pos + 1
-         lk(pos) = m%link_kind(g); la(pos) = m%link_a(g); lb(pos) = m%link_b(g)
-         lpar(:, pos) = m%link_par(:, g)
+         call copy_link(g, pos)
       end do
       pos = 0; g = 0
       do q = 1, m%nchain
@@ -751,7 +869,8 @@ contains
             end do
             do i = 1, ch%ncontact
                pos = pos + 1
-               ca(pos) = ch%first + i - 1; cb(pos) = ch%first + i; cg(pos) = ch%gap(i)
+               call rows_append_pair(cr, ch%first + i - 1, ch%first + i, stat)
+               cg(pos) = ch%gap(i)
                cs(pos) = ch%scheme; cl(pos) = ch%law; cpar(:, pos) = ch%par
             end do
          end associate
@@ -760,41 +879,53 @@ contains
          g = g + 1; pos = pos + 1
          call copy_contact(g, pos)
       end do
-      call move_alloc(lk, m%link_kind); call move_alloc(la, m%link_a)
-      call move_alloc(lb, m%link_b); call move_alloc(lpar, m%link_par)
-      call move_alloc(ca, m%con_a); call move_alloc(cb, m%con_b); call move_alloc(cs, m%con_scheme)
+      if (stat /= 0) then
+         call out_of_memory('the rows of the chains one by one', &
+                            (REAL_BYTES + INT_BYTES)*2.0_dp*(nl + nc), FIX_SMALLER_SCENE, stat, message)
+         return
+      end if
+      call move_alloc(lk, m%link_kind); call move_alloc(lpar, m%link_par)
+      call move_alloc(cs, m%con_scheme)
       call move_alloc(cl, m%con_law); call move_alloc(cg, m%con_gap)
       call move_alloc(cpar, m%con_par); call move_alloc(cm, m%con_mstar)
+      call rows_move(lr, m%lnk); call rows_move(cr, m%con)
       m%nlink = nl; m%ncontact = nc
       deallocate (m%chain); m%nchain = 0
    contains
+      subroutine copy_link(from, to)
+         integer, intent(in) :: from, to
+         integer :: st
+         lk(to) = m%link_kind(from); lpar(:, to) = m%link_par(:, from)
+         call rows_append(lr, m%lnk%node(row_lo(m%lnk, from):row_hi(m%lnk, from)), &
+                          m%lnk%coef(row_lo(m%lnk, from):row_hi(m%lnk, from)), st)
+         if (st /= 0) stat = st
+      end subroutine copy_link
       subroutine copy_contact(from, to)
          integer, intent(in) :: from, to
-         ca(to) = m%con_a(from); cb(to) = m%con_b(from); cg(to) = m%con_gap(from)
+         integer :: st
+         cg(to) = m%con_gap(from)
          cs(to) = m%con_scheme(from); cl(to) = m%con_law(from); cpar(:, to) = m%con_par(:, from)
+         call rows_append(cr, m%con%node(row_lo(m%con, from):row_hi(m%con, from)), &
+                          m%con%coef(row_lo(m%con, from):row_hi(m%con, from)), st)
+         if (st /= 0) stat = st
       end subroutine copy_contact
    end subroutine model_expand_chains
    !> For the impulse-level integrators: which contacts are rigid (restitution or Lagrange,
    !> solved by complementarity), their restitution (Lagrange without one: 0, plastic), and
-   !> their moving sides — a side on ground or on a fixed node does not move, so its column of
-   !> the constraint matrix B is left out (sa/sb = 0); movable = rigid with a moving side.
-   pure subroutine rigid_contact_sides(m, rigid, e, sa, sb, movable)
+   !> which can move — a rigid contact with a term on a free node (terms on a fixed node do not
+   !> move: the Delassus operator leaves them out).
+   pure subroutine rigid_contacts(m, rigid, e, movable)
       type(model_t), intent(in) :: m
       logical, intent(out) :: rigid(:), movable(:)
       real(dp), intent(out) :: e(:)
-      integer, intent(out) :: sa(:), sb(:)
-      integer :: c
+      integer :: c, k
       do c = 1, m%ncontact
          rigid(c) = m%con_scheme(c) /= SCHEME_PENALTY
          e(c) = max(m%con_par(P_RESTITUTION, c), 0.0_dp)
-         sa(c) = m%con_a(c); sb(c) = m%con_b(c)
-         if (sa(c) > 0) then
-            if (m%fixed(sa(c))) sa(c) = 0
-         end if
-         if (sb(c) > 0) then
-            if (m%fixed(sb(c))) sb(c) = 0
-         end if
-         movable(c) = rigid(c) .and. (sa(c) > 0 .or. sb(c) > 0)
+         movable(c) = .false.
+         do k = row_lo(m%con, c), row_hi(m%con, c)
+            if (.not. m%fixed(m%con%node(k)) .and. m%con%coef(k) /= 0.0_dp) movable(c) = rigid(c)
+         end do
       end do
-   end subroutine rigid_contact_sides
+   end subroutine rigid_contacts
 end module martello_model

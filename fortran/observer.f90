@@ -9,6 +9,7 @@ module martello_observer
    use martello_kinds, only: dp, i8
    use martello_status
    use martello_model, only: model_t
+   use martello_element_rows, only: rows_t, row_dot, row_dot1, row_lo, row_hi
    use martello_assembly, only: mech_state_t, kinetic_energy, recoverable_energy, mass_times, &
       load_breakpoint
    use martello_links, only: link_force, LINK_SPRING, LINK_BAR, LINK_BILINEAR, LINK_DASHPOT, &
@@ -124,10 +125,12 @@ module martello_observer
       logical :: smooth_steps = .false.
       !> per node (0:n): the time of the last phase change (onset, separation, impact) of a
       !> contact at it; the chatter resolutions at the previous sample (the jumps of the
-      !> forces a located peak of |a| must not straddle). con_nodes: each contact's nodes,
-      !> for the phase changes the method does not name them at (the fused chain step does)
+      !> forces a located peak of |a| must not straddle). con_rows: the contacts' rows
+      !> (their nodes), for the phase changes the method does not name them at (the fused
+      !> chain step does)
       real(dp), allocatable :: node_change(:)
-      integer, allocatable :: con_nodes(:, :)
+      type(rows_t) :: con_rows
+      logical :: has_con_rows = .false.
       integer(i8) :: chatter_prev = 0_i8
       !> per contact, for the general fixed-step path: its force and force rate at the
       !> previous sample (the fused chain step computes them again from its previous state)
@@ -301,14 +304,14 @@ contains
          e_kin = energies(1); o%e_links0 = energies(2); o%e_cont0 = energies(3)
       else
          if (o%smooth_steps) then
-            o%con_nodes = reshape([(m%con_a(c), m%con_b(c), c = 1, m%ncontact)], [2, m%ncontact])
+            o%con_rows = m%con; o%has_con_rows = .true.
          end if
          do c = 1, m%ncontact
-            if (ms%con_on(c)) call observer_open_phase(o, c, 0.0_dp, v(m%con_a(c)) - v(m%con_b(c)))
+            if (ms%con_on(c)) call observer_open_phase(o, c, 0.0_dp, row_dot(m%con, c, v))
             ! the force and its rate the first step's located peaks start from
             if (allocated(o%c_prev_f)) &
-               call contact_force_rate(m, ms, c, v(m%con_a(c)) - v(m%con_b(c)), &
-                                       a(m%con_a(c)) - a(m%con_b(c)), o%c_prev_f(c), o%c_prev_fr(c))
+               call contact_force_rate(m, ms, c, row_dot(m%con, c, v), &
+                                       row_dot(m%con, c, a), o%c_prev_f(c), o%c_prev_fr(c))
          end do
          e_kin = kinetic_energy(m, v, o%work)
          call recoverable_energy(m, ms, u, o%e_links0, o%e_cont0)
@@ -660,16 +663,17 @@ contains
       integer :: k, j
       if (.not. allocated(o%node_change)) return
       if (size(o%node_change) < 2) return           ! node peaks not tracked
-      do k = 1, 2
-         if (present(nodes)) then
+      if (present(nodes)) then
+         do k = 1, 2
             j = nodes(k)
-         else if (allocated(o%con_nodes)) then
-            j = o%con_nodes(k, c)
-         else
-            return
-         end if
-         o%node_change(j) = max(o%node_change(j), t)
-      end do
+            o%node_change(j) = max(o%node_change(j), t)
+         end do
+      else if (o%has_con_rows) then
+         do k = row_lo(o%con_rows, c), row_hi(o%con_rows, c)
+            j = o%con_rows%node(k)
+            o%node_change(j) = max(o%node_change(j), t)
+         end do
+      end if
    end subroutine phase_change
 
    !> Phases of the penalty contacts of a fixed step (t − h, t], from the committed state
@@ -684,26 +688,25 @@ contains
       type(model_t), intent(in) :: m
       type(mech_state_t), intent(in) :: ms
       real(dp), intent(in) :: un(0:), vn(0:), an(0:), u(0:), v(0:), a(0:), t, h
-      integer :: c, ia, ib
+      integer :: c
       real(dp) :: f, fr
       logical :: located
       located = allocated(o%c_prev_f) .and. o%prev_t >= 0.0_dp .and. t > o%prev_t
       do c = 1, m%ncontact
          if (.not. ms%is_penalty(c)) cycle
-         ia = m%con_a(c); ib = m%con_b(c)
          if (located) then
-            call contact_force_rate(m, ms, c, v(ia) - v(ib), a(ia) - a(ib), f, fr)
+            call contact_force_rate(m, ms, c, row_dot(m%con, c, v), row_dot(m%con, c, a), f, fr)
             call observer_contact_step_peaks(o, c, o%ph_open(c) .and. ms%con_on(c), t - o%prev_t, &
-                                       un(ia) - un(ib) - m%con_gap(c), vn(ia) - vn(ib), &
+                                       row_dot(m%con, c, un) - m%con_gap(c), row_dot(m%con, c, vn), &
                                        o%c_prev_f(c), o%c_prev_fr(c), ms%con_pen(c), &
-                                       v(ia) - v(ib), f, fr)
+                                       row_dot(m%con, c, v), f, fr)
             o%c_prev_f(c) = f; o%c_prev_fr(c) = fr
          end if
          if (ms%con_on(c) .neqv. o%ph_open(c)) &
             call observer_phase_change(o, c, ms%con_on(c), ms%con_pen(c), ms%con_f(c), &
-                                       un(ia) - un(ib) - m%con_gap(c), vn(ia) - vn(ib), &
-                                       an(ia) - an(ib), u(ia) - u(ib) - m%con_gap(c), v(ia) - v(ib), &
-                                       a(ia) - a(ib), t, h)
+                                       row_dot(m%con, c, un) - m%con_gap(c), row_dot(m%con, c, vn), &
+                                       row_dot(m%con, c, an), row_dot(m%con, c, u) - m%con_gap(c), &
+                                       row_dot(m%con, c, v), row_dot(m%con, c, a), t, h)
          if (tracks(o, TRACK_PHASES)) call observer_phase_peaks(o%ph_open(c), ms%con_pen(c), &
                                                                ms%con_f(c), o%ph_pen(c), o%ph_f(c))
       end do
@@ -1024,13 +1027,6 @@ contains
       end if
    end subroutine track
 
-   !> x(i) of a node array on 1..n, 0 for the ground (i = 0)
-   pure real(dp) function nodal(x, i)
-      real(dp), intent(in) :: x(:)
-      integer, intent(in) :: i
-      nodal = 0.0_dp
-      if (i > 0) nodal = x(i)
-   end function nodal
 
    !> x ← max(x, y), the NaN x starts from replaced without comparing it (an ordered
    !> comparison with a NaN raises the invalid flag: a trap under -ffpe-trap=invalid)
@@ -1051,21 +1047,20 @@ contains
       type(observer_t), intent(inout) :: o
       type(model_t), intent(in) :: m
       real(dp), intent(in) :: h, un(:), vn(:), an(:), u(:), v(:), a(:), f1(:)
-      integer :: j, ia, ib
+      integer :: j
       real(dp) :: dv0, dv1, da0, da1
       logical :: damper
       do j = 1, m%nlink
-         ia = m%link_a(j); ib = m%link_b(j)
-         dv0 = nodal(vn, ia) - nodal(vn, ib); dv1 = nodal(v, ia) - nodal(v, ib)
+         dv0 = row_dot1(m%lnk, j, vn); dv1 = row_dot1(m%lnk, j, v)
          damper = m%link_kind(j) == LINK_DASHPOT .or. m%link_kind(j) == LINK_FLUID_DAMPER
          da0 = 0.0_dp; da1 = 0.0_dp
          if (damper) then
-            da0 = nodal(an, ia) - nodal(an, ib); da1 = nodal(a, ia) - nodal(a, ib)
+            da0 = row_dot1(m%lnk, j, an); da1 = row_dot1(m%lnk, j, a)
          end if
          if (.not. (dv0*dv1 < 0.0_dp .or. da0*da1 < 0.0_dp)) cycle
          call observer_link_step_extremum(m%link_kind(j), m%link_par(:, j), h, &
-                                          nodal(un, ia) - nodal(un, ib), dv0, da0, &
-                                          nodal(u, ia) - nodal(u, ib), dv1, da1, f1(j), &
+                                          row_dot1(m%lnk, j, un), dv0, da0, &
+                                          row_dot1(m%lnk, j, u), dv1, da1, f1(j), &
                                           o%link_force_absmax(j), o%link_du_absmax(j))
       end do
    end subroutine link_step_peaks
