@@ -1,6 +1,6 @@
 """Write benchmarks/p2/laws/: P2's bouncing oscillator (docs/problems.md P2) on a penalty
-plane with every law, on Newmark, HHT, generalized-α, central difference, Moreau–Jean (θ = 0.5), rkf45, rk8pd, msbdf and
-IDA, checked against the independent
+plane with every law, on Newmark, HHT, generalized-α, central difference, Moreau–Jean (θ = 0.5), rkf45, rk8pd, msbdf,
+IDA, CVODE and ARKODE, checked against the independent
 engine (reference/independent/, docs/independent-reference.md): impact and separation times,
 realised e, peak penetration of every phase, peaks and energies. Regenerate the scenes with
 
@@ -22,6 +22,8 @@ INTEGRATORS = {"newmark": 'preset = "average-acceleration"', "hht": "alpha = -0.
                # (undamped Hertz: 3.3e-6 of the energy put in at rtol 1e-10, 2.5e-8 at 1e-12;
                # tests/test_dynamics.py bounds it by 1e-6)
                "msbdf": "rtol = 1.0e-12\natol = 1.0e-16", "central-difference": "",
+               # SUNDIALS CVODE (BDF) and ARKODE (Dormand-Prince 5(4)), docs/sundials-ode.md
+               "cvode": "rtol = 1.0e-12\natol = 1.0e-16", "arkode": "rtol = 1.0e-10\natol = 1.0e-14",
                "moreau-jean": "theta = 0.5"}
 # Moreau–Jean linearises the smooth forces once a step: its energy balance then holds that
 # linearisation error, O(h²) (on the undamped Hertz plane 1.55e-3 of the energy put in at

@@ -1,6 +1,6 @@
 """Write benchmarks/p7/laws/: P7's two oscillators of different period (docs/problems.md P7,
 benchmarks/p7/p7_two_oscillators.toml) with every penalty law on the event-locating
-integrators (rkf45, rk8pd, msbdf, IDA) and Newmark, HHT and generalized-α (the two Kelvin laws
+integrators (rkf45, rk8pd, msbdf, IDA, CVODE, ARKODE) and Newmark, HHT and generalized-α (the two Kelvin laws
 with event_split), each checked against the
 independent engine (reference/independent/p7_two_<law>.json, docs/independent-reference.md):
 impact and separation times, realised e and peak penetration of every phase, the nodes'
@@ -24,7 +24,7 @@ LAWS = {  # law: contact keys (the P7 law variants of benchmarks/independent/mak
     "kelvin_clipped": 'law = "kelvin", stiffness = 1.0e5, restitution = 0.65, clipped = true',
     **{law: f'law = "{law}", stiffness = {HERTZ_K:.1e}, restitution = 0.65'
        for law in ("hunt-crossley", "lankarani-nikravesh", "flores", "gonthier", "hertzdamp", "jankowski")}}
-INTEGRATORS = ("rkf45", "rk8pd", "msbdf", "ida")
+INTEGRATORS = ("rkf45", "rk8pd", "msbdf", "ida", "cvode", "arkode")
 # fixed steps at Δt = 1e-5 for the laws whose force has no kink inside a phase: linear,
 # hertz, the Hunt–Crossley family (which P7 never drives past its cut, 1 + χδ̇ = 0: the
 # engine logs no cut here) and jankowski. The Hunt–Crossley family's χ = a/v_in takes the rate
@@ -60,7 +60,7 @@ def settings(integ, law=None):
         return FIXED[integ] + "\n" + KELVIN_FIXED
     if integ in FIXED:
         return FIXED[integ] + "\ndt = 1.0e-5"
-    if integ == "msbdf":
+    if integ in ("msbdf", "cvode"):
         # msbdf (variable-order BDF, at most fifth order) at rtol 1e-10 confirmed only 5.98
         # digits of the linear and Kelvin contacts' e and peaks; at 1e-12 it reaches the
         # references' own digits (7.0)
