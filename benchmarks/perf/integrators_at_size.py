@@ -5,8 +5,8 @@ cost of a contact event at size (docs/sundials-ode.md "Events at size").
 Scenes (one process per run, so that its CPU time is its own):
   closing  a row of n oscillators (m = 1e5 kg, k alternating 2e7 / 5e7 N/m, 5 % damping by
            dashpots to ground), linear penalty contacts (1e9 N/m) across 5 mm gaps, every
-           other oscillator started at 0.3 m/s towards its right neighbour: every contact
-           closes and opens within the window. ida, cvode, arkode at rtol 1e-8; the general
+           other oscillator started towards its right neighbour: every contact
+           closes within the window, each at its own time (speeds 0.2 … 0.4 m/s). ida, cvode, arkode at rtol 1e-8; the general
            Newmark path (fused_chain = false) and the fused chain step at dt = 1e-4 s.
   closed   the same row with every contact pre-compressed by 1 mm under a 3 m/s² ground pulse:
            every contact stays closed (moreau-jean, fast-nonlinear, and the others for
@@ -43,7 +43,8 @@ def scene(n, integrator, kind, t_end, max_wall):
     loads = {}
     if kind == "closing":
         chain["gap"] = 5.0e-3
-        chain["v0"] = [0.3 if i % 2 == 0 else 0.0 for i in range(n)]
+        # speeds 0.2 … 0.4 m/s spread over the row: the contacts close at n/2 different times
+        chain["v0"] = [0.3 + 0.1 * math.sin(1.7 * i) if i % 2 == 0 else 0.0 for i in range(n)]
     else:
         chain["gap"] = -1.0e-3
         loads = {"ground_acceleration": {"type": "sine", "amplitude": 3.0, "omega": 12.566370614359172}}
@@ -66,12 +67,12 @@ def scene(n, integrator, kind, t_end, max_wall):
 
 
 def one(n, integrator, kind, t_end, max_wall):
-    from martello.run import run
+    from martello.run import run_full
     from martello.scene.loader import from_dict
     s = from_dict(scene(n, integrator, kind, t_end, max_wall))
     r0 = resource.getrusage(resource.RUSAGE_SELF)
     t0 = time.perf_counter()
-    r = run(s)
+    r = run_full(s, raise_on_failure=False)[0]   # max_wall stops a slow one: its rate stands
     wall = time.perf_counter() - t0
     r1 = resource.getrusage(resource.RUSAGE_SELF)
     cpu = (r1.ru_utime - r0.ru_utime) + (r1.ru_stime - r0.ru_stime)
