@@ -363,6 +363,8 @@ def _dynamic(scene, model, raise_on_failure=True):
         r.set_tracking(*tracked)
         t0 = time.perf_counter()
         st = r.execute(model) if raise_on_failure else r.status_of(model)
+        if st == native.constant("MARTELLO_ERR_INTERRUPTED"):
+            r.check(st, "dynamic run")   # stopped by its user: raised, never an outcome
         wall = time.perf_counter() - t0
         hist = r.history()
         ev_contacts, ev = r.events()
