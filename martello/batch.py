@@ -8,6 +8,7 @@ import os
 import signal
 import time
 from collections import deque
+from contextlib import contextmanager
 from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
 from concurrent.futures.process import BrokenProcessPool
 from pathlib import Path
@@ -60,8 +61,25 @@ def _worker_start(parent):
     die_with_parent(parent)
     signal.signal(signal.SIGINT, signal.SIG_IGN)
     # a forked worker has its parent's handlers: SIGTERM (how a pool ends a worker, and what
-    # a group's SIGTERM brings) ends it as it ends any process
+    # a group's SIGTERM brings) ends it as it ends any process. Both signals were blocked
+    # while it was forked (_held): one sent before this line waits, and takes effect now.
     signal.signal(signal.SIGTERM, signal.SIG_DFL)
+    signal.pthread_sigmask(signal.SIG_UNBLOCK, _HELD)
+
+
+_HELD = {signal.SIGINT, signal.SIGTERM}
+
+
+@contextmanager
+def _held():
+    """SIGINT and SIGTERM held (blocked, not lost) in this thread within the block: a worker
+    forked there starts with them blocked, so that neither reaches it before _worker_start
+    has replaced the handlers it inherited (a study's, which would keep it alive)."""
+    old = signal.pthread_sigmask(signal.SIG_BLOCK, _HELD)
+    try:
+        yield
+    finally:
+        signal.pthread_sigmask(signal.SIG_SETMASK, old)
 
 
 def _pool(workers):
@@ -175,22 +193,23 @@ def run_specs(specs, jobs=0, progress=None, *, fn=None, retries=RETRIES, executo
     complete = False
     try:
         while (waiting or alone or running) and not stopped():
-            while alone and len(running) < jobs:
-                s = alone.popleft()
-                pool = _pool(1)
-                running[pool.submit(fn, s)] = (s, pool, True)
-                workers[pool] = _processes(pool)
-            while waiting and len(running) < jobs:
-                shared = shared or _pool(jobs)
-                s = waiting.popleft()
-                try:
-                    running[shared.submit(fn, s)] = (s, shared, False)
-                    known = workers.setdefault(shared, [])
-                    known += [p for p in _processes(shared) if p not in known]
-                except BrokenProcessPool:     # broke since its last result: a fresh one
-                    waiting.appendleft(s)
-                    shared.shutdown(wait=False, cancel_futures=True)
-                    shared = None
+            with _held():                     # submit() forks the workers
+                while alone and len(running) < jobs:
+                    s = alone.popleft()
+                    pool = _pool(1)
+                    running[pool.submit(fn, s)] = (s, pool, True)
+                    workers[pool] = _processes(pool)
+                while waiting and len(running) < jobs:
+                    shared = shared or _pool(jobs)
+                    s = waiting.popleft()
+                    try:
+                        running[shared.submit(fn, s)] = (s, shared, False)
+                        known = workers.setdefault(shared, [])
+                        known += [p for p in _processes(shared) if p not in known]
+                    except BrokenProcessPool:     # broke since its last result: a fresh one
+                        waiting.appendleft(s)
+                        shared.shutdown(wait=False, cancel_futures=True)
+                        shared = None
             finished, _ = wait(running, timeout=POLL_S, return_when=FIRST_COMPLETED)
             for f in finished:
                 s, pool, isolated = running.pop(f)
