@@ -71,7 +71,8 @@ NOT_IN_CATALOGUE = {"p7_two_oscillators_kelvin", "p7_row_3"}
 # while the same chain with event_split at 2e-5 is verified against p7_chain_10
 SERVES = {"p7_chain_10": ["benchmarks/p7/p7_chain_10_split.toml"],
           "p7_two_kelvin": [f"benchmarks/p7/laws/p7_two_kelvin_{i}.toml" for i in
-                            ("rkf45", "rk8pd", "msbdf", "ida", "newmark", "hht", "generalized_alpha")]}
+                            ("rkf45", "rk8pd", "msbdf", "ida", "cvode", "arkode", "newmark", "hht",
+                             "generalized_alpha")]}
 # the rtol of the primary integration (the second is at 100 × rtol); P8's records restart
 # the integration every 10 ms, where 1e-10 already gives ≥ 6 trusted digits (P8 B: at
 # 1e-10 its second integration, at 1e-8, puts the slow 8th phase's separation 1.9e-6 s off
