@@ -551,6 +551,9 @@ def _check_table(src, check):
         check_fields(src, item, f"check.compare[{i}]", {
             "result": ("str", True, None, None), "oracle": ("str", True, None, None),
             "rtol": ("float", False, NONNEG, None), "atol": ("float", False, NONNEG, None),
+            # the size of the quantity when its reference is 0: what an atol is relative to
+            # (martello.checks.kinds)
+            "scale": ("float", False, POSITIVE, None),
             "why": ("str", True, None, None)})
         if "rtol" not in item and "atol" not in item:
             raise SceneError(src, f"check.compare[{i}]", "needs rtol or atol",
