@@ -6,18 +6,20 @@
 !> falling back to dgbsv if a pivot collapses. Workspaces are allocated once, in band_init.
 module martello_band_matrix
    use martello_kinds, only: dp
-   use martello_lapack, only: dgbsv
+   use martello_lapack, only: dgbsv, dgbtrf, dgbtrs
    use martello_status, only: MARTELLO_OK, out_of_memory, REAL_BYTES, INT_BYTES, FIX_SMALLER_SCENE
    implicit none
    private
    public :: band_t, band_init, band_zero, band_add, band_add_pair, band_pin, band_solve, &
-      band_matvec, band_get
+      band_matvec, band_get, band_factor, band_solve_factored
 
    type :: band_t
       integer :: n = 0, kd = 0
       real(dp), allocatable :: ab(:, :)
       real(dp), allocatable :: dl(:), d(:), du(:), rhs_copy(:)
       integer, allocatable :: ipiv(:)
+      !> band_factor's method: 1 the Thomas pivots in d (multipliers in dl), 2 dgbtrf in ab
+      integer :: factored = 0
    end type band_t
 
 
@@ -159,4 +161,57 @@ contains
          ok = info == 0
       end subroutine general
    end subroutine band_solve
+
+   !> Factorise A in place, for any number of band_solve_factored calls (a Newton matrix kept
+   !> while the tangents do not change): kd = 1 by the Thomas elimination (pivots in d,
+   !> multipliers in dl; ab intact), falling back to dgbtrf where a pivot collapses, as
+   !> band_solve; kd ≠ 1 by dgbtrf (ab becomes its LU). ok = .false. if singular.
+   subroutine band_factor(b, ok)
+      type(band_t), intent(inout) :: b
+      logical, intent(out) :: ok
+      integer :: i, n, r, info
+      n = b%n; r = 2*b%kd + 1
+      ok = .true.
+      if (b%kd == 1) then
+         b%d = b%ab(r, :)
+         do i = 2, n
+            if (abs(b%d(i - 1)) <= 1.0e-14_dp*abs(b%ab(r - 1, i))) exit
+            b%dl(i) = b%ab(r + 1, i - 1)/b%d(i - 1)
+            b%d(i) = b%d(i) - b%dl(i)*b%ab(r - 1, i)
+         end do
+         if (i > n .and. b%d(n) /= 0.0_dp) then
+            b%factored = 1
+            return
+         end if
+      end if
+      if (b%kd == 0) then
+         ok = all(b%ab(r, :) /= 0.0_dp)
+         b%factored = 2
+         return
+      end if
+      call dgbtrf(n, n, b%kd, b%kd, b%ab, size(b%ab, 1), b%ipiv, info)
+      ok = info == 0
+      b%factored = 2
+   end subroutine band_factor
+
+   !> Solve A x = rhs in place with band_factor's factors (A not changed).
+   subroutine band_solve_factored(b, rhs)
+      type(band_t), intent(inout) :: b
+      real(dp), intent(inout) :: rhs(:)
+      integer :: i, n, r, info
+      n = b%n; r = 2*b%kd + 1
+      if (b%kd == 0) then
+         rhs = rhs/b%ab(r, :)
+      else if (b%factored == 1) then
+         do i = 2, n
+            rhs(i) = rhs(i) - b%dl(i)*rhs(i - 1)
+         end do
+         rhs(n) = rhs(n)/b%d(n)
+         do i = n - 1, 1, -1
+            rhs(i) = (rhs(i) - b%ab(r - 1, i + 1)*rhs(i + 1))/b%d(i)
+         end do
+      else
+         call dgbtrs('N', n, b%kd, b%kd, 1, b%ab, size(b%ab, 1), b%ipiv, rhs, n, info)
+      end if
+   end subroutine band_solve_factored
 end module martello_band_matrix

@@ -35,8 +35,18 @@ module martello_generalized_alpha
       real(dp), allocatable :: fint(:), fint_n(:), fext(:), fext_n(:), res(:), du(:), work(:), &
                                ma(:), man(:)
       type(band_t) :: jac, mband, cjac
-      !> J of the last converged iterate is intact (kd ≤ 1): the next step starts from it
+      !> J of the last converged iterate is assembled (and factored, or due): the next step
+      !> starts from it
       logical :: tangent_valid = .false.
+      !> The kept Newton matrix (docs/integrators.md, kept factors): J is assembled from the
+      !> element tangents tan_link, tan_con (∂f/∂du, ∂f/∂du̇ of each element) at one iterate;
+      !> an iterate whose tangents are the same numbers has the same J, so its factors serve
+      !> again (a branch change of a piecewise-linear law, or any move of a nonlinear law's
+      !> tangent, assembles and factors anew). jac_assembled: J holds an assembly of the current
+      !> step length; jac_factored: its factors are in jac (made at the first solve after it).
+      logical :: jac_assembled = .false., jac_factored = .false.
+      real(dp), allocatable :: tan_link(:, :), tan_con(:, :), tan_link_trial(:, :), &
+                               tan_con_trial(:, :), jdiag(:)
       !> event_split: a step is split at the located onset/separation of a Kelvin contact
       !> (docs/integrators.md, event-split steps); the step's start state is kept in us, vs, as
       logical :: event_split = .false.
@@ -83,6 +93,13 @@ contains
       if (stat == MARTELLO_OK) call band_init(self%jac, n, self%kd, stat, msg)
       if (stat == MARTELLO_OK) call band_init(self%mband, n, self%kd, stat, msg)
       if (stat == MARTELLO_OK) call band_init(self%cjac, n, self%kd, stat, msg)
+      if (stat == MARTELLO_OK) then
+         allocate (self%tan_link(2, m%nlink), self%tan_con(2, m%ncontact), self%jdiag(n), &
+                   self%tan_link_trial(2, m%nlink), self%tan_con_trial(2, m%ncontact), stat=stat)
+         if (stat /= 0) call out_of_memory('the element tangents of '//integrator_name(s%kind), &
+                                           REAL_BYTES*(4*(m%nlink + m%ncontact) + n + 0.0_dp), &
+                                           FIX_SMALLER_SCENE, stat, msg)
+      end if
       if (stat /= MARTELLO_OK) then
          call observer_fail(o, MARTELLO_ERR_MEMORY, 0.0_dp, msg, stat)
          return
@@ -469,6 +486,7 @@ contains
          self%cm = (1.0_dp - self%am)/(self%beta*hh*hh)
          self%cv = self%gamma/(self%beta*hh)
          self%tangent_valid = .false.
+         self%jac_assembled = .false.; self%jac_factored = .false.
       end subroutine set_step
 
       !> Commit a (sub-)step: its trapezoidal works to the observer
@@ -507,7 +525,7 @@ contains
                self%u(1:n) = self%un(1:n) + h*self%vn(1:n) + 0.5_dp*h*h*self%an(1:n)
                call newton_iterations(converged, flips, was_on, 0)
             end if
-            self%tangent_valid = converged .and. self%kd <= 1
+            self%tangent_valid = converged
             if (converged .or. stat /= MARTELLO_OK) return
             if (.not. any(flips >= 3)) exit
             self%ms%forced_off = self%ms%forced_off .or. flips >= 3
@@ -523,7 +541,7 @@ contains
 
       !> u = u_n + Δu with J Δu = −r(u_n), where r(u_n) uses the committed internal force and
       !> the damping tangent C of the last evaluation for the velocity change (exact for
-      !> linear dampers). J is intact: the kd ≤ 1 solve works on copies.
+      !> linear dampers), solved with J's kept factors.
       subroutine linearised_first_iterate(ok)
          logical, intent(out) :: ok
          associate (u => self%u, v => self%v, a => self%a, un => self%un, vn => self%vn, &
@@ -540,8 +558,7 @@ contains
                   - (1.0_dp - af)*fext - af*fext_n
             res(self%fixed_nodes) = 0.0_dp
             du = -res(1:n)
-            call band_solve(self%jac, du, ok)
-            o%counters(C_FACTORIZATIONS) = o%counters(C_FACTORIZATIONS) + 1_i8
+            call solve_kept(du, ok)
             o%counters(C_NEWTON) = o%counters(C_NEWTON) + 1_i8
             u(1:n) = un(1:n) + du
          end associate
@@ -559,14 +576,23 @@ contains
                     cjac => self%cjac, am => self%am, af => self%af, kd => self%kd)
             call newmark_kinematics(self, self%beta, self%gamma)
             if (want_jac) then
-               jac%ab = 0.0_dp; cjac%ab = 0.0_dp
-               call internal_forces(m, self%ms, u, v, fint, jac%ab, 1.0_dp - af, (1.0_dp - af)*self%cv, &
-                                    cjac%ab)
-               call assemble_mass(m, self%cm, jac)
-               o%counters(C_JACOBIANS) = o%counters(C_JACOBIANS) + 1_i8
-               do i = 1, size(self%fixed_nodes)
-                  call band_pin(jac, self%fixed_nodes(i))
-               end do
+               call internal_forces(m, self%ms, u, v, fint, link_tan=self%tan_link_trial, &
+                                    con_tan=self%tan_con_trial)
+               if (.not. (self%jac_assembled .and. all(self%tan_link_trial == self%tan_link) .and. &
+                          all(self%tan_con_trial == self%tan_con))) then
+                  ! a tangent moved: J anew on this iterate's tangents, factored when solved
+                  jac%ab = 0.0_dp; cjac%ab = 0.0_dp
+                  call internal_forces(m, self%ms, u, v, fint, jac%ab, 1.0_dp - af, &
+                                       (1.0_dp - af)*self%cv, cjac%ab)
+                  call assemble_mass(m, self%cm, jac)
+                  o%counters(C_JACOBIANS) = o%counters(C_JACOBIANS) + 1_i8
+                  do i = 1, size(self%fixed_nodes)
+                     call band_pin(jac, self%fixed_nodes(i))
+                  end do
+                  self%jdiag = jac%ab(2*kd + 1, :)
+                  self%tan_link = self%tan_link_trial; self%tan_con = self%tan_con_trial
+                  self%jac_assembled = .true.; self%jac_factored = .false.
+               end if
             else
                call internal_forces(m, self%ms, u, v, fint)
             end if
@@ -588,11 +614,29 @@ contains
             incr = 0.0_dp
             if (want_jac) then
                do i = 1, n
-                  if (res(i) /= 0.0_dp) incr = max(incr, abs(res(i))/abs(jac%ab(2*kd + 1, i)))
+                  if (res(i) /= 0.0_dp) incr = max(incr, abs(res(i))/abs(self%jdiag(i)))
                end do
             end if
          end associate
       end subroutine evaluate
+
+      !> J x = rhs in place with J's kept factors, factoring J first if it was assembled since
+      !> (counted in factorizations); ok = .false. if J is singular.
+      subroutine solve_kept(x, ok)
+         real(dp), intent(inout) :: x(:)
+         logical, intent(out) :: ok
+         if (.not. self%jac_factored) then
+            call band_factor(self%jac, ok)
+            o%counters(C_FACTORIZATIONS) = o%counters(C_FACTORIZATIONS) + 1_i8
+            if (.not. ok) then
+               self%jac_assembled = .false.
+               return
+            end if
+            self%jac_factored = .true.
+         end if
+         ok = .true.
+         call band_solve_factored(self%jac, x)
+      end subroutine solve_kept
 
       subroutine newton_iterations(converged, flips, was_on, first)
          logical, intent(out) :: converged
@@ -609,7 +653,8 @@ contains
                uscale = max(uscale, abs(un(i)), h*abs(vn(i)), h*h*abs(an(i)))
             end do
             do it = first, self%max_newton
-               ! J is assembled at every iterate: the converged one serves the next step
+               ! J at every iterate's tangents (kept while they do not move): the converged one
+               ! serves the next step
                call evaluate(.true.)
                do i = 1, m%ncontact
                   on = self%ms%con_pen_trial(i) > 0.0_dp .and. .not. self%ms%forced_off(i)
@@ -629,8 +674,7 @@ contains
                end if
                if (it == self%max_newton) exit
                du = -res(1:n)
-               call band_solve(self%jac, du, ok)
-               o%counters(C_FACTORIZATIONS) = o%counters(C_FACTORIZATIONS) + 1_i8
+               call solve_kept(du, ok)
                o%counters(C_NEWTON) = o%counters(C_NEWTON) + 1_i8
                if (.not. ok) then
                   call stepper_fail(o, MARTELLO_ERR_SINGULAR, t, 'singular effective stiffness in the Newton step', stat)

@@ -140,6 +140,11 @@ def cmd_check(args):
     return 0 if ok else 1
 
 
+def cmd_export(args):
+    from . import export
+    return export.main(args)
+
+
 def _print_version(args):
     print(f"martello {native.version()} ({native.library_versions()})")
     return 0
@@ -305,6 +310,31 @@ def main(argv=None):
     p.add_argument("--refresh", action="store_true", help="recompute even if the cache has it")
     p.add_argument("-j", "--jobs", type=int, default=0, help="parallel runs (default: all cores)")
     p.set_defaults(func=cmd_reference)
+
+    p = sub.add_parser("export", help="write a scene as a model for another code (OpenSees)",
+                       description="Write a standalone OpenSeesPy script DIR/model.py (and with --tcl "
+                       "DIR/model.tcl) that rebuilds the scene in OpenSees and, run inside DIR, writes "
+                       "DIR/history.csv in the format martello compare reads. What OpenSees cannot "
+                       "express is refused naming what and why; each mapping and its differences are "
+                       "in the script's header and docs/opensees.md.")
+    p.add_argument("scene", help="scene file (TOML), or a path in the catalogue")
+    p.add_argument("--to", default="opensees", help="the other code (default and only: opensees)")
+    p.add_argument("-o", "--output", required=True, help="folder for model.py (replaced whole)")
+    p.add_argument("--tcl", action="store_true", help="also write model.tcl for OpenSees' Tcl interpreter")
+    p.add_argument("--integrator", help="override the scene's integrator (newmark, hht, "
+                   "generalized-alpha, central-difference)")
+    p.add_argument("--dt", type=float, help="override the step [s]")
+    p.add_argument("--t-end", type=float, help="override the end time [s]")
+    p.add_argument("--beta", type=float, help="Newmark beta (with --integrator newmark)")
+    p.add_argument("--gamma", type=float, help="Newmark gamma (with --integrator newmark)")
+    p.add_argument("--alpha", type=float, help="HHT alpha in [-1/3, 0] (with --integrator hht)")
+    p.add_argument("--rho-inf", type=float, help="generalized-alpha rho_inf in [0, 1]")
+    p.add_argument("--material", action="append", metavar="LAW=MATERIAL",
+                   help="map a law onto another OpenSees material (docs/opensees.md), e.g. "
+                   "kelvin=JankowskiImpact; a change of law is stated on stderr")
+    p.add_argument("--tol", type=float, help="NormDispIncr tolerance in m (default: the scene's "
+                   "tol_increment x 0.1 m)")
+    p.set_defaults(func=cmd_export)
 
     p = sub.add_parser("version", help="versions of martello and the libraries it links")
     p.set_defaults(func=_print_version)

@@ -53,6 +53,11 @@ class ResultError(MartelloError):
     that cannot take them. Nothing is written."""
 
 
+class ExportError(MartelloError):
+    """A scene cannot be written for another code (martello export): the message names what
+    the other code cannot express and why. Nothing is written."""
+
+
 class SolverError(MartelloError):
     """The native library returned a failure status."""
 

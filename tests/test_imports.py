@@ -107,7 +107,7 @@ LAYERS = [("martello.errors", "martello.paths", "martello.history", "martello.in
           ("martello.run",), ("martello.batch",),
           ("martello.metrics",), ("martello.reference",),
           ("martello.checks",),
-          ("martello.study", "martello.compare", "martello.report"),
+          ("martello.study", "martello.compare", "martello.report", "martello.export"),
           ("martello.plot",), ("martello.api",), ("martello.cli",), ("martello.__main__", "martello")]
 
 

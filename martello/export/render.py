@@ -1,0 +1,164 @@
+"""An OpenSeesModel (martello.export.opensees) written out as a standalone OpenSeesPy script or
+a Tcl script: the same commands in both languages, then a loop of single steps that samples
+the history every `output.every` steps and writes history.csv only when the run finished
+(docs/opensees.md "The exported script")."""
+
+import math
+
+from .opensees import Column, _File
+
+HISTORY = "history.csv"
+
+
+def _py(x):
+    if isinstance(x, _File):
+        return f"os.path.join(HERE, {str(x)!r})"
+    if isinstance(x, str):
+        return repr(x)
+    if isinstance(x, bool):
+        return "1" if x else "0"
+    if isinstance(x, int):
+        return str(x)
+    x = float(x)
+    if not math.isfinite(x):               # pragma: no cover - the exporter writes finite numbers
+        raise ValueError(f"not a finite number: {x}")
+    return repr(x)
+
+
+def _tcl(x):
+    if isinstance(x, str):
+        return x
+    return _py(x)
+
+
+def _header(model, version, scene_path):
+    lines = [f"{model.title}: exported by martello {version} from {model.source}",
+             "(docs/opensees.md in martello). It writes history.csv in the format that",
+             f"`martello compare history.csv --against {scene_path}` scores.",
+             "",
+             "martello -> OpenSees:"]
+    lines += [f"  {a} -> {b}" for a, b in model.mapping]
+    lines += ["", "Differences from martello's model:"]
+    lines += [f"  - {d}" for d in model.differences] or \
+        ["  none: every item maps onto an OpenSees object with the same law"]
+    return lines
+
+
+def _sample_py(col):
+    k, a = col.kind, col.args
+    if k == "t":
+        return "t"
+    if k in ("u", "v", "a"):
+        fn = {"u": "nodeDisp", "v": "nodeVel", "a": "nodeAccel"}[k]
+        return f"ops.{fn}({a[0]}, 1)"
+    if k == "penetration":
+        ua = f"ops.nodeDisp({a[0]}, 1)" if a[0] else "0.0"
+        ub = f"ops.nodeDisp({a[1]}, 1)" if a[1] else "0.0"
+        return f"{ua} - {ub} - {_py(a[2])}"
+    if k == "force":
+        return f"-ops.eleResponse({a[0]}, 'basicForce')[0]"
+    raise ValueError(k)                    # pragma: no cover
+
+
+def _sample_tcl(col):
+    k, a = col.kind, col.args
+    if k == "t":
+        return "$t"
+    if k in ("u", "v", "a"):
+        fn = {"u": "nodeDisp", "v": "nodeVel", "a": "nodeAccel"}[k]
+        return f"[{fn} {a[0]} 1]"
+    if k == "penetration":
+        ua = f"[nodeDisp {a[0]} 1]" if a[0] else "0.0"
+        ub = f"[nodeDisp {a[1]} 1]" if a[1] else "0.0"
+        return f"[expr {{{ua} - {ub} - {_tcl(a[2])}}}]"
+    if k == "force":
+        return f"[expr {{-[lindex [eleResponse {a[0]} basicForce] 0]}}]"
+    raise ValueError(k)                    # pragma: no cover
+
+
+def python_script(model, version, scene_path):
+    out = ['#!/usr/bin/env python3'] + ["# " + line if line else "#"
+                                        for line in _header(model, version, scene_path)]
+    out += ["# Run inside this folder, with OpenSeesPy installed: python model.py", "",
+            '"""A martello scene rebuilt in OpenSeesPy (the comments above say which)."""', "",
+           "import math", "import os", "import sys", "",
+           "import openseespy.opensees as ops", "",
+           "HERE = os.path.dirname(os.path.abspath(__file__))",
+           f"DT = {_py(model.dt)}",
+           f"STEPS = {model.steps}",
+           f"EVERY = {model.every}",
+           f"COLUMNS = {[c.name for c in model.columns]!r}", "", "",
+           "def build():",
+           '    """The scene as an OpenSees domain and a transient analysis."""']
+    for name, args in model.commands:
+        if name != "endPattern":              # Tcl's closing brace of a Plain pattern
+            out.append(f"    ops.{name}({', '.join(_py(a) for a in args)})")
+    out += ["", "",
+            "def sample(t):",
+            "    return [" + ", ".join(_sample_py(c) for c in model.columns) + "]",
+            "", "",
+            "def main():",
+            "    build()",
+            "    rows = [sample(0.0)]",
+            "    for k in range(1, STEPS + 1):",
+            "        if ops.analyze(1, DT) != 0:",
+            "            sys.exit(f'model.py: OpenSees failed at step {k} of {STEPS} '",
+            "                     f'(t = {k * DT:.6g} s): no history written')",
+            "        if k % EVERY == 0 or k == STEPS:",
+            "            rows.append(sample(k * DT))",
+            "    for row in rows:",
+            "        bad = [COLUMNS[j] for j, x in enumerate(row) if not math.isfinite(x)]",
+            "        if bad:",
+            "            sys.exit(f'model.py: {bad[0]} is not finite at t = {row[0]:.6g} s '",
+            "                     '(the run diverged): no history written')",
+            f"    path = os.path.join(HERE, {HISTORY!r})",
+            "    with open(path + '.part', 'w') as f:",
+            "        f.write(','.join(COLUMNS) + '\\n')",
+            "        for row in rows:",
+            "            f.write(','.join(f'{x:.17g}' for x in row) + '\\n')",
+            "    os.replace(path + '.part', path)",
+            "    ops.wipe()",
+            "    print(f'model.py: {STEPS} steps of {DT:g} s, {len(rows)} rows -> {path}')",
+            "", "",
+            "if __name__ == '__main__':",
+            "    main()", ""]
+    return "\n".join(out)
+
+
+def tcl_script(model, version, scene_path):
+    out = ["# " + line if line else "#" for line in _header(model, version, scene_path)]
+    out += ["# Run inside this folder: OpenSees model.tcl", ""]
+    for name, args in model.commands:
+        if name == "endPattern":
+            out.append("}")
+        elif name == "pattern" and args[0] == "Plain":
+            out.append(" ".join([name] + [_tcl(a) for a in args]) + " {")
+        else:
+            out.append(("    " if out[-1].endswith("{") or out[-1].startswith("    load") else "")
+                       + " ".join([name] + [_tcl(a) for a in args]))
+    fmt = ",".join(["%.17g"] * len(model.columns))
+    out += ["",
+            f"set dt {_tcl(model.dt)}",
+            f"set steps {model.steps}",
+            f"set every {model.every}",
+            "proc sample {t} {",
+            f"    return [format \"{fmt}\" " + " ".join(_sample_tcl(c) for c in model.columns) + "]",
+            "}",
+            "set rows [list [sample 0.0]]",
+            "for {set k 1} {$k <= $steps} {incr k} {",
+            "    if {[analyze 1 $dt] != 0} {",
+            "        puts stderr \"model.tcl: OpenSees failed at step $k of $steps: no history written\"",
+            "        exit 1",
+            "    }",
+            "    if {$k % $every == 0 || $k == $steps} { lappend rows [sample [expr {$k * $dt}]] }",
+            "}",
+            f"set f [open {HISTORY}.part w]",
+            f"puts $f \"{','.join(c.name for c in model.columns)}\"",
+            "foreach r $rows { puts $f $r }",
+            "close $f",
+            f"file rename -force {HISTORY}.part {HISTORY}",
+            "wipe", ""]
+    return "\n".join(out)
+
+
+__all__ = ["python_script", "tcl_script", "HISTORY", "Column"]

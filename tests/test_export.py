@@ -1,0 +1,285 @@
+"""martello export --to opensees without OpenSees (docs/opensees.md): the generated OpenSeesPy
+script executed against a recording fake of the openseespy API that checks every call
+(tests/opensees_fake.py), the Tcl script executed by tclsh against Tcl stand-ins of the same
+commands, the materials' parameters against the published formulas written again here, the
+refusals, and the half-Kelvin law against an independent integration. The real OpenSees runs
+are tests/test_export_opensees.py and benchmarks/opensees/."""
+
+import csv
+import math
+import runpy
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+from scipy.integrate import solve_ivp
+
+from martello.errors import ExportError
+from martello.export import export, half_kelvin_e, opensees_model
+from martello.scene.loader import from_dict, load
+from tests.opensees_fake import FakeOpenSees
+
+P7 = "benchmarks/p7/p7_two_oscillators.toml"
+
+
+def two_bodies(law="kelvin", integrator="newmark", **contact):
+    """Two free masses approaching (P5's two bodies): m1 = 1 kg at 1 m/s, m2 = 2 kg."""
+    c = {"name": "c", "a": "m1", "b": "m2", "gap": 0.001, "scheme": "penalty", "law": law,
+         "stiffness": 1e6 if law in ("linear", "kelvin") else 1e8}
+    c.update(contact)
+    an = {"type": "dynamic", "integrator": integrator, "dt": 1e-5, "t_end": 4e-3}
+    if integrator == "hht":
+        an["alpha"] = -0.1
+    if integrator == "generalized-alpha":
+        an["rho_inf"] = 0.8
+    return {"title": "two bodies", "node": [{"name": "m1", "mass": 1.0, "v0": 1.0},
+                                            {"name": "m2", "mass": 2.0}],
+            "contact": [c], "analysis": an}
+
+
+def run_fake(folder):
+    """Execute folder/model.py against the fake; returns the fake and history.csv's rows."""
+    fake = FakeOpenSees()
+    mods = {"openseespy": type(sys)("openseespy"), "openseespy.opensees": fake.module()}
+    mods["openseespy"].opensees = mods["openseespy.opensees"]
+    saved = {k: sys.modules.get(k) for k in mods}
+    sys.modules.update(mods)
+    try:
+        runpy.run_path(str(folder / "model.py"), run_name="__main__")
+    finally:
+        for k, v in saved.items():
+            if v is None:
+                sys.modules.pop(k, None)
+            else:
+                sys.modules[k] = v
+    rows = list(csv.reader(open(folder / "history.csv")))
+    return fake, rows
+
+
+def calls(fake, name, kind=None):
+    return [a for n, a in fake.calls if n == name and (kind is None or a[0] == kind)]
+
+
+def test_p7_kelvin_script_builds_the_scene_and_samples_every_output_step(tmp_path):
+    scene = load(P7)
+    export(scene, tmp_path / "x")
+    fake, rows = run_fake(tmp_path / "x")
+    # the nodes: two masses of 1 kg and a fixed ground
+    assert sorted(v[0] for v in fake.masses.values()) == [1.0, 1.0]
+    assert list(fake.fixed.values()) == [(1,)]
+    # springs k = 100 and 400, dashpots c = 2 zeta sqrt(k m) with zeta = 5 %
+    el = sorted(a[2] for a in calls(fake, "uniaxialMaterial", "Elastic"))
+    assert el == [100.0, 400.0]
+    vis = sorted(a[2] for a in calls(fake, "uniaxialMaterial", "Viscous"))
+    assert vis == pytest.approx([2 * 0.05 * math.sqrt(100.0), 2 * 0.05 * math.sqrt(400.0)], rel=1e-15)
+    # the Kelvin contact: ViscoelasticGap, c = 2 xi sqrt(k m*) with xi from e = 0.65
+    (kind, tag, K, C, gap), = calls(fake, "uniaxialMaterial", "ViscoelasticGap")
+    xi = -math.log(0.65) / math.sqrt(math.pi ** 2 + math.log(0.65) ** 2)
+    assert (K, gap) == (1e5, -0.01)
+    assert C == pytest.approx(2 * xi * math.sqrt(1e5 * 0.5), rel=1e-14)
+    # its element runs from a (s1) to b (s2): deformation u_b − u_a < −gap is contact
+    el = [e for e in fake.elements.values() if e[3][1] == tag][0]
+    s1, s2 = [t for t, m in fake.masses.items()]
+    assert (el[1], el[2]) == (s1, s2)
+    # the springs: from ground (i) to the node (j), deformation u_node
+    ground = next(iter(fake.fixed))
+    assert all(e[1] == ground for e in fake.elements.values() if e[3][1] != tag)
+    # ground motion 3 sin(8 t): Trig of period 2 pi/8, factor 3, UniformExcitation along 1
+    (_, _, t0, t1, period, *opts), = calls(fake, "timeSeries", "Trig")
+    assert (t0, period, opts) == (0.0, pytest.approx(2 * math.pi / 8), ["-factor", 3.0, "-shift", 0.0])
+    assert calls(fake, "integrator") == [("Newmark", 0.5, 0.25)]       # OpenSees: gamma, beta
+    # history: t = k dt at every 10th of 40000 steps, and t = 0
+    head, data = rows[0], np.array(rows[1:], float)
+    assert head == ["t", "u:s1", "v:s1", "a:s1", "u:s2", "v:s2", "a:s2", "penetration:s1-s2",
+                    "force:s1-s2"]
+    assert len(data) == 4001 and fake.steps == 40000
+    assert np.array_equal(data[:, 0], np.arange(4001) * 10 * 1e-4)
+    t = data[:, 0]
+    # the fake's u = tag·1e-3·sin(t) sampled after the step (t = 0: before the first)
+    assert np.allclose(data[:, 1], s1 * 1e-3 * np.sin(t), rtol=0, atol=1e-18)
+    assert np.allclose(data[:, 7], (s1 - s2) * 1e-3 * np.sin(t) - 0.01, rtol=0, atol=1e-17)
+    assert np.allclose(data[:, 8], tag + t, rtol=0, atol=1e-12)          # P = −basicForce
+
+
+def test_tcl_script_issues_the_same_commands(tmp_path):
+    """model.tcl, run by tclsh with every OpenSees command a Tcl procedure that logs its
+    arguments, issues the same commands with the same numbers as model.py."""
+    scene = from_dict(two_bodies("hunt-crossley", restitution=0.5, exponent=1.5), source="tb")
+    export(scene, tmp_path / "x", tcl=True)
+    fake, _ = run_fake(tmp_path / "x")
+    names = sorted({n for n, _ in fake.calls})
+    stubs = "".join(f"proc {n} args {{ puts [concat CALL {n} $args] }}\n" for n in names)
+    stubs += ("proc analyze args { return 0 }\nproc nodeDisp args { return 0.0 }\n"
+              "proc nodeVel args { return 0.0 }\nproc nodeAccel args { return 0.0 }\n"
+              "proc eleResponse args { return {0.0} }\n")
+    (tmp_path / "run.tcl").write_text(stubs + "source model.tcl\n")
+    r = subprocess.run(["tclsh", str(tmp_path / "run.tcl")], cwd=tmp_path / "x", capture_output=True, text=True)
+    assert r.returncode == 0, r.stderr
+    got = [line.split()[1:] for line in r.stdout.splitlines() if line.startswith("CALL")]
+    want = [[n] + list(a) for n, a in fake.calls if n not in ("analyze",)]
+    assert len(got) == len(want)
+    for g, w in zip(got, want):
+        assert g[0] == w[0] and len(g) == len(w), (g, w)
+        for x, y in zip(g[1:], w[1:]):
+            if isinstance(y, str):
+                assert x == y
+            else:
+                assert float(x) == float(y), (g, w)
+    assert (tmp_path / "x" / "history.csv").read_text().startswith("t,u:m1,")
+
+
+@pytest.mark.parametrize("law, e, a", [
+    ("hunt-crossley", 0.5, 1.5 * (1 - 0.5)),                 # Hunt & Crossley (1975)
+    ("lankarani-nikravesh", 0.8, 0.75 * (1 - 0.64)),        # Lankarani & Nikravesh (1990)
+    ("flores", 0.5, 8 * (1 - 0.5) / (5 * 0.5)),             # Flores et al. (2011)
+    ("gonthier", 0.5, (1 - 0.25) / 0.5),                    # Gonthier et al. (2004)
+    ("hertzdamp", 0.8, 0.75 * (1 - 0.64)),                  # Muthukumar & DesRoches (2006)
+])
+def test_hunt_crossley_family_is_hertzdamp_with_xinorm_the_published_factor(tmp_path, law, e, a):
+    """OpenSees' Hertzdamp force is (Kh + ξ_N·Kh/v_in·δ̇)·δ^n: the family's K δ^n (1 + χ δ̇)
+    with χ = a/v_in, so xiNorm = a."""
+    extra = {} if law == "hertzdamp" else {"exponent": 1.3}
+    m = opensees_model(from_dict(two_bodies(law, restitution=e, **extra), source="tb"))
+    (mat,) = [c.args for c in m.commands if c.name == "uniaxialMaterial" and c.args[0] == "Hertzdamp"]
+    assert mat[2] == 1e8 and mat[3] == pytest.approx(a, rel=1e-15) and mat[4] == -0.001
+    assert mat[5] == (1.5 if law == "hertzdamp" else 1.3)
+    assert any("v_in" in d for d in m.differences)
+
+
+def test_hertz_linear_and_jankowski_materials():
+    m = opensees_model(from_dict(two_bodies("hertz", exponent=1.5), source="tb"))
+    assert [c.args for c in m.commands if c.name == "uniaxialMaterial"] == [("Hertzdamp", 1, 1e8, 0.0, -0.001, 1.5)]
+    m = opensees_model(from_dict(two_bodies("linear"), source="tb"))
+    (mat,) = [c.args for c in m.commands if c.name == "uniaxialMaterial"]
+    assert mat[:3] == ("ElasticPPGap", 1, 1e6) and mat[3] < -1e100 and mat[4] == -0.001
+    m = opensees_model(from_dict(two_bodies("jankowski", restitution=0.65), source="tb"))
+    (mat,) = [c.args for c in m.commands if c.name == "uniaxialMaterial"]
+    xi = 4.5 * math.sqrt(5) * (1 - 0.65 ** 2) / (0.65 * (0.65 * (9 * math.pi - 16) + 16))   # Jankowski (2005)
+    assert mat[0] == "JankowskiImpact" and mat[2] == 1e8 and mat[3] == pytest.approx(xi, rel=1e-15)
+    assert mat[4] == pytest.approx(2.0 / 3.0, rel=1e-15) and mat[5:] == (-0.001, 1.5)   # m*, gap, n
+
+
+def test_integrators_map_onto_opensees_conventions():
+    m = opensees_model(from_dict(two_bodies("kelvin", integrator="hht"), source="tb"))
+    (integ,) = [c.args for c in m.commands if c.name == "integrator"]
+    # OpenSees' HHT weighs the new state: alpha_OS = 1 + alpha, gamma = 1/2 − alpha, beta = (1 − alpha)²/4
+    assert integ == ("HHT", pytest.approx(0.9), pytest.approx(0.6), pytest.approx(0.3025))
+    m = opensees_model(from_dict(two_bodies("kelvin", integrator="generalized-alpha"), source="tb"))
+    (integ,) = [c.args for c in m.commands if c.name == "integrator"]
+    rho = 0.8                      # Chung & Hulbert (1993) eq. 25, weights of the new state
+    am, af = 1 - (2 * rho - 1) / (rho + 1), 1 - rho / (rho + 1)
+    assert integ == ("GeneralizedAlpha", pytest.approx(am), pytest.approx(af),
+                     pytest.approx(0.5 + am - af), pytest.approx(0.25 * (1 + am - af) ** 2))
+    assert any("interpolated state" in d for d in m.differences)
+    m = opensees_model(from_dict(two_bodies("kelvin"), source="tb"),
+                       analysis={"integrator": "newmark", "beta": 1 / 6})
+    assert [c.args for c in m.commands if c.name == "integrator"] == [("Newmark", 0.5, 1 / 6)]
+
+
+def test_overrides_replace_an_event_driven_integrator():
+    d = two_bodies("kelvin", integrator="rk8pd")
+    with pytest.raises(ExportError, match="integrator = rk8pd.*no event-driven"):
+        opensees_model(from_dict(d, source="tb"))
+    m = opensees_model(from_dict(d, source="tb"), analysis={"integrator": "newmark", "dt": 2e-5})
+    assert m.dt == 2e-5 and m.steps == 200
+    with pytest.raises(ExportError, match="analysis.alpha: missing for integrator hht"):
+        opensees_model(from_dict(d, source="tb"), analysis={"integrator": "hht"})
+
+
+@pytest.mark.parametrize("change, match", [
+    ({"scheme": "restitution", "restitution": 0.5}, "scheme = restitution.*no Newton restitution"),
+    ({"scheme": "lagrange"}, "scheme = lagrange.*Lagrange multipliers"),
+    ({"clipped": True, "restitution": 0.5}, "clipped = true.*no OpenSees material clips"),
+    ({"gap": -1e-4, "restitution": 0.5}, "initial overlap"),
+])
+def test_what_opensees_cannot_express_is_refused_naming_what_and_why(change, match):
+    c = {"name": "c", "a": "m1", "b": "m2", "gap": 0.001, "scheme": "penalty", "law": "kelvin",
+         "stiffness": 1e6}
+    c.update(change)
+    for k in [k for k in ("stiffness", "law") if change.get("scheme") not in (None, "penalty")]:
+        c.pop(k)
+    d = two_bodies()
+    d["contact"] = [c]
+    if change.get("scheme") in ("restitution", "lagrange"):
+        d["analysis"]["integrator"] = "rk8pd"
+    with pytest.raises(ExportError, match=match):
+        opensees_model(from_dict(d, source="tb"), analysis={"integrator": "newmark"})
+
+
+def test_static_mass_coupling_and_central_difference_refusals():
+    with pytest.raises(ExportError, match="static"):
+        opensees_model(load("benchmarks/p1/p1_static_penalty.toml"))
+    with pytest.raises(ExportError, match="mass_coupling"):
+        opensees_model(load("benchmarks/p4/p4_equal_rods_newmark_consistent_eps0.1.toml"))
+    with pytest.raises(ExportError, match="central-difference with v0 != 0.*drops the initial velocity"):
+        opensees_model(from_dict(two_bodies("linear", integrator="central-difference"), source="tb"))
+    d = two_bodies("kelvin", integrator="central-difference", restitution=0.5)
+    with pytest.raises(ExportError, match="velocity-dependent forces \\(c\\)"):
+        opensees_model(from_dict(d, source="tb"))
+
+
+def test_a_full_kelvin_is_never_mapped_onto_a_half_kelvin_silently(tmp_path):
+    """JankowskiImpact with n = 1 damps only while approaching: asked for, the change of law
+    and both restitutions are stated in the differences, the script and on stderr."""
+    scene = from_dict(two_bodies("kelvin", restitution=0.65), source="tb")
+    m = opensees_model(scene)
+    assert [c.args[0] for c in m.commands if c.name == "uniaxialMaterial"] == ["ViscoelasticGap"]
+    with pytest.raises(ExportError, match="law kelvin as Hertzdamp"):
+        opensees_model(scene, materials={"kelvin": "Hertzdamp"})
+    m = export(scene, tmp_path / "h", materials={"kelvin": "JankowskiImpact"})
+    (mat,) = [c.args for c in m.commands if c.name == "uniaxialMaterial"]
+    xi = -math.log(0.65) / math.sqrt(math.pi ** 2 + math.log(0.65) ** 2)
+    assert mat[0] == "JankowskiImpact" and mat[3] == pytest.approx(xi, rel=1e-14) and mat[6] == 1.0
+    (note,) = [d for d in m.differences if "half-Kelvin" in d]
+    assert "e = 0.821" in note and "0.65" in note
+    assert "e = 0.821" in (tmp_path / "h" / "model.py").read_text()
+    from martello.cli import main
+    r = subprocess.run([sys.executable, "-m", "martello", "export", "benchmarks/p7/p7_two_oscillators.toml",
+                        "-o", str(tmp_path / "cli"), "--material", "kelvin=JankowskiImpact"],
+                       capture_output=True, text=True)
+    assert r.returncode == 0 and "note: kelvin contact s1-s2 as JankowskiImpact" in r.stderr
+    assert main(["export", P7, "-o", str(tmp_path / "bad"), "--material", "glue=Elastic"]) == 1
+
+
+def test_half_kelvin_restitution_against_an_independent_integration():
+    """e = exp(−(ξ/ν)·atan(ν/ξ)), ν = √(1 − ξ²), against scipy's integration of
+    m*δ̈ = −kδ − cδ̇ while approaching and −kδ while restoring; 0.8214 at the ξ that gives
+    0.65 for the full Kelvin law (scipy's rtol 1e-12: the digits asserted)."""
+    for xi in (0.05, 0.1358, 0.3, 0.6, 0.9):
+        w = 1.0
+
+        def f(t, y):
+            d, dd = y
+            return [dd, -w * w * d - (2 * xi * w * dd if dd > 0 else 0.0)]
+
+        turn = lambda t, y: y[1]                       # noqa: E731
+        turn.terminal, turn.direction = True, -1
+        out = lambda t, y: y[0]                        # noqa: E731
+        out.terminal, out.direction = True, -1
+        a = solve_ivp(f, (0, 10), [0.0, 1.0], rtol=1e-12, atol=1e-14, events=turn, method="DOP853")
+        b = solve_ivp(f, (a.t[-1], a.t[-1] + 10), a.y[:, -1], rtol=1e-12, atol=1e-14, events=out,
+                      method="DOP853")
+        assert -b.y_events[0][0][1] == pytest.approx(half_kelvin_e(xi), rel=1e-9)
+    xi65 = -math.log(0.65) / math.sqrt(math.pi ** 2 + math.log(0.65) ** 2)
+    assert round(half_kelvin_e(xi65), 4) == 0.8214
+    assert half_kelvin_e(0.0) == 1.0
+
+
+def test_initial_state_and_loads(tmp_path):
+    """P2 released above a plane under gravity: a0 = g is committed (OpenSees' Newmark takes
+    the committed acceleration as a_0), gravity is a Plain pattern of m·g; a rectangular
+    pulse ends one ulp before t_end (martello's window is half-open)."""
+    scene = load("benchmarks/p2/p2_penalty_kelvin.toml")
+    m = opensees_model(scene)
+    acc = [c.args for c in m.commands if c.name == "setNodeAccel"]
+    assert acc == [(1, 1, scene.gravity, "-commit")]
+    loads = [c.args for c in m.commands if c.name == "load"]
+    assert loads == [(1, scene.nodes[0]["mass"] * scene.gravity)]
+    d = two_bodies("linear")
+    d["loads"] = {"force": [{"node": "m2", "function": {"type": "rectangular", "amplitude": 5.0,
+                                                        "t_start": 0.0, "t_end": 1e-3}}]}
+    m = opensees_model(from_dict(d, source="tb"))
+    (rect,) = [c.args for c in m.commands if c.name == "timeSeries"]
+    assert rect[0] == "Rectangular" and rect[3] == math.nextafter(1e-3, 0) and rect[5] == 5.0
+    assert [c.args for c in m.commands if c.name == "setNodeAccel"] == [(2, 1, 2.5, "-commit")]
