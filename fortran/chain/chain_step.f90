@@ -40,7 +40,6 @@ module martello_chain_step
    use martello_integrator_settings, only: integrator_settings_t, INT_NEWMARK
    use martello_fixed_step, only: stepper_t
    use martello_generalized_alpha, only: generalized_alpha_t
-   use martello_chain_kernels, only: forward_kernel, refactor_kernel, back_kernel
    implicit none
    private
    public :: chain_step_t, chain_fusable
@@ -101,7 +100,7 @@ module martello_chain_step
       type(generalized_alpha_t), allocatable :: gen
       type(model_t), allocatable :: gm
    contains
-      procedure :: from_chain_of_one_kind
+      procedure :: from_chain_of_one_kind, pair_contact
       procedure :: init => chain_init
       procedure :: step => chain_step
       procedure :: begin_step => chain_begin_step
@@ -116,6 +115,25 @@ module martello_chain_step
          type(model_t), intent(in) :: m
          integer, intent(out) :: st
       end subroutine per_node
+      !> The other elements at the iterate, one by one (fortran/chain/one_by_one.f90): forces,
+      !> branches, works; and their tangents on their branches, per node.
+      module subroutine others(self, m, flipped)
+         class(chain_step_t), intent(inout) :: self
+         type(model_t), intent(in) :: m
+         logical, intent(inout) :: flipped
+      end subroutine others
+      module subroutine others_tangent(self, m)
+         class(chain_step_t), intent(inout) :: self
+         type(model_t), intent(in) :: m
+      end subroutine others_tangent
+      !> A step the fused sweeps do not settle, by the general path (fortran/chain/general_path.f90).
+      module subroutine general_step(self, m, t, o, stat)
+         class(chain_step_t), intent(inout) :: self
+         type(model_t), intent(in) :: m
+         real(dp), intent(in) :: t
+         type(observer_t), intent(inout) :: o
+         integer, intent(out) :: stat
+      end subroutine general_step
    end interface
 
 contains
@@ -227,6 +245,224 @@ contains
       self%un = self%u; self%vn = self%v; self%an = self%a
       self%factored = .false.
    end subroutine chain_init
+
+   !> The forward sweep of the first iterate (martello_chain_step linearised_sweep) on explicit-shape arrays (no descriptors, no aliasing: the
+   !> compiler keeps everything in registers but the arrays).
+   subroutine forward_kernel(n, h, gm, c1, c2, cv, acc, pl, kel, oth, pcs, fx, sk, sc, vn, an, &
+                             sm, mass, fe, rp, cg, kp, cp, pk, pc, brf, xcd, xco, xjo, fixed)
+      integer, intent(in), value :: n, sk, sc, sm
+      real(dp), intent(in), value :: h, gm, c1, c2, cv, acc
+      logical, intent(in), value :: pl, kel, oth, pcs, fx
+      real(dp), intent(in) :: vn(0:n), an(0:n), mass(*), rp(n), cg(n), kp(0:*), cp(0:*), &
+                              pk(0:*), pc(0:*), xcd(0:*), xco(0:*), xjo(0:*)
+      integer(int8), intent(in) :: brf(0:n)
+      logical, intent(in) :: fixed(n)
+      real(dp), intent(inout) :: fe(0:n)     !< in: the committed internal force; out: y
+      integer :: i
+      real(dp) :: dvm, dv0, dvp, a0, ap, cdv, cd, co, com, ym, g1, lm
+      ! a₀ = −c₁vₙ − c₂aₙ and Δv₀ = v₀ − vₙ = h((1 − γ)aₙ + γa₀) of each node
+      g1 = 1.0_dp - gm
+      dvm = 0.0_dp; com = 0.0_dp; ym = 0.0_dp; lm = 0.0_dp
+      a0 = -c1*vn(1) - c2*an(1)
+      dv0 = h*(g1*an(1) + gm*a0)
+      do i = 1, n
+         ap = 0.0_dp; dvp = 0.0_dp
+         if (i < n) then
+            ap = -c1*vn(i + 1) - c2*an(i + 1)
+            dvp = h*(g1*an(i + 1) + gm*ap)
+         end if
+         ! C_t(i, i) and C_t(i, i+1) on the factors' branches
+         cd = cg(i); co = 0.0_dp
+         if (pl) then
+            cd = cd + cp(i - 1) + cp(i); co = -cp(i)
+         end if
+         if (kel) then
+            if (brf(i - 1) == BRANCH_ON) cd = cd + pc((i - 1)*sc)
+            if (brf(i) == BRANCH_ON) then
+               cd = cd + pc(i*sc); co = co - pc(i*sc)
+            end if
+         end if
+         if (oth) then
+            cd = cd + xcd(i); co = co + xco(i)
+         end if
+         cdv = cd*dv0 + com*dvm + co*dvp
+         ym = mass(1 + (i - 1)*sm)*(acc - a0) - fe(i) - cdv - lm*ym
+         fe(i) = ym
+         dvm = dv0; dv0 = dvp; a0 = ap; com = co
+         ! L(i+1, i) for the next node
+         if (i < n) lm = coupling(i, cv, pl, pcs, oth, fx, sk, sc, kp, cp, pk, pc, brf, xjo, &
+                                  fixed)*rp(i)
+      end do
+      fe(0) = 0.0_dp
+   end subroutine forward_kernel
+
+   !> The forward sweep after a branch change (martello_chain_step refactor_sweep): J on the
+   !> current branches factorised, the residual forward-substituted; ok = .false. on a pivot
+   !> that is not > 0.
+   subroutine refactor_kernel(n, cm, cv, acc, pl, pcs, oth, sk, sc, a, sm, mass, fixed, fe, kg, &
+                              cg, kp, cp, pk, pc, br, xjd, xjo, rp, ok)
+      integer, intent(in) :: n, sk, sc, sm
+      real(dp), intent(in) :: cm, cv, acc
+      logical, intent(in) :: pl, pcs, oth, fixed(n)
+      real(dp), intent(in) :: a(0:n), mass(*), kg(n), cg(n), kp(0:*), cp(0:*), pk(0:*), pc(0:*), &
+                              xjd(0:*), xjo(0:*)
+      real(dp), intent(inout) :: fe(0:n)     !< in: the internal force at the iterate; out: y
+      integer(int8), intent(in) :: br(0:n)
+      real(dp), intent(out) :: rp(n)
+      logical, intent(out) :: ok
+      integer :: i
+      real(dp) :: p, jd, jo, jom, tp, tpm, ym, gm
+      ok = .true.
+      tpm = 0.0_dp; gm = 0.0_dp; ym = 0.0_dp; jom = 0.0_dp
+      do i = 1, n
+         ! tp: the tangent of pair (i, i+1), K_t + c_v C_t
+         tp = 0.0_dp
+         if (i < n) then
+            if (pl) tp = kp(i) + cv*cp(i)
+            if (pcs) then
+               if (br(i) == BRANCH_ON) tp = tp + (pk(i*sk) + cv*pc(i*sc))
+            end if
+         end if
+         jd = kg(i) + cv*cg(i) + tpm + tp
+         if (oth) jd = jd + xjd(i)
+         ! J(i, i+1) as the sweeps compute it again (coupling)
+         jo = 0.0_dp
+         if (i < n) jo = coupling(i, cv, pl, pcs, oth, .true., sk, sc, kp, cp, pk, pc, br, xjo, fixed)
+         if (fixed(i)) then
+            p = 1.0_dp
+         else
+            p = cm*mass(1 + (i - 1)*sm) + jd - jom*gm
+         end if
+         if (.not. (p > 0.0_dp)) ok = .false.
+         rp(i) = 1.0_dp/p
+         if (fixed(i)) then
+            ym = 0.0_dp
+         else
+            ym = mass(1 + (i - 1)*sm)*(acc - a(i)) - fe(i) - gm*ym
+         end if
+         gm = jo*rp(i)
+         fe(i) = ym
+         tpm = tp; jom = jo
+      end do
+      fe(0) = 0.0_dp
+   end subroutine refactor_kernel
+
+   !> J(i, i+1), i < n, of the factors made on the branches brf: −(K_t + c_v C_t) of the pair
+   !> (i, i+1) (its summed links, its contact where on), plus the other elements' (xjo), 0 at
+   !> a fixed row or column (fx: some node is fixed). L(i+1, i) = J(i, i+1)·rp(i): the sweeps
+   !> compute it again from the branch bytes rather than read it from an array (8 B per node
+   !> less to keep, and to stream at every step), to the same bits as the factorisation.
+   pure real(dp) function coupling(i, cv, pl, pcs, oth, fx, sk, sc, kp, cp, pk, pc, brf, xjo, &
+                                   fixed) result(jo)
+      integer, intent(in) :: i, sk, sc
+      real(dp), intent(in) :: cv, kp(0:*), cp(0:*), pk(0:*), pc(0:*), xjo(0:*)
+      logical, intent(in) :: pl, pcs, oth, fx, fixed(*)
+      integer(int8), intent(in) :: brf(0:*)
+      real(dp) :: tp
+      tp = 0.0_dp
+      if (pl) tp = kp(i) + cv*cp(i)
+      if (pcs) then
+         if (brf(i) == BRANCH_ON) tp = tp + (pk(i*sk) + cv*pc(i*sc))
+      end if
+      jo = -tp
+      if (oth) jo = jo + xjo(i)
+      if (fx) then
+         if (fixed(i) .or. fixed(i + 1)) jo = 0.0_dp
+      end if
+   end function coupling
+
+   !> The backward sweep and the elements at the new iterate (martello_chain_step evaluate) (no descriptors, no aliasing). The parameter
+   !> arrays of the pair contacts are read at i·stride (stride 0: one value for the chain).
+   subroutine back_kernel(n, from_start, pl, pcs, kel, oth, fx, ss, sg, sk, sc, sl, cm, cv, c1, &
+                          c2, h, gm, rp, u, v, a, un, vn, an, sm, mass, fe, kg, cg, kp, cp, psgn, &
+                          pgap, pk, pc, plaw, pbr, pbrc, pbrf, xjo, fixed, mdu, wd, wl, wc, flip)
+      integer, intent(in), value :: n, ss, sg, sk, sc, sl, sm
+      logical, intent(in), value :: from_start, pl, pcs, kel, oth, fx
+      real(dp), intent(in), value :: cm, cv, c1, c2, h, gm
+      real(dp), intent(in) :: rp(n), un(0:n), vn(0:n), an(0:n), mass(*), kg(n), &
+                              cg(n), kp(0:*), cp(0:*), psgn(0:*), pgap(0:*), pk(0:*), pc(0:*), &
+                              xjo(0:*)
+      logical, intent(in) :: fixed(n)
+      integer(int8), intent(in) :: plaw(0:*), pbrc(0:n), pbrf(0:n)
+      real(dp), intent(inout) :: u(0:n), v(0:n), a(0:n)
+      real(dp), intent(inout) :: fe(0:n)     !< in: y; out: the internal force
+      integer(int8), intent(inout) :: pbr(0:n)
+      real(dp), intent(out) :: mdu, wd, wl, wc
+      logical, intent(out) :: flip
+      integer :: i
+      integer(int8) :: br, law
+      real(dp) :: x, ui, vi, ai, uni, vni, u1, v1, un1, vn1, fi, f1, du, dun, fp, s, pen, penn, &
+                  f, fn, gp, g1, k, c, hd, lx
+      g1 = 1.0_dp - gm
+      mdu = 0.0_dp; wd = 0.0_dp; wl = 0.0_dp; wc = 0.0_dp; flip = .false.
+      x = 0.0_dp; u1 = 0.0_dp; v1 = 0.0_dp; un1 = 0.0_dp; vn1 = 0.0_dp; f1 = 0.0_dp
+      do i = n, 1, -1
+         ! Δu(i) = D⁻¹y(i) − L(i+1, i)·Δu(i+1)
+         lx = 0.0_dp
+         if (i < n) lx = coupling(i, cv, pl, pcs, oth, fx, sk, sc, kp, cp, pk, pc, pbrf, xjo, &
+                                  fixed)*rp(i)*x
+         x = rp(i)*fe(i) - lx
+         uni = un(i); vni = vn(i)
+         if (from_start) then
+            ! the Newmark a₀, v₀ of u = uₙ, as the general path's kinematics associate them
+            ai = -c1*vni - c2*an(i)
+            vi = vni + h*(g1*an(i) + gm*ai) + cv*x
+            ai = ai + cm*x
+            ui = uni + x
+         else
+            ui = u(i) + x; vi = v(i) + cv*x; ai = a(i) + cm*x
+         end if
+         u(i) = ui; v(i) = vi; a(i) = ai
+         mdu = mdu + mass(1 + (i - 1)*sm)*x
+         ! the links of node i to ground
+         k = kg(i); c = cg(i); hd = 0.5_dp*(ui - uni)
+         fi = k*ui + c*vi
+         wl = wl + k*(uni + ui)*hd
+         wd = wd + c*(vni + vi)*hd
+         if (i < n) then
+            ! the pair (i, i+1): node i+1 is known
+            du = ui - u1; dun = uni - un1
+            if (pl) then
+               fp = kp(i)*du + cp(i)*(vi - v1)
+               wl = wl + 0.5_dp*kp(i)*(dun + du)*(du - dun)
+               wd = wd + 0.5_dp*cp(i)*((vni - vn1) + (vi - v1))*(du - dun)
+               fi = fi + fp; f1 = f1 - fp
+            end if
+            if (pcs) then
+               ! linear or Kelvin (Anagnostopoulos 1988), as martello_contact_laws
+               s = psgn(i*ss); gp = pgap(i*sg)
+               pen = s*du - gp; penn = s*dun - gp
+               br = BRANCH_OFF; f = 0.0_dp
+               if (pen > 0.0_dp) then
+                  br = BRANCH_ON; f = pk(i*sk)*pen
+                  if (kel) then
+                     law = plaw(i*sl)
+                     if (law /= AFFINE_LINEAR) then
+                        f = f + pc(i*sc)*(s*(vi - v1))
+                        if (law == AFFINE_KELVIN_CLIPPED .and. f <= 0.0_dp) then
+                           f = 0.0_dp; br = BRANCH_CLIPPED
+                        end if
+                     end if
+                  end if
+               end if
+               pbr(i) = br
+               if (br /= pbrf(i)) flip = .true.
+               fn = 0.0_dp
+               if (pbrc(i) == BRANCH_ON) then
+                  fn = pk(i*sk)*penn
+                  if (kel) fn = fn + pc(i*sc)*(s*(vni - vn1))
+               end if
+               wc = wc + 0.5_dp*(fn + f)*(pen - penn)
+               fi = fi + s*f; f1 = f1 - s*f
+            end if
+            fe(i + 1) = f1
+         end if
+         f1 = fi
+         u1 = ui; v1 = vi; un1 = uni; vn1 = vni
+      end do
+      fe(1) = f1
+      fe(0) = 0.0_dp
+   end subroutine back_kernel
 
    !> The committed state becomes the start of the next step by swapping the buffers: the
    !> step writes every entry of u, v, a before reading it.
@@ -424,110 +660,6 @@ contains
       end subroutine sweep
    end subroutine evaluate
 
-   !> The bilinear links and the other contacts at the iterate, one by one (after the sweep:
-   !> fe holds the rest): forces into fe, branches, works.
-   subroutine others(self, m, flipped)
-      class(chain_step_t), intent(inout) :: self
-      type(model_t), intent(in) :: m
-      logical, intent(inout) :: flipped
-      integer :: idx, j, a, b
-      real(dp) :: du, f, kt, pen, penn, fn
-      logical :: yielding
-      integer(int8) :: br
-      associate (u => self%u, v => self%v, un => self%un, vn => self%vn, fe => self%fe, &
-                 par => m%link_par)
-         do idx = 1, size(self%blk%bl)
-            ! the return map from the committed state
-            j = self%blk%bl(idx); a = m%link_a(j); b = m%link_b(j)
-            du = u(a) - u(b)
-            call bilinear_return_map(par(L_STIFF, j), par(L_YIELD, j), par(L_HARDENING, j), &
-                                     self%bfc(idx), self%bdu(idx), du, f, kt, yielding)
-            br = B_ELASTIC
-            if (yielding) br = merge(B_UPPER, B_LOWER, f > par(L_HARDENING, j)*par(L_STIFF, j)*du)
-            self%bbr(idx) = br
-            flipped = flipped .or. br /= self%bbrf(idx)
-            self%wl = self%wl + 0.5_dp*(self%bfc(idx) + f)*(du - self%bdu(idx))
-            self%bft(idx) = f; self%bdut(idx) = du
-            fe(a) = fe(a) + f; fe(b) = fe(b) - f
-         end do
-         do idx = 1, size(self%blk%xg)
-            j = self%blk%xg(idx); a = m%con_a(j); b = m%con_b(j)
-            pen = u(a) - u(b) - m%con_gap(j)
-            call contact_law(m, j, pen, v(a) - v(b), br, f)
-            self%xbr(idx) = br
-            flipped = flipped .or. br /= self%xbrf(idx)
-            penn = un(a) - un(b) - m%con_gap(j)
-            call contact_law(m, j, penn, vn(a) - vn(b), br, fn, self%xbrc(idx))
-            self%wc = self%wc + 0.5_dp*(fn + f)*(pen - penn)
-            fe(a) = fe(a) + f; fe(b) = fe(b) - f
-         end do
-         fe(0) = 0.0_dp
-      end associate
-   end subroutine others
-
-   !> Contact j's force f at δ = pen, δ̇ = rate and its branch br: on its whole law, or on
-   !> the given branch on (the committed one).
-   subroutine contact_law(m, j, pen, rate, br, f, on)
-      type(model_t), intent(in) :: m
-      integer, intent(in) :: j
-      real(dp), intent(in) :: pen, rate
-      integer(int8), intent(out) :: br
-      real(dp), intent(out) :: f
-      integer(int8), intent(in), optional :: on
-      br = BRANCH_OFF; f = 0.0_dp
-      if (present(on)) then
-         if (on /= BRANCH_ON) return
-      else if (.not. (pen > 0.0_dp)) then
-         return
-      end if
-      br = BRANCH_ON
-      f = m%con_par(P_STIFF, j)*pen
-      if (m%con_law(j) == LAW_KELVIN) then
-         f = f + m%con_par(P_DAMPING, j)*rate
-         if (.not. present(on) .and. m%con_par(P_CLIP, j) > 0.5_dp .and. f <= 0.0_dp) then
-            f = 0.0_dp; br = BRANCH_CLIPPED
-         end if
-      end if
-   end subroutine contact_law
-
-   !> The other elements' tangents on their current branches, per node: xjd, xjo of
-   !> K_t + c_v C_t and C_t alone in xcd, xco (what the factors are made with).
-   subroutine others_tangent(self, m)
-      class(chain_step_t), intent(inout) :: self
-      type(model_t), intent(in) :: m
-      integer :: idx, j
-      real(dp) :: k, c
-      self%xjd = 0.0_dp; self%xjo = 0.0_dp; self%xcd = 0.0_dp; self%xco = 0.0_dp
-      do idx = 1, size(self%blk%bl)
-         j = self%blk%bl(idx)
-         k = m%link_par(L_STIFF, j)
-         if (self%bbr(idx) /= B_ELASTIC) k = m%link_par(L_HARDENING, j)*k
-         call stencil(m%link_a(j), m%link_b(j), k, 0.0_dp)
-      end do
-      do idx = 1, size(self%blk%xg)
-         j = self%blk%xg(idx)
-         if (self%xbr(idx) /= BRANCH_ON) cycle
-         c = 0.0_dp
-         if (m%con_law(j) == LAW_KELVIN) c = m%con_par(P_DAMPING, j)
-         call stencil(m%con_a(j), m%con_b(j), m%con_par(P_STIFF, j), c)
-      end do
-      self%xjd(0) = 0.0_dp; self%xcd(0) = 0.0_dp
-   contains
-      !> J += k + c_v c, C_t += c on the two-node stencil of (i, l): |i − l| ≤ 1 or one end
-      !> on ground (0).
-      subroutine stencil(i, l, k, c)
-         integer, intent(in) :: i, l
-         real(dp), intent(in) :: k, c
-         real(dp) :: val
-         val = k + self%cv*c
-         self%xjd(i) = self%xjd(i) + val; self%xjd(l) = self%xjd(l) + val
-         self%xcd(i) = self%xcd(i) + c; self%xcd(l) = self%xcd(l) + c
-         if (i > 0 .and. l > 0) then
-            self%xjo(min(i, l)) = self%xjo(min(i, l)) - val
-            self%xco(min(i, l)) = self%xco(min(i, l)) - c
-         end if
-      end subroutine stencil
-   end subroutine others_tangent
 
    !> Accept the last evaluation: committed ← trial (branches, bilinear states).
    subroutine commit(self)
@@ -536,111 +668,6 @@ contains
       call swap(self%bfc, self%bft); call swap(self%bdu, self%bdut)
    end subroutine commit
 
-   !> A step the fused sweeps do not settle, taken by the general path from the same
-   !> committed state (its chatter rule, line search and failure messages). Its stepper is
-   !> made at the first such step (on the model with its chains as links and contacts one by
-   !> one: their numbers are those of all the model's items) and handed the committed state
-   !> each time: the element states from ours (a contact we hold open has no force), f_ext at
-   !> t_n.
-   subroutine general_step(self, m, t, o, stat)
-      class(chain_step_t), intent(inout) :: self
-      type(model_t), intent(in) :: m
-      real(dp), intent(in) :: t
-      type(observer_t), intent(inout) :: o
-      integer, intent(out) :: stat
-      self%factored = .false.
-      if (m%nchain > 0) then
-         if (.not. allocated(self%gm)) then
-            allocate (self%gm, stat=stat)
-            if (stat /= 0) then
-               call out_of_memory('a copy of the model for the general path of the fused chain step', &
-                                  -1.0_dp, FIX_SMALLER_SCENE, stat, o%message)
-            else
-               call model_expanded(m, self%gm, stat, o%message)
-            end if
-            if (stat /= MARTELLO_OK) then
-               call observer_failed(o, t, stat); return
-            end if
-            call effective_mass_prepare(self%gm, o%message, stat)
-            if (stat /= MARTELLO_OK) return
-         end if
-         call take(self%gm)
-      else
-         call take(m)
-      end if
-   contains
-      subroutine take(gm)
-         type(model_t), intent(in) :: gm
-         integer(i8) :: saved(size(o%counters))
-         integer :: idx, j, i
-         if (.not. allocated(self%gen)) then
-            ! its start at t = 0 (a = M⁻¹(f_ext − f_int)) is overwritten below: not counted
-            allocate (self%gen, stat=stat)
-            if (stat /= 0) then
-               call out_of_memory('the general path of the fused chain step', -1.0_dp, &
-                                  FIX_SMALLER_SCENE, stat, o%message)
-               call observer_failed(o, t, stat); return
-            end if
-            saved = o%counters
-            call self%gen%init(gm, self%settings, o, stat)
-            o%counters = saved
-            if (stat /= MARTELLO_OK) return
-         end if
-         associate (gen => self%gen, ms => self%gen%ms)
-            gen%un = self%un; gen%vn = self%vn; gen%an = self%an; gen%t0 = self%t0
-            do idx = 1, size(self%blk%blo)
-               j = self%blk%blo(idx)
-               ms%link_fc(j) = self%bfc(idx); ms%link_u(j) = self%bdu(idx)
-            end do
-            ms%forced_off = .false.
-            call internal_forces(gm, ms, gen%un, gen%vn, gen%fint)
-            call mech_commit(gm, ms, gen%un)
-            do i = 1, m%n - 1
-               if (pair_contact(self, i) > 0) call hold(pair_contact(self, i), self%pbrc(i))
-            end do
-            do idx = 1, size(self%blk%xc)
-               call hold(self%blk%xc(idx), self%xbrc(idx))
-            end do
-            call external_forces(gm, gen%mrow, self%t0, gen%fext)
-            gen%tangent_valid = .false.
-            call gen%step(gm, t, o, stat)
-            if (stat /= MARTELLO_OK) return
-            self%u = gen%u; self%v = gen%v; self%a = gen%a
-            do idx = 1, size(self%blk%blo)
-               j = self%blk%blo(idx)
-               self%bfc(idx) = ms%link_fc(j); self%bdu(idx) = ms%link_u(j)
-            end do
-            do i = 1, m%n - 1
-               if (pair_contact(self, i) > 0) self%pbrc(i) = branch_of(pair_contact(self, i))
-            end do
-            do idx = 1, size(self%blk%xc)
-               self%xbrc(idx) = branch_of(self%blk%xc(idx))
-            end do
-         end associate
-      end subroutine take
-
-      !> contact j committed off here is off there (no force)
-      subroutine hold(j, br)
-         integer, intent(in) :: j
-         integer(int8), intent(in) :: br
-         if (br /= BRANCH_OFF) return
-         self%gen%ms%con_on(j) = .false.; self%gen%ms%con_f(j) = 0.0_dp
-      end subroutine hold
-
-      !> our branch of contact j from the general path's committed state: clipped where the
-      !> Kelvin law's cut-off holds its force at 0
-      integer(int8) function branch_of(j) result(br)
-         integer, intent(in) :: j
-         integer :: a, b, scheme, law
-         real(dp) :: gap, par(NPAR_CONTACT)
-         br = BRANCH_OFF
-         if (.not. self%gen%ms%con_on(j)) return
-         br = BRANCH_ON
-         call model_contact_at(m, j, a, b, gap, scheme, law, par)
-         if (law == LAW_KELVIN .and. par(P_CLIP) > 0.5_dp .and. self%gen%ms%con_f(j) == 0.0_dp) &
-            br = BRANCH_CLIPPED
-      end function branch_of
-   end subroutine general_step
 
    !> The observer's start: the phases of the contacts closed at t = 0 and the energies
    !> there.
@@ -652,8 +679,8 @@ contains
       integer, intent(out) :: stat
       integer :: i, idx, j
       do i = 1, self%n - 1
-         if (pair_contact(self, i) == 0 .or. self%pbrc(i) == BRANCH_OFF) cycle
-         call observer_open_phase(o, pair_contact(self, i), 0.0_dp, &
+         if (self%pair_contact(i) == 0 .or. self%pbrc(i) == BRANCH_OFF) cycle
+         call observer_open_phase(o, self%pair_contact(i), 0.0_dp, &
                                   self%blk%sgn(i*self%blk%ss)*(self%v(i) - self%v(i + 1)))
       end do
       do idx = 1, size(self%blk%xg)
@@ -716,7 +743,7 @@ contains
             e(2) = e(2) + eb
          end do
          do i = 1, n - 1
-            if (pair_contact(self, i) == 0) cycle
+            if (self%pair_contact(i) == 0) cycle
             pen = self%blk%sgn(i*self%blk%ss)*(u(i) - u(i + 1)) - self%blk%gap(i*self%blk%sg)
             if (pen > 0.0_dp) e(3) = e(3) + 0.5_dp*self%blk%k(i*self%blk%sk)*pen*pen
          end do

@@ -157,7 +157,10 @@ contains
    !> ends), inside it (step_maxima: the force and its rate at the start computed again from
    !> the state there), and its open phase's maxima. A pair whose phase changes in the step
    !> is listed in changed (nch of them) for pair_change, and the pass stops at the CHANGES-th
-   !> (p: where to go on). hl: the step from the previous sample; step: there is one.
+   !> (p: where to go on). hl: the step from the previous sample; step: there is one. A
+   !> contact open before and after the step (most of them, most steps) costs its δ and one
+   !> comparison, in a loop of its own where the chain is of one kind (every pair a contact
+   !> numbered in order, one sign and gap); the others are closed_pair's.
    subroutine pair_pass(p, n, hl, loc, step, contacts, phases, kel, first, number, ss, sg, sk, &
                         sc, sl, sgn, gap, kk, cc, law, br, un, vn, an, u, v, a, pen_max, &
                         force_max, ph_open, ph_pen, ph_f, changed, nch)
@@ -172,21 +175,54 @@ contains
       real(dp), intent(inout) :: pen_max(*), force_max(*), ph_pen(*), ph_f(*)
       logical, intent(in) :: ph_open(*)
       integer, intent(out) :: changed(CHANGES), nch
-      integer :: i, c, q
-      integer(int8) :: lw
-      real(dp) :: s, gp, pen, f, kp, cp, d0, r0, q0, r1, q1, f0, fr0, fr1, dm, fm
-      logical :: on, was
+      integer :: q, c
+      real(dp) :: s, gp, pen
+      logical :: full
       nch = 0
-      do q = p, n - 1
-         i = q + 1
-         if (first >= 0) then
+      if (first >= 0 .and. ss == 0 .and. sg == 0) then
+         s = sgn(0); gp = gap(0)
+         do q = p, n - 1
             c = first + q
-         else
-            c = number(q)
-            if (c == 0) cycle
-         end if
-         s = sgn(q*ss); gp = gap(q*sg)
-         pen = s*(u(q) - u(i)) - gp
+            pen = s*(u(q) - u(q + 1)) - gp
+            if (br(q) == BRANCH_OFF .and. .not. ph_open(c)) then
+               if (contacts .and. pen > pen_max(c)) pen_max(c) = pen
+            else
+               call closed_pair(q, c, s, gp, pen, full)
+               if (full) return
+            end if
+         end do
+      else
+         do q = p, n - 1
+            if (first >= 0) then
+               c = first + q
+            else
+               c = number(q)
+               if (c == 0) cycle
+            end if
+            s = sgn(q*ss); gp = gap(q*sg)
+            pen = s*(u(q) - u(q + 1)) - gp
+            if (br(q) == BRANCH_OFF .and. .not. ph_open(c)) then
+               if (contacts .and. pen > pen_max(c)) pen_max(c) = pen
+            else
+               call closed_pair(q, c, s, gp, pen, full)
+               if (full) return
+            end if
+         end do
+      end if
+      p = n
+   contains
+      !> pair q (contact c, its sign s and gap gp; δ = pen at the state) closed at the start or
+      !> the end of the step; full: the list of changes is full, p where to go on
+      subroutine closed_pair(q, c, s, gp, pen, full)
+         integer, intent(in) :: q, c
+         real(dp), intent(in) :: s, gp, pen
+         logical, intent(out) :: full
+         integer :: i
+         integer(int8) :: lw
+         real(dp) :: f, kp, cp, d0, r0, q0, r1, q1, f0, fr0, fr1, dm, fm
+         logical :: on, was
+         full = .false.
+         i = q + 1
          kp = kk(q*sk); cp = 0.0_dp; lw = AFFINE_LINEAR
          if (kel) then
             lw = law(q*sl)
@@ -204,9 +240,9 @@ contains
             if (contacts) call contact_peaks(pen, f, pen_max(c), force_max(c))
             nch = nch + 1; changed(nch) = q
             if (nch == CHANGES) then
-               p = q + 1; return
+               p = q + 1; full = .true.
             end if
-            cycle
+            return
          end if
          if (on .and. was .and. loc .and. (contacts .or. phases) .and. pen > 0.0_dp) then
             ! a phase over the whole step: its maxima inside it, where δ or the force turns
@@ -231,8 +267,7 @@ contains
          end if
          if (phases) call phase_peaks(on, pen, f, ph_pen(c), ph_f(c))
          if (contacts) call contact_peaks(pen, f, pen_max(c), force_max(c))
-      end do
-      p = n
+      end subroutine closed_pair
    end subroutine pair_pass
 
    !> The phase change of pair contact p (nodes p, p + 1) in the step (t − h, t], listed by
