@@ -60,12 +60,20 @@ module martello_chain_step
       !> the masses, read at 1 + (i − 1)·sm: one value for every node (sm = 0) or each's
       real(dp), allocatable :: mass(:)
       integer :: sm = 1
-      !> the linear links (springs, bars, dashpots) summed: of node i to ground (kg, cg,
-      !> 1:n), of the pair (i, i+1) (kp, cp, 0:n with 0 and n zero; allocated if any)
-      real(dp), allocatable :: kg(:), cg(:), kp(:), cp(:)
+      !> the per-node arrays in one block, each x(i) at store(ox + i): u, v, a, their values
+      !> at the step's start un, vn, an and fe (below) on nodes 0:n, the reciprocal pivots rp
+      !> and the summed linear links of a node to ground kg, cg on 1:n (no entries where the
+      !> chain's are read, chain_links); each one's first entries on L1 sets of their own,
+      !> whatever malloc gives (layout, fortran/chain/per_node.f90)
+      real(dp), allocatable :: store(:)
+      integer :: ou = 0, ov = 0, oa = 0, oun = 0, ovn = 0, oan = 0, ofe = 0, orp = 0, okg = 0, &
+                 ocg = 0
+      !> the linear links of the pair (i, i+1) summed (kp, cp, 0:n with 0 and n zero;
+      !> allocated if any)
+      real(dp), allocatable :: kp(:), cp(:)
       logical :: pair_links = .false.
       !> the links are those of the model's one chain on every node, dashpots included: kg and
-      !> cg are its k and c, read there (no copy)
+      !> cg are its k and c, read there (no copy, no entries in store)
       logical :: chain_links = .false.
       !> the pair contacts (of (i, i+1), i < n) with their laws, and the other elements one by
       !> one (node_block_t, what observer_block reads too)
@@ -85,8 +93,8 @@ module martello_chain_step
       !> at the last evaluation minus the nodal forces (fnod, as applied), which the forward
       !> sweeps overwrite, entry by entry as they read it, with the forward-substituted
       !> right-hand side y, and the backward sweep, entry by entry after reading y, with the
-      !> internal force again: one array for both
-      real(dp), allocatable :: rp(:), fe(:), fnod(:)
+      !> internal force again: one array for both (rp and fe in store)
+      real(dp), allocatable :: fnod(:)
       !> a node is fixed (its row and column of J are the identity's)
       logical :: any_fixed = .false.
       logical :: factored = .false.
@@ -206,8 +214,7 @@ contains
       self%measures_itself = .true.
       ! st: every allocation of the per-node state (stat > 0 if one failed)
       allocate (self%mass(merge(1, n, self%sm == 0)), self%fixed_nodes(count(m%fixed)), &
-                self%u(0:n), self%v(0:n), self%a(0:n), self%un(0:n), self%vn(0:n), self%an(0:n), &
-                self%pen(0), self%force(0), self%rp(n), self%fe(0:n), self%fnod(m%nforce), stat=st)
+                self%pen(0), self%force(0), self%fnod(m%nforce), stat=st)
       if (st == 0) call per_node(self, m, st)
       if (st /= 0) then
          write (num, '(i0)') n
@@ -217,32 +224,37 @@ contains
          return
       end if
       self%mass = m%mass(1:size(self%mass))
-      self%u(0) = 0.0_dp; self%v(0) = 0.0_dp
-      call model_initial_state(m, self%u(1:n), self%v(1:n))
-      self%fixed_nodes = pack([(i, i = 1, n)], m%fixed)
-      ! the bilinear springs start elastic, on k·Δu₀ (clamped into the band by the first
-      ! step), as mech_init
-      do i = 1, size(self%blk%bl)
-         self%bdu(i) = self%u(m%link_a(self%blk%bl(i))) - self%u(m%link_b(self%blk%bl(i)))
-         self%bfc(i) = m%link_par(L_STIFF, self%blk%bl(i))*self%bdu(i)
-      end do
-      self%rp = 0.0_dp; self%fe = 0.0_dp; self%fnod = 0.0_dp
-      self%any_fixed = size(self%fixed_nodes) > 0
-      ! the elements at (u0, v0) with their whole laws: the evaluation at an iterate with no
-      ! increment, works from (u0, v0) itself
-      self%un = self%u; self%vn = self%v; self%a = 0.0_dp; self%an = 0.0_dp
-      self%acc = uniform_acceleration(m, 0.0_dp)
-      call evaluate(self, m, .false., flipped)
-      call nodal_forces(self, m, 0.0_dp)
-      ! M a = f_ext − f_int on the free nodes: M is diagonal (counted as the general path's
-      ! factorisation of M)
-      do i = 1, n
-         self%a(i) = 0.0_dp
-         if (.not. m%fixed(i)) self%a(i) = (m%mass(i)*self%acc - self%fe(i))/m%mass(i)
-      end do
-      o%counters(C_FACTORIZATIONS) = o%counters(C_FACTORIZATIONS) + 1_i8
-      call commit(self)
-      self%un = self%u; self%vn = self%v; self%an = self%a
+      associate (x => self%store)
+         x(self%ou) = 0.0_dp; x(self%ov) = 0.0_dp
+         call model_initial_state(m, x(self%ou + 1:self%ou + n), x(self%ov + 1:self%ov + n))
+         self%fixed_nodes = pack([(i, i = 1, n)], m%fixed)
+         ! the bilinear springs start elastic, on k·Δu₀ (clamped into the band by the first
+         ! step), as mech_init
+         do i = 1, size(self%blk%bl)
+            self%bdu(i) = x(self%ou + m%link_a(self%blk%bl(i))) - x(self%ou + m%link_b(self%blk%bl(i)))
+            self%bfc(i) = m%link_par(L_STIFF, self%blk%bl(i))*self%bdu(i)
+         end do
+         x(self%orp + 1:self%orp + n) = 0.0_dp; x(self%ofe:self%ofe + n) = 0.0_dp
+         self%fnod = 0.0_dp
+         self%any_fixed = size(self%fixed_nodes) > 0
+         ! the elements at (u0, v0) with their whole laws: the evaluation at an iterate with no
+         ! increment, works from (u0, v0) itself
+         x(self%oun:self%oun + n) = x(self%ou:self%ou + n); x(self%ovn:self%ovn + n) = x(self%ov:self%ov + n)
+         x(self%oa:self%oa + n) = 0.0_dp; x(self%oan:self%oan + n) = 0.0_dp
+         self%acc = uniform_acceleration(m, 0.0_dp)
+         call evaluate(self, m, .false., flipped)
+         call nodal_forces(self, m, 0.0_dp)
+         ! M a = f_ext − f_int on the free nodes: M is diagonal (counted as the general path's
+         ! factorisation of M)
+         do i = 1, n
+            x(self%oa + i) = 0.0_dp
+            if (.not. m%fixed(i)) x(self%oa + i) = (m%mass(i)*self%acc - x(self%ofe + i))/m%mass(i)
+         end do
+         o%counters(C_FACTORIZATIONS) = o%counters(C_FACTORIZATIONS) + 1_i8
+         call commit(self)
+         x(self%oun:self%oun + n) = x(self%ou:self%ou + n); x(self%ovn:self%ovn + n) = x(self%ov:self%ov + n)
+         x(self%oan:self%oan + n) = x(self%oa:self%oa + n)
+      end associate
       self%factored = .false.
    end subroutine chain_init
 
@@ -285,7 +297,8 @@ contains
          if (oth) then
             cd = cd + xcd(i); co = co + xco(i)
          end if
-         cdv = cd*dv0 + com*dvm + co*dvp
+         cdv = cd*dv0
+         if (pl .or. kel .or. oth) cdv = cdv + com*dvm + co*dvp    ! (0·x is not folded)
          ym = mass(1 + (i - 1)*sm)*(acc - a0) - fe(i) - cdv - lm*ym
          fe(i) = ym
          dvm = dv0; dv0 = dvp; a0 = ap; com = co
@@ -431,7 +444,7 @@ contains
             if (pcs) then
                ! linear or Kelvin (Anagnostopoulos 1988), as martello_contact_laws
                s = psgn(i*ss); gp = pgap(i*sg)
-               pen = s*du - gp; penn = s*dun - gp
+               pen = s*du - gp
                br = BRANCH_OFF; f = 0.0_dp
                if (pen > 0.0_dp) then
                   br = BRANCH_ON; f = pk(i*sk)*pen
@@ -447,12 +460,16 @@ contains
                end if
                pbr(i) = br
                if (br /= pbrf(i)) flip = .true.
-               fn = 0.0_dp
-               if (pbrc(i) == BRANCH_ON) then
-                  fn = pk(i*sk)*penn
-                  if (kel) fn = fn + pc(i*sc)*(s*(vni - vn1))
+               if (br == BRANCH_ON .or. pbrc(i) == BRANCH_ON) then
+                  ! it pushes at one end of the step at least: its trapezoidal work
+                  penn = s*dun - gp
+                  fn = 0.0_dp
+                  if (pbrc(i) == BRANCH_ON) then
+                     fn = pk(i*sk)*penn
+                     if (kel) fn = fn + pc(i*sc)*(s*(vni - vn1))
+                  end if
+                  wc = wc + 0.5_dp*(fn + f)*(pen - penn)
                end if
-               wc = wc + 0.5_dp*(fn + f)*(pen - penn)
                fi = fi + s*f; f1 = f1 - s*f
             end if
             fe(i + 1) = f1
@@ -468,7 +485,7 @@ contains
    !> step writes every entry of u, v, a before reading it.
    subroutine chain_begin_step(self)
       class(chain_step_t), intent(inout) :: self
-      call swap(self%u, self%un); call swap(self%v, self%vn); call swap(self%a, self%an)
+      call swap_at(self%ou, self%oun); call swap_at(self%ov, self%ovn); call swap_at(self%oa, self%oan)
    end subroutine chain_begin_step
 
    subroutine chain_step(self, m, t, o, stat)
@@ -492,7 +509,8 @@ contains
          o%counters(C_NEWTON) = o%counters(C_NEWTON) + 1_i8
       else
          ! no factors: the elements at u = u_n (a solve with zero factors is no increment)
-         self%rp = 0.0_dp; self%fe = 0.0_dp
+         self%store(self%orp + 1:self%orp + self%n) = 0.0_dp
+         self%store(self%ofe:self%ofe + self%n) = 0.0_dp
       end if
       call evaluate(self, m, .true., flipped)
       call nodal_forces(self, m, t)
@@ -520,7 +538,7 @@ contains
       do j = 1, m%nforce
          i = m%force_node(j)
          f = tf_value(m%force_fn(j), self%t0)
-         w_ext = w_ext + 0.5_dp*(f + self%fnod(j))*(self%u(i) - self%un(i))
+         w_ext = w_ext + 0.5_dp*(f + self%fnod(j))*(self%store(self%ou + i) - self%store(self%oun + i))
       end do
       call observer_work(o, damping=self%wd, links=self%wl, contact=self%wc)
       call observer_work(o, external=w_ext)
@@ -535,7 +553,8 @@ contains
       real(dp) :: f
       do j = 1, m%nforce
          f = tf_value(m%force_fn(j), t)
-         self%fe(m%force_node(j)) = self%fe(m%force_node(j)) + self%fnod(j) - f
+         self%store(self%ofe + m%force_node(j)) = self%store(self%ofe + m%force_node(j)) + &
+                                                  self%fnod(j) - f
          self%fnod(j) = f
       end do
    end subroutine nodal_forces
@@ -547,30 +566,39 @@ contains
    subroutine linearised_sweep(self, m)
       class(chain_step_t), intent(inout) :: self
       type(model_t), intent(in) :: m
-      if (self%chain_links) then
-         call sweep(m%chain(1)%c)
-      else
-         call sweep(self%cg)
-      end if
+      integer :: n
+      n = self%n
+      associate (x => self%store)
+         if (self%chain_links) then
+            call sweep(m%chain(1)%c)
+         else
+            call sweep(x(self%ocg + 1:self%ocg + n))
+         end if
+      end associate
       call pin_fixed(self)
    contains
       subroutine sweep(cg)
          real(dp), intent(in), contiguous :: cg(:)
-         if (.not. (self%pair_links .or. self%blk%kelvin .or. self%others) .and. &
-             self%from_chain_of_one_kind()) then
-            ! the usual chain, with these as constants (back_kernel's call says why)
-            call forward_kernel(self%n, self%h, self%gamma, self%c1, self%c2, self%cv, self%acc, &
-                                .false., .false., .false., self%blk%pairs, .false., 0, 0, &
-                                self%vn, self%an, 0, self%mass, self%fe, self%rp, cg, self%kp, &
-                                self%cp, self%blk%k, self%blk%c, self%pbrf, self%xcd, self%xco, &
-                                self%xjo, m%fixed)
-         else
-            call forward_kernel(self%n, self%h, self%gamma, self%c1, self%c2, self%cv, self%acc, &
-                                self%pair_links, self%blk%kelvin, self%others, self%blk%pairs, &
-                                self%any_fixed, self%blk%sk, self%blk%sc, self%vn, self%an, self%sm, &
-                                self%mass, self%fe, self%rp, cg, self%kp, self%cp, self%blk%k, &
-                                self%blk%c, self%pbrf, self%xcd, self%xco, self%xjo, m%fixed)
-         end if
+         associate (x => self%store)
+            if (.not. (self%pair_links .or. self%blk%kelvin .or. self%others) .and. &
+                self%from_chain_of_one_kind()) then
+               ! the usual chain, with these as constants (back_kernel's call says why)
+               call forward_kernel(n, self%h, self%gamma, self%c1, self%c2, self%cv, self%acc, &
+                                   .false., .false., .false., self%blk%pairs, .false., 0, 0, &
+                                   x(self%ovn:self%ovn + n), x(self%oan:self%oan + n), 0, self%mass, &
+                                   x(self%ofe:self%ofe + n), x(self%orp + 1:self%orp + n), cg, self%kp, &
+                                   self%cp, self%blk%k, self%blk%c, self%pbrf, self%xcd, self%xco, &
+                                   self%xjo, m%fixed)
+            else
+               call forward_kernel(n, self%h, self%gamma, self%c1, self%c2, self%cv, self%acc, &
+                                   self%pair_links, self%blk%kelvin, self%others, self%blk%pairs, &
+                                   self%any_fixed, self%blk%sk, self%blk%sc, x(self%ovn:self%ovn + n), &
+                                   x(self%oan:self%oan + n), self%sm, self%mass, &
+                                   x(self%ofe:self%ofe + n), x(self%orp + 1:self%orp + n), cg, self%kp, &
+                                   self%cp, self%blk%k, self%blk%c, self%pbrf, self%xcd, self%xco, &
+                                   self%xjo, m%fixed)
+            end if
+         end associate
       end subroutine sweep
    end subroutine linearised_sweep
 
@@ -583,23 +611,30 @@ contains
       type(model_t), intent(in) :: m
       type(observer_t), intent(inout) :: o
       logical, intent(out) :: ok
+      integer :: n
+      n = self%n
       if (self%others) call others_tangent(self, m)
       self%pbrf = self%pbr; self%bbrf = self%bbr; self%xbrf = self%xbr
       o%counters(C_JACOBIANS) = o%counters(C_JACOBIANS) + 1_i8
       o%counters(C_FACTORIZATIONS) = o%counters(C_FACTORIZATIONS) + 1_i8
-      if (self%chain_links) then
-         call sweep(m%chain(1)%k, m%chain(1)%c)
-      else
-         call sweep(self%kg, self%cg)
-      end if
+      associate (x => self%store)
+         if (self%chain_links) then
+            call sweep(m%chain(1)%k, m%chain(1)%c)
+         else
+            call sweep(x(self%okg + 1:self%okg + n), x(self%ocg + 1:self%ocg + n))
+         end if
+      end associate
       self%factored = ok
    contains
       subroutine sweep(kg, cg)
          real(dp), intent(in), contiguous :: kg(:), cg(:)
-         call refactor_kernel(self%n, self%cm, self%cv, self%acc, self%pair_links, &
-                              self%blk%pairs, self%others, self%blk%sk, self%blk%sc, self%a, self%sm, &
-                              self%mass, m%fixed, self%fe, kg, cg, self%kp, self%cp, self%blk%k, &
-                              self%blk%c, self%pbr, self%xjd, self%xjo, self%rp, ok)
+         associate (x => self%store)
+            call refactor_kernel(n, self%cm, self%cv, self%acc, self%pair_links, self%blk%pairs, &
+                                 self%others, self%blk%sk, self%blk%sc, x(self%oa:self%oa + n), &
+                                 self%sm, self%mass, m%fixed, x(self%ofe:self%ofe + n), kg, cg, &
+                                 self%kp, self%cp, self%blk%k, self%blk%c, self%pbr, self%xjd, &
+                                 self%xjo, x(self%orp + 1:self%orp + n), ok)
+         end associate
       end subroutine sweep
    end subroutine refactor_sweep
 
@@ -609,7 +644,7 @@ contains
       class(chain_step_t), intent(inout) :: self
       integer :: k
       do k = 1, size(self%fixed_nodes)
-         self%fe(self%fixed_nodes(k)) = 0.0_dp
+         self%store(self%ofe + self%fixed_nodes(k)) = 0.0_dp
       end do
    end subroutine pin_fixed
 
@@ -626,38 +661,61 @@ contains
       logical, intent(in) :: from_start
       logical, intent(out) :: flipped
       real(dp) :: mdu
-      if (self%chain_links) then
-         call sweep(m%chain(1)%k, m%chain(1)%c)
-      else
-         call sweep(self%kg, self%cg)
-      end if
+      integer :: n
+      n = self%n
+      associate (x => self%store)
+         if (self%chain_links) then
+            call sweep(m%chain(1)%k, m%chain(1)%c)
+         else
+            call sweep(x(self%okg + 1:self%okg + n), x(self%ocg + 1:self%ocg + n))
+         end if
+      end associate
       self%mdu = self%mdu + mdu
       if (self%others) call others(self, m, flipped)
       self%fnod = 0.0_dp
    contains
       subroutine sweep(kg, cg)
          real(dp), intent(in), contiguous :: kg(:), cg(:)
-         if (.not. (self%pair_links .or. self%blk%kelvin) .and. self%blk%pairs .and. &
-             self%from_chain_of_one_kind()) then
-            ! the usual chain (springs and dashpots to ground, one linear contact law and gap
-            ! for every pair, one mass): the same kernel with these as constants, which the
-            ! compiler specialises (no branches on them, the parameters read once)
-            call back_kernel(self%n, from_start, .false., .true., .false., .false., .false., 0, 0, &
-                             0, 0, 0, self%cm, self%cv, self%c1, self%c2, self%h, self%gamma, &
-                             self%rp, self%u, self%v, self%a, self%un, self%vn, self%an, 0, &
-                             self%mass, self%fe, kg, cg, self%kp, self%cp, self%blk%sgn, self%blk%gap, &
-                             self%blk%k, self%blk%c, self%blk%law, self%pbr, self%pbrc, self%pbrf, &
-                             self%xjo, m%fixed, mdu, self%wd, self%wl, self%wc, flipped)
+         ! from the start or from the iterate, a kernel each (the choice is not tested per node)
+         if (from_start) then
+            call on_branches(kg, cg, .true.)
          else
-            call back_kernel(self%n, from_start, self%pair_links, self%blk%pairs, self%blk%kelvin, &
-                             self%others, self%any_fixed, self%blk%ss, self%blk%sg, self%blk%sk, self%blk%sc, &
-                             self%blk%sl, self%cm, self%cv, self%c1, self%c2, self%h, self%gamma, &
-                             self%rp, self%u, self%v, self%a, self%un, self%vn, self%an, self%sm, &
-                             self%mass, self%fe, kg, cg, self%kp, self%cp, self%blk%sgn, self%blk%gap, &
-                             self%blk%k, self%blk%c, self%blk%law, self%pbr, self%pbrc, self%pbrf, &
-                             self%xjo, m%fixed, mdu, self%wd, self%wl, self%wc, flipped)
+            call on_branches(kg, cg, .false.)
          end if
       end subroutine sweep
+      subroutine on_branches(kg, cg, start)
+         real(dp), intent(in), contiguous :: kg(:), cg(:)
+         logical, intent(in) :: start
+         associate (x => self%store)
+            if (.not. (self%pair_links .or. self%blk%kelvin) .and. self%blk%pairs .and. &
+                self%from_chain_of_one_kind()) then
+               ! the usual chain (springs and dashpots to ground, one linear contact law and gap
+               ! for every pair, one mass): the same kernel with these as constants, which the
+               ! compiler specialises (no branches on them, the parameters read once)
+               call back_kernel(n, start, .false., .true., .false., .false., .false., 0, 0, 0, 0, &
+                                0, self%cm, self%cv, self%c1, self%c2, self%h, self%gamma, &
+                                x(self%orp + 1:self%orp + n), x(self%ou:self%ou + n), &
+                                x(self%ov:self%ov + n), x(self%oa:self%oa + n), &
+                                x(self%oun:self%oun + n), x(self%ovn:self%ovn + n), &
+                                x(self%oan:self%oan + n), 0, self%mass, x(self%ofe:self%ofe + n), kg, &
+                                cg, self%kp, self%cp, self%blk%sgn, self%blk%gap, self%blk%k, &
+                                self%blk%c, self%blk%law, self%pbr, self%pbrc, self%pbrf, self%xjo, &
+                                m%fixed, mdu, self%wd, self%wl, self%wc, flipped)
+            else
+               call back_kernel(n, start, self%pair_links, self%blk%pairs, self%blk%kelvin, &
+                                self%others, self%any_fixed, self%blk%ss, self%blk%sg, self%blk%sk, &
+                                self%blk%sc, self%blk%sl, self%cm, self%cv, self%c1, self%c2, self%h, &
+                                self%gamma, x(self%orp + 1:self%orp + n), x(self%ou:self%ou + n), &
+                                x(self%ov:self%ov + n), x(self%oa:self%oa + n), &
+                                x(self%oun:self%oun + n), x(self%ovn:self%ovn + n), &
+                                x(self%oan:self%oan + n), self%sm, self%mass, &
+                                x(self%ofe:self%ofe + n), kg, cg, self%kp, self%cp, self%blk%sgn, &
+                                self%blk%gap, self%blk%k, self%blk%c, self%blk%law, self%pbr, &
+                                self%pbrc, self%pbrf, self%xjo, m%fixed, mdu, self%wd, self%wl, &
+                                self%wc, flipped)
+            end if
+         end associate
+      end subroutine on_branches
    end subroutine evaluate
 
 
@@ -681,14 +739,18 @@ contains
       do i = 1, self%n - 1
          if (self%pair_contact(i) == 0 .or. self%pbrc(i) == BRANCH_OFF) cycle
          call observer_open_phase(o, self%pair_contact(i), 0.0_dp, &
-                                  self%blk%sgn(i*self%blk%ss)*(self%v(i) - self%v(i + 1)))
+                                  self%blk%sgn(i*self%blk%ss)*(self%store(self%ov + i) - &
+                                                                self%store(self%ov + i + 1)))
       end do
       do idx = 1, size(self%blk%xg)
          j = self%blk%xg(idx)
          if (self%xbrc(idx) /= BRANCH_OFF) call observer_open_phase(o, self%blk%xc(idx), 0.0_dp, &
-                                                               self%v(m%con_a(j)) - self%v(m%con_b(j)))
+                                                               self%store(self%ov + m%con_a(j)) - &
+                                                               self%store(self%ov + m%con_b(j)))
       end do
-      call observer_begin(o, m, self%ms, self%u, self%v, self%a, energy_interval, self%advice, &
+      call observer_begin(o, m, self%ms, self%store(self%ou:self%ou + self%n), &
+                          self%store(self%ov:self%ov + self%n), self%store(self%oa:self%oa + self%n), &
+                          energy_interval, self%advice, &
                           0.0_dp, stat, energies=energies(self, m))
       if (stat /= MARTELLO_OK) call observer_failed(o, 0.0_dp, stat)
    end subroutine chain_measure_start
@@ -705,9 +767,12 @@ contains
       integer, intent(out) :: stat
       real(dp), allocatable :: e(:)     ! unallocated: not present (the energies are not due)
       if (observer_energy_due(o, k)) e = energies(self, m)
-      call observer_block(o, m, t, merge(self%h, 0.0_dp, k > 0), k, self%blk, self%un, self%vn, &
-                          self%an, self%u, self%v, self%a, self%pbrc, self%xbrc, self%bfc, &
-                          self%bdu, stat, e)
+      associate (x => self%store, n => self%n)
+         call observer_block(o, m, t, merge(self%h, 0.0_dp, k > 0), k, self%blk, &
+                             x(self%oun:self%oun + n), x(self%ovn:self%ovn + n), &
+                             x(self%oan:self%oan + n), x(self%ou:self%ou + n), x(self%ov:self%ov + n), &
+                             x(self%oa:self%oa + n), self%pbrc, self%xbrc, self%bfc, self%bdu, stat, e)
+      end associate
    end subroutine chain_measure
 
    !> [kinetic, links, contacts] energy of the committed state: ½ vᵀMv, the springs' ½ k Δu²
@@ -721,13 +786,16 @@ contains
       real(dp) :: du, pen, eb
       n = self%n
       e = 0.0_dp
-      associate (u => self%u, v => self%v)
+      call of_state(self%store(self%ou:self%ou + n), self%store(self%ov:self%ov + n))
+   contains
+      subroutine of_state(u, v)
+         real(dp), intent(in) :: u(0:n), v(0:n)
          do i = 1, n
             e(1) = e(1) + 0.5_dp*m%mass(i)*v(i)*v(i)
             if (self%chain_links) then
                e(2) = e(2) + 0.5_dp*m%chain(1)%k(i)*u(i)*u(i)
             else
-               e(2) = e(2) + 0.5_dp*self%kg(i)*u(i)*u(i)
+               e(2) = e(2) + 0.5_dp*self%store(self%okg + i)*u(i)*u(i)
             end if
          end do
          if (self%pair_links) then
@@ -752,7 +820,7 @@ contains
             pen = u(m%con_a(j)) - u(m%con_b(j)) - m%con_gap(j)
             e(3) = e(3) + contact_elastic_energy(m%con_law(j), m%con_par(:, j), max(pen, 0.0_dp))
          end do
-      end associate
+      end subroutine of_state
    end function energies
 
    !> Every pair contact shares its sign, gap, stiffness and law, and every node its mass
@@ -774,6 +842,13 @@ contains
          c = self%blk%number(i)
       end if
    end function pair_contact
+
+   !> x ↔ y (two arrays' offsets in store)
+   subroutine swap_at(x, y)
+      integer, intent(inout) :: x, y
+      integer :: tmp
+      tmp = x; x = y; y = tmp
+   end subroutine swap_at
 
    subroutine swap(x, y)
       real(dp), allocatable, intent(inout) :: x(:), y(:)

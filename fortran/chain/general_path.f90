@@ -58,7 +58,11 @@ contains
             if (stat /= MARTELLO_OK) return
          end if
          associate (gen => self%gen, ms => self%gen%ms)
-            gen%un = self%un; gen%vn = self%vn; gen%an = self%an; gen%t0 = self%t0
+            associate (x => self%store, n => self%n)
+               gen%un = x(self%oun:self%oun + n); gen%vn = x(self%ovn:self%ovn + n)
+               gen%an = x(self%oan:self%oan + n)
+            end associate
+            gen%t0 = self%t0
             do idx = 1, size(self%blk%blo)
                j = self%blk%blo(idx)
                ms%link_fc(j) = self%bfc(idx); ms%link_u(j) = self%bdu(idx)
@@ -76,7 +80,10 @@ contains
             gen%tangent_valid = .false.
             call gen%step(gm, t, o, stat)
             if (stat /= MARTELLO_OK) return
-            self%u = gen%u; self%v = gen%v; self%a = gen%a
+            associate (x => self%store, n => self%n)
+               x(self%ou:self%ou + n) = gen%u; x(self%ov:self%ov + n) = gen%v
+               x(self%oa:self%oa + n) = gen%a
+            end associate
             do idx = 1, size(self%blk%blo)
                j = self%blk%blo(idx)
                self%bfc(idx) = ms%link_fc(j); self%bdu(idx) = ms%link_u(j)

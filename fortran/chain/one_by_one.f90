@@ -13,39 +13,49 @@ contains
       class(chain_step_t), intent(inout) :: self
       type(model_t), intent(in) :: m
       logical, intent(inout) :: flipped
-      integer :: idx, j, a, b
-      real(dp) :: du, f, kt, pen, penn, fn
-      logical :: yielding
-      integer(int8) :: br
-      associate (u => self%u, v => self%v, un => self%un, vn => self%vn, fe => self%fe, &
-                 par => m%link_par)
-         do idx = 1, size(self%blk%bl)
-            ! the return map from the committed state
-            j = self%blk%bl(idx); a = m%link_a(j); b = m%link_b(j)
-            du = u(a) - u(b)
-            call bilinear_return_map(par(L_STIFF, j), par(L_YIELD, j), par(L_HARDENING, j), &
-                                     self%bfc(idx), self%bdu(idx), du, f, kt, yielding)
-            br = B_ELASTIC
-            if (yielding) br = merge(B_UPPER, B_LOWER, f > par(L_HARDENING, j)*par(L_STIFF, j)*du)
-            self%bbr(idx) = br
-            flipped = flipped .or. br /= self%bbrf(idx)
-            self%wl = self%wl + 0.5_dp*(self%bfc(idx) + f)*(du - self%bdu(idx))
-            self%bft(idx) = f; self%bdut(idx) = du
-            fe(a) = fe(a) + f; fe(b) = fe(b) - f
-         end do
-         do idx = 1, size(self%blk%xg)
-            j = self%blk%xg(idx); a = m%con_a(j); b = m%con_b(j)
-            pen = u(a) - u(b) - m%con_gap(j)
-            call contact_law(m, j, pen, v(a) - v(b), br, f)
-            self%xbr(idx) = br
-            flipped = flipped .or. br /= self%xbrf(idx)
-            penn = un(a) - un(b) - m%con_gap(j)
-            call contact_law(m, j, penn, vn(a) - vn(b), br, fn, self%xbrc(idx))
-            self%wc = self%wc + 0.5_dp*(fn + f)*(pen - penn)
-            fe(a) = fe(a) + f; fe(b) = fe(b) - f
-         end do
-         fe(0) = 0.0_dp
+      integer :: n
+      n = self%n
+      associate (x => self%store)
+         call at_state(x(self%ou:self%ou + n), x(self%ov:self%ov + n), x(self%oun:self%oun + n), &
+                       x(self%ovn:self%ovn + n), x(self%ofe:self%ofe + n))
       end associate
+   contains
+      subroutine at_state(u, v, un, vn, fe)
+         real(dp), intent(in) :: u(0:n), v(0:n), un(0:n), vn(0:n)
+         real(dp), intent(inout) :: fe(0:n)
+         integer :: idx, j, a, b
+         real(dp) :: du, f, kt, pen, penn, fn
+         logical :: yielding
+         integer(int8) :: br
+         associate (par => m%link_par)
+            do idx = 1, size(self%blk%bl)
+               ! the return map from the committed state
+               j = self%blk%bl(idx); a = m%link_a(j); b = m%link_b(j)
+               du = u(a) - u(b)
+               call bilinear_return_map(par(L_STIFF, j), par(L_YIELD, j), par(L_HARDENING, j), &
+                                        self%bfc(idx), self%bdu(idx), du, f, kt, yielding)
+               br = B_ELASTIC
+               if (yielding) br = merge(B_UPPER, B_LOWER, f > par(L_HARDENING, j)*par(L_STIFF, j)*du)
+               self%bbr(idx) = br
+               flipped = flipped .or. br /= self%bbrf(idx)
+               self%wl = self%wl + 0.5_dp*(self%bfc(idx) + f)*(du - self%bdu(idx))
+               self%bft(idx) = f; self%bdut(idx) = du
+               fe(a) = fe(a) + f; fe(b) = fe(b) - f
+            end do
+            do idx = 1, size(self%blk%xg)
+               j = self%blk%xg(idx); a = m%con_a(j); b = m%con_b(j)
+               pen = u(a) - u(b) - m%con_gap(j)
+               call contact_law(m, j, pen, v(a) - v(b), br, f)
+               self%xbr(idx) = br
+               flipped = flipped .or. br /= self%xbrf(idx)
+               penn = un(a) - un(b) - m%con_gap(j)
+               call contact_law(m, j, penn, vn(a) - vn(b), br, fn, self%xbrc(idx))
+               self%wc = self%wc + 0.5_dp*(fn + f)*(pen - penn)
+               fe(a) = fe(a) + f; fe(b) = fe(b) - f
+            end do
+            fe(0) = 0.0_dp
+         end associate
+      end subroutine at_state
    end subroutine others
 
    !> Contact j's force f at δ = pen, δ̇ = rate and its branch br: on its whole law, or on

@@ -4,7 +4,13 @@
 !> node_block_t (one value for the chain where every pair shares it), the other elements one
 !> by one.
 submodule (martello_chain_step) per_node_layout
+   use, intrinsic :: iso_c_binding, only: c_loc, c_intptr_t
    implicit none
+
+   !> The L1 data cache's way size (bytes: its sets repeat every page of 4 kB on the x86-64 and
+   !> ARM cores of today, 32 kB 8-way or 48 kB 12-way) and the slots of it the arrays of store
+   !> start in, one each
+   integer, parameter :: WAY = 4096, SLOTS = 16
 
 contains
 
@@ -23,11 +29,11 @@ contains
       self%chain_links = m%nchain == 1 .and. m%nlink == 0
       if (self%chain_links) self%chain_links = m%chain(1)%first == 1 .and. m%chain(1)%n == n .and. &
                                                allocated(m%chain(1)%c)
-      allocate (self%kg(merge(0, n, self%chain_links)), self%cg(merge(0, n, self%chain_links)), &
-                self%blk%number(0:n), pair(m%ncontact), self%pbr(0:n), self%pbrc(0:n), self%pbrf(0:n), &
-                stat=st)
+      call layout(self, m, st)
       if (st /= 0) return
-      self%kg = 0.0_dp; self%cg = 0.0_dp
+      allocate (self%blk%number(0:n), pair(m%ncontact), self%pbr(0:n), self%pbrc(0:n), &
+                self%pbrf(0:n), stat=st)
+      if (st /= 0) return
       self%pair_links = .false.
       do j = 1, m%nlink
          a = m%link_a(j); b = m%link_b(j)
@@ -54,7 +60,9 @@ contains
             lo = min(a, b)
             self%kp(lo) = self%kp(lo) + k; self%cp(lo) = self%cp(lo) + cd
          else
-            self%kg(a + b) = self%kg(a + b) + k; self%cg(a + b) = self%cg(a + b) + cd
+            associate (kg => self%store(self%okg + a + b), cg => self%store(self%ocg + a + b))
+               kg = kg + k; cg = cg + cd
+            end associate
          end if
       end do
       ! the chains' springs and dashpots (chain_fusable: linear)
@@ -62,8 +70,8 @@ contains
          associate (ch => m%chain(q))
             do i = 1, ch%n
                j = ch%first + i - 1
-               self%kg(j) = self%kg(j) + ch%k(i)
-               if (allocated(ch%c)) self%cg(j) = self%cg(j) + ch%c(i)
+               self%store(self%okg + j) = self%store(self%okg + j) + ch%k(i)
+               if (allocated(ch%c)) self%store(self%ocg + j) = self%store(self%ocg + j) + ch%c(i)
             end do
          end associate
       end do
@@ -114,6 +122,66 @@ contains
       if (st /= 0) return
       self%xjd = 0.0_dp; self%xjo = 0.0_dp; self%xcd = 0.0_dp; self%xco = 0.0_dp
    end subroutine per_node
+
+   !> The per-node arrays of the step in one block (store), each starting in its own slot of
+   !> WAY/SLOTS bytes of the L1 cache's way, away from the model's k and c that the sweeps
+   !> read beside them (chain_links). A sweep streams up to ten such arrays at once; arrays
+   !> allocated one by one start at the same offset of a page wherever a large one is mapped
+   !> (glibc: 16 B past a page boundary), so their streams meet on the same cache sets and an
+   !> 8-way cache holds only 8 of them (docs/performance.md "Where the time goes"). Placed
+   !> from the block's true address, the layout does not depend on malloc.
+   !> st > 0: the block could not be allocated.
+   subroutine layout(self, m, st)
+      class(chain_step_t), intent(inout) :: self
+      type(model_t), intent(in) :: m
+      integer, intent(out) :: st
+      integer, parameter :: U = 1, V = 2, A = 3, UN = 4, VN = 5, AN = 6, FE = 7, RP = 8, KG = 9, &
+                            CG = 10
+      integer :: len(CG), first(CG), off(CG), narr, j, slot, pos
+      integer(c_intptr_t) :: base
+      logical :: taken(0:SLOTS - 1)
+      len = self%n + 1; len(RP:CG) = self%n
+      first = 0; first(RP:CG) = 1           ! the index of each one's first entry
+      narr = merge(RP, CG, self%chain_links)
+      allocate (self%store(sum(len(1:narr)) + (narr + 1)*(WAY/8)), stat=st)
+      if (st /= 0) return
+      self%store = 0.0_dp
+      ! the slots of the model's arrays the sweeps read beside these
+      taken = .false.
+      if (self%chain_links) then
+         taken(slot_of(address(m%chain(1)%k(1)))) = .true.
+         taken(slot_of(address(m%chain(1)%c(1)))) = .true.
+      end if
+      base = address(self%store(1))
+      pos = 1; slot = 0
+      do j = 1, narr
+         do while (taken(modulo(slot, SLOTS)) .and. slot < 2*SLOTS)
+            slot = slot + 1
+         end do
+         ! the first position from pos whose address is at the slot's start (mod WAY)
+         pos = pos + int(modulo(modulo(slot, SLOTS)*(WAY/SLOTS) - (base + (pos - 1)*8_c_intptr_t), &
+                                int(WAY, c_intptr_t))/8)
+         off(j) = pos - first(j)
+         taken(modulo(slot, SLOTS)) = .true.
+         pos = pos + len(j)
+      end do
+      self%ou = off(U); self%ov = off(V); self%oa = off(A); self%oun = off(UN); self%ovn = off(VN)
+      self%oan = off(AN); self%ofe = off(FE); self%orp = off(RP)
+      if (.not. self%chain_links) then
+         self%okg = off(KG); self%ocg = off(CG)
+      end if
+   contains
+      integer function slot_of(addr)
+         integer(c_intptr_t), intent(in) :: addr
+         slot_of = int(modulo(addr, int(WAY, c_intptr_t))/(WAY/SLOTS))
+      end function slot_of
+   end subroutine layout
+
+   !> The address of x (the layout's reckoning)
+   integer(c_intptr_t) function address(x)
+      real(dp), target, intent(in) :: x
+      address = transfer(c_loc(x), 0_c_intptr_t)
+   end function address
 
    !> The pair contacts' parameters: sign, gap, stiffness, damping and law, each one value for
    !> the chain (stride 0) where every pair has a contact and they share it.
