@@ -177,10 +177,11 @@ typedef struct martello_run martello_run;
 enum { MARTELLO_INT_NEWMARK = 1, MARTELLO_INT_HHT = 2, MARTELLO_INT_GENERALIZED_ALPHA = 3,
        MARTELLO_INT_CENTRAL_DIFFERENCE = 4, MARTELLO_INT_MOREAU_JEAN = 5,
        MARTELLO_INT_NEWMARK_LAGRANGE = 6, MARTELLO_INT_RKF45 = 7, MARTELLO_INT_RK8PD = 8,
-       MARTELLO_INT_MSBDF = 9, MARTELLO_INT_IDA = 10, MARTELLO_INT_FAST_NONLINEAR = 11 };
+       MARTELLO_INT_MSBDF = 9, MARTELLO_INT_IDA = 10, MARTELLO_INT_FAST_NONLINEAR = 11,
+       MARTELLO_INT_CVODE = 12, MARTELLO_INT_ARKODE = 13 };
 enum { MARTELLO_FAMILY_NEWMARK = 1, MARTELLO_FAMILY_TIME_STEPPING = 2,
        MARTELLO_FAMILY_CONSTRAINED_NEWMARK = 3, MARTELLO_FAMILY_EVENT_DRIVEN = 4,
-       MARTELLO_FAMILY_DAE = 5, MARTELLO_FAMILY_MODAL = 6 };
+       MARTELLO_FAMILY_DAE = 5, MARTELLO_FAMILY_MODAL = 6, MARTELLO_FAMILY_ODE = 7 };
 
 /* The settings of a run, field by field the Fortran type integrator_settings_t
  * (fortran/integrator_settings.f90). martello_settings_default fills the registry's
@@ -210,6 +211,7 @@ typedef struct martello_settings {
   double max_steps;         /* steps a run may take (a whole number; the run fails past it) */
   double max_wall;          /* wall-clock seconds a run may take (0: no limit) */
   bool event_split;         /* Newmark family: split a step at a penalty onset/separation */
+  int method;               /* cvode, arkode: a value of the table "methods" (0: the default) */
 } martello_settings;
 
 /* Indices of martello_run_counters, martello_run_energy and the values of

@@ -62,6 +62,14 @@ int martello_eval_next_breakpoint(martello_eval *ev, double t, double *tb);
 int martello_eval_power(martello_eval *ev, double power[5]);
 int martello_eval_energy(martello_eval *ev, const double *u, const double *v, double *kinetic,
                          double *recoverable);
+/* The half-bandwidth kd of the node couplings (fortran/model.f90 model_bandwidth) and 1 if
+ * the mass is lumped (no mass couplings: M^-1 diagonal), else 0. */
+int martello_eval_bandwidth(martello_eval *ev, int *kd, int *lumped);
+/* The tangent stiffness K_t = d f_int/d u and damping C_t = d f_int/d v at (u, v), on the
+ * laws' branches held, in LAPACK's general band layout with ldab = 3 kd + 1: K(i, k) (0-based
+ * nodes, |i - k| <= kd) at k_band[(2 kd + i - k) + k (3 kd + 1)], n columns. */
+int martello_eval_tangent(martello_eval *ev, const double *u, const double *v, double *k_band,
+                          double *c_band);
 /* The number of links of the scene. */
 int martello_eval_link_count(martello_eval *ev, int *n_links);
 /* The rates of the peak quantities at the state (t, u, v) with accelerations a, on the laws'
@@ -204,4 +212,5 @@ int martello_impulse_accumulation(double e, double s, double a, double t, double
 /* The C integrators, dispatched by martello_dynamic_run. */
 int martello_event_driven_run(martello_model *model, martello_run *run);
 int martello_ida_run(martello_model *model, martello_run *run);
+int martello_ode_run(martello_model *model, martello_run *run);
 #endif

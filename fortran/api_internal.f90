@@ -149,6 +149,45 @@ contains
       c_eval_commit = MARTELLO_OK
    end function c_eval_commit
 
+   !> The half-bandwidth kd of the model's node couplings (model_bandwidth) and whether its
+   !> mass is lumped (no couplings: M⁻¹ diagonal).
+   integer(c_int) function c_eval_bandwidth(handle, kd, lumped) bind(C, name='martello_eval_bandwidth')
+      type(c_ptr), value :: handle
+      integer(c_int), intent(out) :: kd, lumped
+      type(evaluator_t), pointer :: ep
+      ep => get_eval(handle)
+      kd = 0; lumped = 0
+      c_eval_bandwidth = MARTELLO_ERR_ARGUMENT
+      if (.not. associated(ep)) return
+      kd = model_bandwidth(ep%m)
+      lumped = merge(1, 0, ep%m%ncoupling == 0)
+      c_eval_bandwidth = MARTELLO_OK
+   end function c_eval_bandwidth
+
+   !> K_t and C_t at (u, v) in band storage (evaluator_tangent): n columns of 3 kd + 1.
+   integer(c_int) function c_eval_tangent(handle, u, v, k, c) bind(C, name='martello_eval_tangent')
+      type(c_ptr), value :: handle
+      real(c_double), intent(in) :: u(*), v(*)
+      real(c_double), intent(out) :: k(*), c(*)
+      type(evaluator_t), pointer :: ep
+      integer :: kd, n
+      ep => get_eval(handle)
+      c_eval_tangent = MARTELLO_ERR_ARGUMENT
+      if (.not. associated(ep)) return
+      n = ep%m%n
+      kd = model_bandwidth(ep%m)
+      call tangent(k(1:(3*kd + 1)*n), c(1:(3*kd + 1)*n))
+      c_eval_tangent = MARTELLO_OK
+   contains
+      subroutine tangent(kf, cf)
+         real(c_double), intent(out), target :: kf(:), cf(:)
+         real(dp), pointer, contiguous :: k2(:, :), c2(:, :)
+         k2(1:3*kd + 1, 1:n) => kf
+         c2(1:3*kd + 1, 1:n) => cf
+         call evaluator_tangent(ep, u(1:n), v(1:n), k2, c2)
+      end subroutine tangent
+   end function c_eval_tangent
+
    !> Event-driven integrators: hold the laws on smooth branches (evaluator_use_branches).
    integer(c_int) function c_eval_use_branches(handle, nsw) bind(C, name='martello_eval_use_branches')
       type(c_ptr), value :: handle

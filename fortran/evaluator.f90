@@ -14,7 +14,7 @@ module martello_evaluator
    public :: evaluator_t, evaluator_init, evaluator_load, evaluator_acceleration, &
       evaluator_forces, evaluator_solve_mass, evaluator_commit, &
       evaluator_energy, evaluator_power, evaluator_use_branches, evaluator_switches, &
-      evaluator_next_breakpoint, evaluator_rates
+      evaluator_next_breakpoint, evaluator_rates, evaluator_tangent
 
    type :: evaluator_t
       type(model_t), pointer :: m => null()
@@ -196,6 +196,19 @@ contains
          call evaluator_solve_mass(ev, jerk, ok)
       end associate
    end subroutine evaluator_rates
+
+   !> The tangent stiffness K_t = ∂f_int/∂u and damping C_t = ∂f_int/∂v at (u, v), on the
+   !> laws' branches held, in the band layout of martello_band_matrix (A(i,j) in
+   !> k(2kd+1+i−j, j), kd = model_bandwidth; ldab = 3kd + 1): the analytic Jacobian of the
+   !> first-order form (docs/sundials-ode.md).
+   subroutine evaluator_tangent(ev, u, v, k, c)
+      type(evaluator_t), intent(inout) :: ev
+      real(dp), intent(in) :: u(:), v(:)
+      real(dp), intent(out), contiguous :: k(:, :), c(:, :)
+      k = 0.0_dp; c = 0.0_dp
+      call evaluator_load(ev, u, v)
+      call internal_forces(ev%m, ev%ms, ev%u, ev%v, ev%f, k, 1.0_dp, 0.0_dp, c)
+   end subroutine evaluator_tangent
 
    !> The powers at the state of the last force evaluation: of the external and the internal
    !> forces on the free nodes, f·v, and of the dampers, the other links and the penalty

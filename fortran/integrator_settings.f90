@@ -12,12 +12,14 @@ module martello_integrator_settings
       INT_MSBDF, INT_IDA, INT_LAST, SETTINGS, INTEGRATORS, setting_t, NSETTINGS, S_DT, S_T_END, &
       S_BETA, S_GAMMA, S_ALPHA, S_RHO_INF, S_TOL_RESIDUAL, S_TOL_INCREMENT, S_MAX_NEWTON, &
       S_CHECK_STABILITY, S_EVERY, S_DIVERGENCE_FACTOR, S_RTOL, S_ATOL, S_THETA, S_EVENT_TOL, &
-      S_H_MAX, S_FUSED_CHAIN, S_MAX_STEPS, S_MAX_WALL, S_EVENT_SPLIT, T_INT
+      S_H_MAX, S_FUSED_CHAIN, S_MAX_STEPS, S_MAX_WALL, S_EVENT_SPLIT, S_METHOD, T_INT, METHODS, &
+      INT_CVODE, INT_ARKODE
    implicit none
    private
    public :: integrator_settings_t, integrator_name, scheme_supported, settings_default, &
       settings_check, INT_NEWMARK, INT_HHT, INT_GENERALIZED_ALPHA, INT_CENTRAL_DIFFERENCE, &
-      INT_MOREAU_JEAN, INT_NEWMARK_LAGRANGE, INT_RKF45, INT_RK8PD, INT_MSBDF, INT_IDA, INT_LAST
+      INT_MOREAU_JEAN, INT_NEWMARK_LAGRANGE, INT_RKF45, INT_RK8PD, INT_MSBDF, INT_IDA, INT_CVODE, &
+      INT_ARKODE, INT_LAST
 
    !> martello_settings. Defaults are the registry's; which fields an integrator reads is its
    !> row of the registry's table "reads".
@@ -49,6 +51,8 @@ module martello_integrator_settings
       real(c_double) :: max_wall = SETTINGS(S_MAX_WALL)%default
       !> the Newmark family: split a step at a located penalty onset/separation (docs/integrators.md)
       logical(c_bool) :: event_split = SETTINGS(S_EVENT_SPLIT)%default /= 0.0_dp
+      !> cvode, arkode: the method, a value of the registry's table methods (0: the default)
+      integer(c_int) :: method = nint(SETTINGS(S_METHOD)%default)
    end type integrator_settings_t
 
 contains
@@ -104,6 +108,15 @@ contains
             ' is invalid for '//integrator_name(s%kind)//': set it to '//trim(SETTINGS(i)%text)
          return
       end do
+      if (btest(INTEGRATORS(s%kind)%reads, S_METHOD) .and. s%method /= 0) then
+         if (.not. any(METHODS%value == s%method .and. METHODS%integrator == s%kind)) then
+            write (num, '(i0)') s%method
+            message = 'settings.method = '//trim(num)//' is no method of '// &
+               integrator_name(s%kind)//': set it to 0 or to the value of a row of the'// &
+               ' registry''s table methods whose integrator is '//integrator_name(s%kind)
+            return
+         end if
+      end if
       if (s%max_steps /= aint(s%max_steps)) then
          write (num, '(es11.4)') s%max_steps
          message = 'settings.max_steps = '//trim(adjustl(num))//' is invalid for '// &
@@ -150,6 +163,7 @@ contains
       case (S_MAX_STEPS); x = s%max_steps
       case (S_MAX_WALL); x = s%max_wall
       case (S_EVENT_SPLIT); x = merge(1.0_dp, 0.0_dp, logical(s%event_split))
+      case (S_METHOD); x = s%method
       case default; x = 0.0_dp
       end select
    end function setting_value

@@ -30,11 +30,12 @@ module martello_registry
    private
    public :: SCHEME_PENALTY, SCHEME_LAGRANGE, SCHEME_AUGMENTED, SCHEME_RESTITUTION, &
       INT_NEWMARK, INT_HHT, INT_GENERALIZED_ALPHA, INT_CENTRAL_DIFFERENCE, INT_MOREAU_JEAN, &
-      INT_NEWMARK_LAGRANGE, INT_RKF45, INT_RK8PD, INT_MSBDF, INT_IDA, INT_FAST_NONLINEAR, INT_LAST, &
-      NSETTINGS, S_DT, S_T_END, S_BETA, S_GAMMA, S_ALPHA, S_RHO_INF, S_TOL_RESIDUAL, &
+      INT_NEWMARK_LAGRANGE, INT_RKF45, INT_RK8PD, INT_MSBDF, INT_IDA, INT_FAST_NONLINEAR, INT_CVODE, &
+      INT_ARKODE, INT_LAST, NSETTINGS, S_DT, S_T_END, S_BETA, S_GAMMA, S_ALPHA, S_RHO_INF, S_TOL_RESIDUAL, &
       S_TOL_INCREMENT, S_MAX_NEWTON, S_CHECK_STABILITY, S_EVERY, S_DIVERGENCE_FACTOR, S_RTOL, &
-      S_ATOL, S_THETA, S_EVENT_TOL, S_H_MAX, S_FUSED_CHAIN, S_MAX_STEPS, S_MAX_WALL, S_EVENT_SPLIT, SETTINGS, &
-      INTEGRATORS, setting_t, integrator_t, &
+      S_ATOL, S_THETA, S_EVENT_TOL, S_H_MAX, S_FUSED_CHAIN, S_MAX_STEPS, S_MAX_WALL, S_EVENT_SPLIT, S_METHOD, SETTINGS, &
+      INTEGRATORS, METHODS, method_t, METHOD_DEFAULT, METHOD_BDF, METHOD_ADAMS, METHOD_ERK, &
+      METHOD_DIRK, METHOD_IMEX, setting_t, integrator_t, &
       registry_shape, registry_column, registry_row, registry_find, registry_name, &
       NAME_LEN, TEXT_LEN, MAX_COLS, T_DOUBLE, T_INT, T_BOOL, TRACK_NODE_PEAKS, TRACK_LINK_PEAKS, &
       TRACK_CONTACT_PEAKS, TRACK_PHASES, TRACK_ALL
@@ -53,12 +54,13 @@ module martello_registry
    integer, parameter :: INT_NEWMARK = 1, INT_HHT = 2, INT_GENERALIZED_ALPHA = 3, &
                          INT_CENTRAL_DIFFERENCE = 4, INT_MOREAU_JEAN = 5, &
                          INT_NEWMARK_LAGRANGE = 6, INT_RKF45 = 7, INT_RK8PD = 8, INT_MSBDF = 9, &
-                         INT_IDA = 10, INT_FAST_NONLINEAR = 11, INT_LAST = 11
+                         INT_IDA = 10, INT_FAST_NONLINEAR = 11, INT_CVODE = 12, INT_ARKODE = 13, &
+                         INT_LAST = 13
 
    ! Integrator families: how the run is carried out (docs/integrators.md).
    integer, parameter :: FAMILY_NEWMARK = 1, FAMILY_TIME_STEPPING = 2, &
                          FAMILY_CONSTRAINED_NEWMARK = 3, FAMILY_EVENT_DRIVEN = 4, FAMILY_DAE = 5, &
-                         FAMILY_MODAL = 6
+                         FAMILY_MODAL = 6, FAMILY_ODE = 7
 
    ! The settings of a run, in the order of the fields of martello_settings after `kind`.
    integer, parameter :: S_DT = 1, S_T_END = 2, S_BETA = 3, S_GAMMA = 4, S_ALPHA = 5, &
@@ -67,7 +69,7 @@ module martello_registry
                          S_DIVERGENCE_FACTOR = 12, S_RTOL = 13, S_ATOL = 14, S_THETA = 15, &
                          S_EVENT_TOL = 16, S_H_MAX = 17, S_FUSED_CHAIN = 18, &
                          S_MAX_STEPS = 19, S_MAX_WALL = 20, S_EVENT_SPLIT = 21, &
-                         NSETTINGS = 21
+                         S_METHOD = 22, NSETTINGS = 22
    integer, parameter :: MAX_COLS = NSETTINGS   !< the widest table: reads, a column per setting
    ! C types of the settings (rows of the table "setting_types")
    integer, parameter :: T_DOUBLE = 1, T_INT = 2, T_BOOL = 3
@@ -103,6 +105,18 @@ module martello_registry
       integer :: reads, schemes
       character(len=TEXT_LEN) :: text
    end type integrator_t
+
+   !> One method of the SUNDIALS ODE integrators (the setting method, docs/sundials-ode.md):
+   !> its value, the integrator that runs it and its kind (METHOD_*). An ARKODE table's name is
+   !> ARKODE's own without its prefix, lower case, '_' -> '-' (ARKODE_VERNER_8_5_6 is
+   !> verner-8-5-6: stages, embedded order, order); an ImEx pair names the pair, whose
+   !> ARKODE tables are <name>_ERK_<s_p_q> and <name>_DIRK_<s_p_q>. The implicit tables are
+   !> those measured to their tolerance here (docs/sundials-ode.md, methods left out).
+   type :: method_t
+      character(len=NAME_LEN) :: name
+      integer :: value, integrator, kind
+      character(len=TEXT_LEN) :: text
+   end type method_t
 
    type(named_t), parameter :: STATUS_CODES(*) = [ &
       named_t('MARTELLO_OK', MARTELLO_OK, 'success'), &
@@ -237,7 +251,9 @@ module martello_registry
               'GSL adaptive ODE steppers with event location (docs/event-driven.md)'), &
       named_t('dae', FAMILY_DAE, 'SUNDIALS IDA on the contact DAE with events (docs/ida.md)'), &
       named_t('modal', FAMILY_MODAL, &
-              'modes of the linear part, nonlinear elements as pseudo-forces (docs/integrators.md)')]
+              'modes of the linear part, nonlinear elements as pseudo-forces (docs/integrators.md)'), &
+      named_t('ode', FAMILY_ODE, &
+              'SUNDIALS CVODE and ARKODE on the first-order ODE with root finding (docs/sundials-ode.md)')]
 
    type(named_t), parameter :: SETTING_TYPES(*) = [named_t('double', T_DOUBLE, 'C double'), &
       named_t('int', T_INT, 'C int'), named_t('bool', T_BOOL, 'C bool (stdbool.h)')]
@@ -284,7 +300,32 @@ module martello_registry
                 'a whole number in [1, 2^53]'), &
       setting_t('max_wall', T_DOUBLE, 0.0_dp, 0.0_dp, BIG, .false., .false., &
                 'a number >= 0 [s] (0: no limit)'), &
-      setting_t('event_split', T_BOOL, 0.0_dp, 0.0_dp, 1.0_dp, .false., .false., 'true or false')]
+      setting_t('event_split', T_BOOL, 0.0_dp, 0.0_dp, 1.0_dp, .false., .false., 'true or false'), &
+      setting_t('method', T_INT, 0.0_dp, 0.0_dp, 399.0_dp, .false., .false., &
+                'a row of the table methods for the integrator, or 0 (its default)')]
+
+   ! Methods (values frozen; table "methods"): the kinds
+   integer, parameter :: METHOD_DEFAULT = 0, METHOD_BDF = 1, METHOD_ADAMS = 2, METHOD_ERK = 3, &
+                         METHOD_DIRK = 4, METHOD_IMEX = 5
+   type(method_t), parameter :: METHODS(*) = [ &
+      method_t('bdf', 1, INT_CVODE, METHOD_BDF, 'CVODE variable-order BDF, orders 1-5 (the default)'), &
+      method_t('adams', 2, INT_CVODE, METHOD_ADAMS, 'CVODE variable-order Adams-Moulton, orders 1-12'), &
+      method_t('heun-euler-2-1-2', 100, INT_ARKODE, METHOD_ERK, 'explicit RK, order 2'), &
+      method_t('bogacki-shampine-4-2-3', 101, INT_ARKODE, METHOD_ERK, 'explicit RK, order 3'), &
+      method_t('zonneveld-5-3-4', 103, INT_ARKODE, METHOD_ERK, 'explicit RK, order 4'), &
+      method_t('cash-karp-6-4-5', 106, INT_ARKODE, METHOD_ERK, 'explicit RK, order 5'), &
+      method_t('fehlberg-6-4-5', 107, INT_ARKODE, METHOD_ERK, 'explicit RK, order 5'), &
+      method_t('dormand-prince-7-4-5', 108, INT_ARKODE, METHOD_ERK, &
+               'explicit RK, order 5 (the arkode default)'), &
+      method_t('verner-8-5-6', 110, INT_ARKODE, METHOD_ERK, 'explicit RK, order 6'), &
+      method_t('fehlberg-13-7-8', 111, INT_ARKODE, METHOD_ERK, 'explicit RK, order 8'), &
+      method_t('sdirk-2-1-2', 200, INT_ARKODE, METHOD_DIRK, 'diagonally implicit RK, order 2'), &
+      method_t('trbdf2-3-3-2', 202, INT_ARKODE, METHOD_DIRK, 'TR-BDF2 as an ESDIRK, order 2'), &
+      method_t('kvaerno-4-2-3', 203, INT_ARKODE, METHOD_DIRK, 'ESDIRK, order 3'), &
+      method_t('sdirk-5-3-4', 207, INT_ARKODE, METHOD_DIRK, 'SDIRK, order 4'), &
+      method_t('ark548l2sa-8-4-5', 303, INT_ARKODE, METHOD_IMEX, &
+               'ImEx additive RK, order 5: loads explicit, internal forces implicit'), &
+      method_t('ark548l2sab-8-4-5', 304, INT_ARKODE, METHOD_IMEX, 'ImEx additive RK, order 5')]
 
    ! Settings read by groups of integrators (bit S_x).
    integer, parameter :: READS_BASE = 2**S_DT + 2**S_T_END + 2**S_EVERY + 2**S_MAX_STEPS + 2**S_MAX_WALL
@@ -330,7 +371,13 @@ module martello_registry
                    'SUNDIALS IDA, variable-order BDF on the contact DAE'), &
       integrator_t('fast-nonlinear', INT_FAST_NONLINEAR, FAMILY_MODAL, .false., &
                    READS_BASE + READS_DIVERGENCE + 2**S_TOL_RESIDUAL + 2**S_MAX_NEWTON, &
-                   RUNS_PENALTY, 'Wilson (2002) fast nonlinear analysis: exact modal steps, pseudo-forces')]
+                   RUNS_PENALTY, 'Wilson (2002) fast nonlinear analysis: exact modal steps, pseudo-forces'), &
+      integrator_t('cvode', INT_CVODE, FAMILY_ODE, .true., &
+                   READS_BASE + READS_DIVERGENCE + READS_ADAPTIVE + 2**S_METHOD, RUNS_PENALTY, &
+                   'SUNDIALS CVODE, variable-order BDF or Adams, banded analytic Jacobian'), &
+      integrator_t('arkode', INT_ARKODE, FAMILY_ODE, .true., &
+                   READS_BASE + READS_DIVERGENCE + READS_ADAPTIVE + 2**S_METHOD, RUNS_PENALTY, &
+                   'SUNDIALS ARKODE, explicit, diagonally implicit or ImEx Runge-Kutta tables')]
 
    !> The tables; text: the prefix of their C constants in c/martello.h ('' if none).
    type(named_t), parameter :: TABLES(*) = [ &
@@ -343,7 +390,7 @@ module martello_registry
       named_t('counters', 0, 'MARTELLO_COUNTER_'), named_t('energy', 0, 'MARTELLO_ENERGY_'), &
       named_t('events', 0, 'MARTELLO_EVENT_'), named_t('constants', 0, 'MARTELLO_'), &
       named_t('history', 0, ''), named_t('history_per', 0, ''), &
-      named_t('tracking', 0, 'MARTELLO_TRACK_')]
+      named_t('tracking', 0, 'MARTELLO_TRACK_'), named_t('methods', 0, '')]
 
 contains
 
@@ -376,6 +423,7 @@ contains
       case ('constants'); rows = size(CONSTANTS)
       case ('history'); rows = size(HISTORY)
       case ('history_per'); rows = size(HISTORY_PER)
+      case ('methods'); rows = size(METHODS); cols = 3
       case default
          rows = 0; cols = 0; ok = .false.
       end select
@@ -391,7 +439,8 @@ contains
       character(len=NAME_LEN), parameter :: SETTING_COLS(6) = [character(len=NAME_LEN) :: &
          'default', 'min', 'max', 'min_open', 'max_open', 'type'], &
          INTEGRATOR_COLS(3) = [character(len=NAME_LEN) :: 'value', 'family', 'adaptive'], &
-         LAW_COLS(3) = [character(len=NAME_LEN) :: 'value', 'exponent', 'exponent_fixed']
+         LAW_COLS(3) = [character(len=NAME_LEN) :: 'value', 'exponent', 'exponent_fixed'], &
+         METHOD_COLS(3) = [character(len=NAME_LEN) :: 'value', 'integrator', 'kind']
       name = ''
       call registry_shape(table, rows, cols, ok)
       ok = ok .and. j >= 1 .and. j <= cols
@@ -403,6 +452,7 @@ contains
       case ('reads'); name = SETTINGS(j)%name
       case ('compatibility'); name = SCHEMES(j)%name
       case ('laws'); name = LAW_COLS(j)
+      case ('methods'); name = METHOD_COLS(j)
       case ('history'); name = 'per'
       case default; name = 'value'
       end select
@@ -439,6 +489,9 @@ contains
             values(1:cols) = [(merge(1.0_dp, 0.0_dp, btest(INTEGRATORS(i)%schemes, SCHEMES(j)%value)), &
                                j = 1, cols)]
          end if
+      case ('methods')
+         name = METHODS(i)%name; text = METHODS(i)%text
+         values(1:3) = [real(dp) :: METHODS(i)%value, METHODS(i)%integrator, METHODS(i)%kind]
       case ('settings')
          name = SETTINGS(i)%name; text = SETTINGS(i)%text
          values(1:6) = [SETTINGS(i)%default, unbounded(SETTINGS(i)%lo, -1), &

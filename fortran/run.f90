@@ -27,7 +27,7 @@ module martello_run
    !> output contacts', the others keep their first and last phase
    integer, parameter :: PHASE_LISTS = 1000
 
-   !> Dispatched to the C integrators (c/event_driven.c, c/ida.c).
+   !> Dispatched to the C integrators (c/event_driven.c, c/ida.c, c/sundials_ode.c).
    interface
       integer(c_int) function c_event_driven_run(model, run) bind(C, name='martello_event_driven_run')
          import :: c_int, c_ptr
@@ -37,6 +37,10 @@ module martello_run
          import :: c_int, c_ptr
          type(c_ptr), value :: model, run
       end function c_ida_run
+      integer(c_int) function c_ode_run(model, run) bind(C, name='martello_ode_run')
+         import :: c_int, c_ptr
+         type(c_ptr), value :: model, run
+      end function c_ode_run
    end interface
 
    type :: run_t
@@ -126,6 +130,8 @@ contains
             stat = c_event_driven_run(c_loc(m), c_loc(rp))
          case (INT_IDA)
             stat = c_ida_run(c_loc(m), c_loc(rp))
+         case (INT_CVODE, INT_ARKODE)
+            stat = c_ode_run(c_loc(m), c_loc(rp))
          end select
          if (st /= 0) call out_of_memory('the state of the integrator', -1.0_dp, FIX_SMALLER_SCENE, &
                                          stat, rp%results%message)

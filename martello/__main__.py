@@ -1,5 +1,18 @@
+"""`python -m martello` and the `martello` command (pyproject.toml's entry point): the command
+line of martello.cli, with a Ctrl-C while its modules load ending as one line, exit 130, like
+a Ctrl-C at any later moment (martello.cli.run_command)."""
+
 import sys
 
-from .cli import main
 
-sys.exit(main())
+def main():
+    try:
+        from .cli import main as command_line
+        return command_line()
+    except KeyboardInterrupt:     # before the command runs (after, run_command has its own)
+        print("martello: interrupted", file=sys.stderr)
+        return 130
+
+
+if __name__ == "__main__":
+    sys.exit(main())

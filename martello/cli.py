@@ -7,10 +7,12 @@ import sys
 from pathlib import Path
 
 from . import errors
-from .binding import native
 from .errors import MartelloError
-from .scene import catalogue
-from .scene.loader import load
+
+# Only the standard library and martello.errors here: each command imports what it needs when
+# it runs (inside run_command's error handling), so that `martello --help` and a usage error
+# need neither numpy nor the native library, and a missing or unloadable library, or a
+# Ctrl-C while the modules load, is one line like every other failure.
 
 DESCRIPTION = """\
 martello: verification and benchmark suite for contact and impact in structural dynamics.
@@ -29,6 +31,8 @@ examples:
 
 
 def cmd_list(args):
+    from .scene import catalogue
+    from .scene.loader import load
     files = catalogue.scene_files()
     if not files:
         print("the catalogue is empty")
@@ -43,7 +47,10 @@ def cmd_list(args):
 
 
 def cmd_run(args):
+    from .binding import native
     from .checks.measures import run_measured
+    from .scene import catalogue
+    from .scene.loader import load
     from .run import write_results
     from .run import check_budget
     from .errors import ResultError
@@ -133,6 +140,7 @@ def cmd_reference(args):
 
 def cmd_check(args):
     from .report import check_catalogue
+    from .scene import catalogue
     files = [catalogue.find(p) for p in args.scenes] if args.scenes else catalogue.scene_files()
     # a scene named on the command line must have something to verify
     ok = check_catalogue(files, Path(args.output), plots=not args.no_plots,
@@ -145,7 +153,13 @@ def cmd_export(args):
     return export.main(args)
 
 
+def cmd_testset(args):
+    from . import testset
+    return testset.main(args)
+
+
 def _print_version(args):
+    from .binding import native
     print(f"martello {native.version()} ({native.library_versions()})")
     return 0
 
@@ -177,6 +191,24 @@ def _jobs(text):
     return n
 
 
+def _path(text):
+    """A path argument (-o and the like): not empty (an empty -o used to mean the default)."""
+    if not text:
+        raise argparse.ArgumentTypeError("is empty (give a path, or leave the option out for "
+                                         "the default)")
+    return text
+
+
+def _caused_by_interrupt(exc):
+    seen = set()
+    while exc is not None and id(exc) not in seen:
+        if isinstance(exc, KeyboardInterrupt):
+            return True
+        seen.add(id(exc))
+        exc = exc.__cause__ or exc.__context__
+    return False
+
+
 def run_command(args):
     """Run the parsed command. Every failure ends as one line on stderr and exit code 1: the
     message of a MartelloError (input the user can fix, a failed run), a system error (a
@@ -205,6 +237,11 @@ def run_command(args):
     except Exception as exc:
         if args.debug:
             raise
+        if _caused_by_interrupt(exc):
+            # a Ctrl-C inside code that wraps what it catches (a class's __set_name__ while
+            # a module loads turns it into a RuntimeError)
+            print("martello: interrupted", file=sys.stderr)
+            return 130
         if isinstance(exc, MemoryError):
             print("martello: error: out of memory (the scene asks for more than this machine "
                   "has: record less, or use fewer nodes)", file=sys.stderr)
@@ -234,7 +271,7 @@ def main(argv=None):
                        "summary.json (displacements, contact forces, penetrations, cost, "
                        "conditioning, provenance) and, for dynamic runs, history.csv.")
     p.add_argument("scene", help="scene file (TOML)")
-    p.add_argument("-o", "--output", help="output folder (default: out/<scene name>)")
+    p.add_argument("-o", "--output", type=_path, help="output folder (default: out/<scene name>)")
     p.add_argument("--print", action="store_true", help="also print the summary")
     p.add_argument("--force", action="store_true",
                    help="run even if it needs more than 1e9 node-steps or writes more than 1 GB")
@@ -249,7 +286,7 @@ def main(argv=None):
                        "verification table and write report.md, verification.csv and plots. "
                        "Exit code 1 if any check fails.")
     p.add_argument("scenes", nargs="*", help="scene files (default: the catalogue)")
-    p.add_argument("-o", "--output", default="out/check", help="report folder (default: out/check)")
+    p.add_argument("-o", "--output", type=_path, default="out/check", help="report folder (default: out/check)")
     p.add_argument("--no-plots", action="store_true", help="skip the PNG plots")
     p.set_defaults(func=cmd_check)
 
@@ -259,12 +296,17 @@ def main(argv=None):
                        "bar; write a tidy CSV (one row per run) and work-precision and "
                        "error-vs-step plots with the measured orders.")
     p.add_argument("study", help="study file (TOML)")
-    p.add_argument("-o", "--output", help="output folder (default: out/studies/<name>)")
+    p.add_argument("-o", "--output", type=_path, help="output folder (default: out/studies/<name>)")
     p.add_argument("-j", "--jobs", type=_jobs, default=0,
                    help=f"parallel runs, 0 to {MAX_JOBS} (default 0: all cores)")
     p.add_argument("--scheduler", metavar="ADDRESS", help="run on the Dask cluster whose scheduler "
                    "is at ADDRESS (tcp://host:8786, or a scheduler file .json) instead of local "
                    "processes (docs/studies.md)")
+    p.add_argument("--no-plots", action="store_true", help="skip the PNG plots")
+    p.add_argument("--use-study-scheduler", action="store_true",
+                   help="run on the Dask scheduler the study file names (its `scheduler`): "
+                   "without this flag that key is not used, since Dask exchanges pickled objects "
+                   "with the scheduler and a study file may come from anyone")
     p.set_defaults(func=cmd_study)
 
     p = sub.add_parser("compare", help="score another code's time history against a scene",
@@ -279,7 +321,7 @@ def main(argv=None):
     p.add_argument("--columns", action="append", metavar="NAMES",
                    help="names of a recorder file's value columns, e.g. u:s1,-u:s2 (a leading - flips "
                    "the sign); once per recorder file, in order (default: u of the scene's free nodes)")
-    p.add_argument("-o", "--output", help="write the scores as JSON here")
+    p.add_argument("-o", "--output", type=_path, help="write the scores as JSON here")
     p.set_defaults(func=cmd_compare)
 
     p = sub.add_parser("plot", help="pictures of a run or a study folder (PNG and SVG)",
@@ -288,7 +330,7 @@ def main(argv=None):
                        "the links it wrote, energy terms) or a study folder (martello study: error "
                        "against the step and work-precision, per case). See docs/plot.md.")
     p.add_argument("folder", help="a folder written by martello run or martello study")
-    p.add_argument("-o", "--output", help="folder for the pictures (default: FOLDER/plots)")
+    p.add_argument("-o", "--output", type=_path, help="folder for the pictures (default: FOLDER/plots)")
     p.add_argument("--format", default="png,svg", help="png, svg or png,svg (default)")
     p.add_argument("--nodes", help="nodes to plot, e.g. s1,s2 (default: the first six)")
     p.add_argument("--contacts", help="contacts to plot (default: the first six)")
@@ -303,7 +345,7 @@ def main(argv=None):
                        "scene physics in $MARTELLO_CACHE_DIR (default $XDG_CACHE_HOME/martello or "
                        "~/.cache/martello). See docs/reference.md.")
     p.add_argument("scene", help="scene file (TOML)")
-    p.add_argument("-o", "--output", help="folder for history.csv and reference.json "
+    p.add_argument("-o", "--output", type=_path, help="folder for history.csv and reference.json "
                    "(default: out/reference/<scene name>)")
     p.add_argument("--every", type=float, help="spacing of the stored samples in s "
                    "(default: the scene's output interval, 1000 to 20000 samples)")
@@ -319,7 +361,7 @@ def main(argv=None):
                        "in the script's header and docs/opensees.md.")
     p.add_argument("scene", help="scene file (TOML), or a path in the catalogue")
     p.add_argument("--to", default="opensees", help="the other code (default and only: opensees)")
-    p.add_argument("-o", "--output", required=True, help="folder for model.py (replaced whole)")
+    p.add_argument("-o", "--output", type=_path, required=True, help="folder for model.py (replaced whole)")
     p.add_argument("--tcl", action="store_true", help="also write model.tcl for OpenSees' Tcl interpreter")
     p.add_argument("--integrator", help="override the scene's integrator (newmark, hht, "
                    "generalized-alpha, central-difference)")
@@ -335,6 +377,18 @@ def main(argv=None):
     p.add_argument("--tol", type=float, help="NormDispIncr tolerance in m (default: the scene's "
                    "tol_increment x 0.1 m)")
     p.set_defaults(func=cmd_export)
+
+    p = sub.add_parser("testset", help="write the pounding test set: a JSON file and a page per problem",
+                       description="Write the machine-readable pounding test set (docs/testset.md): for "
+                       "every catalogue scene with a closed-form [check], DIR/<id>.json (the model in "
+                       "neutral terms, parameters and units, reference values with trusted digits, "
+                       "tolerance kinds, provenance) and DIR/<id>.md (its page), plus index.json and "
+                       "README.md, versioned with martello.")
+    p.add_argument("scenes", nargs="*", help="scene files (default: the catalogue)")
+    p.add_argument("-o", "--output", type=_path, required=True, help="folder of the set (replaced whole)")
+    p.add_argument("--run", action="store_true", help="also run each scene and add martello's own "
+                   "values as regression tolerances")
+    p.set_defaults(func=cmd_testset)
 
     p = sub.add_parser("version", help="versions of martello and the libraries it links")
     p.set_defaults(func=_print_version)

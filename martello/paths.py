@@ -132,12 +132,19 @@ def check_output_folder(outdir, marker, refuse):
     """What folder_replaced will demand of outdir, checked before the work that fills it (a
     run of an hour must not end in "-o names a file"): outdir is absent, or a folder that is
     empty or holds `marker`; its first existing ancestor is a folder we may write in.
-    Returns outdir made absolute; refuse(text) otherwise. Nothing is created."""
+    A symbolic link to a folder stands for that folder (the output replaces the folder and
+    the link keeps pointing at it). Returns outdir made absolute (a link resolved);
+    refuse(text) otherwise. Nothing is created."""
     outdir = Path(os.path.abspath(outdir))
+    if outdir.is_symlink() and outdir.is_dir():
+        outdir = outdir.resolve()        # a link to a folder: the folder is the output's
     if not outdir.name:
         raise refuse(f"{outdir}: cannot be an output folder (give a folder to create)")
-    if outdir.exists() or outdir.is_symlink():
-        if not outdir.is_dir() or outdir.is_symlink():
+    if outdir.is_symlink():
+        raise refuse(f"{outdir}: is a symbolic link to no folder (-o names the folder the "
+                     "results go to: give a new folder, or an earlier one of the same command)")
+    if outdir.exists():
+        if not outdir.is_dir():
             raise refuse(f"{outdir}: is not a folder (-o names the folder the results go to: "
                          "give a new folder, or an earlier one of the same command)")
         held = sorted(p.name for p in outdir.iterdir())

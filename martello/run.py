@@ -18,6 +18,7 @@ from .results import (ARRAYS_FILE, PHASE_FIELDS, ItemArrays, is_large)
 from .scene.bars import RodElements, RodNodes
 from .scene.chain import ChainContacts, ChainLinks
 from .scene.items import ItemTable, Listed, Names
+from .scene.spec import DEFAULT_METHODS
 
 # The names a link's type, a contact's scheme and law take (the library's tables); results
 # store them as codes into these (martello.results).
@@ -312,6 +313,8 @@ def integrator_settings(an):
     """The analysis table -> the native settings: the library's defaults, overridden by every
     setting the table gives (output.every is the setting every)."""
     given = {k: an[k] for k in native.settings_defaults() if an.get(k) is not None}
+    if "method" in given:   # a name of the library's table methods -> its value
+        given["method"] = native.value("methods", given["method"])
     return native.settings(an["integrator"], **given, every=an["output"]["every"])
 
 
@@ -325,8 +328,10 @@ def integrator_description(an):
         d.update(rho_inf=an["rho_inf"])
     elif an["integrator"] == "moreau-jean":
         d.update(theta=an["theta"])
-    elif an["integrator"] in ("rkf45", "rk8pd", "msbdf", "ida"):
+    elif an["integrator"] in ("rkf45", "rk8pd", "msbdf", "ida", "cvode", "arkode"):
         d.update(rtol=an["rtol"], atol=an["atol"], event_tol=an["event_tol"], h_max=an["h_max"])
+    if an["integrator"] in ("cvode", "arkode"):
+        d.update(method=an.get("method") or DEFAULT_METHODS[an["integrator"]])
     if an["integrator"] in ("newmark", "hht", "generalized-alpha", "newmark-lagrange"):
         d.update(tol_residual=an["tol_residual"], tol_increment=an["tol_increment"],
                  max_newton=an["max_newton"])
@@ -438,6 +443,8 @@ def _dynamic(scene, model, raise_on_failure=True):
         warnings.append(f"dt = {an['dt']!r} s is past the stability limit dt_crit = "
                         f"{extra['dt_critical']:.6g} s (check_stability = false): the result "
                         "may be wrong although no guard stopped it")
+    if dense_note(an, len(scene.nodes)):
+        warnings.append(dense_note(an, len(scene.nodes)))
     if st >= 0 and energy["balance_relative"] > 1e-2:
         warnings.append(f"energy balance error {100 * energy['balance_relative']:.1f} % of the energy put in: "
                         "the step is too large for this scene (the result is inaccurate)")
@@ -714,12 +721,30 @@ def _g(x):
     return f"{x:.3g}".replace("e+0", "e").replace("e+", "e").replace("e-0", "e-")
 
 
+# msbdf (GSL) builds a dense Jacobian of the 2n-dimensional state by finite differences and
+# factorises it densely (docs/event-driven.md): past this many nodes a run says so and names
+# cvode, the same variable-order BDF on the library's analytic band Jacobian (docs/sundials-ode.md).
+DENSE_NOTE_NODES = 200
+
+
+def dense_note(an, nodes):
+    """The note a scene of `nodes` nodes gets when its analysis chose msbdf, or None."""
+    if an.get("type") != "dynamic" or an.get("integrator") != "msbdf" or nodes <= DENSE_NOTE_NODES:
+        return None
+    return (f"msbdf forms and factorises a dense {2 * nodes} x {2 * nodes} Jacobian by finite "
+            f"differences ({2 * nodes + 2} force evaluations and O(n^3) work each time, "
+            f"{_size(8.0 * (2 * nodes) ** 2)} of memory): for {nodes} nodes use integrator = "
+            '"cvode" (the same variable-order BDF, analytic band Jacobian, O(n))')
+
+
 def check_budget(scene, force=False):
     """Refuse (SceneError naming the field) a run that needs more than MAX_WORK node-steps or
     would write more than OUTPUT_LIMIT, unless force; return the warnings to print (output
     above OUTPUT_WARN, or above the limits when forced)."""
     est, an, warnings = output_estimate(scene), scene.analysis, []
     nodes = max(1, len(scene.nodes))
+    if dense_note(an, nodes):
+        warnings.append(dense_note(an, nodes))
     if est["steps"] * nodes > MAX_WORK:
         adaptive = an["type"] == "dynamic" and an["integrator"] in native.adaptive_integrators()
         key = "h_max" if adaptive and an.get("h_max") else "dt"

@@ -132,3 +132,61 @@ def test_check_fails_when_listed_reference_data_are_missing(tmp_path, monkeypatc
     for module in (store, report):
         monkeypatch.setattr(module, "manifest", real)
     assert report.check_catalogue([p7], tmp_path / "out2", plots=False, stream=io.StringIO())
+
+
+@pytest.mark.parametrize("lib, why", [("/nonexistent/libmartello.so", "native library not found"),
+                                      (str(P1), "cannot load the native library")])
+def test_help_needs_no_library_and_a_command_says_why_in_one_line(lib, why):
+    """The native library is loaded when a command first needs it: --help and usage errors
+    work without one; a command that needs it says, in one line, what is wrong with it."""
+    env = dict(os.environ, MARTELLO_LIB=lib)
+    run = lambda *a: subprocess.run([sys.executable, "-m", "martello", *a], cwd=ROOT, env=env,
+                                    capture_output=True, text=True, timeout=120)
+    r = run("--help")
+    assert r.returncode == 0 and "examples" in r.stdout, r.stderr
+    r = run("run", "--help")
+    assert r.returncode == 0 and "--force" in r.stdout
+    for args in (("list",), ("run", str(P1), "-o", "/nonexistent/x"), ("version",)):
+        r = run(*args)
+        assert r.returncode == 1 and r.stderr.count("\n") == 1, r.stderr
+        assert r.stderr.startswith("martello: error: ") and why in r.stderr and lib in r.stderr
+
+
+def test_an_empty_output_path_is_refused_not_taken_for_the_default(tmp_path):
+    r = martello("run", P1, "-o", "", cwd=tmp_path)
+    assert r.returncode == 1 and r.stderr.count("\n") == 1
+    assert "-o/--output: is empty" in r.stderr
+    assert not any(tmp_path.iterdir())
+
+
+def test_ctrl_c_while_the_modules_load_is_one_line_and_exit_130(tmp_path):
+    """SIGINT at moments spread over a command's start (the imports, the library, the run),
+    counted from the moment the package `martello` is imported (-X importtime says when; the
+    interpreter's own start and runpy's look-up of the package and of martello.__main__, a
+    few milliseconds after it, come before any code of martello can catch it, and end on
+    SIGINT as Python does): never a traceback; exit 130 with one line,
+    or the command's own end when the signal came too late to matter."""
+    import signal
+    import time
+    for delay in (0.02, 0.05, 0.1, 0.2, 0.3, 0.45, 0.6):
+        out = tmp_path / f"o{delay}"
+        p = subprocess.Popen([sys.executable, "-X", "importtime", "-m", "martello", "run", str(P1),
+                              "-o", str(out)], cwd=ROOT, stdout=subprocess.PIPE,
+                             stderr=subprocess.PIPE, bufsize=0)
+        head = b""
+        while not head.endswith(b"| martello\n") and b"| martello\n" not in head:
+            chunk = os.read(p.stderr.fileno(), 1 << 16)
+            assert chunk, head.decode()[-500:]
+            head += chunk
+        time.sleep(delay)
+        p.send_signal(signal.SIGINT)
+        _, rest = p.communicate(timeout=120)
+        err = "".join(ln for ln in (head + rest).decode().splitlines(keepends=True)
+                      if not ln.startswith("import time:"))
+        assert "Traceback" not in err and "internal error" not in err, (delay, err)
+        if p.returncode == -signal.SIGINT:    # in the interpreter's shutdown, after the command
+            assert (out / "summary.json").exists() and not err, (delay, err)
+            continue
+        assert p.returncode in (0, 130), (delay, p.returncode, err)
+        if p.returncode == 130:
+            assert err.count("\n") == 1 and "interrupted" in err, (delay, err)

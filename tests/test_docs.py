@@ -21,7 +21,7 @@ from tests.docs_tables import DOCS, ROOT, parse_table, registry_tables, read_tab
 REGISTRY = {"integrators", "schemes", "laws", "link-kinds", "compatibility",
             "integrator-parameters", "counters", "energy-terms", "history-columns",
             "status-codes", "families", "setting-types", "contact-parameters",
-            "link-parameters", "time-functions", "events", "constants", "tracking"}
+            "link-parameters", "time-functions", "events", "constants", "tracking", "methods"}
 
 
 # --- reading the source text ---------------------------------------------------------------
@@ -286,6 +286,10 @@ def test_integrator_parameters_table_is_the_registry():
             assert _split(r["valid"]) == list(ns["NEWMARK_PRESETS"]), key
             assert r["settings field"] == "—", key
             continue
+        if short == "method":   # the scene names a row of the table methods; the field holds its value
+            assert r["type"] == "string" and r["settings field"] == "method", key
+            assert r["integrators"] == ", ".join(i for i in integrators if "method" in reads[i]), key
+            continue
         g = settings[short]
         readers = [i for i in integrators if short in reads[i]]
         assert r["integrators"] == ("all" if readers == list(integrators) else ", ".join(readers)), key
@@ -348,7 +352,7 @@ REGISTRY_DOCS = {
     "link_parameters": "link-parameters", "time_functions": "time-functions",
     "counters": "counters", "energy": "energy-terms", "events": "events",
     "constants": "constants", "history": "history-columns", "history_per": "history-columns",
-    "tracking": "tracking",
+    "tracking": "tracking", "methods": "methods",
     "tables": None,   # the list of tables itself: docs/c-api.md's overview
 }
 
@@ -370,7 +374,7 @@ def test_every_registry_table_is_documented():
     ("families", "families"), ("setting_types", "setting-types"),
     ("contact_parameters", "contact-parameters"), ("link_parameters", "link-parameters"),
     ("time_functions", "time-functions"), ("events", "events"), ("constants", "constants"),
-    ("tracking", "tracking")])
+    ("tracking", "tracking"), ("methods", "methods")])
 def test_c_api_tables_are_the_registry(table, label):
     native = _registry()
     prefix = {r.name: r.text for r in native.registry("tables")}[table]

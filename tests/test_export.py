@@ -92,7 +92,7 @@ def test_p7_kelvin_script_builds_the_scene_and_samples_every_output_step(tmp_pat
     # history: t = k dt at every 10th of 40000 steps, and t = 0
     head, data = rows[0], np.array(rows[1:], float)
     assert head == ["t", "u:s1", "v:s1", "a:s1", "u:s2", "v:s2", "a:s2", "penetration:s1-s2",
-                    "force:s1-s2"]
+                    "force:s1-s2", "energy:kinetic", "energy:recoverable"]
     assert len(data) == 4001 and fake.steps == 40000
     assert np.array_equal(data[:, 0], np.arange(4001) * 10 * 1e-4)
     t = data[:, 0]
@@ -100,6 +100,12 @@ def test_p7_kelvin_script_builds_the_scene_and_samples_every_output_step(tmp_pat
     assert np.allclose(data[:, 1], s1 * 1e-3 * np.sin(t), rtol=0, atol=1e-18)
     assert np.allclose(data[:, 7], (s1 - s2) * 1e-3 * np.sin(t) - 0.01, rtol=0, atol=1e-17)
     assert np.allclose(data[:, 8], tag + t, rtol=0, atol=1e-12)          # P = −basicForce
+    # energies: ½ Σ m v² of the fake's velocities; springs 100 and 400 to ground, the
+    # contact open (δ < 0) at the fake's displacements
+    u1, u2 = s1 * 1e-3 * np.sin(t), s2 * 1e-3 * np.sin(t)
+    assert np.allclose(data[:, 9], 0.5 * ((s1 * 1e-3 * np.cos(t)) ** 2 + (s2 * 1e-3 * np.cos(t)) ** 2),
+                       rtol=1e-13, atol=0)
+    assert np.allclose(data[:, 10], 0.5 * 100 * u1 ** 2 + 0.5 * 400 * u2 ** 2, rtol=1e-13, atol=1e-300)
 
 
 def test_tcl_script_issues_the_same_commands(tmp_path):
@@ -179,7 +185,7 @@ def test_integrators_map_onto_opensees_conventions():
 
 def test_overrides_replace_an_event_driven_integrator():
     d = two_bodies("kelvin", integrator="rk8pd")
-    with pytest.raises(ExportError, match="integrator = rk8pd.*no event-driven"):
+    with pytest.raises(ExportError, match="integrator = rk8pd.*no event-driven, ODE or DAE"):
         opensees_model(from_dict(d, source="tb"))
     m = opensees_model(from_dict(d, source="tb"), analysis={"integrator": "newmark", "dt": 2e-5})
     assert m.dt == 2e-5 and m.steps == 200
@@ -283,3 +289,12 @@ def test_initial_state_and_loads(tmp_path):
     (rect,) = [c.args for c in m.commands if c.name == "timeSeries"]
     assert rect[0] == "Rectangular" and rect[3] == math.nextafter(1e-3, 0) and rect[5] == 5.0
     assert [c.args for c in m.commands if c.name == "setNodeAccel"] == [(2, 1, 2.5, "-commit")]
+
+
+def test_scorecard_doc_deterministic_part_is_current():
+    """docs/opensees-scorecard.md's first part (which catalogue scenes OpenSees runs as they
+    are, with another integrator, or not, and why) is regenerated from the catalogue and the
+    exporter and must equal the committed copy (benchmarks/opensees/scorecard.py --docs)."""
+    r = subprocess.run([sys.executable, "benchmarks/opensees/scorecard.py", "--check"],
+                       capture_output=True, text=True)
+    assert r.returncode == 0, r.stdout + r.stderr

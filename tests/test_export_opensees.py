@@ -40,6 +40,9 @@ def test_exported_kelvin_scene_equals_martellos_newmark(tmp_path):
         ref = data[:, cols.index(c)]
         assert np.max(np.abs(os_h[:, head.index(c)] - ref)) <= 1e-7 * np.max(np.abs(ref))
     assert summary["contacts"]["s1-s2"]["impacts"] >= 3
+    for c in ("energy:kinetic", "energy:recoverable"):     # the script's own bookkeeping
+        ref = data[:, cols.index(c)]
+        assert np.max(np.abs(os_h[:, head.index(c)] - ref)) <= 1e-6 * np.max(np.abs(ref)), c
 
 
 def test_exported_frames_equal_martellos_condensed_frames(tmp_path):

@@ -173,6 +173,21 @@ def test_output_naming_a_file_is_refused_before_a_long_run(tmp_path):
     assert (tmp_path / "afile").read_text() == "mine\n"
 
 
+def test_output_through_a_symbolic_link_fills_the_folder_it_points_at(tmp_path):
+    (tmp_path / "real").mkdir()
+    (tmp_path / "link").symlink_to(tmp_path / "real")
+    r = martello("run", P1, "-o", tmp_path / "link")
+    assert r.returncode == 0, r.stderr
+    assert (tmp_path / "link").is_symlink() and (tmp_path / "real" / "summary.json").is_file()
+    r = martello("run", P1, "-o", tmp_path / "link")       # again: replaced in place
+    assert r.returncode == 0, r.stderr
+    assert (tmp_path / "link").is_symlink() and (tmp_path / "real" / "summary.json").is_file()
+    (tmp_path / "dangling").symlink_to(tmp_path / "nowhere")
+    one_line_error(martello("run", P1, "-o", tmp_path / "dangling"),
+                   "dangling: is a symbolic link to no folder")
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["dangling", "link", "real"]
+
+
 def test_output_folder_of_something_else_is_not_replaced(tmp_path):
     (tmp_path / "notes").mkdir()
     (tmp_path / "notes" / "mine.txt").write_text("keep\n")

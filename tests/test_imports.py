@@ -20,9 +20,9 @@ def module_name(path):
 
 
 FILES = {module_name(p): p for p in sorted(PACKAGE.rglob("*.py"))}
-# martello.__main__ runs the command line when imported (python -m martello, tested in
-# test_cli.py): it is a script, not a module to import.
-MODULES = sorted(m for m in FILES if m != "martello.__main__")
+# martello.__main__ runs the command line only as a script (python -m martello), so it
+# imports like any other module.
+MODULES = sorted(FILES)
 
 
 def imports_of(name):
@@ -107,7 +107,8 @@ LAYERS = [("martello.errors", "martello.paths", "martello.history", "martello.in
           ("martello.run",), ("martello.batch",),
           ("martello.metrics",), ("martello.reference",),
           ("martello.checks",),
-          ("martello.study", "martello.compare", "martello.report", "martello.export"),
+          ("martello.study", "martello.compare", "martello.report", "martello.export",
+           "martello.testset"),
           ("martello.plot",), ("martello.api",), ("martello.cli",), ("martello.__main__", "martello")]
 
 

@@ -130,7 +130,7 @@ def test_integrator_kinds_are_their_rows_in_order():
 
 def test_loader_tables_are_the_librarys():
     assert scene.INTEGRATORS == native.integrators()
-    assert scene.ADAPTIVE == native.adaptive_integrators() == ("rkf45", "rk8pd", "msbdf", "ida")
+    assert scene.ADAPTIVE == native.adaptive_integrators() == ("rkf45", "rk8pd", "msbdf", "ida", "cvode", "arkode")
     assert COMPATIBLE == native.compatibility()
     assert set(COMPATIBLE) == set(scene.SCHEMES) == set(native.names("schemes"))
     assert scene.LAWS == native.names("laws")
@@ -148,6 +148,10 @@ def test_loader_defaults_and_ranges_are_the_librarys():
     ranges = native.settings_ranges()
     for name, default in native.settings_defaults().items():
         kind, required, check, scene_default = spec[name]
+        if name == "method":   # a name in the scene (a row of the table methods), a value in the library
+            assert kind == "str" and scene_default is None
+            assert set().union(*scene.METHODS.values()) == set(native.names("methods"))
+            continue
         if not required and name not in ("beta", "gamma", "alpha", "rho_inf"):
             assert scene_default == default and type(scene_default) is type(default), name
         if kind != "bool":

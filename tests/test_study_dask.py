@@ -28,7 +28,8 @@ rtol = [1e-6, 1e-8, 1e-10]
 
 # Starts a LocalCluster of two worker processes (one thread each, as docs/studies.md asks of
 # real workers) and runs the study on it through the command line, the cluster named by the
-# study file's own `scheduler` key (written at the top of a copy of it).
+# study file's own `scheduler` key (written at the top of a copy of it), which the command
+# line must allow (--use-study-scheduler).
 DASK_RUN = """
 import sys, time
 from pathlib import Path
@@ -41,7 +42,7 @@ if __name__ == "__main__":
         t1 = time.perf_counter()
         study = Path(sys.argv[1]).with_name("on_dask.toml")
         study.write_text(f'scheduler = "{cluster.scheduler_address}"\\n' + Path(sys.argv[1]).read_text())
-        rc = main(["study", str(study), "-o", sys.argv[2]])
+        rc = main(["study", str(study), "-o", sys.argv[2], "--use-study-scheduler"])
         print(f"cluster start {t1 - t0:.1f} s, study {time.perf_counter() - t1:.1f} s")
     sys.exit(rc)
 """
@@ -67,7 +68,8 @@ def test_dask_study_equals_the_local_study_row_for_row(tmp_path):
     r = subprocess.run([sys.executable, str(script), str(study), str(tmp_path / "dask")], cwd=ROOT,
                        capture_output=True, text=True, timeout=240)
     assert r.returncode == 0, r.stderr[-3000:]
-    assert "runs on the Dask cluster at tcp://127.0.0.1:" in r.stderr and "(2 worker(s))" in r.stderr
+    assert "runs on the Dask cluster at tcp://127.0.0.1:" in r.stderr and "2 worker(s))" in r.stderr
+    assert "on_dask.toml, used by --use-study-scheduler" in r.stderr
     a, b = rows(tmp_path / "local" / "runs.csv"), rows(tmp_path / "dask" / "runs.csv")
     assert len(a) == len(b) == 16
     assert list(a[0]) == list(b[0])                   # the same columns, in the same order
@@ -81,14 +83,37 @@ def test_dask_study_equals_the_local_study_row_for_row(tmp_path):
     print(f"local study {local_s:.1f} s; {r.stdout.strip()}")
 
 
-def test_a_scheduler_that_does_not_answer_is_one_error():
+def test_a_scheduler_that_does_not_answer_is_one_error_saying_where_the_address_came_from():
     # port 9 (discard) on the loopback: nothing listens there
     t0 = time.perf_counter()
-    with pytest.raises(MartelloError, match=r"--scheduler tcp://127.0.0.1:9: no Dask scheduler "
-                                            r"answers there .*start one with `dask scheduler`"):
+    with pytest.raises(MartelloError, match=r"the Dask scheduler tcp://127.0.0.1:9 \(given by "
+                                            r"--scheduler\): no Dask scheduler answers there .*"
+                                            r"start one with `dask scheduler`"):
         with dask_executor("tcp://127.0.0.1:9", timeout=2):
             pass
     assert time.perf_counter() - t0 < 30
+    with pytest.raises(MartelloError, match=r"tcp://127.0.0.1:9 \(the scheduler of s.toml, used "
+                                            r"by --use-study-scheduler\): no Dask scheduler"):
+        with dask_executor("tcp://127.0.0.1:9", "the scheduler of s.toml, used by "
+                           "--use-study-scheduler", timeout=2):
+            pass
+
+
+def test_a_study_file_does_not_choose_the_machine_its_runs_go_to(tmp_path, capsys):
+    """A study file's `scheduler` is not used unless the command line says so: the study runs
+    on local processes (nothing listens at port 9: connecting there would fail) and a note
+    says why."""
+    study = tmp_path / "s.toml"
+    study.write_text('scheduler = "tcp://127.0.0.1:9"\n' + TINY)
+    assert main(["study", str(study), "-o", str(tmp_path / "out"), "-j", "2", "--no-plots"]) == 0
+    err = capsys.readouterr().err
+    assert (f"note: {study} names a Dask scheduler (scheduler = 'tcp://127.0.0.1:9'), not used: "
+            "the runs go to local processes (--use-study-scheduler runs them there)") in err
+    assert "worker(s)" in err and "Dask cluster" not in err
+    t0 = time.perf_counter()
+    rc = main(["study", str(study), "-o", str(tmp_path / "out2"), "--use-study-scheduler"])
+    assert rc == 1 and "tcp://127.0.0.1:9 (the scheduler of" in capsys.readouterr().err
+    assert not (tmp_path / "out2").exists()
 
 
 def test_the_atlas_refuses_a_scheduler(capsys):

@@ -43,7 +43,12 @@ def lib():
         raise MartelloError(
             f"native library not found at {path}: build it with ./scripts/build "
             "(or point MARTELLO_LIB at libmartello.so)")
-    L = ctypes.CDLL(str(path))
+    try:
+        L = ctypes.CDLL(str(path))
+    except OSError as exc:        # not a shared library, another architecture, a missing dependency
+        raise MartelloError(f"cannot load the native library {path}: {' '.join(str(exc).split())} "
+                            "(rebuild it with ./scripts/build, or point MARTELLO_LIB at a "
+                            "working libmartello.so)") from None
     c_int, c_double, c_char_p = ctypes.c_int, ctypes.c_double, ctypes.c_char_p
     protos = {
         "martello_version": (c_char_p, []),
@@ -105,7 +110,12 @@ def lib():
         "martello_write_csv": (c_int, [c_char_p, c_char_p, _DOUBLE_P, ctypes.c_int64, c_int]),
     }
     for name, (res, args) in protos.items():
-        fn = getattr(L, name)
+        try:
+            fn = getattr(L, name)
+        except AttributeError:    # a library of another version of martello
+            raise MartelloError(f"the native library {path} has no function {name}: it is not "
+                                "the version this package needs (rebuild it with ./scripts/build, "
+                                "or point MARTELLO_LIB at the matching libmartello.so)") from None
         fn.restype, fn.argtypes = res, args
     return L
 

@@ -73,6 +73,9 @@ class OpenSeesModel:
     files: dict = field(default_factory=dict)     # data files the script reads: name -> text
     mapping: list = field(default_factory=list)   # (martello item, OpenSees object) lines
     differences: list = field(default_factory=list)
+    contact_materials: list = field(default_factory=list)   # (contact, law, material)
+    integrator: str = ""
+    energy: dict = field(default_factory=dict)   # what energy:kinetic and energy:recoverable sum
 
 
 def _kelvin_e(xi):
@@ -114,8 +117,10 @@ class _Builder:
 
     # --- refusals -------------------------------------------------------------------------
     def refuse(self, what, why, fix=None):
-        raise ExportError(f"{self.src}: {what}: cannot be exported to OpenSees ({why}"
+        exc = ExportError(f"{self.src}: {what}: cannot be exported to OpenSees ({why}"
                           + (f"; {fix}" if fix else "") + ")")
+        exc.what, exc.why = what, why
+        raise exc
 
     def check_scene(self):
         s, an = self.s, self.an
@@ -124,8 +129,9 @@ class _Builder:
                         "the static problems have closed forms of their own")
         if an["integrator"] not in NEWMARK_FAMILY:
             self.refuse(f"analysis.integrator = {an['integrator']}",
-                        "OpenSees has no event-driven, DAE, Moreau–Jean or modal (fast "
-                        "nonlinear) integrator; its transient integrators are the Newmark family",
+                        "OpenSees' transient integrators are the Newmark family: it has no "
+                        "event-driven, ODE or DAE (GSL, CVODE, ARKODE, IDA), Moreau–Jean or modal "
+                        "(fast nonlinear) integrator",
                         "give --integrator newmark, hht, generalized-alpha or central-difference "
                         "and --dt")
         if s.couplings:
@@ -179,6 +185,9 @@ class _Builder:
     def tag(self, i):
         return self.ground if i < 0 else self.node_tag[i]
 
+    def etag(self, i):
+        return 0 if i < 0 else self.node_tag[i]
+
     def add(self, name, *args):
         self.cmds.append(Command(name, tuple(args)))
 
@@ -199,6 +208,7 @@ class _Builder:
         s = self.s
         frames = s.extras.get("frames", [])
         self.ndm, self.ndf = (2, 3) if frames else (1, 1)
+        self.energy = {"kinetic": [], "springs": [], "bilinear": [], "contacts": [], "blocks": []}
         self.add("wipe")
         self.add("model", "basic", "-ndm", self.ndm, "-ndf", self.ndf)
         self.nodes(frames)
@@ -246,6 +256,9 @@ class _Builder:
         # frames side by side, left to right in the scene's order: a joint between one
         # frame's last column line and the next one's first is a zero-length element
         self.x0 = 0.0
+        for i, n in enumerate(s.nodes):
+            if not n["fixed"] and self.node_tag[i]:
+                self.energy["kinetic"].append((self.node_tag[i], n["mass"]))
         for fr in frames:
             tag = self.frame(fr, tag)
             self.x0 += float(fr["frame"].x[-1])
@@ -287,8 +300,11 @@ class _Builder:
                 floor += 1
                 master = joint[(line, floor)]
             self.node_tag[i] = master
+            self.energy["kinetic"].append((master, float(masses[k])))
             self.add("mass", master, float(masses[k]), 0.0, 0.0)
             self.map.append((f"frame node {name} (m = {masses[k]:g} kg)", f"node {master}"))
+        self.energy["blocks"].append(([self.node_tag[s.index[nm]] for nm in fr["nodes"]],
+                                      [[float(x) for x in row] for row in fr["K"]]))
         a0, a1 = fr["rayleigh"]
         if fr["zeta"] > 0:
             self.region = getattr(self, "region", 0) + 1
@@ -335,10 +351,15 @@ class _Builder:
                 self.refuse(f"link {name}", f"link type {kind}")
             ele = self.zero_length(i, j, mat)
             self.map.append((f"link {name} ({kind})", f"zeroLength {ele}: {what}"))
+            ta, tb = self.etag(lk["a"]), self.etag(lk["b"])      # ground: 0 in the energies
+            if kind in ("spring", "bar"):
+                self.energy["springs"].append((ta, tb, lk["k"] if kind == "spring" else lk["EA"] / lk["L"]))
+            elif kind == "bilinear":
+                self.energy["bilinear"].append((ele, ta, tb, lk["k"], lk["hardening"]))
 
     def contacts(self):
         s = self.s
-        self.contact_ele = []
+        self.contact_ele, self.contact_mat = [], []
         mass = [n["mass"] for n in s.nodes]
         fixed = [n["fixed"] for n in s.nodes]
         for ci, c in enumerate(s.contacts):
@@ -392,6 +413,8 @@ class _Builder:
                             f"n = {law.n:g}")
             ele = self.zero_length(i, j, mat)
             self.contact_ele.append(ele)
+            self.contact_mat.append((name, law.law, mat_kind))
+            self.energy["contacts"].append((self.etag(a), self.etag(b), gap, law.K, law.n))
             self.map.append((f"contact {name} ({law.law}, K = {law.K:g}, n = {law.n:g}, damping = "
                              f"{law.c:g}, gap = {gap:g})", f"zeroLength {ele}: {what}"))
 
@@ -625,10 +648,13 @@ class _Builder:
             tb = 0 if c["b"] < 0 else self.node_tag[c["b"]]
             cols.append(Column(f"penetration:{nm}", "penetration", (ta, tb, float(c["gap"]))))
             cols.append(Column(f"force:{nm}", "force", (self.contact_ele[ci],)))
+        cols += [Column("energy:kinetic", "energy", ("kinetic",)),
+                 Column("energy:recoverable", "energy", ("recoverable",))]
         return OpenSeesModel(title=s.title, source=str(s.source), ndm=self.ndm, ndf=self.ndf,
                              commands=self.cmds, columns=cols, dt=self.dt, steps=self.steps,
                              every=self.every, files=self.files, mapping=self.map,
-                             differences=self.diff)
+                             differences=self.diff, contact_materials=self.contact_mat,
+                             integrator=self.an["integrator"], energy=self.energy)
 
 
 class _File(str):

@@ -57,7 +57,32 @@ def _sample_py(col):
         return f"{ua} - {ub} - {_py(a[2])}"
     if k == "force":
         return f"-ops.eleResponse({a[0]}, 'basicForce')[0]"
+    if k == "energy":
+        return f"{a[0]}()"
     raise ValueError(k)                    # pragma: no cover
+
+
+def _energy_py(e):
+    """kinetic() and recoverable(): ½ vᵀMv, and the stored energy of docs/results.md's
+    `recoverable` (springs and bars ½k du², bilinear springs ρk du²/2 + F_p²/(2(1 − ρ)k),
+    penalty contacts K δ^(n+1)/(n + 1), frames ½ uᵀK*u with martello's condensed K*)."""
+    out = ["def u(tag):", "    return ops.nodeDisp(tag, 1) if tag else 0.0", "", "",
+           "def kinetic():",
+           f"    return 0.5 * sum(m * ops.nodeVel(tag, 1) ** 2 for tag, m in {e['kinetic']!r})", "", "",
+           "def recoverable():", "    w = 0.0",
+           f"    for a, b, k in {e['springs']!r}:", "        w += 0.5 * k * (u(a) - u(b)) ** 2",
+           f"    for ele, a, b, k, rho in {e['bilinear']!r}:",
+           "        du = u(a) - u(b)",
+           "        fp = ops.eleResponse(ele, 'basicForce')[0] - rho * k * du",
+           "        w += 0.5 * rho * k * du * du + fp * fp / (2.0 * (1.0 - rho) * k)",
+           f"    for a, b, gap, K, n in {e['contacts']!r}:",
+           "        d = u(a) - u(b) - gap",
+           "        w += K * d ** (n + 1) / (n + 1) if d > 0 else 0.0",
+           f"    for tags, K in {e['blocks']!r}:",
+           "        x = [u(t) for t in tags]",
+           "        w += 0.5 * sum(x[i] * K[i][j] * x[j] for i in range(len(x)) for j in range(len(x)))",
+           "    return w"]
+    return out
 
 
 def _sample_tcl(col):
@@ -93,7 +118,7 @@ def python_script(model, version, scene_path):
     for name, args in model.commands:
         if name != "endPattern":              # Tcl's closing brace of a Plain pattern
             out.append(f"    ops.{name}({', '.join(_py(a) for a in args)})")
-    out += ["", "",
+    out += ["", ""] + _energy_py(model.energy) + ["", "",
             "def sample(t):",
             "    return [" + ", ".join(_sample_py(c) for c in model.columns) + "]",
             "", "",
@@ -136,13 +161,14 @@ def tcl_script(model, version, scene_path):
         else:
             out.append(("    " if out[-1].endswith("{") or out[-1].startswith("    load") else "")
                        + " ".join([name] + [_tcl(a) for a in args]))
-    fmt = ",".join(["%.17g"] * len(model.columns))
+    cols = [c for c in model.columns if c.kind != "energy"]    # the energies: model.py only
+    fmt = ",".join(["%.17g"] * len(cols))
     out += ["",
             f"set dt {_tcl(model.dt)}",
             f"set steps {model.steps}",
             f"set every {model.every}",
             "proc sample {t} {",
-            f"    return [format \"{fmt}\" " + " ".join(_sample_tcl(c) for c in model.columns) + "]",
+            f"    return [format \"{fmt}\" " + " ".join(_sample_tcl(c) for c in cols) + "]",
             "}",
             "set rows [list [sample 0.0]]",
             "for {set k 1} {$k <= $steps} {incr k} {",
@@ -153,7 +179,7 @@ def tcl_script(model, version, scene_path):
             "    if {$k % $every == 0 || $k == $steps} { lappend rows [sample [expr {$k * $dt}]] }",
             "}",
             f"set f [open {HISTORY}.part w]",
-            f"puts $f \"{','.join(c.name for c in model.columns)}\"",
+            f"puts $f \"{','.join(c.name for c in cols)}\"",
             "foreach r $rows { puts $f $r }",
             "close $f",
             f"file rename -force {HISTORY}.part {HISTORY}",

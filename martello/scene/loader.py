@@ -22,7 +22,7 @@ from .fields import (ANY, MAX_DEPTH, NONNEG, POSITIVE, check_fields, choice, fin
                      kind_ok)
 from .spec import (ALL_SPECIFIC, ANALYSIS_TYPES, CONTACT_COMMON, CONTACT_SCHEMES,
                    ARRAY_ITEMS, FIXED_EXPONENT, FUNCTION_TYPES, GROUND, INTEGRATOR_KEYS,
-                   INTEGRATORS, LARGE_SCENE_TRACKS, LAWS, LINK_COMMON, LINK_TYPES,
+                   INTEGRATORS, LARGE_SCENE_TRACKS, LAWS, LINK_COMMON, LINK_TYPES, METHODS,
                    NEWMARK_PRESETS, NODE_KEYS, OUTPUT_KEYS, SCHEMES, TOP_KEYS, TRACKABLE)
 
 
@@ -425,6 +425,8 @@ def _dynamic_analysis(src, raw, an, index, contacts, links):
             elif an["beta"] is None or an["gamma"] is None:
                 raise SceneError(src, "analysis.beta" if an["beta"] is None else "analysis.gamma",
                                  "missing", "Newmark needs both beta and gamma (or a preset)")
+    if an.get("method") is not None:
+        choice(src, "analysis.method", an["method"], METHODS[integ])
     if integ == "hht" and an["alpha"] is None:
         raise SceneError(src, "analysis.alpha", "missing", "HHT needs alpha in [-1/3, 0]")
     if integ == "generalized-alpha" and an["rho_inf"] is None:

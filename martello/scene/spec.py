@@ -69,6 +69,15 @@ INTEGRATORS = native.integrators()
 ADAPTIVE = native.adaptive_integrators()
 
 
+# The methods of the SUNDIALS ODE integrators by integrator (the library's table methods;
+# docs/sundials-ode.md): the names analysis.method takes.
+METHODS = {i: tuple(r.name for r in native.registry("methods")
+                    if int(r.values["integrator"]) == native.value("integrators", i))
+           for i in INTEGRATORS}
+# what method = 0 (none given) runs (c/sundials_ode.c, the registry's texts say "default")
+DEFAULT_METHODS = {"cvode": "bdf", "arkode": "dormand-prince-7-4-5"}
+
+
 def _setting(kind, name, required=False, default=True):
     """A key that is a native setting: the library's valid range and, unless required or
     default=False, its default (the registry's table settings)."""
@@ -110,6 +119,7 @@ ANALYSIS_TYPES = {
                 "max_steps": _whole(_setting("float", "max_steps")),
                 "max_wall": _setting("float", "max_wall"),
                 "event_split": _setting("bool", "event_split"),
+                "method": ("str", False, None, None),
                 "output": ("table", False, None, None)},
 }
 OUTPUT_KEYS = {"every": _setting("int", "every"), "nodes": ("list", False, None, None),

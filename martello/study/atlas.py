@@ -458,7 +458,8 @@ def main(args):
     atlas = load_atlas(args.study)
     out = Path(args.output) if args.output else (OUTPUT_ROOT / atlas["output"] if atlas["output"]
                                                  else Path("out") / "studies" / Path(args.study).stem)
-    rows, bounds = run_atlas(atlas, out, jobs=getattr(args, "jobs", 0) or 0)
+    rows, bounds = run_atlas(atlas, out, jobs=getattr(args, "jobs", 0) or 0,
+                             plots=not getattr(args, "no_plots", False))
     counts = {}
     for r in rows:
         counts[r["class"]] = counts.get(r["class"], 0) + 1

@@ -46,20 +46,22 @@ class DaskExecutor(Executor):
 
 
 @contextmanager
-def dask_executor(address, timeout=CONNECT_TIMEOUT_S):
+def dask_executor(address, origin="given by --scheduler", timeout=CONNECT_TIMEOUT_S):
     """(executor, number of workers) on the Dask scheduler at address (tcp://host:port, or a
-    scheduler file's path); the client is closed on exit. MartelloError with one line
-    naming the fix when Dask is missing or nothing answers."""
+    scheduler file's path); the client is closed on exit. `origin` says where the address
+    came from (every message names it). MartelloError with one line naming the fix when Dask
+    is missing or nothing answers."""
+    where = f"the Dask scheduler {address} ({origin})"
     try:
         from distributed import Client
     except ImportError:
-        raise MartelloError("--scheduler needs Dask's distributed scheduler: "
-                            "pip install 'dask[distributed]' (requirements.txt)") from None
+        raise MartelloError(f"{where}: running on a Dask cluster needs Dask's distributed "
+                            "scheduler: pip install 'martello[dask]'") from None
     kwargs = {"scheduler_file": address} if str(address).endswith(".json") else {"address": address}
     try:
         client = Client(timeout=timeout, **kwargs)
     except (OSError, TimeoutError, ValueError) as exc:
-        raise MartelloError(f"--scheduler {address}: no Dask scheduler answers there "
+        raise MartelloError(f"{where}: no Dask scheduler answers there "
                             f"({type(exc).__name__}: {str(exc).splitlines()[0] if str(exc) else ''}); "
                             f"start one with `dask scheduler` and workers with `dask worker "
                             f"{address} --nthreads 1`") from None
@@ -67,7 +69,7 @@ def dask_executor(address, timeout=CONNECT_TIMEOUT_S):
         try:
             client.wait_for_workers(1, timeout=timeout)
         except TimeoutError:
-            raise MartelloError(f"--scheduler {address}: the scheduler has no worker after {timeout} s; "
+            raise MartelloError(f"{where}: the scheduler has no worker after {timeout} s; "
                                 f"start some with `dask worker {address} --nthreads 1`") from None
         workers = len(client.nthreads())
         yield DaskExecutor(client), workers

@@ -368,21 +368,43 @@ def run_study(study, outdir, jobs=0, plots=True, stream=None, executor=None, whe
     return rows, order_rows
 
 
+def scheduler_of(args, study, stream=None):
+    """(address, where it came from) of the Dask scheduler the study runs on, or (None, None)
+    for local processes. Only the command line names one: --scheduler ADDRESS, or the study
+    file's `scheduler` when --use-study-scheduler says so (Dask exchanges pickled objects with
+    its scheduler: a study file from someone else must not make this machine connect to a
+    server of their choosing). A file's scheduler not used is said in a note."""
+    given = getattr(args, "scheduler", None)
+    if given:
+        return given, "given by --scheduler"
+    if not study.scheduler:
+        return None, None
+    if not getattr(args, "use_study_scheduler", False):
+        print(f"note: {study.path} names a Dask scheduler (scheduler = {study.scheduler!r}), "
+              "not used: the runs go to local processes (--use-study-scheduler runs them there)",
+              file=stream or sys.stderr)
+        return None, None
+    address = study.scheduler
+    if address.endswith(".json") and not Path(address).is_absolute():
+        address = str(study.path.parent / address)     # a scheduler file beside the study file
+    return address, f"the scheduler of {study.path}, used by --use-study-scheduler"
+
+
 def main(args):
     path = Path(args.study)
     study = load_study(path)
     out = Path(args.output) if args.output else (OUTPUT_ROOT / study.output if study.output
                                                  else Path("out") / "studies" / path.stem)
-    scheduler = getattr(args, "scheduler", None) or study.scheduler
-    if scheduler and not getattr(args, "scheduler", None) and scheduler.endswith(".json"):
-        scheduler = str(path.parent / scheduler)     # a scheduler file beside the study file
+    scheduler, origin = scheduler_of(args, study)
+    plots = not getattr(args, "no_plots", False)
     if scheduler:
         from .cluster import dask_executor
-        with dask_executor(scheduler) as (executor, workers):
-            rows, order_rows = run_study(study, out, executor=executor,
-                                         where=f"the Dask cluster at {scheduler} ({workers} worker(s))")
+        with dask_executor(scheduler, origin) as (executor, workers):
+            rows, order_rows = run_study(study, out, executor=executor, plots=plots,
+                                         where=f"the Dask cluster at {scheduler} ({origin}; "
+                                               f"{workers} worker(s))")
     else:
-        rows, order_rows = run_study(study, out, jobs=getattr(args, "jobs", 0) or 0)
+        rows, order_rows = run_study(study, out, jobs=getattr(args, "jobs", 0) or 0, plots=plots)
     counts = {}
     for r in rows:
         counts[r["classification"]] = counts.get(r["classification"], 0) + 1

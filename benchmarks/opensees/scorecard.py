@@ -1,0 +1,241 @@
+"""The OpenSees scorecard (docs/opensees-scorecard.md): which catalogue scenes OpenSees can run,
+and how well it runs them.
+
+    .venv/bin/python benchmarks/opensees/scorecard.py [-o out/opensees-scorecard] [--only TEXT]
+        [--docs]        # regenerate docs/opensees-scorecard.md (both parts)
+        [--check]       # compare the committed doc's deterministic part with the catalogue's (CI)
+
+For every dynamic catalogue scene the exporter (martello export --to opensees) either maps it
+with its own integrator and step, maps it only with another integrator (an event-driven,
+Moreau–Jean or modal scene: OpenSees has none of them), or refuses it with a reason: that
+table is deterministic (the catalogue and the exporter only) and CI checks the committed copy
+(tests/test_export.py). For the scenes it maps as they are, the script exports them, runs the
+exported model.py under this interpreter's openseespy, runs martello on the same scene and
+scores both with `martello compare` against martello's reference (closed form, stored data or a
+reference computed on demand and cached: docs/reference.md). The three numbers split
+OpenSees' error: martello's own digits at the same integrator and step are the numerical error
+of the method; OpenSees against martello (max |Δu| over max |u|) is the difference of the two
+models (a material law, HHT's state interpolation, Hertzdamp's v_in: docs/opensees.md); the
+realised e against the reference's says which of the two moved the law. That part is measured
+(it depends on the machine's OpenSees) and is regenerated, not checked, by CI."""
+
+import argparse
+import json
+import os
+import re
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+HERE = Path(__file__).resolve().parent
+ROOT = HERE.parent.parent
+DOC = ROOT / "docs" / "opensees-scorecard.md"
+BEGIN_D, END_D = "<!-- scorecard:deterministic -->", "<!-- /scorecard:deterministic -->"
+BEGIN_M, END_M = "<!-- scorecard:measured -->", "<!-- /scorecard:measured -->"
+MAX_NODE_STEPS = 2e6      # larger scenes are listed, not run (--cap): OpenSees takes ~50 us a step
+sys.path.insert(0, str(ROOT))
+
+
+def classify():
+    """[(scene path relative to benchmarks/, problem, status, integrator, dt, materials, why)]
+    for every dynamic catalogue scene: status "as is", "other integrator" or "refused"."""
+    from martello.errors import ExportError
+    from martello.export import opensees_model
+    from martello.scene import catalogue
+    from martello.scene.loader import load
+    rows = []
+    for f in catalogue.scene_files():
+        s = load(f)
+        rel = str(f.relative_to(catalogue.ROOT))
+        an = s.analysis
+        mats = lambda m: ", ".join(sorted({f"{law}→{mat}" for _, law, mat in m.contact_materials})) or "-"  # noqa: E731
+        try:
+            m = opensees_model(s)
+            rows.append((rel, s.problem, "as is", an["integrator"], an.get("dt"), mats(m), ""))
+            continue
+        except ExportError as e:
+            why = _reason(e)
+        try:
+            m = opensees_model(s, analysis={"integrator": "newmark"})
+            rows.append((rel, s.problem, "other integrator", an.get("integrator", "-"), an.get("dt"),
+                         mats(m), why))
+        except ExportError as e:
+            rows.append((rel, s.problem, "refused", an.get("integrator", "static"), an.get("dt"), "-",
+                         _reason(e)))
+    return rows
+
+
+def _reason(e):
+    """A refusal as 'item: why', the item without its position and name (contact[3] (c).)."""
+    what = re.sub(r"^\w+\[\d+\] \([^)]*\)[.: ]*", "", getattr(e, "what", str(e)))
+    what = re.sub(r" \(.*\)$", "", what)
+    return f"{what}: {getattr(e, 'why', '')}".replace("|", "/")
+
+
+def _short(why):
+    return why
+
+
+def deterministic_part(rows):
+    from collections import Counter
+    n = Counter(r[2] for r in rows)
+    out = [BEGIN_D, "",
+           f"Of {len(rows)} catalogue scenes, OpenSees runs **{n['as is']}** as they are (their "
+           f"integrator and step), **{n['other integrator']}** only with a Newmark-family integrator "
+           f"in place of theirs, and **{n['refused']}** not at all.", "",
+           "| status | scenes | by integrator | why (the exporter's words, most frequent) |", "|---|---|---|---|"]
+    for status in ("as is", "other integrator", "refused"):
+        sel = [r for r in rows if r[2] == status]
+        by = Counter(r[3] for r in sel)
+        whys = Counter(_short(r[6]) for r in sel if r[6])
+        out.append(f"| {status} | {len(sel)} | " + ", ".join(f"{k} {v}" for k, v in sorted(by.items()))
+                   + " | " + ("; ".join(f"{w} ({c})" for w, c in whys.most_common(3)) or "-") + " |")
+    out += ["", "Materials the contacts of the scenes run as they are map onto:", "",
+            "| law → material | scenes |", "|---|---|"]
+    mats = Counter(m for r in rows if r[2] == "as is" for m in r[5].split(", "))
+    out += [f"| {m} | {c} |" for m, c in sorted(mats.items())]
+    out += ["", "<details><summary>every scene</summary>", "",
+            "| scene | problem | status | integrator | Δt [s] | law → material |", "|---|---|---|---|---|---|"]
+    out += [f"| `{r[0]}` | {r[1] or '-'} | {r[2]} | {r[3]} | {r[4] if r[4] is not None else '-'} | {r[5]} |"
+            for r in rows]
+    out += ["", "</details>", "", END_D]
+    return "\n".join(out)
+
+
+def _history(path):
+    head = path.read_text().split("\n", 1)[0].split(",")
+    return head, np.loadtxt(path, delimiter=",", skiprows=1, ndmin=2)
+
+
+def score(path, scene, out):
+    r = subprocess.run([sys.executable, "-m", "martello", "compare", str(path), "--against", str(scene),
+                        "-o", str(out)], capture_output=True, text=True, cwd=ROOT)
+    if r.returncode:
+        return {"error": r.stderr.strip().splitlines()[-1] if r.stderr.strip() else "compare failed"}
+    return json.loads(out.read_text())["metrics"]
+
+
+def measure(rows, out, only=None, cap=MAX_NODE_STEPS):
+    """Run the scenes OpenSees takes as they are; returns measured rows."""
+    from martello.scene import catalogue
+    from martello.scene.loader import load
+    res = []
+    for rel, problem, status, integ, dt, mats, _ in rows:
+        if status != "as is" or (only and only not in rel):
+            continue
+        scene = catalogue.ROOT / rel
+        s = load(scene)
+        size = len(s.nodes) * s.analysis["t_end"] / s.analysis["dt"]
+        if size > cap:
+            res.append({"scene": rel, "problem": problem, "integrator": integ, "dt": dt, "materials": mats,
+                        "opensees": f"not measured: {size:.2g} node-steps (cap {cap:.0e})"})
+            continue
+        work = out / rel.replace("/", "__").removesuffix(".toml")
+        t0 = time.time()
+        r = subprocess.run([sys.executable, "-m", "martello", "export", str(scene), "-o", str(work / "os")],
+                           capture_output=True, text=True, cwd=ROOT)
+        row = {"scene": rel, "problem": problem, "integrator": integ, "dt": dt, "materials": mats}
+        if r.returncode == 0:
+            r = subprocess.run([sys.executable, "model.py"], capture_output=True, text=True, cwd=work / "os",
+                               timeout=3600)
+        if r.returncode:
+            row["opensees"] = "failed: " + (r.stderr.strip().splitlines() or ["?"])[-1][:120]
+            res.append(row)
+            print(f"{rel}: {row['opensees']}", flush=True)
+            continue
+        row["opensees_seconds"] = time.time() - t0
+        m = subprocess.run([sys.executable, "-m", "martello", "run", str(scene), "-o", str(work / "m")],
+                           capture_output=True, text=True, cwd=ROOT)
+        os_score = score(work / "os" / "history.csv", scene, work / "os_score.json")
+        m_score = score(work / "m" / "history.csv", scene, work / "m_score.json") if m.returncode == 0 else {}
+        ho, do = _history(work / "os" / "history.csv")
+        if m.returncode == 0:
+            hm, dm = _history(work / "m" / "history.csv")
+            us = [c for c in ho if c.startswith("u:") and c in hm]
+            n = min(len(do), len(dm))
+            if us and n and np.array_equal(do[:n, 0], dm[:n, 0]):
+                diff = max(np.max(np.abs(do[:n, ho.index(c)] - dm[:n, hm.index(c)])) for c in us)
+                peak = max(np.max(np.abs(dm[:n, hm.index(c)])) for c in us)
+                row["os_vs_martello"] = float(diff / peak) if peak > 0 else float(diff)
+        row.update(os=os_score, martello=m_score)
+        res.append(row)
+        print(f"{rel}: OpenSees scd {os_score.get('scd')}, martello scd {m_score.get('scd')}, "
+              f"|OS - martello| {row.get('os_vs_martello')}", flush=True)
+    return res
+
+
+def _f(x, fmt):
+    return "–" if x is None or (isinstance(x, float) and not np.isfinite(x)) else format(x, fmt)
+
+
+def measured_part(res, version):
+    out = [BEGIN_M, "",
+           f"Measured with OpenSees {version} (openseespy), `benchmarks/opensees/scorecard.py --docs`: each "
+           "scene at its own integrator and step. scd: significant correct digits of u against martello's "
+           "reference ([compare.md](compare.md)); impacts: found / in the reference; e: mean realised "
+           "restitution / the reference's; energy: error of kinetic + recoverable energy at the end over "
+           "the reference's largest (OpenSees' own bookkeeping in model.py); |OS − m|: OpenSees against "
+           "martello at the same settings, max |Δu| over max |u|.", "",
+           "| scene | law → material | integrator | Δt [s] | scd OpenSees | scd martello | impacts OS / ref | e OS / ref | energy OS | \\|OS − m\\| |",
+           "|---|---|---|---|---|---|---|---|---|---|"]
+    for r in res:
+        if "os" not in r:
+            out.append(f"| `{r['scene']}` | {r['materials']} | {r['integrator']} | {r['dt']} | {r.get('opensees')} | | | | | |")
+            continue
+        o, m = r["os"], r["martello"]
+        e = f"{_f(o.get('restitution'), '.4f')} / {_f(o.get('restitution_ref'), '.4f')}"
+        out.append(f"| `{r['scene']}` | {r['materials']} | {r['integrator']} | {r['dt']} | {_f(o.get('scd'), '.2f')} | "
+                   f"{_f(m.get('scd'), '.2f')} | {o.get('impact_count', '–')} / {o.get('impact_count_ref', '–')} | "
+                   f"{e} | {_f(o.get('energy_error'), '.1e')} | {_f(r.get('os_vs_martello'), '.1e')} |")
+    out += ["", END_M]
+    return "\n".join(out)
+
+
+def _replace(text, begin, end, block):
+    i, j = text.find(begin), text.find(end)
+    if i < 0 or j < 0:
+        return text.rstrip() + "\n\n" + block + "\n"
+    return text[:i] + block + text[j + len(end):]
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("-o", "--output", default="out/opensees-scorecard")
+    ap.add_argument("--only", help="measure only scenes whose path contains this text")
+    ap.add_argument("--docs", action="store_true", help=f"regenerate {DOC.relative_to(ROOT)}")
+    ap.add_argument("--check", action="store_true", help="check the committed doc's deterministic part")
+    ap.add_argument("--deterministic", action="store_true", help="regenerate only the doc's deterministic "
+                    "part (seconds, no OpenSees): after adding catalogue scenes")
+    ap.add_argument("--cap", type=float, default=MAX_NODE_STEPS, help="largest nodes x steps to run")
+    args = ap.parse_args()
+    rows = classify()
+    det = deterministic_part(rows)
+    if args.check:
+        text = DOC.read_text()
+        i, j = text.find(BEGIN_D), text.find(END_D)
+        ok = i >= 0 and text[i:j + len(END_D)] == det
+        print("docs/opensees-scorecard.md: deterministic part " + ("up to date" if ok else
+              "differs from the catalogue's: run .venv/bin/python benchmarks/opensees/scorecard.py "
+              "--deterministic"))
+        return 0 if ok else 1
+    if args.deterministic:
+        DOC.write_text(_replace(DOC.read_text(), BEGIN_D, END_D, det))
+        return 0
+    import openseespy.opensees as ops
+    out = Path(args.output)
+    out.mkdir(parents=True, exist_ok=True)
+    res = measure(rows, out, args.only, args.cap)
+    (out / "scorecard.json").write_text(json.dumps({"classification": rows, "measured": res}, indent=1, default=str))
+    meas = measured_part(res, ops.version())
+    print(meas)
+    if args.docs:
+        text = DOC.read_text() if DOC.exists() else "# The OpenSees scorecard\n"
+        DOC.write_text(_replace(_replace(text, BEGIN_D, END_D, det), BEGIN_M, END_M, meas))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
