@@ -258,56 +258,26 @@ contains
       self%factored = .false.
    end subroutine chain_init
 
-   !> The forward sweep of the first iterate (martello_chain_step linearised_sweep) on explicit-shape arrays (no descriptors, no aliasing: the
-   !> compiler keeps everything in registers but the arrays).
+   !> The forward sweep of the first iterate (linearised_sweep) on explicit-shape arrays (no
+   !> descriptors, no aliasing: the compiler keeps everything in registers but the arrays);
+   !> forward_usual is the same sweep (forward_sweep.inc) with the usual chain's flags and
+   !> strides as constants.
    subroutine forward_kernel(n, h, gm, c1, c2, cv, acc, pl, kel, oth, pcs, fx, sk, sc, vn, an, &
                              sm, mass, fe, rp, cg, kp, cp, pk, pc, brf, xcd, xco, xjo, fixed)
       integer, intent(in), value :: n, sk, sc, sm
       real(dp), intent(in), value :: h, gm, c1, c2, cv, acc
       logical, intent(in), value :: pl, kel, oth, pcs, fx
-      real(dp), intent(in) :: vn(0:n), an(0:n), mass(*), rp(n), cg(n), kp(0:*), cp(0:*), &
-                              pk(0:*), pc(0:*), xcd(0:*), xco(0:*), xjo(0:*)
-      integer(int8), intent(in) :: brf(0:n)
-      logical, intent(in) :: fixed(n)
-      real(dp), intent(inout) :: fe(0:n)     !< in: the committed internal force; out: y
-      integer :: i
-      real(dp) :: dvm, dv0, dvp, a0, ap, cdv, cd, co, com, ym, g1, lm
-      ! a₀ = −c₁vₙ − c₂aₙ and Δv₀ = v₀ − vₙ = h((1 − γ)aₙ + γa₀) of each node
-      g1 = 1.0_dp - gm
-      dvm = 0.0_dp; com = 0.0_dp; ym = 0.0_dp; lm = 0.0_dp
-      a0 = -c1*vn(1) - c2*an(1)
-      dv0 = h*(g1*an(1) + gm*a0)
-      do i = 1, n
-         ap = 0.0_dp; dvp = 0.0_dp
-         if (i < n) then
-            ap = -c1*vn(i + 1) - c2*an(i + 1)
-            dvp = h*(g1*an(i + 1) + gm*ap)
-         end if
-         ! C_t(i, i) and C_t(i, i+1) on the factors' branches
-         cd = cg(i); co = 0.0_dp
-         if (pl) then
-            cd = cd + cp(i - 1) + cp(i); co = -cp(i)
-         end if
-         if (kel) then
-            if (brf(i - 1) == BRANCH_ON) cd = cd + pc((i - 1)*sc)
-            if (brf(i) == BRANCH_ON) then
-               cd = cd + pc(i*sc); co = co - pc(i*sc)
-            end if
-         end if
-         if (oth) then
-            cd = cd + xcd(i); co = co + xco(i)
-         end if
-         cdv = cd*dv0
-         if (pl .or. kel .or. oth) cdv = cdv + com*dvm + co*dvp    ! (0·x is not folded)
-         ym = mass(1 + (i - 1)*sm)*(acc - a0) - fe(i) - cdv - lm*ym
-         fe(i) = ym
-         dvm = dv0; dv0 = dvp; a0 = ap; com = co
-         ! L(i+1, i) for the next node
-         if (i < n) lm = coupling(i, cv, pl, pcs, oth, fx, sk, sc, kp, cp, pk, pc, brf, xjo, &
-                                  fixed)*rp(i)
-      end do
-      fe(0) = 0.0_dp
+      include 'forward_sweep.inc'
    end subroutine forward_kernel
+
+   subroutine forward_usual(n, h, gm, c1, c2, cv, acc, vn, an, mass, fe, rp, cg, kp, cp, pk, pc, &
+                            brf, xcd, xco, xjo, fixed)
+      integer, intent(in), value :: n
+      real(dp), intent(in), value :: h, gm, c1, c2, cv, acc
+      logical, parameter :: pl = .false., kel = .false., oth = .false., pcs = .true., fx = .false.
+      integer, parameter :: sk = 0, sc = 0, sm = 0
+      include 'forward_sweep.inc'
+   end subroutine forward_usual
 
    !> The forward sweep after a branch change (martello_chain_step refactor_sweep): J on the
    !> current branches factorised, the residual forward-substituted; ok = .false. on a pivot
@@ -384,102 +354,41 @@ contains
       end if
    end function coupling
 
-   !> The backward sweep and the elements at the new iterate (martello_chain_step evaluate) (no descriptors, no aliasing). The parameter
-   !> arrays of the pair contacts are read at i·stride (stride 0: one value for the chain).
+   !> The backward sweep and the elements at the new iterate (evaluate) on explicit-shape
+   !> arrays (no descriptors, no aliasing). The parameter arrays of the pair contacts are read
+   !> at i·stride (stride 0: one value for the chain). back_usual_start and back_usual_iterate
+   !> are the same sweep (back_sweep.inc) with the usual chain's flags and strides, and from
+   !> where it starts, as constants.
    subroutine back_kernel(n, from_start, pl, pcs, kel, oth, fx, ss, sg, sk, sc, sl, cm, cv, c1, &
                           c2, h, gm, rp, u, v, a, un, vn, an, sm, mass, fe, kg, cg, kp, cp, psgn, &
                           pgap, pk, pc, plaw, pbr, pbrc, pbrf, xjo, fixed, mdu, wd, wl, wc, flip)
       integer, intent(in), value :: n, ss, sg, sk, sc, sl, sm
       logical, intent(in), value :: from_start, pl, pcs, kel, oth, fx
       real(dp), intent(in), value :: cm, cv, c1, c2, h, gm
-      real(dp), intent(in) :: rp(n), un(0:n), vn(0:n), an(0:n), mass(*), kg(n), &
-                              cg(n), kp(0:*), cp(0:*), psgn(0:*), pgap(0:*), pk(0:*), pc(0:*), &
-                              xjo(0:*)
-      logical, intent(in) :: fixed(n)
-      integer(int8), intent(in) :: plaw(0:*), pbrc(0:n), pbrf(0:n)
-      real(dp), intent(inout) :: u(0:n), v(0:n), a(0:n)
-      real(dp), intent(inout) :: fe(0:n)     !< in: y; out: the internal force
-      integer(int8), intent(inout) :: pbr(0:n)
-      real(dp), intent(out) :: mdu, wd, wl, wc
-      logical, intent(out) :: flip
-      integer :: i
-      integer(int8) :: br, law
-      real(dp) :: x, ui, vi, ai, uni, vni, u1, v1, un1, vn1, fi, f1, du, dun, fp, s, pen, penn, &
-                  f, fn, gp, g1, k, c, hd, lx
-      g1 = 1.0_dp - gm
-      mdu = 0.0_dp; wd = 0.0_dp; wl = 0.0_dp; wc = 0.0_dp; flip = .false.
-      x = 0.0_dp; u1 = 0.0_dp; v1 = 0.0_dp; un1 = 0.0_dp; vn1 = 0.0_dp; f1 = 0.0_dp
-      do i = n, 1, -1
-         ! Δu(i) = D⁻¹y(i) − L(i+1, i)·Δu(i+1)
-         lx = 0.0_dp
-         if (i < n) lx = coupling(i, cv, pl, pcs, oth, fx, sk, sc, kp, cp, pk, pc, pbrf, xjo, &
-                                  fixed)*rp(i)*x
-         x = rp(i)*fe(i) - lx
-         uni = un(i); vni = vn(i)
-         if (from_start) then
-            ! the Newmark a₀, v₀ of u = uₙ, as the general path's kinematics associate them
-            ai = -c1*vni - c2*an(i)
-            vi = vni + h*(g1*an(i) + gm*ai) + cv*x
-            ai = ai + cm*x
-            ui = uni + x
-         else
-            ui = u(i) + x; vi = v(i) + cv*x; ai = a(i) + cm*x
-         end if
-         u(i) = ui; v(i) = vi; a(i) = ai
-         mdu = mdu + mass(1 + (i - 1)*sm)*x
-         ! the links of node i to ground
-         k = kg(i); c = cg(i); hd = 0.5_dp*(ui - uni)
-         fi = k*ui + c*vi
-         wl = wl + k*(uni + ui)*hd
-         wd = wd + c*(vni + vi)*hd
-         if (i < n) then
-            ! the pair (i, i+1): node i+1 is known
-            du = ui - u1; dun = uni - un1
-            if (pl) then
-               fp = kp(i)*du + cp(i)*(vi - v1)
-               wl = wl + 0.5_dp*kp(i)*(dun + du)*(du - dun)
-               wd = wd + 0.5_dp*cp(i)*((vni - vn1) + (vi - v1))*(du - dun)
-               fi = fi + fp; f1 = f1 - fp
-            end if
-            if (pcs) then
-               ! linear or Kelvin (Anagnostopoulos 1988), as martello_contact_laws
-               s = psgn(i*ss); gp = pgap(i*sg)
-               pen = s*du - gp
-               br = BRANCH_OFF; f = 0.0_dp
-               if (pen > 0.0_dp) then
-                  br = BRANCH_ON; f = pk(i*sk)*pen
-                  if (kel) then
-                     law = plaw(i*sl)
-                     if (law /= AFFINE_LINEAR) then
-                        f = f + pc(i*sc)*(s*(vi - v1))
-                        if (law == AFFINE_KELVIN_CLIPPED .and. f <= 0.0_dp) then
-                           f = 0.0_dp; br = BRANCH_CLIPPED
-                        end if
-                     end if
-                  end if
-               end if
-               pbr(i) = br
-               if (br /= pbrf(i)) flip = .true.
-               if (br == BRANCH_ON .or. pbrc(i) == BRANCH_ON) then
-                  ! it pushes at one end of the step at least: its trapezoidal work
-                  penn = s*dun - gp
-                  fn = 0.0_dp
-                  if (pbrc(i) == BRANCH_ON) then
-                     fn = pk(i*sk)*penn
-                     if (kel) fn = fn + pc(i*sc)*(s*(vni - vn1))
-                  end if
-                  wc = wc + 0.5_dp*(fn + f)*(pen - penn)
-               end if
-               fi = fi + s*f; f1 = f1 - s*f
-            end if
-            fe(i + 1) = f1
-         end if
-         f1 = fi
-         u1 = ui; v1 = vi; un1 = uni; vn1 = vni
-      end do
-      fe(1) = f1
-      fe(0) = 0.0_dp
+      include 'back_sweep.inc'
    end subroutine back_kernel
+
+   subroutine back_usual_start(n, cm, cv, c1, c2, h, gm, rp, u, v, a, un, vn, an, mass, fe, kg, &
+                               cg, kp, cp, psgn, pgap, pk, pc, plaw, pbr, pbrc, pbrf, xjo, fixed, &
+                               mdu, wd, wl, wc, flip)
+      integer, intent(in), value :: n
+      real(dp), intent(in), value :: cm, cv, c1, c2, h, gm
+      logical, parameter :: from_start = .true., pl = .false., pcs = .true., kel = .false., &
+                            oth = .false., fx = .false.
+      integer, parameter :: ss = 0, sg = 0, sk = 0, sc = 0, sl = 0, sm = 0
+      include 'back_sweep.inc'
+   end subroutine back_usual_start
+
+   subroutine back_usual_iterate(n, cm, cv, c1, c2, h, gm, rp, u, v, a, un, vn, an, mass, fe, kg, &
+                                 cg, kp, cp, psgn, pgap, pk, pc, plaw, pbr, pbrc, pbrf, xjo, fixed, &
+                                 mdu, wd, wl, wc, flip)
+      integer, intent(in), value :: n
+      real(dp), intent(in), value :: cm, cv, c1, c2, h, gm
+      logical, parameter :: from_start = .false., pl = .false., pcs = .true., kel = .false., &
+                            oth = .false., fx = .false.
+      integer, parameter :: ss = 0, sg = 0, sk = 0, sc = 0, sl = 0, sm = 0
+      include 'back_sweep.inc'
+   end subroutine back_usual_iterate
 
    !> The committed state becomes the start of the next step by swapping the buffers: the
    !> step writes every entry of u, v, a before reading it.
@@ -581,14 +490,13 @@ contains
          real(dp), intent(in), contiguous :: cg(:)
          associate (x => self%store)
             if (.not. (self%pair_links .or. self%blk%kelvin .or. self%others) .and. &
-                self%from_chain_of_one_kind()) then
-               ! the usual chain, with these as constants (back_kernel's call says why)
-               call forward_kernel(n, self%h, self%gamma, self%c1, self%c2, self%cv, self%acc, &
-                                   .false., .false., .false., self%blk%pairs, .false., 0, 0, &
-                                   x(self%ovn:self%ovn + n), x(self%oan:self%oan + n), 0, self%mass, &
-                                   x(self%ofe:self%ofe + n), x(self%orp + 1:self%orp + n), cg, self%kp, &
-                                   self%cp, self%blk%k, self%blk%c, self%pbrf, self%xcd, self%xco, &
-                                   self%xjo, m%fixed)
+                self%blk%pairs .and. self%from_chain_of_one_kind()) then
+               ! the usual chain: its kernel with these as constants (evaluate says why)
+               call forward_usual(n, self%h, self%gamma, self%c1, self%c2, self%cv, self%acc, &
+                                  x(self%ovn:self%ovn + n), x(self%oan:self%oan + n), self%mass, &
+                                  x(self%ofe:self%ofe + n), x(self%orp + 1:self%orp + n), cg, self%kp, &
+                                  self%cp, self%blk%k, self%blk%c, self%pbrf, self%xcd, self%xco, &
+                                  self%xjo, m%fixed)
             else
                call forward_kernel(n, self%h, self%gamma, self%c1, self%c2, self%cv, self%acc, &
                                    self%pair_links, self%blk%kelvin, self%others, self%blk%pairs, &
@@ -676,33 +584,35 @@ contains
    contains
       subroutine sweep(kg, cg)
          real(dp), intent(in), contiguous :: kg(:), cg(:)
-         ! from the start or from the iterate, a kernel each (the choice is not tested per node)
-         if (from_start) then
-            call on_branches(kg, cg, .true.)
-         else
-            call on_branches(kg, cg, .false.)
-         end if
-      end subroutine sweep
-      subroutine on_branches(kg, cg, start)
-         real(dp), intent(in), contiguous :: kg(:), cg(:)
-         logical, intent(in) :: start
          associate (x => self%store)
             if (.not. (self%pair_links .or. self%blk%kelvin) .and. self%blk%pairs .and. &
                 self%from_chain_of_one_kind()) then
                ! the usual chain (springs and dashpots to ground, one linear contact law and gap
-               ! for every pair, one mass): the same kernel with these as constants, which the
-               ! compiler specialises (no branches on them, the parameters read once)
-               call back_kernel(n, start, .false., .true., .false., .false., .false., 0, 0, 0, 0, &
-                                0, self%cm, self%cv, self%c1, self%c2, self%h, self%gamma, &
-                                x(self%orp + 1:self%orp + n), x(self%ou:self%ou + n), &
-                                x(self%ov:self%ov + n), x(self%oa:self%oa + n), &
-                                x(self%oun:self%oun + n), x(self%ovn:self%ovn + n), &
-                                x(self%oan:self%oan + n), 0, self%mass, x(self%ofe:self%ofe + n), kg, &
-                                cg, self%kp, self%cp, self%blk%sgn, self%blk%gap, self%blk%k, &
-                                self%blk%c, self%blk%law, self%pbr, self%pbrc, self%pbrf, self%xjo, &
-                                m%fixed, mdu, self%wd, self%wl, self%wc, flipped)
+               ! for every pair, one mass): its kernels, with these and where the sweep starts as
+               ! constants the compiler folds (no branches on them, the parameters read once)
+               if (from_start) then
+                  call back_usual_start(n, self%cm, self%cv, self%c1, self%c2, self%h, self%gamma, &
+                                        x(self%orp + 1:self%orp + n), x(self%ou:self%ou + n), &
+                                        x(self%ov:self%ov + n), x(self%oa:self%oa + n), &
+                                        x(self%oun:self%oun + n), x(self%ovn:self%ovn + n), &
+                                        x(self%oan:self%oan + n), self%mass, x(self%ofe:self%ofe + n), &
+                                        kg, cg, self%kp, self%cp, self%blk%sgn, self%blk%gap, &
+                                        self%blk%k, self%blk%c, self%blk%law, self%pbr, self%pbrc, &
+                                        self%pbrf, self%xjo, m%fixed, mdu, self%wd, self%wl, &
+                                        self%wc, flipped)
+               else
+                  call back_usual_iterate(n, self%cm, self%cv, self%c1, self%c2, self%h, &
+                                          self%gamma, x(self%orp + 1:self%orp + n), &
+                                          x(self%ou:self%ou + n), x(self%ov:self%ov + n), &
+                                          x(self%oa:self%oa + n), x(self%oun:self%oun + n), &
+                                          x(self%ovn:self%ovn + n), x(self%oan:self%oan + n), &
+                                          self%mass, x(self%ofe:self%ofe + n), kg, cg, self%kp, &
+                                          self%cp, self%blk%sgn, self%blk%gap, self%blk%k, &
+                                          self%blk%c, self%blk%law, self%pbr, self%pbrc, self%pbrf, &
+                                          self%xjo, m%fixed, mdu, self%wd, self%wl, self%wc, flipped)
+               end if
             else
-               call back_kernel(n, start, self%pair_links, self%blk%pairs, self%blk%kelvin, &
+               call back_kernel(n, from_start, self%pair_links, self%blk%pairs, self%blk%kelvin, &
                                 self%others, self%any_fixed, self%blk%ss, self%blk%sg, self%blk%sk, &
                                 self%blk%sc, self%blk%sl, self%cm, self%cv, self%c1, self%c2, self%h, &
                                 self%gamma, x(self%orp + 1:self%orp + n), x(self%ou:self%ou + n), &
@@ -715,7 +625,7 @@ contains
                                 self%wc, flipped)
             end if
          end associate
-      end subroutine on_branches
+      end subroutine sweep
    end subroutine evaluate
 
 
