@@ -36,12 +36,12 @@ module martello_model
 
    !> A chain added whole (model_add_chain, docs/c-api.md "Chains"): nodes first … first + n − 1,
    !> node i with a spring k(i) to ground (bilinear with fy(i), rho(i) when given) and, where
-   !> c(i) > 0, a dashpot c(i); nodes i and i + 1 in contact through gap(i), one scheme, law
-   !> and parameter row for all. Held per node (the methods that take a chain as a whole read
-   !> these arrays); its links and contacts are the items numbered link0 + 1 … and
-   !> contact0 + 1 … (spring then dashpot of each node, in order), made one by one only by
-   !> model_expand_chains, for the methods that take items one by one. glink, gcontact: the
-   !> items added one by one before it.
+   !> c(i) > 0, a dashpot c(i); nodes i and i + 1 in contact through gap(i) (one value when
+   !> every gap is the same), one scheme, law and parameter row for all. Held per node (the
+   !> methods that take a chain as a whole read these arrays); its links and contacts are the
+   !> items numbered link0 + 1 … and contact0 + 1 … (spring then dashpot of each node, in
+   !> order), made one by one only on a copy (model_expanded), for the methods that take
+   !> items one by one. glink, gcontact: the items added one by one before it.
    type :: chain_t
       integer :: first = 0, n = 0, nlink = 0, ncontact = 0
       integer :: link0 = 0, contact0 = 0, glink = 0, gcontact = 0

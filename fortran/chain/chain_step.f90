@@ -199,7 +199,7 @@ contains
       type(integrator_settings_t), intent(in) :: s
       type(observer_t), intent(inout) :: o
       integer, intent(out) :: stat
-      integer :: n, i, st
+      integer :: n, i, j, st
       logical :: flipped
       character(len=16) :: num
       character(len=512) :: msg
@@ -227,7 +227,12 @@ contains
       associate (x => self%store)
          x(self%ou) = 0.0_dp; x(self%ov) = 0.0_dp
          call model_initial_state(m, x(self%ou + 1:self%ou + n), x(self%ov + 1:self%ov + n))
-         self%fixed_nodes = pack([(i, i = 1, n)], m%fixed)
+         ! the fixed nodes, listed (no array of every node made for it)
+         j = 0
+         do i = 1, n
+            if (.not. m%fixed(i)) cycle
+            j = j + 1; self%fixed_nodes(j) = i
+         end do
          ! the bilinear springs start elastic, on k·Δu₀ (clamped into the band by the first
          ! step), as mech_init
          do i = 1, size(self%blk%bl)

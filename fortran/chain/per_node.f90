@@ -31,8 +31,7 @@ contains
                                                allocated(m%chain(1)%c)
       call layout(self, m, st)
       if (st /= 0) return
-      allocate (self%blk%number(0:n), pair(m%ncontact), self%pbr(0:n), self%pbrc(0:n), &
-                self%pbrf(0:n), stat=st)
+      allocate (pair(m%ncontact), self%pbr(0:n), self%pbrc(0:n), self%pbrf(0:n), stat=st)
       if (st /= 0) return
       self%pair_links = .false.
       do j = 1, m%nlink
@@ -82,33 +81,25 @@ contains
       if (st /= 0) return
       self%bbr = B_ELASTIC; self%bbrf = B_ELASTIC
       ! the pair contacts: the chains' (chain_fusable: one to a pair), then the first contact
-      ! added one by one between i and i + 1; numbered among all the model's contacts
-      self%blk%number = 0; pair = .false.
-      do q = 1, m%nchain
-         associate (ch => m%chain(q))
-            do i = 1, ch%ncontact
-               self%blk%number(ch%first + i - 1) = ch%contact0 + i
-            end do
-         end associate
-      end do
-      do j = 1, m%ncontact
-         a = m%con_a(j); b = m%con_b(j)
-         if (a == 0 .or. b == 0) cycle
-         lo = min(a, b)
-         if (self%blk%number(lo) == 0) then
-            self%blk%number(lo) = model_contact_index(m, j); pair(j) = .true.
-         end if
-      end do
-      self%blk%pairs = any(self%blk%number > 0)
+      ! added one by one between i and i + 1; numbered among all the model's contacts. One
+      ! chain over every node and nothing else: pair i has contact contact0 + i (no list made)
+      pair = .false.
+      if (n > 1 .and. m%nchain == 1 .and. m%ncontact == 0) then
+         if (m%chain(1)%first == 1 .and. m%chain(1)%n == n .and. m%chain(1)%ncontact == n - 1) &
+            self%blk%first = m%chain(1)%contact0
+      end if
+      if (self%blk%first < 0) then
+         allocate (self%blk%number(0:n), stat=st)
+         if (st /= 0) return
+         call number_pairs()
+      else
+         allocate (self%blk%number(0:0), stat=st)
+         if (st /= 0) return
+         self%blk%number = 0
+      end if
+      self%blk%pairs = self%blk%first >= 0 .or. any(self%blk%number > 0)
       call pair_parameters(self, m, st)
       if (st /= 0) return
-      if (n > 1) then
-         c = self%blk%number(1)
-         if (c > 0 .and. all(self%blk%number(1:n - 1) == [(c - 1 + j, j = 1, n - 1)])) self%blk%first = c - 1
-      end if
-      if (self%blk%first >= 0) then
-         deallocate (self%blk%number); allocate (self%blk%number(0:0), stat=st); self%blk%number = 0
-      end if
       self%pbr = BRANCH_OFF; self%pbrc = BRANCH_OFF; self%pbrf = BRANCH_OFF
       self%blk%xg = pack([(j, j = 1, m%ncontact)], .not. pair)
       nx = size(self%blk%xg)
@@ -121,6 +112,35 @@ contains
       allocate (self%xjd(0:nx), self%xjo(0:nx), self%xcd(0:nx), self%xco(0:nx), stat=st)
       if (st /= 0) return
       self%xjd = 0.0_dp; self%xjo = 0.0_dp; self%xcd = 0.0_dp; self%xco = 0.0_dp
+   contains
+      !> blk%number of every pair from the chains and the contacts added one by one; a list
+      !> numbered in order becomes first
+      subroutine number_pairs()
+         self%blk%number = 0
+         do q = 1, m%nchain
+            associate (ch => m%chain(q))
+               do i = 1, ch%ncontact
+                  self%blk%number(ch%first + i - 1) = ch%contact0 + i
+               end do
+            end associate
+         end do
+         do j = 1, m%ncontact
+            a = m%con_a(j); b = m%con_b(j)
+            if (a == 0 .or. b == 0) cycle
+            lo = min(a, b)
+            if (self%blk%number(lo) == 0) then
+               self%blk%number(lo) = model_contact_index(m, j); pair(j) = .true.
+            end if
+         end do
+         if (n > 1) then
+            c = self%blk%number(1)
+            if (c > 0 .and. all(self%blk%number(1:n - 1) == [(c - 1 + j, j = 1, n - 1)])) then
+               self%blk%first = c - 1
+               deallocate (self%blk%number); allocate (self%blk%number(0:0), stat=st)
+               if (st == 0) self%blk%number = 0
+            end if
+         end if
+      end subroutine number_pairs
    end subroutine per_node
 
    !> The per-node arrays of the step in one block (store), each starting in its own slot of
@@ -184,66 +204,86 @@ contains
    end function address
 
    !> The pair contacts' parameters: sign, gap, stiffness, damping and law, each one value for
-   !> the chain (stride 0) where every pair has a contact and they share it.
+   !> the chain (stride 0) where every pair has a contact and they share it, else one per
+   !> pair: a first pass finds which, a second fills the arrays per pair (no array of all
+   !> pairs is made for a parameter they share).
    subroutine pair_parameters(self, m, st)
       class(chain_step_t), intent(inout) :: self
       type(model_t), intent(in) :: m
       integer, intent(out) :: st
-      integer :: n, i, j, a, b, scheme, claw
-      real(dp), allocatable :: sgn(:), gap(:), k(:), c(:)
-      real(dp) :: par(NPAR_CONTACT), mstar
-      integer(int8), allocatable :: law(:)
-      logical :: every
+      integer :: n, i
+      real(dp) :: s1, g1, k1, c1, si, gi, ki, ci
+      integer(int8) :: l1, li
+      logical :: has, one(5)
       n = m%n
-      allocate (sgn(0:n), gap(0:n), k(0:n), c(0:n), law(0:n), stat=st)
-      if (st /= 0) return
       ! a pair without a contact: a gap no motion closes
-      sgn = 1.0_dp; gap = huge(1.0_dp); k = 0.0_dp; c = 0.0_dp; law = AFFINE_LINEAR
+      one = n > 1
+      call law_of(1, has, s1, g1, k1, c1, l1)
+      self%blk%kelvin = l1 /= AFFINE_LINEAR
       do i = 1, n - 1
-         j = self%blk%number(i)
-         if (j == 0) cycle
-         call model_contact_at(m, j, a, b, gap(i), scheme, claw, par)
-         sgn(i) = merge(1.0_dp, -1.0_dp, a == i)
-         k(i) = par(P_STIFF)
-         if (claw == LAW_KELVIN) then
-            ! the damping of a target restitution, with the pair's m* (as
-            ! effective_mass_prepare gives the contacts added one by one)
-            c(i) = par(P_DAMPING)
-            if (par(P_RESTITUTION) >= 0.0_dp) then
-               mstar = pair_effective_mass(m, a, b)
-               c(i) = 0.0_dp
-               if (ieee_is_finite(mstar)) c(i) = damping_from_restitution(claw, &
-                                                                          par(P_RESTITUTION), par, mstar)
-            end if
-            law(i) = merge(AFFINE_KELVIN_CLIPPED, AFFINE_KELVIN, par(P_CLIP) > 0.5_dp)
-         end if
+         call law_of(i, has, si, gi, ki, ci, li)
+         if (.not. has) one = .false.
+         one = one .and. [si == s1, gi == g1, ki == k1, ci == c1, li == l1]
+         self%blk%kelvin = self%blk%kelvin .or. li /= AFFINE_LINEAR
       end do
-      self%blk%kelvin = any(law(1:n - 1) /= AFFINE_LINEAR)
-      every = n > 1 .and. all(self%blk%number(1:n - 1) > 0)
-      call one_or_all(sgn, self%blk%sgn, self%blk%ss)
-      if (st == 0) call one_or_all(gap, self%blk%gap, self%blk%sg)
-      if (st == 0) call one_or_all(k, self%blk%k, self%blk%sk)
-      if (st == 0) call one_or_all(c, self%blk%c, self%blk%sc)
+      st = 0
+      call arrange(self%blk%sgn, self%blk%ss, one(1), s1, 1.0_dp)
+      call arrange(self%blk%gap, self%blk%sg, one(2), g1, huge(1.0_dp))
+      call arrange(self%blk%k, self%blk%sk, one(3), k1, 0.0_dp)
+      call arrange(self%blk%c, self%blk%sc, one(4), c1, 0.0_dp)
       if (st /= 0) return
-      if (every .and. all(law(1:n - 1) == law(1))) then
-         allocate (self%blk%law(0:0), stat=st); self%blk%law(0) = law(1); self%blk%sl = 0
-      else
-         call move_alloc(law, self%blk%law); self%blk%sl = 1
-      end if
+      allocate (self%blk%law(0:merge(0, n, one(5))), stat=st)
+      if (st /= 0) return
+      self%blk%sl = merge(0, 1, one(5)); self%blk%law = merge(l1, AFFINE_LINEAR, one(5))
+      do i = 1, n - 1
+         call law_of(i, has, si, gi, ki, ci, li)
+         if (.not. one(1)) self%blk%sgn(i) = si
+         if (.not. one(2)) self%blk%gap(i) = gi
+         if (.not. one(3)) self%blk%k(i) = ki
+         if (.not. one(4)) self%blk%c(i) = ci
+         if (.not. one(5)) self%blk%law(i) = li
+      end do
    contains
-      !> x(0:n) as one value at index 0 (stride 0) if pairs 1 … n−1 all have a contact and
-      !> share it, else whole (stride 1).
-      subroutine one_or_all(x, to, stride)
-         real(dp), allocatable, intent(inout) :: x(:)
-         real(dp), allocatable, intent(out) :: to(:)
-         integer, intent(out) :: stride
-         if (every .and. all(x(1:n - 1) == x(1))) then
-            allocate (to(0:0), stat=st); if (st /= 0) return
-            to(0) = x(1); stride = 0
-         else
-            allocate (to(0:n), stat=st); if (st /= 0) return
-            to(0:n) = x; stride = 1
+      !> pair i's contact (has: it has one) and law; a gap no motion closes where it has none
+      subroutine law_of(i, has, sgn, gap, k, c, law)
+         integer, intent(in) :: i
+         logical, intent(out) :: has
+         real(dp), intent(out) :: sgn, gap, k, c
+         integer(int8), intent(out) :: law
+         integer :: j, a, b, scheme, claw
+         real(dp) :: par(NPAR_CONTACT), mstar
+         sgn = 1.0_dp; gap = huge(1.0_dp); k = 0.0_dp; c = 0.0_dp; law = AFFINE_LINEAR
+         j = self%pair_contact(i)
+         has = j > 0
+         if (.not. has) return
+         call model_contact_at(m, j, a, b, gap, scheme, claw, par)
+         sgn = merge(1.0_dp, -1.0_dp, a == i)
+         k = par(P_STIFF)
+         if (claw /= LAW_KELVIN) return
+         ! the damping of a target restitution, with the pair's m* (as effective_mass_prepare
+         ! gives the contacts added one by one)
+         c = par(P_DAMPING)
+         if (par(P_RESTITUTION) >= 0.0_dp) then
+            mstar = pair_effective_mass(m, a, b)
+            c = 0.0_dp
+            if (ieee_is_finite(mstar)) c = damping_from_restitution(claw, par(P_RESTITUTION), par, &
+                                                                    mstar)
          end if
-      end subroutine one_or_all
+         law = merge(AFFINE_KELVIN_CLIPPED, AFFINE_KELVIN, par(P_CLIP) > 0.5_dp)
+      end subroutine law_of
+
+      !> x as one value (x(0) = x1, stride 0), or one per pair (0:n, stride 1), none where
+      !> there is no contact (the ends 0 and n, and until the second pass fills the pairs)
+      subroutine arrange(x, stride, shared, x1, none)
+         real(dp), allocatable, intent(out) :: x(:)
+         integer, intent(out) :: stride
+         logical, intent(in) :: shared
+         real(dp), intent(in) :: x1, none
+         if (st /= 0) return
+         allocate (x(0:merge(0, n, shared)), stat=st)
+         if (st /= 0) return
+         stride = merge(0, 1, shared)
+         x = merge(x1, none, shared)
+      end subroutine arrange
    end subroutine pair_parameters
 end submodule per_node_layout

@@ -61,7 +61,8 @@ contains
       end do
       lpar = 0.0_dp; lpar(L_STIFF) = 50.0_dp
       call model_add_link(m, LINK_SPRING, 1, 0, lpar, st)
-      k = [(100.0_dp + 300.0_dp*mod(i, 2), i = 1, N)]; c = 0.5_dp; gap = 0.01_dp
+      k = [(100.0_dp + 300.0_dp*mod(i, 2), i = 1, N)]; c = 0.5_dp
+      gap = [(0.01_dp + 0.001_dp*mod(i, 3), i = 1, N - 1)]
       cpar = 0.0_dp; cpar(P_STIFF) = 1.0e4_dp
       call model_add_chain(m, 1, N, k, c=c, gap=gap, scheme=SCHEME_PENALTY, law=LAW_LINEAR, &
                            par=cpar, stat=st)
