@@ -73,7 +73,7 @@ typedef struct {
   int *act;      /* per contact: ACT_* at the restart being prepared */
   int *opened;   /* per rigid contact: opened by the multiplier check at this restart */
   int *was_closed, *hit, *cand; /* per rigid contact, at an impact */
-  double *w_in;  /* per contact: approach speed of the impact being resolved */
+  double *w_in, *w_out; /* per contact: approach and rebound speed of the impact being resolved */
   /* work */
   double *u, *v, *a, *x, *uq, *vq, *fint, *fext, *force, *lam;
   double *S, *rhs, *mb;
@@ -87,7 +87,12 @@ typedef struct {
    * roots 2 nc .. 2 nc + nsw - 1 */
   int nsw, *sw_a, *sw_b;
   double *sw_al, *sw_be, *sw_ga;
-  double *t_impact, *flight;  /* per rigid contact: its last impact, the flight that ended there */
+  martello_accumulation acc; /* the accumulation rule's phases (c/accumulation.c) */
+  /* the release roots: the closed set at the last restart (its rigid contacts lc[0..mc), their
+   * door list dlc and W factored in Wc), the free accelerations ar and the signed multipliers
+   * lr of a state, and the tension each needs before it counts (lamtol, per rigid contact) */
+  int mc, *lc, *dlc;
+  double *Wc, *ar, *lr, *lamtol;
   double *v_last;             /* node velocities at the last accepted state (located extrema) */
   /* located peaks (c/located_peaks.c): element quantities and rates (the layout of
    * c/located_peaks.c's packed layout) at the ends of the stretch (0, 1)
@@ -159,14 +164,6 @@ static void apply_B(const ida_problem *P, const double *lam, double *x) {
 }
 
 static double dot_B(const ida_problem *P, int j, const double *x) { return pen_rate(P, j, x); }
-
-/* The first recorded output time after t (t = k every dt, or t_end): the horizon of the
- * accumulation policy. */
-static double next_output(const ida_problem *P, double t) {
-  double k = floor(t / P->out_dt) + 1.0, tk;
-  while ((tk = k * P->every * P->dt) <= t) k += 1.0;
-  return fmin(tk, P->t_end);
-}
 
 /* Gap within which a rigid contact touches (see POSITION_TOL_FACTOR). */
 static double position_tol(const ida_problem *P, int j, const double *u) {
@@ -283,19 +280,55 @@ static int commit(ida_problem *P, const double *u, const double *v) {
   return st;
 }
 
-/* Two root functions per contact: (delta, delta') while open or penalty, (P, 1) while a rigid
- * contact is closed; then one per switch slot of the laws' branches (g > 0: the branch is
- * left; an unused slot stays at -1). */
+/* The signed multipliers of the closed set at (t, u, v) into P->lr (per rigid contact,
+ * compression > 0): the bilateral contact forces W_H lambda = -B_H a_free of the set closed at
+ * the last restart, from the state itself. IDA's own multiplier P, an index-2 algebraic
+ * variable out of the error test, is not accurate between the steps' ends: while a contact
+ * holds a node still, IDA's steps grow to the output interval and the root of its interpolated
+ * P fell up to 8e-3 s from the release (P9 at rtol 1e-11), at a time that moved with the
+ * output interval. */
+static int closed_multipliers(ida_problem *P, double t, const double *u, const double *v) {
+  int st = martello_eval_acceleration(P->ev, t, u, v, P->ar);
+  if (st == MARTELLO_OK)
+    st = martello_impulse_project(P->n, P->mc, P->dlc, TOPOLOGY(P), P->Wc, NULL, P->ar, P->x);
+  for (int k = 0; k < P->mc; k++) P->lr[P->lc[k]] = P->x[k];
+  return st;
+}
+
+/* The release roots from the restart on: the closed set, W_H factored, and each contact's
+ * tension bar, the rounding of the forces at its nodes (as on the event-driven integrator). */
+static int closed_set_roots(ida_problem *P, const double *u, const double *v) {
+  P->mc = 0;
+  for (int r = 0; r < P->nr; r++)
+    if (P->closed[r]) {
+      int j = P->rig_con[r], a = P->con_a[j], b = P->con_b[j];
+      double fs = fabs(P->lam[r]);
+      if (a >= 0) fs += P->mass[a] * fabs(P->a[a]);
+      if (b >= 0) fs += P->mass[b] * fabs(P->a[b]);
+      P->lamtol[r] = 1e3 * DBL_EPSILON * fs;
+      P->lc[P->mc] = r;
+      P->dlc[P->mc++] = j;
+    }
+  (void)u;
+  (void)v;
+  if (P->mc == 0) return MARTELLO_OK;
+  return martello_impulse_factor(P->n, P->mc, P->dlc, TOPOLOGY(P), P->Wc);
+}
+
+/* Two root functions per contact: (delta, delta') while open or penalty, (lambda + its
+ * tension bar, 1) while a rigid contact is closed (lambda of the state, closed_multipliers);
+ * then one per switch slot of the laws' branches (g > 0: the branch is left; an unused slot
+ * stays at -1). */
 static int roots(realtype t, N_Vector yy, N_Vector yp, realtype *g, void *data) {
   ida_problem *P = data;
   const double *y = N_VGetArrayPointer(yy);
-  (void)t;
   (void)yp;
   gather(P, y, P->uq, P->vq);
+  if (P->mc > 0 && closed_multipliers(P, t, P->uq, P->vq) != MARTELLO_OK) return -1;
   for (int j = 0; j < P->nc; j++) {
     int r = P->rig[j];
     if (r >= 0 && P->closed[r]) {
-      g[2 * j] = y[P->ip[r]];
+      g[2 * j] = P->lr[r] + P->lamtol[r];
       g[2 * j + 1] = 1.0;
     } else {
       g[2 * j] = penetration(P, j, P->uq);
@@ -417,7 +450,10 @@ static int rigid_impacts(ida_problem *P, double t, double *u, double *v) {
   for (int r = 0; r < P->nr; r++) {
     int j = P->rig_con[r];
     P->hit[r] = 0;
-    P->cand[r] = P->closed[r] || P->act[j] == ACT_IMPACT || penetration(P, j, u) >= -position_tol(P, j, u);
+    /* a contact released here leaves at rest: it takes no impulse (its rounding-level rate
+     * made a spurious impact at 1e-35 m/s on P9 when the release fell on an output time) */
+    P->cand[r] = P->closed[r] || P->act[j] == ACT_IMPACT ||
+                 (P->act[j] != ACT_RELEASE && penetration(P, j, u) >= -position_tol(P, j, u));
     if (P->cand[r]) P->aset[m++] = r;
   }
   if (m > 0) {
@@ -436,9 +472,7 @@ static int rigid_impacts(ida_problem *P, double t, double *u, double *v) {
       if (P->rhs[k] > 0.0 && !P->closed[r]) {
         P->hit[r] = 1;
         P->w_in[j] = P->w0[k];
-        /* the impact sequence the accumulation policy reads */
-        P->flight[r] = P->t_impact[r] >= 0.0 ? t - P->t_impact[r] : 0.0;
-        P->t_impact[r] = t;
+        P->w_out[j] = pen_rate(P, j, v);
         if (P->act[j] != ACT_IMPACT) P->events++;
       }
     }
@@ -450,10 +484,11 @@ static int rigid_impacts(ida_problem *P, double t, double *u, double *v) {
         P->opened[r] = 1;
       }
   }
-  /* closing: the accumulation policy (docs/impulse.md §4) with event_tol and the position
-   * tolerance as the resolution, and the normal acceleration a_n that presses each
-   * contact that took an impulse with the contacts already closed enforced (their forces from
-   * the persistent-contact rule): aset = [closed set, candidates] */
+  /* closing: the accumulation rule (docs/impulse.md §4) with IDA's resolutions (event_tol,
+   * the position tolerance of the contact and the like one of its rate), and the normal
+   * acceleration a_n that presses each contact that took an impulse with the contacts already
+   * closed enforced (their forces from the persistent-contact rule): aset = [closed set,
+   * candidates]. The phase of a contact closed here starts at its accumulation point. */
   int mc = closed_set(P), ma = mc;
   for (int r = 0; r < P->nr; r++)
     if (!P->closed[r] && (P->hit[r] || P->act[P->rig_con[r]] == ACT_IMPACT)) P->aset[ma++] = r;
@@ -470,12 +505,29 @@ static int rigid_impacts(ida_problem *P, double t, double *u, double *v) {
   }
   for (int k = mc; k < ma; k++) {
     int r = P->aset[k], j = P->rig_con[r];
-    double t_inf, an = dot_B(P, j, P->a), rebound = fmax(-pen_rate(P, j, v), 0.0);
+    double an = dot_B(P, j, P->a), rebound = fmax(-pen_rate(P, j, v), 0.0);
     double e = P->rest[j] >= 0.0 ? P->rest[j] : 0.0;
+    double v_res = POSITION_TOL_FACTOR *
+                   (P->rtol * (fabs(node_u(P->con_a[j], v)) + fabs(node_u(P->con_b[j], v))) + P->atol);
+    double da = 0.0;
     for (int l = 0; l < mc; l++) an -= P->S[k + ma * l] * P->w0[l];
-    /* tentative: rigid_multipliers opens it again if its multiplier is not compressive */
-    if (martello_impulse_accumulation(e, rebound, an, t, P->flight[r], P->event_tol,
-                                      next_output(P, t), P->t_end, &t_inf))
+    if (rebound > 0.0 && an > 0.0) {
+      /* the change of a_n over the next flight tau = 2 s/a_n, at the end of a tangent step of
+       * length tau (the closed contacts' forces held) */
+      const double tau = 2.0 * rebound / an;
+      for (int i = 0; i < P->n; i++) {
+        P->uq[i] = u[i] + tau * v[i];
+        P->vq[i] = v[i] + tau * P->a[i];
+      }
+      st = martello_eval_acceleration(P->ev, t + tau, P->uq, P->vq, P->x);
+      if (st != MARTELLO_OK) return fail(P, st, "IDA: acceleration failed at t = %.9e s", t + tau);
+      da = dot_B(P, j, P->x) - dot_B(P, j, P->a);
+    }
+    /* tentative: rigid_multipliers opens it again if its multiplier is not compressive. A
+     * contact that nothing presses (a_n <= 0) stays open, as on the event-driven integrator:
+     * bodies that move on together after a plastic impact are not in a persistent contact */
+    if (an > 0.0 && martello_accumulation_decide(&P->acc, j, e, rebound, an, da, t,
+                                                 P->event_tol, position_tol(P, j, u), v_res, 1))
       P->closed[r] = 1;
   }
   return project_closed(P, t, u, v);
@@ -558,7 +610,7 @@ static int prepare_restart(ida_problem *P, double t, double *u, double *v, N_Vec
     case ACT_RELEASE:
       P->closed[r] = 0;
       nudge(P, j, -1, u);
-      martello_observer_set_phase(P->obs, j, 0, t, w);
+      martello_accumulation_release(&P->acc, P->obs, j, t, w);
       any_rigid = 1;
       P->events++;
       break;
@@ -586,13 +638,13 @@ static int prepare_restart(ida_problem *P, double t, double *u, double *v, N_Vec
     int j = P->rig_con[r];
     if (P->opened[r]) nudge(P, j, -1, u);
     if ((P->hit[r] || P->act[j] == ACT_IMPACT) && !P->was_closed[r]) {
-      double w_in = P->hit[r] ? P->w_in[j] : 0.0;
-      if (P->closed[r])
-        martello_observer_set_phase(P->obs, j, 1, t, w_in);
-      else if (P->hit[r])
-        martello_observer_add_impact(P->obs, j, t, w_in, pen_rate(P, j, v), 0.0, 0.0);
+      /* every impulse is an impact (its rebound as Newton's law left it); a contact it closes
+       * is persistent from its accumulation point (an instant later for a plastic impact or
+       * one touching at rest), as on the event-driven integrator */
+      if (P->hit[r]) martello_observer_add_impact(P->obs, j, t, P->w_in[j], P->w_out[j], 0.0, 0.0);
+      if (P->closed[r]) martello_accumulation_hold(&P->acc, P->obs, j);
     } else if (P->opened[r] && martello_observer_in_phase(P->obs, j)) {
-      martello_observer_set_phase(P->obs, j, 0, t, pen_rate(P, j, v));
+      martello_accumulation_release(&P->acc, P->obs, j, t, pen_rate(P, j, v));
     }
   }
   if ((st = martello_eval_energy(P->ev, u, v, &ke1, &dummy)) != MARTELLO_OK)
@@ -615,6 +667,8 @@ static int prepare_restart(ida_problem *P, double t, double *u, double *v, N_Vec
     d[P->im[r]] = 0.0;
   }
   for (int j = 0; j < P->nc; j++) P->act[j] = ACT_NONE;
+  if ((st = closed_set_roots(P, u, v)) != MARTELLO_OK)
+    return fail(P, MARTELLO_ERR_SINGULAR, "IDA: redundant closed contacts at t = %.9e s (B^T M^-1 B singular)", t);
   return hand_work(P);
 }
 
@@ -786,11 +840,12 @@ static void release(ida_problem *P) {
                  P->rig_con, P->iu, P->iv, P->ip, P->im, P->closed, P->act,
                  P->opened, P->was_closed, P->hit, P->cand, P->q, P->w0, P->w_in, P->u, P->v, P->a, P->x, P->uq, P->vq, P->fint, P->fext,
                  P->force, P->lam, P->S, P->rhs, P->mb, P->cols, P->dc, P->aset,
-                 P->sw_a, P->sw_b, P->sw_al, P->sw_be, P->sw_ga, P->t_impact, P->flight,
+                 P->sw_a, P->sw_b, P->sw_al, P->sw_be, P->sw_ga, P->w_out, P->lc, P->dlc, P->Wc, P->ar, P->lr, P->lamtol,
                  P->v_last, P->el0, P->el1, P->elc, P->pv0, P->pa0, P->pj0, P->pv1, P->pa1,
                  P->pj1, P->ua, P->va, P->aa};
   for (size_t k = 0; k < sizeof all / sizeof all[0]; k++) free(all[k]);
   if (P->ev) martello_eval_free(&P->ev);
+  martello_accumulation_free(&P->acc);
 }
 
 /* Half-bandwidth of the Jacobian in the interleaved layout: the node couplings are probed
@@ -904,9 +959,14 @@ static int setup(ida_problem *P, martello_model *model, martello_run *run) {
   P->act = take(ucn, sizeof(int), &failed);
   P->w_in = take(ucn, sizeof(double), &failed);
   P->force = take(ucn, sizeof(double), &failed);
-  P->t_impact = take(nr, sizeof(double), &failed);
+  P->w_out = take(ucn, sizeof(double), &failed);
+  P->lc = take(nr, sizeof(int), &failed);
+  P->dlc = take(nr, sizeof(int), &failed);
+  P->Wc = take(nr * nr, sizeof(double), &failed);
+  P->ar = take(un, sizeof(double), &failed);
+  P->lr = take(nr, sizeof(double), &failed);
+  P->lamtol = take(nr, sizeof(double), &failed);
   P->v_last = take(un, sizeof(double), &failed);
-  P->flight = take(nr, sizeof(double), &failed);
   double **work[] = {&P->u, &P->v, &P->a, &P->x, &P->uq, &P->vq, &P->fint, &P->fext, &P->mb};
   for (size_t k = 0; k < sizeof work / sizeof work[0]; k++) *work[k] = take(un, sizeof(double), &failed);
   if (failed > 0.0) return fail_memory(P, "an array of the IDA state", failed);
@@ -926,7 +986,8 @@ static int setup(ida_problem *P, martello_model *model, martello_run *run) {
     }
   }
   P->N = pos;
-  for (int r = 0; r < P->nr; r++) P->t_impact[r] = -1.0;   /* no impact yet */
+  if (martello_accumulation_init(&P->acc, nc, P->t_end) != MARTELLO_OK)
+    return fail_memory(P, "the accumulation phases of the IDA run", (double)nc * sizeof(double));
   if ((st = martello_eval_create(model, &P->ev)) == MARTELLO_ERR_MEMORY) {
     char line[480]; /* the model's message is the line (martello_eval_create) */
     martello_model_message(model, line, (int)sizeof line);

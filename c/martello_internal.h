@@ -198,16 +198,47 @@ int martello_impulse_factor(int n, int m, const int *list, const int *a, const i
 int martello_impulse_project(int n, int m, const int *list, const int *a, const int *b,
                              const int *col, const double *cols, const double *L,
                              const double *target, double *x, double *P);
-/* The accumulation policy (docs/impulse.md §4, from the impact sequence): 1 if the impacts of
- * a contact leaving at t with separation speed s >= 0, pressed by the relative acceleration a,
- * restitution e, have accumulated: no rebound; or, with the accumulation point
- * *t_inf = t + 2 s/(a (1 - e)) before t_end, a next flight 2 s/a no longer than tau_res (the
- * method's time resolution) or shorter than the flight tau_prev that ended at t (0: none seen)
- * with *t_inf strictly before t_horizon (the next output time). *t_inf = t without rebound,
- * HUGE_VAL-like when there is no accumulation point. */
-int martello_impulse_accumulation(double e, double s, double a, double t, double tau_prev,
-                                  double tau_res, double t_horizon, double t_end,
+/* The accumulation (Zeno) rule (docs/impulse.md §4): 1 if the impacts of a contact leaving at
+ * t with separation speed s >= 0, pressed by the relative acceleration a, restitution e, have
+ * accumulated: no rebound (s = 0 or e = 0; *t_inf = t), or a next flight 2 s/a the method does
+ * not resolve -- one whose end it does not locate to 1 % of its length from its position error
+ * a step d_res and its speed error v_res (adding up over the flight for a method that restarts
+ * at order 1 after an impact: restarts = 1, BDF), or shorter than t_res -- while a changes by
+ * no more than da over that flight, |da| <= 1 % (1 - e)^2 a, so that the constant-acceleration
+ * series predicts the end of the rest to 1 % of the flight. *t_inf = t + 2 s/(a (1 - e)), the
+ * accumulation point, HUGE_VAL-like when there is none. */
+int martello_impulse_accumulation(double e, double s, double a, double da, double t,
+                                  double t_res, double d_res, double v_res, int restarts,
                                   double *t_inf);
+
+/* ---- accumulations of the C integrators (c/accumulation.c, docs/impulse.md §4) ------------
+ * The per-contact bookkeeping every C integrator with rigid contacts shares: the rule
+ * decided by martello_impulse_accumulation, and the persistent phase of a contact it holds,
+ * written to the observer from the predicted accumulation point t_inf (never after t_end),
+ * closed no earlier than it opened: a run reports its phases in order. */
+typedef struct {
+  int nc;          /* contacts */
+  double t_end;    /* the run's end: no phase opens at or after it */
+  double *t_hold;  /* per contact: where the phase of its last accumulation starts */
+} martello_accumulation;
+/* For nc contacts of a run ending at t_end; MARTELLO_ERR_MEMORY if t_hold cannot be had. */
+int martello_accumulation_init(martello_accumulation *acc, int nc, double t_end);
+void martello_accumulation_free(martello_accumulation *acc);
+/* The rule for contact j leaving at t (martello_impulse_accumulation with the change da of a
+ * over the next flight and the method's resolutions t_res, d_res, v_res, restarts): 1 if its
+ * impacts have accumulated, and then its phase start t_inf is kept. */
+int martello_accumulation_decide(martello_accumulation *acc, int j, double e, double s,
+                                 double a, double da, double t, double t_res, double d_res,
+                                 double v_res, int restarts);
+/* Contact j (just decided, or touching at rest: t_hold = t) joins the persistent set: its phase
+ * opens at its kept t_inf, unless that is not before t_end. */
+int martello_accumulation_hold(martello_accumulation *acc, martello_observer *obs, int j);
+/* Contact j is persistent from t (touching at rest, or a plastic impact): its phase start. */
+void martello_accumulation_at(martello_accumulation *acc, int j, double t);
+/* Contact j leaves the persistent set at t, separating at rate v: its open phase closes at
+ * max(t, its start). */
+int martello_accumulation_release(martello_accumulation *acc, martello_observer *obs, int j,
+                                  double t, double v);
 
 /* The C integrators, dispatched by martello_dynamic_run. */
 int martello_event_driven_run(martello_model *model, martello_run *run);

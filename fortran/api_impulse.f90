@@ -116,12 +116,13 @@ contains
       call project_factored(pb%sa, pb%sb, cols(:, pb%ic), l(:, 1:m), goal, x(1:n), p(1:m))
    end function c_impulse_project
 
-   integer(c_int) function c_impulse_accumulation(e, s, a, t, tau_prev, tau_res, t_horizon, &
-                                                  t_end, t_inf) bind(C, name='martello_impulse_accumulation')
-      real(c_double), value :: e, s, a, t, tau_prev, tau_res, t_horizon, t_end
+   integer(c_int) function c_impulse_accumulation(e, s, a, da, t, t_res, d_res, v_res, restarts, &
+                                                  t_inf) bind(C, name='martello_impulse_accumulation')
+      real(c_double), value :: e, s, a, da, t, t_res, d_res, v_res
+      integer(c_int), value :: restarts
       real(c_double), intent(out) :: t_inf
       logical :: acc
-      call impulse_accumulation(e, s, a, t, tau_prev, tau_res, t_horizon, t_end, acc, t_inf)
+      call impulse_accumulation(e, s, a, da, t, t_res, d_res, v_res, restarts /= 0, acc, t_inf)
       c_impulse_accumulation = merge(1, 0, acc)
    end function c_impulse_accumulation
 

@@ -16,7 +16,7 @@ module martello_impulse
    private
    public :: contact_graph_t, contact_graph, delassus_columns, delassus_bandwidth, &
       delassus_diagonal_band, newton_impulses, contact_forces, apply_impulses, delassus_factor, &
-      project_factored, impulse_accumulation, lcp_work_reals, LEMKE_MAX, IMPULSE_OK, &
+      project_factored, impulse_accumulation, flight_resolution, lcp_work_reals, LEMKE_MAX, IMPULSE_OK, &
       IMPULSE_INFEASIBLE, IMPULSE_NOT_CONVERGED, IMPULSE_SINGULAR, IMPULSE_NO_MEMORY
 
    !> Up to this many contacts an LCP is solved by Lemke on a dense W (finite, exact to
@@ -27,6 +27,9 @@ module martello_impulse
    !> finish makes the solution exact to round-off before that)
    real(dp), parameter :: PGS_TOL = 1.0e-14_dp
    integer, parameter :: PGS_MAX_SWEEPS = 100000
+   !> A flight of an impact sequence is resolved when the method locates its end to this
+   !> fraction of its length (flight_resolution, docs/impulse.md §4)
+   real(dp), parameter :: RESOLVED_FRACTION = 1.0e-2_dp
 
    integer, parameter :: IMPULSE_OK = 0
    !> no solution (Lemke's secondary ray): redundant contacts that Newton's law cannot all
@@ -226,24 +229,23 @@ contains
       call apply_impulses(c, p, x)
    end subroutine project_factored
 
-   !> The accumulation (Zeno) policy, the one rule of every integrator (docs/impulse.md §4),
-   !> decided from the impact sequence, not from error tolerances. A contact leaving at t with
-   !> separation speed s ≥ 0, pressed by its relative acceleration a > 0, makes the geometric
-   !> series of flights τ, eτ, e²τ, … (τ = 2s/a; Moreau 1988, §9) that ends at the accumulation
-   !> point t∞ = t + 2s/(a(1 − e)), returned in t_inf (huge when there is none): the contact
-   !> is persistent from there. It has accumulated
+   !> The accumulation (Zeno) rule, the one rule of every integrator (docs/impulse.md §4),
+   !> decided from the impact sequence and the method's resolution, never from output
+   !> settings. A contact leaving at t with separation speed s ≥ 0, pressed by its relative
+   !> acceleration a > 0, makes the flights τ, eτ, e²τ, … (τ = 2s/a; Moreau 1988, §9) that
+   !> end at the accumulation point t∞ = t + 2s/(a(1 − e)), returned in t_inf (huge when there
+   !> is none): the contact is persistent from there. It has accumulated
    !>  1. with no rebound (s = 0 or e = 0): t∞ = t, the persistent-contact rule decides;
-   !>  2. otherwise only if t∞ < t_end (no event is ever written after the run), and
-   !>     a. the next flight τ is shorter than the method's time resolution tau_res (the step
-   !>        of a time-stepping scheme, event_tol for the event-driven ones: closer events are
-   !>        simultaneous), or
-   !>     b. the sequence is seen to decay — τ shorter than the flight tau_prev that ended at t
-   !>        (0: none observed) — and t∞ comes strictly before t_horizon, the next output time:
-   !>        the rest of the series is over before anything is recorded.
+   !>  2. when its next flight, the longest of the remaining ones, is one the method does not
+   !>     resolve, τ ≤ flight_resolution(…), and the constant-acceleration series predicts the
+   !>     end of the rest as well as a resolved flight's: a changes over the next flight by
+   !>     da, so the rest, T = τ/(1 − e) long, ends off by about |da/τ| T²/a, at most
+   !>     RESOLVED_FRACTION τ when |da| ≤ RESOLVED_FRACTION (1 − e)² a.
    !> No accumulation without pressing (a ≤ 0) or dissipation (e ≥ 1).
-   pure subroutine impulse_accumulation(e, s, a, t, tau_prev, tau_res, t_horizon, t_end, &
+   pure subroutine impulse_accumulation(e, s, a, da, t, t_res, d_res, v_res, restarts, &
                                         accumulates, t_inf)
-      real(dp), intent(in) :: e, s, a, t, tau_prev, tau_res, t_horizon, t_end
+      real(dp), intent(in) :: e, s, a, da, t, t_res, d_res, v_res
+      logical, intent(in) :: restarts
       logical, intent(out) :: accumulates
       real(dp), intent(out) :: t_inf
       real(dp) :: tau
@@ -255,10 +257,31 @@ contains
       if (.not. (a > 0.0_dp) .or. e >= 1.0_dp) return
       tau = 2.0_dp*s/a
       t_inf = t + tau/(1.0_dp - e)
-      if (.not. (t_inf < t_end)) return
-      accumulates = tau <= tau_res .or. (tau_prev > 0.0_dp .and. tau < tau_prev .and. &
-                                         t_inf < t_horizon)
+      accumulates = tau <= flight_resolution(a, t_res, d_res, v_res, restarts) .and. &
+                    abs(da) <= RESOLVED_FRACTION*(1.0_dp - e)**2*a
    end subroutine impulse_accumulation
+
+   !> The shortest flight a method resolves under the pressing acceleration a > 0
+   !> (docs/impulse.md §4): one whose end it locates to RESOLVED_FRACTION (1 %) of its length,
+   !> and no shorter than t_res (the step of a time-stepping scheme; event_tol of an
+   !> event-driven one: closer events are simultaneous). A flight τ leaves at aτ/2: its end is
+   !> off by d/(aτ/2) in time when its gap is off by d, and its length by 2v/a when its launch
+   !> speed is off by v. d is the method's position error over the flight: d_res, its error a
+   !> step, for a one-step method; for a multistep one that restarts at order 1 after every
+   !> impact (restarts: BDF) it adds up over the flight's steps, h₁ = √(2 d_res/a) long
+   !> (backward Euler's error a h²/2 is d_res), to τ √(a d_res/2), and its end is off by h₁.
+   pure real(dp) function flight_resolution(a, t_res, d_res, v_res, restarts)
+      real(dp), intent(in) :: a, t_res, d_res, v_res
+      logical, intent(in) :: restarts
+      real(dp) :: d
+      d = max(d_res, 0.0_dp)
+      if (restarts) then
+         flight_resolution = sqrt(2.0_dp*d/a)/RESOLVED_FRACTION
+      else
+         flight_resolution = sqrt(2.0_dp*d/(RESOLVED_FRACTION*a))
+      end if
+      flight_resolution = max(t_res, flight_resolution, 2.0_dp*max(v_res, 0.0_dp)/(RESOLVED_FRACTION*a))
+   end function flight_resolution
 
    ! ---- the LCP solvers (docs/impulse.md §2) -----------------------------------------------
 

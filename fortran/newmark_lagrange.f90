@@ -277,10 +277,11 @@ contains
             v_imp = dd0 + alpha_imp*h*ddd0
             e_eff = e_con(c)
             ! Zeno: the next rebound flight under the pressing acceleration δ̈_n is shorter than
-            ! a step (one impact a step is what the tuned (β, γ) resolve); the scheme keeps no
-            ! impact sequence (tau_prev = 0) and writes no t∞, so that is its only clause
-            call impulse_accumulation(e_eff, e_eff*max(v_imp, 0.0_dp), ddd0, t_prev + alpha_imp*h, &
-                                      0.0_dp, h, -huge(1.0_dp), huge(1.0_dp), zeno, t_inf)
+            ! a step, the scheme's time resolution (one impact a step is what the tuned (β, γ)
+            ! resolve; positions and speeds it keeps to round-off); it writes no t∞, so the
+            ! change of δ̈ over the flight does not enter (da = 0)
+            call impulse_accumulation(e_eff, e_eff*max(v_imp, 0.0_dp), ddd0, 0.0_dp, &
+                                      t_prev + alpha_imp*h, h, 0.0_dp, 0.0_dp, .false., zeno, t_inf)
             if (zeno) e_eff = 0.0_dp
             rr = h*(dd0 + h*ddd0 + e_eff*v_imp)/(d0 + h*dd0 + 0.5_dp*h*h*ddd0)
             if (.not. (rr > 0.0_dp .and. ieee_is_finite(rr)) .or. v_imp <= 0.0_dp) then

@@ -32,7 +32,8 @@ def door():
     L.martello_impulse_newton.argtypes = topology + [_D, _D, _D, ctypes.POINTER(ci)]
     L.martello_impulse_contact_forces.argtypes = topology + [_D, _D, _I, ctypes.POINTER(ci)]
     L.martello_impulse_delassus.argtypes = topology + [_D]
-    L.martello_impulse_accumulation.argtypes = [cd, cd, cd, cd, cd, cd, cd, cd, ctypes.POINTER(cd)]
+    L.martello_impulse_accumulation.argtypes = [cd, cd, cd, cd, cd, cd, cd, cd, ci,
+                                                ctypes.POINTER(cd)]
     for f in ("newton", "contact_forces", "delassus", "accumulation"):
         getattr(L, "martello_impulse_" + f).restype = ci
     return L
@@ -212,36 +213,73 @@ def test_delassus_matrix_of_a_chain(door):
 
 # --- the accumulation policy --------------------------------------------------------------------
 
-def accumulation(door, e, s, a, t=1.0, tau_prev=0.0, tau_res=0.0, t_horizon=1e300, t_end=1e300):
+def accumulation(door, e, s, a, da=0.0, t=1.0, t_res=0.0, d_res=0.0, v_res=0.0, restarts=0):
     t_inf = ctypes.c_double()
-    acc = door.martello_impulse_accumulation(e, s, a, t, tau_prev, tau_res, t_horizon, t_end,
+    acc = door.martello_impulse_accumulation(e, s, a, da, t, t_res, d_res, v_res, restarts,
                                              ctypes.byref(t_inf))
     return acc, t_inf.value
 
 
-def test_accumulation_policy_clauses(door):
+RHO = 0.01      # a resolved flight's end is located to 1 % of its length (docs/impulse.md §4)
+
+
+def test_accumulation_rule_clauses(door):
     # no rebound: accumulated at once (t∞ = t), pressed or not (the held-set LCP decides)
     assert accumulation(door, 0.0, 1.0, 9.81) == (1, 1.0)
     assert accumulation(door, 0.5, 0.0, -1.0) == (1, 1.0)
-    # not pressed, or no dissipation: never
-    assert accumulation(door, 0.5, 1e-30, 0.0)[0] == 0
-    assert accumulation(door, 1.0, 1e-30, 9.81)[0] == 0
-    # t∞ = t + 2s/(a(1 − e)) for the geometric series of flights; no decay seen (the first
-    # impact): resolved, whatever the horizon
+    # not pressed, or no dissipation: never, however short the flight
+    assert accumulation(door, 0.5, 1e-30, 0.0, t_res=1.0)[0] == 0
+    assert accumulation(door, 1.0, 1e-30, 9.81, t_res=1.0)[0] == 0
+    # t∞ = t + 2s/(a(1 − e)), the geometric series of the flights; a method that resolves
+    # every flight (no resolution given) never holds the sequence
     acc, t_inf = accumulation(door, 0.5, 0.3, 2.0)
     assert acc == 0 and t_inf == 1.0 + 2 * 0.3 / (2.0 * 0.5)
-    # a decaying sequence (next flight 2s/a = 0.3 s after one of 0.6 s) accumulates iff t∞ =
-    # 1.6 s comes strictly before the next output; a growing one never does
-    assert accumulation(door, 0.5, 0.3, 2.0, tau_prev=0.6, t_horizon=1.6 * (1 + EPS))[0] == 1
-    assert accumulation(door, 0.5, 0.3, 2.0, tau_prev=0.6, t_horizon=1.6)[0] == 0
-    assert accumulation(door, 0.5, 0.3, 2.0, tau_prev=0.3, t_horizon=10.0)[0] == 0
-    # a flight below the method's time resolution accumulates on its own
-    assert accumulation(door, 0.5, 0.3, 2.0, tau_res=0.3)[0] == 1
-    assert accumulation(door, 0.5, 0.3, 2.0, tau_res=0.3 * (1 - EPS))[0] == 0
-    # never past the end of the run: t∞ must come before t_end, whatever else holds
-    assert accumulation(door, 0.5, 0.3, 2.0, tau_prev=0.6, tau_res=1.0, t_horizon=10.0,
-                        t_end=1.6)[0] == 0
-    # independent of any tolerance: the decision reads only e, s, a and the sequence's times
+    tau = 2 * 0.3 / 2.0                                   # the next flight, 0.3 s
+    # the time resolution: a flight no longer than t_res is not resolved
+    assert accumulation(door, 0.5, 0.3, 2.0, t_res=tau)[0] == 1
+    assert accumulation(door, 0.5, 0.3, 2.0, t_res=tau * (1 - 4 * EPS))[0] == 0
+    # a one-step method locates the end of a flight τ leaving at aτ/2 to d/(aτ/2) from its
+    # position error d: resolved while that is more than 1 % of τ, i.e. τ² > 2d/(ρa)
+    d_edge = RHO * 2.0 * tau ** 2 / 2
+    assert accumulation(door, 0.5, 0.3, 2.0, d_res=d_edge * (1 + 4 * EPS))[0] == 1
+    assert accumulation(door, 0.5, 0.3, 2.0, d_res=d_edge * (1 - 4 * EPS))[0] == 0
+    # a method that restarts at order 1 (BDF) errs by one backward-Euler step h₁ = √(2d/a)
+    # on the end of a flight: resolved while h₁ < ρτ, a 1e4 times tighter bound on d here
+    d_bdf = 2.0 * (RHO * tau) ** 2 / 2
+    assert accumulation(door, 0.5, 0.3, 2.0, d_res=d_bdf * (1 + 4 * EPS), restarts=1)[0] == 1
+    assert accumulation(door, 0.5, 0.3, 2.0, d_res=d_bdf * (1 - 4 * EPS), restarts=1)[0] == 0
+    assert accumulation(door, 0.5, 0.3, 2.0, d_res=d_edge * 0.5, restarts=1)[0] == 1
+    # a launch speed off by v makes the flight off by 2v/a: resolved while below ρτ
+    v_edge = RHO * tau * 2.0 / 2
+    assert accumulation(door, 0.5, 0.3, 2.0, v_res=v_edge * (1 + 4 * EPS))[0] == 1
+    assert accumulation(door, 0.5, 0.3, 2.0, v_res=v_edge * (1 - 4 * EPS))[0] == 0
+    # an unresolved flight is held only while a changes over it by at most ρ(1 − e)² a: the
+    # constant-acceleration series then predicts t∞ as well as a resolved flight's end
+    da_edge = RHO * (1 - 0.5) ** 2 * 2.0
+    for sign in (1, -1):
+        assert accumulation(door, 0.5, 0.3, 2.0, da=sign * da_edge, t_res=1.0)[0] == 1
+        assert accumulation(door, 0.5, 0.3, 2.0, da=sign * da_edge * (1 + 4 * EPS),
+                            t_res=1.0)[0] == 0
+    # the rule reads the sequence and the method's resolution: no output time, no t_end
+
+
+def test_constant_acceleration_series_error_on_the_bouncing_oscillator():
+    # docs/impulse.md §4: the rest of a sequence is predicted by the constant-acceleration
+    # series; on P2's spring the flights are exactly (2/ω) atan(e v/(ω (u_s − h))) (the closed
+    # form), so the prediction from an impact whose next flight is τ errs by ≈ ω²τ³/(12(1 − e³))
+    # (atan x = x − x³/3 + …), third order in τ. The rule's bound |da/τ| T²/a with da the
+    # change of a over a flight (ω² s τ, the spring's) is ω²τ³/(2(1 − e)²): above it.
+    from martello.oracles.p2_bouncing import bouncing_oscillator_restitution
+    m, k, h, g, e = 1.0, 100.0, 0.05, 9.81, 0.8
+    w, a = math.sqrt(k / m), g - k * h / m
+    ref = bouncing_oscillator_restitution(m, k, h, g, e, 80)
+    for n in (10, 20, 40):
+        s = e * ref.v[n]                             # leaving impact n
+        tau = 2 * s / a
+        predicted = ref.t[n] + tau / (1 - e)
+        err = abs(predicted - ref.zeno_time)
+        assert err == pytest.approx(w ** 2 * tau ** 3 / (12 * (1 - e ** 3)), rel=0.05)
+        assert err <= w ** 2 * tau ** 3 / (2 * (1 - e) ** 2)
 
 
 # A ball dropped from H0 onto a rigid floor under gravity alone: the pressing acceleration is g
@@ -264,61 +302,71 @@ def ball_closed_form(e, n):
     return t, v, t1 + 2 * e * G * t1 / (G * (1 - e))
 
 
+def flights_resolved(e, flight_res):
+    """How many impacts of the ball come before the one whose next flight 2 e v/g is not
+    resolved (no longer than flight_res), that one included."""
+    t1 = math.sqrt(2 * H0 / G)
+    n = 1
+    while 2 * e ** n * G * t1 / G > flight_res:
+        n += 1
+    return n
+
+
+def held_ball(s):
+    c = s["contacts"]["floor"]
+    t_on, t_off = np.array(c["impact_times"]), c["separation_times"]
+    instant = np.array([x is not None and x == y for x, y in zip(t_off, t_on)])
+    return t_on, instant, c
+
+
 @pytest.mark.parametrize("stepper", ["rkf45", "rk8pd", "msbdf"])
 @pytest.mark.parametrize("e", [0.3, 0.6, 0.85])
 def test_event_driven_holds_the_ball_from_the_accumulation_point(stepper, e):
     # The persistent phase starts at the predicted t∞ of the last resolved impact: exact for
-    # constant g, so its error is the error of that impact's time and speed (2/(g(1 − e))
-    # times the speed error). rkf45 and rk8pd at rtol 1e-12 keep every impact within 1e-9 s
+    # constant g (da = 0), so its error is the error of that impact's time and speed (2/(g(1 −
+    # e)) times the speed error). rkf45 and rk8pd at rtol 1e-12 keep every impact within 1e-9 s
     # (measured ≤ 3e-11); msbdf locates events on rk4imp runs whose errors add up from impact
-    # to impact (measured 4.1e-7 s at the 20th for e = 0.85): 1e-6, its P2 bar. The contact is
-    # held once the rest of the sequence ends before the next output (docs/impulse.md §4).
+    # to impact: 1e-6, its P2 bar. The contact is held at the first impact whose next flight
+    # the method does not resolve (docs/impulse.md §4): its end not located to 1 % from the
+    # position error a step d = atol + rtol |u| + 16 ε (|u| + gap) (u = H0 on the floor),
+    # τ² ≤ 2d/(0.01 g), or for msbdf, which restarts at order 1, √(2d/g) ≥ 0.01 τ.
     rtol, atol = 1e-12, 1e-14
     an = {"type": "dynamic", "integrator": stepper, "dt": 0.01, "t_end": 3.0, "rtol": rtol,
           "atol": atol}
     s, hist = execute(ball(e, an))
-    c = s["contacts"]["floor"]
-    t_on, t_off = np.array(c["impact_times"]), c["separation_times"]
-    instant = np.array([x is not None and x == y for x, y in zip(t_off, t_on)])
+    t_on, instant, c = held_ball(s)
     t_ref, v_ref, t_inf = ball_closed_form(e, int(instant.sum()))
     bar = 1e-6 if stepper == "msbdf" else 1e-9
     assert np.abs(t_on[instant] - t_ref).max() <= bar
     assert np.abs(np.array(c["approach_speeds"])[instant] - v_ref).max() <= bar
-    assert (~instant).sum() == 1 and t_off[-1] is None
+    assert (~instant).sum() == 1 and c["separation_times"][-1] is None
     assert abs(t_on[~instant][0] - t_inf) <= (1e-6 if stepper == "msbdf" else 1e-8)
-    # the policy's clause (docs/impulse.md §4), from the sequence alone: the contact is held
-    # at the first decaying impact after which t∞ comes before the next output (the same t∞
-    # from every impact for constant g), not one impact earlier
-    assert t_inf < next_output(t_ref[-1], 0.01)
-    assert len(t_ref) < 2 or next_output(t_ref[-2], 0.01) <= t_inf
+    d = atol + rtol * H0 + 16 * EPS * 2 * H0
+    res = math.sqrt(2 * d / G) / RHO if stepper == "msbdf" else math.sqrt(2 * d / (RHO * G))
+    assert instant.sum() == flights_resolved(e, res)
     assert hist["u:ball"][hist["t"] > t_inf + 0.01] == pytest.approx(H0, rel=1e-14)
 
 
 @pytest.mark.parametrize("e", [0.3, 0.6, 0.85])
-def test_ida_closes_the_ball_at_the_first_unresolved_rebound(e):
-    # IDA closes the contact at the first impact after which the accumulation point t∞ comes
-    # before the next output (the same policy as every integrator, docs/impulse.md §4), so the
-    # rest of the sequence it skips lasts less than one output interval. IDA's impact
-    # times carry its global error, which grows with the restarts (measured 1.2e-11 s on the
-    # first five, 1.1e-6 s at the 30th): 1e-5.
+def test_ida_holds_the_ball_from_the_accumulation_point(e):
+    # IDA closes the contact at the first impact whose next flight it does not resolve (the
+    # rule of every integrator, docs/impulse.md §4): IDA restarts at order 1 (BDF) and its
+    # position error is 10 (rtol max(|u|, gap) + atol), u = H0 on the floor. The impact that
+    # closes it is an impact; the persistent phase starts at the predicted t∞ (exact for
+    # constant g). IDA's impact times carry its global error, which grows with the restarts
+    # (measured 1.2e-11 s on the first five, 1.1e-6 s at the 30th): 1e-5.
     rtol, atol = 1e-12, 1e-16
     an = {"type": "dynamic", "integrator": "ida", "dt": 1e-3, "t_end": 3.0, "rtol": rtol,
           "atol": atol}
     s, _ = execute(ball(e, an))
-    c = s["contacts"]["floor"]
-    t_ref, v_ref, t_inf = ball_closed_form(e, len(c["impact_times"]))
-    assert c["separation_times"][-1] is None
-    t_stick = c["impact_times"][-1]
-    assert t_stick == pytest.approx(t_ref[-1], abs=1e-5)
-    # closed at the first impact of the output interval that holds t∞ (the rest of the
-    # sequence is over before the next output), not one impact earlier
-    assert 0.0 < t_inf - t_stick < 1e-3 + 1e-5
-    assert next_output(t_ref[-2], 1e-3) <= t_inf + 1e-5
-
-
-def next_output(t, dt):
-    """The first output time after t on the grid k dt."""
-    return (math.floor(t / dt) + 1) * dt
+    t_on, instant, c = held_ball(s)
+    t_ref, v_ref, t_inf = ball_closed_form(e, int(instant.sum()))
+    assert np.abs(t_on[instant] - t_ref).max() <= 1e-5
+    assert (~instant).sum() == 1 and c["separation_times"][-1] is None
+    assert abs(t_on[~instant][0] - t_inf) <= 1e-5
+    assert c["persistent_from"] == t_on[~instant][0]
+    d = 10 * (rtol * H0 + atol)
+    assert instant.sum() == flights_resolved(e, math.sqrt(2 * d / G) / RHO)
 
 
 # --- one multi-contact impact, three integrators ----------------------------------------------
