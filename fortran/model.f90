@@ -319,20 +319,9 @@ contains
       integer, intent(in) :: kind, a, b
       real(dp), intent(in) :: par(NPAR_LINK)
       integer, intent(out) :: stat
-      stat = MARTELLO_OK
-      if (m%nlink >= size(m%link_kind)) then
-         call fail(m, stat, 'add_link: more links than declared at model_create'); return
-      end if
-      call model_check_link(m, kind, a, b, par, stat)
-      if (stat /= MARTELLO_OK) return
-      call rows_append_pair(m%lnk, a, b, stat)
-      if (stat /= 0) then
-         call out_of_memory('a link row', REAL_BYTES + INT_BYTES, FIX_SMALLER_SCENE, stat, m%errmsg)
-         return
-      end if
-      m%nlink = m%nlink + 1
-      m%link_kind(m%nlink) = kind
-      m%link_par(:, m%nlink) = par
+      call link_room(m, 'add_link', stat)
+      if (stat == MARTELLO_OK) call model_check_link(m, kind, a, b, par, stat)
+      if (stat == MARTELLO_OK) call append_link(m, kind, [a, b], [1.0_dp, -1.0_dp], par, stat)
    end subroutine model_add_link
 
    !> Add a link whose elongation is Σ coef(k)·u(node(k)) (node 0: the ground, left out): a
@@ -342,13 +331,27 @@ contains
       integer, intent(in) :: kind, node(:)
       real(dp), intent(in) :: coef(:), par(NPAR_LINK)
       integer, intent(out) :: stat
-      stat = MARTELLO_OK
-      if (m%nlink >= size(m%link_kind)) then
-         call fail(m, stat, 'add_link_row: more links than declared at model_create'); return
-      end if
-      call check_row(m, 'add_link_row', node, coef, stat)
+      call link_room(m, 'add_link_row', stat)
+      if (stat == MARTELLO_OK) call check_row(m, 'add_link_row', node, coef, stat)
       if (stat == MARTELLO_OK) call model_check_link(m, kind, 0, -1, par, stat)
-      if (stat /= MARTELLO_OK) return
+      if (stat == MARTELLO_OK) call append_link(m, kind, node, coef, par, stat)
+   end subroutine model_add_link_row
+
+   !> Room for one more link (the capacity of model_create).
+   subroutine link_room(m, what, stat)
+      type(model_t), intent(inout) :: m
+      character(len=*), intent(in) :: what
+      integer, intent(out) :: stat
+      stat = MARTELLO_OK
+      if (m%nlink >= size(m%link_kind)) call fail(m, stat, what//': more links than declared at model_create')
+   end subroutine link_room
+
+   !> A checked link appended: its row, kind and parameters.
+   subroutine append_link(m, kind, node, coef, par, stat)
+      type(model_t), intent(inout) :: m
+      integer, intent(in) :: kind, node(:)
+      real(dp), intent(in) :: coef(:), par(NPAR_LINK)
+      integer, intent(out) :: stat
       call rows_append(m%lnk, node, coef, stat)
       if (stat /= 0) then
          call out_of_memory('a link row', (REAL_BYTES + INT_BYTES)*size(node), FIX_SMALLER_SCENE, &
@@ -358,7 +361,7 @@ contains
       m%nlink = m%nlink + 1
       m%link_kind(m%nlink) = kind
       m%link_par(:, m%nlink) = par
-   end subroutine model_add_link_row
+   end subroutine append_link
 
    !> What a row needs: nodes of the model or 0 (the ground), finite coefficients, at least
    !> one term on a node.
@@ -412,22 +415,10 @@ contains
       integer, intent(in) :: a, b, scheme, law
       real(dp), intent(in) :: gap, par(NPAR_CONTACT)
       integer, intent(out) :: stat
-      stat = MARTELLO_OK
-      if (m%ncontact >= size(m%con_scheme)) then
-         call fail(m, stat, 'add_contact: more contacts than declared at model_create'); return
-      end if
-      call model_check_contact(m, a, b, gap, scheme, law, par, stat)
-      if (stat /= MARTELLO_OK) return
-      call rows_append_pair(m%con, a, b, stat)
-      if (stat /= 0) then
-         call out_of_memory('a contact row', REAL_BYTES + INT_BYTES, FIX_SMALLER_SCENE, stat, m%errmsg)
-         return
-      end if
-      m%ncontact = m%ncontact + 1
-      m%con_gap(m%ncontact) = gap
-      m%con_scheme(m%ncontact) = scheme; m%con_law(m%ncontact) = law
-      m%con_par(:, m%ncontact) = par
-      m%con_mstar(m%ncontact) = 0.0_dp
+      call contact_room(m, 'add_contact', stat)
+      if (stat == MARTELLO_OK) call model_check_contact(m, a, b, gap, scheme, law, par, stat)
+      if (stat == MARTELLO_OK) call append_contact(m, [a, b], [1.0_dp, -1.0_dp], gap, scheme, law, &
+                                                   par, stat)
    end subroutine model_add_contact
 
    !> Add a contact whose penetration is Σ coef(k)·u(node(k)) − gap (node 0: the ground, left
@@ -438,13 +429,28 @@ contains
       integer, intent(in) :: node(:), scheme, law
       real(dp), intent(in) :: coef(:), gap, par(NPAR_CONTACT)
       integer, intent(out) :: stat
-      stat = MARTELLO_OK
-      if (m%ncontact >= size(m%con_scheme)) then
-         call fail(m, stat, 'add_contact_row: more contacts than declared at model_create'); return
-      end if
-      call check_row(m, 'add_contact_row', node, coef, stat)
+      call contact_room(m, 'add_contact_row', stat)
+      if (stat == MARTELLO_OK) call check_row(m, 'add_contact_row', node, coef, stat)
       if (stat == MARTELLO_OK) call model_check_contact(m, 0, -1, gap, scheme, law, par, stat)
-      if (stat /= MARTELLO_OK) return
+      if (stat == MARTELLO_OK) call append_contact(m, node, coef, gap, scheme, law, par, stat)
+   end subroutine model_add_contact_row
+
+   !> Room for one more contact (the capacity of model_create).
+   subroutine contact_room(m, what, stat)
+      type(model_t), intent(inout) :: m
+      character(len=*), intent(in) :: what
+      integer, intent(out) :: stat
+      stat = MARTELLO_OK
+      if (m%ncontact >= size(m%con_scheme)) &
+         call fail(m, stat, what//': more contacts than declared at model_create')
+   end subroutine contact_room
+
+   !> A checked contact appended: its row, gap, scheme, law and parameters.
+   subroutine append_contact(m, node, coef, gap, scheme, law, par, stat)
+      type(model_t), intent(inout) :: m
+      integer, intent(in) :: node(:), scheme, law
+      real(dp), intent(in) :: coef(:), gap, par(NPAR_CONTACT)
+      integer, intent(out) :: stat
       call rows_append(m%con, node, coef, stat)
       if (stat /= 0) then
          call out_of_memory('a contact row', (REAL_BYTES + INT_BYTES)*size(node), FIX_SMALLER_SCENE, &
@@ -456,7 +462,7 @@ contains
       m%con_scheme(m%ncontact) = scheme; m%con_law(m%ncontact) = law
       m%con_par(:, m%ncontact) = par
       m%con_mstar(m%ncontact) = 0.0_dp
-   end subroutine model_add_contact_row
+   end subroutine append_contact
 
    !> What add_contact checks of one contact (its nodes, scheme, law and parameters; b = −1:
    !> a row's contact, its nodes checked by check_row); a chain's contacts too.

@@ -558,6 +558,16 @@ def measured_part(res, fna):
       f"the gaps and the devices as FNA's link elements). Cost: Newmark "
       f"{a['cost']['wall_time_s']:.2f} s, FNA {b['cost']['wall_time_s']:.2f} s "
       f"({b['cost'].get('modes', '?')} modes).\n")
+    w("## Every integrator on the 3D scene\n")
+    wp = ROOT / "docs" / "p11" / "work_precision.md"
+    if wp.exists():
+        w("Configuration A, record 1, its first seconds, by every integrator that takes penalty "
+          "contacts, against rk8pd at rtol 1e-12 (`benchmarks/p11/work_precision.py -o docs/p11`; its "
+          "own table, regenerated with it):\n")
+        w("![work-precision](p11/work_precision.png)\n")
+        w(wp.read_text().rstrip() + "\n")
+    else:
+        w("Not run here (`benchmarks/p11/work_precision.py -o docs/p11` writes it).\n")
     w(comparison(pen, tB, tA, seedg))
     return "\n".join(L)
 
