@@ -45,11 +45,11 @@ def closed_form(e):
 @pytest.mark.parametrize("integrator,tol", [
     # event-located impacts and the impulse-level steppers: the impulse solves Newton's law
     # with the exact Delassus W = g M⁻¹ gᵀ, so the velocities are right to round-off
-    ("rk8pd", 1e-12), ("rkf45", 1e-12), ("msbdf", 1e-12), ("ida", 1e-10),
-    ("moreau-jean", 1e-12), ("newmark-lagrange", 1e-9)])
+    ("rk8pd", 1e-12), ("rkf45", 1e-12), ("msbdf", 1e-12), ("ida", 1e-10), ("cvode", 1e-10),
+    ("arkode", 1e-10), ("moreau-jean", 1e-12), ("newmark-lagrange", 1e-9)])
 def test_eccentric_impact_is_the_closed_form_under_every_restitution_integrator(integrator, tol):
     an = {"type": "dynamic", "integrator": integrator, "dt": 1e-3, "t_end": 0.1}
-    if integrator in ("rk8pd", "rkf45", "msbdf", "ida"):
+    if integrator in ("rk8pd", "rkf45", "msbdf", "ida", "cvode", "arkode"):
         an.update(rtol=1e-10, atol=1e-14)
     s, (cols, hist) = run_full(from_dict(eccentric_pair(
         {"scheme": "restitution", "restitution": E_RES}, an)))

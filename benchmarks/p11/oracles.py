@@ -112,7 +112,7 @@ def eccentric_impact():
     d = tomllib.loads(path.read_text())
     ref = oracle(**d["check"]["params"])
     out = {}
-    for integ in ("rk8pd", "rkf45", "msbdf", "ida", "moreau-jean", "newmark-lagrange"):
+    for integ in ("rk8pd", "rkf45", "msbdf", "ida", "cvode", "arkode", "moreau-jean", "newmark-lagrange"):
         dd = {k: v for k, v in d.items() if k != "check"}
         an = dict(d["analysis"], integrator=integ)
         if integ in ("moreau-jean", "newmark-lagrange"):
