@@ -248,6 +248,22 @@ contains
       c_model_add_stiffness_block = stat
    end function c_model_add_stiffness_block
 
+   integer(c_int) function c_model_set_influence(handle, n, iota) bind(C, name='martello_model_set_influence')
+      type(c_ptr), value :: handle
+      integer(c_int), value :: n
+      real(c_double), intent(in) :: iota(*)
+      type(model_t), pointer :: mp
+      integer :: stat
+      mp => get_model(handle)
+      c_model_set_influence = MARTELLO_ERR_ARGUMENT
+      if (.not. associated(mp)) return
+      if (n /= mp%n) then
+         mp%errmsg = 'set_influence: give one value per node (n = n_nodes)'; return
+      end if
+      call model_set_influence(mp, iota(1:n), stat)
+      c_model_set_influence = stat
+   end function c_model_set_influence
+
    integer(c_int) function c_model_set_gravity(handle, g) bind(C, name='martello_model_set_gravity')
       type(c_ptr), value :: handle
       real(c_double), value :: g

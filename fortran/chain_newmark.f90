@@ -27,7 +27,7 @@ module martello_chain_newmark
    use martello_model, only: model_t, model_bandwidth, SCHEME_PENALTY, model_link_index, &
       model_initial_state, &
       model_contact_index, model_link_at, model_contact_at, model_expand_chains, model_nlinks, &
-      model_ncontacts
+      model_ncontacts, model_has_influence
    use martello_links, only: LINK_SPRING, LINK_BAR, LINK_DASHPOT, LINK_BILINEAR, L_STIFF, L_DAMP, &
       L_YIELD, L_HARDENING, bilinear_return_map, bilinear_energy
    use martello_contact_laws, only: LAW_LINEAR, LAW_KELVIN, P_STIFF, P_DAMPING, P_CLIP, &
@@ -144,7 +144,8 @@ contains
       ok = s%kind == INT_NEWMARK .and. logical(s%fused_chain) .and. 2.0_dp*s%beta >= s%gamma
       if (.not. ok) return
       ! stiffness blocks (frames) are not in the sweep's per-node parameters
-      ok = model_bandwidth(m) <= 1 .and. m%ncoupling == 0 .and. m%nblock == 0
+      ok = model_bandwidth(m) <= 1 .and. m%ncoupling == 0 .and. m%nblock == 0 &
+           .and. .not. model_has_influence(m)     ! the sweep loads every node with its mass
       do j = 1, m%nlink
          select case (m%link_kind(j))
          case (LINK_SPRING, LINK_BAR, LINK_DASHPOT, LINK_BILINEAR)

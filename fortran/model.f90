@@ -18,6 +18,7 @@ module martello_model
    public :: model_t, model_init, model_set_node, model_add_link, model_add_contact, &
       model_initial_state, model_u0, &
       model_add_mass_coupling, model_add_nodal_force, model_set_ground_acceleration, &
+      model_set_influence, model_influence, model_has_influence, &
       model_add_stiffness_block, stiffness_block_t, model_bandwidth, rigid_contact_sides, &
       SCHEME_PENALTY, SCHEME_LAGRANGE, SCHEME_AUGMENTED, &
       SCHEME_RESTITUTION, scheme_name, chain_t, model_add_chain, model_expand_chains, &
@@ -79,8 +80,12 @@ module martello_model
       !> count the items added one by one (model_nlinks, model_ncontacts: all of them)
       integer :: nchain = 0
       type(chain_t), allocatable :: chain(:)
-      ! loads: gravity is an acceleration along +u acting on M; ground acceleration loads −M·1·ü_g
+      ! loads: gravity is an acceleration along +u acting on M·ι; ground acceleration loads
+      ! −M·ι·ü_g (ι the influence vector, Chopra, Dynamics of Structures §9.4)
       real(dp) :: gravity = 0.0_dp
+      !> ι of each node: its motion per unit of the uniform acceleration's (a 3D building's uy
+      !> and rz move otherwise than the scene's axis); no entries while every one is 1
+      real(dp), allocatable :: influence(:)
       integer :: nforce = 0
       integer, allocatable :: force_node(:)
       type(time_function_t), allocatable :: force_fn(:)
@@ -117,7 +122,7 @@ contains
          return
       end if
       m%n = n
-      allocate (m%mass(n), m%u0(0), m%v0(0), m%fixed(n), &
+      allocate (m%mass(n), m%u0(0), m%v0(0), m%influence(0), m%fixed(n), &
                 m%link_kind(max_links), m%link_a(max_links), m%link_b(max_links), &
                 m%link_par(NPAR_LINK, max_links), &
                 m%con_a(max_contacts), m%con_b(max_contacts), m%con_scheme(max_contacts), &
@@ -196,6 +201,43 @@ contains
       u0 = 0.0_dp
       if (size(m%u0) > 0) u0 = m%u0(i)
    end function model_u0
+
+   !> Set the influence vector ι (nodes 1..n): gravity and the ground acceleration load M·ι.
+   subroutine model_set_influence(m, iota, stat)
+      type(model_t), intent(inout) :: m
+      real(dp), intent(in) :: iota(:)
+      integer, intent(out) :: stat
+      stat = MARTELLO_OK
+      if (size(iota) /= m%n) then
+         call fail(m, stat, 'set_influence: give one value per node'); return
+      end if
+      if (.not. all(ieee_is_finite(iota))) then
+         call fail(m, stat, 'set_influence: the influence must be finite'); return
+      end if
+      if (allocated(m%influence)) deallocate (m%influence)
+      allocate (m%influence(m%n), stat=stat)
+      if (stat /= 0) then
+         call out_of_memory('the influence vector', REAL_BYTES*m%n, FIX_SMALLER_SCENE, stat, m%errmsg)
+         return
+      end if
+      m%influence = iota
+   end subroutine model_set_influence
+
+   !> ι of node i (1 where none was set).
+   pure real(dp) function model_influence(m, i) result(iota)
+      type(model_t), intent(in) :: m
+      integer, intent(in) :: i
+      iota = 1.0_dp
+      if (.not. allocated(m%influence)) return
+      if (size(m%influence) > 0) iota = m%influence(i)
+   end function model_influence
+
+   !> Whether an influence vector was set (else ι = 1 for every node).
+   pure logical function model_has_influence(m) result(has)
+      type(model_t), intent(in) :: m
+      has = .false.
+      if (allocated(m%influence)) has = size(m%influence) > 0
+   end function model_has_influence
 
    subroutine model_add_link(m, kind, a, b, par, stat)
       type(model_t), intent(inout) :: m

@@ -263,6 +263,8 @@ def build_model(scene, chain_door=True):
     for b in scene.blocks:
         m.add_stiffness_block(b["nodes"], b["k"], b["c"])
     m.set_gravity(scene.gravity)
+    if scene.influence is not None:
+        m.set_influence(scene.influence)
     for f in scene.forces:
         m.add_nodal_force(f["node"], *_function_args(f["function"], scene.source))
     if scene.ground is not None:
@@ -454,6 +456,12 @@ def _dynamic(scene, model, raise_on_failure=True):
         if fr["histories"] and len(hist):
             columns = columns + list(extra_cols)
             hist = np.hstack([hist, np.column_stack(list(extra_cols.values()))])
+    buildings = {}
+    for b in scene.extras.get("buildings", []):
+        buildings[b["prefix"]], extra_cols = building_results(b, columns, hist)
+        if b["histories"] and len(hist):
+            columns = columns + list(extra_cols)
+            hist = np.hstack([hist, np.column_stack(list(extra_cols.values()))])
     summary = {
         "title": scene.title, "problem": scene.problem,
         "analysis": {k: v for k, v in an.items() if k != "output"} | {"output_every": an["output"]["every"]},
@@ -467,6 +475,7 @@ def _dynamic(scene, model, raise_on_failure=True):
         "links": arrays.entries("links", pick("links", out_links)),
         **({"arrays": arrays} if large else {}),
         **({"frames": frames} if frames else {}),
+        **({"buildings": buildings} if buildings else {}),
         "stability": {"omega_max": extra["omega_max"] or None,
                       "dt_critical": extra["dt_critical"] or None},
         "cost": counters | {"wall_time_s": wall},
@@ -599,6 +608,77 @@ def frame_results(fr, columns, hist):
             "rayleigh": {"a0": fr["rayleigh"][0], "a1": fr["rayleigh"][1], "zeta": fr["zeta"]}}, series
 
 
+def _extremes(x, t):
+    """Signed extremes of a sampled series and their times (None without samples)."""
+    if not len(x):
+        return {"max": None, "min": None, "t_max": None, "t_min": None}
+    i, j = int(np.argmax(x)), int(np.argmin(x))
+    return {"max": float(x[i]), "min": float(x[j]), "t_max": float(t[i]), "t_min": float(t[j])}
+
+
+def building_description(b):
+    """What a building's summary says of it whatever the run: its modes and damping."""
+    return {"model": b["building"].model, "dofs": len(b["nodes"]), "modes": b["modes"],
+            "damping": {"kind": b["damping"], "zeta": b["zeta"], "a0": b["rayleigh"][0],
+                        "a1": b["rayleigh"][1]},
+            "ground_angle": b["ground_angle"]}
+
+
+def building_results(b, columns, hist):
+    """A building's peaks from the recorded floor DOFs (martello.building3d's operators
+    applied to every recorded sample: exact at output.every = 1): signed extremes of every
+    member's end forces (N, V2, V3, T, M2, M3 at ends i and j; a rigid floor's beams carry no
+    in-plane forces, so no N, V3, M2) with their times and the largest biaxial moment
+    √(M2² + M3²) at each end; per storey the shears along x and y and the torque about the
+    floor's reference point; per requested plan point its ux, uy. Also the member histories
+    (M2, M3 at both ends, by column name)."""
+    col = {name: i for i, name in enumerate(columns)}
+    t = hist[:, col["t"]] if len(hist) else np.zeros(0)
+    U = hist[:, [col[f"u:{n}"] for n in b["nodes"]]] if len(hist) else np.zeros((0, len(b["nodes"])))
+    F = U @ b["recovery"].T
+    bd = b["building"]
+    members, series = {}, {}
+    for e, m in enumerate(bd.elements):
+        rigid_beam = m.kind == "beam" and bd.floors[m.storey - 1].rigid
+        out = {"kind": m.kind, "storey" if m.kind != "beam" else "floor": m.storey}
+        for end, off in (("i", 0), ("j", 6)):
+            for k, q in enumerate(("N", "V2", "V3", "T", "M2", "M3")):
+                if rigid_beam and q in ("N", "V3", "M2"):
+                    continue
+                x = F[:, 12 * e + off + k]
+                out[f"{q}_{end}"] = _extremes(x, t)
+                if q in ("M2", "M3"):
+                    series[f"{q}_{end}:{b['prefix']}.{m.name}"] = x
+            res = np.hypot(F[:, 12 * e + off + 4], F[:, 12 * e + off + 5])
+            out[f"M_{end}_resultant_max"] = float(res.max()) if len(res) else None
+        members[m.name] = out
+    S = U @ b["storey"].T
+    storeys = {str(s + 1): {q: _extremes(S[:, 3 * s + k], t) for k, q in enumerate(("shear_x", "shear_y", "torque"))}
+               for s in range(bd.storeys)}
+    points = {}
+    for p in b["points"]:
+        P = U @ bd.point_operator(p["floor"], p["x"], p["y"]).T
+        points[p["name"]] = {"floor": p["floor"], "x": p["x"], "y": p["y"],
+                             "ux": _extremes(P[:, 0], t), "uy": _extremes(P[:, 1], t)}
+    return building_description(b) | {"members": members, "storeys": storeys, "points": points}, series
+
+
+def _static_building(b, scene, u):
+    """A building's member end forces, storey shears and torques at the static solution."""
+    U = np.array([u[scene.index[n]] for n in b["nodes"]])
+    F = b["recovery"] @ U
+    S = b["storey"] @ U
+    members = {m.name: dict(zip([f"{q}_{e}" for e in "ij" for q in ("N", "V2", "V3", "T", "M2", "M3")],
+                                map(float, F[12 * k:12 * k + 12])))
+               for k, m in enumerate(b["building"].elements)}
+    return building_description(b) | {
+        "members": members,
+        "storeys": {str(s + 1): dict(zip(("shear_x", "shear_y", "torque"), map(float, S[3 * s:3 * s + 3])))
+                    for s in range(b["building"].storeys)},
+        "points": {p["name"]: dict(zip(("ux", "uy"), map(float, b["building"].point_operator(
+            p["floor"], p["x"], p["y"]) @ U))) for p in b["points"]}}
+
+
 def _static_frame(fr, scene, u):
     """A frame's member end forces, storey drifts and shears at the static solution."""
     U = np.array([u[scene.index[n]] for n in fr["nodes"]])
@@ -638,6 +718,8 @@ def _static(scene, model):
         "contacts": contacts,
         **({"frames": {fr["prefix"]: _static_frame(fr, scene, r["u"])
                        for fr in scene.extras["frames"]}} if scene.extras.get("frames") else {}),
+        **({"buildings": {b["prefix"]: _static_building(b, scene, r["u"])
+                          for b in scene.extras["buildings"]}} if scene.extras.get("buildings") else {}),
         "conditioning": {"rcond": r["rcond"],
                          "condition_estimate": _finite_or_none(1.0 / r["rcond"]) if r["rcond"] > 0 else None,
                          "digits_lost": r["digits_lost"],

@@ -77,6 +77,7 @@ def lib():
         "martello_model_add_stiffness_block": (c_int, [_VOID_P, c_int, _INT_P, _DOUBLE_P,
                                                        _DOUBLE_P]),
         "martello_model_set_gravity": (c_int, [_VOID_P, c_double]),
+        "martello_model_set_influence": (c_int, [_VOID_P, c_int, _DOUBLE_P]),
         "martello_model_add_nodal_force": (c_int, [_VOID_P, c_int, c_int, _DOUBLE_P, c_int,
                                                    _DOUBLE_P, _DOUBLE_P]),
         "martello_model_set_ground_acceleration": (c_int, [_VOID_P, c_int, _DOUBLE_P, c_int,
@@ -466,6 +467,11 @@ class Model(_Handle):
 
     def set_gravity(self, g):
         self.check(lib().martello_model_set_gravity(self._h, g), "gravity")
+
+    def set_influence(self, iota):
+        """ι of every node: gravity and the ground acceleration load M·ι (default 1)."""
+        iota = _f64(iota)
+        self.check(lib().martello_model_set_influence(self._h, iota.size, iota), "influence")
 
     def add_nodal_force(self, node, kind, par, t=(), y=()):
         t, y = _f64(t), _f64(y)

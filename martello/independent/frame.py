@@ -82,7 +82,9 @@ def frame_block(tab: dict) -> FrameBlock:
     widths = _each(tab["bay_width"], nb, "bay_width")
     cols = _sections(tab["column"], ns, nb + 1, "column")
     beams = _sections(tab["beam"], ns, nb, "beam")
-    floor_mass = _each(tab["mass"], ns, "mass")
+    joint_mass = isinstance(tab["mass"], list) and any(isinstance(v, list) for v in tab["mass"])
+    floor_mass = ([_each(row, nb + 1, "mass") for row in tab["mass"]] if joint_mass
+                  else _each(tab["mass"], ns, "mass"))
     model = tab.get("mass_model", "diaphragm")
     base = tab.get("base", "fixed")
     if model not in ("diaphragm", "joints") or base not in ("fixed", "pinned"):
@@ -115,7 +117,8 @@ def frame_block(tab: dict) -> FrameBlock:
         names = [f"{prefix}{s + 1}.{i}" for s in range(ns) for i in range(nb + 1)]
         share = np.array([(widths[i - 1] if i > 0 else 0.0) + (widths[i] if i < nb else 0.0)
                           for i in range(nb + 1)]) / (2.0 * sum(widths))
-        mass = np.concatenate([m * share for m in floor_mass])
+        # each joint's own mass where the scene gives them (docs/scene-input.md "[[frame]]")
+        mass = np.concatenate([np.array(m) if joint_mass else m * share for m in floor_mass])
         lateral = [[dofs(i, s + 1)[0]] for s in range(ns) for i in range(nb + 1)]
     in_lateral = {q for group in lateral for q in group}
     rest = [q for q in free if q not in in_lateral]
