@@ -431,11 +431,19 @@ def scheduler_of(args, study, stream=None):
     return address, f"the scheduler of {study.path}, used by --use-study-scheduler"
 
 
+def output_folder(path, study, output=None):
+    """The folder a study writes: `output` if given, else the study's `output` key (relative
+    to the repository in a checkout, to the working folder once installed), else
+    out/studies/<file name>."""
+    if output:
+        return Path(output)
+    return OUTPUT_ROOT / study.output if study.output else Path("out") / "studies" / Path(path).stem
+
+
 def main(args):
     path = Path(args.study)
     study = load_study(path)
-    out = Path(args.output) if args.output else (OUTPUT_ROOT / study.output if study.output
-                                                 else Path("out") / "studies" / path.stem)
+    out = output_folder(path, study, args.output)
     scheduler, origin = scheduler_of(args, study)
     plots = not getattr(args, "no_plots", False)
     if scheduler:
