@@ -15,7 +15,8 @@ module martello_fixed_step
    use martello_integrator_settings, only: integrator_settings_t, integrator_name
    use martello_run_checks, only: check_run_settings
    use martello_observer, only: observer_t, observer_begin, observer_sample, observer_fail, observer_failed, &
-      observer_penalty_phases, observer_finish, C_STEPS, C_FACTORIZATIONS
+      observer_penalty_phases, observer_finish
+   use martello_run_quantities, only: C_STEPS, C_FACTORIZATIONS
    implicit none
    private
    public :: run_fixed_step, stepper_t, stepper_start, stepper_rest_start, solve_free_mass, &

@@ -10,8 +10,8 @@ module martello_generalized_alpha
    use martello_model, only: model_t, model_bandwidth
    use martello_band_matrix
    use martello_assembly
-   use martello_observer, only: observer_t, observer_work, observer_fail, C_NEWTON, C_RESIDUALS, &
-      C_FACTORIZATIONS, C_JACOBIANS, C_CHATTER, free_side_crossing
+   use martello_observer, only: observer_t, observer_work, observer_fail, free_side_crossing
+   use martello_run_quantities, only: C_NEWTON, C_RESIDUALS, C_FACTORIZATIONS, C_JACOBIANS, C_CHATTER
    use martello_contact_laws, only: contact_force, LAW_KELVIN, LAW_LINEAR, LAW_JANKOWSKI, P_CLIP, &
       P_STIFF, P_DAMPING
    use martello_links, only: LINK_BILINEAR, L_STIFF, L_YIELD, L_HARDENING

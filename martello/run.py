@@ -15,7 +15,6 @@ from .binding.native import constant
 from .errors import RecordError, ResultError, SceneError
 from .paths import folder_replaced
 from .results import (ARRAYS_FILE, PHASE_FIELDS, ItemArrays, is_large)
-from .scene.bars import RodElements, RodNodes
 from .scene.chain import ChainContacts, ChainLinks
 from .scene.items import ItemTable, Listed, Names
 from .scene.spec import DEFAULT_METHODS
@@ -100,18 +99,15 @@ def contact_arrays(contacts):
 
 def node_arrays(nodes):
     """(mass, u0, v0, fixed) of the scene's nodes, for Model.set_nodes: a listed segment's
-    read from its dicts, a chain's arrays as they are."""
+    read from its dicts, a generated one's arrays as it gives them (martello.scene.items)."""
     parts = []
     for seg in segments(nodes):
         if isinstance(seg, list):
             parts.append([np.fromiter((nd[key] for nd in seg), dt, len(seg))
                           for key, dt in (("mass", np.float64), ("u0", np.float64),
                                           ("v0", np.float64), ("fixed", np.int32))])
-        elif isinstance(seg, RodNodes):
-            parts.append(list(seg.arrays()))
         else:
-            b = seg.block
-            parts.append([b.mass, b.u0, b.v0, np.zeros(b.n, np.int32)])
+            parts.append(list(seg.arrays()))
     return tuple(np.concatenate([p[k] for p in parts]) if parts else np.zeros(0)
                  for k in range(4))
 
@@ -133,62 +129,29 @@ CHUNK = 1 << 16
 
 def link_chunks(segs):
     """(kind, a, b, par) arrays of links (segments of the scene's link table), in order, a
-    chunk at a time."""
+    chunk at a time: a listed segment's from its dicts, a generated one's as it gives them."""
     for seg in segs:
         if isinstance(seg, list):
             if seg:
                 yield link_arrays(seg)
-            continue
-        if isinstance(seg, RodElements):
-            r = seg.rod
-            for k0 in range(0, len(seg), CHUNK):
-                m = min(CHUNK, len(seg) - k0)
-                a = (r.node0 + np.arange(k0, k0 + m)).astype(np.int32)   # element k: k, k + 1
-                par = np.zeros((m, constant("NPAR_LINK")))
-                par[:, constant("L_STIFF")] = r.EA / r.mesh["element_length"]
-                yield np.full(m, native.value("links", "bar"), np.int32), a, a + 1, par
-            continue
-        b = seg.block
-        spring, damper = seg.spring, seg.damper
-        kind_spring = native.value("links", "spring" if b.fy is None else "bilinear")
-        for i0 in range(0, b.n, CHUNK):
-            i1 = min(i0 + CHUNK, b.n)
-            d0, d1 = np.searchsorted(b.dampers, (i0, i1))
-            at = spring[i0]
-            s, d = spring[i0:i1] - at, damper[d0:d1] - at
-            m = (i1 - i0) + (d1 - d0)
-            kind = np.empty(m, np.int32)
-            a = np.empty(m, np.int32)
-            par = np.zeros((m, constant("NPAR_LINK")))
-            kind[s] = kind_spring
-            a[s] = b.node0 + np.arange(i0, i1)
-            par[s, constant("L_STIFF")] = b.k[i0:i1]
-            if b.fy is not None:
-                par[s, constant("L_YIELD")] = b.fy[i0:i1]
-                par[s, constant("L_HARDENING")] = b.hardening[i0:i1]
-            kind[d] = native.value("links", "dashpot")
-            a[d] = b.node0 + b.dampers[d0:d1]
-            par[d, constant("L_DAMP")] = b.c[d0:d1]
-            yield kind, a, np.full(m, -1, np.int32), par
+        else:
+            yield from seg.chunks(CHUNK)
 
 
 def contact_chunks(segs):
     """(a, b, gap, scheme, law, par) arrays of contacts (segments of the scene's contact
-    table), in order, a chunk at a time; a chain's contacts share one row of parameters, its
-    template's."""
+    table), in order, a chunk at a time; a generated segment's contacts share one row of
+    parameters, its template's."""
     for seg in segs:
         if isinstance(seg, list):
             if seg:
                 yield contact_arrays(seg)
             continue
-        b = seg.block
-        _, _, _, scheme, law, row = contact_arrays([b.template])
-        for j0 in range(0, len(seg), CHUNK):
-            j1 = min(j0 + CHUNK, len(seg))
-            m = j1 - j0
-            a = (b.node0 + np.arange(j0, j1)).astype(np.int32)
-            yield (a, a + 1, b.gap[j0:j1], np.full(m, scheme[0], np.int32),
-                   np.full(m, law[0], np.int32), np.repeat(row, m, axis=0))
+        _, _, _, scheme, law, row = contact_arrays([seg.template])
+        for a, b, gap in seg.chunks(CHUNK):
+            m = len(a)
+            yield (a, b, gap, np.full(m, scheme[0], np.int32), np.full(m, law[0], np.int32),
+                   np.repeat(row, m, axis=0))
 
 
 def _function_args(fn, source="<scene>", t_end=None):
@@ -569,23 +532,14 @@ def _names(table):
 
 def _codes(table, key, categories):
     """Codes of a category column (index into categories, −1 where None), segment by
-    segment: a chain's from its block."""
+    segment: a generated one's as it gives them."""
     at = {c: i for i, c in enumerate(categories)}
     parts = []
     for seg in segments(table):
         if isinstance(seg, list):
             parts.append(np.fromiter((at.get(it.get(key), -1) for it in seg), np.int8, len(seg)))
-            continue
-        if isinstance(seg, RodElements):
-            parts.append(np.full(len(seg), at["bar"], np.int8))
-            continue
-        b = seg.block
-        if key == "type":          # the chain's springs, then dampers where it has them
-            codes = np.full(len(seg), at["spring" if b.fy is None else "bilinear"], np.int8)
-            codes[seg.damper] = at["dashpot"]
         else:
-            codes = np.full(len(seg), at.get(b.template.get(key), -1), np.int8)
-        parts.append(codes)
+            parts.append(seg.codes(key, at))
     return np.concatenate(parts) if parts else np.zeros(0, np.int8)
 
 

@@ -40,9 +40,6 @@ DT = {"moreau-jean": "5.0e-6"}
 # does not bound them (at Δt = 1e-5 the second impact is 7.5e-5 s off against a bound of
 # 4e-5; docs/independent-reference.md "Open").
 REFUSED = {("jankowski", "moreau-jean"), ("kelvin_clipped", "moreau-jean")}
-# ARKODE fails on Jankowski: its error test fails repeatedly at the onset, where the damping
-# rises as δ^(1/4) (h = 4e-8 s at t = 0.106 s, ARK_ERR_FAILURE)
-REFUSED.add(("jankowski", "arkode"))
 
 
 def name(law, integ):
