@@ -301,7 +301,7 @@ class CheckResult:
 
 def check(scenes=None, output="out/check", *, plots=False, stream=None):
     """Verify scenes against their closed forms and reference data as ``martello check``
-    does (docs/verification.md): ``scenes`` scene files or catalogue paths (default: the
+    does (docs/coverage.md): ``scenes`` scene files or catalogue paths (default: the
     whole catalogue; a scene named must have something to verify); the table is printed on
     ``stream`` (default stdout) and report.md, verification.csv (and with ``plots`` the PNGs)
     written in ``output``. A ``CheckResult``."""
@@ -313,7 +313,10 @@ def check(scenes=None, output="out/check", *, plots=False, stream=None):
     ok = check_catalogue(files, out, plots=plots, stream=stream or sys.stdout,
                          require_checks=bool(scenes))
     table = out / "verification.csv"
-    rows = list(csv.DictReader(open(table, newline=""))) if table.exists() else []
+    rows = []
+    if table.exists():
+        with open(table, newline="") as fh:
+            rows = list(csv.DictReader(fh))
     return CheckResult(ok, rows, out)
 
 
