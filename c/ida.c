@@ -1130,7 +1130,7 @@ static int peak_skip(void *ctx, int kind, int j) {
 /* The peaks inside [t0, t1] of IDA's last step, on its interpolant (docs/run-layer.md,
  * located peaks): every quantity's value and rate at both ends (the start's kept from the
  * last step's end when IDA went on: P->start_rates), then c/located_peaks.c. */
-static int located_peaks(ida_problem *P, void *mem, double t0, double t1) {
+static int located_peaks(ida_problem *P, void *mem, double t0, double t1, int at_event) {
   const int n = P->n;
   martello_peak_ends e;
   int st;
@@ -1148,6 +1148,7 @@ static int located_peaks(ida_problem *P, void *mem, double t0, double t1) {
   martello_peak_ends_set(&e, 0, n, P->nc, P->nl, P->pv0, P->pa0, P->pj0, P->el0);
   martello_peak_ends_set(&e, 1, n, P->nc, P->nl, P->pv1, P->pa1, P->pj1, P->el1);
   e.skip = peak_skip;
+  if (at_event && (st = martello_peak_fold_end(P->obs, &e, P)) != MARTELLO_OK) return st;
   return martello_locate_peaks(P->obs, &e, t0, t1, P->rtol, P->event_tol, peak_probe, P);
 }
 
@@ -1315,7 +1316,7 @@ static int integrate(ida_problem *P, SUNContext sunctx, void **memp, N_Vector yy
     }
     if ((st = work_quadrature(P, mem, t_last, t_r, ytmp)) != MARTELLO_OK) break;
     if ((st = node_extrema(P, mem, t_last, t_r, N_VGetArrayPointer(yy), ytmp)) != MARTELLO_OK) break;
-    if ((st = located_peaks(P, mem, t_last, t_r)) != MARTELLO_OK) break;
+    if ((st = located_peaks(P, mem, t_last, t_r, restart)) != MARTELLO_OK) break;
     keep_end_rates(P, !restart);
     t_last = t_r;
     P->t_now = t_r;
