@@ -1,5 +1,5 @@
 /* Peaks located inside the accepted steps of the adaptive integrators (GSL in
- * c/event_driven.c, IDA in c/ida.c; docs/run-layer.md, located peaks): one procedure for
+ * c/event_driven.c, IDA, CVODE and ARKODE in c/ode_events.c; docs/run-layer.md, located peaks): one procedure for
  * every scalar quantity of the state the summary reports a peak of — node |v| and |a|,
  * contact penetration and force, link |force| and |elongation|.
  *

@@ -140,6 +140,11 @@ int martello_model_add_contacts(martello_model *model, int n, const int *a, cons
 int martello_model_add_stiffness_block(martello_model *model, int n, const int *nodes,
                                        const double *k, const double *c);
 int martello_model_set_gravity(martello_model *model, double g);
+/* The influence vector iota[n_nodes]: how far each node moves per unit motion along the
+ * scene's axis, so that gravity and the ground acceleration load M iota (default 1 for
+ * every node; Chopra, Dynamics of Structures, 9.4). A 3D building's floors: cos and sin of
+ * the motion's direction on ux and uy, 0 on rz (docs/buildings.md). */
+int martello_model_set_influence(martello_model *model, int n, const double *iota);
 /* A time function: kind MARTELLO_TF_*, par[MARTELLO_NPAR_TF], and for a table n_table
  * samples (t[i], y[i]) with t strictly increasing (y scaled by par[0]). */
 int martello_model_add_nodal_force(martello_model *model, int node, int kind,

@@ -11,6 +11,7 @@ module martello_api_internal
    use martello_contact_laws, only: P_RESTITUTION
    use martello_integrator_settings, only: integrator_settings_t
    use martello_observer
+   use martello_run_quantities, only: NCOUNTERS
    use martello_run, only: run_t
    use martello_api_handles, only: get_model, get_run, get_eval, get_observer
    implicit none

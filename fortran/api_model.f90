@@ -248,6 +248,22 @@ contains
       c_model_add_stiffness_block = stat
    end function c_model_add_stiffness_block
 
+   integer(c_int) function c_model_set_influence(handle, n, iota) bind(C, name='martello_model_set_influence')
+      type(c_ptr), value :: handle
+      integer(c_int), value :: n
+      real(c_double), intent(in) :: iota(*)
+      type(model_t), pointer :: mp
+      integer :: stat
+      mp => get_model(handle)
+      c_model_set_influence = MARTELLO_ERR_ARGUMENT
+      if (.not. associated(mp)) return
+      if (n /= mp%n) then
+         mp%errmsg = 'set_influence: give one value per node (n = n_nodes)'; return
+      end if
+      call model_set_influence(mp, iota(1:n), stat)
+      c_model_set_influence = stat
+   end function c_model_set_influence
+
    integer(c_int) function c_model_set_gravity(handle, g) bind(C, name='martello_model_set_gravity')
       type(c_ptr), value :: handle
       real(c_double), value :: g
@@ -298,6 +314,7 @@ contains
       type(c_ptr), value :: handle
       real(c_double), intent(out) :: mstar(*)
       type(model_t), pointer :: mp
+      type(model_t), allocatable :: items
       integer :: stat
       mp => get_model(handle)
       c_model_effective_masses = MARTELLO_ERR_ARGUMENT
@@ -306,8 +323,14 @@ contains
          mp%errmsg = 'effective_masses: every node must be set (set_node) first'
          c_model_effective_masses = MARTELLO_ERR_STATE; return
       end if
-      call model_expand_chains(mp, stat, mp%errmsg)
-      if (stat == MARTELLO_OK) call contact_effective_masses(mp, mstar(1:mp%ncontact), mp%errmsg, stat)
+      if (mp%nchain == 0) then
+         call contact_effective_masses(mp, mstar(1:mp%ncontact), mp%errmsg, stat)
+      else
+         ! the chains' contacts one by one, on a copy (the model keeps its chains)
+         call model_expanded(mp, items, stat, mp%errmsg)
+         if (stat == MARTELLO_OK) &
+            call contact_effective_masses(items, mstar(1:items%ncontact), mp%errmsg, stat)
+      end if
       c_model_effective_masses = stat
    end function c_model_effective_masses
 
@@ -331,7 +354,8 @@ contains
       integer(c_int), value :: max_iter
       real(c_double), intent(out) :: u(*), force(*), penetration(*), conditioning(4)
       integer(c_int), intent(out) :: active(*), counters(3)
-      type(model_t), pointer :: mp
+      type(model_t), pointer :: mp, m
+      type(model_t), allocatable, target :: items
       type(static_result_t) :: r
       integer :: stat, n, nc
       mp => get_model(handle)
@@ -345,9 +369,15 @@ contains
          c_static_solve = MARTELLO_ERR_STATE; return
       end if
       mp%errmsg = ''
-      call model_expand_chains(mp, stat, mp%errmsg)
-      if (stat == MARTELLO_OK) call static_solve(mp, tol, int(max_iter), r, stat)
-      n = mp%n; nc = mp%ncontact
+      ! the chains' items one by one, on a copy (the model keeps its chains)
+      m => mp; stat = MARTELLO_OK
+      if (mp%nchain > 0) then
+         call model_expanded(mp, items, stat, mp%errmsg)
+         if (stat == MARTELLO_OK) m => items
+      end if
+      if (stat == MARTELLO_OK) call static_solve(m, tol, int(max_iter), r, stat)
+      if (.not. associated(m, mp)) mp%errmsg = m%errmsg
+      n = m%n; nc = m%ncontact
       if (allocated(r%u)) then
          u(1:n) = r%u; force(1:nc) = r%force; penetration(1:nc) = r%penetration
          active(1:nc) = merge(1, 0, r%active)

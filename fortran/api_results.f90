@@ -5,8 +5,9 @@ module martello_api_results
    use, intrinsic :: iso_c_binding
    use martello_kinds, only: dp
    use martello_status
-   use martello_observer, only: NCOUNTERS, NENERGY, NEVENT, tracks, TRACK_NODE_PEAKS, &
-      TRACK_LINK_PEAKS, TRACK_CONTACT_PEAKS, observer_events
+   use martello_observer, only: tracks, observer_events
+   use martello_run_quantities, only: NCOUNTERS, NENERGY, NEVENT
+   use martello_registry, only: TRACK_NODE_PEAKS, TRACK_LINK_PEAKS, TRACK_CONTACT_PEAKS
    use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan
    use martello_run, only: run_t
    use martello_api_handles, only: get_run

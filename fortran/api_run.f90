@@ -6,7 +6,7 @@ module martello_api_run
    use martello_model, only: model_t
    use martello_integrator_settings, only: integrator_settings_t, settings_default, settings_check
    use martello_run, only: run_t, run_dynamic
-   use martello_observer, only: TRACK_ALL
+   use martello_registry, only: TRACK_ALL
    use martello_api_handles, only: get_model, get_run, copy_message
    implicit none
    private

@@ -16,7 +16,7 @@ module martello_assembly
    private
    public :: mech_state_t, mech_init, internal_forces, external_forces, mech_commit, &
       element_power, recoverable_energy, mass_times, external_work, kinetic_energy, &
-      assemble_mass, uniform_acceleration, load_breakpoint, ONSET_SPEED_FLOOR
+      assemble_mass, uniform_acceleration, load_breakpoint, load_pattern, ONSET_SPEED_FLOOR
 
    !> Hunt–Crossley-type laws scale damping by 1/v_in; a contact first seen while δ̇ ≤ 0
    !> (grazing, or a step that lands inside) uses this floor [m/s] instead of a division by 0.
@@ -457,6 +457,18 @@ contains
          y(m%mc_b(j)) = y(m%mc_b(j)) + m%mc_value(j)*x(m%mc_a(j))
       end do
    end subroutine mass_times
+
+   !> M·ι (0:n, ground 0): what the uniform acceleration (gravity − ü_g) loads, ι the
+   !> model's influence vector (1 for every node of a 1D scene; Chopra §9.4). work: 0:n.
+   pure subroutine load_pattern(m, work, mrow)
+      type(model_t), intent(in) :: m
+      real(dp), intent(out) :: work(0:), mrow(0:)
+      work = 1.0_dp; work(0) = 0.0_dp
+      if (allocated(m%influence)) then
+         if (size(m%influence) > 0) work(1:m%n) = m%influence
+      end if
+      call mass_times(m, work, mrow)
+   end subroutine load_pattern
 
    !> jac += c·M (band).
    pure subroutine assemble_mass(m, c, jac)

@@ -7,8 +7,8 @@ module martello_central_difference
    use martello_model, only: model_t, model_bandwidth
    use martello_band_matrix, only: band_t, band_init
    use martello_assembly, only: internal_forces, external_forces, mech_commit, external_work
-   use martello_observer, only: observer_t, observer_work, observer_fail, C_RESIDUALS, &
-      C_FACTORIZATIONS
+   use martello_observer, only: observer_t, observer_work, observer_fail
+   use martello_run_quantities, only: C_RESIDUALS, C_FACTORIZATIONS
    use martello_integrator_settings, only: integrator_settings_t
    use martello_stability, only: omega_max
    use martello_fixed_step, only: stepper_t, stepper_rest_start, solve_free_mass, stepper_fail, &

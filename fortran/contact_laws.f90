@@ -9,6 +9,7 @@
 !> rather than a silently wrong number: pure procedures cannot stop in Fortran 2008.
 module martello_contact_laws
    use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan
+   use, intrinsic :: iso_fortran_env, only: int8
    use martello_kinds, only: dp
    implicit none
    private
@@ -18,6 +19,8 @@ module martello_contact_laws
    public :: NPAR_CONTACT, P_STIFF, P_EXPONENT, P_DAMPING, P_RESTITUTION, P_CLIP, HERTZ_EXPONENT
    public :: contact_force, contact_elastic_energy, damping_from_restitution, exact_hc_factor
    public :: law_is_known, law_exponent
+   public :: BRANCH_OFF, BRANCH_ON, BRANCH_CLIPPED, AFFINE_LINEAR, AFFINE_KELVIN, &
+             AFFINE_KELVIN_CLIPPED
 
    ! Law identifiers: values are frozen, the C and Python layers use the same integers.
    integer, parameter :: LAW_LINEAR = 1
@@ -29,6 +32,13 @@ module martello_contact_laws
    integer, parameter :: LAW_GONTHIER = 7
    integer, parameter :: LAW_HERTZDAMP = 8
    integer, parameter :: LAW_JANKOWSKI = 9
+
+   !> The laws that are affine on each branch (linear, k δ; Kelvin, k δ + c δ̇, clipped at 0
+   !> or not) and their branches, as a method that holds them per contact keeps them in bytes
+   !> (the fused chain step, and observer_block that measures it): open, pushing, and in
+   !> phase with no force (a clipped Kelvin law past its cut-off).
+   integer(int8), parameter :: AFFINE_LINEAR = 1, AFFINE_KELVIN = 2, AFFINE_KELVIN_CLIPPED = 3
+   integer(int8), parameter :: BRANCH_OFF = 0, BRANCH_ON = 1, BRANCH_CLIPPED = 2
 
    ! Layout of par(NPAR_CONTACT); slots 6 to 8 are reserved and must be zero. The effective
    ! mass m* the kelvin and jankowski laws need is the model's (martello_effective_mass).

@@ -44,8 +44,7 @@ contains
                             + INT_BYTES*count(m%fixed), FIX_SMALLER_SCENE, stat, m%errmsg)
          return
       end if
-      ev%work = 1.0_dp; ev%work(0) = 0.0_dp
-      call mass_times(m, ev%work, ev%mrow)
+      call load_pattern(m, ev%work, ev%mrow)
       ev%u = 0.0_dp; ev%v = 0.0_dp
       call model_initial_state(m, ev%u(1:n), ev%v(1:n))
       call mech_init(m, ev%ms, ev%u, ev%v, stat, m%errmsg)

@@ -27,9 +27,8 @@ module martello_fast_nonlinear
    use martello_links, only: LINK_SPRING, LINK_BAR, LINK_DASHPOT, LINK_BILINEAR, L_STIFF, L_DAMP
    use martello_assembly, only: internal_forces, external_forces, mech_commit, external_work, &
       mass_times
-   use martello_observer, only: observer_t, observer_work, observer_fail, C_NEWTON, C_RESIDUALS, &
-      C_FACTORIZATIONS
-   use martello_run_quantities, only: C_MODES
+   use martello_observer, only: observer_t, observer_work, observer_fail
+   use martello_run_quantities, only: C_MODES, C_NEWTON, C_RESIDUALS, C_FACTORIZATIONS, C_JACOBIANS
    use martello_integrator_settings, only: integrator_settings_t
    use martello_fixed_step, only: stepper_t, stepper_start, stepper_fail, contact_state
    use martello_lapack, only: dsygv, dgesv, dgetrf, dgetrs
@@ -38,7 +37,6 @@ module martello_fast_nonlinear
    use martello_model, only: model_bandwidth
    use martello_band_matrix, only: band_t, band_init, band_zero
    use martello_stability, only: free_dofs
-   use martello_observer, only: C_JACOBIANS
    implicit none
    private
    public :: fast_nonlinear_t, modal_step_coefficients

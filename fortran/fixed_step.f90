@@ -9,13 +9,14 @@ module martello_fixed_step
    use martello_kinds, only: dp, i8
    use martello_status
    use martello_model, only: model_t, model_initial_state
-   use martello_assembly, only: mech_state_t, mech_init, mass_times, assemble_mass, internal_forces, &
+   use martello_assembly, only: mech_state_t, mech_init, load_pattern, assemble_mass, internal_forces, &
       external_forces, mech_commit
    use martello_band_matrix, only: band_t, band_zero, band_pin, band_solve
    use martello_integrator_settings, only: integrator_settings_t, integrator_name
    use martello_run_checks, only: check_run_settings
    use martello_observer, only: observer_t, observer_begin, observer_sample, observer_fail, observer_failed, &
-      observer_penalty_phases, observer_finish, C_STEPS, C_FACTORIZATIONS
+      observer_penalty_phases, observer_finish
+   use martello_run_quantities, only: C_STEPS, C_FACTORIZATIONS
    implicit none
    private
    public :: run_fixed_step, stepper_t, stepper_start, stepper_rest_start, solve_free_mass, &
@@ -35,7 +36,7 @@ module martello_fixed_step
       !> per contact at the end of the step: penetration δ and force (the mean force p/h of
       !> an impulse), as the method defines them
       real(dp), allocatable :: pen(:), force(:)
-      real(dp), allocatable :: mrow(:)          !< M·1: gravity and ground-motion loads
+      real(dp), allocatable :: mrow(:)          !< M·ι: gravity and ground-motion loads
       integer, allocatable :: fixed_nodes(:)
       type(mech_state_t) :: ms                  !< links and penalty contacts, committed
       !> what to change when the run diverges (ends the observer's message)
@@ -211,8 +212,7 @@ contains
          if (.not. m%fixed(j)) cycle
          k = k + 1; self%fixed_nodes(k) = j
       end do
-      self%un = 1.0_dp; self%un(0) = 0.0_dp
-      call mass_times(m, self%un, self%mrow)
+      call load_pattern(m, self%un, self%mrow)
       call mech_init(m, self%ms, self%u, self%v, stat, msg)
       if (stat /= MARTELLO_OK) then
          call observer_fail(o, MARTELLO_ERR_MEMORY, 0.0_dp, msg, stat)

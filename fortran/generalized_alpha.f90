@@ -10,9 +10,10 @@ module martello_generalized_alpha
    use martello_model, only: model_t, model_bandwidth
    use martello_band_matrix
    use martello_assembly
-   use martello_observer, only: observer_t, observer_work, observer_fail, C_NEWTON, C_RESIDUALS, &
-      C_FACTORIZATIONS, C_JACOBIANS, C_CHATTER, free_side_crossing
-   use martello_contact_laws, only: contact_force, LAW_KELVIN, LAW_LINEAR, P_CLIP, P_STIFF, P_DAMPING
+   use martello_observer, only: observer_t, observer_work, observer_fail, free_side_crossing
+   use martello_run_quantities, only: C_NEWTON, C_RESIDUALS, C_FACTORIZATIONS, C_JACOBIANS, C_CHATTER
+   use martello_contact_laws, only: contact_force, LAW_KELVIN, LAW_LINEAR, LAW_JANKOWSKI, P_CLIP, &
+      P_STIFF, P_DAMPING
    use martello_links, only: LINK_BILINEAR, L_STIFF, L_YIELD, L_HARDENING
    use martello_integrator_settings
    use martello_stability, only: omega_max
@@ -23,10 +24,13 @@ module martello_generalized_alpha
    public :: generalized_alpha_t, generalized_alpha_coefficients
 
    !> The switches of a contact in an event-split step (first_switch), and the branch a
-   !> contact is held on up to each (the left limit)
+   !> contact is held on up to each (the left limit). SW_TURN: a Jankowski contact's switch
+   !> between approach and restitution (δ̇ through 0: its damping term c δ̇ turns on or off,
+   !> a kink of the force, no jump), solved on the whole law (δ̇ is 0 at its end to O(h³))
    integer, parameter :: SW_ONSET = 1, SW_SEPARATION = 2, SW_CUT = 3, SW_REENGAGE = 4, &
-                         SW_CUT_SEPARATION = 5
-   integer, parameter :: HELD(5) = [CONTACT_OPEN, CONTACT_ON, CONTACT_ON, CONTACT_CUT, CONTACT_CUT]
+                         SW_CUT_SEPARATION = 5, SW_TURN = 6
+   integer, parameter :: HELD(6) = [CONTACT_OPEN, CONTACT_ON, CONTACT_ON, CONTACT_CUT, CONTACT_CUT, &
+                                    CONTACT_FREE]
 
    type, extends(stepper_t) :: generalized_alpha_t
       integer :: kd = 0, max_newton = 30
@@ -47,8 +51,9 @@ module martello_generalized_alpha
       logical :: jac_assembled = .false., jac_factored = .false.
       real(dp), allocatable :: tan_link(:, :), tan_con(:, :), tan_link_trial(:, :), &
                                tan_con_trial(:, :), jdiag(:)
-      !> event_split: a step is split at the located onset/separation of a Kelvin contact
-      !> (docs/integrators.md, event-split steps); the step's start state is kept in us, vs, as
+      !> event_split: a step is split at the located switches of the Kelvin, linear and
+      !> Jankowski laws and bilinear links (docs/integrators.md, event-split steps); the step's
+      !> start state is kept in us, vs, as
       logical :: event_split = .false.
       real(dp), allocatable :: us(:), vs(:), as(:), jump(:)
    contains
@@ -115,6 +120,7 @@ contains
       self%cv = self%gamma/(self%beta*self%h)
       self%event_split = logical(s%event_split) .and. (any(m%con_law == LAW_KELVIN) .or. &
                                                         any(m%con_law == LAW_LINEAR) .or. &
+                                                        any(m%con_law == LAW_JANKOWSKI) .or. &
                                                         any(m%link_kind == LINK_BILINEAR))
       if (self%event_split) then
          allocate (self%us(0:n), self%vs(0:n), self%as(0:n), self%jump(0:n), stat=stat)
@@ -167,6 +173,7 @@ contains
       real(dp) :: rnorm, incr, fscale, uscale, fmag, fext_mag, wd, wl, wc, h
       real(dp) :: t_a      !< event-split steps: the start of the stretch being solved
       integer :: turned    !< event-split steps: a link unloaded at the stretch's start
+      integer :: turned_con  !< event-split steps: a Jankowski contact turned at the stretch's start
       integer :: n
       logical :: ok, converged
       character(len=256) :: msg
@@ -220,7 +227,7 @@ contains
          pending = .true.                ! the solved stretch is not committed
          h_full = h
          t_a = self%t0                   ! the stretch [t_a, t] of length h
-         turned = 0
+         turned = 0; turned_con = 0
          do k = 1, MAX_SPLITS
             call first_switch(first, tau, kind)
             if (first == 0) exit
@@ -267,8 +274,13 @@ contains
             end if
             ! an unloading: the link has turned at the boundary (located to O(h²) in time, its
             ! du̇ may still point outward there): the rest of the step starts it elastic
-            turned = 0
+            turned = 0; turned_con = 0
             if (first < 0 .and. kind == 0) turned = -first
+            ! a Jankowski contact that turned at the boundary (located from the start's rates:
+            ! its δ̇ may still have the old sign there, within the step's O(h²)): the rest of
+            ! the step does not look for that turn again (a sub-step of a few ulps of the step
+            ! would follow, whose algorithmic acceleration carries the rounding of u over τ²)
+            if (first > 0 .and. kind == SW_TURN) turned_con = first
             if (tau >= h_left) exit                 ! the switch is on the step's end
             ! the rest of the step, from the boundary
             self%un = self%u; self%vn = self%v; self%an = self%a
@@ -323,6 +335,18 @@ contains
             q0 = self%an(ia) - self%an(ib)
             if (.not. self%ms%con_on(j)) then
                kj = SW_ONSET; sg = 1.0_dp                  ! g = δ
+            else if (m%con_law(j) == LAW_JANKOWSKI) then
+               ! its separation (F ~ δ^(3/2): C¹) and its turn, δ̇ through 0 (g = ∓δ̇ from the
+               ! start's sign; no jerk: O(h²) in time, a C¹ kink whose location error costs
+               ! its square), a boundary without a jump
+               if (r0 /= 0.0_dp .and. j /= turned_con) then
+                  sg = sign(1.0_dp, r0)
+                  tj = switch_time(-sg*r0, -sg*q0, 0.0_dp, -sg*r1, .false.)
+                  if (tj < tau) then
+                     tau = tj; first = j; kind = SW_TURN
+                  end if
+               end if
+               kj = SW_SEPARATION; sg = -1.0_dp
             else if (.not. clipped(j)) then
                kj = SW_SEPARATION; sg = -1.0_dp            ! g = −δ
             else
@@ -419,11 +443,14 @@ contains
                             r, r, fplus, dfd, dfv)
       end function onset_force
 
-      !> The contact laws whose force is not smooth at δ = 0: Kelvin (it jumps by cδ̇) and
-      !> linear (its slope jumps by k); the Hertz and Hunt–Crossley family rise as δ^n, n > 1.
+      !> The contact laws whose force is not smooth at δ = 0: Kelvin (it jumps by cδ̇), linear
+      !> (its slope jumps by k) and Jankowski (its damping c δ^(1/4) δ̇ rises as δ^(1/4), and
+      !> switches off and on with the sign of δ̇); the Hertz and Hunt–Crossley family rise as
+      !> δ^n, n > 1, smoothly enough for the trapezoidal rule's second order.
       pure logical function kinked_law(j)
          integer, intent(in) :: j
-         kinked_law = m%con_law(j) == LAW_KELVIN .or. m%con_law(j) == LAW_LINEAR
+         kinked_law = m%con_law(j) == LAW_KELVIN .or. m%con_law(j) == LAW_LINEAR .or. &
+                      m%con_law(j) == LAW_JANKOWSKI
       end function kinked_law
 
       pure logical function clipped(j)
@@ -441,6 +468,8 @@ contains
          integer, intent(in) :: j, kind
          integer :: ia, ib
          real(dp) :: fplus
+         ok = .true.
+         if (kind == SW_TURN) return          ! a kink: the force is continuous there
          ia = m%con_a(j); ib = m%con_b(j)
          fplus = 0.0_dp
          if (kind == SW_ONSET .or. kind == SW_REENGAGE) fplus = max(onset_force(j), 0.0_dp)

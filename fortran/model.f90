@@ -18,11 +18,12 @@ module martello_model
    public :: model_t, model_init, model_set_node, model_add_link, model_add_contact, &
       model_initial_state, model_u0, &
       model_add_mass_coupling, model_add_nodal_force, model_set_ground_acceleration, &
+      model_set_influence, model_influence, model_has_influence, &
       model_add_stiffness_block, stiffness_block_t, model_bandwidth, rigid_contact_sides, &
       SCHEME_PENALTY, SCHEME_LAGRANGE, SCHEME_AUGMENTED, &
-      SCHEME_RESTITUTION, scheme_name, chain_t, model_add_chain, model_expand_chains, &
+      SCHEME_RESTITUTION, scheme_name, chain_t, model_add_chain, model_expanded, &
       model_nlinks, model_ncontacts, model_link_index, model_contact_index, model_contact_at, &
-      model_link_at
+      model_link_at, model_check_link, model_check_contact
 
    !> Symmetric stiffness and damping matrices between a set of nodes (a statically condensed
    !> structure, e.g. a planar frame on its lateral DOFs, docs/problems.md P10): internal
@@ -36,12 +37,12 @@ module martello_model
 
    !> A chain added whole (model_add_chain, docs/c-api.md "Chains"): nodes first … first + n − 1,
    !> node i with a spring k(i) to ground (bilinear with fy(i), rho(i) when given) and, where
-   !> c(i) > 0, a dashpot c(i); nodes i and i + 1 in contact through gap(i), one scheme, law
-   !> and parameter row for all. Held per node (the methods that take a chain as a whole read
-   !> these arrays); its links and contacts are the items numbered link0 + 1 … and
-   !> contact0 + 1 … (spring then dashpot of each node, in order), made one by one only by
-   !> model_expand_chains, for the methods that take items one by one. glink, gcontact: the
-   !> items added one by one before it.
+   !> c(i) > 0, a dashpot c(i); nodes i and i + 1 in contact through gap(i) (one value when
+   !> every gap is the same), one scheme, law and parameter row for all. Held per node (the
+   !> methods that take a chain as a whole read these arrays); its links and contacts are the
+   !> items numbered link0 + 1 … and contact0 + 1 … (spring then dashpot of each node, in
+   !> order), made one by one only on a copy (model_expanded), for the methods that take
+   !> items one by one. glink, gcontact: the items added one by one before it.
    type :: chain_t
       integer :: first = 0, n = 0, nlink = 0, ncontact = 0
       integer :: link0 = 0, contact0 = 0, glink = 0, gcontact = 0
@@ -79,14 +80,76 @@ module martello_model
       !> count the items added one by one (model_nlinks, model_ncontacts: all of them)
       integer :: nchain = 0
       type(chain_t), allocatable :: chain(:)
-      ! loads: gravity is an acceleration along +u acting on M; ground acceleration loads −M·1·ü_g
+      ! loads: gravity is an acceleration along +u acting on M·ι; ground acceleration loads
+      ! −M·ι·ü_g (ι the influence vector, Chopra, Dynamics of Structures §9.4)
       real(dp) :: gravity = 0.0_dp
+      !> ι of each node: its motion per unit of the uniform acceleration's (a 3D building's uy
+      !> and rz move otherwise than the scene's axis); no entries while every one is 1
+      real(dp), allocatable :: influence(:)
       integer :: nforce = 0
       integer, allocatable :: force_node(:)
       type(time_function_t), allocatable :: force_fn(:)
       type(time_function_t) :: ground_accel
       character(len=512) :: errmsg = ''
    end type model_t
+
+   ! The chains: fortran/chain/model_chains.f90 (submodule chains)
+   interface
+      !> Add a chain (chain_t) on nodes first … first + n − 1: k(n) the springs to ground; c(n)
+      !> the dashpots (0: none; absent: none), fy(n), rho(n) the bilinear springs' yield force
+      !> and hardening (absent: linear springs); gap(n − 1) the contacts between neighbours
+      !> (absent: none) with scheme, law and par.
+      module subroutine model_add_chain(m, first, n, k, c, fy, rho, gap, scheme, law, par, stat)
+         type(model_t), intent(inout) :: m
+         integer, intent(in) :: first, n, scheme, law
+         real(dp), intent(in) :: k(:), par(NPAR_CONTACT)
+         real(dp), intent(in), optional :: c(:), fy(:), rho(:), gap(:)
+         integer, intent(out) :: stat
+      end subroutine model_add_chain
+      !> Links and contacts of the model: added one by one and in chains.
+      pure module integer function model_nlinks(m) result(nl)
+         type(model_t), intent(in) :: m
+      end function model_nlinks
+      pure module integer function model_ncontacts(m) result(nc)
+         type(model_t), intent(in) :: m
+      end function model_ncontacts
+      !> The number of link (contact) j added one by one among all the model's links (contacts).
+      pure module integer function model_link_index(m, j) result(idx)
+         type(model_t), intent(in) :: m
+         integer, intent(in) :: j
+      end function model_link_index
+      pure module integer function model_contact_index(m, j) result(idx)
+         type(model_t), intent(in) :: m
+         integer, intent(in) :: j
+      end function model_contact_index
+      !> Link number j of all the model's links: kind, nodes and parameters.
+      pure module subroutine model_link_at(m, j, kind, a, b, par)
+         type(model_t), intent(in) :: m
+         integer, intent(in) :: j
+         integer, intent(out) :: kind, a, b
+         real(dp), intent(out) :: par(NPAR_LINK)
+      end subroutine model_link_at
+      !> Contact number j of all the model's contacts: nodes, gap, scheme, law, parameters.
+      pure module subroutine model_contact_at(m, j, a, b, gap, scheme, law, par)
+         type(model_t), intent(in) :: m
+         integer, intent(in) :: j
+         integer, intent(out) :: a, b, scheme, law
+         real(dp), intent(out) :: gap, par(NPAR_CONTACT)
+      end subroutine model_contact_at
+      !> The chains made into links and contacts one by one, in place (the model's own copy).
+      module subroutine model_expand_chains(m, stat, message)
+         type(model_t), intent(inout) :: m
+         integer, intent(out) :: stat
+         character(len=*), intent(inout) :: message
+      end subroutine model_expand_chains
+      !> A copy of the model with its chains as links and contacts one by one.
+      module subroutine model_expanded(m, copy, stat, message)
+         type(model_t), intent(in) :: m
+         type(model_t), allocatable, intent(out) :: copy
+         integer, intent(out) :: stat
+         character(len=*), intent(inout) :: message
+      end subroutine model_expanded
+   end interface
 
 contains
 
@@ -117,7 +180,7 @@ contains
          return
       end if
       m%n = n
-      allocate (m%mass(n), m%u0(0), m%v0(0), m%fixed(n), &
+      allocate (m%mass(n), m%u0(0), m%v0(0), m%influence(0), m%fixed(n), &
                 m%link_kind(max_links), m%link_a(max_links), m%link_b(max_links), &
                 m%link_par(NPAR_LINK, max_links), &
                 m%con_a(max_contacts), m%con_b(max_contacts), m%con_scheme(max_contacts), &
@@ -197,6 +260,43 @@ contains
       if (size(m%u0) > 0) u0 = m%u0(i)
    end function model_u0
 
+   !> Set the influence vector ι (nodes 1..n): gravity and the ground acceleration load M·ι.
+   subroutine model_set_influence(m, iota, stat)
+      type(model_t), intent(inout) :: m
+      real(dp), intent(in) :: iota(:)
+      integer, intent(out) :: stat
+      stat = MARTELLO_OK
+      if (size(iota) /= m%n) then
+         call fail(m, stat, 'set_influence: give one value per node'); return
+      end if
+      if (.not. all(ieee_is_finite(iota))) then
+         call fail(m, stat, 'set_influence: the influence must be finite'); return
+      end if
+      if (allocated(m%influence)) deallocate (m%influence)
+      allocate (m%influence(m%n), stat=stat)
+      if (stat /= 0) then
+         call out_of_memory('the influence vector', REAL_BYTES*m%n, FIX_SMALLER_SCENE, stat, m%errmsg)
+         return
+      end if
+      m%influence = iota
+   end subroutine model_set_influence
+
+   !> ι of node i (1 where none was set).
+   pure real(dp) function model_influence(m, i) result(iota)
+      type(model_t), intent(in) :: m
+      integer, intent(in) :: i
+      iota = 1.0_dp
+      if (.not. allocated(m%influence)) return
+      if (size(m%influence) > 0) iota = m%influence(i)
+   end function model_influence
+
+   !> Whether an influence vector was set (else ι = 1 for every node).
+   pure logical function model_has_influence(m) result(has)
+      type(model_t), intent(in) :: m
+      has = .false.
+      if (allocated(m%influence)) has = size(m%influence) > 0
+   end function model_has_influence
+
    subroutine model_add_link(m, kind, a, b, par, stat)
       type(model_t), intent(inout) :: m
       integer, intent(in) :: kind, a, b
@@ -206,15 +306,15 @@ contains
       if (m%nlink >= size(m%link_kind)) then
          call fail(m, stat, 'add_link: more links than declared at model_create'); return
       end if
-      call check_link(m, kind, a, b, par, stat)
+      call model_check_link(m, kind, a, b, par, stat)
       if (stat /= MARTELLO_OK) return
       m%nlink = m%nlink + 1
       m%link_kind(m%nlink) = kind; m%link_a(m%nlink) = a; m%link_b(m%nlink) = b
       m%link_par(:, m%nlink) = par
    end subroutine model_add_link
 
-   !> What add_link checks of one link (its nodes, kind and parameters).
-   subroutine check_link(m, kind, a, b, par, stat)
+   !> What add_link checks of one link (its nodes, kind and parameters); a chain's links too.
+   subroutine model_check_link(m, kind, a, b, par, stat)
       type(model_t), intent(inout) :: m
       integer, intent(in) :: kind, a, b
       real(dp), intent(in) :: par(NPAR_LINK)
@@ -229,7 +329,7 @@ contains
       if (.not. all(ieee_is_finite(par))) then
          call fail(m, stat, 'add_link: parameters must be finite'); return
       end if
-   end subroutine check_link
+   end subroutine model_check_link
 
    subroutine model_add_contact(m, a, b, gap, scheme, law, par, stat)
       type(model_t), intent(inout) :: m
@@ -240,7 +340,7 @@ contains
       if (m%ncontact >= size(m%con_a)) then
          call fail(m, stat, 'add_contact: more contacts than declared at model_create'); return
       end if
-      call check_contact(m, a, b, gap, scheme, law, par, stat)
+      call model_check_contact(m, a, b, gap, scheme, law, par, stat)
       if (stat /= MARTELLO_OK) return
       m%ncontact = m%ncontact + 1
       m%con_a(m%ncontact) = a; m%con_b(m%ncontact) = b; m%con_gap(m%ncontact) = gap
@@ -249,8 +349,9 @@ contains
       m%con_mstar(m%ncontact) = 0.0_dp
    end subroutine model_add_contact
 
-   !> What add_contact checks of one contact (its nodes, scheme, law and parameters).
-   subroutine check_contact(m, a, b, gap, scheme, law, par, stat)
+   !> What add_contact checks of one contact (its nodes, scheme, law and parameters); a
+   !> chain's contacts too.
+   subroutine model_check_contact(m, a, b, gap, scheme, law, par, stat)
       type(model_t), intent(inout) :: m
       integer, intent(in) :: a, b, scheme, law
       real(dp), intent(in) :: gap, par(NPAR_CONTACT)
@@ -278,7 +379,7 @@ contains
             call fail(m, stat, 'add_contact: target restitution must lie in [0, 1]'); return
          end if
       end if
-   end subroutine check_contact
+   end subroutine model_check_contact
 
    subroutine model_add_mass_coupling(m, a, b, value, stat)
       type(model_t), intent(inout) :: m
@@ -440,298 +541,6 @@ contains
       end do
    end function model_bandwidth
 
-   !> Add a chain (chain_t) on nodes first … first + n − 1: k(n) the springs to ground; c(n)
-   !> the dashpots (0: none; absent: none), fy(n), rho(n) the bilinear springs' yield force
-   !> and hardening (absent: linear springs); gap(n − 1) the contacts between neighbours
-   !> (absent: none) with scheme, law and par. Every link and contact is checked as add_link
-   !> and add_contact check it; the first bad one stops the call, and the message names it
-   !> (`chain entry i`, 0-based node of the chain). Items added one by one and chains are
-   !> numbered in the order of the calls.
-   subroutine model_add_chain(m, first, n, k, c, fy, rho, gap, scheme, law, par, stat)
-      type(model_t), intent(inout) :: m
-      integer, intent(in) :: first, n, scheme, law
-      real(dp), intent(in) :: k(:), par(NPAR_CONTACT)
-      real(dp), intent(in), optional :: c(:), fy(:), rho(:), gap(:)
-      integer, intent(out) :: stat
-      type(chain_t), allocatable :: grown(:)
-      type(chain_t) :: new
-      real(dp) :: lp(NPAR_LINK)
-      integer :: i, kind
-      character(len=24) :: num
-      stat = MARTELLO_OK
-      if (n < 1 .or. first < 1 .or. first + n - 1 > m%n) then
-         call fail(m, stat, 'add_chain: its nodes first ... first + n - 1 must be nodes of the model'//&
-                   ' (n >= 1)'); return
-      end if
-      if (present(fy) .neqv. present(rho)) then
-         call fail(m, stat, 'add_chain: give both fy and hardening (bilinear springs) or neither')
-         return
-      end if
-      kind = merge(LINK_BILINEAR, LINK_SPRING, present(fy))
-      do i = 1, n
-         lp = 0.0_dp; lp(L_STIFF) = k(i)
-         if (present(fy)) then
-            lp(L_YIELD) = fy(i); lp(L_HARDENING) = rho(i)
-         end if
-         call check_link(m, kind, first + i - 1, 0, lp, stat)
-         if (stat == MARTELLO_OK .and. present(c)) then
-            if (.not. (c(i) >= 0.0_dp .and. ieee_is_finite(c(i)))) &
-               call fail(m, stat, 'add_chain: dashpot c must be finite and >= 0 (0: none)')
-         end if
-         if (stat == MARTELLO_OK .and. present(gap) .and. i < n) &
-            call check_contact(m, first + i - 1, first + i, gap(i), scheme, law, par, stat)
-         if (stat /= MARTELLO_OK) then
-            write (num, '(i0)') i - 1
-            m%errmsg = 'chain entry '//trim(num)//': '//trim(m%errmsg); return
-         end if
-      end do
-      ! the new chain's arrays and the grown list allocated before anything moves: a failure
-      ! leaves the model as it was
-      allocate (new%k(n), stat=stat)
-      if (stat == 0 .and. present(c)) allocate (new%c(n), stat=stat)
-      if (stat == 0 .and. present(fy)) allocate (new%fy(n), new%rho(n), stat=stat)
-      if (stat == 0 .and. present(gap) .and. n > 1) allocate (new%gap(n - 1), stat=stat)
-      if (stat == 0) allocate (grown(m%nchain + 1), stat=stat)
-      if (stat /= 0) then
-         write (num, '(i0)') n
-         call out_of_memory('a chain of '//trim(num)//' nodes', REAL_BYTES*n*(1 + merge(1, 0, present(c)) &
-                            + merge(2, 0, present(fy)) + merge(1, 0, present(gap))), &
-                            FIX_SMALLER_SCENE, stat, m%errmsg)
-         return
-      end if
-      new%first = first; new%n = n
-      new%glink = m%nlink; new%gcontact = m%ncontact
-      new%link0 = model_nlinks(m); new%contact0 = model_ncontacts(m)
-      new%k = k(1:n)
-      new%nlink = n
-      if (present(c)) then
-         new%c = c(1:n); new%nlink = n + count(c(1:n) > 0.0_dp)
-      end if
-      if (present(fy)) then
-         new%fy = fy(1:n); new%rho = rho(1:n)
-      end if
-      if (present(gap) .and. n > 1) then
-         new%gap = gap(1:n - 1); new%ncontact = n - 1
-      end if
-      new%scheme = scheme; new%law = law; new%par = par
-      do i = 1, m%nchain
-         call move_chain(m%chain(i), grown(i))
-      end do
-      call move_chain(new, grown(m%nchain + 1))
-      call move_alloc(grown, m%chain)
-      m%nchain = m%nchain + 1
-   contains
-      !> to ← from, the arrays moved, not copied
-      subroutine move_chain(from, to)
-         type(chain_t), intent(inout) :: from
-         type(chain_t), intent(inout) :: to
-         to%first = from%first; to%n = from%n; to%nlink = from%nlink; to%ncontact = from%ncontact
-         to%link0 = from%link0; to%contact0 = from%contact0
-         to%glink = from%glink; to%gcontact = from%gcontact
-         to%scheme = from%scheme; to%law = from%law; to%par = from%par
-         call move_alloc(from%k, to%k); call move_alloc(from%c, to%c)
-         call move_alloc(from%fy, to%fy); call move_alloc(from%rho, to%rho)
-         call move_alloc(from%gap, to%gap)
-      end subroutine move_chain
-   end subroutine model_add_chain
-
-   !> Links of the model: added one by one and in chains.
-   pure integer function model_nlinks(m) result(nl)
-      type(model_t), intent(in) :: m
-      integer :: j
-      nl = m%nlink
-      do j = 1, m%nchain
-         nl = nl + m%chain(j)%nlink
-      end do
-   end function model_nlinks
-
-   !> Contacts of the model: added one by one and in chains.
-   pure integer function model_ncontacts(m) result(nc)
-      type(model_t), intent(in) :: m
-      integer :: j
-      nc = m%ncontact
-      do j = 1, m%nchain
-         nc = nc + m%chain(j)%ncontact
-      end do
-   end function model_ncontacts
-
-   !> The number of link j added one by one among all the model's links.
-   pure integer function model_link_index(m, j) result(idx)
-      type(model_t), intent(in) :: m
-      integer, intent(in) :: j
-      integer :: q
-      idx = j
-      do q = 1, m%nchain
-         if (m%chain(q)%glink < j) idx = idx + m%chain(q)%nlink
-      end do
-   end function model_link_index
-
-   !> The number of contact j added one by one among all the model's contacts.
-   pure integer function model_contact_index(m, j) result(idx)
-      type(model_t), intent(in) :: m
-      integer, intent(in) :: j
-      integer :: q
-      idx = j
-      do q = 1, m%nchain
-         if (m%chain(q)%gcontact < j) idx = idx + m%chain(q)%ncontact
-      end do
-   end function model_contact_index
-
-   !> Link number j of all the model's links (one by one or in a chain): kind, nodes and
-   !> parameters.
-   pure subroutine model_link_at(m, j, kind, a, b, par)
-      type(model_t), intent(in) :: m
-      integer, intent(in) :: j
-      integer, intent(out) :: kind, a, b
-      real(dp), intent(out) :: par(NPAR_LINK)
-      integer :: q, i, pos, g
-      g = j
-      do q = 1, m%nchain
-         associate (ch => m%chain(q))
-            if (j > ch%link0 .and. j <= ch%link0 + ch%nlink) then
-               ! the spring, then (where c > 0) the dashpot of each node, in order
-               pos = ch%link0
-               do i = 1, ch%n
-                  par = 0.0_dp; a = ch%first + i - 1; b = 0
-                  pos = pos + 1
-                  if (pos == j) then
-                     kind = LINK_SPRING; par(L_STIFF) = ch%k(i)
-                     if (allocated(ch%fy)) then
-                        kind = LINK_BILINEAR; par(L_YIELD) = ch%fy(i); par(L_HARDENING) = ch%rho(i)
-                     end if
-                     return
-                  end if
-                  if (allocated(ch%c)) then
-                     if (ch%c(i) > 0.0_dp) pos = pos + 1
-                     if (pos == j) then
-                        kind = LINK_DASHPOT; par(L_DAMP) = ch%c(i); return
-                     end if
-                  end if
-               end do
-            end if
-            ! one added one by one after this chain: its number among those
-            if (ch%link0 < j) g = g - ch%nlink
-         end associate
-      end do
-      kind = m%link_kind(g); a = m%link_a(g); b = m%link_b(g); par = m%link_par(:, g)
-   end subroutine model_link_at
-
-   !> Contact number j of all the model's contacts (one by one or in a chain): nodes, gap,
-   !> scheme, law and parameters.
-   pure subroutine model_contact_at(m, j, a, b, gap, scheme, law, par)
-      type(model_t), intent(in) :: m
-      integer, intent(in) :: j
-      integer, intent(out) :: a, b, scheme, law
-      real(dp), intent(out) :: gap, par(NPAR_CONTACT)
-      integer :: q, g
-      g = j
-      do q = 1, m%nchain
-         associate (ch => m%chain(q))
-            if (j > ch%contact0 .and. j <= ch%contact0 + ch%ncontact) then
-               a = ch%first + (j - ch%contact0) - 1; b = a + 1; gap = ch%gap(j - ch%contact0)
-               scheme = ch%scheme; law = ch%law; par = ch%par
-               return
-            end if
-            ! one added one by one after this chain: its number among those
-            if (ch%contact0 < j) g = g - ch%ncontact
-         end associate
-      end do
-      a = m%con_a(g); b = m%con_b(g); gap = m%con_gap(g); scheme = m%con_scheme(g)
-      law = m%con_law(g); par = m%con_par(:, g)
-   end subroutine model_contact_at
-
-   !> The chains as links and contacts one by one, numbered as model_add_chain says, for the
-   !> methods that take items one by one (a run's integrator, the static solve); the free
-   !> capacity of model_create is kept.
-   !> stat, message: as martello_status out_of_memory if they cannot be allocated (the model
-   !> is left as it was).
-   subroutine model_expand_chains(m, stat, message)
-      type(model_t), intent(inout) :: m
-      integer, intent(out) :: stat
-      character(len=*), intent(inout) :: message
-      integer :: nl, nc, free_l, free_c, q, i, g, pos
-      integer, allocatable :: lk(:), la(:), lb(:), ca(:), cb(:), cs(:), cl(:)
-      real(dp), allocatable :: lpar(:, :), cg(:), cpar(:, :), cm(:)
-      character(len=96) :: what
-      stat = MARTELLO_OK
-      if (m%nchain == 0) return
-      nl = model_nlinks(m); nc = model_ncontacts(m)
-      free_l = size(m%link_kind) - m%nlink; free_c = size(m%con_a) - m%ncontact
-      allocate (lk(nl + free_l), la(nl + free_l), lb(nl + free_l), lpar(NPAR_LINK, nl + free_l), &
-                ca(nc + free_c), cb(nc + free_c), cs(nc + free_c), cl(nc + free_c), &
-                cg(nc + free_c), cm(nc + free_c), cpar(NPAR_CONTACT, nc + free_c), stat=stat)
-      if (stat /= 0) then
-         write (what, '(a,i0,a,i0,a)') 'the chains as ', nl + free_l, ' links and ', nc + free_c, &
-            ' contacts one by one'
-         call out_of_memory(trim(what), REAL_BYTES*(NPAR_LINK*real(nl + free_l, dp) &
-                            + (NPAR_CONTACT + 2.0_dp)*(nc + free_c)) &
-                            + INT_BYTES*(3.0_dp*(nl + free_l) + 4.0_dp*(nc + free_c)), &
-                            FIX_SMALLER_SCENE, stat, message)
-         return
-      end if
-      cm = 0.0_dp
-      ! in the order of the calls: the items added one by one before each chain, the chain
-      pos = 0; g = 0
-      do q = 1, m%nchain
-         associate (ch => m%chain(q))
-            do while (g < ch%glink)
-               g = g + 1; pos = pos + 1
-               lk(pos) = m%link_kind(g); la(pos) = m%link_a(g); lb(pos) = m%link_b(g)
-               lpar(:, pos) = m%link_par(:, g)
-            end do
-            do i = 1, ch%n
-               pos = pos + 1
-               la(pos) = ch%first + i - 1; lb(pos) = 0; lpar(:, pos) = 0.0_dp
-               lk(pos) = LINK_SPRING; lpar(L_STIFF, pos) = ch%k(i)
-               if (allocated(ch%fy)) then
-                  lk(pos) = LINK_BILINEAR; lpar(L_YIELD, pos) = ch%fy(i)
-                  lpar(L_HARDENING, pos) = ch%rho(i)
-               end if
-               if (.not. allocated(ch%c)) cycle
-               if (.not. (ch%c(i) > 0.0_dp)) cycle
-               pos = pos + 1
-               la(pos) = ch%first + i - 1; lb(pos) = 0; lpar(:, pos) = 0.0_dp
-               lk(pos) = LINK_DASHPOT; lpar(L_DAMP, pos) = ch%c(i)
-            end do
-         end associate
-      end do
-      do while (g < m%nlink)
-         g = g + 1; pos = pos + 1
-         lk(pos) = m%link_kind(g); la(pos) = m%link_a(g); lb(pos) = m%link_b(g)
-         lpar(:, pos) = m%link_par(:, g)
-      end do
-      pos = 0; g = 0
-      do q = 1, m%nchain
-         associate (ch => m%chain(q))
-            do while (g < ch%gcontact)
-               g = g + 1; pos = pos + 1
-               call copy_contact(g, pos)
-            end do
-            do i = 1, ch%ncontact
-               pos = pos + 1
-               ca(pos) = ch%first + i - 1; cb(pos) = ch%first + i; cg(pos) = ch%gap(i)
-               cs(pos) = ch%scheme; cl(pos) = ch%law; cpar(:, pos) = ch%par
-            end do
-         end associate
-      end do
-      do while (g < m%ncontact)
-         g = g + 1; pos = pos + 1
-         call copy_contact(g, pos)
-      end do
-      call move_alloc(lk, m%link_kind); call move_alloc(la, m%link_a)
-      call move_alloc(lb, m%link_b); call move_alloc(lpar, m%link_par)
-      call move_alloc(ca, m%con_a); call move_alloc(cb, m%con_b); call move_alloc(cs, m%con_scheme)
-      call move_alloc(cl, m%con_law); call move_alloc(cg, m%con_gap)
-      call move_alloc(cpar, m%con_par); call move_alloc(cm, m%con_mstar)
-      m%nlink = nl; m%ncontact = nc
-      deallocate (m%chain); m%nchain = 0
-   contains
-      subroutine copy_contact(from, to)
-         integer, intent(in) :: from, to
-         ca(to) = m%con_a(from); cb(to) = m%con_b(from); cg(to) = m%con_gap(from)
-         cs(to) = m%con_scheme(from); cl(to) = m%con_law(from); cpar(:, to) = m%con_par(:, from)
-      end subroutine copy_contact
-   end subroutine model_expand_chains
    !> For the impulse-level integrators: which contacts are rigid (restitution or Lagrange,
    !> solved by complementarity), their restitution (Lagrange without one: 0, plastic), and
    !> their moving sides — a side on ground or on a fixed node does not move, so its column of

@@ -35,7 +35,8 @@ module martello_moreau_jean
    use martello_band_matrix, only: band_t, band_init, band_matvec, band_pin
    use martello_assembly, only: internal_forces, external_forces, mech_commit, assemble_mass, mass_times
    use martello_observer, only: observer_t, observer_work, observer_fail, observer_open_phase, &
-      observer_close_phase, C_NEWTON, C_RESIDUALS, C_FACTORIZATIONS, C_EVENTS, C_JACOBIANS
+      observer_close_phase
+   use martello_run_quantities, only: C_NEWTON, C_RESIDUALS, C_FACTORIZATIONS, C_EVENTS, C_JACOBIANS
    use martello_integrator_settings, only: integrator_settings_t
    use martello_fixed_step, only: stepper_t, stepper_start, contact_state
    use martello_impulse, only: contact_graph_t, contact_graph, delassus_columns, &

@@ -38,8 +38,8 @@ module martello_newmark_lagrange
    use martello_assembly, only: internal_forces, external_forces, mech_commit, mass_times, &
       external_work
    use martello_observer, only: observer_t, observer_work, observer_fail, observer_open_phase, &
-      observer_close_phase, free_side_crossing, C_REJECTED, C_NEWTON, C_RESIDUALS, &
-      C_FACTORIZATIONS, C_EVENTS
+      observer_close_phase, free_side_crossing
+   use martello_run_quantities, only: C_REJECTED, C_NEWTON, C_RESIDUALS, C_FACTORIZATIONS, C_EVENTS
    use martello_integrator_settings, only: integrator_settings_t
    use martello_fixed_step, only: stepper_t, stepper_start, newmark_kinematics, contact_state
    use martello_linalg, only: solve_symmetric_indefinite

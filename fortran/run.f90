@@ -5,11 +5,12 @@ module martello_run
    use, intrinsic :: iso_c_binding, only: c_int, c_ptr, c_loc, c_funptr, c_null_funptr, c_null_ptr
    use martello_kinds, only: dp
    use martello_status
-   use martello_model, only: model_t, model_nlinks, model_ncontacts, model_expand_chains
+   use martello_model, only: model_t, model_nlinks, model_ncontacts, model_expanded
    use martello_integrator_settings
    use martello_effective_mass, only: effective_mass_prepare
    use martello_run_checks, only: check_schemes
-   use martello_observer, only: observer_t, observer_init, observer_phase_lists, TRACK_ALL
+   use martello_observer, only: observer_t, observer_init, observer_phase_lists, observer_close
+   use martello_registry, only: TRACK_ALL
    use martello_fixed_step, only: run_fixed_step, stepper_t
    use martello_generalized_alpha, only: generalized_alpha_t
    use martello_central_difference, only: central_difference_t
@@ -17,7 +18,7 @@ module martello_run
    use martello_newmark_lagrange, only: newmark_lagrange_t
    use martello_fast_nonlinear, only: fast_nonlinear_t
    use martello_registry, only: INT_FAST_NONLINEAR
-   use martello_chain_newmark, only: chain_newmark_t, chain_fusable
+   use martello_chain_step, only: chain_step_t, chain_fusable
    implicit none
    private
    public :: run_t, run_dynamic, PHASE_LISTS
@@ -62,7 +63,9 @@ contains
    !> Validate the run against the model (outputs in range, schemes runnable by the
    !> integrator, a positive definite mass matrix), derive the contacts' effective masses,
    !> size the results and run the integrator: a one-step method on the fixed-step strategy,
-   !> or a C integrator (docs/run-layer.md).
+   !> or a C integrator (docs/run-layer.md). The caller's chains stay as they are: a method
+   !> that takes items one by one runs on a copy of the model with them made into links and
+   !> contacts (model_expanded), which the run owns.
    subroutine run_dynamic(mp, rp, stat)
       type(model_t), pointer, intent(in) :: mp
       type(run_t), pointer, intent(in) :: rp
@@ -70,6 +73,8 @@ contains
       integer :: cap, nl, nc, st
       logical :: fused
       class(stepper_t), allocatable :: stepper
+      type(model_t), allocatable, target :: expanded
+      type(model_t), pointer :: m
       stat = MARTELLO_ERR_ARGUMENT
       if (.not. rp%configured) then
          rp%results%message = 'dynamic_run: call martello_run_set_settings first'
@@ -91,21 +96,25 @@ contains
       rp%results%progress = rp%progress; rp%results%progress_user = rp%progress_user
       if (stat == MARTELLO_OK) call observer_phase_lists(rp%results, rp%phase_lists, stat)
       ! the chains held per node stay so for the fused chain step, which takes them whole;
-      ! every other method takes their links and contacts one by one
+      ! every other method takes their links and contacts one by one, from a copy
+      m => mp
       fused = chain_fusable(mp, rp%settings) .and. .not. logical(rp%settings%event_split)
       if (stat == MARTELLO_OK .and. .not. fused .and. mp%nchain > 0) then
-         call model_expand_chains(mp, stat, rp%results%message)
-         fused = chain_fusable(mp, rp%settings) .and. .not. logical(rp%settings%event_split)
+         call model_expanded(mp, expanded, stat, rp%results%message)
+         if (stat == MARTELLO_OK) then
+            m => expanded
+            fused = chain_fusable(m, rp%settings) .and. .not. logical(rp%settings%event_split)
+         end if
       end if
-      if (stat == MARTELLO_OK) call check_schemes(mp, rp%settings%kind, rp%results%message, stat)
-      if (stat == MARTELLO_OK) call effective_mass_prepare(mp, rp%results%message, stat)
+      if (stat == MARTELLO_OK) call check_schemes(m, rp%settings%kind, rp%results%message, stat)
+      if (stat == MARTELLO_OK) call effective_mass_prepare(m, rp%results%message, stat)
       if (stat == MARTELLO_OK) then
          ! st: the stepper's allocation (a few hundred bytes: its arrays come at its init)
          st = 0
          select case (rp%settings%kind)
          case (INT_NEWMARK, INT_HHT, INT_GENERALIZED_ALPHA)
             if (fused) then
-               allocate (chain_newmark_t :: stepper, stat=st)
+               allocate (chain_step_t :: stepper, stat=st)
             else
                allocate (generalized_alpha_t :: stepper, stat=st)
             end if
@@ -118,15 +127,16 @@ contains
          case (INT_FAST_NONLINEAR)
             allocate (fast_nonlinear_t :: stepper, stat=st)
          case (INT_RKF45, INT_RK8PD, INT_MSBDF)
-            stat = c_event_driven_run(c_loc(mp), c_loc(rp))
+            stat = c_event_driven_run(c_loc(m), c_loc(rp))
          case (INT_IDA)
-            stat = c_ida_run(c_loc(mp), c_loc(rp))
+            stat = c_ida_run(c_loc(m), c_loc(rp))
          case (INT_CVODE, INT_ARKODE)
-            stat = c_ode_run(c_loc(mp), c_loc(rp))
+            stat = c_ode_run(c_loc(m), c_loc(rp))
          end select
          if (st /= 0) call out_of_memory('the state of the integrator', -1.0_dp, FIX_SMALLER_SCENE, &
                                          stat, rp%results%message)
-         if (allocated(stepper)) call run_fixed_step(mp, rp%settings, rp%results, stepper, stat)
+         if (allocated(stepper)) call run_fixed_step(m, rp%settings, rp%results, stepper, stat)
+         call observer_close(rp%results, m)
       end if
       rp%done = .true.
    end subroutine run_dynamic

@@ -10,7 +10,7 @@
 module martello_statics
    use martello_kinds, only: dp
    use martello_status
-   use martello_model, only: model_t, SCHEME_PENALTY, SCHEME_LAGRANGE, SCHEME_AUGMENTED, &
+   use martello_model, only: model_t, model_influence, SCHEME_PENALTY, SCHEME_LAGRANGE, SCHEME_AUGMENTED, &
       SCHEME_RESTITUTION, model_u0
    use martello_contact_laws, only: LAW_LINEAR, P_STIFF
    use martello_links, only: LINK_SPRING, LINK_BAR, LINK_DASHPOT, LINK_FLUID_DAMPER, L_STIFF
@@ -86,12 +86,15 @@ contains
          return
       end if
       kfree = 0.0_dp; fext = 0.0_dp
+      ! gravity on M·ι (ι the influence vector, 1 along the scene's axis)
       do i = 1, n
-         if (dof(i) > 0) fext(dof(i)) = m%gravity*m%mass(i)
+         if (dof(i) > 0) fext(dof(i)) = m%gravity*m%mass(i)*model_influence(m, i)
       end do
       do j = 1, m%ncoupling
-         if (dof(m%mc_a(j)) > 0) fext(dof(m%mc_a(j))) = fext(dof(m%mc_a(j))) + m%gravity*m%mc_value(j)
-         if (dof(m%mc_b(j)) > 0) fext(dof(m%mc_b(j))) = fext(dof(m%mc_b(j))) + m%gravity*m%mc_value(j)
+         if (dof(m%mc_a(j)) > 0) fext(dof(m%mc_a(j))) = fext(dof(m%mc_a(j))) &
+            + m%gravity*m%mc_value(j)*model_influence(m, m%mc_b(j))
+         if (dof(m%mc_b(j)) > 0) fext(dof(m%mc_b(j))) = fext(dof(m%mc_b(j))) &
+            + m%gravity*m%mc_value(j)*model_influence(m, m%mc_a(j))
       end do
       do j = 1, m%nforce
          i = dof(m%force_node(j))

@@ -20,7 +20,8 @@ The package by concern, from the bottom up; each layer imports only the layers b
 0. ``errors``, ``paths``, ``history``: exceptions, where the folders are, time histories;
 1. ``binding`` (the ctypes binding to libmartello, the only ctypes code) and ``oracles``
    (closed forms, written from the mathematics alone), then ``closed_forms`` (all of them
-   by name) and ``frame2d`` (planar frames: assembly, condensation, member-force recovery);
+   by name), ``frame2d`` (planar frames: assembly, condensation, member-force recovery) and
+   ``building3d`` (3D buildings on rigid or flexible floors: the same, with modes);
 2. ``scene`` (scene files, their generators and variants) and ``ground_motion`` (records,
    spectra, synthetic accelerograms);
 3. ``run`` (one scene), then ``batch`` (many, on the local cores);

@@ -8,13 +8,15 @@ import os
 import signal
 import time
 from collections import deque
-from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, as_completed, wait
+from contextlib import contextmanager
+from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
 from concurrent.futures.process import BrokenProcessPool
 from pathlib import Path
 
 import numpy as np
 
-from .errors import MartelloError, SceneError
+from .binding.system import die_with_parent
+from .errors import Interrupted, MartelloError, SceneError
 from .run import run_full
 from .scene.loader import from_dict
 
@@ -34,6 +36,8 @@ def execute(spec):
             summary, history = run_full(s, raise_on_failure=False)
             walls.append(summary["cost"]["wall_time_s"])
         summary["cost"]["wall_time_s"] = min(walls)
+    except Interrupted:
+        raise                     # stopped by its user: no outcome of the run
     except MartelloError as exc:
         return out | {"status": "error", "message": str(exc)}
     keep = {k: summary.get(k) for k in ("status", "message", "t_reached", "contacts", "energy",
@@ -45,15 +49,64 @@ def execute(spec):
 # How many times a spec whose worker died is run again, each time alone in a process of its
 # own, before its row is marked failed with the reason.
 RETRIES = 2
+# How often (s) a sweep waiting for its runs looks whether it was asked to stop.
+POLL_S = 0.2
+
+
+def _worker_start(parent):
+    """Every worker process, first: it ends with its parent (martello.binding.system: a
+    sweep whose process is killed leaves no worker behind); it ignores SIGINT, which a
+    Ctrl-C at a terminal sends to the whole process group: stopping is the parent's to
+    decide (it keeps the finished rows, then ends the workers)."""
+    die_with_parent(parent)
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    # a forked worker has its parent's handlers: SIGTERM (how a pool ends a worker, and what
+    # a group's SIGTERM brings) ends it as it ends any process. Both signals were blocked
+    # while it was forked (_held): one sent before this line waits, and takes effect now.
+    signal.signal(signal.SIGTERM, signal.SIG_DFL)
+    signal.pthread_sigmask(signal.SIG_UNBLOCK, _HELD)
+
+
+_HELD = {signal.SIGINT, signal.SIGTERM}
+
+
+@contextmanager
+def _held():
+    """SIGINT and SIGTERM held (blocked, not lost) in this thread within the block: a worker
+    forked there starts with them blocked, so that neither reaches it before _worker_start
+    has replaced the handlers it inherited (a study's, which would keep it alive)."""
+    old = signal.pthread_sigmask(signal.SIG_BLOCK, _HELD)
+    try:
+        yield
+    finally:
+        signal.pthread_sigmask(signal.SIG_SETMASK, old)
 
 
 def _pool(workers):
-    return ProcessPoolExecutor(max_workers=workers)
+    return ProcessPoolExecutor(max_workers=workers, initializer=_worker_start,
+                               initargs=(os.getpid(),))
 
 
 def _processes(pool):
     """The worker processes a pool has started (private to concurrent.futures: best effort)."""
     return list((getattr(pool, "_processes", None) or {}).values())
+
+
+def _end(pool):
+    """End a pool now: its workers are killed, whatever they run (a sweep that was asked to
+    stop does not wait for runs of minutes to finish), and reaped."""
+    procs = _processes(pool)
+    for p in procs:
+        try:
+            p.kill()
+        except (OSError, ValueError):     # already gone, or closed
+            pass
+    pool.shutdown(wait=False, cancel_futures=True)
+    for p in procs:
+        try:
+            p.join(2.0)
+        except (OSError, ValueError, AssertionError):
+            pass
 
 
 def _death(processes):
@@ -78,18 +131,27 @@ def _death(processes):
     return f"exit code {codes[0]}" if codes else "ended abruptly"
 
 
-def run_specs(specs, jobs=0, progress=None, *, fn=None, retries=RETRIES, executor=None):
+def run_specs(specs, jobs=0, progress=None, *, fn=None, retries=RETRIES, executor=None,
+              stop=None):
     """Run specs in worker processes (ProcessPoolExecutor), or on `executor` (any
     concurrent.futures executor, e.g. a Dask cluster's: martello.study.cluster, which
     reschedules the work of a lost worker itself); yield results as they finish. Specs with
     a precomputed status (incompatible combinations) are not run.
+
+    Every run is in a worker process, even with jobs = 1: the calling process stays free to
+    answer a Ctrl-C at once (a native run holds its thread until the run looks at the
+    clock), and a run that crashes takes only its worker. The workers end with the calling
+    process, however it ends (_worker_start).
 
     A worker that dies (killed, out of memory, a crash in the native library) breaks its
     pool and fails every spec running in it. Those specs are run again, each alone in a
     process of its own, so the one that kills its worker is found and the others finish;
     one whose worker still dies after `retries` further runs gives a row with status
     "error" and the reason. Specs not yet started go to a fresh pool. Every spec gives a
-    row. `fn` runs one spec (default: execute)."""
+    row, unless `stop` (a threading.Event) is set: then the results already finished are
+    yielded, the runs in flight are ended (their workers killed, a cluster's futures
+    cancelled) and the generator returns without the others, within about POLL_S. `fn` runs
+    one spec (default: execute)."""
     fn = fn or execute
     todo = [s for s in specs if "status" not in s]
     for s in specs:
@@ -98,6 +160,7 @@ def run_specs(specs, jobs=0, progress=None, *, fn=None, retries=RETRIES, executo
                 progress.update(False)
             yield dict(s)
     jobs = jobs or os.cpu_count() or 1
+    stopped = stop.is_set if stop is not None else (lambda: False)
 
     def done(r):
         if progress:
@@ -106,17 +169,20 @@ def run_specs(specs, jobs=0, progress=None, *, fn=None, retries=RETRIES, executo
 
     if executor is not None:
         futs = {executor.submit(fn, s): s for s in todo}
-        for f in as_completed(futs):
-            try:
-                r = f.result()
-            except Exception as exc:      # the cluster gave up on the case: keep the row
-                r = {"id": futs[f]["id"], "status": "error", "message": f"worker failed: {exc!r}"}
-            yield done(r)
-        return
-    if jobs == 1 or len(todo) <= 1:
-        # in this process: no worker to lose (a crash here ends the caller too)
-        for s in todo:
-            yield done(fn(s))
+        pending = set(futs)
+        try:
+            while pending and not stopped():
+                finished, pending = wait(pending, timeout=POLL_S, return_when=FIRST_COMPLETED)
+                for f in finished:
+                    try:
+                        r = f.result()
+                    except Exception as exc:      # the cluster gave up on the case: keep the row
+                        r = {"id": futs[f]["id"], "status": "error",
+                             "message": f"worker failed: {exc!r}"}
+                    yield done(r)
+        finally:
+            for f in pending:
+                f.cancel()
         return
     waiting = deque(todo)          # not started
     alone = deque()                # to run again, each in a process of its own
@@ -124,30 +190,34 @@ def run_specs(specs, jobs=0, progress=None, *, fn=None, retries=RETRIES, executo
     running = {}                   # future -> (spec, pool, alone?)
     workers = {}                   # pool -> its processes, for the exit codes
     shared = None
+    complete = False
     try:
-        while waiting or alone or running:
-            while alone and len(running) < jobs:
-                s = alone.popleft()
-                pool = _pool(1)
-                running[pool.submit(fn, s)] = (s, pool, True)
-                workers[pool] = _processes(pool)
-            while waiting and len(running) < jobs:
-                shared = shared or _pool(jobs)
-                s = waiting.popleft()
-                try:
-                    running[shared.submit(fn, s)] = (s, shared, False)
-                    known = workers.setdefault(shared, [])
-                    known += [p for p in _processes(shared) if p not in known]
-                except BrokenProcessPool:     # broke since its last result: a fresh one
-                    waiting.appendleft(s)
-                    shared.shutdown(wait=False, cancel_futures=True)
-                    shared = None
-            finished, _ = wait(running, return_when=FIRST_COMPLETED)
+        while (waiting or alone or running) and not stopped():
+            with _held():                     # submit() forks the workers
+                while alone and len(running) < jobs:
+                    s = alone.popleft()
+                    pool = _pool(1)
+                    running[pool.submit(fn, s)] = (s, pool, True)
+                    workers[pool] = _processes(pool)
+                while waiting and len(running) < jobs:
+                    shared = shared or _pool(jobs)
+                    s = waiting.popleft()
+                    try:
+                        running[shared.submit(fn, s)] = (s, shared, False)
+                        known = workers.setdefault(shared, [])
+                        known += [p for p in _processes(shared) if p not in known]
+                    except BrokenProcessPool:     # broke since its last result: a fresh one
+                        waiting.appendleft(s)
+                        shared.shutdown(wait=False, cancel_futures=True)
+                        shared = None
+            finished, _ = wait(running, timeout=POLL_S, return_when=FIRST_COMPLETED)
             for f in finished:
                 s, pool, isolated = running.pop(f)
                 try:
                     r = f.result()
                 except BrokenProcessPool:
+                    if stopped():             # ended by the stop, not by its run
+                        continue
                     deaths[s["id"]] = deaths.get(s["id"], 0) + 1
                     why = _death(workers.get(pool, []))
                     pool.shutdown(wait=False)
@@ -165,9 +235,13 @@ def run_specs(specs, jobs=0, progress=None, *, fn=None, retries=RETRIES, executo
                     pool.shutdown(wait=False)
                     workers.pop(pool, None)
                 yield done(r)
+        complete = not (waiting or alone or running)
     finally:
         pools = {id(p): p for _, p, _ in running.values()}
         if shared is not None:
             pools[id(shared)] = shared
         for pool in pools.values():
-            pool.shutdown(wait=True, cancel_futures=True)
+            if complete:
+                pool.shutdown(wait=True)
+            else:                 # stopped, or the caller went away: nothing to wait for
+                _end(pool)

@@ -219,6 +219,9 @@ def run_command(args):
         code = args.func(args)
         sys.stdout.flush()       # here, not at exit: a reader that went away shows below
         return code
+    except errors.Stopped as exc:
+        print(f"martello: {_one_line(exc)}", file=sys.stderr)
+        return 130
     except errors.Interrupted as exc:
         text = _one_line(exc)
         print(f"martello: {text[text.find('interrupted at'):]}: nothing written", file=sys.stderr)

@@ -75,3 +75,9 @@ class DivergenceError(SolverError):
 class Interrupted(SolverError):
     """The run was stopped by the user (Ctrl-C, through the native loop's progress callback):
     nothing it computed is a result. The command line exits 130."""
+
+
+class Stopped(Exception):
+    """A sweep (a study, an atlas) stopped by SIGINT or SIGTERM, its finished rows kept in its
+    output folder marked partial (martello.study.resume): the message says how many and where.
+    Not a MartelloError: the command line exits 130 with the message, not 1 with an error."""

@@ -41,7 +41,8 @@ class Member:
 @dataclass
 class PlanarFrame:
     """A regular planar frame: heights[s] of storey s + 1 (bottom up), widths[b] of bay b + 1
-    (left to right), columns[s][line] and beams[s][bay] as (E, A, I), floor masses[s]."""
+    (left to right), columns[s][line] and beams[s][bay] as (E, A, I), floor masses[s] (with
+    mass_model "joints" also a list of the bays + 1 joint masses of the floor)."""
     heights: list
     widths: list
     columns: list
@@ -84,12 +85,13 @@ class PlanarFrame:
         return [f"{prefix}{s + 1}.{i}" for s in range(self.storeys) for i in range(self.bays + 1)]
 
     def lateral_masses(self):
-        """The mass of each lateral DOF: the floor's mass, or its share by tributary width."""
+        """The mass of each lateral DOF: the floor's mass, or its share by tributary width,
+        or (joint masses: masses[s] a list of bays + 1 values) each joint's own."""
         if self.mass_model == "diaphragm":
             return np.asarray(self.masses, float)
         w = np.asarray(self.widths, float)
         trib = (np.concatenate([[0.0], w]) + np.concatenate([w, [0.0]])) / 2 / w.sum()
-        return np.concatenate([m * trib for m in self.masses])
+        return np.concatenate([np.asarray(m, float) if np.ndim(m) else m * trib for m in self.masses])
 
     def lateral_index(self, floor, line):
         """The lateral DOF (0-based) of the joint (line, floor), floor >= 1."""

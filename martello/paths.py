@@ -17,10 +17,12 @@ directory, a FIFO, a socket or a device is refused from its stat(2) mode without
 opened for reading (opening a FIFO blocks until a writer comes; /dev/zero never ends), and
 so is a file larger than its reader's limit (docs/behaviour.md, "Failures and limits")."""
 
+import fcntl
 import os
 import shutil
 import stat
 import tempfile
+import time
 from contextlib import contextmanager
 from pathlib import Path
 
@@ -164,6 +166,54 @@ def check_output_folder(outdir, marker, refuse):
     return outdir
 
 
+# A temporary folder is held by its writer with flock(2) on the folder while it writes; one
+# that nobody holds is stale: its writer was killed (SIGKILL, the out-of-memory killer, a
+# crash). The `.old` folder of the final swap is never held: it exists for the moment of two
+# renames, so one that is an hour old is stale.
+OLD_STALE_S = 3600.0
+
+
+def _locked(path):
+    """An open descriptor of the folder `path` holding an exclusive flock, or None if another
+    process holds it (or it cannot be opened)."""
+    try:
+        fd = os.open(path, os.O_RDONLY | getattr(os, "O_DIRECTORY", 0) | getattr(os, "O_CLOEXEC", 0))
+    except OSError:
+        return None
+    try:
+        fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+    except OSError:
+        os.close(fd)
+        return None
+    return fd
+
+
+def stale_temporaries(outdir):
+    """The temporary folders beside outdir (folder_replaced's `.NAME.*.tmp` and `.NAME.*.old`)
+    whose writer is gone, oldest first."""
+    outdir = Path(outdir)
+    try:
+        found = [p for p in outdir.parent.iterdir()
+                 if p.name.startswith(f".{outdir.name}.") and p.name.endswith((".tmp", ".old"))
+                 and p.is_dir() and not p.is_symlink()]
+    except OSError:
+        return []
+    stale = []
+    for p in found:
+        if p.name.endswith(".old"):
+            try:
+                if time.time() - p.stat().st_mtime > OLD_STALE_S:
+                    stale.append(p)
+            except OSError:
+                pass
+            continue
+        fd = _locked(p)
+        if fd is not None:
+            os.close(fd)
+            stale.append(p)
+    return sorted(stale, key=lambda p: p.stat().st_mtime if p.exists() else 0.0)
+
+
 @contextmanager
 def folder_replaced(outdir, marker, refuse):
     """Fill a folder that replaces outdir whole, atomically: the block gets a temporary folder
@@ -173,18 +223,31 @@ def folder_replaced(outdir, marker, refuse):
 
     outdir may exist only as a folder that is empty or holds the file `marker` (an earlier
     output of the same kind); else, or if the folders cannot be made or renamed, refuse(text)
-    is raised (an exception class taking the one-line message)."""
+    is raised (an exception class taking the one-line message). Temporary folders of earlier
+    writers that were killed (stale_temporaries) are removed first."""
     outdir = check_output_folder(outdir, marker, refuse)
+    for stale in stale_temporaries(outdir):       # of writers killed before they finished
+        shutil.rmtree(stale, ignore_errors=True)
     try:
         outdir.parent.mkdir(parents=True, exist_ok=True)
         tmp = Path(tempfile.mkdtemp(prefix=f".{outdir.name}.", suffix=".tmp", dir=outdir.parent))
     except OSError as exc:
         raise refuse(f"{outdir}: cannot create the output folder: {exc.strerror or exc}") from None
+    held = _locked(tmp)          # ours until it is in place (stale_temporaries)
     try:
-        yield tmp
-    except BaseException:
-        shutil.rmtree(tmp, ignore_errors=True)
-        raise
+        try:
+            yield tmp
+        except BaseException:
+            shutil.rmtree(tmp, ignore_errors=True)
+            raise
+        _into_place(tmp, outdir, refuse)
+    finally:
+        if held is not None:
+            os.close(held)
+
+
+def _into_place(tmp, outdir, refuse):
+    """Rename the filled folder tmp to outdir, atomically replacing an earlier outdir."""
     old = None
     try:
         mask = os.umask(0)

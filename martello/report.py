@@ -3,12 +3,14 @@ verification.csv and plots. Every number says how it was obtained (scene, scheme
 analysis, tolerance, version)."""
 
 import csv
+import math
 import sys
 import time
 from pathlib import Path
 
 from .binding import native
 from .checks.measures import run_measured
+from .checks import kinds
 from .checks.independent_rows import verify_independent
 from .checks.reference_data import verify_reference_data
 from .checks.verify import verify
@@ -29,11 +31,14 @@ def check_catalogue(files, outdir, plots=True, stream=sys.stdout, require_checks
     failed. A scene with nothing to verify (no [check] table, no stored reference data) is
     listed as "ran, not verified"; it is a failure if require_checks (scenes named on the
     command line) or if reference/references.toml lists reference data for it that are
-    missing (an installation without its data must not pass as verified)."""
+    missing (an installation without its data must not pass as verified). Each row's kind
+    (martello.checks.kinds) says whether it counts as verification."""
     outdir.mkdir(parents=True, exist_ok=True)
     rows, failures, t_start = [], [], time.perf_counter()
+    unchecked = []              # (scene file, title) that ran with nothing to verify
     print(f"martello {native.version()} ({native.library_versions()})", file=stream)
-    header = f"{'scene':<44} {'scheme':<19} {'quantity':<36} {'digits':>6} {'tol':>8}  result"
+    header = (f"{'scene':<44} {'scheme':<19} {'quantity':<36} {'digits':>6} {'tol':>8}  "
+              f"{'result':<6} kind")
     print(header, file=stream)
     print("-" * len(header), file=stream)
     for k, path in enumerate(files, 1):
@@ -60,11 +65,13 @@ def check_catalogue(files, outdir, plots=True, stream=sys.stdout, require_checks
                                     "scripts/regenerate_reference)")
                 elif require_checks:
                     failures.append(f"{path}: nothing to verify: no [check] table "
-                                    "(docs/scene-format.md) and no stored reference data for its "
+                                    "(docs/scene-input.md) and no stored reference data for its "
                                     "physics; `martello run` runs a scene without verifying it")
+                unchecked.append((str(path), s.title))
                 print(f"{s.title[:44]:<44} (no closed form or reference data: ran, not verified)",
                       file=stream)
                 continue
+            kinds.classify(rows_here, s.contacts)
             laws = ",".join(sorted({c["scheme"] if c["scheme"] != "penalty" else c.get("law") or "linear"
                                     for c in s.contacts})) or "-"
             for r in rows_here:
@@ -73,12 +80,13 @@ def check_catalogue(files, outdir, plots=True, stream=sys.stdout, require_checks
                          problem=s.problem,
                          digits_lost=summary.get("conditioning", {}).get("digits_lost", 0.0))
                 rows.append(r)
-                tol = f"{r['rtol']:8.0e}" if r["rtol"] else ("   exact" if r["atol"] < 1e-100
-                                                             else f"{r['atol']:8.0e}")
+                result = "pass" if r["passed"] else "FAIL"
+                if not kinds.asserted(r):
+                    result = "-"
                 print(f"{s.title[:44]:<44} {schemes[:19]:<19} {r['quantity'][:36]:<36} "
-                      f"{r['digits']:6.1f} {tol}  {'pass' if r['passed'] else 'FAIL'}",
+                      f"{r['digits']:6.1f} {_tol_short(r)}  {result:<6} {r['kind']}",
                       file=stream)
-                if not r["passed"]:
+                if kinds.failed(r):
                     failures.append(f"{path}: {r['quantity']} = {r['value']!r}, "
                                     f"reference {r['reference']!r}")
             for w in summary.get("warnings", []):
@@ -95,7 +103,7 @@ def check_catalogue(files, outdir, plots=True, stream=sys.stdout, require_checks
     elapsed = time.perf_counter() - t_start
     _write_csv(rows, outdir / "verification.csv")
     pngs = _plots(rows, outdir) if plots and rows else []
-    _write_markdown(rows, failures, pngs, outdir / "report.md", elapsed)
+    _write_markdown(rows, failures, pngs, outdir / "report.md", elapsed, len(files), unchecked)
     (outdir / "coverage.md").write_text(coverage_markdown(rows) + "\n")
     print("\n" + headline(rows, failures, len(files), elapsed) + f" Report: {outdir / 'report.md'}",
           file=stream)
@@ -104,67 +112,132 @@ def check_catalogue(files, outdir, plots=True, stream=sys.stdout, require_checks
     return not failures
 
 
-VERIFICATION = ("closed form", "independent reference")
+def _tol_short(r):
+    """The tolerance column of the table: relative to the quantity (kinds.relative_tolerance)."""
+    if not kinds.asserted(r):
+        return "    none"
+    t = kinds.relative_tolerance(r)
+    return "   exact" if t == 0.0 else f"{t:8.0e}"
+
+
+VERIFICATION = kinds.INDEPENDENT      # the oracles independent of the solvers
+
+
+def summary_counts(rows, failures, n_scenes):
+    """The counts every report prints the same way (stdout, report.md, coverage.md, the
+    README through docs/coverage.md): rows by kind, verified cells, scenes."""
+    by = {k: [r for r in rows if kinds.kind_of(r) == k] for k in kinds.KINDS}
+    cells = coverage(rows)
+    return {"scenes": n_scenes,
+            "scenes_with_rows": len({r.get("file") for r in rows}),
+            "verification": len(by[kinds.VERIFICATION]),
+            "verification_passed": sum(bool(r["passed"]) for r in by[kinds.VERIFICATION]),
+            "verification_closed_form": sum(r["evidence"] == "closed form" for r in by[kinds.VERIFICATION]),
+            "verification_independent": sum(r["evidence"] == "independent reference"
+                                            for r in by[kinds.VERIFICATION]),
+            "loose": len(by[kinds.LOOSE]), "loose_passed": sum(bool(r["passed"]) for r in by[kinds.LOOSE]),
+            "unconverged": len(by[kinds.UNCONVERGED]), "repeat": len(by[kinds.REPEAT]),
+            "regression": len(by[kinds.REGRESSION]),
+            "regression_passed": sum(bool(r["passed"]) for r in by[kinds.REGRESSION]),
+            "cells": len(cells), "cells_verified": sum(c["state"] == "verified" for c in cells),
+            "cells_wrong": sum(c["state"] == "WRONG" for c in cells),
+            "cells_partly": sum(c["state"] == "partly verified" for c in cells),
+            "cells_not_verified": sum(c["state"] == "not verified" for c in cells),
+            "failures": len(failures)}
 
 
 def headline(rows, failures, n_scenes, elapsed):
-    """Only rows against a closed form or the independent reference count as verification;
-    regression rows (drift from stored data) and identities are counted apart."""
-    ver = [r for r in rows if r.get("evidence") in VERIFICATION]
-    other = [r for r in rows if r.get("evidence") not in VERIFICATION]
-    kinds = ", ".join(f"{sum(r['evidence'] == k for r in ver)} vs {k}" for k in VERIFICATION)
-    return (f"verification: {sum(r['passed'] for r in ver)} of {len(ver)} checks passed ({kinds}); "
-            f"regression, not verification: {sum(r['passed'] for r in other)} of {len(other)} passed; "
-            f"{len(failures)} failure(s); {n_scenes} scenes in {elapsed:.1f} s.")
+    """Only rows of kind verification (martello.checks.kinds: an independent oracle, a
+    tolerance < 1 %, runs that converge at their order, not a repeat) count as
+    verification; the other kinds are counted apart."""
+    c = summary_counts(rows, failures, n_scenes)
+    return (f"verification: {c['verification_passed']} of {c['verification']} distinct rows passed "
+            f"({c['verification_closed_form']} vs closed form, {c['verification_independent']} vs "
+            f"independent reference; tolerance < 1 %); {c['cells_verified']} of {c['cells']} cells "
+            f"verified, {c['cells_partly']} partly, {c['cells_wrong']} wrong; not counted: {c['loose_passed']} of {c['loose']} "
+            f"loose rows (tolerance 1-10 %) passed, {c['unconverged']} unconverged (no bound: "
+            f"nothing asserted), {c['repeat']} repeats of identical elements, "
+            f"{c['regression_passed']} of {c['regression']} regression rows passed; "
+            f"{c['failures']} failure(s); {n_scenes} scenes in {elapsed:.1f} s.")
 
 
 def coverage(rows):
-    """The coverage matrix: one cell per problem × contact law (or scheme) × integrator, with
-    its kind of evidence (the strongest of its rows: closed form, then independent reference,
-    else regression only: self-consistent), its fewest digits among the verifying rows, and
-    whether every row of the cell passed."""
+    """The coverage matrix: one cell per problem × contact law (or scheme) × integrator. A
+    cell is verified when it holds verification rows (kinds.VERIFICATION), no loose or
+    unconverged row and no failed one: every quantity it compares is verified to < 1 %;
+    partly verified when it also holds loose or unconverged rows (named, with their
+    orders); WRONG when an asserted row failed; else not verified (loose or unconverged rows
+    only, or regression only). Per cell: the evidence of its verification rows, their
+    fewest digits and largest tolerance, the rows by kind."""
     cells = {}
     for r in rows:
         key = (r.get("problem") or "-", r.get("laws", "-"), r.get("integrator", "-"))
-        c = cells.setdefault(key, {"kinds": set(), "digits": [], "n": 0, "ok": True, "files": {}})
-        c["kinds"].add(r.get("evidence", "regression"))
-        c["n"] += 1
-        c["ok"] &= bool(r["passed"])
-        if r.get("evidence") in VERIFICATION:
+        c = cells.setdefault(key, {"kinds": {k: 0 for k in kinds.KINDS}, "evidence": set(), "digits": [],
+                                   "tol": [], "orders": [], "ok": True, "files": {}})
+        kind = kinds.kind_of(r)
+        c["kinds"][kind] += 1
+        c["ok"] &= not kinds.failed(r)
+        if kind == kinds.VERIFICATION:
+            c["evidence"].add(r["evidence"])
             c["digits"].append(r["digits"])
-        verified = c["files"].setdefault(r.get("file", "?"), False)
-        c["files"][r.get("file", "?")] = verified or r.get("evidence") in VERIFICATION
+            c["tol"].append(kinds.relative_tolerance(r))
+        o = r.get("run_order", r.get("order"))
+        if kind == kinds.UNCONVERGED and isinstance(o, float) and math.isfinite(o):
+            c["orders"].append(o)
+        f = r.get("file", "?")
+        c["files"][f] = c["files"].get(f, False) or kind == kinds.VERIFICATION
     out = []
     for (problem, laws, integ), c in sorted(cells.items()):
-        kind = next((k for k in VERIFICATION if k in c["kinds"]), "regression only (self-consistent)")
-        # scenes of a verified cell whose own rows are regression only are named, so that a
-        # cell's state never speaks for a scene it does not cover
-        apart = sorted(Path(f).stem for f, v in c["files"].items() if not v) if kind in VERIFICATION else []
-        out.append({"problem": problem, "law": laws, "integrator": integ, "evidence": kind,
-                    "digits": min(c["digits"]) if c["digits"] else None, "rows": c["n"],
-                    "regression_only_scenes": apart,
-                    "state": "verified" if c["ok"] and kind in VERIFICATION else
-                    ("WRONG" if not c["ok"] else "self-consistent only")})
+        n = c["kinds"]
+        has = n[kinds.VERIFICATION] > 0
+        evidence = next((k for k in VERIFICATION if k in c["evidence"]), None)
+        parts = []
+        if n[kinds.LOOSE]:
+            parts.append(f"{n[kinds.LOOSE]} loose")
+        if n[kinds.UNCONVERGED]:
+            orders = c["orders"]
+            parts.append(f"{n[kinds.UNCONVERGED]} unconverged" +
+                         (f" (order {min(orders):.2f}" + (f" to {max(orders):.2f}" if max(orders) > min(orders) else "")
+                          + ")" if orders else " (tolerance ≥ 10 %)"))
+        if has:
+            why = evidence + (": not verification: " + ", ".join(parts) if parts else "")
+        elif parts:
+            why = ", ".join(parts) + " rows only"
+        else:
+            why = "regression only (self-consistent)"
+        # scenes of a verified cell with no verification row of their own are named, so that
+        # a cell's state never speaks for a scene it does not cover
+        apart = sorted(Path(f).stem for f, v in c["files"].items() if not v) if has else []
+        state = ("WRONG" if not c["ok"] else "verified" if has and not parts
+                 else "partly verified" if has else "not verified")
+        out.append({"problem": problem, "law": laws, "integrator": integ, "evidence": why,
+                    "digits": min(c["digits"]) if c["digits"] else None,
+                    "tolerance": max(c["tol"]) if c["tol"] else None,
+                    "rows": sum(n.values()), "by_kind": dict(n),
+                    "unverified_scenes": apart, "state": state})
     return out
 
 
 def coverage_markdown(rows):
     cells = coverage(rows)
-    n_ver = sum(c["state"] == "verified" for c in cells)
-    n_bad = sum(c["state"] == "WRONG" for c in cells)
-    n_self = sum(c["state"] == "self-consistent only" for c in cells)
-    lines = [f"{n_ver} cells verified against a closed form or the independent reference, "
-             f"{n_bad} wrong, {n_self} self-consistent only (regression against data martello made), "
-             f"of {len(cells)} problem × law/scheme × integrator cells that `martello check` ran.", "",
-             "| problem | law / scheme | integrator | evidence | fewest digits | rows | state |",
-             "|---|---|---|---|---|---|---|"]
+    n = {s: sum(c["state"] == s for c in cells) for s in ("verified", "partly verified", "not verified", "WRONG")}
+    lines = [f"{n['verified']} cells verified (every row of the cell verification: an independent "
+             f"oracle, a tolerance < 1 %, runs converging at their order), {n['partly verified']} partly "
+             f"verified, {n['not verified']} not verified, {n['WRONG']} wrong, of {len(cells)} "
+             "problem × law/scheme × integrator cells that `martello check` ran.", "",
+             "| problem | law / scheme | integrator | evidence | fewest digits | largest tolerance | "
+             "rows: verification / loose / unconverged / repeat / regression | state |",
+             "|---|---|---|---|---|---|---|---|"]
     for c in cells:
         d = f"{c['digits']:.1f}" if c["digits"] is not None else "—"
+        tol = f"{c['tolerance']:.0e}" if c["tolerance"] else ("exact" if c["tolerance"] == 0.0 else "—")
         ev = c["evidence"]
-        if c["regression_only_scenes"]:
-            ev += "; regression only: " + ", ".join(f"`{n}`" for n in c["regression_only_scenes"])
-        lines.append(f"| {c['problem']} | {c['law']} | {c['integrator']} | {ev} | {d} | "
-                     f"{c['rows']} | {c['state']} |")
+        if c["unverified_scenes"]:
+            ev += "; scenes without a verification row: " + ", ".join(f"`{n}`" for n in c["unverified_scenes"])
+        k = c["by_kind"]
+        lines.append(f"| {c['problem']} | {c['law']} | {c['integrator']} | {ev} | {d} | {tol} | "
+                     f"{k['verification']} / {k['loose']} / {k['unconverged']} / {k['repeat']} / "
+                     f"{k['regression']} | {c['state']} |")
     return "\n".join(lines)
 
 
@@ -179,8 +252,10 @@ def _missing_reference_data(path):
 
 
 def _write_csv(rows, path):
-    keys = ["scene", "file", "scheme", "analysis", "evidence", "quantity", "value", "reference", "abs_error",
-            "rel_error", "digits", "rtol", "atol", "passed", "status", "digits_lost", "why"]
+    keys = ["scene", "file", "problem", "laws", "integrator", "scheme", "analysis", "evidence", "kind",
+            "quantity", "value", "reference", "abs_error", "rel_error", "digits", "rtol", "atol", "scale",
+            "tolerance_relative", "order", "run_order", "formal_order", "reruns", "repeats", "passed", "status",
+            "digits_lost", "why"]
     with open(path, "w", newline="") as fh:
         w = csv.DictWriter(fh, fieldnames=keys, extrasaction="ignore")
         w.writeheader()
@@ -198,12 +273,13 @@ def _plots(rows, outdir):
     # per scene file: the check with the smallest margin (digits obtained − digits asked)
     scenes = {}
     for r in rows:
-        need = -np.log10(r["rtol"]) if r["rtol"] else 0.0
+        tol = kinds.relative_tolerance(r)
+        need = -np.log10(tol) if kinds.asserted(r) and 0 < tol < math.inf else 0.0
         key = f"{Path(r['file']).stem}"
         d = scenes.setdefault(key, {"got": 16.0, "need": 0.0, "margin": np.inf, "ok": True, "n": 0})
         if r["digits"] - need < d["margin"]:
             d.update(got=r["digits"], need=need, margin=r["digits"] - need)
-        d["ok"] &= r["passed"]
+        d["ok"] &= not kinds.failed(r)
         d["n"] += 1
     names = list(scenes)
     y = np.arange(len(names))
@@ -212,7 +288,7 @@ def _plots(rows, outdir):
             color=["tab:green" if scenes[n]["ok"] else "tab:red" for n in names], alpha=0.8,
             label="correct digits of the scene's tightest check")
     ax.scatter([scenes[n]["need"] for n in names], y, marker="|", s=120, color="k",
-               label="digits that check's rtol asks for (atol-only checks: 0)")
+               label="digits that check's tolerance asks for (relative to the quantity)")
     ax.set_yticks(y, [f"{n[:60]} ({scenes[n]['n']})" for n in names], fontsize=7)
     ax.invert_yaxis()
     ax.set_xlim(0, 16.5)
@@ -228,33 +304,49 @@ def _plots(rows, outdir):
 
 
 def _tol(r):
-    if r["rtol"]:
-        return f"{r['rtol']:.0e}"
-    return "exact" if not r["atol"] else f"atol {r['atol']:.0e}"
+    if not kinds.asserted(r):
+        return "none"
+    t = kinds.relative_tolerance(r)
+    return "exact" if t == 0.0 else f"{t:.0e}"
 
 
 def _problem_table(rows):
-    """Per problem: scenes, checks, passed, and the fewest digits of its verification rows
-    (regression rows measure drift from stored data, not accuracy: counted apart)."""
+    """Per problem: scenes, rows by kind, and the fewest digits of its verification rows."""
     by = {}
     for r in rows:
         key = r.get("problem") or r["scene"].split()[0]
-        d = by.setdefault(key, {"scenes": set(), "n": 0, "ok": 0, "min": None, "reg": 0})
-        d["scenes"].add(r["scene"]); d["n"] += 1; d["ok"] += r["passed"]
-        if r.get("evidence") in VERIFICATION:
+        d = by.setdefault(key, {"scenes": set(), "min": None, **{k: 0 for k in kinds.KINDS}, "failed": 0})
+        d["scenes"].add(r["file"])
+        kind = kinds.kind_of(r)
+        d[kind] += 1
+        d["failed"] += kinds.failed(r)
+        if kind == kinds.VERIFICATION:
             d["min"] = r["digits"] if d["min"] is None else min(d["min"], r["digits"])
-        else:
-            d["reg"] += 1
-    lines = ["| problem | scenes | checks | passed | of them regression | fewest digits "
-             "(verification rows) |", "|---|---|---|---|---|---|"]
+    lines = ["| problem | scenes | verification | loose | unconverged | repeat | regression | failed | "
+             "fewest digits (verification rows) |", "|---|---|---|---|---|---|---|---|---|"]
     for k in sorted(by):
         d = by[k]
         low = "-" if d["min"] is None else f"{d['min']:.1f}"
-        lines.append(f"| {k} | {len(d['scenes'])} | {d['n']} | {d['ok']} | {d['reg']} | {low} |")
+        lines.append(f"| {k} | {len(d['scenes'])} | {d['verification']} | {d['loose']} | {d['unconverged']} | "
+                     f"{d['repeat']} | {d['regression']} | {d['failed']} | {low} |")
     return "\n".join(lines)
 
 
-def _write_markdown(rows, failures, pngs, path, elapsed):
+def not_verified_scenes(rows, unchecked):
+    """The scenes no verification row covers, by name, with why: nothing to check, or only
+    rows of other kinds."""
+    out = [(Path(f).stem, title, "ran, not verified: no closed form or reference data")
+           for f, title in unchecked]
+    files = {}
+    for r in rows:
+        files.setdefault(r["file"], [r["scene"], set()])[1].add(kinds.kind_of(r))
+    for f, (title, ks) in sorted(files.items()):
+        if kinds.VERIFICATION not in ks:
+            out.append((Path(f).stem, title, "rows of kind " + ", ".join(sorted(ks)) + " only"))
+    return sorted(out)
+
+
+def _write_markdown(rows, failures, pngs, path, elapsed, n_scenes, unchecked=()):
     lines = [f"# martello catalogue verification", "",
              f"martello {native.version()}; {native.library_versions()}; "
              f"{time.strftime('%Y-%m-%d %H:%M UTC', time.gmtime())}; {elapsed:.1f} s.", "",
@@ -266,18 +358,32 @@ def _write_markdown(rows, failures, pngs, path, elapsed):
              "this scene's own settings showed when the data were made: it checks for drift, "
              "not accuracy). "
              "digits = −log10 of the relative error (16 = exact to round-off).", "",
-             "**" + headline(rows, failures, len({r['file'] for r in rows}), elapsed) + "** "
-             "Kinds of evidence: *closed form* (martello.oracles), *independent reference* "
-             "(martello.independent, docs/independent-reference.md: digits = min(the run's, the "
-             "reference's trusted digits), tolerance from the run's measured order), "
-             "*regression* (drift from stored data made by martello itself: not verification).", "",
-             _problem_table(rows), "", "## Coverage", "", coverage_markdown(rows), "", "## Rows", "",
-             "| scene | scheme | analysis | evidence | quantity | value | reference | digits | rtol | pass |",
-             "|---|---|---|---|---|---|---|---|---|---|"]
+             "**" + headline(rows, failures, n_scenes, elapsed) + "**", "",
+             "Kinds of rows (martello/checks/kinds.py, docs/coverage.md): *verification* — an "
+             "oracle independent of the solvers (a closed form; the independent engine, "
+             "docs/independent-reference.md: digits = min(the run's, the reference's trusted "
+             "digits)), a tolerance below 1 % of the quantity, and for rows against the "
+             "engine, reruns at 2Δt and 4Δt (adaptive: 100 and 10⁴ × rtol) that converge at "
+             "the method's formal order; *loose* — a tolerance of 1-10 %: asserted, not "
+             "counted; *unconverged* — reruns that do not show the formal order, or bound "
+             "nothing below 10 %: the error and the order are shown, nothing is asserted; "
+             "*repeat* — the row of a contact identical to an earlier one of the scene (counted "
+             "once); *regression* — drift from stored data made by martello itself.", "",
+             _problem_table(rows), "", "## Scenes not verified", ""]
+    missing = not_verified_scenes(rows, unchecked)
+    lines += [f"{len(missing)} of {n_scenes} scenes have no verification row:", ""] + \
+        [f"- `{stem}` ({title}): {why}" for stem, title, why in missing]
+    lines += ["", "## Coverage", "", coverage_markdown(rows), "", "## Rows", "",
+              "| scene | scheme | analysis | evidence | kind | quantity | value | reference | digits | "
+              "tolerance | order | pass |",
+              "|---|---|---|---|---|---|---|---|---|---|---|---|"]
     for r in rows:
-        lines.append(f"| {r['scene']} | {r['scheme']} | {r['analysis']} | {r.get('evidence', '')} | `{r['quantity']}` | "
-                     f"{_fmt(r['value'])} | {_fmt(r['reference'])} | {r['digits']:.1f} | "
-                     f"{_tol(r)} | {'yes' if r['passed'] else '**NO**'} |")
+        order = r.get("order")
+        order = "" if order is None else ("noise" if order != order else f"{order:.2f}")
+        ok = "—" if not kinds.asserted(r) else ("yes" if r["passed"] else "**NO**")
+        lines.append(f"| {r['scene']} | {r['scheme']} | {r['analysis']} | {r.get('evidence', '')} | "
+                     f"{kinds.kind_of(r)} | `{r['quantity']}` | {_fmt(r['value'])} | {_fmt(r['reference'])} | "
+                     f"{r['digits']:.1f} | {_tol(r)} | {order} | {ok} |")
     if failures:
         lines += ["", "## Failures", ""] + [f"- {f}" for f in failures]
     for p in pngs:

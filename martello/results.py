@@ -25,7 +25,7 @@ from pathlib import Path
 import numpy as np
 
 from .errors import ResultError
-from .scene.items import Names
+from .scene.chain import Names      # with the chain's name rules known (Names.from_spec)
 from .scene.spec import ARRAY_ITEMS
 
 ARRAYS_FILE = "results.npz"

@@ -15,7 +15,6 @@ from .binding.native import constant
 from .errors import RecordError, ResultError, SceneError
 from .paths import folder_replaced
 from .results import (ARRAYS_FILE, PHASE_FIELDS, ItemArrays, is_large)
-from .scene.bars import RodElements, RodNodes
 from .scene.chain import ChainContacts, ChainLinks
 from .scene.items import ItemTable, Listed, Names
 from .scene.spec import DEFAULT_METHODS
@@ -100,18 +99,15 @@ def contact_arrays(contacts):
 
 def node_arrays(nodes):
     """(mass, u0, v0, fixed) of the scene's nodes, for Model.set_nodes: a listed segment's
-    read from its dicts, a chain's arrays as they are."""
+    read from its dicts, a generated one's arrays as it gives them (martello.scene.items)."""
     parts = []
     for seg in segments(nodes):
         if isinstance(seg, list):
             parts.append([np.fromiter((nd[key] for nd in seg), dt, len(seg))
                           for key, dt in (("mass", np.float64), ("u0", np.float64),
                                           ("v0", np.float64), ("fixed", np.int32))])
-        elif isinstance(seg, RodNodes):
-            parts.append(list(seg.arrays()))
         else:
-            b = seg.block
-            parts.append([b.mass, b.u0, b.v0, np.zeros(b.n, np.int32)])
+            parts.append(list(seg.arrays()))
     return tuple(np.concatenate([p[k] for p in parts]) if parts else np.zeros(0)
                  for k in range(4))
 
@@ -133,62 +129,29 @@ CHUNK = 1 << 16
 
 def link_chunks(segs):
     """(kind, a, b, par) arrays of links (segments of the scene's link table), in order, a
-    chunk at a time."""
+    chunk at a time: a listed segment's from its dicts, a generated one's as it gives them."""
     for seg in segs:
         if isinstance(seg, list):
             if seg:
                 yield link_arrays(seg)
-            continue
-        if isinstance(seg, RodElements):
-            r = seg.rod
-            for k0 in range(0, len(seg), CHUNK):
-                m = min(CHUNK, len(seg) - k0)
-                a = (r.node0 + np.arange(k0, k0 + m)).astype(np.int32)   # element k: k, k + 1
-                par = np.zeros((m, constant("NPAR_LINK")))
-                par[:, constant("L_STIFF")] = r.EA / r.mesh["element_length"]
-                yield np.full(m, native.value("links", "bar"), np.int32), a, a + 1, par
-            continue
-        b = seg.block
-        spring, damper = seg.spring, seg.damper
-        kind_spring = native.value("links", "spring" if b.fy is None else "bilinear")
-        for i0 in range(0, b.n, CHUNK):
-            i1 = min(i0 + CHUNK, b.n)
-            d0, d1 = np.searchsorted(b.dampers, (i0, i1))
-            at = spring[i0]
-            s, d = spring[i0:i1] - at, damper[d0:d1] - at
-            m = (i1 - i0) + (d1 - d0)
-            kind = np.empty(m, np.int32)
-            a = np.empty(m, np.int32)
-            par = np.zeros((m, constant("NPAR_LINK")))
-            kind[s] = kind_spring
-            a[s] = b.node0 + np.arange(i0, i1)
-            par[s, constant("L_STIFF")] = b.k[i0:i1]
-            if b.fy is not None:
-                par[s, constant("L_YIELD")] = b.fy[i0:i1]
-                par[s, constant("L_HARDENING")] = b.hardening[i0:i1]
-            kind[d] = native.value("links", "dashpot")
-            a[d] = b.node0 + b.dampers[d0:d1]
-            par[d, constant("L_DAMP")] = b.c[d0:d1]
-            yield kind, a, np.full(m, -1, np.int32), par
+        else:
+            yield from seg.chunks(CHUNK)
 
 
 def contact_chunks(segs):
     """(a, b, gap, scheme, law, par) arrays of contacts (segments of the scene's contact
-    table), in order, a chunk at a time; a chain's contacts share one row of parameters, its
-    template's."""
+    table), in order, a chunk at a time; a generated segment's contacts share one row of
+    parameters, its template's."""
     for seg in segs:
         if isinstance(seg, list):
             if seg:
                 yield contact_arrays(seg)
             continue
-        b = seg.block
-        _, _, _, scheme, law, row = contact_arrays([b.template])
-        for j0 in range(0, len(seg), CHUNK):
-            j1 = min(j0 + CHUNK, len(seg))
-            m = j1 - j0
-            a = (b.node0 + np.arange(j0, j1)).astype(np.int32)
-            yield (a, a + 1, b.gap[j0:j1], np.full(m, scheme[0], np.int32),
-                   np.full(m, law[0], np.int32), np.repeat(row, m, axis=0))
+        _, _, _, scheme, law, row = contact_arrays([seg.template])
+        for a, b, gap in seg.chunks(CHUNK):
+            m = len(a)
+            yield (a, b, gap, np.full(m, scheme[0], np.int32), np.full(m, law[0], np.int32),
+                   np.repeat(row, m, axis=0))
 
 
 def _function_args(fn, source="<scene>"):
@@ -263,6 +226,8 @@ def build_model(scene, chain_door=True):
     for b in scene.blocks:
         m.add_stiffness_block(b["nodes"], b["k"], b["c"])
     m.set_gravity(scene.gravity)
+    if scene.influence is not None:
+        m.set_influence(scene.influence)
     for f in scene.forces:
         m.add_nodal_force(f["node"], *_function_args(f["function"], scene.source))
     if scene.ground is not None:
@@ -368,6 +333,8 @@ def _dynamic(scene, model, raise_on_failure=True):
         r.set_tracking(*tracked)
         t0 = time.perf_counter()
         st = r.execute(model) if raise_on_failure else r.status_of(model)
+        if st == native.constant("MARTELLO_ERR_INTERRUPTED"):
+            r.check(st, "dynamic run")   # stopped by its user: raised, never an outcome
         wall = time.perf_counter() - t0
         hist = r.history()
         ev_contacts, ev = r.events()
@@ -454,6 +421,12 @@ def _dynamic(scene, model, raise_on_failure=True):
         if fr["histories"] and len(hist):
             columns = columns + list(extra_cols)
             hist = np.hstack([hist, np.column_stack(list(extra_cols.values()))])
+    buildings = {}
+    for b in scene.extras.get("buildings", []):
+        buildings[b["prefix"]], extra_cols = building_results(b, columns, hist)
+        if b["histories"] and len(hist):
+            columns = columns + list(extra_cols)
+            hist = np.hstack([hist, np.column_stack(list(extra_cols.values()))])
     summary = {
         "title": scene.title, "problem": scene.problem,
         "analysis": {k: v for k, v in an.items() if k != "output"} | {"output_every": an["output"]["every"]},
@@ -467,6 +440,7 @@ def _dynamic(scene, model, raise_on_failure=True):
         "links": arrays.entries("links", pick("links", out_links)),
         **({"arrays": arrays} if large else {}),
         **({"frames": frames} if frames else {}),
+        **({"buildings": buildings} if buildings else {}),
         "stability": {"omega_max": extra["omega_max"] or None,
                       "dt_critical": extra["dt_critical"] or None},
         "cost": counters | {"wall_time_s": wall},
@@ -546,23 +520,14 @@ def _names(table):
 
 def _codes(table, key, categories):
     """Codes of a category column (index into categories, −1 where None), segment by
-    segment: a chain's from its block."""
+    segment: a generated one's as it gives them."""
     at = {c: i for i, c in enumerate(categories)}
     parts = []
     for seg in segments(table):
         if isinstance(seg, list):
             parts.append(np.fromiter((at.get(it.get(key), -1) for it in seg), np.int8, len(seg)))
-            continue
-        if isinstance(seg, RodElements):
-            parts.append(np.full(len(seg), at["bar"], np.int8))
-            continue
-        b = seg.block
-        if key == "type":          # the chain's springs, then dampers where it has them
-            codes = np.full(len(seg), at["spring" if b.fy is None else "bilinear"], np.int8)
-            codes[seg.damper] = at["dashpot"]
         else:
-            codes = np.full(len(seg), at.get(b.template.get(key), -1), np.int8)
-        parts.append(codes)
+            parts.append(seg.codes(key, at))
     return np.concatenate(parts) if parts else np.zeros(0, np.int8)
 
 
@@ -597,6 +562,77 @@ def frame_results(fr, columns, hist):
                             "shear": extremes(shear[:, s])} for s in range(frame.storeys)}
     return {"members": members, "storeys": storeys,
             "rayleigh": {"a0": fr["rayleigh"][0], "a1": fr["rayleigh"][1], "zeta": fr["zeta"]}}, series
+
+
+def _extremes(x, t):
+    """Signed extremes of a sampled series and their times (None without samples)."""
+    if not len(x):
+        return {"max": None, "min": None, "t_max": None, "t_min": None}
+    i, j = int(np.argmax(x)), int(np.argmin(x))
+    return {"max": float(x[i]), "min": float(x[j]), "t_max": float(t[i]), "t_min": float(t[j])}
+
+
+def building_description(b):
+    """What a building's summary says of it whatever the run: its modes and damping."""
+    return {"model": b["building"].model, "dofs": len(b["nodes"]), "modes": b["modes"],
+            "damping": {"kind": b["damping"], "zeta": b["zeta"], "a0": b["rayleigh"][0],
+                        "a1": b["rayleigh"][1]},
+            "ground_angle": b["ground_angle"]}
+
+
+def building_results(b, columns, hist):
+    """A building's peaks from the recorded floor DOFs (martello.building3d's operators
+    applied to every recorded sample: exact at output.every = 1): signed extremes of every
+    member's end forces (N, V2, V3, T, M2, M3 at ends i and j; a rigid floor's beams carry no
+    in-plane forces, so no N, V3, M2) with their times and the largest biaxial moment
+    √(M2² + M3²) at each end; per storey the shears along x and y and the torque about the
+    floor's reference point; per requested plan point its ux, uy. Also the member histories
+    (M2, M3 at both ends, by column name)."""
+    col = {name: i for i, name in enumerate(columns)}
+    t = hist[:, col["t"]] if len(hist) else np.zeros(0)
+    U = hist[:, [col[f"u:{n}"] for n in b["nodes"]]] if len(hist) else np.zeros((0, len(b["nodes"])))
+    F = U @ b["recovery"].T
+    bd = b["building"]
+    members, series = {}, {}
+    for e, m in enumerate(bd.elements):
+        rigid_beam = m.kind == "beam" and bd.floors[m.storey - 1].rigid
+        out = {"kind": m.kind, "storey" if m.kind != "beam" else "floor": m.storey}
+        for end, off in (("i", 0), ("j", 6)):
+            for k, q in enumerate(("N", "V2", "V3", "T", "M2", "M3")):
+                if rigid_beam and q in ("N", "V3", "M2"):
+                    continue
+                x = F[:, 12 * e + off + k]
+                out[f"{q}_{end}"] = _extremes(x, t)
+                if q in ("M2", "M3"):
+                    series[f"{q}_{end}:{b['prefix']}.{m.name}"] = x
+            res = np.hypot(F[:, 12 * e + off + 4], F[:, 12 * e + off + 5])
+            out[f"M_{end}_resultant_max"] = float(res.max()) if len(res) else None
+        members[m.name] = out
+    S = U @ b["storey"].T
+    storeys = {str(s + 1): {q: _extremes(S[:, 3 * s + k], t) for k, q in enumerate(("shear_x", "shear_y", "torque"))}
+               for s in range(bd.storeys)}
+    points = {}
+    for p in b["points"]:
+        P = U @ bd.point_operator(p["floor"], p["x"], p["y"]).T
+        points[p["name"]] = {"floor": p["floor"], "x": p["x"], "y": p["y"],
+                             "ux": _extremes(P[:, 0], t), "uy": _extremes(P[:, 1], t)}
+    return building_description(b) | {"members": members, "storeys": storeys, "points": points}, series
+
+
+def _static_building(b, scene, u):
+    """A building's member end forces, storey shears and torques at the static solution."""
+    U = np.array([u[scene.index[n]] for n in b["nodes"]])
+    F = b["recovery"] @ U
+    S = b["storey"] @ U
+    members = {m.name: dict(zip([f"{q}_{e}" for e in "ij" for q in ("N", "V2", "V3", "T", "M2", "M3")],
+                                map(float, F[12 * k:12 * k + 12])))
+               for k, m in enumerate(b["building"].elements)}
+    return building_description(b) | {
+        "members": members,
+        "storeys": {str(s + 1): dict(zip(("shear_x", "shear_y", "torque"), map(float, S[3 * s:3 * s + 3])))
+                    for s in range(b["building"].storeys)},
+        "points": {p["name"]: dict(zip(("ux", "uy"), map(float, b["building"].point_operator(
+            p["floor"], p["x"], p["y"]) @ U))) for p in b["points"]}}
 
 
 def _static_frame(fr, scene, u):
@@ -638,6 +674,8 @@ def _static(scene, model):
         "contacts": contacts,
         **({"frames": {fr["prefix"]: _static_frame(fr, scene, r["u"])
                        for fr in scene.extras["frames"]}} if scene.extras.get("frames") else {}),
+        **({"buildings": {b["prefix"]: _static_building(b, scene, r["u"])
+                          for b in scene.extras["buildings"]}} if scene.extras.get("buildings") else {}),
         "conditioning": {"rcond": r["rcond"],
                          "condition_estimate": _finite_or_none(1.0 / r["rcond"]) if r["rcond"] > 0 else None,
                          "digits_lost": r["digits_lost"],

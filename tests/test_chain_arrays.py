@@ -13,7 +13,8 @@ import pytest
 
 from martello.errors import SceneError
 from martello.reference.store import physics_digest
-from martello.scene.items import Alternating, Listed, Names, Neighbours, Numbered
+from martello.scene.chain import Alternating, Neighbours
+from martello.scene.items import Listed, Names, Numbered
 from martello.scene.loader import from_dict
 
 

@@ -102,7 +102,7 @@ def test_the_cycle_finder_finds_a_cycle():
 # The package's own __init__ ("martello") is its face: it gives the API's names lazily
 # (PEP 562), so it sits on top; test_import_martello_loads_nothing_else keeps it cheap.
 LAYERS = [("martello.errors", "martello.paths", "martello.history", "martello.independent"),
-          ("martello.binding", "martello.oracles"), ("martello.closed_forms", "martello.frame2d"),
+          ("martello.binding", "martello.oracles"), ("martello.closed_forms", "martello.frame2d", "martello.building3d"),
           ("martello.scene", "martello.ground_motion"), ("martello.results",),
           ("martello.run",), ("martello.batch",),
           ("martello.metrics",), ("martello.reference",),

@@ -181,3 +181,38 @@ def test_unsupported_parts_are_refused():
     scene["contact"][0]["scheme"] = "lagrange"
     with pytest.raises(independent.Unsupported, match="lagrange"):
         independent.solve(scene)
+
+
+# --- [[frame]]: the engine's own frame model (martello/independent/frame.py) ---------------------
+
+def _portal(base, beam_I):
+    return {"prefix": "P", "storeys": 1, "bays": 1, "storey_height": 3.0, "bay_width": 6.0,
+            "column": {"E": 3e10, "A": 1e6, "I": 2e-3}, "beam": {"E": 3e10, "A": 1e6, "I": beam_I},
+            "mass": 1e4, "base": base}
+
+
+@pytest.mark.parametrize("base, k", [("fixed", 24.0), ("pinned", 6.0)])
+def test_a_portal_with_a_rigid_beam_has_the_textbook_lateral_stiffness(base, k):
+    # verification against closed forms: two columns fixed at both ends sway with 12EI/h³
+    # each, pinned at the base with 3EI/h³ (Chopra, Dynamics of Structures, §1.3)
+    from martello.independent.frame import frame_block
+    fb = frame_block(_portal(base, 1e6))
+    assert fb.K.shape == (1, 1) and fb.nodes == ["P1"]
+    assert fb.K[0, 0] == pytest.approx(k * 3e10 * 2e-3 / 27.0, rel=1e-6)
+
+
+def test_the_engines_frame_and_the_front_ends_agree():
+    # two codes of one model (the engine's martello/independent/frame.py and the front end's
+    # martello.frame2d): a cross-check of two implementations, to round-off
+    import tomllib
+    from pathlib import Path
+    from martello.independent.frame import frame_block
+    from martello.scene.frame import expand_frames
+    root = Path(__file__).resolve().parent.parent
+    d = tomllib.loads((root / "benchmarks" / "p10" / "p10_A.toml").read_text())
+    _, frames = expand_frames("p10_A.toml", d)
+    for fr, tab in zip(frames, d["frame"]):
+        fb = frame_block(tab)
+        assert fb.nodes == fr["nodes"]
+        assert np.max(np.abs(fb.K - fr["K"])) <= 1e-12 * np.max(np.abs(fr["K"]))
+        assert np.max(np.abs(fb.C - fr["C"])) <= 1e-12 * np.max(np.abs(fr["C"]))

@@ -18,7 +18,7 @@ from martello.history import history_dict, interpolate
 from martello.metrics.score import score
 from martello.reference.base import ReferenceError
 from martello.reference.build import _method_runs, reference_scene
-from martello.reference.event_located import event_located_run
+from martello.reference.independent_engine import NAME as ENGINE, engine_run
 from martello.reference.selection import reference_for_scene
 from martello.reference.store import find_reference_data, load_reference, manifest, physics_digest
 from martello.scene.loader import from_dict, load
@@ -56,8 +56,8 @@ def _fresh(entry):
     ref = load_reference(entry["folder"])
     level = meta["refinement"][-1]
     sc, d, path = reference_scene(entry)
-    if method["integrator"] == "scipy-dop853":
-        out = event_located_run(sc, level["rtol"], ref.times)
+    if method["integrator"] == ENGINE:
+        out = engine_run(d, path.parent, level["rtol"], ref.times, sc.analysis["t_end"])
     else:
         spec = _method_runs(entry, method, d, path, level["dt"], level["rtol"])
         out = execute(spec)
@@ -85,29 +85,28 @@ def test_fresh_computation_matches_the_stored_data(entry):
         assert len(out["summary"]["contacts"][name]["impact_times"]) == len(ev["impact_times"])
 
 
-def test_event_located_engine_reproduces_the_closed_form():
+def test_the_independent_engine_as_a_reference_reproduces_the_closed_form():
     # P2 with a Kelvin plane: exact piecewise solution
-    # (martello.oracles.p2_bouncing.bouncing_oscillator_kelvin)
-    sc = load(ROOT / "benchmarks" / "p2" / "p2_penalty_kelvin.toml")
+    # (martello.oracles.p2_bouncing.bouncing_oscillator_kelvin); the engine reads the scene's
+    # own tables (not the loaded Scene) and its result is scored as a library run's
+    path = ROOT / "benchmarks" / "p2" / "p2_penalty_kelvin.toml"
+    d = tomllib.loads(path.read_text())
     grid = np.linspace(0.0, 0.7, 1401)
-    out = event_located_run(sc, 1e-12, grid)
-    ref = reference_for_scene(sc)
+    out = engine_run(d, path.parent, 1e-12, grid)
+    ref = reference_for_scene(load(path))
     m = score(out["summary"], out["history"], ref, times=grid)
     assert m["max_rel_error"] < 1e-10
     assert m["impact_time_error"] < 1e-11 and m["impact_count_error"] == 0
     assert m["phase_penetration_error"] < 1e-9 and m["restitution_error"] < 1e-10
 
 
-def test_event_located_engine_finds_a_contact_inside_one_step():
-    # Two free masses whose gap closes for a moment: the gap's maximum is checked, so a
-    # contact shallower than one step's sign test is still found (docs/problems.md P7).
-    d = {"node": [{"name": "m1", "mass": 1.0, "v0": 1e-3}, {"name": "m2", "mass": 1.0}],
-         "link": [{"type": "spring", "a": "m1", "b": "ground", "k": 1.0}],
-         "contact": [{"name": "c", "a": "m1", "b": "m2", "gap": 9.9999e-4, "scheme": "penalty",
-                      "law": "linear", "stiffness": 1e6}],
-         "analysis": {"type": "dynamic", "integrator": "newmark", "dt": 1e-3, "t_end": 3.0}}
-    out = event_located_run(from_dict(d), 1e-10, np.linspace(0, 3.0, 301))
-    assert len(out["summary"]["contacts"]["c"]["impact_times"]) == 1
+def test_the_independent_engine_says_what_it_cannot_run():
+    from martello.independent import Unsupported
+    d = {"node": [{"name": "m", "mass": 1.0}],
+         "contact": [{"name": "c", "a": "m", "b": "ground", "scheme": "lagrange"}],
+         "analysis": {"type": "dynamic", "integrator": "rk8pd", "dt": 1e-3, "t_end": 1.0}}
+    with pytest.raises(Unsupported, match="lagrange"):
+        engine_run(d, ROOT, 1e-10, np.linspace(0.0, 1.0, 11))
 
 
 def test_stale_reference_data_are_refused(tmp_path):

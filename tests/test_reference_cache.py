@@ -22,7 +22,7 @@ from martello.scene.loader import from_dict, load
 ROOT = Path(__file__).resolve().parent.parent
 
 # Two masses on springs to the ground, a Hertz contact between them (F = K δ^1.5, δ = u1 −
-# u2 − gap, docs/scene-format.md), the first thrown at the second: a scene of no catalogue
+# u2 − gap, docs/scene-input.md), the first thrown at the second: a scene of no catalogue
 # problem, with no closed form and no stored reference data.
 M1, M2, K1, K2, KC, GAP, V0, T_END = 2.0, 1.0, 50.0, 200.0, 1.0e5, 0.02, 0.5, 2.0
 SCENE = f"""
@@ -148,9 +148,10 @@ def test_compare_computes_and_caches_the_reference_of_a_new_scene(work):
     assert "computed and cached" in r.stderr
     rep = json.loads(out.read_text())
     comp = rep["computed_reference"]
-    assert comp["method"]["integrator"] == "rk8pd" and not comp["cached"]
-    # the trusted digits come from two routes: rk8pd refined, and the independent engine
-    assert "scipy-dop853" in comp["digits_basis"]
+    assert comp["method"]["integrator"] == "independent" and not comp["cached"]
+    # the trusted digits come from two routes: the independent engine refined, and martello's
+    # own best run (rk8pd)
+    assert "rk8pd" in comp["digits_basis"]
     # both the reference (its refinement and cross-check say ≥ 8 digits) and the scipy
     # history here (DOP853 at rtol 1e-12 with every onset a located root: ~1e-11) are far
     # more accurate than 1e-8 of the peak: 8 significant digits at least
@@ -228,7 +229,10 @@ def test_recorder_errors_are_one_line(work, cli, content, args, message):
 def test_reference_command_writes_digits_and_provenance(work, cli, tmp_path):
     r = cli("reference", work["scene"], "-o", tmp_path / "ref")
     assert r.returncode == 0, r.stderr
-    assert "trusted digits from refinement of rk8pd and its difference from scipy-dop853" in r.stdout
+    # the independent engine computes it, martello's own best run (rk8pd) cross-checks it
+    assert "reference by independent" in r.stdout and "engine: martello.independent" in r.stdout
+    assert "trusted digits from refinement of independent and its difference from rk8pd" in r.stdout
+    assert "the two agree to" in r.stdout
     meta = json.loads((tmp_path / "ref" / "reference.json").read_text())
     for key in ("scene", "scene_sha256", "physics_sha256", "method", "refinement", "cross_check",
                 "digits", "digits_basis", "martello_version", "libraries", "date", "cache_key"):
@@ -283,12 +287,15 @@ def test_cache_key_is_the_physics(work):
 
 def test_methods_follow_the_scene():
     p7 = load(ROOT / "benchmarks" / "p7" / "p7_two_oscillators.toml")
-    assert [m["integrator"] for m in cache.default_methods(p7, 1e-3)] == ["rk8pd", "scipy-dop853", "newmark"]
+    assert [m["integrator"] for m in cache.default_methods(p7, 1e-3)] == ["independent", "rk8pd", "newmark"]
     e = load(ROOT / "benchmarks" / "p2" / "p2_restitution_e08.toml")
-    assert [m["integrator"] for m in cache.default_methods(e, 1e-3)] == ["rk8pd", "rkf45"]
+    assert [m["integrator"] for m in cache.default_methods(e, 1e-3)] == ["independent", "rk8pd", "rkf45"]
     chain = load(ROOT / "benchmarks" / "p7" / "p7_chain_10.toml")
-    ms = cache.default_methods(chain, 6e-3)
+    ms = cache.default_methods(chain, 6e-3)[1:]
     assert ms[0]["integrator"] == "rk8pd" and ms[0]["refine"] == "h_max" and ms[1]["integrator"] == "newmark"
+    big = load(ROOT / "benchmarks" / "p7" / "p7_chain_1000.toml")
+    assert cache.default_methods(big, 1e-2)[0]["integrator"] == "rk8pd"
+    assert "1000 nodes" in cache.engine_skipped(big)
     # Newmark's step divides the sample spacing: its outputs fall on the stored samples
     assert (6e-3 / ms[1]["dt"]) == pytest.approx(round(6e-3 / ms[1]["dt"]), abs=1e-9)
 

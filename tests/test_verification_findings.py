@@ -117,11 +117,13 @@ def test_the_energy_balance_is_an_identity_not_accuracy():
 
 
 def test_the_headline_counts_only_verification():
-    rows = [{"evidence": "closed form", "passed": True}, {"evidence": "independent reference", "passed": True},
+    rows = [{"evidence": "closed form", "passed": True, "rtol": 1e-6, "reference": 1.0, "digits": 9.0},
+            {"evidence": "independent reference", "passed": True, "rtol": 0.0, "atol": 1e-9, "reference": 1.0,
+             "digits": 9.0},
             {"evidence": "regression", "passed": True}]
     text = headline(rows, [], 3, 1.0)
-    assert text.startswith("verification: 2 of 2 checks passed (1 vs closed form, 1 vs independent reference)")
-    assert "regression, not verification: 1 of 1 passed" in text
+    assert text.startswith("verification: 2 of 2 distinct rows passed (1 vs closed form, 1 vs independent reference")
+    assert "0 of 1 regression rows passed" not in text and "1 of 1 regression rows passed" in text
 
 
 def test_stored_independent_references_say_what_they_are():
@@ -164,9 +166,10 @@ def test_a_verified_cell_names_its_regression_only_scenes():
     # (Newmark at Δt = 1e-4 without a split: regression rows only); the cell's state must not
     # speak for the latter
     from martello.report import coverage, coverage_markdown
-    base = {"problem": "P7", "laws": "kelvin", "integrator": "newmark", "passed": True, "digits": 4.7}
+    base = {"problem": "P7", "laws": "kelvin", "integrator": "newmark", "passed": True, "digits": 4.7,
+            "rtol": 1e-6, "reference": 1.0}
     rows = [dict(base, evidence="independent reference", file="laws/p7_two_kelvin_newmark.toml"),
             dict(base, evidence="regression", file="p7/p7_two_oscillators.toml")]
     (cell,) = coverage(rows)
-    assert cell["state"] == "verified" and cell["regression_only_scenes"] == ["p7_two_oscillators"]
-    assert "regression only: `p7_two_oscillators`" in coverage_markdown(rows)
+    assert cell["state"] == "verified" and cell["unverified_scenes"] == ["p7_two_oscillators"]
+    assert "scenes without a verification row: `p7_two_oscillators`" in coverage_markdown(rows)

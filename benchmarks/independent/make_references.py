@@ -1,4 +1,4 @@
-"""Write the independent engine's references (docs/independent-reference.md) for P7 and P8
+"""Write the independent engine's references (docs/independent-reference.md) for P2, P7-P10
 into reference/independent/<name>.json: strict JSON, each with its trusted digits.
 
     .venv/bin/python benchmarks/independent/make_references.py [NAME ...]
@@ -54,6 +54,11 @@ REFERENCES = {
     "p8_bare": ("benchmarks/p8/p8_bare.toml", None),
     "p8_A": ("benchmarks/p8/p8_A.toml", None),
     "p8_B": ("benchmarks/p8/p8_B.toml", None),
+    # P10's planar frames (the engine's own frame model, martello/independent/frame.py), 20 s
+    # of record 1: linear frames, two linear gaps, fluid dampers (A, B)
+    "p10_bare": ("benchmarks/p10/p10_bare.toml", None),
+    "p10_A": ("benchmarks/p10/p10_A.toml", None),
+    "p10_B": ("benchmarks/p10/p10_B.toml", None),
 }
 # stored, but not used by `martello check` (docs/independent-reference.md): the P7 Kelvin
 # pair of p7_two_oscillators.toml (p7_two_kelvin, of the same physics, serves the catalogue's
@@ -66,7 +71,8 @@ NOT_IN_CATALOGUE = {"p7_two_oscillators_kelvin", "p7_row_3"}
 # while the same chain with event_split at 2e-5 is verified against p7_chain_10
 SERVES = {"p7_chain_10": ["benchmarks/p7/p7_chain_10_split.toml"],
           "p7_two_kelvin": [f"benchmarks/p7/laws/p7_two_kelvin_{i}.toml" for i in
-                            ("rkf45", "rk8pd", "msbdf", "ida", "newmark", "hht", "generalized_alpha")]}
+                            ("rkf45", "rk8pd", "msbdf", "ida", "cvode", "arkode", "newmark", "hht",
+                             "generalized_alpha")]}
 # the rtol of the primary integration (the second is at 100 × rtol); P8's records restart
 # the integration every 10 ms, where 1e-10 already gives ≥ 6 trusted digits (P8 B: at
 # 1e-10 its second integration, at 1e-8, puts the slow 8th phase's separation 1.9e-6 s off
@@ -75,7 +81,7 @@ SERVES = {"p7_chain_10": ["benchmarks/p7/p7_chain_10_split.toml"],
 # χ = a/v_in ≈ 10 s/m), at 1e-12 8.6; Gonthier 6.5 and 8.5 (Jankowski, whose damping goes as
 # δ^(1/4) at first touch, is 6.5 at 1e-11 and 6.2 at 1e-12: it stays at 1e-11)
 RTOL = {"p8_bare": 1e-10, "p8_A": 1e-10, "p8_B": 1e-11, "p7_two_flores": 1e-12, "p7_two_gonthier": 1e-12,
-        "p9_davis_penalty_kelvin": 1e-12}
+        "p9_davis_penalty_kelvin": 1e-12, "p10_bare": 1e-10, "p10_A": 1e-10, "p10_B": 1e-10}
 
 
 def build(name):

@@ -118,25 +118,43 @@ def score(path, scene, out):
     return json.loads(out.read_text())["metrics"]
 
 
-def measure(rows, out, only=None, cap=MAX_NODE_STEPS):
-    """Run the scenes OpenSees takes as they are; returns measured rows."""
+def _martello_history(scene, dt, folder):
+    """martello's own run of the scene at step dt, its history.csv in folder (the scene's
+    other settings unchanged); True when it ran."""
+    from martello.run import run_full, write_history
+    from martello.scene.loader import load
+    s = load(scene)
+    s.analysis["dt"] = dt
+    try:
+        _, (cols, data) = run_full(s)
+    except Exception:
+        return False
+    folder.mkdir(parents=True, exist_ok=True)
+    write_history(folder / "history.csv", list(cols), data)
+    return True
+
+
+def measure(rows, out, only=None, cap=MAX_NODE_STEPS, refine=1):
+    """Run the scenes OpenSees takes as they are, at their step and (refine > 1) at the step
+    halved refine − 1 times; returns measured rows."""
     from martello.scene import catalogue
     from martello.scene.loader import load
     res = []
-    for rel, problem, status, integ, dt, mats, _ in rows:
-        if status != "as is" or (only and only not in rel):
-            continue
+    wanted = [w for w in (only or "").split(",") if w]
+    todo = [(rel, problem, integ, dt / 2 ** k, mats, k) for rel, problem, status, integ, dt, mats, _ in rows
+            if status == "as is" and (not wanted or any(w in rel for w in wanted)) for k in range(refine)]
+    for rel, problem, integ, dt, mats, k in todo:
         scene = catalogue.ROOT / rel
         s = load(scene)
-        size = len(s.nodes) * s.analysis["t_end"] / s.analysis["dt"]
+        size = len(s.nodes) * s.analysis["t_end"] / dt
         if size > cap:
             res.append({"scene": rel, "problem": problem, "integrator": integ, "dt": dt, "materials": mats,
                         "opensees": f"not measured: {size:.2g} node-steps (cap {cap:.0e})"})
             continue
-        work = out / rel.replace("/", "__").removesuffix(".toml")
+        work = out / (rel.replace("/", "__").removesuffix(".toml") + (f"__dt{k}" if k else ""))
         t0 = time.time()
-        r = subprocess.run([sys.executable, "-m", "martello", "export", str(scene), "-o", str(work / "os")],
-                           capture_output=True, text=True, cwd=ROOT)
+        r = subprocess.run([sys.executable, "-m", "martello", "export", str(scene), "-o", str(work / "os")]
+                           + (["--dt", repr(dt)] if k else []), capture_output=True, text=True, cwd=ROOT)
         row = {"scene": rel, "problem": problem, "integrator": integ, "dt": dt, "materials": mats}
         if r.returncode == 0:
             r = subprocess.run([sys.executable, "model.py"], capture_output=True, text=True, cwd=work / "os",
@@ -147,12 +165,11 @@ def measure(rows, out, only=None, cap=MAX_NODE_STEPS):
             print(f"{rel}: {row['opensees']}", flush=True)
             continue
         row["opensees_seconds"] = time.time() - t0
-        m = subprocess.run([sys.executable, "-m", "martello", "run", str(scene), "-o", str(work / "m")],
-                           capture_output=True, text=True, cwd=ROOT)
+        m_ok = _martello_history(scene, dt, work / "m")
         os_score = score(work / "os" / "history.csv", scene, work / "os_score.json")
-        m_score = score(work / "m" / "history.csv", scene, work / "m_score.json") if m.returncode == 0 else {}
+        m_score = score(work / "m" / "history.csv", scene, work / "m_score.json") if m_ok else {}
         ho, do = _history(work / "os" / "history.csv")
-        if m.returncode == 0:
+        if m_ok:
             hm, dm = _history(work / "m" / "history.csv")
             us = [c for c in ho if c.startswith("u:") and c in hm]
             n = min(len(do), len(dm))
@@ -174,7 +191,7 @@ def _f(x, fmt):
 def measured_part(res, version):
     out = [BEGIN_M, "",
            f"Measured with OpenSees {version} (openseespy), `benchmarks/opensees/scorecard.py --docs`: each "
-           "scene at its own integrator and step. scd: significant correct digits of u against martello's "
+           "scene at its own integrator and step (with --refine, also at the step halved). scd: significant correct digits of u against martello's "
            "reference ([compare.md](compare.md)); impacts: found / in the reference; e: mean realised "
            "restitution / the reference's; energy: error of kinetic + recoverable energy at the end over "
            "the reference's largest (OpenSees' own bookkeeping in model.py); |OS − m|: OpenSees against "
@@ -204,12 +221,13 @@ def _replace(text, begin, end, block):
 def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("-o", "--output", default="out/opensees-scorecard")
-    ap.add_argument("--only", help="measure only scenes whose path contains this text")
+    ap.add_argument("--only", help="measure only scenes whose path contains one of these texts (comma-separated)")
     ap.add_argument("--docs", action="store_true", help=f"regenerate {DOC.relative_to(ROOT)}")
     ap.add_argument("--check", action="store_true", help="check the committed doc's deterministic part")
     ap.add_argument("--deterministic", action="store_true", help="regenerate only the doc's deterministic "
                     "part (seconds, no OpenSees): after adding catalogue scenes")
     ap.add_argument("--cap", type=float, default=MAX_NODE_STEPS, help="largest nodes x steps to run")
+    ap.add_argument("--refine", type=int, default=1, help="also run at the step halved REFINE − 1 times")
     args = ap.parse_args()
     rows = classify()
     det = deterministic_part(rows)
@@ -227,7 +245,7 @@ def main():
     import openseespy.opensees as ops
     out = Path(args.output)
     out.mkdir(parents=True, exist_ok=True)
-    res = measure(rows, out, args.only, args.cap)
+    res = measure(rows, out, args.only, args.cap, args.refine)
     (out / "scorecard.json").write_text(json.dumps({"classification": rows, "measured": res}, indent=1, default=str))
     meas = measured_part(res, ops.version())
     print(meas)

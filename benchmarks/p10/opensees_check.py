@@ -1,6 +1,7 @@
 """Cross-check of one P10 frame scene against OpenSees (docs/p10-case-study.md, "OpenSees").
 
-    .venv/bin/python benchmarks/p10/opensees_check.py [--python PY] [--record 1] [--dt 5e-4]
+    .venv/bin/python benchmarks/p10/opensees_check.py -o DIR [--python PY] [--record 1] [--dt 5e-4]
+        [--docs]
 
 The bare scene of benchmarks/p10/case_study.py (frames A and B, gaps at floors 1 and 2, no
 dampers), one record, run by martello (Newmark average acceleration) and by OpenSees
@@ -10,29 +11,26 @@ zeroLength elements of an ElasticPPGap material (a linear spring past the gap, n
 Rayleigh damping per frame by region (a0 M + a1 K of each frame's own elements: condensing
 the massless DOFs of a0 M + a1 K gives martello's a0 M + a1 K*), UniformExcitation with the
 record as a Path series, Newmark (½, ¼) at the same step, Newton with a displacement test at
-1e-12. Printed (and, for the default record 1 over 20 s, written to docs/p10/opensees_check.txt,
-which docs/p10-case-study.md quotes): the peak |M| of every column and the peak gap
-penetration from both codes and their relative differences. The two codes share only the input numbers (sections, masses,
+1e-12. Printed and written into DIR (with the parameters and the OpenSees result; --docs, for
+the default record 1 over 20 s, also to docs/p10/opensees_check.txt, which
+docs/p10-case-study.md quotes): the peak |M| of every column and the peak gap penetration from
+both codes and their relative differences. The two codes share only the input numbers (sections, masses,
 gap stiffness, the Rayleigh coefficients a0 and a1 of each frame as martello's summary
 reports them, and the record); the assembly, the solver and the member forces are each
 code's own.
 
-openseespy is not a requirement of martello: with --python the given interpreter (which has
-openseespy) runs the OpenSees half; without it the script makes a venv under
-out/p10-opensees-venv and pip-installs openseespy there, and prints a skip message if that
-fails.
+The OpenSees half runs under --python (an interpreter that imports openseespy), else under this
+one if it does; the script installs nothing, and prints a skip message without one.
 """
 
 import argparse
 import json
 import subprocess
 import sys
-import venv
 from pathlib import Path
 
 HERE = Path(__file__).resolve().parent
 ROOT = HERE.parent.parent
-VENV = ROOT / "out" / "p10-opensees-venv"
 
 
 # --- the OpenSees half (runs under the openseespy interpreter; no martello import) -------------
@@ -117,24 +115,19 @@ def opensees_worker(params_file, out_file):
 # --- the martello half --------------------------------------------------------------------------
 
 def opensees_python(given):
-    if given:
-        return given
-    py = VENV / "bin" / "python"
-    if not py.exists():
-        print(f"making {VENV} and installing openseespy (pip) ...", flush=True)
-        venv.create(VENV, with_pip=True)
-    ok = subprocess.run([str(py), "-c", "import openseespy.opensees"], capture_output=True).returncode == 0
-    if not ok:
-        r = subprocess.run([str(py), "-m", "pip", "install", "-q", "openseespy", "numpy"],
-                           capture_output=True, text=True)
-        if r.returncode != 0:
-            return None
-    return str(py)
+    """The interpreter of the OpenSees half: given, else this one; None if it cannot import
+    openseespy (nothing is installed here)."""
+    py = given or sys.executable
+    ok = subprocess.run([py, "-c", "import openseespy.opensees"], capture_output=True).returncode == 0
+    return py if ok else None
 
 
 def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--python", help="an interpreter with openseespy")
+    ap.add_argument("-o", "--out", help="the folder the run's files and the table are written into")
+    ap.add_argument("--python", help="an interpreter with openseespy (default: this one)")
+    ap.add_argument("--docs", action="store_true",
+                    help="also write the table to docs/p10/opensees_check.txt (record 1, 20 s)")
     ap.add_argument("--record", type=int, default=1)
     ap.add_argument("--dt", type=float, default=5e-4)
     ap.add_argument("--t-end", type=float, default=20.0)
@@ -142,14 +135,16 @@ def main():
     args = ap.parse_args()
     if args.opensees_worker:
         return opensees_worker(*args.opensees_worker)
+    if not args.out:
+        ap.error("give -o DIR, the folder the run's files are written into")
     sys.path.insert(0, str(ROOT)); sys.path.insert(0, str(HERE))
     import case_study as cs
     from martello.ground_motion.records import read_record
     from martello.run import run_full
     py = opensees_python(args.python)
     if py is None:
-        print("SKIPPED: openseespy could not be installed (pip install openseespy failed); "
-              "give --python with an interpreter that has it")
+        print("SKIPPED: no openseespy here: give --python with an interpreter that has it "
+              "(python -m venv DIR && DIR/bin/pip install openseespy)")
         return 0
     sc = cs.scene_for("bare", args.record, dt=args.dt, t_end=args.t_end, tol_residual=1e-12)
     s, _ = run_full(sc)
@@ -166,7 +161,7 @@ def main():
     params = {"frames": frames, "dt": args.dt, "t_end": args.t_end,
               "gaps": [{"floor": f, "line_a": cs.BAYS, "line_b": 0, "k": cs.GAP_K, "gap": cs.JOINT} for f in (1, 2)],
               "record_t": rec.t.tolist(), "record_a": rec.accel.tolist()}
-    out = ROOT / "out" / "p10-opensees"
+    out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
     (out / "params.json").write_text(json.dumps(params))
     r = subprocess.run([py, __file__, "--opensees-worker", str(out / "params.json"), str(out / "result.json")],
@@ -194,10 +189,15 @@ def main():
     emit(f"worst relative difference of the column moments: {worst:.2e}")
     text = "\n".join(lines)
     sys.stdout.write(text + "\n")
-    if args.t_end == 20.0 and args.record == 1:
+    table = "benchmarks/p10/opensees_check.py --record %d --dt %g\n" % (args.record, args.dt) + text + "\n"
+    (out / "opensees_check.txt").write_text(table)
+    if args.docs:
+        if not (args.t_end == 20.0 and args.record == 1):
+            print("--docs: docs/p10-case-study.md quotes record 1 over 20 s; not written")
+            return 1
         (ROOT / "docs" / "p10").mkdir(exist_ok=True)
-        (ROOT / "docs" / "p10" / "opensees_check.txt").write_text(
-            "benchmarks/p10/opensees_check.py --record 1 --dt %g\n" % args.dt + text + "\n")
+        (ROOT / "docs" / "p10" / "opensees_check.txt").write_text(table)
+        print("written: docs/p10/opensees_check.txt")
     return 0
 
 

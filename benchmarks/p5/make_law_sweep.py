@@ -17,7 +17,7 @@ LAWS = {  # law: (stiffness, target e, clipped)
     "hertzdamp": (1e8, 0.8, False), "jankowski": (1e8, 0.65, False)}
 FIXED = {"hht": 'alpha = -0.05', "generalized-alpha": 'rho_inf = 0.9', "central-difference": "",
          "moreau-jean": "theta = 0.5"}
-ADAPTIVE = ("rkf45", "rk8pd", "msbdf", "ida")
+ADAPTIVE = ("rkf45", "rk8pd", "msbdf", "ida", "cvode", "arkode")
 
 
 def tolerance(law, integ):

@@ -1,6 +1,6 @@
 """Write benchmarks/p7/laws/: P7's two oscillators of different period (docs/problems.md P7,
 benchmarks/p7/p7_two_oscillators.toml) with every penalty law on the event-locating
-integrators (rkf45, rk8pd, msbdf, IDA) and Newmark, HHT and generalized-α (the two Kelvin laws
+integrators (rkf45, rk8pd, msbdf, IDA, CVODE, ARKODE) and Newmark, HHT and generalized-α (the two Kelvin laws
 with event_split), each checked against the
 independent engine (reference/independent/p7_two_<law>.json, docs/independent-reference.md):
 impact and separation times, realised e and peak penetration of every phase, the nodes'
@@ -24,7 +24,7 @@ LAWS = {  # law: contact keys (the P7 law variants of benchmarks/independent/mak
     "kelvin_clipped": 'law = "kelvin", stiffness = 1.0e5, restitution = 0.65, clipped = true',
     **{law: f'law = "{law}", stiffness = {HERTZ_K:.1e}, restitution = 0.65'
        for law in ("hunt-crossley", "lankarani-nikravesh", "flores", "gonthier", "hertzdamp", "jankowski")}}
-INTEGRATORS = ("rkf45", "rk8pd", "msbdf", "ida")
+INTEGRATORS = ("rkf45", "rk8pd", "msbdf", "ida", "cvode", "arkode")
 # fixed steps at Δt = 1e-5 for the laws whose force has no kink inside a phase: linear,
 # hertz, the Hunt–Crossley family (which P7 never drives past its cut, 1 + χδ̇ = 0: the
 # engine logs no cut here) and jankowski. The Hunt–Crossley family's χ = a/v_in takes the rate
@@ -49,6 +49,15 @@ FIXED_LAWS = ("linear", "hertz", "hunt-crossley", "lankarani-nikravesh", "flores
 # is not yet asymptotic on HHT (order 1.3 from Δt, 2Δt, 4Δt).
 LAWS["kelvin"] = 'law = "kelvin", stiffness = 1.0e5, restitution = 0.65'
 KELVIN_FIXED = 'event_split = true\ndt = 5.0e-6'
+# The linear law's slope jumps by k at δ = 0 and Jankowski's damping switches off where δ̇
+# turns and rises as δ^(1/4) after the onset: on plain steps their P7 rows converged at
+# order 1 (linear) and erratically (Jankowski: 0.4-0.6, a phase's penetration 4.2 % off);
+# with event_split each switch is a sub-step boundary: second order for the linear law,
+# a regular order of 1.4-2.1 for Jankowski (its τ^(1/4) onset caps it at 5/4 asymptotically:
+# martello/checks/independent_rows.py, JANKOWSKI_ORDER), whose rows' 2Δt bounds fall below
+# 1 % at Δt = 5e-6 (at 1e-5 the third phase's e has 3 × |e_h − e_2h| = 2.3 %).
+SPLIT_FIXED = 'event_split = true\ndt = 1.0e-5'
+JANKOWSKI_FIXED = 'event_split = true\ndt = 5.0e-6'
 
 
 def name(law, integ):
@@ -58,9 +67,13 @@ def name(law, integ):
 def settings(integ, law=None):
     if integ in FIXED and law in ("kelvin", "kelvin_clipped"):
         return FIXED[integ] + "\n" + KELVIN_FIXED
+    if integ in FIXED and law == "jankowski":
+        return FIXED[integ] + "\n" + JANKOWSKI_FIXED
+    if integ in FIXED and law == "linear":
+        return FIXED[integ] + "\n" + SPLIT_FIXED
     if integ in FIXED:
         return FIXED[integ] + "\ndt = 1.0e-5"
-    if integ == "msbdf":
+    if integ in ("msbdf", "cvode"):
         # msbdf (variable-order BDF, at most fifth order) at rtol 1e-10 confirmed only 5.98
         # digits of the linear and Kelvin contacts' e and peaks; at 1e-12 it reaches the
         # references' own digits (7.0)

@@ -9,7 +9,8 @@
  *
  * prints one JSON line: the wall seconds of martello_dynamic_run (its set-up included), the
  * resident memory (VmRSS) before the model, after it is built and after the run, the peak
- * (VmHWM), the counters and a checksum of the peaks (to compare two builds or the two doors).
+ * (VmHWM), the counters, a checksum of the peaks (to compare two builds or the two doors) and
+ * u of the first and last node at the end.
  * --full-phases asks for every contact's phase list (martello_run_set_phase_lists); --track
  * keeps only WHAT, a comma-separated list of node_peaks, link_peaks, contact_peaks, phases,
  * all, or none (martello_run_set_tracking; default all). */
@@ -183,15 +184,23 @@ int main(int argc, char **argv) {
   char sum[40];
   if (checksum != checksum) snprintf(sum, sizeof sum, "null");   /* node peaks not tracked */
   else snprintf(sum, sizeof sum, "%.17g", checksum);
+  /* u of the first and last node at the end: the history's last row (t, u of the two output
+   * nodes, ...); a lean kernel of the same chain (lean_chain.f90) prints the same numbers */
+  int rows = 0, cols = 0;
+  check(martello_run_history_shape(r, &rows, &cols), "history_shape", NULL, r);
+  double *hist = malloc((size_t)rows * cols * sizeof *hist);
+  check(martello_run_history(r, hist), "history", NULL, r);
+  double u_first = hist[(size_t)(rows - 1) * cols + 1], u_last = hist[(size_t)(rows - 1) * cols + 2];
+  free(hist);
   printf("{\"n\": %d, \"steps\": %lld, \"wall_s\": %.6f, \"ns_per_dof_step\": %.3f, "
          "\"rss_start\": %.0f, \"rss_model\": %.0f, \"rss_run\": %.0f, \"rss_peak\": %.0f, "
          "\"model_B_per_dof\": %.1f, \"peak_B_per_dof\": %.1f, \"newton\": %lld, "
          "\"factorizations\": %lld, \"fused\": %lld, \"events\": %d, \"impacts\": %lld, "
-         "\"sum_absmax_u\": %s, \"tracking\": %d}\n",
+         "\"sum_absmax_u\": %s, \"tracking\": %d, \"u_first\": %.17g, \"u_last\": %.17g}\n",
          n, cnt[MARTELLO_COUNTER_STEPS], wall, wall / ((double)n * steps) * 1e9, rss0, rss_model,
          rss_run, hwm, (rss_model - rss0) / n, (hwm - rss0) / n,
          cnt[MARTELLO_COUNTER_NEWTON_ITERATIONS], cnt[MARTELLO_COUNTER_FACTORIZATIONS],
-         cnt[MARTELLO_COUNTER_FUSED_CHAIN_STEPS], nev, impacts, sum, track);
+         cnt[MARTELLO_COUNTER_FUSED_CHAIN_STEPS], nev, impacts, sum, track, u_first, u_last);
   free(u_max); free(u_min); free(v); free(acc); free(upk); free(tpk); free(pen); free(force_max); free(imp);
   martello_run_free(&r);
   martello_model_free(&m);

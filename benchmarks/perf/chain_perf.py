@@ -6,7 +6,7 @@ Each n runs in its own process so that peak memory (ru_maxrss) belongs to that n
 The scene: m = 1e5 kg, k = 3e7 N/m, bilinear (F_y 4.9e4 N, 2 % hardening), 5 % damping,
 Kelvin contacts (ε = 1e9 N/m, e = 0.65) pre-compressed by 1 mm so every contact stays
 closed, ground acceleration 3 sin(4πt) m/s²; Δt = 1e-3 s, 8 s (8000 steps).
-Usage: benchmarks/perf/chain_perf.py [--n 10 100 1000] [--out out/perf]"""
+Usage: benchmarks/perf/chain_perf.py -o DIR [--n 10 100 1000] (the table and the plot go into DIR)"""
 
 import argparse
 import csv
@@ -62,7 +62,7 @@ def one(n):
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--n", type=int, nargs="*", default=[10, 100, 1000, 10000, 100000])
-    ap.add_argument("--out", default=str(ROOT / "out" / "perf"))
+    ap.add_argument("-o", "--out", required=True, help="the folder the table and the plot are written into")
     ap.add_argument("--one", type=int, help=argparse.SUPPRESS)
     args = ap.parse_args()
     if args.one:

@@ -6,7 +6,10 @@ buildings repeated), 5 % damping as a dashpot to ground, 10 mm gaps closed by li
 compression-only contacts (ε = 1e5 N/m; OpenSees: zeroLength + ElasticPPGap, as
 benchmarks/perf/opensees_compare.py), ground acceleration 3 sin 8t m/s²; Newmark average
 acceleration, Δt = 1 ms. Every pair of neighbours pounds: the contacts close and open
-throughout the run. OpenSees: BandGeneral, Newton, NormDispIncr 1e-12 (30 iterations).
+throughout the run. OpenSees: the compact model — one fixed ground node that every
+oscillator's spring and dashpot (zeroLength) join, the oscillators numbered in a row after it
+(the Plain handler takes the fixed DOF out of the system, so BandGeneral's band is the
+chain's) — BandGeneral, Newton, NormDispIncr 1e-12 (30 iterations).
 
 Each run is its own process (peak RSS is that run's), the two codes alternate, and each
 figure is the median of the repeats. Reported per n: the time loop in ns per DOF per step
@@ -20,9 +23,11 @@ the same solution's; both are printed). Then the cost exponent in n (least
 squares on log t against log n), a STREAM-like triad (benchmarks/perf/triad.c) for the memory
 floor, and P7's two oscillators with the linear contact, whole process against whole process.
 
-OpenSeesPy runs in its own environment (default out/bench-venv, created with pip if missing;
-the comparison is skipped with a message if that fails). The machine is shared: the load
-average is printed with every figure.
+OpenSeesPy runs in an environment of the caller's (--opensees-python PY, a Python that imports
+openseespy: `python -m venv DIR && DIR/bin/pip install openseespy`, outside the checkout); the
+script installs nothing, and without one it measures martello alone and says so. Everything
+it writes goes into the folder -o names (scenes, runs, the compiled programs, the JSON
+results). The machine is shared: the load average is printed with every figure.
 
 --library measures the library alone instead: benchmarks/perf/chain_native.c (compiled here
 against build/libmartello.so) builds the same chain through the C API, as a chain held per node
@@ -31,9 +36,9 @@ library's clock around martello_dynamic_run, the process' CPU time, and its resi
 DOF: the model once built, and the peak of the run over the memory before the model; --track
 keeps only what it lists (martello_run_set_tracking).
 
-    .venv/bin/python benchmarks/perf/chain_vs_opensees.py [--n 1000 10000 100000]
-        [--steps 8000] [--repeats 3] [--out out/perf] [--opensees-max-n 10000]
-    .venv/bin/python benchmarks/perf/chain_vs_opensees.py --library [--items]
+    .venv/bin/python benchmarks/perf/chain_vs_opensees.py -o DIR [--n 1000 10000 100000]
+        [--steps 8000] [--repeats 3] [--opensees-python PY] [--opensees-max-n 10000]
+    .venv/bin/python benchmarks/perf/chain_vs_opensees.py -o DIR --library [--items]
         [--track node_peaks,contact_peaks] --n 1000 10000 100000 1000000 --steps 8000
 """
 
@@ -88,14 +93,15 @@ def opensees_one(n, steps, dt, out):
     import openseespy.opensees as ops
     ops.wipe()
     ops.model("basic", "-ndm", 1, "-ndf", 1)
-    # oscillator i is node 2i, its own fixed ground point node 2i − 1 (zeroLength elements):
-    # tags in that order keep the band of the system at its chain width (a single ground
-    # node joined to every oscillator would make BandGeneral's band n wide)
+    # the compact model: one fixed ground node (tag 1), oscillator i is node i + 1; the Plain
+    # constraint handler takes the fixed DOF out of the equations and the Plain numberer
+    # numbers the oscillators in a row, so BandGeneral's band is the chain's
+    ground = 1
+    ops.node(ground, 0.0)
+    ops.fix(ground, 1)
     for i in range(1, n + 1):
-        ops.node(2 * i - 1, 0.0)
-        ops.node(2 * i, 0.0)
-        ops.fix(2 * i - 1, 1)
-        ops.mass(2 * i, M)
+        ops.node(i + 1, 0.0)
+        ops.mass(i + 1, M)
     c1, c2 = 2 * ZETA * math.sqrt(K1 * M), 2 * ZETA * math.sqrt(K2 * M)
     ops.uniaxialMaterial("Elastic", 1, K1)
     ops.uniaxialMaterial("Elastic", 2, K2)
@@ -108,17 +114,17 @@ def opensees_one(n, steps, dt, out):
     for i in range(1, n + 1):
         odd = i % 2 == 1                        # b1, b3, ...: k = 100 (martello's k[0], k[2] ...)
         e += 1
-        ops.element("zeroLength", e, 2 * i - 1, 2 * i, "-mat", 1 if odd else 2, "-dir", 1)
+        ops.element("zeroLength", e, ground, i + 1, "-mat", 1 if odd else 2, "-dir", 1)
         e += 1
-        ops.element("zeroLength", e, 2 * i - 1, 2 * i, "-mat", 3 if odd else 4, "-dir", 1)
+        ops.element("zeroLength", e, ground, i + 1, "-mat", 3 if odd else 4, "-dir", 1)
     for i in range(1, n):
         e += 1
-        ops.element("zeroLength", e, 2 * i + 2, 2 * i, "-mat", 5, "-dir", 1)
+        ops.element("zeroLength", e, i + 2, i + 1, "-mat", 5, "-dir", 1)
     ops.timeSeries("Trig", 1, 0.0, 1.0e6, 2 * math.pi / OMEGA, "-factor", AMP)
     ops.pattern("UniformExcitation", 1, 1, "-accel", 1)
     env = Path(out) / "envelope.out"
     ops.recorder("EnvelopeNode", "-file", str(env), "-precision", 16, "-node",
-                 *range(2, 2 * n + 1, 2), "-dof", 1, "disp")
+                 *range(2, n + 2), "-dof", 1, "disp")
     ops.constraints("Plain")
     ops.numberer("Plain")
     ops.system("BandGeneral")
@@ -182,23 +188,18 @@ def opensees_once(py, n, steps, out):
 
 
 def opensees_python(path):
-    """The OpenSeesPy environment: path, else out/bench-venv (made here with pip); None and a
-    message when it cannot be had."""
-    py = Path(path) if path else ROOT / "out" / "bench-venv" / "bin" / "python"
-    if py.exists():
-        return str(py)
-    if path:
-        print(f"OpenSees comparison skipped: {py} does not exist")
+    """The caller's Python with openseespy (--opensees-python), checked; None, and a message
+    saying how to make one, without it (nothing is installed here)."""
+    how = ("give --opensees-python PY, a Python with openseespy (python -m venv DIR && "
+           "DIR/bin/pip install openseespy, outside the checkout)")
+    if not path:
+        print(f"OpenSees comparison skipped: {how}")
         return None
-    venv = py.parents[1]
-    print(f"creating {venv} with openseespy (pip) ...", flush=True)
-    try:
-        subprocess.run([sys.executable, "-m", "venv", str(venv)], check=True)
-        subprocess.run([str(py), "-m", "pip", "install", "-q", "openseespy"], check=True)
-    except (subprocess.CalledProcessError, OSError) as e:
-        print(f"OpenSees comparison skipped: openseespy could not be installed ({e})")
+    r = subprocess.run([path, "-c", "import openseespy.opensees"], capture_output=True, text=True)
+    if r.returncode != 0:
+        print(f"OpenSees comparison skipped: {path} cannot import openseespy; {how}")
         return None
-    return str(py)
+    return path
 
 
 def triad_gbs(out):
@@ -263,8 +264,8 @@ def main():
     ap.add_argument("--n", type=int, nargs="+", default=[1000, 10000, 100000])
     ap.add_argument("--steps", type=int, default=8000)
     ap.add_argument("--repeats", type=int, default=3)
-    ap.add_argument("--out", default=str(ROOT / "out" / "perf"))
-    ap.add_argument("--opensees-python", help="a Python with openseespy (default out/bench-venv)")
+    ap.add_argument("-o", "--out", required=True, help="the folder everything is written into")
+    ap.add_argument("--opensees-python", help="a Python with openseespy (none: martello alone)")
     ap.add_argument("--opensees-max-n", type=int, default=10000,
                     help="largest n OpenSees runs (it takes ~2 µs per DOF-step)")
     ap.add_argument("--skip-pounding", action="store_true")
@@ -286,7 +287,8 @@ def main():
     if a.library:
         library_alone(a, out)
         return
-    py = opensees_python(a.opensees_python)
+    wants = not a.skip_pounding or any(n <= a.opensees_max_n for n in a.n)
+    py = opensees_python(a.opensees_python) if wants else None
     sys.path.insert(0, str(ROOT))
     from martello.binding import native
     print(f"martello {native.version()}; {os.cpu_count()} cores; "

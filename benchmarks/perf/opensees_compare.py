@@ -10,7 +10,9 @@ reference computed on demand (docs/reference.md), cached in $MARTELLO_CACHE_DIR.
 Run with a Python that has openseespy (pip install openseespy; it is not a requirement of
 martello) and martello on the PATH or importable:
 
-    python benchmarks/perf/opensees_compare.py [--dt 1e-4] [--out out/opensees] [--martello CMD]
+    python benchmarks/perf/opensees_compare.py -o DIR [--dt 1e-4] [--martello CMD]
+
+(the scene, the recorder files and the scores go into DIR)
 
 Measured (openseespy 3.8.0.0, reporting OpenSees 3.7.1; martello 0.1.0; the reference
 rk8pd at rtol 1e-12 cross-checked by the independent engine, 10.9 digits):
@@ -133,7 +135,7 @@ def run_opensees(out, dt):
 def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--dt", type=float, nargs="+", default=[2e-4, 1e-4, 5e-5])
-    ap.add_argument("--out", default="out/opensees")
+    ap.add_argument("-o", "--out", required=True, help="the folder everything is written into")
     ap.add_argument("--martello", help="martello command (default: martello on PATH, else "
                     "python -m martello)")
     args = ap.parse_args()

@@ -77,6 +77,7 @@ def lib():
         "martello_model_add_stiffness_block": (c_int, [_VOID_P, c_int, _INT_P, _DOUBLE_P,
                                                        _DOUBLE_P]),
         "martello_model_set_gravity": (c_int, [_VOID_P, c_double]),
+        "martello_model_set_influence": (c_int, [_VOID_P, c_int, _DOUBLE_P]),
         "martello_model_add_nodal_force": (c_int, [_VOID_P, c_int, c_int, _DOUBLE_P, c_int,
                                                    _DOUBLE_P, _DOUBLE_P]),
         "martello_model_set_ground_acceleration": (c_int, [_VOID_P, c_int, _DOUBLE_P, c_int,
@@ -133,15 +134,20 @@ def registry(table):
     rows, cols = ctypes.c_int(), ctypes.c_int()
     if L.martello_registry_shape(table.encode(), ctypes.byref(rows), ctypes.byref(cols)) != 0:
         raise KeyError(f"the native library has no table {table!r}")
+    def read(status, what):
+        if status != 0:
+            raise SolverError(status, status_name(status), f"registry table {table!r}: {what} refused")
+
     columns = []
     for j in range(cols.value):
-        L.martello_registry_column(table.encode(), j, buf, len(buf))
+        read(L.martello_registry_column(table.encode(), j, buf, len(buf)), f"column {j}")
         columns.append(buf.value.decode())
     out, values = [], np.zeros(max(cols.value, 1))
     for i in range(rows.value):
-        L.martello_registry_entry(table.encode(), i, buf, len(buf), values.ctypes.data_as(_VOID_P))
+        read(L.martello_registry_entry(table.encode(), i, buf, len(buf), values.ctypes.data_as(_VOID_P)),
+             f"row {i}")
         name = buf.value.decode()
-        L.martello_registry_text(table.encode(), i, buf, len(buf))
+        read(L.martello_registry_text(table.encode(), i, buf, len(buf)), f"text of row {i}")
         out.append(Row(name, dict(zip(columns, map(float, values[:cols.value]))), buf.value.decode()))
     return tuple(out)
 
@@ -277,7 +283,9 @@ def version():
 
 def library_versions():
     buf = ctypes.create_string_buffer(256)
-    lib().martello_library_versions(buf, len(buf))
+    st = lib().martello_library_versions(buf, len(buf))
+    if st < 0:
+        raise SolverError(st, status_name(st), "library versions: the buffer was refused")
     return buf.value.decode()
 
 
@@ -467,6 +475,11 @@ class Model(_Handle):
     def set_gravity(self, g):
         self.check(lib().martello_model_set_gravity(self._h, g), "gravity")
 
+    def set_influence(self, iota):
+        """ι of every node: gravity and the ground acceleration load M·ι (default 1)."""
+        iota = _f64(iota)
+        self.check(lib().martello_model_set_influence(self._h, iota.size, iota), "influence")
+
     def add_nodal_force(self, node, kind, par, t=(), y=()):
         t, y = _f64(t), _f64(y)
         self.check(lib().martello_model_add_nodal_force(
@@ -537,7 +550,7 @@ class Run(_Handle):
 
     def link_peaks(self, n_links):
         f, du = np.zeros(max(n_links, 1)), np.zeros(max(n_links, 1))
-        lib().martello_run_link_peaks(self._h, f.ctypes.data, du.ctypes.data)
+        self._check(lib().martello_run_link_peaks(self._h, f.ctypes.data, du.ctypes.data), "link peaks")
         return f[:n_links], du[:n_links]
 
     def execute(self, model):
@@ -551,31 +564,32 @@ class Run(_Handle):
         (if any) sees its progress, and Ctrl-C (SIGINT, in the main thread) stops it cleanly
         with MARTELLO_ERR_INTERRUPTED instead of waiting for the end of the run."""
         with _watch() as callback:
-            lib().martello_run_set_progress(self._h, callback, None)
+            self._check(lib().martello_run_set_progress(self._h, callback, None), "progress")
             try:
                 return lib().martello_dynamic_run(model.handle, self._h)
             finally:
-                lib().martello_run_set_progress(self._h, PROGRESS_FN(), None)
+                self._check(lib().martello_run_set_progress(self._h, PROGRESS_FN(), None), "progress")
 
     def history(self):
         rows, cols = ctypes.c_int(), ctypes.c_int()
-        lib().martello_run_history_shape(self._h, ctypes.byref(rows), ctypes.byref(cols))
+        self._check(lib().martello_run_history_shape(self._h, ctypes.byref(rows), ctypes.byref(cols)),
+                    "history shape")
         buf = np.zeros(max(rows.value * cols.value, 1))
-        lib().martello_run_history(self._h, buf)
+        self._check(lib().martello_run_history(self._h, buf), "history")
         return buf[: rows.value * cols.value].reshape(rows.value, cols.value)
 
     def events(self):
         n = ctypes.c_int()
-        lib().martello_run_events(self._h, ctypes.byref(n), None, None)
+        self._check(lib().martello_run_events(self._h, ctypes.byref(n), None, None), "events")
         contacts = np.zeros(max(n.value, 1), dtype=np.int32)
         values = np.zeros((max(n.value, 1), constant("NEVENT")))
-        lib().martello_run_events(self._h, ctypes.byref(n), contacts.ctypes.data_as(_VOID_P),
-                                  values.ctypes.data_as(_VOID_P))
+        self._check(lib().martello_run_events(self._h, ctypes.byref(n), contacts.ctypes.data_as(_VOID_P),
+                                              values.ctypes.data_as(_VOID_P)), "events")
         return contacts[: n.value], values[: n.value]
 
     def counters(self):
         c = np.zeros(constant("NCOUNTERS"), dtype=np.int64)
-        lib().martello_run_counters(self._h, c)
+        self._check(lib().martello_run_counters(self._h, c), "counters")
         return dict(zip(counter_names(), map(int, c)))
 
     def peaks(self, n_nodes, n_contacts, nodes=True, contacts=True):
@@ -588,18 +602,20 @@ class Run(_Handle):
         arrays = [out_array(n_nodes, nodes) for _ in range(4)] + \
                  [out_array(n_contacts, contacts) for _ in range(2)] + \
                  [out_array(n_contacts, True, np.int32)] + [out_array(n_nodes, nodes) for _ in range(2)]
-        lib().martello_run_peaks(self._h, *(None if a is None else a.ctypes.data for a in arrays))
+        self._check(lib().martello_run_peaks(self._h, *(None if a is None else a.ctypes.data for a in arrays)),
+                    "peaks")
         out = {k: a[: (n_contacts if 4 <= i <= 6 else n_nodes)]
                for i, (k, a) in enumerate(zip(names, arrays)) if a is not None}
         if nodes:
             absmax = [np.zeros(max(n_nodes, 1)) for _ in range(2)]
-            lib().martello_run_abs_peaks(self._h, absmax[0].ctypes.data, absmax[1].ctypes.data)
+            self._check(lib().martello_run_abs_peaks(self._h, absmax[0].ctypes.data, absmax[1].ctypes.data),
+                        "peaks")
             out["u_absmax"], out["t_absmax"] = absmax[0][:n_nodes], absmax[1][:n_nodes]
         return out
 
     def energy(self):
         e, extra = np.zeros(constant("NENERGY")), np.zeros(4)
-        lib().martello_run_energy(self._h, e, extra)
+        self._check(lib().martello_run_energy(self._h, e, extra), "energy")
         d = dict(zip(energy_names(), map(float, e)))
         return d, {"balance_max": float(extra[0]), "omega_max": float(extra[1]),
                    "dt_critical": float(extra[2]), "t_reached": float(extra[3])}

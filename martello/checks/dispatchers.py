@@ -16,6 +16,7 @@ from ..oracles.p5_contact_laws import (HC_FACTORS, hc_max_penetration, hertz_imp
                                        kelvin_xi_from_e, linear_contact_time)
 from ..oracles.p4_wave_theory import penalty_rod_impact
 from ..oracles.p6_hysteresis import elastoplastic_impulse
+from ..oracles.p10_frames import frame_sine_ground_response
 
 
 def two_body_impact(law, m1, m2, v0, stiffness, restitution=None, exponent=None, clipped=False):
@@ -80,6 +81,17 @@ def sdof_sine_ground_final(m, k, zeta, ag_amp, omega_g, t_end):
     acceleration at t_end, from rest."""
     r = sdof_sine_ground_response(m, k, zeta, ag_amp, omega_g, np.array([t_end]))
     return {"u": float(r.u[0]), "v": float(r.v[0])}
+
+
+def frame_sine_ground_final(frame, ag_amp, omega_g, t_end):
+    """P10: a linear frame's lateral displacements and velocities at t_end under
+    ag_amp sin(omega_g t) from rest, by modal superposition (oracles.p10_frames), as named
+    values u_<node>, v_<node>."""
+    r = frame_sine_ground_response(frame, ag_amp, omega_g, [t_end])
+    out = {}
+    for nm, (u, v) in r.items():
+        out[f"u_{nm}"], out[f"v_{nm}"] = float(u[0]), float(v[0])
+    return out
 
 
 def bouncing_kelvin_events(m, k, h, g, eps, n_impacts, restitution=None, damping=0.0,

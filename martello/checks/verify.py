@@ -116,5 +116,6 @@ def verify(scene, summary):
             "value": value, "reference": reference, "abs_error": err,
             "rel_error": err / abs(reference) if reference != 0 else float("nan"),
             "digits": digits(value, reference), "rtol": rtol, "atol": atol,
+            "scale": item.get("scale") or abs(reference),
             "passed": bool(err <= atol + rtol * abs(reference)), "why": item["why"]})
     return rows

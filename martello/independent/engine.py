@@ -97,6 +97,7 @@ class System:
         self.fvreg = np.array([x[5] for x in m.dampers])
         self.fsec = np.where(self.fvreg > 0, self.fc * np.where(self.fvreg > 0, self.fvreg, 1.0)
                              ** (self.falpha - 1.0), 0.0)
+        self.blocks = [(ix, K, C) for _, ix, K, C in m.blocks]
         self.ca = [c.a if c.a != GROUND else n for c in m.contacts]
         self.cb = [c.b if c.b != GROUND else n for c in m.contacts]
         self.nfev = 0
@@ -158,6 +159,11 @@ class System:
             if len(w):
                 f -= np.bincount(a, w, n + 1)
                 f += np.bincount(b, w, n + 1)
+        dblock = 0.0
+        for ix, K, C in self.blocks:          # [[frame]]: f = K u + C v on its nodes
+            fc = C @ vE[ix]
+            f[ix] -= K @ uE[ix] + fc
+            dblock += float(fc @ vE[ix])
         dcon = 0.0
         for j, c in enumerate(self.m.contacts):
             if modes.active[j] and c.scheme == "penalty":
@@ -171,11 +177,13 @@ class System:
         acc = (f[:n] + fext) * self.minv
         plast = float(np.sum(np.where(modes.reg != 0, fp * dvb, 0.0)))
         return np.concatenate([np.where(self.free, v, 0.0), acc,
-                               [float(fext @ v), float(fd @ dvd + ff @ dvf), dcon, plast]])
+                               [float(fext @ v), float(fd @ dvd + ff @ dvf) + dblock, dcon, plast]])
 
     def recoverable(self, y, modes):
         uE, _ = self.ext(y)
         e = 0.5 * float(np.sum(self.sk * (uE[self.sa] - uE[self.sb]) ** 2))
+        for ix, K, _ in self.blocks:
+            e += 0.5 * float(uE[ix] @ K @ uE[ix])
         dub = uE[self.ba] - uE[self.bb]
         _, fp = self.bilinear_force(dub, modes)
         e += float(np.sum(0.5 * self.brho * self.bk * dub ** 2 + fp ** 2 / (2.0 * (1.0 - self.brho) * self.bk)))

@@ -16,6 +16,7 @@ from pathlib import Path
 import numpy as np
 
 from .errors import Unsupported
+from .frame import FrameBlock, frame_block
 from .laws import ContactLaw, contact_law
 
 GROUND = -1
@@ -169,6 +170,7 @@ class Model:
     ground: TimeFunction
     forces: list             # (node index, TimeFunction)
     t_end: float
+    blocks: list = field(default_factory=list)   # (name, node indices, K, C): [[frame]]
 
     @property
     def breaks(self):
@@ -191,8 +193,11 @@ def model_from_dict(doc: dict, base: Path | None = None, t_end: float | None = N
     doc = expand_chains(doc)
     if doc.get("mass_coupling") or doc.get("bar"):
         raise Unsupported("bars and mass couplings (the engine takes a diagonal mass matrix)")
-    if doc.get("frame"):
-        raise Unsupported("[[frame]] stiffness blocks (the engine models nodes, links and contacts)")
+    frames = [frame_block(tab) for tab in doc.get("frame", [])]
+    if frames:
+        doc = dict(doc)
+        doc["node"] = list(doc.get("node", [])) + [{"name": nm, "mass": float(mm)} for fb in frames
+                                                    for nm, mm in zip(fb.nodes, fb.mass)]
     an = doc.get("analysis", {})
     if an.get("type") != "dynamic" and t_end is None:
         raise Unsupported("a static analysis")
@@ -239,6 +244,7 @@ def model_from_dict(doc: dict, base: Path | None = None, t_end: float | None = N
     for c in doc.get("contact", []):
         a, b = idx[c["a"]], idx[c["b"]]
         contacts.append(contact_law(c, a, b, effective_mass(mass, fixed, a, b)))
+    blocks = [(fb.name, np.array([idx[nm] for nm in fb.nodes]), fb.K, fb.C) for fb in frames]
     loads = doc.get("loads", {})
     forces = []
     for f in loads.get("force", []):
@@ -248,13 +254,14 @@ def model_from_dict(doc: dict, base: Path | None = None, t_end: float | None = N
                  springs=springs, dashpots=dashpots, bilinears=bilinears, dampers=dampers,
                  contacts=contacts, gravity=float(loads.get("gravity", 0.0)),
                  ground=time_function(loads.get("ground_acceleration"), base), forces=forces,
-                 t_end=float(t_end if t_end is not None else an["t_end"]))
+                 t_end=float(t_end if t_end is not None else an["t_end"]), blocks=blocks)
 
 
-def load_model(scene, t_end: float | None = None, contact: dict | None = None) -> Model:
+def load_model(scene, t_end: float | None = None, contact: dict | None = None,
+               base: Path | None = None) -> Model:
     """A scene path, TOML text or dict as a Model; `contact` overrides every contact's
-    scheme keys (as a study's variant does); `t_end` the end time."""
-    base = None
+    scheme keys (as a study's variant does); `t_end` the end time; `base` the folder a
+    dict's or text's record files are relative to (a path's: its own folder)."""
     if isinstance(scene, (str, Path)) and Path(scene).suffix == ".toml" and Path(scene).exists():
         base = Path(scene).resolve().parent
         doc = tomllib.loads(Path(scene).read_text())
@@ -270,5 +277,5 @@ def load_model(scene, t_end: float | None = None, contact: dict | None = None) -
     return model_from_dict(doc, base, t_end)
 
 
-__all__ = ["Model", "Unsupported", "TimeFunction", "ContactLaw", "load_model", "model_from_dict",
-           "effective_mass", "expand_chains", "GROUND"]
+__all__ = ["Model", "Unsupported", "TimeFunction", "ContactLaw", "FrameBlock", "load_model",
+           "model_from_dict", "effective_mass", "expand_chains", "GROUND"]

@@ -1,7 +1,8 @@
-"""Building the stored reference data (reference/, scripts/regenerate_reference): each entry
-of reference/references.toml is run by the first method of its list that the library (or the
-independent event-located engine) runs, checked by refinement and by a second method, and
-written with its provenance."""
+"""Building the stored reference data (reference/, scripts/regenerate_reference) and the
+references of `martello reference` (cache.py): each is run by the first method of its list
+that runs the scene — the independent engine (independent_engine.py) or a library
+integrator — checked by refinement and by the next method that runs it, and written with its
+provenance, including what could not run the scene and why."""
 
 from __future__ import annotations
 
@@ -25,7 +26,7 @@ from ..paths import REFERENCE_ROOT, REPO
 from ..scene.loader import load
 from ..scene.spec import ADAPTIVE
 from ..scene.variants import analysis_for, override_contacts, runnable_scene
-from .event_located import Unsupported, event_located_run
+from .independent_engine import DESCRIPTION as ENGINE_DESCRIPTION, NAME as ENGINE, Unsupported, engine_run
 from .store import load_reference, manifest, physics_digest
 
 
@@ -123,20 +124,20 @@ CROSS_CHECKED_KINDS = ("u", "v", "penetration", "force")
 
 
 def _run_levels(method, sdict, scene_path, scene, grid, store, label, jobs, stream, keep_output):
-    """The refinement levels of one method, run: (levels, results), or None when the method
-    cannot run the scene (not built, or a part the independent engine does not model)."""
-    if method["integrator"] == "scipy-dop853":
+    """The refinement levels of one method, run: (levels, results), or (None, why) when the
+    method cannot run the scene (not built, or a part the independent engine does not
+    model)."""
+    if method["integrator"] == ENGINE:
         rt = float(method["rtol"])
         levels = [(None, rt), (None, rt * 100.0)]
-        print(f"{label}: scipy DOP853 with event location at rtol={rt:g}, {rt * 100:g}", file=stream)
+        print(f"{label}: the independent engine (DOP853, event-located) at rtol={rt:g}, {rt * 100:g}",
+              file=stream)
         try:
-            res = [event_located_run(scene, r_, grid) for _, r_ in levels]
+            res = [engine_run(sdict, scene_path.parent, r_, grid, scene.analysis["t_end"])
+                   for _, r_ in levels]
         except Unsupported as exc:
-            print(f"  scipy-dop853: the scene has {exc}, which it does not model; next method",
-                  file=stream)
-            return None
-        if any(r["status"] != "MARTELLO_OK" for r in res):
-            raise MartelloError(f"{label}: reference run failed: {res[0].get('message')}")
+            print(f"  {ENGINE}: it does not model {exc}; next method", file=stream)
+            return None, f"does not model {exc}"
         return levels, res
     dt = float(method["dt"])
     if method.get("refine") == "h_max":
@@ -157,9 +158,9 @@ def _run_levels(method, sdict, scene_path, scene, grid, store, label, jobs, stre
                       + (f" h_max={lv[2]:g}" if len(lv) > 2 else "") for lv in levels), file=stream)
     res = sorted(run_specs(specs, jobs), key=lambda r: r["id"])
     if any(r["status"] in ("MARTELLO_ERR_UNSUPPORTED", "incompatible") for r in res):
-        print(f"  {method['integrator']}: not available ({res[0].get('message', '')[:80]}); next method",
-              file=stream)
-        return None
+        why = next(r.get("message", "") for r in res if r["status"] in ("MARTELLO_ERR_UNSUPPORTED", "incompatible"))
+        print(f"  {method['integrator']}: not available ({why[:80]}); next method", file=stream)
+        return None, f"not available: {why}"
     bad = [r for r in res if r["status"] != "MARTELLO_OK"]
     if bad:
         raise MartelloError(f"{label}: reference run failed: {bad[0]['status']}: "
@@ -172,7 +173,7 @@ def compute_reference(scene, sdict, scene_path, methods, store_every, label="ref
     """A reference history of a scene, with the digits it can be trusted to.
 
     methods are tried in order (integrator + its analysis keys + dt, rtol for adaptive
-    ones; "scipy-dop853" is the independent event-located engine): the first that runs the
+    ones; "independent" is the independent engine, martello.independent): the first that runs the
     scene is used, checked by refinement (Δt, Δt·2, Δt·4 for fixed steps; rtol, rtol·100 for
     adaptive ones): the digits trusted in each column are −log10 of max |y_h − y_2h| over the
     column's peak (the finest run's error for a first-order method, a 3× overestimate for a
@@ -185,16 +186,17 @@ def compute_reference(scene, sdict, scene_path, methods, store_every, label="ref
     t_end = scene.analysis["t_end"]
     store = float(store_every)
     grid = np.linspace(0.0, t_end, int(round(t_end / store)) + 1)
-    chosen = None
+    chosen, not_run = None, []
     for method in methods:
-        ran = _run_levels(method, sdict, scene_path, scene, grid, store, label, jobs, stream,
-                          keep_output)
-        if ran is not None:
-            chosen = (method, *ran)
+        levels, res = _run_levels(method, sdict, scene_path, scene, grid, store, label, jobs, stream,
+                                  keep_output)
+        if levels is not None:
+            chosen = (method, levels, res)
             break
+        not_run.append({"method": method["integrator"], "why": res})
     if chosen is None:
         raise MartelloError(f"{label}: none of the reference methods runs ("
-                            + ", ".join(m["integrator"] for m in methods) + ")")
+                            + "; ".join(f"{n['method']}: {n['why']}" for n in not_run) + ")")
     method, levels, results = chosen
     fine = _sampled(results[0], grid)
     coarse = [_sampled(r, grid) for r in results[1:]]
@@ -243,7 +245,7 @@ def compute_reference(scene, sdict, scene_path, methods, store_every, label="ref
                                                               "energy:input"))]
     digits = {c: v for c, v in digits.items() if c in cols}
     cross = _cross_check(methods, method, scene, sdict, scene_path, grid, store, fine,
-                         stream, keep_output) if cross_check else None
+                         stream, keep_output, not_run) if cross_check else None
     if cross is not None:
         for c, cap in cross["digits"].items():
             if c in digits and c.partition(":")[0] in CROSS_CHECKED_KINDS and digits[c] > cap:
@@ -260,6 +262,9 @@ def compute_reference(scene, sdict, scene_path, methods, store_every, label="ref
             "stored": {"every_s": store, "rows": len(grid)},
             "events": events, "peaks": peaks, "event_refinement": ev_diff,
             "event_horizon": t_end, "cross_check": cross,
+            "engine": ENGINE_DESCRIPTION if method["integrator"] == ENGINE else
+            f"the library's {method['integrator']}",
+            "not_run": not_run,
             "masses": {n["name"]: n["mass"] for n in scene.nodes},
             "cost": fs["cost"],
             "martello_version": native.version(), "libraries": native.library_versions(),
@@ -268,26 +273,32 @@ def compute_reference(scene, sdict, scene_path, methods, store_every, label="ref
     return {"grid": grid, "columns": cols, "fine": fine, "digits": digits, "meta": meta}
 
 
-def _cross_check(methods, chosen, scene, sdict, scene_path, grid, store, fine, stream, keep_output):
+def _cross_check(methods, chosen, scene, sdict, scene_path, grid, store, fine, stream, keep_output,
+                 not_run=None):
     """The next method of the list that runs the scene, as an independent check of the
     chosen one: its method, max relative difference of u and per-column digits
-    (−log10 of the difference over the column's peak), or None."""
+    (−log10 of the difference over the column's peak: the digits the two agree to), or
+    None. A method that cannot run the scene is added to not_run with why."""
     for other in methods:
         if other is chosen or other.get("cross_check") is False:
             continue
         # only the methods after the chosen one: those before it did not run the scene
         if methods.index(other) < methods.index(chosen):
             continue
-        if other["integrator"] == "scipy-dop853":
+        if other["integrator"] == ENGINE:
             try:
-                r = event_located_run(scene, float(other["rtol"]), grid)
-            except Unsupported:
+                r = engine_run(sdict, scene_path.parent, float(other["rtol"]), grid, scene.analysis["t_end"])
+            except Unsupported as exc:
+                if not_run is not None:
+                    not_run.append({"method": ENGINE, "why": f"does not model {exc}"})
                 continue
         else:
             spec = _spec(other, sdict, scene_path, float(other["dt"]), other.get("rtol"), store,
                          keep_output)
             r = execute(spec)
         if r["status"] != "MARTELLO_OK":
+            if not_run is not None:
+                not_run.append({"method": other["integrator"], "why": f"{r['status']}: {r.get('message', '')}"})
             continue
         oy = _sampled(r, grid)
         per = {}

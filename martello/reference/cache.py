@@ -24,12 +24,13 @@ from ..errors import MartelloError
 from ..scene.loader import load
 from .base import ReferenceError
 from .build import compute_reference, write_reference
+from .independent_engine import NAME as ENGINE
 from .store import load_reference, physics_digest
 
 ENV_CACHE = "MARTELLO_CACHE_DIR"
 # Bumped when the way references are computed here changes: older cache entries are then
 # not reused.
-FORMAT = 1
+FORMAT = 2
 # Stored samples: the scene's own output interval, kept between t_end/20000 and t_end/1000
 # (the comparison interpolates between them with the quintic Hermite of history.py, whose
 # error (Δ ω)⁶/… is far below the trusted digits at ≥ 1000 samples per history).
@@ -44,6 +45,10 @@ RK8_STEPS = 5.0e5
 # The independent engine is Python: its right-hand side costs ~10 µs per node; beyond this
 # many nodes it would take minutes, and a library method is the cross-check instead.
 INDEPENDENT_MAX_NODES = 60
+# The engine's primary tolerance (its second integration, the refinement level, at 100 ×):
+# at 1e-12 its 1e-10 run confirms 8.5 digits of the two-mass Hertz scene of
+# tests/test_reference_cache.py, at 1e-11 only 7.75 (the 1e-9 run bounds the digits).
+ENGINE_RTOL = 1.0e-12
 # Up to this many nodes the loader writes every node's history by default.
 OUTPUT_ALL_NODES = 50
 
@@ -87,18 +92,23 @@ def store_spacing(scene, every=None):
 
 def default_methods(scene, store):
     """The methods a scene's reference is computed with, the most accurate first; the first
-    that runs is refined, the next that runs cross-checks it (build.compute_reference).
+    that runs is refined, the next that runs cross-checks it (build.compute_reference), and
+    each one that cannot run the scene is recorded with why.
 
+    - first the independent engine (martello.independent via independent_engine.py: the
+      scene's equations written again from its file, every switch event-located on scipy's
+      DOP853, at rtol 1e-11 and 1e-9), for a scene of at most INDEPENDENT_MAX_NODES nodes it
+      models (every penalty law, restitution without accumulating impacts, springs, dashpots,
+      bilinear links, fluid dampers, [[frame]], gravity, forces and ground motion by every
+      time function); cross-checked by martello's own best run:
     - penalty contacts only: rk8pd (GSL's 8th-order Runge–Kutta–Prince–Dormand with event
-      location, docs/event-driven.md) at rtol 1e-12, cross-checked by the independent
-      engine (event_located.py: scipy's DOP853 on the equations written from the scene) or,
-      where it does not model the scene, by Newmark at a small step;
-    - Lagrange or restitution contacts: rk8pd, cross-checked by rkf45 (another pair of the
-      same event-driven integrator: it shares the event handling, not the stepping);
-    - hysteretic (bilinear) links: rk8pd with a largest step h_max, refined in h_max (no
-      engine locates yield: the error of a step over a kink is set by its length, and
-      shrinks as h_max² — measured on P7's chain of ten: 1.7e-5, 1.5e-7, 4e-8 at h_max =
-      1e-3, 1e-4, 3e-5 s), cross-checked by Newmark (average acceleration) at a small step."""
+      location, docs/event-driven.md) at rtol 1e-12, then Newmark at a small step;
+    - Lagrange or restitution contacts: rk8pd, then rkf45 (another pair of the same
+      event-driven integrator: it shares the event handling, not the stepping);
+    - hysteretic (bilinear) links: rk8pd with a largest step h_max, refined in h_max (the
+      error of a step over a kink is set by its length, and shrinks as h_max² — measured on
+      P7's chain of ten: 1.7e-5, 1.5e-7, 4e-8 at h_max = 1e-3, 1e-4, 3e-5 s), then Newmark
+      (average acceleration) at a small step."""
     an = scene.analysis
     t_end = float(an["t_end"])
     schemes = {c["scheme"] for c in scene.contacts}
@@ -108,21 +118,30 @@ def default_methods(scene, store):
     newmark = {"integrator": "newmark", "preset": "average-acceleration", "dt": dt_nm,
                "tol_residual": 1.0e-12, "tol_increment": 1.0e-14}
     if schemes - {"penalty"}:
-        return [rk8, {"integrator": "rkf45", "dt": store, "rtol": 1.0e-12, "atol": 1.0e-15}]
-    if any(lk["type"] == "bilinear" for lk in scene.links):
+        library = [rk8, {"integrator": "rkf45", "dt": store, "rtol": 1.0e-12, "atol": 1.0e-15}]
+    elif any(lk["type"] == "bilinear" for lk in scene.links):
         h = max(float(an["dt"]) / 10.0, t_end / RK8_STEPS)
-        return [dict(rk8, h_max=h, refine="h_max"), newmark]
-    methods = [rk8]
-    if len(scene.nodes) <= INDEPENDENT_MAX_NODES:
-        methods.append({"integrator": "scipy-dop853", "rtol": 1.0e-12})
-    return methods + [newmark]
+        library = [dict(rk8, h_max=h, refine="h_max"), newmark]
+    else:
+        library = [rk8, newmark]
+    engine = [{"integrator": ENGINE, "rtol": ENGINE_RTOL}] if len(scene.nodes) <= INDEPENDENT_MAX_NODES else []
+    return engine + library
+
+
+def engine_skipped(scene):
+    """Why the independent engine is not tried on a scene, or None."""
+    if len(scene.nodes) > INDEPENDENT_MAX_NODES:
+        return (f"{len(scene.nodes)} nodes, more than {INDEPENDENT_MAX_NODES}: its Python right-hand "
+                "side would take minutes")
+    return None
 
 
 INDEPENDENCE = {
-    "scipy-dop853": "independent engine (martello/reference/event_located.py: scipy DOP853 on "
-                    "the equations of motion written from the scene, not the library's kernels)",
+    ENGINE: "the independent engine (martello.independent: the scene's equations written again "
+            "from its file, every switch event-located on scipy's DOP853; no code shared with the "
+            "library or the front end)",
     "rkf45": "same library, another Runge–Kutta pair (shares the model and the event handling)",
-    "rk8pd": "same library, another integrator (shares the model's force kernels)",
+    "rk8pd": "martello's own best run (the library's rk8pd with event location)",
     "newmark": "same library, another integrator (shares the model's force kernels)",
 }
 
@@ -201,7 +220,7 @@ def computed_reference(scene, sdict, scene_path, refresh=False, every=None, jobs
     methods = default_methods(scene, store)
     t0 = time.perf_counter()
     # a large scene keeps its own output selection (the loader writes every node only up to
-    # 50 of them: docs/scene-format.md)
+    # 50 of them: docs/scene-input.md)
     keep = len(scene.nodes) > OUTPUT_ALL_NODES
     if keep and not scene.analysis["output"]["nodes"]:
         raise ReferenceError(f"{scene_path}: [analysis.output] nodes is empty: name the nodes to "
@@ -215,6 +234,12 @@ def computed_reference(scene, sdict, scene_path, refresh=False, every=None, jobs
              f"{cross['method']['integrator']}: {INDEPENDENCE.get(cross['method']['integrator'], '')}"
              if cross else f"refinement of {meta['method']['integrator']} only: no second method runs "
              "this scene, so an error both refinement levels share is not seen")
+    skipped = engine_skipped(scene)
+    if skipped:
+        meta["not_run"] = [{"method": ENGINE, "why": skipped}] + meta["not_run"]
+    if cross:
+        # the digits the two agree to, per column (the digits stored are at most these)
+        meta["digits_agreed"] = {c: cross["digits"][c] for c in meta["digits"] if c in cross["digits"]}
     meta = {"name": scene_path.stem, "scene": str(scene_path.resolve()), "format": FORMAT,
             "cache_key": key, **meta, "digits_basis": basis,
             "methods_tried": [m["integrator"] for m in methods],
@@ -249,7 +274,15 @@ def describe(ref, folder, cached, scene_path=None, stream=None):
     when = (f"from the cache (computed {meta['date']} for {meta['scene']})" if cached
             else f"computed in {meta.get('compute_time_s', 0.0):.1f} s")
     print(f"{scene_path or meta['scene']}: reference by {m['integrator']} ({how}), {when}", file=stream)
+    print(f"  engine: {meta.get('engine', m['integrator'])}", file=stream)
+    for n in meta.get("not_run", []):
+        print(f"  could not run: {n['method']}: {n['why']}", file=stream)
     print(f"  trusted digits from {meta['digits_basis']}", file=stream)
+    agreed = meta.get("digits_agreed")
+    if agreed:
+        low = min(agreed, key=agreed.get)
+        print(f"  the two agree to {agreed[low]:.1f} digits at least ({low}); per column below, "
+              "the stored digits are at most the agreed ones", file=stream)
     width = max(len(c) for c in meta["digits"])
     for c, d in meta["digits"].items():
         print(f"  {c:<{width}}  {d:5.1f} digits", file=stream)

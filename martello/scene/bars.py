@@ -316,6 +316,22 @@ class RodElements:
         return {"name": f"{r.name}.e{k + 1}", "type": "bar", "a": r.node0 + i, "b": r.node0 + j,
                 "EA": r.EA, "L": r.mesh["element_length"]}
 
+    def chunks(self, size):
+        """(kind, a, b, par) arrays of its bars for the library's bulk door, size at a time:
+        element k joins nodes k and k + 1."""
+        from ..binding import native        # the run layer's (this module loads without it)
+        r = self.rod
+        for k0 in range(0, len(self), size):
+            m = min(size, len(self) - k0)
+            a = (r.node0 + np.arange(k0, k0 + m)).astype(np.int32)
+            par = np.zeros((m, native.constant("NPAR_LINK")))
+            par[:, native.constant("L_STIFF")] = r.EA / r.mesh["element_length"]
+            yield np.full(m, native.value("links", "bar"), np.int32), a, a + 1, par
+
+    def codes(self, key, at):
+        """Its bars' codes in a category column."""
+        return np.full(len(self), at["bar"] if key == "type" else -1, np.int8)
+
 
 class RodCouplings:
     """A rod's consistent-mass couplings as a segment of the scene's coupling table."""

@@ -20,9 +20,102 @@ from functools import cached_property
 
 import numpy as np
 
+from ..binding import native
+from ..binding.native import constant
 from ..errors import SceneError
 from .fields import MAX_GENERATED, check_fields, kind_ok
-from .items import Alternating, Neighbours, Numbered
+from .items import Names, Numbered, Rule, _number, key_for  # noqa: F401 (Names: for results)
+
+class Alternating(Rule):
+    """``<prefix><i>.<a>`` for every i of first ... first + count - 1, each followed by
+    ``<prefix><i>.<b>`` where second[i] is true: a chain's springs and dampers, in the
+    order the chain makes them."""
+    KEY = "alternate"
+
+    def __init__(self, prefix, a, b, first, second):
+        self.prefix, self.a, self.b, self.first = prefix, a, b, first
+        self.second = np.asarray(second, bool)
+        self.count = len(self.second) + int(self.second.sum())
+
+    @cached_property
+    def start(self):
+        """Position of item i's first name: i plus the second names before it (made when a
+        name is first asked for by position or found)."""
+        return np.arange(len(self.second)) + np.concatenate(
+            ([0], np.cumsum(self.second[:-1]))).astype(np.int64)
+
+    def __len__(self):
+        return self.count
+
+    def name(self, j):
+        if not 0 <= j < self.count:
+            raise IndexError(j)
+        i = int(self.start.searchsorted(j, side="right")) - 1
+        return f"{self.prefix}{self.first + i}.{self.a if j == self.start[i] else self.b}"
+
+    def find(self, name):
+        if not isinstance(name, str) or not name.startswith(self.prefix):
+            return -1
+        head, dot, tail = name[len(self.prefix):].partition(".")
+        k = _number(head)
+        if not dot or k is None or tail not in (self.a, self.b):
+            return -1
+        i = k - self.first
+        if not 0 <= i < len(self.second) or (tail == self.b and not self.second[i]):
+            return -1
+        return int(self.start[i]) + (tail == self.b)
+
+    def literal(self):
+        return self.prefix, ""
+
+    def spec(self, arrays):
+        key = key_for(arrays)
+        arrays[key] = self.second
+        return {"prefix": self.prefix, "first": self.first, "alternate": [self.a, self.b],
+                "second": key}
+
+    @classmethod
+    def from_spec(cls, s, arrays):
+        return cls(s["prefix"], *s["alternate"], s["first"], arrays[s["second"]])
+
+
+class Neighbours(Rule):
+    """``<prefix><i>-<prefix><i+1>`` for i = first ... first + count - 1: a chain's contacts."""
+    KEY = "neighbours"
+
+    def __init__(self, prefix, first, count):
+        self.prefix, self.first, self.count = prefix, first, count
+
+    def __len__(self):
+        return self.count
+
+    def name(self, j):
+        if not 0 <= j < self.count:
+            raise IndexError(j)
+        i = self.first + j
+        return f"{self.prefix}{i}-{self.prefix}{i + 1}"
+
+    def find(self, name):
+        if not isinstance(name, str) or not name.startswith(self.prefix):
+            return -1
+        rest = name[len(self.prefix):]
+        head = rest.split("-", 1)[0]
+        k = _number(head)
+        if k is None or rest != f"{k}-{self.prefix}{k + 1}":
+            return -1
+        j = k - self.first
+        return j if 0 <= j < self.count else -1
+
+    def literal(self):
+        return self.prefix, ""
+
+    def spec(self, arrays):
+        return {"prefix": self.prefix, "first": self.first, "neighbours": self.count}
+
+    @classmethod
+    def from_spec(cls, s, arrays):
+        return cls(s["prefix"], s["first"], s["neighbours"])
+
 
 # [[chain]]: scalars apply to every oscillator, lists give one value each (n for
 # oscillators, n − 1 for gaps).
@@ -90,8 +183,9 @@ class ChainBlock:
     dampers: np.ndarray = field(init=False)    # oscillators with a damper (ζ_i > 0)
 
     def __post_init__(self):
-        self.dampers = (np.flatnonzero(self.zeta > 0) if self.zeta is not None
-                        else np.zeros(0, np.int64))
+        # int32: a million oscillators keep 4 MB of it through the run, not 8
+        self.dampers = (np.flatnonzero(self.zeta > 0).astype(np.int32) if self.zeta is not None
+                        else np.zeros(0, np.int32))
 
     @property
     def n_links(self):
@@ -185,6 +279,11 @@ class ChainNodes:
         return {"name": f"{b.prefix}{i + 1}", "mass": float(b.mass[i]), "u0": float(b.u0[i]),
                 "v0": float(b.v0[i]), "fixed": False}
 
+    def arrays(self):
+        """(mass, u0, v0, fixed) of its nodes, for the run layer."""
+        b = self.block
+        return b.mass, b.u0, b.v0, np.zeros(b.n, np.int32)
+
 
 class ChainLinks:
     """A chain's springs and dampers as a segment of the scene's link table."""
@@ -228,6 +327,42 @@ class ChainLinks:
         return {"name": f"{name}.spring", "type": "bilinear", "a": node, "b": -1, "k": float(b.k[i]),
                 "fy": float(b.fy[i]), "hardening": float(b.hardening[i])}
 
+    def chunks(self, size):
+        """(kind, a, b, par) arrays of its links for the library's bulk door, size oscillators
+        (and their dampers) at a time, in the order of the links."""
+        b = self.block
+        spring, damper = self.spring, self.damper
+        kind_spring = native.value("links", "spring" if b.fy is None else "bilinear")
+        for i0 in range(0, b.n, size):
+            i1 = min(i0 + size, b.n)
+            d0, d1 = np.searchsorted(b.dampers, (i0, i1))
+            at = spring[i0]
+            s, d = spring[i0:i1] - at, damper[d0:d1] - at
+            m = (i1 - i0) + (d1 - d0)
+            kind = np.empty(m, np.int32)
+            a = np.empty(m, np.int32)
+            par = np.zeros((m, constant("NPAR_LINK")))
+            kind[s] = kind_spring
+            a[s] = b.node0 + np.arange(i0, i1)
+            par[s, constant("L_STIFF")] = b.k[i0:i1]
+            if b.fy is not None:
+                par[s, constant("L_YIELD")] = b.fy[i0:i1]
+                par[s, constant("L_HARDENING")] = b.hardening[i0:i1]
+            kind[d] = native.value("links", "dashpot")
+            a[d] = b.node0 + b.dampers[d0:d1]
+            par[d, constant("L_DAMP")] = b.c[d0:d1]
+            yield kind, a, np.full(m, -1, np.int32), par
+
+    def codes(self, key, at):
+        """Its links' codes in a category column (at: category -> code): the springs', then
+        the dampers' where it has them, for "type"."""
+        b = self.block
+        codes = np.full(len(self), -1, np.int8)
+        if key == "type":
+            codes[:] = at["spring" if b.fy is None else "bilinear"]
+            codes[self.damper] = at["dashpot"]
+        return codes
+
 
 class ChainContacts:
     """A chain's neighbour contacts as a segment of the scene's contact table."""
@@ -244,3 +379,20 @@ class ChainContacts:
         c.update(name=f"{b.prefix}{j + 1}-{b.prefix}{j + 2}", a=b.node0 + j, b=b.node0 + j + 1,
                  gap=float(b.gap[j]))
         return c
+
+    @property
+    def template(self):
+        """The validated fields every contact of the chain shares (its parameters' one row)."""
+        return self.block.template
+
+    def chunks(self, size):
+        """(a, b, gap) arrays of its contacts for the library's bulk door, size at a time."""
+        b = self.block
+        for j0 in range(0, len(self), size):
+            j1 = min(j0 + size, len(self))
+            a = (b.node0 + np.arange(j0, j1)).astype(np.int32)
+            yield a, a + 1, b.gap[j0:j1]
+
+    def codes(self, key, at):
+        """Its contacts' codes in a category column: the template's for all."""
+        return np.full(len(self), at.get(self.block.template.get(key), -1), np.int8)

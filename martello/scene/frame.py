@@ -57,6 +57,25 @@ def _sections(src, where, value, rows, per_row):
     return out
 
 
+def _masses(src, where, value, storeys, bays, mass_model):
+    """Floor masses (a scalar or one per floor) or, for mass_model "joints", a list of one
+    list per floor of bays + 1 joint masses (left to right): any planar model written exactly."""
+    if not (isinstance(value, list) and any(isinstance(v, list) for v in value)):
+        return per_item(src, where, value, storeys, POSITIVE)
+    if mass_model != "joints":
+        raise SceneError(src, where, "joint masses need mass_model = \"joints\"",
+                         "give one mass per floor, or set mass_model = \"joints\"")
+    if len(value) != storeys:
+        raise SceneError(src, where, f"has {len(value)} floors", f"give a list of {storeys} lists")
+    out = []
+    for s, row in enumerate(value):
+        if not isinstance(row, list):
+            raise SceneError(src, f"{where}[{s}]", "must be a list of joint masses",
+                             f"{bays + 1} masses, left to right")
+        out.append(per_item(src, f"{where}[{s}]", row, bays + 1, POSITIVE))
+    return out
+
+
 def expand_frames(src, data):
     """Replace [[frame]] tables by their lateral nodes; return (data, frames) with frames the
     list of what each frame stands for (PlanarFrame, node names, K, C, recovery operators)."""
@@ -87,7 +106,7 @@ def expand_frames(src, data):
             widths=per_item(src, f"{w}.bay_width", f["bay_width"], nb, POSITIVE),
             columns=_sections(src, f"{w}.column", f["column"], ns, nb + 1),
             beams=_sections(src, f"{w}.beam", f["beam"], ns, nb),
-            masses=per_item(src, f"{w}.mass", f["mass"], ns, POSITIVE),
+            masses=_masses(src, f"{w}.mass", f["mass"], ns, nb, f["mass_model"]),
             base=f["base"], mass_model=f["mass_model"])
         if lateral > 1 and max(modes) > lateral:
             raise SceneError(src, f"{w}.rayleigh_modes", f"mode {max(modes)} of a frame with "

@@ -1,26 +1,29 @@
 """The item tables of a scene (nodes, links, contacts) stored by segment, so that a generator's
-items are arrays, never one Python dict each (docs/scene-input.md, "Generators").
+items are arrays, never one Python dict each (docs/scene-input.md, "Generators"). A scene with
+no generator has one listed segment per table: lists of dicts.
 
 A table is a sequence of segments in the order of the expanded scene: a *listed* segment holds
 validated dicts (the items written in the file, and those of the small generators), a
-*generated* one (a [[chain]]'s nodes, links or contacts: martello.scene.chain) holds arrays
-and gives an item's dict only when asked. The run layer reads the arrays of each segment
-(``table.segments``); everything else may go on treating the table as a list of dicts
-(``len``, indexing, iteration), which for a generated item builds the dict the loader used to
-make. Such a dict is a copy: changing it does not change the scene.
+*generated* one (a [[chain]]'s nodes, links or contacts: martello.scene.chain; a rod's:
+martello.scene.bars) holds arrays and gives an item's dict only when asked, and its arrays to
+the run layer (``arrays()`` of nodes, ``chunks(size)`` of links and contacts, ``codes(key,
+at)`` of a category column): the run layer knows no generator. Everything else may go on
+treating the table as a list of dicts (``len``, indexing, iteration), which for a generated
+item builds the dict the loader used to make. Such a dict is a copy: changing it does not
+change the scene.
 
 Names are stored the same way (``Names``): a listed segment keeps its strings, a generated one
-its rule (``<prefix><i>``, ``<prefix><i>.spring``, ...), which finds an index from a name by
-parsing it. ``Names.spec()`` writes the rules as JSON-ready data and ``Names.from_spec`` reads
-them back: that is how results.npz names its rows without a string per item
-(docs/results.md)."""
+its rule (``<prefix><i>`` here; a chain's ``<prefix><i>.spring`` and ``<prefix><i>-<prefix><i+1>``
+in martello.scene.chain), which finds an index from a name by parsing it. ``Names.spec()``
+writes the rules as JSON-ready data and ``Names.from_spec`` reads them back, each rule from the
+key that marks its spec (``Rule.KEY``): that is how results.npz names its rows without a string
+per item (docs/results.md)."""
 
 from bisect import bisect_right
 from collections.abc import Mapping, Sequence
-from functools import cached_property
 
 
-def _key(arrays):
+def key_for(arrays):
     """A new key for an array a name rule needs."""
     return f"names.{sum(k.startswith('names.') for k in arrays)}"
 
@@ -32,8 +35,20 @@ def _number(text):
     return int(text)
 
 
-class Listed:
+class Rule:
+    """A kind of names segment; its spec (``spec``) is marked by the key KEY, from which
+    ``Names.from_spec`` reads it back (``from_spec``). Every subclass is known by its KEY."""
+    KEY = None
+    KINDS = {}
+
+    def __init_subclass__(cls, **kw):
+        super().__init_subclass__(**kw)
+        Rule.KINDS[cls.KEY] = cls
+
+
+class Listed(Rule):
     """Names given one by one."""
+    KEY = "names"
 
     def __init__(self, names=()):
         self.names = list(names)
@@ -60,10 +75,15 @@ class Listed:
     def spec(self, arrays):
         return {"names": list(self.names)}
 
+    @classmethod
+    def from_spec(cls, s, arrays):
+        return cls(s["names"])
 
-class Numbered:
+
+class Numbered(Rule):
     """``<prefix><number><suffix>`` for numbers first, first + 1, ... (count of them), or for
     the increasing numbers of an array."""
+    KEY = "prefix"              # the key every rule has: the fallback
 
     def __init__(self, prefix, suffix="", first=1, count=0, numbers=None):
         self.prefix, self.suffix, self.first = prefix, suffix, first
@@ -100,92 +120,15 @@ class Numbered:
         out = {"prefix": self.prefix, "suffix": self.suffix}
         if self.numbers is None:
             return out | {"first": self.first, "count": self.count}
-        key = _key(arrays)
+        key = key_for(arrays)
         arrays[key] = self.numbers
         return out | {"numbers": key}
 
-
-class Alternating:
-    """``<prefix><i>.<a>`` for every i of first ... first + count - 1, each followed by
-    ``<prefix><i>.<b>`` where second[i] is true: a chain's springs and dampers, in the
-    order the chain makes them."""
-
-    def __init__(self, prefix, a, b, first, second):
-        import numpy as np
-        self.prefix, self.a, self.b, self.first = prefix, a, b, first
-        self.second = np.asarray(second, bool)
-        self.count = len(self.second) + int(self.second.sum())
-
-    @cached_property
-    def start(self):
-        """Position of item i's first name: i plus the second names before it (made when a
-        name is first asked for by position or found)."""
-        import numpy as np
-        return np.arange(len(self.second)) + np.concatenate(
-            ([0], np.cumsum(self.second[:-1]))).astype(np.int64)
-
-    def __len__(self):
-        return self.count
-
-    def name(self, j):
-        if not 0 <= j < self.count:
-            raise IndexError(j)
-        i = int(self.start.searchsorted(j, side="right")) - 1
-        return f"{self.prefix}{self.first + i}.{self.a if j == self.start[i] else self.b}"
-
-    def find(self, name):
-        if not isinstance(name, str) or not name.startswith(self.prefix):
-            return -1
-        head, dot, tail = name[len(self.prefix):].partition(".")
-        k = _number(head)
-        if not dot or k is None or tail not in (self.a, self.b):
-            return -1
-        i = k - self.first
-        if not 0 <= i < len(self.second) or (tail == self.b and not self.second[i]):
-            return -1
-        return int(self.start[i]) + (tail == self.b)
-
-    def literal(self):
-        return self.prefix, ""
-
-    def spec(self, arrays):
-        key = _key(arrays)
-        arrays[key] = self.second
-        return {"prefix": self.prefix, "first": self.first, "alternate": [self.a, self.b],
-                "second": key}
-
-
-class Neighbours:
-    """``<prefix><i>-<prefix><i+1>`` for i = first ... first + count - 1: a chain's contacts."""
-
-    def __init__(self, prefix, first, count):
-        self.prefix, self.first, self.count = prefix, first, count
-
-    def __len__(self):
-        return self.count
-
-    def name(self, j):
-        if not 0 <= j < self.count:
-            raise IndexError(j)
-        i = self.first + j
-        return f"{self.prefix}{i}-{self.prefix}{i + 1}"
-
-    def find(self, name):
-        if not isinstance(name, str) or not name.startswith(self.prefix):
-            return -1
-        rest = name[len(self.prefix):]
-        head = rest.split("-", 1)[0]
-        k = _number(head)
-        if k is None or rest != f"{k}-{self.prefix}{k + 1}":
-            return -1
-        j = k - self.first
-        return j if 0 <= j < self.count else -1
-
-    def literal(self):
-        return self.prefix, ""
-
-    def spec(self, arrays):
-        return {"prefix": self.prefix, "first": self.first, "neighbours": self.count}
+    @classmethod
+    def from_spec(cls, s, arrays):
+        if "numbers" in s:
+            return cls(s["prefix"], s["suffix"], numbers=arrays[s["numbers"]])
+        return cls(s["prefix"], s["suffix"], s["first"], s["count"])
 
 
 def _comparable(x, y):
@@ -302,18 +245,13 @@ class Names(_Segmented):
 
     @classmethod
     def from_spec(cls, spec, arrays):
+        """Names from their spec (``spec``): each rule by the key that marks it, among the
+        rules loaded (a generator's module registers its own: martello.scene.chain)."""
         segs = []
         for s in spec:
-            if "names" in s:
-                segs.append(Listed(s["names"]))
-            elif "alternate" in s:
-                segs.append(Alternating(s["prefix"], *s["alternate"], s["first"], arrays[s["second"]]))
-            elif "neighbours" in s:
-                segs.append(Neighbours(s["prefix"], s["first"], s["neighbours"]))
-            elif "numbers" in s:
-                segs.append(Numbered(s["prefix"], s["suffix"], numbers=arrays[s["numbers"]]))
-            else:
-                segs.append(Numbered(s["prefix"], s["suffix"], s["first"], s["count"]))
+            kind = next((Rule.KINDS[k] for k in s if k in Rule.KINDS and k != Numbered.KEY),
+                        Numbered)
+            segs.append(kind.from_spec(s, arrays))
         return cls(segs)
 
 

@@ -46,7 +46,10 @@ class Scene:
     index: dict = field(default_factory=dict)   # node name -> index (a NameIndex)
     couplings: list = field(default_factory=list)  # dicts: a, b (indices), value
     extras: dict = field(default_factory=dict)     # what generators ([[bar]]) know of the scene
-    blocks: list = field(default_factory=list)     # dicts: name, nodes (indices), k, c ([[frame]])
+    blocks: list = field(default_factory=list)     # dicts: name, nodes (indices), k, c ([[frame]], [[building]])
+    # the ground motion's (and gravity's) influence on each node, M·ι loaded (None: ι = 1
+    # everywhere, the scene's axis; a [[building]]'s uy and rz nodes differ)
+    influence: np.ndarray | None = None
 
     def node_index(self, name):
         return -1 if name == GROUND else self.index[name]
@@ -160,6 +163,11 @@ def from_dict(data, source="<scene>", base_dir=Path("."), digest=None):
     if "frame" in data:
         from .frame import expand_frames        # numpy.linalg and the frame model: only here
         data, extras["frames"] = expand_frames(src, data)   # [[frame]]: condensed frames (P10)
+    building_couplings = []
+    if "building" in data:
+        from .building import expand_buildings   # the 3D model: only here
+        # [[building]]: 3D buildings condensed to their floors' DOFs (P11)
+        data, extras["buildings"], building_couplings = expand_buildings(src, data)
 
     # nodes
     generated = [ChainNodes(b) for b in chains] + rods["node"]
@@ -288,14 +296,17 @@ def from_dict(data, source="<scene>", base_dir=Path("."), digest=None):
     if atype == "dynamic":
         _dynamic_analysis(src, an, analysis, index, contacts, links)
         # a frame's member forces are recovered from its lateral displacements: recorded
-        for fr in extras.get("frames", []):
+        for fr in extras.get("frames", []) + extras.get("buildings", []):
             out = analysis["output"]["nodes"]
             analysis["output"]["nodes"] = out + [n for n in fr["nodes"] if n not in out]
+    blocks, influence = [], None
     if "frames" in extras:
         from .frame import frame_blocks
         blocks = frame_blocks(extras["frames"], index)
-    else:
-        blocks = []
+    if "buildings" in extras:
+        from .building import building_blocks, influence_vector
+        blocks += building_blocks(extras["buildings"], index)
+        influence = influence_vector(extras["buildings"], index, len(index))
     listed = [(i, lk) for seg, at in zip(links.segments, links.offsets) if isinstance(seg, list)
               for i, lk in enumerate(seg, start=at)]
     ground_k = _ground_stiffness(lk for _, lk in listed)
@@ -321,6 +332,9 @@ def from_dict(data, source="<scene>", base_dir=Path("."), digest=None):
         if mc["a"] == mc["b"]:
             raise SceneError(src, f"{where}.b", "couples a node with itself", "name two different nodes")
         couplings.append(mc)
+    # a building's floor masses about a reference point other than their centres
+    couplings += [{"a": index[mc["a"]], "b": index[mc["b"]], "value": mc["value"]}
+                  for mc in building_couplings]
     couplings = ItemTable([couplings] + rods["mass_coupling"], None)
 
     meta = {k: data.get(k, "") for k in ("title", "problem", "description")}
@@ -331,7 +345,7 @@ def from_dict(data, source="<scene>", base_dir=Path("."), digest=None):
                  description=meta["description"], nodes=nodes, links=links, contacts=contacts,
                  gravity=lt["gravity"], forces=forces, ground=ground, analysis=analysis,
                  check=check, digest=digest, index=index, couplings=couplings, extras=extras,
-                 blocks=blocks)
+                 blocks=blocks, influence=influence)
 
 
 
@@ -551,6 +565,9 @@ def _check_table(src, check):
         check_fields(src, item, f"check.compare[{i}]", {
             "result": ("str", True, None, None), "oracle": ("str", True, None, None),
             "rtol": ("float", False, NONNEG, None), "atol": ("float", False, NONNEG, None),
+            # the size of the quantity when its reference is 0: what an atol is relative to
+            # (martello.checks.kinds)
+            "scale": ("float", False, POSITIVE, None),
             "why": ("str", True, None, None)})
         if "rtol" not in item and "atol" not in item:
             raise SceneError(src, f"check.compare[{i}]", "needs rtol or atol",

@@ -144,5 +144,5 @@ INTEGRATOR_KEYS = {i: native.settings_read(i) - _READ_BY_ALL | ({"preset"} if i 
 ALL_SPECIFIC = set().union(*INTEGRATOR_KEYS.values())
 
 TOP_KEYS = {"title", "problem", "description", "node", "link", "contact", "loads", "analysis",
-            "check", "chain", "bar", "mass_coupling", "frame"}
+            "check", "chain", "bar", "mass_coupling", "frame", "building"}
 

@@ -50,11 +50,12 @@ from ..binding import native
 from ..errors import MartelloError, StudyError
 from ..history import history_dict
 from ..oracles.p2_bouncing import bouncing_oscillator_restitution
-from ..paths import OUTPUT_ROOT, REPO, check_output_folder, folder_replaced
+from ..paths import OUTPUT_ROOT, REPO, check_output_folder
 from ..reference.closed_form import kelvin_bounce_reference, two_body_kelvin_reference
 from ..scene.spec import ADAPTIVE, INTEGRATORS
 from .outcome import failed_rows, status_class
 from .output import Progress, csv_cell, md_cell, palette_png, slug
+from .resume import row_key, run_resumable
 from .study_file import read_toml
 CLASSES = ("accurate", "inaccurate", "unstable", "failed", "unavailable", "no reference")
 CLASS_COLORS = {"accurate": "#2ca02c", "inaccurate": "#ffd92f", "unstable": "#d62728",
@@ -291,7 +292,39 @@ def point_spec(mp, method, xv, yv, ident):
     return spec, exp, par
 
 
+def _row(res, info, specs, atlas):
+    mp, method, xv, yv, exp, par = info[res["id"]]
+    if exp is None:
+        cls, det = "no reference", {"error": math.nan, "velocity_error": math.nan,
+                                    "energy_growth": math.nan, "error_growth": math.nan}
+    else:
+        cls, det = classify(res, exp, atlas["accurate_tol"], atlas["growth_tol"])
+    s = res.get("summary") or {}
+    cost = s.get("cost") or {}
+    stab = s.get("stability") or {}
+    (xa, _), (ya, _) = next(iter(mp["x"].items())), next(iter(mp["y"].items()))
+    adaptive = method["integrator"] in ADAPTIVE
+    return {"run": res["id"], "map": mp["name"], "experiment": mp["experiment"],
+            "method": method["label"], "integrator": method["integrator"],
+            "x_axis": "rtol" if (adaptive and xa == "dt_ratio") else xa, "x": xv,
+            "y_axis": ya, "y": yv, "dt_ratio": par["dt_ratio"] if not adaptive else math.nan,
+            "stiffness_ratio": par.get("stiffness_ratio", math.nan),
+            "restitution": par.get("restitution", math.nan),
+            "mass_ratio": par.get("mass_ratio", math.nan),
+            "omega_max": exp.omega_max if exp else math.nan,
+            "dt_critical": 2.0 / exp.omega_max if exp else math.nan,
+            "dt_critical_reported": stab.get("dt_critical") or math.nan,
+            "dt": res_dt(specs[res["id"]]), "t_end": exp.t_end if exp else math.nan,
+            "class": cls, "status": res.get("status"),
+            "message": (res.get("message") or "").strip()[:300], **det,
+            "steps": cost.get("steps", math.nan),
+            "residual_evaluations": cost.get("residual_evaluations", math.nan),
+            "wall_time_s": cost.get("wall_time_s", math.nan)}
+
+
 def run_atlas(atlas, outdir, jobs=0, plots=True, stream=sys.stderr):
+    """Run an atlas into outdir: atlas.csv, a map per [[map]], atlas.md. Stopped by a signal
+    it keeps the finished rows and the same call resumes it (martello.study.resume)."""
     check_output_folder(outdir, "atlas.csv", MartelloError)   # before hours of runs, not after
     t0 = time.perf_counter()
     specs, info = [], {}
@@ -314,47 +347,35 @@ def run_atlas(atlas, outdir, jobs=0, plots=True, stream=sys.stderr):
                     info[spec["id"]] = (mp, method, xv, yv, exp, par)
     print(f"{atlas['title']}: {len(atlas['maps'])} map(s) x {len(atlas['methods'])} method(s): "
           f"{len(specs)} runs on {jobs or os.cpu_count()} worker(s)", file=stream)
-    rows = []
-    for res in run_specs(specs, jobs, Progress(len(specs), stream=stream)):
-        mp, method, xv, yv, exp, par = info[res["id"]]
-        if exp is None:
-            cls, det = "no reference", {"error": math.nan, "velocity_error": math.nan,
-                                        "energy_growth": math.nan, "error_growth": math.nan}
-        else:
-            cls, det = classify(res, exp, atlas["accurate_tol"], atlas["growth_tol"])
-        s = res.get("summary") or {}
-        cost = s.get("cost") or {}
-        stab = s.get("stability") or {}
-        (xa, _), (ya, _) = next(iter(mp["x"].items())), next(iter(mp["y"].items()))
-        adaptive = method["integrator"] in ADAPTIVE
-        rows.append({"run": res["id"], "map": mp["name"], "experiment": mp["experiment"],
-                     "method": method["label"], "integrator": method["integrator"],
-                     "x_axis": "rtol" if (adaptive and xa == "dt_ratio") else xa, "x": xv,
-                     "y_axis": ya, "y": yv, "dt_ratio": par["dt_ratio"] if not adaptive else math.nan,
-                     "stiffness_ratio": par.get("stiffness_ratio", math.nan),
-                     "restitution": par.get("restitution", math.nan),
-                     "mass_ratio": par.get("mass_ratio", math.nan),
-                     "omega_max": exp.omega_max if exp else math.nan,
-                     "dt_critical": 2.0 / exp.omega_max if exp else math.nan,
-                     "dt_critical_reported": stab.get("dt_critical") or math.nan,
-                     "dt": res_dt(specs[res["id"]]), "t_end": exp.t_end if exp else math.nan,
-                     "class": cls, "status": res.get("status"),
-                     "message": (res.get("message") or "").strip()[:300], **det,
-                     "steps": cost.get("steps", math.nan),
-                     "residual_evaluations": cost.get("residual_evaluations", math.nan),
-                     "wall_time_s": cost.get("wall_time_s", math.nan)})
-    rows.sort(key=lambda r: r["run"])
-    elapsed = time.perf_counter() - t0
-    keys = list(rows[0]) if rows else []
-    bounds = boundaries(rows)
-    # the folder is replaced whole once everything is written (docs/studies.md)
-    with folder_replaced(outdir, "atlas.csv", MartelloError) as tmp:
-        with open(tmp / "atlas.csv", "w", newline="") as fh:
-            w = csv.DictWriter(fh, fieldnames=keys)
+    by_id = {s["id"]: s for s in specs}
+    # what a row depends on (martello.study.resume)
+    keys = {s["id"]: row_key({k: v for k, v in s.items() if k != "id"}, info[s["id"]][0]["name"],
+                             info[s["id"]][0]["experiment"], info[s["id"]][1], info[s["id"]][2:4],
+                             info[s["id"]][5], atlas["accurate_tol"], atlas["growth_tol"],
+                             native.version())
+            for s in specs}
+    bounds = []
+
+    def run(ids, stop):
+        for res in run_specs([by_id[i] for i in ids], jobs, Progress(len(ids), stream=stream),
+                             stop=stop):
+            yield res["id"], _row(res, info, specs, atlas)
+
+    def write(folder, rows, of=None):
+        with open(folder / "atlas.csv", "w", newline="") as fh:
+            w = csv.DictWriter(fh, fieldnames=list(rows[0]) if rows else [])
             w.writeheader()
             w.writerows({k: csv_cell(v) for k, v in r.items()} for r in rows)
-        pngs = [plot_map(atlas, mp, rows, tmp) for mp in atlas["maps"]] if plots else []
-        _markdown(atlas, rows, bounds, pngs, elapsed, tmp / "atlas.md")
+        if of is not None:
+            _markdown(atlas, rows, [], [], time.perf_counter() - t0, folder / "atlas.md", of=of)
+            return
+        bounds[:] = boundaries(rows)
+        pngs = [plot_map(atlas, mp, rows, folder) for mp in atlas["maps"]] if plots else []
+        _markdown(atlas, rows, bounds, pngs, time.perf_counter() - t0, folder / "atlas.md")
+
+    # the folder is replaced whole once everything is written (docs/studies.md)
+    rows = run_resumable(outdir, "atlas.csv", keys, run, write,
+                         lambda folder, rows: write(folder, rows, of=len(specs)), stream)
     return rows, bounds
 
 
@@ -431,12 +452,17 @@ def plot_map(atlas, mp, rows, outdir):
     return p
 
 
-def _markdown(atlas, rows, bounds, pngs, elapsed, path):
+def _markdown(atlas, rows, bounds, pngs, elapsed, path, of=None):
+    """atlas.md; `of` (the number of runs of the atlas) for a partial output."""
     counts = {}
     for r in rows:
         counts[(r["method"], r["class"])] = counts.get((r["method"], r["class"]), 0) + 1
-    lines = [f"# {atlas['title']}", "", atlas["description"].strip(), "",
-             f"{len(rows)} runs in {elapsed:.1f} s; martello {native.version()}; accurate ≤ "
+    lines = [f"# {atlas['title']}", "", atlas["description"].strip(), ""]
+    if of is not None:
+        lines += [f"**Partial: {len(rows)} of {of} runs** (the atlas was interrupted; the same "
+                  f"command runs the other {of - len(rows)} and draws the maps; resume.jsonl "
+                  "holds the rows it keeps).", ""]
+    lines += [f"{len(rows)} runs in {elapsed:.1f} s; martello {native.version()}; accurate ≤ "
              f"{atlas['accurate_tol']:g}, energy growth > {atlas['growth_tol']:g} is unstable.", "",
              "| map | method | y | largest stable Δt/Δt_crit | smallest unstable | largest accurate |",
              "|---|---|---|---|---|---|"]

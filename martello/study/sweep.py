@@ -25,13 +25,14 @@ from ..batch import run_specs
 from ..binding import native
 from ..errors import MartelloError, SceneError
 from ..metrics.score import COST_KEYS, cost, score
-from ..paths import OUTPUT_ROOT, REPO, folder_replaced
+from ..paths import OUTPUT_ROOT, REPO, check_output_folder
 from ..reference.selection import reference_for_scene
 from ..scene.loader import from_dict
 from ..scene.spec import ADAPTIVE
 from ..scene.variants import analysis_for, runnable_scene
 from .outcome import failed_rows, status_class
 from .output import Progress, csv_cell, md_cell, palette_png, slug
+from .resume import row_key, run_resumable
 from .study_file import load_study
 
 
@@ -302,10 +303,16 @@ def plot_case(study, case, ci, rows, order_rows, ref, outdir):
     return p
 
 
-def _markdown(study, rows, order_rows, refs, notes, pngs, elapsed, path):
-    lines = [f"# {study.title}", "", study.description.strip(), "",
-             f"{len(rows)} runs in {elapsed:.1f} s; martello {native.version()} "
-             f"({native.library_versions()}); {time.strftime('%Y-%m-%d %H:%M UTC', time.gmtime())}.", ""]
+def _markdown(study, rows, order_rows, refs, notes, pngs, elapsed, path, of=None):
+    """study.md; `of` (the number of runs of the study) for a partial output: the rows so far,
+    no orders or plots."""
+    lines = [f"# {study.title}", "", study.description.strip(), ""]
+    if of is not None:
+        lines += [f"**Partial: {len(rows)} of {of} runs** (the study was interrupted; the same "
+                  f"command runs the other {of - len(rows)} and writes the orders and plots; "
+                  "resume.jsonl holds the rows it keeps).", ""]
+    lines += [f"{len(rows)} runs in {elapsed:.1f} s; martello {native.version()} "
+              f"({native.library_versions()}); {time.strftime('%Y-%m-%d %H:%M UTC', time.gmtime())}.", ""]
     counts = {}
     for r in rows:
         counts[r["classification"]] = counts.get(r["classification"], 0) + 1
@@ -330,29 +337,43 @@ def _markdown(study, rows, order_rows, refs, notes, pngs, elapsed, path):
     path.write_text("\n".join(lines) + "\n")
 
 
+def _key(study, spec, ref):
+    """What a row's values depend on (martello.study.resume): the run (its scene and
+    settings), its case and method, the reference and the scoring, the version."""
+    case, m = study.cases[spec["case"]], study.methods[spec["method"]]
+    reference = None if ref is None else (ref.name, ref.kind, ref.t_end, ref.columns, ref.digits,
+                                          ref.provenance)
+    return row_key({k: v for k, v in spec.items() if k != "id"}, study.title, study.compare,
+                   case.label, case.scene_label, case.scheme_label, str(case.scene_file),
+                   case.t_end, m.label, m.name, m.params, reference, native.version())
+
+
 def run_study(study, outdir, jobs=0, plots=True, stream=None, executor=None, where=None):
     """Run a loaded study; write runs.csv, orders.csv, study.md and the plots in outdir.
     The runs go to local processes, or to `executor` (a Dask cluster's: study.cluster),
-    described by `where`. Returns (rows, order_rows)."""
+    described by `where`. A signal stops it, keeping the rows finished in outdir, and the
+    same call resumes it (martello.study.resume: Stopped is raised). Returns (rows,
+    order_rows)."""
     stream = stream or sys.stderr
     t0 = time.perf_counter()
     specs, refs, notes = build_specs(study)
-    # the folder is refused before any run if it is not a study's, and replaced whole once
-    # everything is written (docs/studies.md)
-    with folder_replaced(outdir, "runs.csv", MartelloError) as tmp:
-        print(f"{study.title}: {len(study.cases)} case(s) x {len(study.methods)} method(s): "
-              f"{len(specs)} runs on {where or f'{jobs or os.cpu_count()} worker(s)'}", file=stream)
-        progress = Progress(len(specs), stream=stream)
-        by_id = {s["id"]: s for s in specs}
-        rows = []
-        for res in run_specs(specs, jobs, progress, executor=executor):
+    by_id = {s["id"]: s for s in specs}
+    keys = {s["id"]: _key(study, s, refs.get(s["case"])) for s in specs}
+    check_output_folder(outdir, "runs.csv", MartelloError)     # before anything is said
+    print(f"{study.title}: {len(study.cases)} case(s) x {len(study.methods)} method(s): "
+          f"{len(specs)} runs on {where or f'{jobs or os.cpu_count()} worker(s)'}", file=stream)
+    order_rows = []
+
+    def run(ids, stop):
+        progress = Progress(len(ids), stream=stream)
+        for res in run_specs([by_id[i] for i in ids], jobs, progress, executor=executor, stop=stop):
             spec = by_id[res["id"]]
-            rows.append(make_row(study, spec, res, refs.get(spec["case"])))
-        rows.sort(key=lambda r: r["run"])
-        elapsed = time.perf_counter() - t0
-        order_rows = orders(study, rows, refs)
-        write_csv(rows, tmp / "runs.csv")
-        with open(tmp / "orders.csv", "w", newline="") as fh:
+            yield res["id"], make_row(study, spec, res, refs.get(spec["case"]))
+
+    def finish(folder, rows):
+        order_rows[:] = orders(study, rows, refs)
+        write_csv(rows, folder / "runs.csv")
+        with open(folder / "orders.csv", "w", newline="") as fh:
             if order_rows:
                 w = csv.DictWriter(fh, fieldnames=list(order_rows[0]))
                 w.writeheader()
@@ -361,8 +382,18 @@ def run_study(study, outdir, jobs=0, plots=True, stream=None, executor=None, whe
         if plots:
             for ci, case in enumerate(study.cases):
                 if any(r["case"] == case.label for r in rows):
-                    pngs.append(plot_case(study, case, ci, rows, order_rows, refs.get(ci), tmp))
-        _markdown(study, rows, order_rows, refs, notes, pngs, elapsed, tmp / "study.md")
+                    pngs.append(plot_case(study, case, ci, rows, order_rows, refs.get(ci), folder))
+        _markdown(study, rows, order_rows, refs, notes, pngs, time.perf_counter() - t0,
+                  folder / "study.md")
+
+    def partial(folder, rows):
+        write_csv(rows, folder / "runs.csv")
+        _markdown(study, rows, [], refs, notes, [], time.perf_counter() - t0, folder / "study.md",
+                  of=len(specs))
+
+    # the folder is refused before any run if it is not a study's, and replaced whole once
+    # everything is written (docs/studies.md)
+    rows = run_resumable(outdir, "runs.csv", keys, run, finish, partial, stream)
     for n in notes:
         print(f"note: {n}", file=stream)
     return rows, order_rows

@@ -1,0 +1,857 @@
+/* The contact events of the SUNDIALS integrators, one copy for IDA, CVODE and ARKODE
+ * (c/ode_events.h; docs/ida.md, docs/sundials-ode.md).
+ *
+ * Events are roots, two per contact: delta_j and its rate for open contacts and penalty
+ * contacts (the rate root stops at every extremum of the gap, which gives the exact peak
+ * penetration and catches a contact that opens and closes inside one step), the state's
+ * multiplier for closed rigid contacts (release when it turns tensile), then one per switch
+ * slot of the laws' branches. At an onset or a separation of a penalty contact, an impact
+ * (Newton's law with restitution e, all contacts at zero gap at once: an impulse-level LCP), a
+ * closing (e = 0, or an accumulation of impacts: the rule of docs/impulse.md §4, through
+ * c/accumulation.c) or a release, the state is made consistent and the integrator restarts
+ * there instead of stepping across the kink. The works, the extrema of the nodes and the
+ * located peaks of every accepted step are computed on the integrator's own interpolant. */
+#include <float.h>
+#include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "ode_events.h"
+
+/* Position tolerance of a rigid contact, in units of the integrator's own: a rigid contact
+ * within it of zero gap touches (it enters the impact LCP with the one whose root fired, and a
+ * rebound that would not leave it has accumulated). The position error of these integrators is
+ * a small multiple of their local tolerance rtol |u| + atol. */
+#define POSITION_TOL_FACTOR 10.0
+
+/* ---- failures --------------------------------------------------------------------------- */
+
+int oe_fail_memory(ode_events *E, const char *what, double bytes) {
+  char of[192], line[480];
+  snprintf(of, sizeof of, "%s for a scene of %d nodes and %d contacts", what, E->n, E->nc);
+  martello_memory_message(of, bytes, NULL, line, (int)sizeof line);
+  return martello_observer_fail(E->obs, MARTELLO_ERR_MEMORY, E->t_now, line);
+}
+
+int oe_fail(ode_events *E, int code, const char *fmt, ...) {
+  char buf[480], what[96];
+  va_list ap;
+  if (code == MARTELLO_ERR_MEMORY) {
+    snprintf(what, sizeof what, "the work arrays of the %s LCP solver", E->name);
+    return oe_fail_memory(E, what, -1.0);
+  }
+  va_start(ap, fmt);
+  vsnprintf(buf, sizeof buf, fmt, ap);
+  va_end(ap);
+  return martello_observer_fail(E->obs, code, E->t_now, buf);
+}
+
+void *oe_take(size_t count, size_t size, double *failed) {
+  void *p = calloc(count > 0 ? count : 1, size);
+  if (!p && *failed == 0.0) *failed = (double)(count > 0 ? count : 1) * (double)size;
+  return p;
+}
+
+/* ---- kinematics ------------------------------------------------------------------------- */
+
+static double node_u(int i, const double *u) { return i < 0 ? 0.0 : u[i]; }
+
+double oe_pen(const ode_events *E, int j, const double *u) {
+  return (node_u(E->con_a[j], u) - node_u(E->con_b[j], u)) - E->gap[j];
+}
+
+double oe_rate(const ode_events *E, int j, const double *v) {
+  return node_u(E->con_a[j], v) - node_u(E->con_b[j], v);
+}
+
+void oe_gather(const ode_events *E, const double *y, double *u, double *v) {
+  for (int i = 0; i < E->n; i++) {
+    u[i] = y[E->iu[i]];
+    v[i] = y[E->iv[i]];
+  }
+}
+
+/* x <- B lambda over the closed rigid contacts (x has length n). */
+void oe_apply_B(const ode_events *E, const double *lam, double *x) {
+  memset(x, 0, sizeof(double) * (size_t)E->n);
+  for (int r = 0; r < E->nr; r++) {
+    if (!E->closed[r] || lam[r] == 0.0) continue;
+    int j = E->rig_con[r];
+    if (E->con_a[j] >= 0) x[E->con_a[j]] += lam[r];
+    if (E->con_b[j] >= 0) x[E->con_b[j]] -= lam[r];
+  }
+}
+
+double oe_position_tol(const ode_events *E, int j, const double *u) {
+  double s = fabs(E->gap[j]);
+  s = fmax(s, fabs(node_u(E->con_a[j], u)));
+  s = fmax(s, fabs(node_u(E->con_b[j], u)));
+  return POSITION_TOL_FACTOR * (E->rtol * s + E->atol);
+}
+
+static double speed_tol(const ode_events *E, const double *v) {
+  double vm = 0.0;
+  for (int i = 0; i < E->n; i++) vm = fmax(vm, fabs(v[i]));
+  return 64.0 * DBL_EPSILON * vm + DBL_MIN;
+}
+
+/* The kernels decide a penalty law's regime by the sign of delta, so a restart exactly at
+ * delta = 0 would not know on which side it is. */
+void oe_nudge(ode_events *E, int j, int sgn, double *u) {
+  int a = E->con_a[j], b = E->con_b[j];
+  int node = (a >= 0 && !E->fixed[a]) ? a : ((b >= 0 && !E->fixed[b]) ? b : -1);
+  if (node < 0) return;
+  double dir = node == a ? 1.0 : -1.0;
+  double eta = 4.0 * DBL_EPSILON *
+               (fabs(E->gap[j]) + fabs(node_u(a, u)) + fabs(node_u(b, u))) + DBL_MIN;
+  for (int k = 0; k < 80; k++) {
+    double d = oe_pen(E, j, u);
+    if (sgn * d > 0.0) return;
+    u[node] += dir * sgn * (fabs(d) + eta);
+    eta *= 2.0;
+  }
+}
+
+/* ---- the impulse problem of the rigid contacts -------------------------------------------- */
+
+/* M^-1 B_r^T of every rigid contact, once (the mass matrix does not change). */
+static int impulse_columns(ode_events *E) {
+  if (E->cols_ready) return MARTELLO_OK;
+  for (int r = 0; r < E->nr; r++) {
+    int j = E->rig_con[r], st;
+    double *c = E->cols + (size_t)r * (size_t)E->n;
+    memset(c, 0, sizeof(double) * (size_t)E->n);
+    if (E->con_a[j] >= 0) c[E->con_a[j]] -= 1.0;
+    if (E->con_b[j] >= 0) c[E->con_b[j]] += 1.0;
+    if ((st = martello_eval_solve_mass(E->ev, c)) != MARTELLO_OK) return st;
+  }
+  E->cols_ready = 1;
+  return MARTELLO_OK;
+}
+
+/* The rigid contacts aset[0..m) as the impulse door's list (contact indices) into dc. */
+static void door_list(ode_events *E, int m) {
+  for (int k = 0; k < m; k++) E->dc[k] = E->rig_con[E->aset[k]];
+}
+
+/* The impulse door's topology arguments (c/martello_internal.h): sides, columns in cols. */
+#define TOPOLOGY(E) (E)->con_a, (E)->con_b, (E)->rig, (E)->cols
+
+static int closed_set(ode_events *E) {
+  int m = 0;
+  for (int r = 0; r < E->nr; r++)
+    if (E->closed[r]) E->aset[m++] = r;
+  return m;
+}
+
+/* From the state itself: an index-2 multiplier integrated with the state (IDA's P, out of its
+ * error test) is not accurate between the steps' ends: while a contact holds a node still the
+ * steps grow to the output interval and the root of IDA's interpolated P fell up to 8e-3 s
+ * from the release (P9 at rtol 1e-11), at a time that moved with the output interval. */
+int oe_closed_multipliers(ode_events *E, double t, const double *u, const double *v) {
+  int st = martello_eval_acceleration(E->ev, t, u, v, E->ar);
+  if (st == MARTELLO_OK) st = oe_constrain(E, E->ar);
+  for (int k = 0; k < E->mc; k++) E->lr[E->lc[k]] = E->x[k];
+  return st;
+}
+
+int oe_constrain(ode_events *E, double *a) {
+  if (E->mc == 0) return MARTELLO_OK;
+  return martello_impulse_project(E->n, E->mc, E->dlc, TOPOLOGY(E), E->Wc, NULL, a, E->x);
+}
+
+/* The release roots from the restart on: the closed set, W_H factored, and each contact's
+ * tension bar, the rounding of the forces at its nodes (as on the event-driven integrator). */
+static int closed_set_roots(ode_events *E) {
+  E->mc = 0;
+  for (int r = 0; r < E->nr; r++)
+    if (E->closed[r]) {
+      int j = E->rig_con[r], a = E->con_a[j], b = E->con_b[j];
+      double fs = fabs(E->lam[r]);
+      if (a >= 0) fs += E->mass[a] * fabs(E->a[a]);
+      if (b >= 0) fs += E->mass[b] * fabs(E->a[b]);
+      E->lamtol[r] = 1e3 * DBL_EPSILON * fs;
+      E->lc[E->mc] = r;
+      E->dlc[E->mc++] = j;
+    }
+  if (E->mc == 0) return MARTELLO_OK;
+  return martello_impulse_factor(E->n, E->mc, E->dlc, TOPOLOGY(E), E->Wc);
+}
+
+/* Zero the rates of the closed set (for an accumulation this removes the rest of the
+ * bounces: their energy goes to E_IMPACT), then put it on delta = 0 (B u = -gap) by the
+ * mass-weighted projection: at every restart, so that the integrator starts on the
+ * constraints. */
+static int project_closed(ode_events *E, double t, double *u, double *v) {
+  int st, m = closed_set(E);
+  if (m == 0) return MARTELLO_OK;
+  door_list(E, m);
+  if ((st = martello_impulse_factor(E->n, m, E->dc, TOPOLOGY(E), E->S)) != MARTELLO_OK)
+    return oe_fail(E, MARTELLO_ERR_SINGULAR, "%s: redundant closed contacts at t = %.9e s (B^T M^-1 B singular)", E->name, t);
+  for (int k = 0; k < m; k++) E->q[k] = -E->gap[E->rig_con[E->aset[k]]];
+  st = martello_impulse_project(E->n, m, E->dc, TOPOLOGY(E), E->S, NULL, v, E->rhs);
+  if (st == MARTELLO_OK)
+    st = martello_impulse_project(E->n, m, E->dc, TOPOLOGY(E), E->S, E->q, u, E->rhs);
+  if (st != MARTELLO_OK) return oe_fail(E, st, "%s: the constraint projection failed at t = %.9e s", E->name, t);
+  return MARTELLO_OK;
+}
+
+/* Newton's impact law on the rigid contacts that touch (closed, flagged ACT_IMPACT, or open
+ * at zero gap within the position tolerance), all at once (martello_impulse_newton:
+ * simultaneous impacts in a chain), restitution e (0 for a closed contact). E->hit and
+ * E->w_in say which contacts took an impulse and their approach speed. Then the closing
+ * rule (the accumulation policy) and, for the closed set, zero rates and positions. */
+static int rigid_impacts(ode_events *E, double t, double *u, double *v) {
+  int st, m = 0, piv;
+  if ((st = impulse_columns(E)) != MARTELLO_OK) return oe_fail(E, st, "%s: singular mass at an impact", E->name);
+  for (int r = 0; r < E->nr; r++) {
+    int j = E->rig_con[r];
+    E->hit[r] = 0;
+    /* a contact released here leaves at rest: it takes no impulse (its rounding-level rate
+     * made a spurious impact at 1e-35 m/s on P9 when the release fell on an output time) */
+    E->cand[r] = E->closed[r] || E->act[j] == ACT_IMPACT ||
+                 (E->act[j] != ACT_RELEASE && oe_pen(E, j, u) >= -oe_position_tol(E, j, u));
+    if (E->cand[r]) E->aset[m++] = r;
+  }
+  if (m > 0) {
+    door_list(E, m);
+    for (int k = 0; k < m; k++) {
+      int r = E->aset[k], j = E->rig_con[r];
+      E->w0[k] = oe_rate(E, j, v);
+      E->q[k] = E->closed[r] ? 0.0 : (E->rest[j] >= 0.0 ? E->rest[j] : 0.0);
+    }
+    st = martello_impulse_newton(E->n, m, E->dc, TOPOLOGY(E), E->q, v, E->rhs, &piv);
+    if (st != MARTELLO_OK)
+      return oe_fail(E, st, "%s: the impact LCP of %d contacts failed at t = %.9e s (%s)", E->name, m, t,
+                     st == MARTELLO_ERR_SINGULAR ? "redundant contacts" : "pivot limit");
+    for (int k = 0; k < m; k++) {
+      int r = E->aset[k], j = E->rig_con[r];
+      if (E->rhs[k] > 0.0 && !E->closed[r]) {
+        E->hit[r] = 1;
+        E->w_in[j] = E->w0[k];
+        E->w_out[j] = oe_rate(E, j, v);
+        if (E->act[j] != ACT_IMPACT) E->events++;
+      }
+    }
+    /* a closed contact that the impact sets apart (p = 0, separating) opens */
+    double vtol = speed_tol(E, v);
+    for (int r = 0; r < E->nr; r++)
+      if (E->closed[r] && oe_rate(E, E->rig_con[r], v) < -vtol) {
+        E->closed[r] = 0;
+        E->opened[r] = 1;
+      }
+  }
+  /* closing: the accumulation rule (docs/impulse.md §4) with the integrator's resolutions
+   * (event_tol, the position tolerance of the contact and the like one of its rate), and the
+   * normal acceleration a_n that presses each contact that took an impulse with the contacts
+   * already closed enforced (their forces from the persistent-contact rule): aset = [closed
+   * set, candidates]. The phase of a contact closed here starts at its accumulation point. */
+  int mc = closed_set(E), ma = mc;
+  for (int r = 0; r < E->nr; r++)
+    if (!E->closed[r] && (E->hit[r] || E->act[E->rig_con[r]] == ACT_IMPACT)) E->aset[ma++] = r;
+  if (ma > mc) {
+    st = martello_eval_acceleration(E->ev, t, u, v, E->a);
+    if (st != MARTELLO_OK) return oe_fail(E, st, "%s: acceleration failed at t = %.9e s", E->name, t);
+    door_list(E, ma);
+    st = martello_impulse_delassus(E->n, ma, E->dc, TOPOLOGY(E), E->S);
+    if (st == MARTELLO_OK && mc > 0)
+      st = martello_impulse_contact_forces(E->n, mc, E->dc, TOPOLOGY(E), E->a, E->w0,
+                                           E->cand, &piv);
+    if (st != MARTELLO_OK)
+      return oe_fail(E, st, "%s: the contact forces of the closed contacts failed at t = %.9e s", E->name, t);
+  }
+  for (int k = mc; k < ma; k++) {
+    int r = E->aset[k], j = E->rig_con[r];
+    double an = oe_rate(E, j, E->a), rebound = fmax(-oe_rate(E, j, v), 0.0);
+    double e = E->rest[j] >= 0.0 ? E->rest[j] : 0.0;
+    double v_res = POSITION_TOL_FACTOR *
+                   (E->rtol * (fabs(node_u(E->con_a[j], v)) + fabs(node_u(E->con_b[j], v))) + E->atol);
+    double da = 0.0;
+    for (int l = 0; l < mc; l++) an -= E->S[k + ma * l] * E->w0[l];
+    if (rebound > 0.0 && an > 0.0) {
+      /* the change of a_n over the next flight tau = 2 s/a_n, at the end of a tangent step of
+       * length tau (the closed contacts' forces held) */
+      const double tau = 2.0 * rebound / an;
+      for (int i = 0; i < E->n; i++) {
+        E->uq[i] = u[i] + tau * v[i];
+        E->vq[i] = v[i] + tau * E->a[i];
+      }
+      st = martello_eval_acceleration(E->ev, t + tau, E->uq, E->vq, E->x);
+      if (st != MARTELLO_OK) return oe_fail(E, st, "%s: acceleration failed at t = %.9e s", E->name, t + tau);
+      da = oe_rate(E, j, E->x) - oe_rate(E, j, E->a);
+    }
+    /* tentative: rigid_multipliers opens it again if its multiplier is not compressive. A
+     * contact that nothing presses (a_n <= 0) stays open, as on the event-driven integrator:
+     * bodies that move on together after a plastic impact are not in a persistent contact */
+    if (an > 0.0 && martello_accumulation_decide(&E->acc, j, e, rebound, an, da, t,
+                                                 E->event_tol, oe_position_tol(E, j, u), v_res,
+                                                 E->restarts))
+      E->closed[r] = 1;
+  }
+  return project_closed(E, t, u, v);
+}
+
+/* Multipliers of the closed set: the persistent-contact rule (martello_impulse_contact_forces
+ * on the free accelerations); a contact that the solution opens (lambda = 0, opening
+ * acceleration) opens. Leaves a_free in E->a and the multipliers in E->lam. */
+static int rigid_multipliers(ode_events *E, double t, double *u, double *v) {
+  int st = martello_eval_acceleration(E->ev, t, u, v, E->a), piv;
+  if (st != MARTELLO_OK) return oe_fail(E, st, "%s: acceleration failed at t = %.9e s", E->name, t);
+  for (int r = 0; r < E->nr; r++) E->lam[r] = 0.0;
+  int m = closed_set(E);
+  if (m == 0) return MARTELLO_OK;
+  if ((st = impulse_columns(E)) != MARTELLO_OK) return oe_fail(E, st, "%s: singular mass", E->name);
+  door_list(E, m);
+  st = martello_impulse_contact_forces(E->n, m, E->dc, TOPOLOGY(E), E->a, E->rhs,
+                                       E->cand, &piv);
+  if (st != MARTELLO_OK)
+    return oe_fail(E, st, "%s: the contact forces of %d closed contacts failed at t = %.9e s (%s)", E->name, m, t,
+                   st == MARTELLO_ERR_SINGULAR ? "redundant closed contacts" : "pivot limit");
+  for (int k = 0; k < m; k++) {
+    int r = E->aset[k];
+    if (E->cand[k]) {
+      E->lam[r] = E->rhs[k];
+    } else {
+      E->closed[r] = 0;
+      E->opened[r] = 1;
+    }
+  }
+  return MARTELLO_OK;
+}
+
+/* ---- what the observer is handed ---------------------------------------------------------- */
+
+int oe_commit(ode_events *E, const double *u, const double *v) {
+  int st = martello_eval_commit(E->ev, u, v);
+  if (st == MARTELLO_OK && E->nsw > 0)
+    st = martello_eval_switches(E->ev, E->sw_a, E->sw_b, E->sw_al, E->sw_be, E->sw_ga);
+  return st;
+}
+
+int oe_hand_work(ode_events *E) {
+  int st = martello_observer_work(E->obs, E->dw_ext, E->dw_int, E->dw_links, E->dw_contact,
+                                  E->e_impact);
+  E->dw_ext = E->dw_int = E->dw_links = E->dw_contact = E->e_impact = 0.0;
+  return st == MARTELLO_OK ? st : oe_fail(E, st, "%s: could not hand the works to the observer", E->name);
+}
+
+/* Work of the external and internal forces (and of the links other than dampers and of the
+ * penalty contacts) over [t0, t1] on the step's interpolant, 3-point Gauss-Legendre (order
+ * 6), with the link states committed at t0 (as the integrator's residuals saw them). */
+static int work_quadrature(ode_events *E, double t0, double t1) {
+  static const double xg[3] = {-0.7745966692414834, 0.0, 0.7745966692414834};
+  static const double wg[3] = {5.0 / 18.0, 8.0 / 18.0, 5.0 / 18.0};
+  if (!(t1 > t0)) return MARTELLO_OK;
+  double h = t1 - t0, we = 0.0, wi = 0.0, wl = 0.0, wc = 0.0, power[5];
+  for (int k = 0; k < 3; k++) {
+    double tk = t0 + 0.5 * h * (1.0 + xg[k]);
+    int st = E->dky(E->ctx, tk, 0, E->ytmp);
+    if (st != MARTELLO_OK) return st;
+    oe_gather(E, N_VGetArrayPointer(E->ytmp), E->uq, E->vq);
+    st = martello_eval_forces(E->ev, tk, E->uq, E->vq, E->fint, E->fext);
+    if (st == MARTELLO_OK) st = martello_eval_power(E->ev, power);
+    if (st != MARTELLO_OK) return oe_fail(E, st, "%s: force evaluation failed at t = %.9e s", E->name, tk);
+    we += wg[k] * power[0];
+    wi += wg[k] * power[1];
+    wl += wg[k] * power[3];
+    wc += wg[k] * power[4];
+  }
+  E->dw_ext += h * we;
+  E->dw_int += h * wi;
+  E->dw_links += h * wl;
+  E->dw_contact += h * wc;
+  return MARTELLO_OK;
+}
+
+/* The extrema of the node displacements on [t0, t1], inside the last step: a node whose
+ * velocity changes sign against E->v_last gets the root of v located by bisection on the
+ * interpolant (of the method's order: the error of the step) and u there (docs/run-layer.md,
+ * located extrema). */
+static int node_extrema(ode_events *E, double t0, double t1, const double *y1) {
+  for (int i = 0; i < E->n; i++) {
+    const double v0 = E->v_last[i], v1 = y1[E->iv[i]];
+    int is_max, st;
+    if (E->fixed[i]) continue;
+    if (v0 > 0.0 && v1 <= 0.0) is_max = 1;
+    else if (v0 < 0.0 && v1 >= 0.0) is_max = 0;
+    else continue;
+    double lo = t0, hi = t1, u = y1[E->iu[i]];
+    for (int it = 0; it < 200 && hi - lo > fmax(E->event_tol, 4.0 * DBL_EPSILON * fabs(hi)); it++) {
+      const double tm = 0.5 * (lo + hi);
+      if ((st = E->dky(E->ctx, tm, 0, E->ytmp)) != MARTELLO_OK) return st;
+      if ((N_VGetArrayPointer(E->ytmp)[E->iv[i]] > 0.0) == (v0 > 0.0)) lo = tm; else hi = tm;
+    }
+    if (hi < t1) {
+      if ((st = E->dky(E->ctx, hi, 0, E->ytmp)) != MARTELLO_OK) return st;
+      u = N_VGetArrayPointer(E->ytmp)[E->iu[i]];
+    }
+    st = martello_observer_extremum(E->obs, i, hi, u, is_max);
+    if (st != MARTELLO_OK) return oe_fail(E, st, "%s: martello_observer_extremum failed", E->name);
+  }
+  return MARTELLO_OK;
+}
+
+/* u, v, a (E->ua, va, aa) of the nodes at t on the interpolant (y and y': a is the v rows of
+ * y'), and the rates of the peak quantities there: elements into e (packed), node jerks into
+ * jerk. */
+static int interpolated_rates(ode_events *E, double t, double *e, double *jerk) {
+  int st = E->dky(E->ctx, t, 0, E->ytd);
+  if (st != MARTELLO_OK) return st;
+  oe_gather(E, N_VGetArrayPointer(E->ytd), E->ua, E->va);
+  if ((st = E->dky(E->ctx, t, 1, E->ytd)) != MARTELLO_OK) return st;
+  for (int i = 0; i < E->n; i++) E->aa[i] = N_VGetArrayPointer(E->ytd)[E->iv[i]];
+  st = martello_peak_rates(E->ev, t, E->ua, E->va, E->aa, E->nc, E->nl, e, jerk);
+  return st == MARTELLO_OK ? st : oe_fail(E, st, "%s: the rates of the peaks failed at t = %.9e s", E->name, t);
+}
+
+/* The probe of c/located_peaks.c on the interpolant of the last step (of the method's order:
+ * its own solution between the steps' ends). */
+static int peak_probe(void *ctx, double t, int kind, int j, double *q, double *r) {
+  ode_events *E = ctx;
+  int st = interpolated_rates(E, t, E->elc, E->jk);
+  if (st != MARTELLO_OK) return st;
+  martello_peak_pick(kind, j, E->nc, E->nl, E->va, E->aa, E->jk, E->elc, q, r);
+  return MARTELLO_OK;
+}
+
+/* Fixed nodes, rigid contacts and penalty contacts out of a phase have no peak here. */
+static int peak_skip(void *ctx, int kind, int j) {
+  ode_events *E = ctx;
+  if (kind == MARTELLO_PEAK_V || kind == MARTELLO_PEAK_A) return E->fixed[j];
+  if (kind == MARTELLO_PEAK_PEN || kind == MARTELLO_PEAK_FORCE)
+    return E->rig[j] >= 0 || !martello_observer_in_phase(E->obs, j);
+  return 0;
+}
+
+/* The peaks inside [t0, t1] of the last step, on its interpolant (docs/run-layer.md, located
+ * peaks): every quantity's value and rate at both ends (the start's kept from the last step's
+ * end when the integrator went on: E->start_rates), then c/located_peaks.c. */
+static int located_peaks(ode_events *E, double t0, double t1, int at_event) {
+  const size_t nb = sizeof(double) * (size_t)E->n;
+  martello_peak_ends e;
+  int st;
+  if (!(t1 > t0)) return MARTELLO_OK;
+  if (!E->start_rates) {
+    if ((st = interpolated_rates(E, t0, E->el0, E->pj0)) != MARTELLO_OK) return st;
+    memcpy(E->pv0, E->va, nb);
+    memcpy(E->pa0, E->aa, nb);
+  }
+  if ((st = interpolated_rates(E, t1, E->el1, E->pj1)) != MARTELLO_OK) return st;
+  memcpy(E->pv1, E->va, nb);
+  memcpy(E->pa1, E->aa, nb);
+  memset(&e, 0, sizeof e);
+  martello_peak_ends_set(&e, 0, E->n, E->nc, E->nl, E->pv0, E->pa0, E->pj0, E->el0);
+  martello_peak_ends_set(&e, 1, E->n, E->nc, E->nl, E->pv1, E->pa1, E->pj1, E->el1);
+  e.skip = peak_skip;
+  if (at_event && (st = martello_peak_fold_end(E->obs, &e, E)) != MARTELLO_OK) return st;
+  return martello_locate_peaks(E->obs, &e, t0, t1, E->rtol, E->event_tol, peak_probe, E);
+}
+
+int oe_stretch(ode_events *E, double t0, double t1, const double *y1, int at_event) {
+  int st = work_quadrature(E, t0, t1);
+  if (st == MARTELLO_OK) st = node_extrema(E, t0, t1, y1);
+  if (st == MARTELLO_OK) st = located_peaks(E, t0, t1, at_event);
+  return st;
+}
+
+void oe_keep_end_rates(ode_events *E, int unchanged) {
+  double *tmp;
+  E->start_rates = unchanged;
+  if (!unchanged) return;
+  tmp = E->el0; E->el0 = E->el1; E->el1 = tmp;
+  tmp = E->pj0; E->pj0 = E->pj1; E->pj1 = tmp;
+  tmp = E->pv0; E->pv0 = E->pv1; E->pv1 = tmp;
+  tmp = E->pa0; E->pa0 = E->pa1; E->pa1 = tmp;
+}
+
+double oe_next_stop(ode_events *E, double t, double t_out) {
+  double tb = DBL_MAX;
+  if (martello_eval_next_breakpoint(E->ev, t, &tb) != MARTELLO_OK) tb = DBL_MAX;
+  return fmin(tb, t_out);
+}
+
+int oe_add_counts(ode_events *E, const long c[9]) {
+  long long inc[MARTELLO_NCOUNTERS] = {0};
+  for (int k = 0; k < 9; k++) {
+    if (k == MARTELLO_COUNTER_EVENTS || k == MARTELLO_COUNTER_CONTACT_CHATTER_RESOLUTIONS) continue;
+    inc[k] = c[k] >= E->cnt_last[k] ? c[k] - E->cnt_last[k] : c[k];
+    E->cnt_last[k] = c[k];
+  }
+  inc[MARTELLO_COUNTER_EVENTS] = E->events;
+  E->events = 0;
+  return martello_observer_add_counts(E->obs, inc);
+}
+
+/* ---- roots and events ----------------------------------------------------------------------- */
+
+int oe_nroots(const ode_events *E) { return 2 * E->nc + E->nsw; }
+
+int oe_roots(ode_events *E, double t, const double *u, const double *v, double *g) {
+  if (E->mc > 0 && oe_closed_multipliers(E, t, u, v) != MARTELLO_OK) return -1;
+  for (int j = 0; j < E->nc; j++) {
+    int r = E->rig[j];
+    if (r >= 0 && E->closed[r]) {
+      g[2 * j] = E->lr[r] + E->lamtol[r];
+      g[2 * j + 1] = 1.0;
+    } else {
+      g[2 * j] = oe_pen(E, j, u);
+      g[2 * j + 1] = oe_rate(E, j, v);
+    }
+  }
+  for (int s = 0; s < E->nsw; s++) {
+    const int a = E->sw_a[s], b = E->sw_b[s];
+    g[2 * E->nc + s] = E->sw_al[s] * (node_u(a, u) - node_u(b, u)) +
+                       E->sw_be[s] * (node_u(a, v) - node_u(b, v)) + E->sw_ga[s];
+  }
+  return 0;
+}
+
+/* Bisection on the interpolant of the last step for the crossing of delta_j between tl and tr;
+ * returns a time on the tl side within event_tol. */
+static int locate(ode_events *E, int j, double tl, double tr, double *t_cross) {
+  int st = E->dky(E->ctx, tl, 0, E->ytmp);
+  if (st != MARTELLO_OK) return st;
+  oe_gather(E, N_VGetArrayPointer(E->ytmp), E->uq, E->vq);
+  int left_positive = oe_pen(E, j, E->uq) > 0.0;
+  for (int it = 0; it < 200 && tr - tl > fmax(E->event_tol, 4.0 * DBL_EPSILON * fabs(tr)); it++) {
+    double tm = 0.5 * (tl + tr);
+    if ((st = E->dky(E->ctx, tm, 0, E->ytmp)) != MARTELLO_OK) return st;
+    oe_gather(E, N_VGetArrayPointer(E->ytmp), E->uq, E->vq);
+    if ((oe_pen(E, j, E->uq) > 0.0) == left_positive) tl = tm; else tr = tm;
+  }
+  *t_cross = tl;
+  return MARTELLO_OK;
+}
+
+int oe_classify_roots(ode_events *E, double t_last, double tret, const double *y,
+                      const int *found, double *t_r) {
+  oe_gather(E, y, E->u, E->v);
+  double best = tret;
+  int jbest = -1, kbest = ACT_NONE;
+  /* extrema of gaps: peaks, and contacts that opened and closed inside one step */
+  for (int j = 0; j < E->nc; j++) {
+    int r = E->rig[j];
+    if (!found[2 * j + 1] || found[2 * j]) continue;
+    if (r >= 0 && E->closed[r]) continue;
+    double d = oe_pen(E, j, E->u);
+    int want = ACT_NONE, touching = martello_observer_in_phase(E->obs, j);
+    if (r < 0) {
+      /* touching with d > 0: the deepest point, sampled there as an accepted state */
+      if (!touching && d > 0.0) want = ACT_ONSET;
+      else if (touching && d < 0.0) want = ACT_SEPARATION;
+    } else if (d > 0.0) {
+      want = ACT_IMPACT;
+    }
+    if (want == ACT_NONE) continue;
+    double tc;
+    int st = locate(E, j, t_last, tret, &tc);
+    if (st != MARTELLO_OK) return st;
+    if (jbest < 0 || tc < best) {
+      best = tc;
+      jbest = j;
+      kbest = want;
+    }
+  }
+  if (jbest >= 0) {
+    E->act[jbest] = kbest;
+    *t_r = best;
+    return 1;
+  }
+  int any = 0;
+  for (int j = 0; j < E->nc; j++) {
+    int r = E->rig[j], dir = found[2 * j], touching = martello_observer_in_phase(E->obs, j);
+    if (dir == 0) continue;
+    if (r < 0) {
+      if (dir > 0 && !touching) E->act[j] = ACT_ONSET;
+      else if (dir < 0 && touching) E->act[j] = ACT_SEPARATION;
+    } else if (!E->closed[r]) {
+      if (dir > 0) E->act[j] = ACT_IMPACT;
+    } else if (dir < 0) {
+      E->act[j] = ACT_RELEASE;
+    }
+    any |= E->act[j] != ACT_NONE;
+  }
+  *t_r = tret;
+  return any;
+}
+
+/* A root function exactly 0 at the return stays 0 when two nodes move identically (identical
+ * neighbours never touch, docs/problems.md P7; rigid clusters of a chain): the integrator
+ * would stop on it again at once and fail with "root found at and very near t". */
+int oe_root_stays_zero(ode_events *E, const double *y, const int *found) {
+  oe_gather(E, y, E->uq, E->vq);
+  for (int j = 0; j < E->nc; j++) {
+    int r = E->rig[j];
+    if (r >= 0 && E->closed[r]) continue;
+    if ((found[2 * j] && oe_pen(E, j, E->uq) == 0.0) ||
+        (found[2 * j + 1] && oe_rate(E, j, E->vq) == 0.0))
+      return 1;
+  }
+  return 0;
+}
+
+/* An analytic event time that coincides with a stop time lands exactly on delta = 0, where the
+ * root finder reports no sign change, and the kink would then sit at the start of every
+ * following step. */
+int oe_boundary_events(ode_events *E, double t_last, double tret, const double *y,
+                       double h_last, double *t_r) {
+  oe_gather(E, y, E->u, E->v);
+  double best = tret;
+  int jbest = -1, kbest = ACT_NONE;
+  double vmax = 0.0;
+  for (int i = 0; i < E->n; i++) vmax = fmax(vmax, fabs(E->v[i]));
+  double wtol = 10.0 * (E->rtol * vmax + E->atol);
+  for (int j = 0; j < E->nc; j++) {
+    int r = E->rig[j], want = ACT_NONE, touching = martello_observer_in_phase(E->obs, j);
+    if (r >= 0 && E->closed[r]) continue;
+    double d = oe_pen(E, j, E->u), w = oe_rate(E, j, E->v);
+    /* on the surface within round-off of the gap, or of the time */
+    double on = 64.0 * DBL_EPSILON *
+                (fabs(node_u(E->con_a[j], E->u)) + fabs(node_u(E->con_b[j], E->u)) + fabs(E->gap[j]) +
+                 fabs(w) * (fabs(tret) + fabs(h_last)));
+    /* ... and moving across it faster than the integration error of a rate: two bodies
+     * that travel together at zero gap are not a new event */
+    if (r < 0) {
+      if (!touching && (d > 0.0 || (d >= -on && w > wtol))) want = ACT_ONSET;
+      else if (touching && (d < 0.0 || (d <= on && w < -wtol))) want = ACT_SEPARATION;
+    } else if (d > 0.0 || (d >= -on && w > wtol)) {
+      want = ACT_IMPACT;
+    }
+    if (want == ACT_NONE) continue;
+    double tc = tret;
+    int wrong_side = r < 0 ? (touching ? d < 0.0 : d > 0.0) : d > 0.0;
+    if (wrong_side && fabs(d) > on && tret > t_last) {
+      int st = locate(E, j, t_last, tret, &tc);
+      if (st != MARTELLO_OK) return st;
+    }
+    if (jbest < 0 || tc < best) {
+      best = tc;
+      jbest = j;
+      kbest = want;
+    }
+  }
+  if (jbest < 0) return 0;
+  E->act[jbest] = kbest;
+  *t_r = best;
+  return 1;
+}
+
+int oe_prepare_restart(ode_events *E, double t, double *u, double *v) {
+  int st, any_rigid = 0;
+  double ke0 = 0.0, ke1 = 0.0, dummy;
+  if ((st = martello_eval_energy(E->ev, u, v, &ke0, &dummy)) != MARTELLO_OK)
+    return oe_fail(E, st, "%s: energy evaluation failed", E->name);
+  for (int r = 0; r < E->nr; r++) E->opened[r] = 0;
+  for (int j = 0; j < E->nc; j++) {
+    int r = E->rig[j];
+    double w = oe_rate(E, j, v);
+    switch (E->act[j]) {
+    case ACT_ONSET:
+      oe_nudge(E, j, +1, u);
+      martello_observer_set_phase(E->obs, j, 1, t, w);
+      E->events++;
+      break;
+    case ACT_SEPARATION:
+      oe_nudge(E, j, -1, u);
+      martello_observer_set_phase(E->obs, j, 0, t, w);
+      E->events++;
+      break;
+    case ACT_IMPACT:
+      E->w_in[j] = w;
+      any_rigid = 1;
+      E->events++;
+      break;
+    case ACT_RELEASE:
+      E->closed[r] = 0;
+      oe_nudge(E, j, -1, u);
+      martello_accumulation_release(&E->acc, E->obs, j, t, w);
+      any_rigid = 1;
+      E->events++;
+      break;
+    default:
+      break;
+    }
+  }
+  for (int r = 0; r < E->nr; r++) {
+    E->was_closed[r] = E->closed[r];
+    E->hit[r] = 0;
+  }
+  if (any_rigid && (st = rigid_impacts(E, t, u, v)) != MARTELLO_OK) return st;
+  if (!any_rigid && E->nr > 0 && (st = project_closed(E, t, u, v)) != MARTELLO_OK) return st;
+  /* rebounding (not closed) contacts leave from delta < 0 so that the gap root sees the
+   * next approach as a sign change */
+  for (int r = 0; r < E->nr; r++) {
+    int j = E->rig_con[r];
+    if ((E->hit[r] || E->act[j] == ACT_IMPACT) && !E->closed[r]) oe_nudge(E, j, -1, u);
+  }
+  if ((st = oe_commit(E, u, v)) != MARTELLO_OK) return oe_fail(E, st, "%s: commit failed", E->name);
+  if (E->nr > 0 && (st = rigid_multipliers(E, t, u, v)) != MARTELLO_OK) return st;
+  if (E->nr == 0 && (st = martello_eval_acceleration(E->ev, t, u, v, E->a)) != MARTELLO_OK)
+    return oe_fail(E, st, "%s: acceleration failed at t = %.9e s", E->name, t);
+  for (int r = 0; r < E->nr; r++) {
+    int j = E->rig_con[r];
+    if (E->opened[r]) oe_nudge(E, j, -1, u);
+    if ((E->hit[r] || E->act[j] == ACT_IMPACT) && !E->was_closed[r]) {
+      /* every impulse is an impact (its rebound as Newton's law left it); a contact it closes
+       * is persistent from its accumulation point (an instant later for a plastic impact or
+       * one touching at rest), as on the event-driven integrator */
+      if (E->hit[r]) martello_observer_add_impact(E->obs, j, t, E->w_in[j], E->w_out[j], 0.0, 0.0);
+      if (E->closed[r]) martello_accumulation_hold(&E->acc, E->obs, j);
+    } else if (E->opened[r] && martello_observer_in_phase(E->obs, j)) {
+      martello_accumulation_release(&E->acc, E->obs, j, t, oe_rate(E, j, v));
+    }
+  }
+  if ((st = martello_eval_energy(E->ev, u, v, &ke1, &dummy)) != MARTELLO_OK)
+    return oe_fail(E, st, "%s: energy evaluation failed", E->name);
+  E->e_impact += ke0 - ke1;
+  for (int j = 0; j < E->nc; j++) E->act[j] = ACT_NONE;
+  if ((st = closed_set_roots(E)) != MARTELLO_OK)
+    return oe_fail(E, MARTELLO_ERR_SINGULAR, "%s: redundant closed contacts at t = %.9e s (B^T M^-1 B singular)", E->name, t);
+  return oe_hand_work(E);
+}
+
+int oe_initial_contacts(ode_events *E, const double *u0, const double *v0) {
+  double vtol = speed_tol(E, v0);
+  for (int j = 0; j < E->nc; j++) {
+    double d = oe_pen(E, j, u0), w = oe_rate(E, j, v0);
+    if (E->rig[j] < 0) {
+      if (d == 0.0 && w > 0.0) E->act[j] = ACT_ONSET;
+    } else {
+      double htol = oe_position_tol(E, j, u0);
+      if (d > htol)
+        return oe_fail(E, MARTELLO_ERR_ARGUMENT, "contact %d starts penetrated by %.3e m (rigid contacts need delta <= 0 at t = 0)", j, d);
+      if (d >= -htol && w >= -vtol) E->act[j] = ACT_IMPACT;
+    }
+  }
+  return MARTELLO_OK;
+}
+
+int oe_restart_progress(ode_events *E, double t) {
+  E->same_time = t - E->t_prev_restart <= 1e-12 * fmax(fabs(t), E->out_dt) ? E->same_time + 1 : 0;
+  E->t_prev_restart = t;
+  if (E->same_time > 8 * (E->nc + 2))
+    return oe_fail(E, MARTELLO_ERR_NOT_CONVERGED, "%s: contact events keep recurring at t = %.9e s without progress", E->name, t);
+  return MARTELLO_OK;
+}
+
+/* ---- set-up --------------------------------------------------------------------------------- */
+
+void oe_release(ode_events *E) {
+  void *all[] = {E->mass, E->gap, E->rest, E->fixed, E->con_a, E->con_b, E->scheme, E->rig,
+                 E->rig_con, E->iu, E->iv, E->closed, E->act, E->opened, E->was_closed, E->hit,
+                 E->cand, E->q, E->w0, E->w_in, E->w_out, E->u, E->v, E->a, E->x, E->uq, E->vq,
+                 E->fint, E->fext, E->force, E->lam, E->S, E->rhs, E->cols, E->dc, E->aset,
+                 E->sw_a, E->sw_b, E->sw_al, E->sw_be, E->sw_ga, E->lc, E->dlc, E->Wc, E->ar,
+                 E->lr, E->lamtol, E->v_last, E->el0, E->el1, E->elc, E->pv0, E->pa0, E->pj0,
+                 E->pv1, E->pa1, E->pj1, E->ua, E->va, E->aa, E->jk};
+  for (size_t k = 0; k < sizeof all / sizeof all[0]; k++) free(all[k]);
+  if (E->ev) martello_eval_free(&E->ev);
+  martello_accumulation_free(&E->acc);
+}
+
+int oe_setup(ode_events *E, martello_model *model, martello_run *run, const char *name) {
+  int st, n, nc, ncp;
+  double failed = 0.0;
+  char what[96];
+  martello_settings s;
+  E->model = model;
+  E->name = name;
+  E->t_prev_restart = -1.0;
+  snprintf(what, sizeof what, "an array of the %s state", name);
+  if ((st = martello_run_settings(run, &s)) != MARTELLO_OK) return st;
+  E->rtol = s.rtol;
+  E->atol = s.atol;
+  E->event_tol = s.event_tol;
+  E->t_end = s.t_end;
+  E->h_max = s.h_max;
+  E->every = s.every;
+  E->out_dt = s.dt * s.every;
+  E->dt = s.dt;
+  if ((st = martello_model_topology(model, &n, &nc, NULL, NULL, NULL, NULL, NULL, NULL, NULL,
+                                    &ncp)) != MARTELLO_OK)
+    return oe_fail(E, st, "%s: could not read the model", name);
+  E->n = n;
+  E->nc = nc;
+  E->ncoupling = ncp;
+  size_t un = (size_t)n, ucn = (size_t)nc;
+  E->mass = oe_take(un, sizeof(double), &failed);
+  E->fixed = oe_take(un, sizeof(int), &failed);
+  E->con_a = oe_take(ucn, sizeof(int), &failed);
+  E->con_b = oe_take(ucn, sizeof(int), &failed);
+  E->scheme = oe_take(ucn, sizeof(int), &failed);
+  E->gap = oe_take(ucn, sizeof(double), &failed);
+  E->rest = oe_take(ucn, sizeof(double), &failed);
+  E->rig = oe_take(ucn, sizeof(int), &failed);
+  E->rig_con = oe_take(ucn, sizeof(int), &failed);
+  if (failed > 0.0) return oe_fail_memory(E, what, failed);
+  if ((st = martello_model_topology(model, &n, &nc, E->mass, E->fixed, E->con_a, E->con_b,
+                                    E->scheme, E->gap, E->rest, &ncp)) != MARTELLO_OK)
+    return oe_fail(E, st, "%s: could not read the model", name);
+  E->nr = 0;
+  for (int j = 0; j < nc; j++) {
+    if (E->scheme[j] == MARTELLO_SCHEME_LAGRANGE || E->scheme[j] == MARTELLO_SCHEME_RESTITUTION) {
+      E->rig[j] = E->nr;
+      E->rig_con[E->nr++] = j;
+    } else if (E->scheme[j] == MARTELLO_SCHEME_PENALTY) {
+      E->rig[j] = -1;
+    } else {
+      return oe_fail(E, MARTELLO_ERR_UNSUPPORTED, "contact %d: this scheme cannot run on %s", j, name);
+    }
+  }
+  size_t nr = (size_t)E->nr;
+  E->iu = oe_take(un, sizeof(sunindextype), &failed);
+  E->iv = oe_take(un, sizeof(sunindextype), &failed);
+  int **per_rigid[] = {&E->closed, &E->opened, &E->was_closed, &E->hit, &E->cand, &E->dc,
+                       &E->aset, &E->lc, &E->dlc};
+  for (size_t k = 0; k < sizeof per_rigid / sizeof per_rigid[0]; k++)
+    *per_rigid[k] = oe_take(nr, sizeof(int), &failed);
+  double **per_rigid_d[] = {&E->q, &E->w0, &E->lam, &E->rhs, &E->lr, &E->lamtol};
+  for (size_t k = 0; k < sizeof per_rigid_d / sizeof per_rigid_d[0]; k++)
+    *per_rigid_d[k] = oe_take(nr, sizeof(double), &failed);
+  E->cols = oe_take(nr * un, sizeof(double), &failed);
+  E->S = oe_take(nr * nr, sizeof(double), &failed);
+  E->Wc = oe_take(nr * nr, sizeof(double), &failed);
+  E->act = oe_take(ucn, sizeof(int), &failed);
+  E->w_in = oe_take(ucn, sizeof(double), &failed);
+  E->w_out = oe_take(ucn, sizeof(double), &failed);
+  E->force = oe_take(ucn, sizeof(double), &failed);
+  double **per_node[] = {&E->u, &E->v, &E->a, &E->x, &E->uq, &E->vq, &E->fint, &E->fext,
+                         &E->ar, &E->v_last, &E->pv0, &E->pa0, &E->pj0, &E->pv1, &E->pa1,
+                         &E->pj1, &E->ua, &E->va, &E->aa, &E->jk};
+  for (size_t k = 0; k < sizeof per_node / sizeof per_node[0]; k++)
+    *per_node[k] = oe_take(un, sizeof(double), &failed);
+  if (failed > 0.0) return oe_fail_memory(E, what, failed);
+  if (martello_accumulation_init(&E->acc, nc, E->t_end) != MARTELLO_OK) {
+    snprintf(what, sizeof what, "the accumulation phases of the %s run", name);
+    return oe_fail_memory(E, what, (double)nc * sizeof(double));
+  }
+  if ((st = martello_eval_create(model, &E->ev)) == MARTELLO_ERR_MEMORY) {
+    char line[480]; /* the model's message is the line (martello_eval_create) */
+    martello_model_message(model, line, (int)sizeof line);
+    return martello_observer_fail(E->obs, st, E->t_now, line);
+  }
+  if (st != MARTELLO_OK) return oe_fail(E, st, "%s: could not create the force evaluator", name);
+  if ((st = martello_eval_link_count(E->ev, &E->nl)) != MARTELLO_OK)
+    return oe_fail(E, st, "%s: martello_eval_link_count failed", name);
+  {
+    const size_t ne = 4 * (ucn + (size_t)E->nl);
+    double **el[] = {&E->el0, &E->el1, &E->elc};
+    for (size_t k = 0; k < sizeof el / sizeof el[0]; k++) *el[k] = oe_take(ne, sizeof(double), &failed);
+    if (failed > 0.0) return oe_fail_memory(E, what, failed);
+  }
+  /* every switching surface of the laws is a root: hold them on smooth branches */
+  if ((st = martello_eval_use_branches(E->ev, &E->nsw)) != MARTELLO_OK)
+    return oe_fail(E, st, "%s: martello_eval_use_branches failed", name);
+  E->sw_a = oe_take((size_t)E->nsw, sizeof(int), &failed);
+  E->sw_b = oe_take((size_t)E->nsw, sizeof(int), &failed);
+  E->sw_al = oe_take((size_t)E->nsw, sizeof(double), &failed);
+  E->sw_be = oe_take((size_t)E->nsw, sizeof(double), &failed);
+  E->sw_ga = oe_take((size_t)E->nsw, sizeof(double), &failed);
+  if (failed > 0.0) return oe_fail_memory(E, what, failed);
+  if (E->nsw > 0 &&
+      (st = martello_eval_switches(E->ev, E->sw_a, E->sw_b, E->sw_al, E->sw_be, E->sw_ga)) != MARTELLO_OK)
+    return oe_fail(E, st, "%s: martello_eval_switches failed", name);
+  return MARTELLO_OK;
+}

@@ -1,0 +1,177 @@
+/* The contact events of the SUNDIALS integrators (IDA in c/ida.c, CVODE and ARKODE in
+ * c/sundials_ode.c; docs/ida.md, docs/sundials-ode.md): one copy of what they share.
+ *
+ * Every one of them integrates the nodes' u and v (at places iu[i], iv[i] of its state y), has
+ * an interpolant of its last step (y and its derivatives at any t inside it), and treats the
+ * contacts alike: two roots per contact (the gap delta_j and its rate; for a closed rigid
+ * contact its multiplier), one per switch slot of the laws' branches; at an event the state is
+ * made consistent (penalty phases, impacts by Newton's law on all touching rigid contacts at
+ * once, the accumulation rule of c/accumulation.c, releases) and the integrator restarts.
+ * Between events every accepted state is a sample of the observer, with the works, the node
+ * extrema and the located peaks of the step computed on its interpolant. What differs between
+ * the adapters -- the state's layout beyond u and v, the residual or right-hand side, how the
+ * integrator restarts and counts -- stays in them. Not part of the public API. */
+#ifndef MARTELLO_ODE_EVENTS_H
+#define MARTELLO_ODE_EVENTS_H
+#include <nvector/nvector_serial.h>
+
+#include "martello_internal.h"
+
+/* Internal to the library: none of these names is exported from libmartello. */
+#pragma GCC visibility push(hidden)
+
+/* What happens to a contact at a restart. */
+enum { ACT_NONE, ACT_ONSET, ACT_SEPARATION, ACT_IMPACT, ACT_RELEASE };
+
+/* The integrator's interpolant of its last step: the k-th derivative of y at t into out.
+ * MARTELLO_OK, or a status once the run has failed with the integrator's message. */
+typedef int (*ode_interpolant)(void *ctx, double t, int k, N_Vector out);
+
+typedef struct {
+  martello_model *model;
+  martello_observer *obs;     /* what the run measures */
+  martello_eval *ev;
+  const char *name;           /* "IDA", "CVODE", "ARKODE": what the messages say */
+  ode_interpolant dky;        /* the adapter's interpolant, called with ctx */
+  void *ctx;
+  /* scene (martello_model_topology) */
+  int n, nc, nr, ncoupling, nl;
+  double *mass, *gap, *rest;
+  int *fixed, *con_a, *con_b, *scheme;
+  int *rig;                   /* contact -> rigid index, or -1 (penalty) */
+  int *rig_con;               /* rigid index -> contact */
+  sunindextype *iu, *iv;      /* where u_i, v_i sit in y (the adapter's layout) */
+  /* modes */
+  int *closed;   /* per rigid contact: constraint active */
+  int *act;      /* per contact: ACT_* at the restart being prepared */
+  int *opened;   /* per rigid contact: opened by the multiplier check at this restart */
+  int *was_closed, *hit, *cand; /* per rigid contact, at an impact */
+  double *w_in, *w_out; /* per contact: approach and rebound speed of the impact being resolved */
+  /* work */
+  double *u, *v, *a, *x, *uq, *vq, *fint, *fext, *force, *lam;
+  double *S, *rhs;
+  int *aset;
+  double *q, *w0;
+  /* the impulse problem (c/martello_internal.h): M^-1 B_r^T of every rigid contact (column r,
+   * B_r = e_b - e_a), built once; the door lists of the contacts in aset */
+  double *cols;
+  int cols_ready, *dc;
+  /* the switches of the laws' branches (martello_eval_switches), refreshed at every commit:
+   * roots 2 nc .. 2 nc + nsw - 1 */
+  int nsw, *sw_a, *sw_b;
+  double *sw_al, *sw_be, *sw_ga;
+  martello_accumulation acc; /* the accumulation rule's phases (c/accumulation.c) */
+  /* the release roots: the closed set at the last restart (its rigid contacts lc[0..mc), their
+   * door list dlc and W factored in Wc), the free accelerations ar and the signed multipliers
+   * lr of a state, and the tension each needs before it counts (lamtol, per rigid contact) */
+  int mc, *lc, *dlc;
+  double *Wc, *ar, *lr, *lamtol;
+  double *v_last;             /* node velocities at the last accepted state (located extrema) */
+  /* located peaks (c/located_peaks.c): element quantities and rates (its packed layout) at the
+   * ends of the stretch (0, 1) and at a probe (c); node v, a and jerk at both ends; u, v, a and
+   * the jerks of a probe */
+  int start_rates;
+  double *el0, *el1, *elc, *pv0, *pa0, *pj0, *pv1, *pa1, *pj1, *ua, *va, *aa, *jk;
+  N_Vector ytmp, ytd;         /* the interpolant's outputs (the adapter creates them) */
+  /* settings */
+  double rtol, atol, event_tol, t_end, h_max, out_dt, dt;
+  int restarts;               /* 1: the integrator restarts at order 1 after an event (BDF;
+                                 the accumulation rule's resolution), 0: a one-step method */
+  int every;                  /* output intervals dt per stop time out_dt */
+  /* works since the last hand-over to the observer: external, internal, of the links other
+   * than dampers and of the penalty contacts (quadrature), kinetic energy taken out at
+   * restarts */
+  double dw_ext, dw_int, dw_links, dw_contact, e_impact;
+  /* diagnostics */
+  double t_now;               /* where the integration stands (the t_reached of a failure) */
+  int nan_seen;
+  long long events;
+  long cnt_last[9];           /* the integrator's counters at the last hand-over */
+  int same_time;              /* restarts in a row at one time */
+  double t_prev_restart;
+} ode_events;
+
+/* ---- set-up and failures -------------------------------------------------------------------- */
+/* The settings, topology and arrays of a run, its evaluator on smooth branches with their
+ * switches; the contact schemes the caller runs: rigid ones (lagrange, restitution) on the
+ * rigid index. MARTELLO_OK, or a status once the run has failed. The caller fills iu and iv. */
+int oe_setup(ode_events *E, martello_model *model, martello_run *run, const char *name);
+void oe_release(ode_events *E);
+/* The run fails with code at E->t_now, saying fmt (MARTELLO_ERR_MEMORY: the LCP solver's work
+ * arrays, the out-of-memory line). */
+int oe_fail(ode_events *E, int code, const char *fmt, ...);
+/* The out-of-memory line for what (bytes < 0: allocated inside SUNDIALS, amount not known). */
+int oe_fail_memory(ode_events *E, const char *what, double bytes);
+/* calloc(count) (at least one element); on failure its size is kept in *failed (the first that
+ * failed), for the out-of-memory line. */
+void *oe_take(size_t count, size_t size, double *failed);
+
+/* ---- kinematics ----------------------------------------------------------------------------- */
+/* delta = (u_a - u_b) - gap, in the kernels' order of operations (fortran/evaluator.f90). */
+double oe_pen(const ode_events *E, int j, const double *u);
+/* delta' = v_a - v_b. */
+double oe_rate(const ode_events *E, int j, const double *v);
+void oe_gather(const ode_events *E, const double *y, double *u, double *v);
+/* Gap within which a rigid contact touches. */
+double oe_position_tol(const ode_events *E, int j, const double *u);
+/* Move contact j strictly to side sgn (+1: delta > 0) by the smallest shift of one free node. */
+void oe_nudge(ode_events *E, int j, int sgn, double *u);
+
+/* x <- B lambda over the closed rigid contacts (lambda per rigid contact, x per node). */
+void oe_apply_B(const ode_events *E, const double *lam, double *x);
+
+/* ---- roots and events ----------------------------------------------------------------------- */
+/* The number of root functions: two per contact, one per switch slot. */
+int oe_nroots(const ode_events *E);
+/* The root functions at (t, u, v): (delta, delta') of open and penalty contacts, (lambda + its
+ * tension bar, 1) of closed rigid ones (the state's multipliers, oe_closed_multipliers), then the
+ * switches (g > 0: the branch is left). */
+int oe_roots(ode_events *E, double t, const double *u, const double *v, double *g);
+/* The signed multipliers of the closed set at (t, u, v) into E->lr (compression > 0) and the
+ * constrained accelerations into E->ar: W_H lambda = -B_H a_free, a = a_free + M^-1 B_H^T lambda. */
+int oe_closed_multipliers(ode_events *E, double t, const double *u, const double *v);
+/* Accelerations a with the closed set's forces: a <- a + M^-1 B_H^T lambda, W_H lambda = -B_H a
+ * (lambda into E->x; linear in a, so a sum of parts may be constrained part by part). */
+int oe_constrain(ode_events *E, double *a);
+/* What the roots reported at tret mean: 1 (with *t_r and E->act) if the integrator restarts,
+ * 0 if they were extrema of gaps, < 0 on failure. */
+int oe_classify_roots(ode_events *E, double t_last, double tret, const double *y,
+                      const int *found, double *t_r);
+/* A reported root of an open or penalty contact exactly 0 at the return (identical
+ * neighbours): 1 (a restart with no event lets the integrator move away). Closed rigid contacts
+ * are the adapter's (their multiplier). */
+int oe_root_stays_zero(ode_events *E, const double *y, const int *found);
+/* After a step without a root: a contact on the wrong side of its regime (h_last: the last
+ * step). 1 with E->act and *t_r if the integrator must restart, 0 if not, < 0 on failure. */
+int oe_boundary_events(ode_events *E, double t_last, double tret, const double *y,
+                       double h_last, double *t_r);
+/* The contacts at t = 0: penalty contacts at zero gap and closing get an onset; rigid contacts
+ * at zero gap that approach or rest are resolved as impacts (one penetrated is refused). */
+int oe_initial_contacts(ode_events *E, const double *u0, const double *v0);
+/* Make the state (u, v) at a restart at t consistent with E->act: penalty regimes, impacts,
+ * closings, releases; commit; the multipliers of the closed set into E->lam and the free
+ * accelerations into E->a; the release roots; the works handed over. */
+int oe_prepare_restart(ode_events *E, double t, double *u, double *v);
+/* A restart at t: MARTELLO_ERR_NOT_CONVERGED (run failed) when events keep recurring at one
+ * time without progress. */
+int oe_restart_progress(ode_events *E, double t);
+
+/* ---- what the observer is handed ---------------------------------------------------------- */
+/* Commit (u, v) in the evaluator and read the switches again (the branches may change). */
+int oe_commit(ode_events *E, const double *u, const double *v);
+/* The works since the last hand-over (once per commit). */
+int oe_hand_work(ode_events *E);
+/* The stretch [t0, t1] of the last step, on its interpolant: the works (3-point Gauss), the
+ * node extrema against E->v_last (y1: the state at t1) and the located peaks; at_event: the
+ * integrator restarts at t1 (its state jumps there), so the end is a peak candidate too
+ * (martello_peak_fold_end). */
+int oe_stretch(ode_events *E, double t0, double t1, const double *y1, int at_event);
+/* After a stretch: its end's rates are the next one's start unless the integrator restarts. */
+void oe_keep_end_rates(ode_events *E, int unchanged);
+/* The next stop after t: t_out, or a kink of the load before it. */
+double oe_next_stop(ode_events *E, double t, double t_out);
+/* The integrator's counters now (MARTELLO_COUNTER_* order; events and chatter ignored): their
+ * increase since the last hand-over, and the events, to the run. */
+int oe_add_counts(ode_events *E, const long c[9]);
+#pragma GCC visibility pop
+#endif
