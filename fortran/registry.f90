@@ -373,10 +373,12 @@ module martello_registry
                    READS_BASE + READS_DIVERGENCE + 2**S_TOL_RESIDUAL + 2**S_MAX_NEWTON, &
                    RUNS_PENALTY, 'Wilson (2002) fast nonlinear analysis: exact modal steps, pseudo-forces'), &
       integrator_t('cvode', INT_CVODE, FAMILY_ODE, .true., &
-                   READS_BASE + READS_DIVERGENCE + READS_ADAPTIVE + 2**S_METHOD, RUNS_PENALTY, &
+                   READS_BASE + READS_DIVERGENCE + READS_ADAPTIVE + 2**S_METHOD, &
+                   RUNS_PENALTY + RUNS_RIGID, &
                    'SUNDIALS CVODE, variable-order BDF or Adams, banded analytic Jacobian'), &
       integrator_t('arkode', INT_ARKODE, FAMILY_ODE, .true., &
-                   READS_BASE + READS_DIVERGENCE + READS_ADAPTIVE + 2**S_METHOD, RUNS_PENALTY, &
+                   READS_BASE + READS_DIVERGENCE + READS_ADAPTIVE + 2**S_METHOD, &
+                   RUNS_PENALTY + RUNS_RIGID, &
                    'SUNDIALS ARKODE, explicit, diagonally implicit or ImEx Runge-Kutta tables')]
 
    !> The tables; text: the prefix of their C constants in c/martello.h ('' if none).
