@@ -52,6 +52,10 @@ SAMPLE = {
     ("rk8pd", "none"): "sdof/sdof_sine_rk8pd.toml",
     ("rkf45", "none"): "sdof/sdof_sine_rkf45.toml",
     ("msbdf", "none"): "sdof/sdof_sine_msbdf.toml",
+    ("cvode", "restitution"): "p5/p5_cvode_restitution.toml",
+    ("cvode", "lagrange"): "p2/p2_cvode_lagrange.toml",
+    ("arkode", "restitution"): "p5/p5_arkode_restitution.toml",
+    ("arkode", "lagrange"): "p2/p2_arkode_lagrange.toml",
 }
 
 
