@@ -401,19 +401,13 @@ def main():
     if not a.skip_pounding:
         pounding(py, out, a.repeats, rows)
     result = {"triad_gbs": gbs, "rows": rows, "machine": list(os.uname()),
-              "martello": native.version(), "commit": commit(), "track": a.track,
+              "martello": native.version(), "commit": measured_docs.commit(), "track": a.track,
               "date_utc": [start, time.strftime("%Y-%m-%d %H:%M", time.gmtime())],
               "load_end": load()}
     (out / "chain_vs_opensees.json").write_text(json.dumps(result, indent=1))
     print(f"results: {out / 'chain_vs_opensees.json'}")
     if a.docs:
         measured_docs.record(a.docs, result, render(result))
-
-
-def commit():
-    r = subprocess.run(["git", "-C", str(ROOT), "describe", "--always", "--dirty"],
-                       capture_output=True, text=True)
-    return r.stdout.strip() or None
 
 
 def render(result):

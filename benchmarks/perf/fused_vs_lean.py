@@ -102,18 +102,12 @@ def measure(a):
     ns = {f"{t}/{k}": [r["wall_s"] / per for r in rs] for (t, k), rs in runs.items()}
     cpu = {f"{t}/{k}": [r["cpu_s"] / per for r in rs] for (t, k), rs in runs.items()}
     return {"n": a.n, "steps": a.steps, "track": a.track, "repeats": a.repeats,
-            "date_utc": time.strftime("%Y-%m-%d %H:%M", time.gmtime()), "commit": commit(),
+            "date_utc": time.strftime("%Y-%m-%d %H:%M", time.gmtime()), "commit": measured_docs.commit(),
             "load": [min(loads), max(loads)], "same_u_to_the_bit": same,
             "ns_per_dof_step": ns, "cpu_ns_per_dof_step": cpu,
             "flags": {t: b["flags"] for t, b in builds.items()},
             "newton_per_step": runs["generic", "fused"][-1]["newton"] / a.steps,
             "fused_steps": runs["generic", "fused"][-1]["fused"]}
-
-
-def commit():
-    r = subprocess.run(["git", "-C", str(ROOT), "describe", "--always", "--dirty"],
-                       capture_output=True, text=True)
-    return r.stdout.strip() or None
 
 
 def pairs(result, key, a, b):

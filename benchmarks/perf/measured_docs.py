@@ -7,12 +7,20 @@ the page's copy the same (tests/test_generated_docs.py). The table then cannot d
 the measurement it reports, nor be edited by hand."""
 
 import json
+import subprocess
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[2]
 DOC = ROOT / "docs" / "performance.md"
 RECORDS = ROOT / "docs" / "perf"
 END = "<!-- /generated -->"
+
+
+def commit():
+    """The checkout's commit (git describe; -dirty where it has uncommitted changes)."""
+    r = subprocess.run(["git", "-C", str(ROOT), "describe", "--always", "--dirty"],
+                       capture_output=True, text=True)
+    return r.stdout.strip() or None
 
 
 def fence(name):
