@@ -17,10 +17,14 @@ END = "<!-- /generated -->"
 
 
 def commit():
-    """The checkout's commit (git describe; -dirty where it has uncommitted changes)."""
-    r = subprocess.run(["git", "-C", str(ROOT), "describe", "--always", "--dirty"],
-                       capture_output=True, text=True)
-    return r.stdout.strip() or None
+    """The checkout's commit, "-dirty" where the code measured (the library's sources, the
+    front end, the benchmarks, the build) has uncommitted changes; None outside git."""
+    head = subprocess.run(["git", "-C", str(ROOT), "rev-parse", "--short", "HEAD"],
+                          capture_output=True, text=True).stdout.strip()
+    changed = subprocess.run(["git", "-C", str(ROOT), "status", "--porcelain", "--", "fortran", "c",
+                              "martello", "benchmarks/perf", "CMakeLists.txt", "cmake"],
+                             capture_output=True, text=True).stdout.strip()
+    return (head + ("-dirty" if changed else "")) or None
 
 
 def fence(name):
