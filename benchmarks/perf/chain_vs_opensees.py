@@ -412,35 +412,43 @@ def main():
 
 def render(result):
     """The table of a run's results (chain_vs_opensees.json): per n, martello's time loop
-    and OpenSees' (where it ran) per DOF-step and their ratio, martello's whole process
-    (wall and CPU), its peak memory per DOF and the load; medians of the repeats."""
+    per DOF-step, OpenSees' and their ratios where it ran (wall; CPU against the library
+    alone on the same chain), martello's whole process (wall and CPU), its peak memory per
+    DOF and the load; medians of the repeats."""
+    med = statistics.median
     rows = [r for r in result["rows"] if "n" in r]
+    with_os = any(r.get("ratio") is not None for r in rows)
     dates = result["date_utc"]
-    lines = [f"{dates[0]} – {dates[1][-5:]} UTC, martello {result['martello']} at commit "
-             f"{result['commit']}, tracking {result['track'] or 'the scene default (node peaks where OpenSees runs)'}; "
-             f"medians of {len(rows[0]['martello_native_s'])} runs, the codes alternating; "
-             f"triad {result['triad_gbs']:.1f} GB/s", "",
-             "| n | steps | martello ns/DOF-step | OpenSees ns/DOF-step (its CPU/wall) | "
-             "OpenSees/martello, wall | OpenSees/martello, CPU (the library alone) "
-             "| martello process s (CPU s) | peak B/DOF | peak \\|u\\| rel. diff | load |",
-             "|---|---|---|---|---|---|---|---|---|---|"]
+    track = result["track"] or "the scene's default (node peaks too where OpenSees runs)"
+    head = (f"{dates[0]} – {dates[1][-5:]} UTC, martello {result['martello']} at commit "
+            f"{result['commit']}, tracking {track}; medians of {len(rows[0]['martello_native_s'])} "
+            f"run(s){', the codes alternating' if with_os else ''}; load at the start of each "
+            f"size in the table, {result['load_end']:.1f} at the end; triad {result['triad_gbs']:.1f} GB/s")
+    cols = ["n", "steps", "martello time loop ns/DOF-step (wall)"]
+    if with_os:
+        cols += ["OpenSees ns/DOF-step (its CPU/wall)", "OpenSees/martello, wall",
+                 "OpenSees/martello, CPU (the library alone's ns/DOF-step)"]
+    cols += ["martello process s (CPU s)", "peak B/DOF"]
+    if with_os:
+        cols += ["peak \\|u\\| rel. diff"]
+    cols += ["load"]
+    lines = [head, "", "| " + " | ".join(cols) + " |", "|" + "---|" * len(cols)]
     for r in rows:
-        med = statistics.median
-        cpu = med(r["martello_process_cpu_s"]) if "martello_process_cpu_s" in r else None
-        os_ = "–"
-        if r.get("ratio") is not None:
-            share = (f" ({med(c / w for c, w in zip(r['opensees_loop_cpu_s'], r['opensees_loop_s'])):.2f})"
-                     if "opensees_loop_cpu_s" in r else "")
-            os_ = f"{r['opensees_ns_per_dof_step']:.0f}{share}"
-        lines.append(
-            f"| {r['n']} | {r['steps']} | {r['martello_ns_per_dof_step']:.1f} | {os_} | "
-            + (f"{r['ratio']:.0f}×" if r.get("ratio") is not None else "–") + " | "
-            + (f"**{r['cpu_ratio']:.0f}×** ({med(r['library_loop_cpu_s']) / (r['n'] * r['steps']) * 1e9:.1f} ns)"
-               if r.get("cpu_ratio") is not None else "–")
-            + f" | {r['martello_process_s']:.1f}" + (f" ({cpu:.1f})" if cpu is not None else "")
-            + f" | {r['martello_peak_rss_bytes_per_dof']:.0f} | "
-            + (f"{r['peak_u_max_rel_diff']:.1e}" if r.get("peak_u_max_rel_diff") is not None else "–")
-            + f" | {r['load']:.1f} |")
+        cells = [f"{r['n']}", f"{r['steps']}", f"{r['martello_ns_per_dof_step']:.1f}"]
+        if with_os:
+            cells += ["–"] * 3
+            if r.get("ratio") is not None:
+                share = med(c / w for c, w in zip(r["opensees_loop_cpu_s"], r["opensees_loop_s"]))
+                lib_ns = med(r["library_loop_cpu_s"]) / (r["n"] * r["steps"]) * 1e9
+                cells[-3:] = [f"{r['opensees_ns_per_dof_step']:.0f} ({share:.2f})", f"{r['ratio']:.0f}×",
+                              f"**{r['cpu_ratio']:.0f}×** ({lib_ns:.1f})"]
+        cells += [f"{r['martello_process_s']:.1f} ({med(r['martello_process_cpu_s']):.1f})",
+                  f"{r['martello_peak_rss_bytes_per_dof']:.0f}"]
+        if with_os:
+            d = r.get("peak_u_max_rel_diff")
+            cells += [f"{d:.1e}" if d is not None else "–"]
+        cells += [f"{r['load']:.1f}"]
+        lines.append("| " + " | ".join(cells) + " |")
     return "\n".join(lines)
 
 
