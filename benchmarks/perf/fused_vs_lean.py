@@ -40,7 +40,7 @@ import measured_docs  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[2]
 HERE = Path(__file__).resolve().parent
-NAME = "fused_vs_lean"        # docs/perf/NAME.json and its fence in docs/performance.md
+NAME = "fused_vs_lean"        # its record docs/perf/fused_vs_lean.json, its fence in docs/performance.md
 
 
 def fortran_flags(build):
