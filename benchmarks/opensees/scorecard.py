@@ -136,20 +136,28 @@ def _martello_history(scene, dt, folder):
 
 def measure(rows, out, only=None, cap=MAX_NODE_STEPS, refine=1):
     """Run the scenes OpenSees takes as they are, at their step and (refine > 1) at the step
-    halved refine − 1 times; returns measured rows."""
+    halved refine − 1 times; returns measured rows, each also appended to out/measured.jsonl as
+    it is made (a long sweep stopped half-way keeps what it measured)."""
     from martello.scene import catalogue
     from martello.scene.loader import load
     res = []
     wanted = [w for w in (only or "").split(",") if w]
     todo = [(rel, problem, integ, dt / 2 ** k, mats, k) for rel, problem, status, integ, dt, mats, _ in rows
             if status == "as is" and (not wanted or any(w in rel for w in wanted)) for k in range(refine)]
+    log = (out / "measured.jsonl").open("a")
+    keep = res.append
+
+    def record(row):
+        keep(row)
+        log.write(json.dumps(row, default=str) + "\n")
+        log.flush()
     for rel, problem, integ, dt, mats, k in todo:
         scene = catalogue.ROOT / rel
         s = load(scene)
         size = len(s.nodes) * s.analysis["t_end"] / dt
         if size > cap:
-            res.append({"scene": rel, "problem": problem, "integrator": integ, "dt": dt, "materials": mats,
-                        "opensees": f"not measured: {size:.2g} node-steps (cap {cap:.0e})"})
+            record({"scene": rel, "problem": problem, "integrator": integ, "dt": dt, "materials": mats,
+                    "opensees": f"not measured: {size:.2g} node-steps (cap {cap:.0e})"})
             continue
         work = out / (rel.replace("/", "__").removesuffix(".toml") + (f"__dt{k}" if k else ""))
         t0 = time.time()
@@ -157,11 +165,14 @@ def measure(rows, out, only=None, cap=MAX_NODE_STEPS, refine=1):
                            + (["--dt", repr(dt)] if k else []), capture_output=True, text=True, cwd=ROOT)
         row = {"scene": rel, "problem": problem, "integrator": integ, "dt": dt, "materials": mats}
         if r.returncode == 0:
-            r = subprocess.run([sys.executable, "model.py"], capture_output=True, text=True, cwd=work / "os",
-                               timeout=3600)
+            try:
+                r = subprocess.run([sys.executable, "model.py"], capture_output=True, text=True,
+                                   cwd=work / "os", timeout=3600)
+            except subprocess.TimeoutExpired:
+                r = subprocess.CompletedProcess([], 1, "", "model.py did not finish in 3600 s")
         if r.returncode:
             row["opensees"] = "failed: " + (r.stderr.strip().splitlines() or ["?"])[-1][:120]
-            res.append(row)
+            record(row)
             print(f"{rel}: {row['opensees']}", flush=True)
             continue
         row["opensees_seconds"] = time.time() - t0
@@ -178,7 +189,7 @@ def measure(rows, out, only=None, cap=MAX_NODE_STEPS, refine=1):
                 peak = max(np.max(np.abs(dm[:n, hm.index(c)])) for c in us)
                 row["os_vs_martello"] = float(diff / peak) if peak > 0 else float(diff)
         row.update(os=os_score, martello=m_score)
-        res.append(row)
+        record(row)
         print(f"{rel}: OpenSees scd {os_score.get('scd')}, martello scd {m_score.get('scd')}, "
               f"|OS - martello| {row.get('os_vs_martello')}", flush=True)
     return res
