@@ -225,6 +225,17 @@ def test_static_mass_coupling_and_central_difference_refusals():
         opensees_model(from_dict(d, source="tb"))
 
 
+def test_a_building_is_refused_naming_it_and_why():
+    """[[building]] (docs/buildings.md) is a 3D model condensed to its floors' DOFs: the
+    exporter writes none, and says so before the building's mass couplings could be blamed."""
+    b = {"prefix": "B", "storeys": 1, "storey_height": 3.0, "grid_x": [0.0, 6.0], "grid_y": [0.0, 4.0],
+         "column": {"E": 3e10, "b2": 0.3, "b3": 0.5}, "mass": 2.0e5}
+    d = {"building": [b], "analysis": {"type": "dynamic", "integrator": "newmark", "dt": 1e-3, "t_end": 0.1}}
+    with pytest.raises(ExportError, match=r"\[\[building\]\]: cannot be exported.*3D model.*rigidDiaphragm.*"
+                                          r"buildings B: a planar \[\[frame\]\]"):
+        opensees_model(from_dict(d, source="bd"))
+
+
 def test_a_full_kelvin_is_never_mapped_onto_a_half_kelvin_silently(tmp_path):
     """JankowskiImpact with n = 1 damps only while approaching: asked for, the change of law
     and both restitutions are stated in the differences, the script and on stderr."""

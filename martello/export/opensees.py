@@ -134,6 +134,21 @@ class _Builder:
                         "(fast nonlinear) integrator",
                         "give --integrator newmark, hht, generalized-alpha or central-difference "
                         "and --dt")
+        buildings = s.extras.get("buildings", [])
+        if buildings:
+            self.refuse("[[building]]", "the exporter writes chains of nodes and planar frames; a "
+                        "building is a 3D model condensed to its floors' ux, uy, rz, which OpenSees "
+                        "would take as 6-DOF nodes with rigidDiaphragm floors (docs/buildings.md), a "
+                        "model the exporter does not write",
+                        "buildings " + ", ".join(b["prefix"] for b in buildings) + ": a planar "
+                        "[[frame]] per building exports where the plan is symmetric")
+        for kind, items in (("contact", s.contacts), ("link", s.links)):
+            for i, it in enumerate(items):
+                if it.get("terms") is not None:
+                    self.refuse(f"{kind}[{i}] ({it['name']}).terms",
+                                "a row Σ c·u over several DOFs (plan points of rigid floors or "
+                                "written terms): OpenSees' zeroLength acts between two nodes along "
+                                "one direction", "give the element two nodes a and b")
         if s.couplings:
             self.refuse("mass_coupling", "OpenSees nodal masses are diagonal and martello's "
                         "couplings are general off-diagonal terms",
@@ -426,8 +441,12 @@ class _Builder:
         if k == "constant":
             self.add("timeSeries", "Constant", tag, "-factor", fn["value"])
         elif k == "sine":
-            # Trig: factor·sin(2π(t − tStart)/period + shift) on [tStart, tEnd], both included
-            self.add("timeSeries", "Trig", tag, fn["t_start"], fn["t_end"], 2.0 * math.pi / fn["omega"],
+            # Trig: factor·sin(2π(t − tStart)/period + shift) on [tStart, tEnd], both included.
+            # An open-ended sine ends two steps after the analysis (never evaluated later):
+            # UniformExcitation integrates its series over [tStart, tEnd] when it is built, and
+            # an end at 1e300 makes OpenSees print "Ran out of memory" there
+            t1 = min(float(fn["t_end"]), float(self.an["t_end"]) + 2.0 * float(self.an.get("dt") or 0.0))
+            self.add("timeSeries", "Trig", tag, fn["t_start"], t1, 2.0 * math.pi / fn["omega"],
                      "-factor", fn["amplitude"], "-shift", fn["phase"])
         elif k == "half_sine":
             self.add("timeSeries", "Trig", tag, fn["t_start"], fn["t_end"],
