@@ -625,9 +625,18 @@ class _Builder:
             else:
                 rho = an["rho_inf"]
                 am, af = (2.0 - rho) / (1.0 + rho), 1.0 / (1.0 + rho)
-                gamma, beta = 0.5 + am - af, 0.25 * (1.0 + am - af) ** 2
-                self.add("integrator", "GeneralizedAlpha", am, af, gamma, beta)
-                what = f"GeneralizedAlpha alphaM = {am:.17g}, alphaF = {af:.17g} (ρ∞ = {rho:g})"
+                # the two-number form: its constructor sets Chung & Hulbert's γ = ½ + αM − αF,
+                # β = ¼(1 + αM − αF)²; the four-number form hands "$gamma $beta" to a
+                # constructor (αM, αF, β, γ), i.e. swapped (docs/opensees.md "Integrators")
+                self.add("integrator", "GeneralizedAlpha", am, af)
+                what = (f"GeneralizedAlpha alphaM = {am:.17g}, alphaF = {af:.17g} (ρ∞ = {rho:g}; γ, β "
+                        "of Chung & Hulbert set by OpenSees)")
+            if name == "generalized-alpha":
+                self.diff.append(
+                    "generalized-alpha: OpenSees' GeneralizedAlpha forms the inertia with a_{n+1} "
+                    "while its tangent carries alphaM (GeneralizedAlpha::update sets the response "
+                    "(u_{n+αF}, v_{n+αF}, a_{n+1})): its solution is first-order accurate, "
+                    "martello's Chung–Hulbert second order (docs/opensees.md \"Integrators\")")
             if name in ("hht", "generalized-alpha"):
                 self.diff.append(
                     f"{name}: OpenSees evaluates the internal and external forces at the "
