@@ -224,6 +224,26 @@ def _num(x):
     return x if isinstance(x, (int, float)) and np.isfinite(x) else None
 
 
+CAUSES = (("GeneralizedAlpha forms the inertia", "GeneralizedAlpha's inertia at t_{n+1}"),
+          ("interpolated state", "state interpolation of HHT/GA"),
+          ("Hertzdamp takes v_in", "Hertzdamp's v_in"),
+          ("damped only while approaching", "half-Kelvin"),
+          ("event_split", "no event split"),
+          ("fluid damper", "Viscous below v_reg"),
+          ("condenses out", "frames uncondensed"),
+          ("u_{-1} = u_0", "CentralDifference's start from a_0 = 0"))
+
+
+def causes(rel, dt):
+    """The differences of the two models the exporter states for a scene at step dt (the
+    candidates for a model finding), as short names."""
+    from martello.export import opensees_model
+    from martello.scene import catalogue
+    from martello.scene.loader import load
+    diff = opensees_model(load(catalogue.ROOT / rel), analysis={"dt": dt}).differences
+    return [short for key, short in CAUSES if any(key in d for d in diff)]
+
+
 def finding(r):
     """Which side of OpenSees' error against the law is the numerical error and which the model
     difference. OpenSees' error = martello's error at the same integrator and step (the method's
@@ -254,6 +274,8 @@ def finding(r):
     else:
         cls, words = "both", (f"both: \\|OS − m\\| {d:.1e} comparable to the method's error {err_m:.1e}, "
                               "same digits")
+    if cls != "numerical" and r.get("causes"):
+        words += " (stated differences: " + ", ".join(r["causes"]) + ")"
     return cls, "; ".join([words] + notes)
 
 
@@ -267,6 +289,9 @@ def measured_part(res, version, sample_note=""):
     """The measured block: counts, the digits distribution, one row per problem × law → material
     × integrator × Δt, then every scene."""
     from collections import Counter, defaultdict
+    for r in res:
+        if "os" in r and "causes" not in r:
+            r["causes"] = causes(r["scene"], r["dt"])
     ran = [r for r in res if "os" in r]
     other = [r for r in res if "os" not in r]
     cls = Counter(finding(r)[0] for r in ran)

@@ -570,11 +570,14 @@ class _Builder:
             f -= m * self.value_at_zero(s.ground)
         for fo in s.forces:
             f[fo["node"]] += self.value_at_zero(fo["function"])
+        self.accelerated = []               # free nodes with a_0 ≠ 0 (central difference's start)
         for i, nd in enumerate(s.nodes):
             if nd["fixed"]:
                 continue
             tag = self.node_tag[i]
             a0 = f[i] / m[i]
+            if a0 != 0.0:
+                self.accelerated.append(nd["name"])
             if u[i] != 0.0:
                 self.add("setNodeDisp", tag, 1, float(u[i]), "-commit")
             if v[i] != 0.0:
@@ -610,6 +613,12 @@ class _Builder:
             self.add("algorithm", "Linear")
             self.add("integrator", "CentralDifference")
             what = "CentralDifference (explicit: no Newton iteration)"
+            if self.accelerated:
+                self.diff.append(
+                    "central-difference: OpenSees starts from u_{-1} = u_0, i.e. from a_0 = 0 "
+                    "(CentralDifference::domainChanged); here a_0 != 0 at "
+                    f"{', '.join(self.accelerated[:4])} (gravity or a load at t = 0): its velocities "
+                    "carry an error a_0·Δt/2 from the first step on, first order in Δt")
         else:
             self.add("test", "NormDispIncr", tol, iters)
             self.add("algorithm", "Newton")
