@@ -290,7 +290,7 @@ def measured_part(res, version, sample_note=""):
     × integrator × Δt, then every scene."""
     from collections import Counter, defaultdict
     for r in res:
-        if "os" in r and "causes" not in r:
+        if "causes" not in r and not r.get("opensees", "").startswith("not measured"):
             r["causes"] = causes(r["scene"], r["dt"])
     ran = [r for r in res if "os" in r]
     other = [r for r in res if "os" not in r]
@@ -355,8 +355,9 @@ def measured_part(res, version, sample_note=""):
             "|---|---|---|---|---|---|---|---|---|---|---|"]
     for r in sorted(res, key=lambda r: (r["scene"], -(r["dt"] or 0))):
         if "os" not in r:
+            stated = ("stated differences: " + ", ".join(r["causes"])) if r.get("causes") else ""
             out.append(f"| `{r['scene']}` | {r['materials']} | {r['integrator']} | {r['dt']:g} | "
-                       f"{r.get('opensees')} | | | | | | |")
+                       f"{r.get('opensees')} | | | | | | {stated} |")
             continue
         o, m = r["os"], r["martello"]
         e = f"{_f(o.get('restitution'), '.4f')} / {_f(o.get('restitution_ref'), '.4f')}"
