@@ -228,6 +228,11 @@ def test_symmetric_building_is_the_planar_frame():
             for j in (0, 1, 2):
                 mb = rb["buildings"]["B"]["members"][f"C{s_}.{line}.{j}"]["M3_i"]
                 assert mb["max"] == pytest.approx(-mp["min"] / 3, rel=1e-8)
+    # no M2 here: the biaxial resultant's peak is |M3|'s, at its time
+    c = rb["buildings"]["B"]["members"]["C1.0.0"]
+    peak = max(c["M3_i"]["max"], -c["M3_i"]["min"])
+    at = c["M3_i"]["t_max"] if c["M3_i"]["max"] >= -c["M3_i"]["min"] else c["M3_i"]["t_min"]
+    assert c["M_i_resultant_max"] == pytest.approx(peak, rel=1e-12) and c["M_i_resultant_t"] == at
 
 
 def test_reference_point_and_ground_direction_change_nothing_physical():
