@@ -26,7 +26,9 @@
 !> ch. 14 and 18; Wilson, Yuan & Dickens 1982) instead: the start block is the initial u and v
 !> and K_L⁻¹ of the spatial load patterns (M·ι of the ground motion, a unit force at each
 !> loaded node) and of the nonlinear elements' force patterns (their rows gᵀ), in that order;
-!> then blocks x ← K_L⁻¹ M x; every vector M-orthonormalised (Gram–Schmidt, twice; one that
+!> then blocks x ← K_L⁻¹ M x and, with dampers, K_L⁻¹ C_L x (the second-order Krylov space of
+!> K + sC + s²M, Bai & Su 2005: a non-proportional C drives directions K_L⁻¹M alone never
+!> reaches); every vector M-orthonormalised (Gram–Schmidt, twice; one that
 !> vanishes is dropped) until m are kept; then the m × m eigenproblem of K_L, M on them gives
 !> the Ritz modes Φ (φᵀMφ = 1, ΦᵀK_LΦ = diag ω²). K_L is factorised in band storage (shifted
 !> by σM when singular: nodes held by nonlinear elements only). Setup O(n m² + n kd² m + m³),
@@ -198,7 +200,7 @@ contains
                                       self%g1q(i), self%g1v(i))
       end do
       if (self%ritz) then
-         call ritz_newton_setup(self, info, msg)
+         call ritz_newton_setup(self, m, dof, info, msg)
       else
          call newton_setup(self, m, dof, kl, cl, info, msg)
       end if
@@ -249,22 +251,11 @@ contains
       real(dp), intent(in) :: kl(:, :), cl(:, :)
       integer, intent(out) :: info        !< NEWTON_NO_MEMORY (msg says what), or dgetrf's
       character(len=*), intent(out) :: msg
-      logical :: touched(self%nf)
       integer :: j, nf
       character(len=96) :: what
       real(dp), allocatable :: coff(:, :)
       nf = self%nf
-      touched = .false.
-      do j = 1, m%ncontact
-         if (m%con_scheme(j) /= SCHEME_PENALTY) cycle
-         call mark_row(m%con, j)
-      end do
-      do j = 1, m%nlink
-         if (m%link_kind(j) == LINK_FLUID_DAMPER .or. m%link_kind(j) == LINK_BILINEAR) then
-            call mark_row(m%lnk, j)
-         end if
-      end do
-      self%sdof = pack([(j, j = 1, nf)], touched)
+      self%sdof = nonlinear_dofs(m, dof, nf)
       self%ns = size(self%sdof)
       associate (s => self%sdof, ns => self%ns)
          self%phis = self%phi(s, :)
@@ -292,6 +283,27 @@ contains
       if (info /= 0) return
       self%w = transpose(self%phis)
       if (self%ns > 0) call dgetrs('N', nf, self%ns, self%j0, nf, self%ipiv, self%w, nf, info)
+   end subroutine newton_setup
+
+   !> S: the free DOFs (ascending) of penalty contacts, fluid dampers and bilinear springs, where
+   !> the tangents depart from K_L, C_L.
+   function nonlinear_dofs(m, dof, nf) result(sdof)
+      type(model_t), intent(in) :: m
+      integer, intent(in) :: dof(0:), nf
+      integer, allocatable :: sdof(:)
+      logical :: touched(nf)
+      integer :: j
+      touched = .false.
+      do j = 1, m%ncontact
+         if (m%con_scheme(j) /= SCHEME_PENALTY) cycle
+         call mark_row(m%con, j)
+      end do
+      do j = 1, m%nlink
+         if (m%link_kind(j) == LINK_FLUID_DAMPER .or. m%link_kind(j) == LINK_BILINEAR) then
+            call mark_row(m%lnk, j)
+         end if
+      end do
+      sdof = pack([(j, j = 1, nf)], touched)
    contains
       !> The free DOFs of a row's nodes carry a nonlinear force.
       subroutine mark_row(rows, j)
@@ -302,7 +314,7 @@ contains
             if (dof(rows%node(k)) > 0) touched(dof(rows%node(k))) = .true.
          end do
       end subroutine mark_row
-   end subroutine newton_setup
+   end function nonlinear_dofs
 
    !> K_L and C_L of the linear part on the free DOFs (dof: node → DOF, 0 for fixed/ground),
    !> dense: linear_band's entries (the same sums in the same order).
@@ -394,7 +406,7 @@ contains
       real(dp), allocatable :: x(:), y(:), xb(:, :), mx(:, :), kx(:, :), kbar(:, :), mbar(:, :), work(:)
       integer :: n, nf, kd, i, j, q, kept, first, last, lwork
       real(dp) :: kmax, mmax, sigma
-      logical :: ok
+      logical :: ok, damped
       character(len=160) :: what
       n = m%n; nf = self%nf; kd = model_bandwidth(m)
       info = MARTELLO_OK; msg = ''
@@ -452,13 +464,20 @@ contains
          end do
          call solve_add()
       end do
-      ! blocks x ← K_L⁻¹ M x until nv vectors, or the space closes
+      ! blocks x ← K_L⁻¹ M x and, with damping, K_L⁻¹ C_L x (the second-order Krylov space
+      ! of K + sC + s²M: a non-proportional C drives directions K_L⁻¹M alone never reaches)
+      ! until nv vectors, or the space closes
+      damped = any(self%clb%ab /= 0.0_dp)
       first = 1
       do while (kept < nv)
          last = kept
          if (first > last) exit
          do j = first, last
             x = 0.0_dp; x(self%free) = mx(:, j)
+            call solve_add()
+            if (.not. damped) cycle
+            y = 0.0_dp; y(self%free) = xb(:, j)
+            call band_matvec(self%clb, y(1:n), x(1:n))
             call solve_add()
          end do
          first = last + 1
@@ -554,16 +573,20 @@ contains
    !> The Newton matrix of a Ritz basis, J = J0 − Φᵀ(ΔK Φ G1q + ΔC Φ G1v) assembled at each
    !> update (m × m; ΔK, ΔC on the band): here J0 = −I − Coff·G1v, Coff = Φᵀ C_L Φ less its
    !> diagonal, and the work arrays.
-   subroutine ritz_newton_setup(self, info, msg)
+   subroutine ritz_newton_setup(self, m, dof, info, msg)
       class(fast_nonlinear_t), intent(inout) :: self
+      type(model_t), intent(in) :: m
+      integer, intent(in) :: dof(0:)
       integer, intent(out) :: info
       character(len=*), intent(out) :: msg
       real(dp), allocatable :: cphi(:, :), x(:), y(:)
       integer :: j, n, nm, nf
       n = self%klb%n; nm = self%nm; nf = self%nf
       msg = ''
-      allocate (cphi(nf, nm), self%jr(nm, nm), self%vtr(nf, nm), self%ipiv(nm), self%y(nm), &
-                x(0:n), y(0:n), stat=info)
+      self%sdof = nonlinear_dofs(m, dof, nf)
+      self%ns = size(self%sdof)
+      allocate (cphi(nf, nm), self%jr(nm, nm), self%vtr(self%ns, nm), self%ipiv(nm), self%y(nm), &
+                self%phis(self%ns, nm), x(0:n), y(0:n), stat=info)
       if (info /= 0) then
          call out_of_memory('the Newton matrices of fast-nonlinear', &
                             REAL_BYTES*(2*real(nf, dp)*nm + real(nm, dp)**2), FIX_DENSE, info, msg)
@@ -575,6 +598,7 @@ contains
          call band_matvec(self%clb, x(1:n), y(1:n))
          cphi(:, j) = y(self%free)
       end do
+      self%phis = self%phi(self%sdof, :)
       self%jr = matmul(transpose(self%phi), cphi)
       do j = 1, nm
          self%jr(j, j) = 0.0_dp
@@ -584,23 +608,34 @@ contains
       info = 0
    end subroutine ritz_newton_setup
 
-   !> y = −J⁻¹ r for a Ritz basis (ritz_newton_setup), the tangents in self%kband, self%cband.
+   !> y = −J⁻¹ r for a Ritz basis (ritz_newton_setup), the tangents in self%kband, self%cband:
+   !> ΔK, ΔC are nonzero on S only, so Vᵀ = ΔK_SS Φ_S G1q + ΔC_SS Φ_S G1v takes the pairs of S
+   !> within the bandwidth, O(ns·kd·m), and J = J0 − Φ_Sᵀ Vᵀ O(ns·m²).
    subroutine ritz_newton_solve(self, info)
       class(fast_nonlinear_t), intent(inout) :: self
       integer, intent(out) :: info
-      real(dp) :: x(0:self%klb%n), a(self%klb%n), b(self%klb%n), jac(self%nm, self%nm)
-      integer :: j, n
-      n = self%klb%n
-      do j = 1, self%nm
-         x = 0.0_dp; x(self%free) = self%phi(:, j)
-         call band_matvec(self%kband, x(1:n), a)
-         call band_matvec(self%klb, x(1:n), b)
-         self%vtr(:, j) = (a(self%free) - b(self%free))*self%g1q(j)
-         call band_matvec(self%cband, x(1:n), a)
-         call band_matvec(self%clb, x(1:n), b)
-         self%vtr(:, j) = self%vtr(:, j) + (a(self%free) - b(self%free))*self%g1v(j)
-      end do
-      jac = self%jr - matmul(transpose(self%phi), self%vtr)
+      real(dp) :: jac(self%nm, self%nm), dk, dc
+      integer :: i, j, lo, a, b, kd, r
+      kd = self%kband%kd; r = 2*kd + 1
+      self%vtr = 0.0_dp
+      lo = 1
+      associate (s => self%sdof, ns => self%ns)
+         do j = 1, ns
+            b = self%free(s(j))
+            do while (self%free(s(lo)) < b - kd)
+               lo = lo + 1
+            end do
+            do i = lo, ns
+               a = self%free(s(i))
+               if (a > b + kd) exit
+               dk = self%kband%ab(r + a - b, b) - self%klb%ab(r + a - b, b)
+               dc = self%cband%ab(r + a - b, b) - self%clb%ab(r + a - b, b)
+               if (dk == 0.0_dp .and. dc == 0.0_dp) cycle
+               self%vtr(i, :) = self%vtr(i, :) + self%phis(j, :)*(dk*self%g1q + dc*self%g1v)
+            end do
+         end do
+      end associate
+      jac = self%jr - matmul(transpose(self%phis), self%vtr)
       self%y = -self%r
       call dgesv(self%nm, 1, jac, self%nm, self%ipiv, self%y, self%nm, info)
    end subroutine ritz_newton_solve
