@@ -564,9 +564,10 @@ contains
       subroutine m_times(vf, mv)
          real(dp), intent(in) :: vf(:)
          real(dp), intent(out) :: mv(:)
-         y = 0.0_dp; y(self%free) = vf
-         call mass_times(m, y, x)
-         mv = x(self%free)
+         real(dp) :: xs(0:n), ys(0:n)
+         xs = 0.0_dp; xs(self%free) = vf
+         call mass_times(m, xs, ys)
+         mv = ys(self%free)
       end subroutine m_times
    end subroutine ritz_basis
 
