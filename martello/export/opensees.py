@@ -100,7 +100,7 @@ def half_kelvin_e(xi):
 def _law(c, mstar):
     """A penalty contact's law with its damping resolved from a target e by the law's
     published formula, as the kernel does (martello.independent.laws.contact_law)."""
-    return contact_law({k: v for k, v in c.items() if v is not None}, c["a"], c["b"], mstar)
+    return contact_law({k: v for k, v in c.items() if v is not None}, [(c["a"], 1.0), (c["b"], -1.0)], mstar)
 
 
 class _Builder:
@@ -138,6 +138,13 @@ class _Builder:
             self.refuse("mass_coupling", "OpenSees nodal masses are diagonal and martello's "
                         "couplings are general off-diagonal terms",
                         "use lumped masses (bar mass = \"lumped\")")
+        for kind, items in (("contact", s.contacts), ("link", s.links)):
+            for i, c in enumerate(items):
+                if c.get("terms") is not None:
+                    self.refuse(f"{kind}[{i}] ({c['name']}) between plan points or with terms",
+                                "OpenSees' zeroLength elements join two nodes along one axis; a "
+                                "row of several DOFs (a floor's rotation) is not one of them",
+                                "write it between two nodes")
         for i, c in enumerate(s.contacts):
             if c["scheme"] != "penalty":
                 self.refuse(f"contact[{i}] ({c['name']}).scheme = {c['scheme']}",
@@ -364,7 +371,7 @@ class _Builder:
         fixed = [n["fixed"] for n in s.nodes]
         for ci, c in enumerate(s.contacts):
             a, b = c["a"], c["b"]
-            mstar = effective_mass(mass, fixed, a, b)
+            mstar = effective_mass(mass, fixed, [(a, 1.0), (b, -1.0)])
             law = _law(c, mstar)                     # the target e resolved by the published formula
             name, gap = c["name"], float(c["gap"])
             mat_kind = self.materials.get(law.law, DEFAULT_MATERIAL[law.law])
@@ -531,7 +538,7 @@ class _Builder:
         mass_l, fixed = list(m), [nd["fixed"] for nd in s.nodes]
         for c in s.contacts:
             a, b = c["a"], c["b"]
-            law = _law(c, effective_mass(mass_l, fixed, a, b))
+            law = _law(c, effective_mass(mass_l, fixed, [(a, 1.0), (b, -1.0)]))
             d = at(a, 0) - at(b, 0) - c["gap"]
             if d > 0:
                 rate = vt(a, 0) - vt(b, 0)
