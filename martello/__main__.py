@@ -2,10 +2,20 @@
 line of martello.cli, with a Ctrl-C while its modules load ending as one line, exit 130, like
 a Ctrl-C at any later moment (martello.cli.run_command)."""
 
+import signal
 import sys
+
+from . import errors
+
+
+def _first_sigint(signum, frame):
+    errors.sigint_seen = True
+    signal.default_int_handler(signum, frame)      # raises KeyboardInterrupt, as by default
 
 
 def main():
+    if signal.getsignal(signal.SIGINT) is signal.default_int_handler:
+        signal.signal(signal.SIGINT, _first_sigint)
     try:
         from .cli import main as command_line
         return command_line()
