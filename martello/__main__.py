@@ -8,14 +8,9 @@ import sys
 from . import errors
 
 
-def _first_sigint(signum, frame):
-    errors.sigint_seen = True
-    signal.default_int_handler(signum, frame)      # raises KeyboardInterrupt, as by default
-
-
 def main():
     if signal.getsignal(signal.SIGINT) is signal.default_int_handler:
-        signal.signal(signal.SIGINT, _first_sigint)
+        signal.signal(signal.SIGINT, errors.record_sigint)
     try:
         from .cli import main as command_line
         return command_line()

@@ -11,6 +11,15 @@ debug = False
 sigint_seen = False
 
 
+def record_sigint(signum, frame):
+    """The `martello` command's SIGINT handler until a layer installs its own: Python's
+    default (KeyboardInterrupt), the signal recorded in sigint_seen."""
+    global sigint_seen
+    sigint_seen = True
+    import signal
+    signal.default_int_handler(signum, frame)
+
+
 class MartelloError(Exception):
     """Base class: anything the user can fix (bad input, impossible request, failed run)."""
 
