@@ -155,7 +155,8 @@ def headline(rows, failures, n_scenes, elapsed):
     return (f"verification: {c['verification_passed']} of {c['verification']} distinct rows passed "
             f"({c['verification_closed_form']} vs closed form, {c['verification_independent']} vs "
             f"independent reference; tolerance < 1 %); {c['cells_verified']} of {c['cells']} cells "
-            f"verified, {c['cells_partly']} partly, {c['cells_wrong']} wrong; not counted: {c['loose_passed']} of {c['loose']} "
+            f"verified, {c['cells_partly']} partly, {c['cells_not_verified']} not verified, "
+            f"{c['cells_wrong']} wrong; not counted: {c['loose_passed']} of {c['loose']} "
             f"loose rows (tolerance 1-10 %) passed, {c['unconverged']} unconverged (no bound: "
             f"nothing asserted), {c['repeat']} repeats of identical elements, "
             f"{c['regression_passed']} of {c['regression']} regression rows passed; "
@@ -317,7 +318,8 @@ def readme_counts(c):
             f"against closed forms, {c['verification_independent']} against the independent "
             f"engine; each with a tolerance below 1 %); {c['cells_verified']} of {c['cells']} problem × "
             f"law/scheme × integrator cells are verified ([docs/coverage.md](docs/coverage.md)), "
-            f"{c['cells_partly']} partly, {c['cells_wrong']} wrong. Not counted: {c['loose']} loose "
+            f"{c['cells_partly']} partly, {c['cells_not_verified']} not verified, {c['cells_wrong']} "
+            f"wrong. Not counted: {c['loose']} loose "
             f"rows (1-10 %), {c['unconverged']} unconverged, {c['repeat']} repeats of identical "
             f"elements, {c['regression']} regression rows.")
 
