@@ -112,9 +112,9 @@ contains
    end procedure observer_phase_lists
 
    !> An accepted state at t (once per accepted step and at t = 0, after the step's phase
-   !> changes): phase maxima and peaks; the energy terms and the divergence test where
-   !> recorded, every energy_interval-th sample and once a work is not finite; a history row
-   !> where recorded. k: the grid point t = k·dt of the state, or −1. u, v, a on nodes 0:n;
+   !> changes): phase maxima and peaks; the energy terms where recorded and on the energy
+   !> grid (energy_grid), the largest |balance| and the divergence test on the grid alone;
+   !> a history row where recorded. k: the grid point t = k·dt of the state, or −1. u, v, a on nodes 0:n;
    !> u_prev … the previous state if the method keeps it (saves a copy). stat:
    !> MARTELLO_ERR_DIVERGED, with the message, when the run must stop.
    !> folded: the state has been measured item by item already (observer_block, which hands
@@ -123,9 +123,10 @@ contains
    !> element states (no ms), where observer_energy_due.
    module procedure observer_sample_i8
       real(dp) :: e_mech
-      logical :: due, measured
+      logical :: due, grid, measured
       stat = MARTELLO_OK
-      due = observer_energy_due(o, k)
+      grid = energy_grid(o, k)
+      due = grid .or. recorded(o, k)
       o%nsamples = o%nsamples + 1
       measured = .false.
       if (present(folded)) measured = folded
@@ -140,14 +141,14 @@ contains
       ! the next step's start
       if (o%smooth_steps) o%chatter_prev = o%counters(C_CHATTER)
       o%prev_t = t
-      if (due) call energy_at(o, m, ms, u, v, a, energies, e_mech)
+      if (due) call energy_at(o, m, ms, u, v, a, grid, energies, e_mech)
       if (recorded(o, k)) then
          call record(o, t, u(1:), v(1:), a(1:), pen, force, link_f, link_du, stat)
          if (stat /= MARTELLO_OK) then
             call observer_finish(o, t); return
          end if
       end if
-      if (due) call check_divergence(o, t, e_mech, u, v, stat)
+      if (grid) call check_divergence(o, t, e_mech, u, v, stat)
       if (stat == MARTELLO_OK) call observer_watch(o, t, stat)
    end procedure observer_sample_i8
 
