@@ -202,18 +202,18 @@ contains
       else if (-(o%energy(E_CONTACT) + o%energy(E_IMPACT)) > CREATED_BOUND*(o%e0 + o%w_abs) &
                + ENERGY_FLOOR .and. o%e0 + o%w_abs > 0.0_dp) then
          ! a passive contact only takes energy out: the realised restitution exceeds 1
-         write (o%message, '(a,a,es12.5,a,es10.3,a,es10.3,a,a)') integrator_name(o%kind), &
-            ' created energy at its contacts by t = ', t, ' s: ', &
-            -(o%energy(E_CONTACT) + o%energy(E_IMPACT)), ' J, more than 1 % of the initial'// &
-            ' energy + input work (', o%e0 + o%w_abs, ' J): a passive contact cannot'// &
+         write (o%message, '(a,a,a,a,a,a,a,a,a)') integrator_name(o%kind), &
+            ' created energy at its contacts by t = ', sci(t, 5), ' s: ', &
+            sci(-(o%energy(E_CONTACT) + o%energy(E_IMPACT)), 3), ' J, more than 1 % of the initial'// &
+            ' energy + input work (', sci(o%e0 + o%w_abs, 3), ' J): a passive contact cannot'// &
             ' (restitution > 1); ', o%advice
          stat = MARTELLO_ERR_DIVERGED
          call observer_finish(o, t)
       else if (e_mech > o%divergence_factor*(o%e0 + o%w_abs) + ENERGY_FLOOR .and. &
                o%e0 + o%w_abs > 0.0_dp) then
-         write (o%message, '(a,a,es12.5,a,es10.3,a,es10.3,a,a)') integrator_name(o%kind), &
-            ' diverged at t = ', t, ' s: mechanical energy ', e_mech, ' J exceeds ', &
-            o%divergence_factor*(o%e0 + o%w_abs), &
+         write (o%message, '(a,a,a,a,a,a,a,a,a)') integrator_name(o%kind), &
+            ' diverged at t = ', sci(t, 5), ' s: mechanical energy ', sci(e_mech, 3), ' J exceeds ', &
+            sci(o%divergence_factor*(o%e0 + o%w_abs), 3), &
             ' J (divergence_factor x (initial energy + input work)); ', o%advice
          stat = MARTELLO_ERR_DIVERGED
          call observer_finish(o, t)

@@ -41,12 +41,13 @@ contains
       o%every = max(s%every, 1); o%divergence_factor = s%divergence_factor
       o%t_end = s%t_end; o%max_steps = s%max_steps; o%max_wall = s%max_wall
       call system_clock(o%clock0, o%clock_rate)
-      o%clock_last = o%clock0
+      o%clock_last = o%clock0; o%clock_watched = o%clock0
+      o%watch_stride = 1; o%watch_count = 0
       steps = 1.0_dp
       if (s%dt > 0.0_dp .and. s%t_end > 0.0_dp) steps = max(1.0_dp, s%t_end/s%dt*(1.0_dp - 1.0e-12_dp))
       if (steps > o%max_steps .or. .not. ieee_is_finite(steps)) then
-         write (o%message, '(a,a,es10.3,a,es10.3,a)') integrator_name(o%kind), ': the run needs at least ', &
-            steps, ' steps (t_end/dt), more than max_steps = ', o%max_steps, &
+         write (o%message, '(a,a,a,a,a,a)') integrator_name(o%kind), ': the run needs at least ', &
+            sci(steps, 3), ' steps (t_end/dt), more than max_steps = ', sci(o%max_steps, 3), &
             ': raise dt, shorten t_end or raise max_steps'
          stat = MARTELLO_ERR_LIMIT
          steps = 1.0_dp

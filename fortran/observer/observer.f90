@@ -91,9 +91,10 @@ module martello_observer
       integer :: energy_interval = 1
       integer(i8) :: nsamples = -1              !< accepted steps so far (t = 0 is sample 0)
       ! the budget (max_steps, max_wall [s], 0: none) and the caller's progress callback,
-      ! watched every WATCH_EVERY samples (observer_watch)
+      ! watched every watch_stride samples (observer_watch: 1 to WATCH_EVERY, by the pace)
       real(dp) :: t_end = 0.0_dp, max_steps = huge(1.0_dp), max_wall = 0.0_dp
       integer(i8) :: clock0 = 0, clock_last = 0, clock_rate = 1
+      integer(i8) :: clock_watched = 0, watch_stride = 1, watch_count = 0
       type(c_funptr) :: progress = c_null_funptr
       type(c_ptr) :: progress_user = c_null_ptr
       character(len=:), allocatable :: advice   !< ends a divergence message: what to change
