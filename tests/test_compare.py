@@ -110,8 +110,10 @@ GOOD = "t,u:mass\n0,0\n0.1,0.04\n0.2,0.05\n"
     ("t,u:mass\n0,0\n0.1,abc\n", "'abc' is not a number"),
     ("t,u:mass\n0,0\n0.1\n", "1 values for 2 columns"),
     ("t,u:mass\n0,0\n", "1 data row"),
+    ("t,u:mass\n", "0 data row"),        # numpy warned before the error (a second line)
     ("t,a:mass\n0,0\n0.1,0\n", None),
 ])
+@pytest.mark.filterwarnings("error")
 def test_malformed_histories_are_clear_errors(tmp_path, text, match):
     p = tmp_path / "their.csv"
     p.write_text(text)
