@@ -237,6 +237,20 @@ def test_a_building_is_refused_naming_it_and_why():
         opensees_model(from_dict(d, source="bd"))
 
 
+def test_a_row_of_terms_is_refused_naming_the_contact():
+    """A contact between plan points or written as terms (docs/buildings.md) deforms by a row
+    Σ c·u over several DOFs: no zeroLength element is that, and the exporter says so."""
+    d = {"node": [{"name": "A.ux", "mass": 2e5, "v0": 0.3}, {"name": "A.rz", "mass": 3e6},
+                  {"name": "B.ux", "mass": 1.5e5}],
+         "contact": [{"name": "c", "terms": [{"node": "A.ux", "coef": 1.0}, {"node": "A.rz", "coef": -4.0},
+                                            {"node": "B.ux", "coef": -1.0}],
+                      "gap": 0.01, "scheme": "penalty", "law": "linear", "stiffness": 1e8}],
+         "analysis": {"type": "dynamic", "integrator": "newmark", "dt": 1e-4, "t_end": 0.1}}
+    with pytest.raises(ExportError, match=r"contact\[0\] \(c\)\.terms: cannot be exported.*zeroLength acts "
+                                          r"between two nodes"):
+        opensees_model(from_dict(d, source="rows"))
+
+
 def test_a_full_kelvin_is_never_mapped_onto_a_half_kelvin_silently(tmp_path):
     """JankowskiImpact with n = 1 damps only while approaching: asked for, the change of law
     and both restitutions are stated in the differences, the script and on stderr."""
