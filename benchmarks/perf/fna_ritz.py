@@ -32,6 +32,8 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parents[2]
 sys.path.insert(0, str(ROOT))
 
+from benchmarks.perf.integrators_at_size import fit  # noqa: E402  (the log-log slope, one definition)
+
 
 def scene(n, m, t_end):
     nodes = [{"name": f"b{i}", "mass": 1.0e5} for i in range(1, n + 1)]
@@ -68,14 +70,6 @@ def one(n, m, t_end, dump):
                       "cpu_per_sim_s": cpu / t_end, "cost": summary["cost"],
                       "forces": {k: c["max_force"] for k, c in summary["contacts"].items()},
                       "load": os.getloadavg()[0]}))
-
-
-def fit(ns, ys):
-    xs = [math.log(v) for v in ns]
-    ls = [math.log(v) for v in ys]
-    mx, my = sum(xs) / len(xs), sum(ls) / len(ls)
-    den = sum((x - mx) ** 2 for x in xs)
-    return sum((x - mx) * (y - my) for x, y in zip(xs, ls)) / den if den > 0 else float("nan")
 
 
 def main():
