@@ -99,13 +99,13 @@ contains
       integer, intent(inout) :: pend(*), npend
       integer :: i, p
       real(dp) :: hl, x, du, dv, dvn
-      logical :: raised, turns
+      logical :: raised, turns, find
       hl = t - t_prev                    ! the step the extrema are located on
+      find = loc .and. (nodes .or. gu_on .or. gv_on)
       do i = 1, n
-         ! the node's v or a changes sign in the step (rare): its extrema inside it (vn, an
-         ! read only where a node's peaks are tracked)
+         ! the node's v or a changes sign in the step (rare): its extrema inside it
          turns = .false.
-         if (loc .and. (nodes .or. gu_on .or. gv_on)) turns = node_turns(vn(i), an(i), v(i), a(i))
+         if (find) turns = node_turns(vn(i), an(i), v(i), a(i))
          if (nodes) then
             call node_samples(t, u(i), v(i), a(i), umax(i), umin(i), vmax(i), amax(i), uabs(i), &
                               tabs(i), raised)
@@ -132,9 +132,11 @@ contains
             end if
             if (x > gv(i)) gv(i) = x
          end if
-         if (i == 1) cycle
-         ! the pair (i − 1, i)
-         p = i - 1
+      end do
+      ! the pairs (p, p + 1), in a loop of their own (a chain has no links between nodes)
+      if (.not. (pu_on .or. pv_on)) return
+      do p = 1, n - 1
+         i = p + 1
          if (pu_on) then
             du = u(p) - u(i); dv = v(p) - v(i); dvn = vn(p) - vn(i)
             x = abs(du)
