@@ -3,11 +3,12 @@ metrics martello uses on its own runs (martello.metrics), so a researcher can ve
 against martello's closed forms and reference data. The CSV format is documented in
 docs/compare.md: a header row, then one row per time; column t (s) and any of u:<node>,
 v:<node>, a:<node> (m, m/s, m/s²), penetration:<contact> (m, > 0 in contact), force:<contact>
-(N, compressive > 0) and energy:kinetic, energy:recoverable (J) — exactly as in martello's own
-history.csv, so a martello run can be fed back as a self-check. OpenSees node recorder files
-(whitespace-separated, a time column, no header) are read too, their columns named on the
-command line (read_recorder). A scene with neither a closed form nor stored reference data
-gets a reference computed on demand and cached (martello.reference.cache)."""
+(N, compressive > 0), link_force:<link>, elongation:<link> (N, m) and energy:kinetic,
+energy:recoverable (J) — exactly as in martello's own history.csv, so a martello run can be
+fed back as a self-check. OpenSees node recorder files (whitespace-separated, a time column,
+no header) are read too, their columns named on the command line (read_recorder). A scene
+with neither a closed form nor stored reference data gets a reference computed on demand and
+cached (martello.reference.cache)."""
 
 from __future__ import annotations
 
@@ -30,6 +31,9 @@ from .scene.loader import load
 
 NODE_KINDS = ("u", "v", "a")
 CONTACT_KINDS = ("penetration", "force")
+# martello's own history.csv also records each link's state (docs/results.md): accepted so
+# a martello run can be fed back, and scored wherever the reference records the same column
+LINK_KINDS = ("link_force", "elongation")
 # A history to compare is at most this large (a million rows of 50 columns).
 HISTORY_LIMIT = 1024 * MiB
 ENERGY_COLUMNS = ("energy:kinetic", "energy:recoverable", "energy:input", "energy:damping",
@@ -52,14 +56,16 @@ def _check_names(path, header, scene, hline):
         return
     nodes = {n["name"] for n in scene.nodes}
     contacts = {c["name"] for c in scene.contacts}
+    links = scene.links.names
     for c in header:
         kind, sep, name = c.partition(":")
         if c == "t" or c in ENERGY_COLUMNS:
             continue
-        if not sep or kind not in NODE_KINDS + CONTACT_KINDS:
+        if not sep or kind not in NODE_KINDS + CONTACT_KINDS + LINK_KINDS:
             raise HistoryError(path, f"unknown column {c!r}",
                                "valid: t, u:<node>, v:<node>, a:<node>, penetration:<contact>, "
-                               "force:<contact>, energy:kinetic, energy:recoverable, ...", row=hline)
+                               "force:<contact>, link_force:<link>, elongation:<link>, "
+                               "energy:kinetic, energy:recoverable, ...", row=hline)
         if kind in NODE_KINDS and name not in nodes:
             raise HistoryError(path, f"column {c!r} names no node of {scene.source}",
                                "nodes: " + ", ".join(sorted(nodes)), row=hline)
@@ -67,20 +73,35 @@ def _check_names(path, header, scene, hline):
             raise HistoryError(path, f"column {c!r} names no contact of {scene.source}",
                                "contacts: " + ", ".join(sorted(contacts)) if contacts else "it has none",
                                row=hline)
+        if kind in LINK_KINDS and name not in links:
+            raise HistoryError(path, f"column {c!r} names no link of {scene.source}",
+                               "links without a name are link<i>", row=hline)
 
 
 def read_history(path, scene=None):
     """Read and validate a history CSV; returns (columns, 2D array). Lines starting with #
     are comments. Errors name the line: a missing t column, a column that names no node or
     contact of the scene, a non-numeric or non-finite value, times that do not increase
-    (martello.history.parse_csv)."""
+    (martello.history.parse_csv). A link_force:/elongation: column that is NaN in every row
+    is read: the run did not record it (docs/results.md); compare reports it so."""
     path = Path(path)
     try:
         raw = read_input(path, HISTORY_LIMIT)
     except UnreadableFile as exc:
         raise HistoryError(path, exc.problem, exc.fix) from None
     return parse_csv(raw, lambda problem, fix, row: HistoryError(path, problem, fix, row=row),
-                     check_header=lambda header, line: _check_names(path, header, scene, line))
+                     check_header=lambda header, line: _check_names(path, header, scene, line),
+                     unrecorded=LINK_KINDS)
+
+
+def split_unrecorded(columns, data):
+    """(columns, data) without the link columns that are NaN in every row, and their names:
+    an integrator that does not report links writes NaN there (docs/results.md), so the run
+    did not record them; a NaN among finite values is an error of read_history's."""
+    gone = [j for j, c in enumerate(columns)
+            if c.partition(":")[0] in LINK_KINDS and np.isnan(data[:, j]).all()]
+    keep = [j for j in range(len(columns)) if j not in gone]
+    return [columns[j] for j in keep], data[:, keep], [columns[j] for j in gone]
 
 
 def is_recorder_file(path):
@@ -218,7 +239,8 @@ def read_histories(paths, columns=None, scene=None):
 
 def comparable(columns, ref):
     """The columns of a history that the reference also has, u first."""
-    order = {"u": 0, "v": 1, "a": 2, "penetration": 3, "force": 4, "energy": 5}
+    order = {"u": 0, "v": 1, "a": 2, "penetration": 3, "force": 4, "link_force": 5, "elongation": 6,
+             "energy": 7}
     cols = [c for c in columns if c != "t" and c in ref.columns]
     return sorted(cols, key=lambda c: (order.get(c.partition(":")[0], 9), c))
 
@@ -233,7 +255,7 @@ def compare(history_path, scene_path, columns=None, compute=True, stream=None):
     if sc.analysis.get("type") != "dynamic":
         raise MartelloError(f"{scene_path}: a static scene has no time history to compare with "
                             "(compare its nodal values with `martello check`)")
-    columns, data = read_histories(history_path, columns, sc)
+    columns, data, unrecorded = split_unrecorded(*read_histories(history_path, columns, sc))
     history_path = ", ".join(map(str, history_path)) if isinstance(history_path, (list, tuple)) \
         else history_path
     ref = reference_for_scene(sc)
@@ -252,7 +274,9 @@ def compare(history_path, scene_path, columns=None, compute=True, stream=None):
                             "scripts/regenerate_reference; or `martello reference` to compute one)")
     cols = comparable(columns, ref)
     if not cols:
-        raise HistoryError(history_path, "no column can be compared with the reference",
+        raise HistoryError(history_path, "no column can be compared with the reference"
+                           + (f" ({', '.join(unrecorded)}: not recorded by this run, NaN throughout)"
+                              if unrecorded else ""),
                            "the reference has " + ", ".join(c for c in ref.columns))
     h = history_dict((columns, data))
     t = h["t"]
@@ -293,7 +317,7 @@ def compare(history_path, scene_path, columns=None, compute=True, stream=None):
     span = [float(t[0]), float(min(t[-1], ref.t_end))]
     return {"history": str(history_path), "scene": str(scene_path), "reference": ref.name,
             "reference_kind": ref.kind, "reference_digits": ref.trusted_digits(u_cols),
-            "compared_columns": cols, "time_span": span, "rows": int(len(t)),
+            "compared_columns": cols, "unrecorded_columns": unrecorded, "time_span": span, "rows": int(len(t)),
             "score_scd": m.get("scd"), "metrics": {k: v for k, v in m.items() if k not in COST_KEYS},
             "per_column": per_column, "checks": checks, "computed_reference": computed,
             "derived_events": {k: {kk: v[kk] for kk in ("impact_times", "restitution",
@@ -334,6 +358,9 @@ def print_report(rep, stream=sys.stdout):
     print(f"reference: {rep['reference']} (trusted to {rep['reference_digits']:.1f} digits); "
           f"{rep['rows']} rows over [{rep['time_span'][0]:g}, {rep['time_span'][1]:g}] s; "
           f"compared: {', '.join(rep['compared_columns'])}", file=stream)
+    if rep["unrecorded_columns"]:
+        print(f"not recorded by this run (NaN throughout): {', '.join(rep['unrecorded_columns'])}",
+              file=stream)
     print(f"{'metric':<26} {'value':>14}  meaning", file=stream)
     print("-" * 100, file=stream)
     for key, what in DESCRIPTIONS:

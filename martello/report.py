@@ -51,7 +51,7 @@ def check_catalogue(files, outdir, plots=True, stream=sys.stdout, require_checks
             # closed form where the scene names one, else the stored reference data (reference/)
             rows_here = verify(s, summary) if s.check is not None else []
             for r in rows_here:
-                r.setdefault("evidence", "closed form")
+                r.setdefault("evidence", kinds.CLOSED_FORM)
             if history is not None:
                 # accuracy against the independent engine where it has the scene; else the
                 # stored reference data, which only show drift (regression, not verification)
@@ -133,8 +133,9 @@ def summary_counts(rows, failures, n_scenes):
             "scenes_with_rows": len({r.get("file") for r in rows}),
             "verification": len(by[kinds.VERIFICATION]),
             "verification_passed": sum(bool(r["passed"]) for r in by[kinds.VERIFICATION]),
-            "verification_closed_form": sum(r["evidence"] == "closed form" for r in by[kinds.VERIFICATION]),
-            "verification_independent": sum(r["evidence"] == "independent reference"
+            "verification_closed_form": sum(r["evidence"] == kinds.CLOSED_FORM for r in by[kinds.VERIFICATION]),
+            "verification_published": sum(r["evidence"] == kinds.PUBLISHED for r in by[kinds.VERIFICATION]),
+            "verification_independent": sum(r["evidence"] == kinds.INDEPENDENT_ENGINE
                                             for r in by[kinds.VERIFICATION]),
             "loose": len(by[kinds.LOOSE]), "loose_passed": sum(bool(r["passed"]) for r in by[kinds.LOOSE]),
             "unconverged": len(by[kinds.UNCONVERGED]), "repeat": len(by[kinds.REPEAT]),
@@ -153,9 +154,10 @@ def headline(rows, failures, n_scenes, elapsed):
     verification; the other kinds are counted apart."""
     c = summary_counts(rows, failures, n_scenes)
     return (f"verification: {c['verification_passed']} of {c['verification']} distinct rows passed "
-            f"({c['verification_closed_form']} vs closed form, {c['verification_independent']} vs "
-            f"independent reference; tolerance < 1 %); {c['cells_verified']} of {c['cells']} cells "
-            f"verified, {c['cells_partly']} partly, {c['cells_wrong']} wrong; not counted: {c['loose_passed']} of {c['loose']} "
+            f"({c['verification_closed_form']} vs closed form, {c['verification_published']} vs published "
+            f"value, {c['verification_independent']} vs independent reference; tolerance < 1 %); {c['cells_verified']} of {c['cells']} cells "
+            f"verified, {c['cells_partly']} partly, {c['cells_not_verified']} not verified, "
+            f"{c['cells_wrong']} wrong; not counted: {c['loose_passed']} of {c['loose']} "
             f"loose rows (tolerance 1-10 %) passed, {c['unconverged']} unconverged (no bound: "
             f"nothing asserted), {c['repeat']} repeats of identical elements, "
             f"{c['regression_passed']} of {c['regression']} regression rows passed; "
@@ -191,7 +193,7 @@ def coverage(rows):
     for (problem, laws, integ), c in sorted(cells.items()):
         n = c["kinds"]
         has = n[kinds.VERIFICATION] > 0
-        evidence = next((k for k in VERIFICATION if k in c["evidence"]), None)
+        evidence = ", ".join(k for k in VERIFICATION if k in c["evidence"])
         parts = []
         if n[kinds.LOOSE]:
             parts.append(f"{n[kinds.LOOSE]} loose")
@@ -247,7 +249,9 @@ One cell per problem × contact law (or scheme) × integrator; the kind of every
 (martello/checks/kinds.py) says whether it counts:
 
 * **verification**: an oracle independent of the solvers — a `[check]` closed form of
-  `martello.oracles`, or the independent engine `martello.independent`
+  `martello.oracles`, a value published in a vendor's verification manual to its printed
+  digits (*published value*: the `printed_*` fields of `martello.oracles.vendor`,
+  [vendor-problems.md](vendor-problems.md)), or the independent engine `martello.independent`
   ([independent-reference.md](independent-reference.md): digits = min(the run's digits against
   it, the reference's trusted digits)) — with a tolerance below 1 % of the quantity (relative
   to the reference, or to the comparison's `scale` where the reference is 0), and, against the
@@ -314,10 +318,12 @@ def readme_counts(c):
     markers), from the counts of docs/coverage.md."""
     return (f"`martello check` ({c['scenes']} scenes): {c['verification_passed']} of "
             f"{c['verification']} distinct verification rows pass ({c['verification_closed_form']} "
-            f"against closed forms, {c['verification_independent']} against the independent "
+            f"against closed forms, {c['verification_published']} against values published in "
+            f"vendors' verification manuals, {c['verification_independent']} against the independent "
             f"engine; each with a tolerance below 1 %); {c['cells_verified']} of {c['cells']} problem × "
             f"law/scheme × integrator cells are verified ([docs/coverage.md](docs/coverage.md)), "
-            f"{c['cells_partly']} partly, {c['cells_wrong']} wrong. Not counted: {c['loose']} loose "
+            f"{c['cells_partly']} partly, {c['cells_not_verified']} not verified, {c['cells_wrong']} "
+            f"wrong. Not counted: {c['loose']} loose "
             f"rows (1-10 %), {c['unconverged']} unconverged, {c['repeat']} repeats of identical "
             f"elements, {c['regression']} regression rows.")
 
@@ -391,8 +397,10 @@ def _tol(r):
     return "exact" if t == 0.0 else f"{t:.0e}"
 
 
-def _problem_table(rows):
-    """Per problem: scenes, rows by kind, and the fewest digits of its verification rows."""
+def _problem_table(rows, n_scenes):
+    """Per problem: the scenes with rows, rows by kind, and the fewest digits of its
+    verification rows; a last line sums them (the headline's counts; the scenes without
+    rows are the list below it)."""
     by = {}
     for r in rows:
         key = r.get("problem") or r["scene"].split()[0]
@@ -403,13 +411,18 @@ def _problem_table(rows):
         d["failed"] += kinds.failed(r)
         if kind == kinds.VERIFICATION:
             d["min"] = r["digits"] if d["min"] is None else min(d["min"], r["digits"])
-    lines = ["| problem | scenes | verification | loose | unconverged | repeat | regression | failed | "
+    lines = ["| problem | scenes with rows | verification | loose | unconverged | repeat | regression | failed | "
              "fewest digits (verification rows) |", "|---|---|---|---|---|---|---|---|---|"]
     for k in sorted(by):
         d = by[k]
         low = "-" if d["min"] is None else f"{d['min']:.1f}"
         lines.append(f"| {k} | {len(d['scenes'])} | {d['verification']} | {d['loose']} | {d['unconverged']} | "
                      f"{d['repeat']} | {d['regression']} | {d['failed']} | {low} |")
+    total = {k: sum(d[k] for d in by.values()) for k in (*kinds.KINDS, "failed")}
+    lows = [d["min"] for d in by.values() if d["min"] is not None]
+    lines.append(f"| all | {sum(len(d['scenes']) for d in by.values())} of {n_scenes} | "
+                 f"{total['verification']} | {total['loose']} | {total['unconverged']} | {total['repeat']} | "
+                 f"{total['regression']} | {total['failed']} | {f'{min(lows):.1f}' if lows else '-'} |")
     return "\n".join(lines)
 
 
@@ -441,7 +454,8 @@ def _write_markdown(rows, failures, pngs, path, elapsed, n_scenes, unchecked=())
              "digits = −log10 of the relative error (16 = exact to round-off).", "",
              "**" + headline(rows, failures, n_scenes, elapsed) + "**", "",
              "Kinds of rows (martello/checks/kinds.py, docs/coverage.md): *verification* — an "
-             "oracle independent of the solvers (a closed form; the independent engine, "
+             "oracle independent of the solvers (a closed form; a value published in a vendor's "
+             "manual, docs/vendor-problems.md; the independent engine, "
              "docs/independent-reference.md: digits = min(the run's, the reference's trusted "
              "digits)), a tolerance below 1 % of the quantity, and for rows against the "
              "engine, reruns at 2Δt and 4Δt (adaptive: 100 and 10⁴ × rtol) that converge at "
@@ -450,7 +464,7 @@ def _write_markdown(rows, failures, pngs, path, elapsed, n_scenes, unchecked=())
              "nothing below 10 %: the error and the order are shown, nothing is asserted; "
              "*repeat* — the row of a contact identical to an earlier one of the scene (counted "
              "once); *regression* — drift from stored data made by martello itself.", "",
-             _problem_table(rows), "", "## Scenes not verified", ""]
+             _problem_table(rows, n_scenes), "", "## Scenes not verified", ""]
     missing = not_verified_scenes(rows, unchecked)
     lines += [f"{len(missing)} of {n_scenes} scenes have no verification row:", ""] + \
         [f"- `{stem}` ({title}): {why}" for stem, title, why in missing]

@@ -482,3 +482,19 @@ def test_a_storey_mass_past_the_doubles_is_one_line_naming_the_masses(tmp_path):
                      else ln for ln in text.splitlines())
     assert "1e-300" in text
     run_fails(tmp_path, text, "s.toml: frame[0].mass: the stiffness over the masses")
+
+
+def test_an_error_raised_while_a_ctrl_c_is_delivered_is_the_interrupt(monkeypatch, capsys):
+    """A Ctrl-C while numpy imports came back as numpy's ImportError, not chaining the
+    KeyboardInterrupt ('PyCapsule_Import could not import module "datetime"'), and was
+    reported as a bug: the command's first SIGINT handler (martello.__main__) records it."""
+    from types import SimpleNamespace
+    from martello import errors
+
+    def importing(args):
+        raise ImportError('PyCapsule_Import could not import module "datetime"')
+    args = SimpleNamespace(func=importing, debug=False)
+    assert cli.run_command(args) == 1 and "internal error" in capsys.readouterr().err
+    monkeypatch.setattr(errors, "sigint_seen", True)
+    assert cli.run_command(args) == 130
+    assert capsys.readouterr().err == "martello: interrupted\n"
