@@ -49,6 +49,15 @@ int martello_eval_commit(martello_eval *ev, const double *u, const double *v);
  * branch between located switches (fortran/switching.f90, docs/event-driven.md); branches
  * change at commits past their switches. *nsw: the number of switch slots. */
 int martello_eval_use_branches(martello_eval *ev, int *nsw);
+/* As martello_eval_use_branches, but only the laws whose force jumps at a switch are held:
+ * penalty contacts whose force is continuous at onset and separation (linear, Hertz, the
+ * Hunt-Crossley family) and bilinear links stay whole, their kinks inside the integrator's steps
+ * (docs/sundials-ode.md, events at size); continuous[j] = 1 for those contacts (n_contacts
+ * values). */
+int martello_eval_use_smooth_branches(martello_eval *ev, int *nsw, int *continuous);
+/* The approach speed v at the located onset of penalty contact j's phase (committed in contact):
+ * the Hunt-Crossley family's v_in. */
+int martello_eval_set_onset_speed(martello_eval *ev, int j, double v);
 /* The switches of the branches held, g = alpha (u_a - u_b) + beta (v_a - v_b) + gamma with
  * 0-based nodes a, b (-1: ground); g > 0: the branch is left. Constant between commits. */
 int martello_eval_switches(martello_eval *ev, int *a, int *b, double *alpha, double *beta,

@@ -26,6 +26,11 @@ enum { ACT_NONE, ACT_ONSET, ACT_SEPARATION, ACT_IMPACT, ACT_RELEASE };
 /* The integrator's interpolant of its last step: the k-th derivative of y at t into out.
  * MARTELLO_OK, or a status once the run has failed with the integrator's message. */
 typedef int (*ode_interpolant)(void *ctx, double t, int k, N_Vector out);
+/* The polynomial degree of that interpolant (the highest k it answers). */
+typedef int (*ode_degree)(void *ctx);
+
+/* The highest degree of an interpolant the events inside a step read (CVODE's Adams: 12). */
+#define OE_QMAX 12
 
 typedef struct {
   martello_model *model;
@@ -33,7 +38,19 @@ typedef struct {
   martello_eval *ev;
   const char *name;           /* "IDA", "CVODE", "ARKODE": what the messages say */
   ode_interpolant dky;        /* the adapter's interpolant, called with ctx */
+  ode_degree degree;          /* its degree (the events inside a step; NULL: not smooth) */
   void *ctx;
+  /* events inside the steps (docs/sundials-ode.md, events at size): smooth = 1 when the laws
+   * whose force is continuous at their switches are not held on branches; cont[j] = 1 for
+   * such a penalty contact, whose onsets and separations are located after each step on the
+   * interpolant, contact by contact (no root, no restart); d_last, r_last its gap and rate at
+   * the last accepted state; vin[j] > 0: the onset speed located in the stretch, for the
+   * commit; the interpolant's Taylor coefficients at the stretch's end (tay_u, tay_v: k-th
+   * coefficient of node i at k n + i, degree tay_q, ready when tay_ready) */
+  int smooth, *cont, tay_ready, tay_q, nev;
+  double *d_last, *r_last, *vin, *tay_u, *tay_v, tay_t;
+  double *ev_t;               /* the stretch's events: time, contact, kind (2 nc at most) */
+  int *ev_j, *ev_k;
   /* scene (martello_model_topology) */
   int n, nc, nr, ncoupling, nl;
   double *mass, *gap, *rest;
@@ -155,6 +172,20 @@ int oe_prepare_restart(ode_events *E, double t, double *u, double *v);
 /* A restart at t: MARTELLO_ERR_NOT_CONVERGED (run failed) when events keep recurring at one
  * time without progress. */
 int oe_restart_progress(ode_events *E, double t);
+
+/* ---- events inside the steps ---------------------------------------------------------------- */
+/* Hold on branches only the laws whose force jumps (martello_eval_use_smooth_branches): the
+ * continuous contacts lose their roots, their events are located by oe_inner_events. Call after
+ * oe_setup, before the first restart; the adapter sets E->degree. */
+int oe_use_smooth(ode_events *E);
+/* The onsets and separations of the continuous contacts inside [t0, t1] (y1: the state at t1),
+ * each located on the interpolant of the last step by a scalar search on its own gap (its
+ * Taylor coefficients at t1, O(degree) an evaluation), handed to the observer in time order;
+ * a contact that touches and leaves inside the stretch also gets its peak penetration. */
+int oe_inner_events(ode_events *E, double t0, double t1, const double *y1);
+/* An accepted state y (after the observer's sample): the node velocities and the gaps and
+ * rates the next stretch starts from. */
+void oe_accepted(ode_events *E, const double *y);
 
 /* ---- what the observer is handed ---------------------------------------------------------- */
 /* Commit (u, v) in the evaluator and read the switches again (the branches may change). */

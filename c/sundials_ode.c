@@ -246,6 +246,18 @@ static int interpolant(void *ctx, double t, int k, N_Vector out) {
   return MARTELLO_OK;
 }
 
+/* The degree of the interpolant: the order CVODE used in its last step (its Nordsieck array's,
+ * which CVodeGetDky differentiates up to; the order of the next step is set only when it
+ * starts); ARKODE's Hermite interpolant of the highest degree it has (set at its creation),
+ * whose derivatives past its degree are 0. */
+static int degree(void *ctx) {
+  ode_problem *P = ctx;
+  int q = 1;
+  if (P->ark) return ARK_INTERP_MAX_DEGREE;
+  if (CVodeGetLastOrder(P->mem, &q) != CV_SUCCESS || q < 1) return 1;
+  return q;
+}
+
 /* ---- what the observer is handed ------------------------------------------------------------- */
 
 /* An accepted, committed state at t as a sample (a from the right-hand side there, with the
@@ -339,6 +351,11 @@ static int setup(ode_problem *P, martello_model *model, martello_run *run) {
   /* CVODE restarts its BDF or Adams history at order 1; ARKODE's one-step tables lose
    * nothing at a restart (the accumulation rule's resolution, docs/impulse.md §4) */
   E->restarts = !P->ark;
+  E->degree = degree;
+  /* CVODE steps across the laws whose force is continuous at their switches, their events
+   * located inside the steps; ARKODE restarts at them, which costs it less (docs/sundials-ode.md,
+   * events inside the steps) */
+  if (!P->ark && (st = oe_use_smooth(E)) != MARTELLO_OK) return st;
   P->N = 2 * (sunindextype)E->n;
   for (int i = 0; i < E->n; i++) {
     E->iu[i] = 2 * (sunindextype)i;
@@ -467,7 +484,7 @@ static int integrate(ode_problem *P, SUNContext ctx, N_Vector yy, SUNMatrix *Jp,
   int k_out = 1;
   double t_out = fmin((double)E->every * E->dt, E->t_end), t_last = 0.0;
   if ((st = observe(P, 0.0, y, 0)) != MARTELLO_OK) return st;
-  for (int i = 0; i < n; i++) E->v_last[i] = y[2 * i + 1];
+  oe_accepted(E, y);
   double t_stop = oe_next_stop(E, 0.0, t_out);
   if ((st = check(P, be_stop(P, t_stop), "SetStopTime"))) return st;
   const size_t n_found = (size_t)(oe_nroots(E) + 1);
@@ -526,6 +543,7 @@ static int integrate(ode_problem *P, SUNContext ctx, N_Vector yy, SUNMatrix *Jp,
       }
     }
     if (again && t_r < tret && (st = interpolant(P, t_r, 0, yy)) != MARTELLO_OK) break;
+    if ((st = oe_inner_events(E, t_last, t_r, y)) != MARTELLO_OK) break;
     if ((st = oe_stretch(E, t_last, t_r, y)) != MARTELLO_OK) break;
     oe_keep_end_rates(E, !again);
     t_last = t_r;
@@ -544,7 +562,7 @@ static int integrate(ode_problem *P, SUNContext ctx, N_Vector yy, SUNMatrix *Jp,
     }
     int at_output = t_r == t_out || (again && t_out - t_r <= 16.0 * DBL_EPSILON * t_out);
     if ((st = observe(P, t_r, y, at_output ? k_out * E->every : -1)) != MARTELLO_OK) break;
-    for (int i = 0; i < n; i++) E->v_last[i] = y[2 * i + 1];
+    oe_accepted(E, y);
     if (at_output) {
       if (t_out >= E->t_end) {
         t_last = E->t_end;
