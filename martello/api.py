@@ -46,7 +46,7 @@ def catalogue():
 
 
 def load(path):
-    """A validated Scene from a scene file (TOML, docs/scene-format.md).
+    """A validated Scene from a scene file (TOML, docs/scene-input.md).
 
     ``path`` is a file, or a path inside the catalogue such as ``"p2/p2_restitution_e08.toml"``
     (found in benchmarks/ of the checkout or of the installed package) when no such file

@@ -17,7 +17,7 @@ from .errors import MartelloError
 DESCRIPTION = """\
 martello: verification and benchmark suite for contact and impact in structural dynamics.
 
-A scene (TOML, see docs/scene-format.md) describes a small 1D mechanical network: nodes
+A scene (TOML, see docs/scene-input.md) describes a small 1D mechanical network: nodes
 (lumped masses), links (springs, dampers, bars), contacts (lagrange, penalty,
 augmented-lagrange, restitution), loads, and the analysis to run. The catalogue in
 benchmarks/ holds the canonical problems with their closed-form references.

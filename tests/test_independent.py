@@ -216,3 +216,19 @@ def test_the_engines_frame_and_the_front_ends_agree():
         assert fb.nodes == fr["nodes"]
         assert np.max(np.abs(fb.K - fr["K"])) <= 1e-12 * np.max(np.abs(fr["K"]))
         assert np.max(np.abs(fb.C - fr["C"])) <= 1e-12 * np.max(np.abs(fr["C"]))
+
+
+def test_the_engine_reads_peer_at2_records():
+    # a user's ground motion as PEER gives it: the engine's own reader (martello/independent/
+    # scene.py) and the front end's (martello.ground_motion.records) read the same samples in
+    # m/s² (two implementations of one format, cross-checked)
+    from pathlib import Path
+    from martello.ground_motion.records import read_at2
+    from martello.independent.scene import _read_at2_record
+    data = Path(__file__).resolve().parent / "data" / "records"
+    files = sorted(data.glob("peer_*"))       # the valid ones (the others test the front end's errors)
+    assert files
+    for f in files:
+        t, a = _read_at2_record(f, None)
+        rec = read_at2(f)
+        assert np.array_equal(t, rec.t) and np.allclose(a, rec.accel, rtol=1e-15, atol=0.0), f.name

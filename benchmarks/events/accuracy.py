@@ -9,7 +9,7 @@ native wall time of the run (summary cost.wall_time_s) (the minimum of three run
 log-log slope of the error against rtol (or dt).
 
     .venv/bin/python benchmarks/events/accuracy.py [--integrators rk8pd,rkf45,msbdf,ida,newmark,...]
-        [--plot docs/studies/hysteretic_pounding_wp.png] [scene.toml ...]
+        [--plot docs/studies/hysteretic_pounding_work_precision.png] [scene.toml ...]
 """
 import argparse
 import copy

@@ -405,10 +405,41 @@ linear, as in the seed's FNA: the moments are demands, not capped by yielding. T
 devices' elastic spring and preload are not modelled."""
 
 
-def main():
+def check_report(path=None):
+    """docs/p10-case-study.md against this code and library, for CI (tests/test_generated_docs.py):
+    the scenes are current (scene_for exits otherwise), the report names this martello version,
+    its periods are the frames' (deterministic), and a stated sample — the bare frames under
+    record 1 — prints the same peak penetration to the report's digits. A full rerun (15 runs)
+    regenerates it. 0 if current, else 1 with what drifted."""
+    text = (path or REPORT).read_text()
+    problems = []
+    if f"with martello {native.version()}:" not in text:
+        problems.append(f"made by another martello version than {native.version()}")
+    frA, frB = planar("A"), planar("B")
+    blocks = from_dict(scene_dict("bare"), base_dir=HERE).blocks
+    wA = natural_frequencies(blocks[0]["k"], frA.lateral_masses())
+    wB = natural_frequencies(blocks[1]["k"], frB.lateral_masses())
+    periods = (f"| periods | A: {', '.join(f'{2 * np.pi / x:.3f}' for x in wA[:2])} s; "
+               f"B: {', '.join(f'{2 * np.pi / x:.3f}' for x in wB[:3])} s |")
+    if periods not in text:
+        problems.append(f"the periods now read '{periods}'")
+    s = run_full(scene_for("bare", 1))[0]
+    first = f"(records: {1e3 * s['contacts']['gap2']['max_penetration']:.2f}, "
+    if first not in text:
+        problems.append(f"the bare frames' record 1 now reads '{first}'")
+    for p in problems:
+        print(f"docs/p10-case-study.md: {p}: rerun benchmarks/p10/case_study.py")
+    return 1 if problems else 0
+
+
+def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--write-scenes", action="store_true")
-    args = ap.parse_args()
+    ap.add_argument("--check", action="store_true",
+                    help="check docs/p10-case-study.md against a fresh sample (seconds): exit 1 if it drifted")
+    args = ap.parse_args(argv)
+    if args.check:
+        return check_report()
     if args.write_scenes:
         for c in CONFIGS:
             write_scene(c, HERE / f"p10_{c}.toml")
@@ -421,4 +452,4 @@ def main():
 
 
 if __name__ == "__main__":
-    main()
+    sys.exit(main())

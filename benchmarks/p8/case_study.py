@@ -973,13 +973,47 @@ def weaknesses(ctx):
 
 # ================================================================================== main
 
+def time_step_clauses():
+    """The time-step sentence's clauses of the report (bare, record 1, at every Δt of
+    DT_SWEEP), recomputed: a sample of the report's numbers that costs seconds."""
+    from martello.run import run_full
+    s3 = (2, 3)
+    out = []
+    for dt in DT_SWEEP:
+        m = measure(run_full(variant("bare", 1, dt=dt, history=False))[0])
+        out.append(f"Δt = {dt * 1e3:g} ms: penetration {m['peak_penetration'] * 1e3:.4f} mm, b2 s3 "
+                   f"drift {m['drift'][s3] * 1e3:.3f} mm, shear {m['shear'][s3] / 1e3:.1f} kN")
+    return out
+
+
+def check_report(path=None):
+    """docs/p8-case-study.md against this code and library, for CI (tests/test_generated_docs.py):
+    the scenes are current with the parameters, the report names this martello version, and a
+    stated sample — the time-step check's three runs (bare, record 1) — prints the same numbers
+    to the report's digits. A full rerun (104 runs) regenerates it. 0 if current, else 1 with
+    what drifted."""
+    from martello.binding import native
+    text = (path or REPORT).read_text()
+    problems = [f"{p.name} is out of date with the parameters (--write-scenes)" for p in stale_scenes()]
+    if f"with martello {native.version()} " not in text:
+        problems.append(f"made by another martello version than {native.version()}")
+    problems += [f"the time-step check now reads '{c}'" for c in time_step_clauses() if c not in text]
+    for p in problems:
+        print(f"docs/p8-case-study.md: {p}: rerun benchmarks/p8/case_study.py")
+    return 1 if problems else 0
+
+
 def main(argv=None):
     ap = argparse.ArgumentParser(description="P8 case study (seed §5-6)")
     ap.add_argument("--write-scenes", action="store_true", help="rewrite benchmarks/p8/*.toml and stop")
+    ap.add_argument("--check", action="store_true",
+                    help="check docs/p8-case-study.md against a fresh sample (seconds): exit 1 if it drifted")
     args = ap.parse_args(argv)
     if args.write_scenes:
         write_scenes()
         return 0
+    if args.check:
+        return check_report()
     stale = stale_scenes()
     if stale:
         print("out of date with the parameters in case_study.py: "

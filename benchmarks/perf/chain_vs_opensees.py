@@ -264,7 +264,7 @@ def main():
     ap.add_argument("--n", type=int, nargs="+", default=[1000, 10000, 100000])
     ap.add_argument("--steps", type=int, default=8000)
     ap.add_argument("--repeats", type=int, default=3)
-    ap.add_argument("-o", "--out", required=True, help="the folder everything is written into")
+    ap.add_argument("-o", "--out", help="the folder everything is written into (required)")
     ap.add_argument("--opensees-python", help="a Python with openseespy (none: martello alone)")
     ap.add_argument("--opensees-max-n", type=int, default=10000,
                     help="largest n OpenSees runs (it takes ~2 µs per DOF-step)")
@@ -282,6 +282,8 @@ def main():
         n, steps, dt, out = a.opensees_one
         opensees_one(int(n), int(steps), float(dt), out)
         return
+    if not a.out:
+        ap.error("give -o DIR, the folder everything is written into")
     out = Path(a.out)
     out.mkdir(parents=True, exist_ok=True)
     if a.library:

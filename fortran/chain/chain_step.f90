@@ -707,14 +707,11 @@ contains
    contains
       subroutine of_state(u, v)
          real(dp), intent(in) :: u(0:n), v(0:n)
-         do i = 1, n
-            e(1) = e(1) + 0.5_dp*m%mass(i)*v(i)*v(i)
-            if (self%chain_links) then
-               e(2) = e(2) + 0.5_dp*m%chain(1)%k(i)*u(i)*u(i)
-            else
-               e(2) = e(2) + 0.5_dp*self%store(self%okg + i)*u(i)*u(i)
-            end if
-         end do
+         if (self%chain_links) then
+            call of_nodes(u, v, m%mass, m%chain(1)%k)
+         else
+            call of_nodes(u, v, m%mass, self%store(self%okg + 1:self%okg + n))
+         end if
          if (self%pair_links) then
             do i = 1, n - 1
                du = u(i) - u(i + 1)
@@ -727,17 +724,33 @@ contains
                                  m%link_par(L_HARDENING, j), self%bfc(idx), self%bdu(idx), eb)
             e(2) = e(2) + eb
          end do
-         do i = 1, n - 1
-            if (self%pair_contact(i) == 0) cycle
-            pen = self%blk%sgn(i*self%blk%ss)*(u(i) - u(i + 1)) - self%blk%gap(i*self%blk%sg)
-            if (pen > 0.0_dp) e(3) = e(3) + 0.5_dp*self%blk%k(i*self%blk%sk)*pen*pen
-         end do
+         associate (b => self%blk)
+            do i = 1, merge(n - 1, 0, b%pairs)
+               if (b%first < 0) then
+                  if (b%number(i) == 0) cycle
+               end if
+               pen = b%sgn(i*b%ss)*(u(i) - u(i + 1)) - b%gap(i*b%sg)
+               if (pen > 0.0_dp) e(3) = e(3) + 0.5_dp*b%k(i*b%sk)*pen*pen
+            end do
+         end associate
          do idx = 1, size(self%blk%xg)
             j = self%blk%xg(idx)
             pen = u(m%con_a(j)) - u(m%con_b(j)) - m%con_gap(j)
             e(3) = e(3) + contact_elastic_energy(m%con_law(j), m%con_par(:, j), max(pen, 0.0_dp))
          end do
       end subroutine of_state
+      !> ½ Σ m v² and ½ Σ k u² of the springs to ground, on explicit-shape arrays (the
+      !> compiler keeps the sums in registers)
+      subroutine of_nodes(u, v, mass, kg)
+         real(dp), intent(in) :: u(0:n), v(0:n), mass(n), kg(n)
+         real(dp) :: ek, ep
+         ek = e(1); ep = e(2)
+         do i = 1, n
+            ek = ek + 0.5_dp*mass(i)*v(i)*v(i)
+            ep = ep + 0.5_dp*kg(i)*u(i)*u(i)
+         end do
+         e(1) = ek; e(2) = ep
+      end subroutine of_nodes
    end function energies
 
    !> Every pair contact shares its sign, gap, stiffness and law, and every node its mass

@@ -18,6 +18,10 @@ submodule (martello_observer) energy
    !> (≤ 1e-4: the trapezoidal work of a contact closing within a step), far below a
    !> realised restitution past 1 (e = 1.1 creates 21 % of the impact's energy).
    real(dp), parameter :: CREATED_BOUND = 1.0e-2_dp
+   !> Energy [J] below which a state is at rest to round-off: neither divergence test fires
+   !> while the energies it compares stay under it (a mass held against a stop by its load
+   !> jitters at ~1e-41 J; a milligram moving at a nanometre per second has 5e-25 J).
+   real(dp), parameter :: ENERGY_FLOOR = 1.0e-30_dp
 
 contains
 
@@ -177,15 +181,15 @@ contains
 
    !> Divergence at time t, one rule for every integrator: a non-finite state or work, or
    !> the mechanical energy beyond divergence_factor·(e0 + Σ|ΔW_ext|), what the run was
-   !> given (docs/integrators.md "divergence detection").
+   !> given, by more than ENERGY_FLOOR (docs/integrators.md "divergence detection").
    module procedure check_divergence
       stat = MARTELLO_OK
       if (.not. (ieee_is_finite(e_mech) .and. all(ieee_is_finite(u)) .and. &
                  all(ieee_is_finite(v)) .and. &
                  ieee_is_finite(o%w_ext + o%d_damp + o%d_links + o%d_contact + o%d_impact))) then
          call observer_fail_nonfinite(o, t, stat)
-      else if (-(o%energy(E_CONTACT) + o%energy(E_IMPACT)) > CREATED_BOUND*(o%e0 + o%w_abs) .and. &
-               o%e0 + o%w_abs > 0.0_dp) then
+      else if (-(o%energy(E_CONTACT) + o%energy(E_IMPACT)) > CREATED_BOUND*(o%e0 + o%w_abs) &
+               + ENERGY_FLOOR .and. o%e0 + o%w_abs > 0.0_dp) then
          ! a passive contact only takes energy out: the realised restitution exceeds 1
          write (o%message, '(a,a,es12.5,a,es10.3,a,es10.3,a,a)') integrator_name(o%kind), &
             ' created energy at its contacts by t = ', t, ' s: ', &
@@ -194,7 +198,7 @@ contains
             ' (restitution > 1); ', o%advice
          stat = MARTELLO_ERR_DIVERGED
          call observer_finish(o, t)
-      else if (e_mech > o%divergence_factor*(o%e0 + o%w_abs) + tiny(1.0_dp) .and. &
+      else if (e_mech > o%divergence_factor*(o%e0 + o%w_abs) + ENERGY_FLOOR .and. &
                o%e0 + o%w_abs > 0.0_dp) then
          write (o%message, '(a,a,es12.5,a,es10.3,a,es10.3,a,a)') integrator_name(o%kind), &
             ' diverged at t = ', t, ' s: mechanical energy ', e_mech, ' J exceeds ', &

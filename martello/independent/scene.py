@@ -9,6 +9,7 @@ scene that `martello run` accepts, and re-derives from it every quantity the mec
 from __future__ import annotations
 
 import math
+import re
 import tomllib
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -73,12 +74,39 @@ def _read_csv_record(path: Path, units):
             continue                    # the header line
         ts.append(t)
         vs.append(a)
-    used = {"g": "g", "m/s2": "m/s2", "cm/s2": "cm/s2", "m/s^2": "m/s2", "gal": "cm/s2"}.get(
-        units or file_units or "m/s2")
+    used = _UNITS.get((units or file_units or "m/s2").lower())
     if used is None:
         raise Unsupported(f"record {path}: units {units or file_units!r}")
     factor = {"g": STANDARD_GRAVITY, "m/s2": 1.0, "cm/s2": 0.01}[used]
     return np.array(ts), np.array(vs) * factor
+
+
+_UNITS = {"g": "g", "m/s2": "m/s2", "cm/s2": "cm/s2", "m/s^2": "m/s2", "gal": "cm/s2", "m/s/s": "m/s2",
+          "cm/s/s": "cm/s2", "cm/sec2": "cm/s2", "m/sec2": "m/s2"}
+
+
+def _read_at2_record(path: Path, units):
+    """A PEER NGA .AT2 acceleration file (docs/scene-input.md "record"): a title, an event
+    line, the units line (`... IN UNITS OF G`), NPTS and DT on the fourth line (`NPTS= 5590,
+    DT= .0050 SEC` or the old `5590 .0050 NPTS, DT`), then the values; t = i DT. The file's
+    units win over the scene's."""
+    lines = path.read_text(encoding="latin-1").splitlines()
+    m = re.search(r"UNITS?\s+(?:OF\s+)?(\S+)", lines[2], re.IGNORECASE)
+    used = _UNITS.get(m.group(1).lower() if m else (units or "").lower())
+    if used is None:
+        raise Unsupported(f"record {path}: units {m.group(1) if m else units!r}")
+    head = lines[3]
+    fixed = re.match(r"\s*(\S+)\s+(\S+)\s+NPTS\s*,?\s*DT\b", head, re.IGNORECASE)
+    if fixed:
+        npts, dt = int(float(fixed.group(1))), float(fixed.group(2))
+    else:
+        npts = int(float(re.search(r"NPTS\s*=\s*([^\s,]+)", head, re.IGNORECASE).group(1)))
+        dt = float(re.search(r"DT\s*=\s*([^\s,]+)", head, re.IGNORECASE).group(1))
+    values = np.array([float(x) for line in lines[4:] for x in line.split()])
+    if len(values) != npts:
+        raise Unsupported(f"record {path}: NPTS = {npts}, {len(values)} values")
+    factor = {"g": STANDARD_GRAVITY, "m/s2": 1.0, "cm/s2": 0.01}[used]
+    return np.arange(npts) * dt, values * factor
 
 
 def time_function(fn, base: Path | None) -> TimeFunction:
@@ -101,9 +129,12 @@ def time_function(fn, base: Path | None) -> TimeFunction:
             if not path.is_absolute():
                 path = (base or Path.cwd()) / path
             fmt = (p.get("format") or path.suffix.lstrip(".")).lower()
-            if fmt not in ("csv", "txt"):
-                raise Unsupported(f"ground-motion record format {fmt!r} (CSV only)")
-            ts, vs = _read_csv_record(path, p.get("units"))
+            if fmt in ("at2", "peer"):
+                ts, vs = _read_at2_record(path, p.get("units"))
+            elif fmt in ("csv", "txt"):
+                ts, vs = _read_csv_record(path, p.get("units"))
+            else:
+                raise Unsupported(f"ground-motion record format {fmt!r} (AT2 and CSV)")
         p.setdefault("scale", 1.0)
         return TimeFunction("table", p, list(ts), (ts, vs))
     raise Unsupported(f"time function {kind!r}")

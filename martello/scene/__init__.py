@@ -5,4 +5,4 @@
 ``compatibility`` the scheme x integrator table; ``chain`` and ``bars`` are the generators
 that expand ``[[chain]]`` and ``[[bar]]`` tables; ``variants`` derives scene dicts with
 another analysis or other contacts (studies, reference data); ``catalogue`` lists the
-scene files of benchmarks/. docs/scene-format.md documents the format."""
+scene files of benchmarks/. docs/scene-input.md documents the format."""

@@ -2,7 +2,7 @@
 
 A scene is TOML with tables `[[node]]`, `[[link]]`, `[[contact]]`, `[loads]`, `[analysis]`
 and an optional `[check]` (the closed form it is verified against). The format is documented
-in docs/scene-format.md. Every error names the file, the field and what would be valid."""
+in docs/scene-input.md. Every error names the file, the field and what would be valid."""
 
 import hashlib
 import json
@@ -57,12 +57,12 @@ class Scene:
     @classmethod
     def from_dict(cls, data, base_dir=".", source="<scene>"):
         """A validated scene from a dict shaped like the scene file's tables
-        (docs/scene-format.md), e.g. the parsed TOML; record files named in it are relative
+        (docs/scene-input.md), e.g. the parsed TOML; record files named in it are relative
         to base_dir. The dict is not modified."""
         if not isinstance(data, dict):
             raise SceneError(source, "(scene)", f"is a {type(data).__name__}",
                              "give a dict of the scene file's tables: node, link, contact, "
-                             "loads, analysis (docs/scene-format.md)")
+                             "loads, analysis (docs/scene-input.md)")
         return from_dict(data, source=source, base_dir=Path(base_dir))
 
     @classmethod

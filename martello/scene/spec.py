@@ -1,6 +1,6 @@
 """The scene format's vocabulary: the keys of every table with their kinds, checks and
 defaults, the contact schemes and laws, the time functions, the integrators and their
-parameters (docs/scene-format.md). Which integrators run which contact scheme is in
+parameters (docs/scene-input.md). Which integrators run which contact scheme is in
 martello.scene.compatibility."""
 
 from ..binding import native
