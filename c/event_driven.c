@@ -56,7 +56,11 @@ typedef struct {
   int every;
   /* topology */
   double *mass, *gap, *e;
-  int *fixed, *con_a, *con_b, *scheme, *is_pen, *uni, *inert;
+  int *fixed, *scheme, *is_pen, *uni, *inert;
+  /* the elements' rows (martello_model_elements): elem all of them, con the contacts' */
+  int *el_first, *el_node;
+  double *el_coef;
+  martello_rows elem, con;
   double *Cm;                     /* M^-1 B_j^T of unilateral contact j (B_j = e_b - e_a, the
                                      impulse door's sign): column uni[j] */
   /* ODE */
@@ -78,7 +82,7 @@ typedef struct {
   double *Wl, *ql, *pl, *wl, *sl, *el, *tg;
   martello_accumulation acc;      /* the accumulation rule's phases (c/accumulation.c) */
   /* the switches of the laws' branches (martello_eval_switches), refreshed at every commit */
-  int nsw, *sw_a, *sw_b;
+  int nsw, *sw_el;
   double *sw_al, *sw_be, *sw_ga;
   /* located peaks (c/located_peaks.c): the element quantities and their rates
    * (c/located_peaks.c's packed layout) at the start (0) and end
@@ -123,16 +127,13 @@ static int fail_eval(ed_t *w, int status, double t) {
                                 : "event-driven: the force evaluation failed");
 }
 
-/* G_j x = x_a - x_b (ground: x = 0). */
+/* G_j x: contact j's row (x_a - x_b for a node pair). */
 static double gdot(const ed_t *w, int j, const double *x) {
-  double s = 0.0;
-  if (w->con_a[j] >= 0) s += x[w->con_a[j]];
-  if (w->con_b[j] >= 0) s -= x[w->con_b[j]];
-  return s;
+  return martello_rows_dot(&w->con, j, x);
 }
 
-/* The impulse door's topology arguments (c/martello_internal.h): sides and columns in Cm. */
-#define TOPOLOGY(w) (w)->con_a, (w)->con_b, (w)->uni, (w)->Cm
+/* The impulse door's topology arguments (c/martello_internal.h): rows and columns in Cm. */
+#define TOPOLOGY(w) &(w)->con, (w)->uni, (w)->Cm
 
 static int all_finite(const double *x, size_t n) {
   size_t i;
@@ -141,12 +142,9 @@ static int all_finite(const double *x, size_t n) {
   return 1;
 }
 
-/* |x_a| + |x_b|: the magnitude from which G_j x is computed. */
+/* sum |coef x| over the row: the magnitude from which G_j x is computed. */
 static double node_sum(const ed_t *w, int j, const double *x) {
-  double s = 0.0;
-  if (w->con_a[j] >= 0) s += fabs(x[w->con_a[j]]);
-  if (w->con_b[j] >= 0) s += fabs(x[w->con_b[j]]);
-  return s;
+  return martello_rows_abs(&w->con, j, x);
 }
 
 /* |u_a| + |u_b| + |gap|: the magnitude from which the gap is computed. */
@@ -162,20 +160,18 @@ static double gap_tol(const ed_t *w, int j, const double *u) {
 
 /* The value of switch slot s on the state y: g > 0 once its branch is left. */
 static double switch_value(const ed_t *w, int s, const double *y) {
-  const int a = w->sw_a[s], b = w->sw_b[s];
+  const int e = w->sw_el[s];
   double du = 0.0, dv = 0.0;
-  if (a >= 0) { du += y[a]; dv += y[w->n + a]; }
-  if (b >= 0) { du -= y[b]; dv -= y[w->n + b]; }
+  if (e >= 0) { du = martello_rows_dot(&w->elem, e, y); dv = martello_rows_dot(&w->elem, e, y + w->n); }
   return w->sw_al[s] * du + w->sw_be[s] * dv + w->sw_ga[s];
 }
 
 /* The rounding of switch s on y: a value within it is on the surface, not past it (a branch
  * just entered starts there). */
 static double switch_rounding(const ed_t *w, int s, const double *y) {
-  const int a = w->sw_a[s], b = w->sw_b[s];
+  const int e = w->sw_el[s];
   double su = 0.0, sv = 0.0;
-  if (a >= 0) { su += fabs(y[a]); sv += fabs(y[w->n + a]); }
-  if (b >= 0) { su += fabs(y[b]); sv += fabs(y[w->n + b]); }
+  if (e >= 0) { su = martello_rows_abs(&w->elem, e, y); sv = martello_rows_abs(&w->elem, e, y + w->n); }
   return 16.0 * DBL_EPSILON * (fabs(w->sw_al[s]) * su + fabs(w->sw_be[s]) * sv + fabs(w->sw_ga[s]));
 }
 
@@ -332,10 +328,7 @@ static int update_held(ed_t *w, double t, const int *list, int m) {
     if (w->wl[k] == 0.0) continue;
     w->hlist[w->nh++] = k;
     if (!w->held[k]) {
-      int a = w->con_a[k], b = w->con_b[k];
-      double fs = 0.0;
-      if (a >= 0) fs += fabs(w->fext[a]) + fabs(w->fint[a]);
-      if (b >= 0) fs += fabs(w->fext[b]) + fabs(w->fint[b]);
+      double fs = martello_rows_abs(&w->con, k, w->fext) + martello_rows_abs(&w->con, k, w->fint);
       w->held[k] = 1;
       martello_accumulation_hold(&w->acc, w->obs, k);
       /* a release needs a tension beyond the rounding of the forces at the contact */
@@ -695,7 +688,7 @@ static int search_extremum(ed_t *w, int j, int type, double t0, double t1, doubl
  * and past at *tb (*gb, state in w->yb), 0 if it is not crossed, < 0 on failure. */
 static int bracket_switch(ed_t *w, int s, double t0, double t1, double *ga, double *tb,
                           double *gb) {
-  const int n = w->n, a = w->sw_a[s], b = w->sw_b[s];
+  const int n = w->n, e = w->sw_el[s];
   const double h = t1 - t0;
   double x[2][3] = {{0.0, 0.0, 0.0}, {0.0, 0.0, 0.0}}, best = -HUGE_VAL, xbest = 0.0, tol;
   hermite_t p;
@@ -710,13 +703,12 @@ static int bracket_switch(ed_t *w, int s, double t0, double t1, double *ga, doub
     return 1;
   }
   /* du, dv, da at both ends */
-  if (a >= 0) {
-    x[0][0] += w->y0[a]; x[0][1] += w->y0[n + a]; x[0][2] += w->fstart[n + a];
-    x[1][0] += w->y[a]; x[1][1] += w->y[n + a]; x[1][2] += w->f1[n + a];
-  }
-  if (b >= 0) {
-    x[0][0] -= w->y0[b]; x[0][1] -= w->y0[n + b]; x[0][2] -= w->fstart[n + b];
-    x[1][0] -= w->y[b]; x[1][1] -= w->y[n + b]; x[1][2] -= w->f1[n + b];
+  if (e >= 0) {
+    const martello_rows *r = &w->elem;
+    x[0][0] = martello_rows_dot(r, e, w->y0); x[0][1] = martello_rows_dot(r, e, w->y0 + n);
+    x[0][2] = martello_rows_dot(r, e, w->fstart + n);
+    x[1][0] = martello_rows_dot(r, e, w->y); x[1][1] = martello_rows_dot(r, e, w->y + n);
+    x[1][2] = martello_rows_dot(r, e, w->f1 + n);
   }
   hermite_build(&p, h, x[0][0], x[0][1], x[0][2], x[1][0], x[1][1], x[1][2]);
   for (i = 1; i < GRAZING_SAMPLES; i++) {
@@ -951,7 +943,7 @@ static int commit(ed_t *w, double t, const double *w_start) {
   const double *wk = w->y + 2 * w->n;
   int st = martello_eval_commit(w->ev, w->y, w->y + w->n);
   if (st == MARTELLO_OK && w->nsw > 0)   /* the branches may have changed */
-    st = martello_eval_switches(w->ev, w->sw_a, w->sw_b, w->sw_al, w->sw_be, w->sw_ga);
+    st = martello_eval_switches(w->ev, w->sw_el, w->sw_al, w->sw_be, w->sw_ga);
   if (st == MARTELLO_OK)
     st = martello_observer_work(w->obs, wk[0] - w_start[0], wk[1] - w_start[1],
                                 wk[2] - w_start[2], wk[3] - w_start[3], w->e_impact);
@@ -974,13 +966,13 @@ static int observe(ed_t *w, double t, int k) {
 /* ---- set-up and tear-down -------------------------------------------------------------- */
 
 static void ed_free(ed_t *w) {
-  void *bufs[] = {w->mass, w->gap, w->e, w->fixed, w->con_a, w->con_b, w->scheme, w->is_pen,
+  void *bufs[] = {w->mass, w->gap, w->e, w->fixed, w->el_first, w->el_node, w->el_coef, w->scheme, w->is_pen,
                   w->uni, w->inert, w->Cm, w->scale_abs, w->y, w->y0, w->yb, w->ybest, w->yc,
                   w->yerr, w->fstart, w->f, w->f1, w->fj, w->yj, w->fint, w->fext,
                   w->pen0, w->rate0, w->acc0, w->pen1, w->rate1, w->acc1, w->pen, w->rate,
                   w->force, w->lam, w->lam0, w->lam1, w->lamtol, w->hlist, w->held, w->Wh,
                   w->rh, w->ilist, w->hk, w->Wl, w->ql, w->pl, w->wl, w->sl, w->el, w->tg, 
-                  w->sw_a, w->sw_b, w->sw_al, w->sw_be, w->sw_ga, w->el0, w->el1, w->elc,
+                  w->sw_el, w->sw_al, w->sw_be, w->sw_ga, w->el0, w->el1, w->elc,
                   w->jk0, w->jk1, w->fp};
   size_t i;
   for (i = 0; i < sizeof bufs / sizeof bufs[0]; i++) free(bufs[i]);
@@ -1005,17 +997,26 @@ static int ed_setup(ed_t *w) {
   const size_t dim = (size_t)(2 * n + 4);
   const gsl_odeiv2_step_type *T;
   double h0;
-  int j, st, nn, nc_read, ncoup;
+  int j, st, nn, nc_read, ncoup, nl_rows, nterms;
   w->dim = dim;
   if (!(ALLOC(w->mass, n) && ALLOC(w->fixed, n) && ALLOC(w->gap, nc) && ALLOC(w->e, nc) &&
-        ALLOC(w->con_a, nc) && ALLOC(w->con_b, nc) && ALLOC(w->scheme, nc) &&
+        ALLOC(w->scheme, nc) &&
         ALLOC(w->is_pen, nc) &&
         ALLOC(w->uni, nc) && ALLOC(w->inert, nc)))
     return FAIL_ALLOC();
   /* three distinct outputs: the Fortran dummies are intent(out) and must not alias */
-  st = martello_model_topology(w->model, &nn, &nc_read, w->mass, w->fixed, w->con_a, w->con_b,
-                               w->scheme, w->gap, w->e, &ncoup);
+  st = martello_model_topology(w->model, &nn, &nc_read, w->mass, w->fixed, w->scheme, w->gap,
+                               w->e, &ncoup);
   if (st != MARTELLO_OK) return fail(w, st, 0.0, "event-driven: martello_model_topology failed");
+  st = martello_model_elements(w->model, &nl_rows, &nterms, NULL, NULL, NULL);
+  if (st != MARTELLO_OK) return fail(w, st, 0.0, "event-driven: martello_model_elements failed");
+  if (!(ALLOC(w->el_first, nl_rows + nc + 1) && ALLOC(w->el_node, nterms) && ALLOC(w->el_coef, nterms)))
+    return FAIL_ALLOC();
+  st = martello_model_elements(w->model, &nl_rows, &nterms, w->el_first, w->el_node, w->el_coef);
+  if (st != MARTELLO_OK) return fail(w, st, 0.0, "event-driven: martello_model_elements failed");
+  w->elem.first = w->el_first; w->elem.node = w->el_node; w->elem.coef = w->el_coef;
+  w->con = w->elem;
+  w->con.first = w->el_first + nl_rows;
   for (j = 0; j < n; j++)
     if (w->mass[j] < 0.0) {
       return martello_observer_fail(w->obs, MARTELLO_ERR_STATE, 0.0,
@@ -1060,24 +1061,24 @@ static int ed_setup(ed_t *w) {
   /* every switching surface of the laws is an event: hold them on smooth branches */
   st = martello_eval_use_branches(w->ev, &w->nsw);
   if (st != MARTELLO_OK) return fail(w, st, 0.0, "event-driven: martello_eval_use_branches failed");
-  if (!(ALLOC(w->sw_a, w->nsw) && ALLOC(w->sw_b, w->nsw) && ALLOC(w->sw_al, w->nsw) &&
+  if (!(ALLOC(w->sw_el, w->nsw) && ALLOC(w->sw_al, w->nsw) &&
         ALLOC(w->sw_be, w->nsw) && ALLOC(w->sw_ga, w->nsw)))
     return FAIL_ALLOC();
   if (w->nsw > 0 &&
-      martello_eval_switches(w->ev, w->sw_a, w->sw_b, w->sw_al, w->sw_be, w->sw_ga) != MARTELLO_OK)
+      martello_eval_switches(w->ev, w->sw_el, w->sw_al, w->sw_be, w->sw_ga) != MARTELLO_OK)
     return fail(w, MARTELLO_ERR_ARGUMENT, 0.0, "event-driven: martello_eval_switches failed");
   /* M^-1 B_j^T of every unilateral contact; a contact between two immovable sides is inert */
   for (j = 0; j < nc; j++) {
     double *c;
     int i;
-    /* both sides immovable: W_jj = 0 (M is positive definite on the free nodes) */
-    w->inert[j] = (w->con_a[j] < 0 || w->fixed[w->con_a[j]]) &&
-                  (w->con_b[j] < 0 || w->fixed[w->con_b[j]]);
+    /* every term on an immovable node: W_jj = 0 (M is positive definite on the free nodes) */
+    w->inert[j] = 1;
+    for (i = w->con.first[j]; i < w->con.first[j + 1]; i++)
+      if (!w->fixed[w->con.node[i]] && w->con.coef[i] != 0.0) w->inert[j] = 0;
     if (w->is_pen[j]) continue;
     c = w->Cm + (size_t)w->uni[j] * n;
     for (i = 0; i < n; i++) c[i] = 0.0;
-    if (w->con_a[j] >= 0) c[w->con_a[j]] -= 1.0;
-    if (w->con_b[j] >= 0) c[w->con_b[j]] += 1.0;
+    martello_rows_axpy(&w->con, j, -1.0, c);         /* B_j^T = -G_j^T */
     st = martello_eval_solve_mass(w->ev, c);
     if (st != MARTELLO_OK) return fail_eval(w, st, 0.0);
   }
@@ -1263,7 +1264,7 @@ int martello_event_driven_run(martello_model *model, martello_run *run) {
   w.every = s.every;
   st = check_settings(&w);
   if (st != MARTELLO_OK) return st;
-  st = martello_model_topology(model, &w.n, &w.nc, NULL, NULL, NULL, NULL, NULL, NULL, NULL, &nco);
+  st = martello_model_topology(model, &w.n, &w.nc, NULL, NULL, NULL, NULL, NULL, &nco);
   if (st != MARTELLO_OK) return st;
   st = ed_setup(&w);
   if (st == MARTELLO_OK) st = ed_integrate(&w);

@@ -231,9 +231,12 @@ static int bandwidth(ida_problem *P, const double *u0, const double *v0, suninde
     up[k] = u0[k];
     vp[k] = v0[k];
   }
-  for (int j = 0; j < E->nc; j++)
-    if (E->con_a[j] >= 0 && E->con_b[j] >= 0 && E->rig[j] < 0)
-      dnode = abs(E->con_a[j] - E->con_b[j]) > dnode ? abs(E->con_a[j] - E->con_b[j]) : dnode;
+  for (int j = 0; j < E->nc; j++) {
+    if (E->rig[j] >= 0) continue;
+    for (int p = E->con.first[j]; p < E->con.first[j + 1]; p++)
+      for (int q = E->con.first[j]; q < E->con.first[j + 1]; q++)
+        dnode = abs(E->con.node[p] - E->con.node[q]) > dnode ? abs(E->con.node[p] - E->con.node[q]) : dnode;
+  }
   sunindextype b = 1;
 #define WIDEN(p, q) do { sunindextype d_ = (p) > (q) ? (p) - (q) : (q) - (p); if (d_ > b) b = d_; } while (0)
   for (int i = 0; i < n; i++)
@@ -243,11 +246,10 @@ static int bandwidth(ida_problem *P, const double *u0, const double *v0, suninde
       WIDEN(E->iv[i], E->iv[k]);
     }
   for (int r = 0; r < E->nr; r++) {
-    int j = E->rig_con[r], ends[2] = {E->con_a[j], E->con_b[j]};
-    for (int e = 0; e < 2; e++) {
-      if (ends[e] < 0) continue;
-      WIDEN(P->ip[r], E->iv[ends[e]]);
-      WIDEN(P->im[r], E->iu[ends[e]]);
+    int j = E->rig_con[r];
+    for (int k = E->con.first[j]; k < E->con.first[j + 1]; k++) {
+      WIDEN(P->ip[r], E->iv[E->con.node[k]]);
+      WIDEN(P->im[r], E->iu[E->con.node[k]]);
     }
   }
 #undef WIDEN
@@ -276,8 +278,9 @@ static int setup(ida_problem *P, martello_model *model, martello_run *run) {
     E->iu[i] = pos++;
     E->iv[i] = pos++;
     for (int r = 0; r < E->nr; r++) {
-      int j = E->rig_con[r], a = E->con_a[j], b = E->con_b[j];
-      int first = (a >= 0 && b >= 0) ? (a < b ? a : b) : (a > b ? a : b);
+      int j = E->rig_con[r], first = E->n;      /* the row's smallest node */
+      for (int k = E->con.first[j]; k < E->con.first[j + 1]; k++)
+        first = E->con.node[k] < first ? E->con.node[k] : first;
       if (first == i) {
         P->ip[r] = pos++;
         P->im[r] = pos++;

@@ -107,6 +107,17 @@ int martello_model_add_link(martello_model *model, int kind, int a, int b,
 int martello_model_add_contact(martello_model *model, int a, int b, double gap, int scheme,
                                int law, const double par[MARTELLO_NPAR_CONTACT]);
 int martello_model_add_mass_coupling(martello_model *model, int a, int b, double value);
+/* A link or a contact whose deformation is a combination of several DOFs: sum_k coef[k]
+ * u[nodes[k]] over n terms (0-based nodes, -1: the ground, left out), its force f acting on
+ * the nodes as coef[k] f -- a contact's penetration is that minus gap. A node pair a, b is the
+ * row (a, +1), (b, -1), what martello_model_add_link/_add_contact make; a contact between plan
+ * points of two rigid floors is n . (P_a q_a - P_b q_b), six terms (docs/buildings.md). Every
+ * integrator, the impulse problem (W = G M^-1 G^T) and the effective masses read rows. */
+int martello_model_add_link_row(martello_model *model, int kind, int n, const int *nodes,
+                                const double *coef, const double *par);
+int martello_model_add_contact_row(martello_model *model, int n, const int *nodes,
+                                   const double *coef, double gap, int scheme, int law,
+                                   const double *par);
 /* A chain held per node (docs/c-api.md "Chains"): nodes first ... first + n - 1 (0-based, set
  * by set_node(s)), node i with a spring k[i] to ground (a bilinear spring when fy and
  * hardening are given), a dashpot c[i] to ground where c[i] > 0 (c NULL: none), and nodes i,

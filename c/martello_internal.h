@@ -4,6 +4,7 @@
  * nodes), contact arrays length n_contacts; contacts are 0-based. */
 #ifndef MARTELLO_INTERNAL_H
 #define MARTELLO_INTERNAL_H
+#include <math.h>
 #include <stdint.h>
 
 #include "martello.h"
@@ -24,11 +25,58 @@ void martello_memory_message(const char *what, double bytes, const char *fix, ch
 int martello_write_csv(const char *path, const char *header, const double *data, int64_t rows,
                        int cols);
 
-/* Scene topology for impact laws. con_a/con_b are 0-based nodes, -1 = ground; fixed[i] is 0/1;
- * restitution[j] is the contact's e (or -1 if none given). Pass NULL for what you don't need. */
+/* Scene topology for impact laws: fixed[i] is 0/1; restitution[j] is the contact's e (or -1
+ * if none given); the contacts' nodes are their rows (martello_model_elements). Pass NULL for
+ * what you don't need. */
 int martello_model_topology(const martello_model *model, int *n, int *n_contacts, double *mass,
-                            int *fixed, int *con_a, int *con_b, int *scheme, double *gap,
-                            double *restitution, int *n_couplings);
+                            int *fixed, int *scheme, double *gap, double *restitution,
+                            int *n_couplings);
+
+/* The elements as rows of the constraint operator (fortran/element_rows.f90, docs/buildings.md):
+ * element e deforms by G_e x = sum_k coef[k] x[node[k]], k = first[e] .. first[e+1]-1 (0-based
+ * nodes; the ground never appears), its force f acts on the nodes as coef[k] f. A node pair is
+ * (a, +1), (b, -1); a contact between plan points of two floors has up to six terms. Links are
+ * elements 0 .. n_links-1, contact j is element n_links + j. With first, node, coef NULL:
+ * only the sizes (n_terms, all elements' terms together). */
+int martello_model_elements(const martello_model *model, int *n_links, int *n_terms, int *first,
+                            int *node, double *coef);
+
+/* A set of rows (first, node, coef as martello_model_elements gives them; first may point at a
+ * later element, e.g. the contacts: first + n_links). */
+typedef struct {
+  const int *first, *node;
+  const double *coef;
+} martello_rows;
+
+/* G_e x. */
+static inline double martello_rows_dot(const martello_rows *r, int e, const double *x) {
+  double s = 0.0;
+  int k;
+  for (k = r->first[e]; k < r->first[e + 1]; k++) s += r->coef[k] * x[r->node[k]];
+  return s;
+}
+
+/* sum_k |coef_k x[node_k]|: the magnitude G_e x is computed from. */
+static inline double martello_rows_abs(const martello_rows *r, int e, const double *x) {
+  double s = 0.0;
+  int k;
+  for (k = r->first[e]; k < r->first[e + 1]; k++) s += fabs(r->coef[k] * x[r->node[k]]);
+  return s;
+}
+
+/* max_k |coef_k x[node_k]| (0 for an empty row). */
+static inline double martello_rows_max(const martello_rows *r, int e, const double *x) {
+  double s = 0.0;
+  int k;
+  for (k = r->first[e]; k < r->first[e + 1]; k++) s = fmax(s, fabs(r->coef[k] * x[r->node[k]]));
+  return s;
+}
+
+/* y <- y + f G_e^T. */
+static inline void martello_rows_axpy(const martello_rows *r, int e, double f, double *y) {
+  int k;
+  for (k = r->first[e]; k < r->first[e + 1]; k++) y[r->node[k]] += f * r->coef[k];
+}
 
 /* Initial displacements and velocities of every node (fixed nodes: u0, v = 0). */
 int martello_model_initial_state(const martello_model *model, double *u0, double *v0);
@@ -52,15 +100,16 @@ int martello_eval_use_branches(martello_eval *ev, int *nsw);
 /* As martello_eval_use_branches, but only the laws whose force jumps at a switch are held:
  * penalty contacts whose force is continuous at onset and separation (linear, Hertz, the
  * Hunt-Crossley family) and bilinear links stay whole, their kinks inside the integrator's steps
- * (docs/sundials-ode.md, events at size); continuous[j] = 1 for those contacts (n_contacts
+ * (docs/sundials-ode.md, events inside the steps); continuous[j] = 1 for those contacts (n_contacts
  * values). */
 int martello_eval_use_smooth_branches(martello_eval *ev, int *nsw, int *continuous);
 /* The approach speed v at the located onset of penalty contact j's phase (committed in contact):
  * the Hunt-Crossley family's v_in. */
 int martello_eval_set_onset_speed(martello_eval *ev, int j, double v);
-/* The switches of the branches held, g = alpha (u_a - u_b) + beta (v_a - v_b) + gamma with
- * 0-based nodes a, b (-1: ground); g > 0: the branch is left. Constant between commits. */
-int martello_eval_switches(martello_eval *ev, int *a, int *b, double *alpha, double *beta,
+/* The switches of the branches held, g = alpha G_e u + beta G_e v + gamma on the row of
+ * element el (martello_model_elements; -1: an unused slot); g > 0: the branch is left.
+ * Constant between commits. */
+int martello_eval_switches(martello_eval *ev, int *el, double *alpha, double *beta,
                            double *gamma);
 /* The first time after t where a load has a kink (a window's start or end, a table sample),
  * or DBL_MAX. */
@@ -177,34 +226,34 @@ int martello_observer_finish(martello_observer *obs, double t_reached);
 
 /* ---- the impulse problem (fortran/impulse.f90 through fortran/api_impulse.f90;
  * docs/impulse.md) ----------------------------------------------------------------------------
- * The m contacts of a problem are list[0..m) of the caller's topology: contact j joins the
- * 0-based nodes a[j] and b[j] (-1: the ground), its gap rate is gdot_j = B_j v = v_b - v_a
- * (> 0 opening: the penetration rate with the opposite sign), a compressive impulse P >= 0 acts
- * as B_j^T P, and its column C_j = M^-1 B_j^T (martello_eval_solve_mass of e_b - e_a) is column
- * col[j] of the column-major n x (any) array cols. The Delassus matrix is W_kl = B_k C_l;
+ * The m contacts of a problem are list[0..m) of the caller's contact rows g (contact j's
+ * penetration row G_j, martello_rows); its gap rate is gdot_j = B_j v with B_j = -G_j (v_b - v_a
+ * for a node pair; > 0 opening: the penetration rate with the opposite sign), a compressive
+ * impulse P >= 0 acts as B_j^T P, and its column C_j = M^-1 B_j^T (martello_eval_solve_mass
+ * of -G_j^T) is column col[j] of the column-major n x (any) array cols. The Delassus matrix is W_kl = B_k C_l;
  * matrices are m x m column-major; P, e, lambda, held are per problem contact. Status:
  * MARTELLO_OK, MARTELLO_ERR_SINGULAR (redundant contacts: Newton's law has no solution, or the
  * held set's W is not positive definite), MARTELLO_ERR_NOT_CONVERGED (LCP pivot or sweep
  * limit), MARTELLO_ERR_ARGUMENT (n or m < 0). */
-int martello_impulse_delassus(int n, int m, const int *list, const int *a, const int *b,
+int martello_impulse_delassus(int n, int m, const int *list, const martello_rows *g,
                               const int *col, const double *cols, double *W);
 /* Newton's impact law on the m contacts at once, 0 <= gdot+ + e min(gdot-, 0) _|_ P >= 0
  * with gdot- = B v on entry: the impulses P and v <- v + sum_k P_k C_k. */
-int martello_impulse_newton(int n, int m, const int *list, const int *a, const int *b,
+int martello_impulse_newton(int n, int m, const int *list, const martello_rows *g,
                             const int *col, const double *cols, const double *e, double *v,
                             double *P, int *iterations);
 /* The contact forces of contacts at zero gap and gap rate, 0 <= gddot _|_ lambda >= 0 with
  * gddot = B acc + W lambda (acc: the accelerations without them), and the persistent-contact
  * rule: held[k] = 0 iff the solution opens the contact (lambda_k = 0, gddot_k > 0). */
-int martello_impulse_contact_forces(int n, int m, const int *list, const int *a, const int *b,
+int martello_impulse_contact_forces(int n, int m, const int *list, const martello_rows *g,
                                     const int *col, const double *cols, const double *acc,
                                     double *lambda, int *held, int *iterations);
 /* W of contacts held together, Cholesky-factored into L (m x m). */
-int martello_impulse_factor(int n, int m, const int *list, const int *a, const int *b,
+int martello_impulse_factor(int n, int m, const int *list, const martello_rows *g,
                             const int *col, const double *cols, double *L);
 /* With L from martello_impulse_factor: P = W^-1 (target - B x), x <- x + sum_k P_k C_k, the
  * mass-weighted projection onto B x = target (NULL: 0). */
-int martello_impulse_project(int n, int m, const int *list, const int *a, const int *b,
+int martello_impulse_project(int n, int m, const int *list, const martello_rows *g,
                              const int *col, const double *cols, const double *L,
                              const double *target, double *x, double *P);
 /* The accumulation (Zeno) rule (docs/impulse.md §4): 1 if the impacts of a contact leaving at

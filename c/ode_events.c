@@ -56,14 +56,14 @@ void *oe_take(size_t count, size_t size, double *failed) {
 
 /* ---- kinematics ------------------------------------------------------------------------- */
 
-static double node_u(int i, const double *u) { return i < 0 ? 0.0 : u[i]; }
-
+/* delta = G_j u - gap, contact j's row (u_a - u_b - gap for a node pair), in the kernels'
+ * order of operations (fortran/element_rows.f90). */
 double oe_pen(const ode_events *E, int j, const double *u) {
-  return (node_u(E->con_a[j], u) - node_u(E->con_b[j], u)) - E->gap[j];
+  return martello_rows_dot(&E->con, j, u) - E->gap[j];
 }
 
 double oe_rate(const ode_events *E, int j, const double *v) {
-  return node_u(E->con_a[j], v) - node_u(E->con_b[j], v);
+  return martello_rows_dot(&E->con, j, v);
 }
 
 void oe_gather(const ode_events *E, const double *y, double *u, double *v) {
@@ -78,16 +78,12 @@ void oe_apply_B(const ode_events *E, const double *lam, double *x) {
   memset(x, 0, sizeof(double) * (size_t)E->n);
   for (int r = 0; r < E->nr; r++) {
     if (!E->closed[r] || lam[r] == 0.0) continue;
-    int j = E->rig_con[r];
-    if (E->con_a[j] >= 0) x[E->con_a[j]] += lam[r];
-    if (E->con_b[j] >= 0) x[E->con_b[j]] -= lam[r];
+    martello_rows_axpy(&E->con, E->rig_con[r], lam[r], x);
   }
 }
 
 double oe_position_tol(const ode_events *E, int j, const double *u) {
-  double s = fabs(E->gap[j]);
-  s = fmax(s, fabs(node_u(E->con_a[j], u)));
-  s = fmax(s, fabs(node_u(E->con_b[j], u)));
+  double s = fmax(fabs(E->gap[j]), martello_rows_max(&E->con, j, u));
   return POSITION_TOL_FACTOR * (E->rtol * s + E->atol);
 }
 
@@ -98,18 +94,22 @@ static double speed_tol(const ode_events *E, const double *v) {
 }
 
 /* The kernels decide a penalty law's regime by the sign of delta, so a restart exactly at
- * delta = 0 would not know on which side it is. */
+ * delta = 0 would not know on which side it is: contact j moved strictly to side sgn by the
+ * smallest shift of its row's first free node. */
 void oe_nudge(ode_events *E, int j, int sgn, double *u) {
-  int a = E->con_a[j], b = E->con_b[j];
-  int node = (a >= 0 && !E->fixed[a]) ? a : ((b >= 0 && !E->fixed[b]) ? b : -1);
+  int node = -1;
+  double c = 0.0;
+  for (int k = E->con.first[j]; k < E->con.first[j + 1] && node < 0; k++)
+    if (!E->fixed[E->con.node[k]] && E->con.coef[k] != 0.0) {
+      node = E->con.node[k];
+      c = E->con.coef[k];
+    }
   if (node < 0) return;
-  double dir = node == a ? 1.0 : -1.0;
-  double eta = 4.0 * DBL_EPSILON *
-               (fabs(E->gap[j]) + fabs(node_u(a, u)) + fabs(node_u(b, u))) + DBL_MIN;
+  double eta = 4.0 * DBL_EPSILON * (fabs(E->gap[j]) + martello_rows_abs(&E->con, j, u)) + DBL_MIN;
   for (int k = 0; k < 80; k++) {
     double d = oe_pen(E, j, u);
     if (sgn * d > 0.0) return;
-    u[node] += dir * sgn * (fabs(d) + eta);
+    u[node] += sgn * (fabs(d) + eta) / c;
     eta *= 2.0;
   }
 }
@@ -123,8 +123,7 @@ static int impulse_columns(ode_events *E) {
     int j = E->rig_con[r], st;
     double *c = E->cols + (size_t)r * (size_t)E->n;
     memset(c, 0, sizeof(double) * (size_t)E->n);
-    if (E->con_a[j] >= 0) c[E->con_a[j]] -= 1.0;
-    if (E->con_b[j] >= 0) c[E->con_b[j]] += 1.0;
+    martello_rows_axpy(&E->con, j, -1.0, c);       /* B_j^T = -G_j^T */
     if ((st = martello_eval_solve_mass(E->ev, c)) != MARTELLO_OK) return st;
   }
   E->cols_ready = 1;
@@ -137,7 +136,7 @@ static void door_list(ode_events *E, int m) {
 }
 
 /* The impulse door's topology arguments (c/martello_internal.h): sides, columns in cols. */
-#define TOPOLOGY(E) (E)->con_a, (E)->con_b, (E)->rig, (E)->cols
+#define TOPOLOGY(E) &(E)->con, (E)->rig, (E)->cols
 
 static int closed_set(ode_events *E) {
   int m = 0;
@@ -168,10 +167,10 @@ static int closed_set_roots(ode_events *E) {
   E->mc = 0;
   for (int r = 0; r < E->nr; r++)
     if (E->closed[r]) {
-      int j = E->rig_con[r], a = E->con_a[j], b = E->con_b[j];
+      int j = E->rig_con[r];
       double fs = fabs(E->lam[r]);
-      if (a >= 0) fs += E->mass[a] * fabs(E->a[a]);
-      if (b >= 0) fs += E->mass[b] * fabs(E->a[b]);
+      for (int k = E->con.first[j]; k < E->con.first[j + 1]; k++)
+        fs += fabs(E->con.coef[k]) * E->mass[E->con.node[k]] * fabs(E->a[E->con.node[k]]);
       E->lamtol[r] = 1e3 * DBL_EPSILON * fs;
       E->lc[E->mc] = r;
       E->dlc[E->mc++] = j;
@@ -267,7 +266,7 @@ static int rigid_impacts(ode_events *E, double t, double *u, double *v) {
     double an = oe_rate(E, j, E->a), rebound = fmax(-oe_rate(E, j, v), 0.0);
     double e = E->rest[j] >= 0.0 ? E->rest[j] : 0.0;
     double v_res = POSITION_TOL_FACTOR *
-                   (E->rtol * (fabs(node_u(E->con_a[j], v)) + fabs(node_u(E->con_b[j], v))) + E->atol);
+                   (E->rtol * martello_rows_abs(&E->con, j, v) + E->atol);
     double da = 0.0;
     for (int l = 0; l < mc; l++) an -= E->S[k + ma * l] * E->w0[l];
     if (rebound > 0.0 && an > 0.0) {
@@ -326,7 +325,7 @@ static int rigid_multipliers(ode_events *E, double t, double *u, double *v) {
 int oe_commit(ode_events *E, const double *u, const double *v) {
   int st = martello_eval_commit(E->ev, u, v);
   if (st == MARTELLO_OK && E->nsw > 0)
-    st = martello_eval_switches(E->ev, E->sw_a, E->sw_b, E->sw_al, E->sw_be, E->sw_ga);
+    st = martello_eval_switches(E->ev, E->sw_el, E->sw_al, E->sw_be, E->sw_ga);
   /* the onset speeds located inside the stretch replace the commit's interpolated ones */
   for (int k = 0; k < E->nev && st == MARTELLO_OK; k++) {
     int j = E->ev_j[k];
@@ -522,9 +521,10 @@ int oe_roots(ode_events *E, double t, const double *u, const double *v, double *
     }
   }
   for (int s = 0; s < E->nsw; s++) {
-    const int a = E->sw_a[s], b = E->sw_b[s];
-    g[2 * E->nc + s] = E->sw_al[s] * (node_u(a, u) - node_u(b, u)) +
-                       E->sw_be[s] * (node_u(a, v) - node_u(b, v)) + E->sw_ga[s];
+    const int e = E->sw_el[s];
+    const double du = e >= 0 ? martello_rows_dot(&E->elem, e, u) : 0.0;
+    const double dv = e >= 0 ? martello_rows_dot(&E->elem, e, v) : 0.0;
+    g[2 * E->nc + s] = E->sw_al[s] * du + E->sw_be[s] * dv + E->sw_ga[s];
   }
   return 0;
 }
@@ -630,7 +630,7 @@ int oe_boundary_events(ode_events *E, double t_last, double tret, const double *
     double d = oe_pen(E, j, E->u), w = oe_rate(E, j, E->v);
     /* on the surface within round-off of the gap, or of the time */
     double on = 64.0 * DBL_EPSILON *
-                (fabs(node_u(E->con_a[j], E->u)) + fabs(node_u(E->con_b[j], E->u)) + fabs(E->gap[j]) +
+                (martello_rows_abs(&E->con, j, E->u) + fabs(E->gap[j]) +
                  fabs(w) * (fabs(tret) + fabs(h_last)));
     /* ... and moving across it faster than the integration error of a rate: two bodies
      * that travel together at zero gap are not a new event */
@@ -757,7 +757,7 @@ int oe_restart_progress(ode_events *E, double t) {
   return MARTELLO_OK;
 }
 
-/* ---- events inside the steps (docs/sundials-ode.md, events at size) -------------------------
+/* ---- events inside the steps (docs/sundials-ode.md, events inside the steps) -------------------------
  * Where a law's force is continuous at its switches, the integrator steps across them and its
  * error control takes the kink (a jump of a higher derivative); nothing stops or restarts. After
  * each step the gap of every such contact is compared at the two ends of the stretch (O(1) a
@@ -806,10 +806,9 @@ static double tay(const double *c, int n, int i, int q, double s, int deriv) {
 /* Contact j's gap (what = 0) or its rate (1) at t on the interpolant (taylor ready). */
 static double gap_at(const ode_events *E, int j, double t, int what) {
   const double s = t - E->tay_t, *c = what == 0 ? E->tay_u : E->tay_v;
-  const int a = E->con_a[j], b = E->con_b[j];
   double x = 0.0;
-  if (a >= 0) x += tay(c, E->n, a, E->tay_q, s, 0);
-  if (b >= 0) x -= tay(c, E->n, b, E->tay_q, s, 0);
+  for (int k = E->con.first[j]; k < E->con.first[j + 1]; k++)
+    x += E->con.coef[k] * tay(c, E->n, E->con.node[k], E->tay_q, s, 0);
   return what == 0 ? x - E->gap[j] : x;
 }
 
@@ -919,12 +918,9 @@ int oe_use_smooth(ode_events *E) {
   if (failed > 0.0) return oe_fail_memory(E, "the events inside the steps", failed);
   int st = martello_eval_use_smooth_branches(E->ev, &E->nsw, E->cont);
   if (st != MARTELLO_OK) return oe_fail(E, st, "%s: martello_eval_use_smooth_branches failed", E->name);
-  int any = 0;
-  for (int j = 0; j < E->nc; j++) any |= E->cont[j];
   E->smooth = 1;
-  (void)any;
   if (E->nsw > 0 &&
-      (st = martello_eval_switches(E->ev, E->sw_a, E->sw_b, E->sw_al, E->sw_be, E->sw_ga)) != MARTELLO_OK)
+      (st = martello_eval_switches(E->ev, E->sw_el, E->sw_al, E->sw_be, E->sw_ga)) != MARTELLO_OK)
     return oe_fail(E, st, "%s: martello_eval_switches failed", E->name);
   return MARTELLO_OK;
 }
@@ -932,11 +928,11 @@ int oe_use_smooth(ode_events *E) {
 /* ---- set-up --------------------------------------------------------------------------------- */
 
 void oe_release(ode_events *E) {
-  void *all[] = {E->mass, E->gap, E->rest, E->fixed, E->con_a, E->con_b, E->scheme, E->rig,
+  void *all[] = {E->mass, E->gap, E->rest, E->fixed, E->el_first, E->el_node, E->el_coef, E->scheme, E->rig,
                  E->rig_con, E->iu, E->iv, E->closed, E->act, E->opened, E->was_closed, E->hit,
                  E->cand, E->q, E->w0, E->w_in, E->w_out, E->u, E->v, E->a, E->x, E->uq, E->vq,
                  E->fint, E->fext, E->force, E->lam, E->S, E->rhs, E->cols, E->dc, E->aset,
-                 E->sw_a, E->sw_b, E->sw_al, E->sw_be, E->sw_ga, E->lc, E->dlc, E->Wc, E->ar,
+                 E->sw_el, E->sw_al, E->sw_be, E->sw_ga, E->lc, E->dlc, E->Wc, E->ar,
                  E->lr, E->lamtol, E->v_last, E->el0, E->el1, E->elc, E->pv0, E->pa0, E->pj0,
                  E->pv1, E->pa1, E->pj1, E->ua, E->va, E->aa, E->jk, E->cont, E->d_last,
                  E->r_last, E->vin, E->tay_u, E->tay_v, E->ev_t, E->ev_j, E->ev_k};
@@ -963,7 +959,7 @@ int oe_setup(ode_events *E, martello_model *model, martello_run *run, const char
   E->every = s.every;
   E->out_dt = s.dt * s.every;
   E->dt = s.dt;
-  if ((st = martello_model_topology(model, &n, &nc, NULL, NULL, NULL, NULL, NULL, NULL, NULL,
+  if ((st = martello_model_topology(model, &n, &nc, NULL, NULL, NULL, NULL, NULL,
                                     &ncp)) != MARTELLO_OK)
     return oe_fail(E, st, "%s: could not read the model", name);
   E->n = n;
@@ -972,17 +968,30 @@ int oe_setup(ode_events *E, martello_model *model, martello_run *run, const char
   size_t un = (size_t)n, ucn = (size_t)nc;
   E->mass = oe_take(un, sizeof(double), &failed);
   E->fixed = oe_take(un, sizeof(int), &failed);
-  E->con_a = oe_take(ucn, sizeof(int), &failed);
-  E->con_b = oe_take(ucn, sizeof(int), &failed);
   E->scheme = oe_take(ucn, sizeof(int), &failed);
   E->gap = oe_take(ucn, sizeof(double), &failed);
   E->rest = oe_take(ucn, sizeof(double), &failed);
   E->rig = oe_take(ucn, sizeof(int), &failed);
   E->rig_con = oe_take(ucn, sizeof(int), &failed);
   if (failed > 0.0) return oe_fail_memory(E, what, failed);
-  if ((st = martello_model_topology(model, &n, &nc, E->mass, E->fixed, E->con_a, E->con_b,
-                                    E->scheme, E->gap, E->rest, &ncp)) != MARTELLO_OK)
+  if ((st = martello_model_topology(model, &n, &nc, E->mass, E->fixed, E->scheme, E->gap,
+                                    E->rest, &ncp)) != MARTELLO_OK)
     return oe_fail(E, st, "%s: could not read the model", name);
+  {
+    int nl_rows, nterms;
+    if ((st = martello_model_elements(model, &nl_rows, &nterms, NULL, NULL, NULL)) != MARTELLO_OK)
+      return oe_fail(E, st, "%s: could not read the model", name);
+    E->el_first = oe_take((size_t)(nl_rows + nc + 1), sizeof(int), &failed);
+    E->el_node = oe_take((size_t)nterms, sizeof(int), &failed);
+    E->el_coef = oe_take((size_t)nterms, sizeof(double), &failed);
+    if (failed > 0.0) return oe_fail_memory(E, what, failed);
+    if ((st = martello_model_elements(model, &nl_rows, &nterms, E->el_first, E->el_node,
+                                      E->el_coef)) != MARTELLO_OK)
+      return oe_fail(E, st, "%s: could not read the model", name);
+    E->elem.first = E->el_first; E->elem.node = E->el_node; E->elem.coef = E->el_coef;
+    E->con = E->elem;
+    E->con.first = E->el_first + nl_rows;
+  }
   E->nr = 0;
   for (int j = 0; j < nc; j++) {
     if (E->scheme[j] == MARTELLO_SCHEME_LAGRANGE || E->scheme[j] == MARTELLO_SCHEME_RESTITUTION) {
@@ -1041,14 +1050,13 @@ int oe_setup(ode_events *E, martello_model *model, martello_run *run, const char
   /* every switching surface of the laws is a root: hold them on smooth branches */
   if ((st = martello_eval_use_branches(E->ev, &E->nsw)) != MARTELLO_OK)
     return oe_fail(E, st, "%s: martello_eval_use_branches failed", name);
-  E->sw_a = oe_take((size_t)E->nsw, sizeof(int), &failed);
-  E->sw_b = oe_take((size_t)E->nsw, sizeof(int), &failed);
+  E->sw_el = oe_take((size_t)E->nsw, sizeof(int), &failed);
   E->sw_al = oe_take((size_t)E->nsw, sizeof(double), &failed);
   E->sw_be = oe_take((size_t)E->nsw, sizeof(double), &failed);
   E->sw_ga = oe_take((size_t)E->nsw, sizeof(double), &failed);
   if (failed > 0.0) return oe_fail_memory(E, what, failed);
   if (E->nsw > 0 &&
-      (st = martello_eval_switches(E->ev, E->sw_a, E->sw_b, E->sw_al, E->sw_be, E->sw_ga)) != MARTELLO_OK)
+      (st = martello_eval_switches(E->ev, E->sw_el, E->sw_al, E->sw_be, E->sw_ga)) != MARTELLO_OK)
     return oe_fail(E, st, "%s: martello_eval_switches failed", name);
   return MARTELLO_OK;
 }

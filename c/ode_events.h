@@ -40,7 +40,7 @@ typedef struct {
   ode_interpolant dky;        /* the adapter's interpolant, called with ctx */
   ode_degree degree;          /* its degree (the events inside a step; NULL: not smooth) */
   void *ctx;
-  /* events inside the steps (docs/sundials-ode.md, events at size): smooth = 1 when the laws
+  /* events inside the steps (docs/sundials-ode.md, events inside the steps): smooth = 1 when the laws
    * whose force is continuous at their switches are not held on branches; cont[j] = 1 for
    * such a penalty contact, whose onsets and separations are located after each step on the
    * interpolant, contact by contact (no root, no restart); d_last, r_last its gap and rate at
@@ -54,7 +54,11 @@ typedef struct {
   /* scene (martello_model_topology) */
   int n, nc, nr, ncoupling, nl;
   double *mass, *gap, *rest;
-  int *fixed, *con_a, *con_b, *scheme;
+  int *fixed, *scheme;
+  /* the elements' rows (martello_model_elements): elem all of them, con the contacts' */
+  int *el_first, *el_node;
+  double *el_coef;
+  martello_rows elem, con;
   int *rig;                   /* contact -> rigid index, or -1 (penalty) */
   int *rig_con;               /* rigid index -> contact */
   sunindextype *iu, *iv;      /* where u_i, v_i sit in y (the adapter's layout) */
@@ -75,7 +79,7 @@ typedef struct {
   int cols_ready, *dc;
   /* the switches of the laws' branches (martello_eval_switches), refreshed at every commit:
    * roots 2 nc .. 2 nc + nsw - 1 */
-  int nsw, *sw_a, *sw_b;
+  int nsw, *sw_el;
   double *sw_al, *sw_be, *sw_ga;
   martello_accumulation acc; /* the accumulation rule's phases (c/accumulation.c) */
   /* the release roots: the closed set at the last restart (its rigid contacts lc[0..mc), their

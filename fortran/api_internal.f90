@@ -9,6 +9,7 @@ module martello_api_internal
    use martello_evaluator
    use martello_switching, only: switch_count, force_continuous
    use martello_contact_laws, only: P_RESTITUTION
+   use martello_element_rows, only: row_dot, rows_terms
    use martello_integrator_settings, only: integrator_settings_t
    use martello_observer
    use martello_run_quantities, only: NCOUNTERS
@@ -19,14 +20,14 @@ module martello_api_internal
 
 contains
 
-   integer(c_int) function c_model_topology(handle, n, nc, mass, fixed, con_a, con_b, scheme, &
+   integer(c_int) function c_model_topology(handle, n, nc, mass, fixed, scheme, &
                                             gap, restitution, ncoupling) bind(C, name='martello_model_topology')
       type(c_ptr), value :: handle
       integer(c_int), intent(out) :: n, nc, ncoupling
-      type(c_ptr), value :: mass, fixed, con_a, con_b, scheme, gap, restitution
+      type(c_ptr), value :: mass, fixed, scheme, gap, restitution
       type(model_t), pointer :: mp
       real(c_double), pointer :: pm(:), pg(:), pe(:)
-      integer(c_int), pointer :: pf(:), pa(:), pb(:), ps(:)
+      integer(c_int), pointer :: pf(:), ps(:)
       mp => get_model(handle)
       c_model_topology = MARTELLO_ERR_ARGUMENT
       if (.not. associated(mp)) return
@@ -38,12 +39,6 @@ contains
          call c_f_pointer(fixed, pf, [n]); pf = merge(1, 0, mp%fixed)
       end if
       if (nc > 0) then
-         if (c_associated(con_a)) then
-            call c_f_pointer(con_a, pa, [nc]); pa = mp%con_a(1:nc) - 1
-         end if
-         if (c_associated(con_b)) then
-            call c_f_pointer(con_b, pb, [nc]); pb = mp%con_b(1:nc) - 1
-         end if
          if (c_associated(scheme)) then
             call c_f_pointer(scheme, ps, [nc]); ps = mp%con_scheme(1:nc)
          end if
@@ -56,6 +51,40 @@ contains
       end if
       c_model_topology = MARTELLO_OK
    end function c_model_topology
+
+   !> The rows of the elements (martello_element_rows, docs/buildings.md): links first, then
+   !> contacts — element e (0-based) is link e + 1 for e < n_links, else contact e − n_links + 1
+   !> — with terms first[e] … first[e + 1] − 1 (0-based) of node (0-based) and coef. With first,
+   !> node, coef NULL only the sizes: n_links and n_terms (all elements' terms).
+   integer(c_int) function c_model_elements(handle, n_links, n_terms, first, node, coef) &
+      bind(C, name='martello_model_elements')
+      type(c_ptr), value :: handle, first, node, coef
+      integer(c_int), intent(out) :: n_links, n_terms
+      type(model_t), pointer :: mp
+      integer(c_int), pointer :: pfirst(:), pnode(:)
+      real(c_double), pointer :: pcoef(:)
+      integer :: ne, tl, tc
+      mp => get_model(handle)
+      c_model_elements = MARTELLO_ERR_ARGUMENT
+      if (.not. associated(mp)) return
+      tl = rows_terms(mp%lnk); tc = rows_terms(mp%con)
+      n_links = mp%nlink; n_terms = tl + tc
+      ne = mp%nlink + mp%ncontact
+      if (c_associated(first)) then
+         call c_f_pointer(first, pfirst, [ne + 1])
+         pfirst(1:mp%nlink + 1) = mp%lnk%first(1:mp%nlink + 1) - 1
+         pfirst(mp%nlink + 1:ne + 1) = mp%con%first(1:mp%ncontact + 1) - 1 + tl
+      end if
+      if (c_associated(node) .and. n_terms > 0) then
+         call c_f_pointer(node, pnode, [n_terms])
+         pnode(1:tl) = mp%lnk%node(1:tl) - 1; pnode(tl + 1:) = mp%con%node(1:tc) - 1
+      end if
+      if (c_associated(coef) .and. n_terms > 0) then
+         call c_f_pointer(coef, pcoef, [n_terms])
+         pcoef(1:tl) = mp%lnk%coef(1:tl); pcoef(tl + 1:) = mp%con%coef(1:tc)
+      end if
+      c_model_elements = MARTELLO_OK
+   end function c_model_elements
 
    !> Initial displacements and velocities of the nodes (fixed nodes: u0, v = 0).
    integer(c_int) function c_model_initial_state(handle, u0, v0) bind(C, name='martello_model_initial_state')
@@ -202,8 +231,8 @@ contains
       c_eval_use_branches = MARTELLO_OK
    end function c_eval_use_branches
 
-   !> Adaptive integrators that step across continuous kinks (docs/sundials-ode.md, events at
-   !> size): only the laws whose force jumps at a switch are held on branches; continuous(j) = 1
+   !> Adaptive integrators that step across continuous kinks (docs/sundials-ode.md, events
+   !> inside the steps): only the laws whose force jumps at a switch are held on branches; continuous(j) = 1
    !> for each penalty contact left whole (its onsets and separations are the caller's to
    !> locate), 0 for the others.
    integer(c_int) function c_eval_use_smooth_branches(handle, nsw, continuous) &
@@ -239,10 +268,10 @@ contains
       c_eval_set_onset_speed = MARTELLO_OK
    end function c_eval_set_onset_speed
 
-   integer(c_int) function c_eval_switches(handle, na, nb, alpha, beta, gamma) &
+   integer(c_int) function c_eval_switches(handle, el, alpha, beta, gamma) &
       bind(C, name='martello_eval_switches')
       type(c_ptr), value :: handle
-      integer(c_int), intent(out) :: na(*), nb(*)
+      integer(c_int), intent(out) :: el(*)
       real(c_double), intent(out) :: alpha(*), beta(*), gamma(*)
       type(evaluator_t), pointer :: ep
       integer :: ns
@@ -250,7 +279,7 @@ contains
       c_eval_switches = MARTELLO_ERR_ARGUMENT
       if (.not. associated(ep)) return
       ns = switch_count(ep%m)
-      if (ns > 0) call evaluator_switches(ep, na(1:ns), nb(1:ns), alpha(1:ns), beta(1:ns), gamma(1:ns))
+      if (ns > 0) call evaluator_switches(ep, el(1:ns), alpha(1:ns), beta(1:ns), gamma(1:ns))
       c_eval_switches = MARTELLO_OK
    end function c_eval_switches
 
@@ -399,7 +428,7 @@ contains
       ! δ of every contact; the forces of the penalty contacts and the link states are the
       ! evaluator's, committed at this state
       do j = 1, ep%m%ncontact
-         op%c_pen(j) = ep%u(ep%m%con_a(j)) - ep%u(ep%m%con_b(j)) - ep%m%con_gap(j)
+         op%c_pen(j) = row_dot(ep%m%con, j, ep%u) - ep%m%con_gap(j)
          op%c_force(j) = merge(ep%ms%con_f(j), force(j), ep%ms%is_penalty(j))
       end do
       call observer_sample(op, ep%m, ep%ms, t, ep%u, ep%v, op%acc, op%c_pen, op%c_force, int(k), &

@@ -90,6 +90,47 @@ contains
       c_model_add_contact = stat
    end function c_model_add_contact
 
+   !> A link or contact as a row of n terms, nodes 0-based (−1: the ground), its deformation
+   !> Σ coef·u(node) (docs/buildings.md, "Contacts between plan points").
+   integer(c_int) function c_model_add_link_row(handle, kind, n, nodes, coef, par) &
+      bind(C, name='martello_model_add_link_row')
+      type(c_ptr), value :: handle
+      integer(c_int), value :: kind, n
+      integer(c_int), intent(in) :: nodes(*)
+      real(c_double), intent(in) :: coef(*), par(NPAR_LINK)
+      type(model_t), pointer :: mp
+      integer :: stat
+      mp => get_model(handle)
+      c_model_add_link_row = MARTELLO_ERR_ARGUMENT
+      if (.not. associated(mp)) return
+      if (n < 0) then
+         mp%errmsg = 'add_link_row: n must be >= 0'; return
+      end if
+      call model_add_link_row(mp, int(kind), int(nodes(1:n)) + 1, coef(1:n), par, stat)
+      c_model_add_link_row = stat
+   end function c_model_add_link_row
+
+   integer(c_int) function c_model_add_contact_row(handle, n, nodes, coef, gap, scheme, law, par) &
+      bind(C, name='martello_model_add_contact_row')
+      type(c_ptr), value :: handle
+      integer(c_int), value :: n, scheme, law
+      integer(c_int), intent(in) :: nodes(*)
+      real(c_double), intent(in) :: coef(*)
+      real(c_double), value :: gap
+      real(c_double), intent(in) :: par(NPAR_CONTACT)
+      type(model_t), pointer :: mp
+      integer :: stat
+      mp => get_model(handle)
+      c_model_add_contact_row = MARTELLO_ERR_ARGUMENT
+      if (.not. associated(mp)) return
+      if (n < 0) then
+         mp%errmsg = 'add_contact_row: n must be >= 0'; return
+      end if
+      call model_add_contact_row(mp, int(nodes(1:n)) + 1, coef(1:n), gap, int(scheme), int(law), &
+                                 par, stat)
+      c_model_add_contact_row = stat
+   end function c_model_add_contact_row
+
    !> The bulk doors: n entries in one call, each checked exactly as by the one-entry door it
    !> repeats (same model, same order); the first bad entry stops the call, and the message
    !> names its 0-based index (docs/c-api.md, "Building a large model").

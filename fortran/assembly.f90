@@ -11,6 +11,7 @@ module martello_assembly
    use martello_contact_laws, only: contact_force, contact_elastic_energy, LAW_LINEAR, LAW_KELVIN, &
       P_STIFF, P_DAMPING
    use martello_band_matrix, only: band_t, band_add
+   use martello_element_rows, only: row_dot, row_add, row_stencil
    use martello_time_functions, only: tf_value, tf_next_breakpoint, TF_NONE
    implicit none
    private
@@ -89,7 +90,7 @@ contains
       ! The initial state is elastic and unloaded history: the committed force of a bilinear
       ! spring starts on its elastic line k·u0 (clamped into the band by the first step).
       do j = 1, m%nlink
-         s%link_u(j) = u(m%link_a(j)) - u(m%link_b(j))
+         s%link_u(j) = row_dot(m%lnk, j, u)
          s%link_fc(j) = 0.0_dp
          if (m%link_kind(j) == LINK_SPRING .or. m%link_kind(j) == LINK_BAR .or. &
              m%link_kind(j) == LINK_BILINEAR) s%link_fc(j) = m%link_par(L_STIFF, j)*s%link_u(j)
@@ -133,11 +134,10 @@ contains
       if (tangent) r = (size(jac, 1) - 1)/3*2 + 1
       fint = 0.0_dp
       ! associate: the descriptors are read once, not at every access inside the loop
-      associate (la => m%link_a, lb => m%link_b, kind => m%link_kind, par => m%link_par, &
+      associate (kind => m%link_kind, par => m%link_par, &
                  fc => s%link_fc, lu => s%link_u, fc_trial => s%link_fc_trial, f_trial => s%link_f_trial)
          do j = 1, m%nlink
-            a = la(j); b = lb(j)
-            du = u(a) - u(b); dv = v(a) - v(b)
+            du = row_dot(m%lnk, j, u); dv = row_dot(m%lnk, j, v)
             select case (kind(j))
             case (LINK_SPRING, LINK_BAR)
                kt = par(L_STIFF, j); ct = 0.0_dp
@@ -155,19 +155,17 @@ contains
             end select
             fc_trial(j) = fnew
             f_trial(j) = f
-            fint(a) = fint(a) + f
-            fint(b) = fint(b) - f
-            if (tangent) call stencil(jac, a, b, ck*kt + cc*ct)
-            if (present(cmat) .and. ct /= 0.0_dp) call stencil(cmat, a, b, ct)
+            call row_add(m%lnk, j, f, fint)
+            if (tangent) call row_stencil(jac, r, m%lnk, j, ck*kt + cc*ct)
+            if (present(cmat) .and. ct /= 0.0_dp) call row_stencil(cmat, r, m%lnk, j, ct)
             if (present(link_tan)) link_tan(:, j) = [kt, ct]
          end do
       end associate
       if (present(con_tan)) con_tan = 0.0_dp
       do j = 1, m%ncontact
          if (.not. s%is_penalty(j)) cycle
-         a = m%con_a(j); b = m%con_b(j)
-         pen = u(a) - u(b) - m%con_gap(j)
-         rate = v(a) - v(b)
+         pen = row_dot(m%con, j, u) - m%con_gap(j)
+         rate = row_dot(m%con, j, v)
          s%con_pen_trial(j) = pen; s%con_rate_trial(j) = rate
          if (s%con_branch(j) == CONTACT_ON .and. m%con_law(j) == LAW_LINEAR) then
             ! held in contact: the linear law extended past delta = 0 (smooth)
@@ -205,10 +203,10 @@ contains
          end if
          s%con_f_trial(j) = f
          if (present(con_tan)) con_tan(:, j) = [dfd, dfv]
-         fint(a) = fint(a) + f
-         fint(b) = fint(b) - f
-         if (tangent .and. (dfd /= 0.0_dp .or. dfv /= 0.0_dp)) call stencil(jac, a, b, ck*dfd + cc*dfv)
-         if (present(cmat) .and. dfv /= 0.0_dp) call stencil(cmat, a, b, dfv)
+         call row_add(m%con, j, f, fint)
+         if (tangent .and. (dfd /= 0.0_dp .or. dfv /= 0.0_dp)) &
+            call row_stencil(jac, r, m%con, j, ck*dfd + cc*dfv)
+         if (present(cmat) .and. dfv /= 0.0_dp) call row_stencil(cmat, r, m%con, j, dfv)
       end do
       do j = 1, m%nblock
          associate (nd => m%block(j)%node, kb => m%block(j)%k, cb => m%block(j)%c, &
@@ -239,19 +237,6 @@ contains
          end associate
       end do
       fint(0) = 0.0_dp
-   contains
-      !> The two-node stencil of band_add_pair, in line (this loop runs n times a step).
-      subroutine stencil(ab, i, k, val)
-         real(dp), intent(inout) :: ab(:, :)
-         integer, intent(in) :: i, k
-         real(dp), intent(in) :: val
-         if (i > 0) ab(r, i) = ab(r, i) + val
-         if (k > 0) ab(r, k) = ab(r, k) + val
-         if (i > 0 .and. k > 0) then
-            ab(r + i - k, k) = ab(r + i - k, k) - val
-            ab(r + k - i, i) = ab(r + k - i, i) - val
-         end if
-      end subroutine stencil
    end subroutine internal_forces
 
    !> The approach speed where δ crosses 0 between a committed state (δ0 < 0, rate r0) and a
@@ -283,7 +268,7 @@ contains
          w_damp = 0.0_dp; w_links = 0.0_dp; w_contact = 0.0_dp
       end if
       do j = 1, m%nlink
-         du = u(m%link_a(j)) - u(m%link_b(j))
+         du = row_dot(m%lnk, j, u)
          if (present(w_damp)) then
             w = 0.5_dp*(s%link_f(j) + s%link_f_trial(j))*(du - s%link_u(j))
             if (is_damper(m%link_kind(j))) then
@@ -340,7 +325,7 @@ contains
       real(dp) :: p
       p_damp = 0.0_dp; p_links = 0.0_dp; p_contact = 0.0_dp
       do j = 1, m%nlink
-         p = s%link_f_trial(j)*(v(m%link_a(j)) - v(m%link_b(j)))
+         p = s%link_f_trial(j)*row_dot(m%lnk, j, v)
          if (is_damper(m%link_kind(j))) then
             p_damp = p_damp + p
          else
@@ -425,7 +410,7 @@ contains
       real(dp) :: du, eb
       e_links = 0.0_dp; e_contacts = 0.0_dp
       do j = 1, m%nlink
-         du = u(m%link_a(j)) - u(m%link_b(j))
+         du = row_dot(m%lnk, j, u)
          select case (m%link_kind(j))
          case (LINK_SPRING, LINK_BAR)
             e_links = e_links + 0.5_dp*m%link_par(L_STIFF, j)*du**2

@@ -1,11 +1,15 @@
 !> The effective mass of every contact and what derives from it. For contact c with row B of
-!> the constraint matrix (δ = B u − gap: +1 at node a, −1 at node b, nothing for ground or a
-!> fixed node), the relative motion obeys δ̈ = −(B M⁻¹ Bᵀ) P + …, so the contact sees
+!> the constraint matrix (δ = B u − gap: the contact's row, martello_element_rows — +1 at
+!> node a, −1 at node b for a pair, the plan-point kinematics of two floors in general;
+!> nothing for ground or a fixed node), the relative motion obeys δ̈ = −(B M⁻¹ Bᵀ) P + …, so
+!> the contact sees
 !>
 !>   m* = 1/(B M⁻¹ Bᵀ)
 !>
 !> (the inverse of the contact's Delassus operator, docs/moreau-jean.md; = m_a m_b/(m_a + m_b)
-!> for a diagonal M, m_a against a wall, infinite if neither side moves). M is the lumped
+!> for a diagonal M, m_a against a wall, infinite if neither side moves; for two rigid floors
+!> struck at points with lever arms r1, r2 1/(1/m1 + r1²/J1 + 1/m2 + r2²/J2), the eccentric
+!> effective mass of docs/buildings.md). M is the lumped
 !> diagonal plus the consistent couplings (docs/p4-bars.md), restricted to the free nodes.
 !> m* sets the damping of a penalty contact given a target restitution (contact_laws'
 !> damping_from_restitution, docs/problems.md P5) and the Jankowski damping coefficient.
@@ -17,6 +21,7 @@ module martello_effective_mass
    use martello_contact_laws, only: P_RESTITUTION, P_DAMPING, damping_from_restitution
    use martello_stability, only: free_dofs, mass_band
    use martello_lapack, only: dpbtrf, dpbtrs
+   use martello_element_rows, only: row_lo, row_hi
    implicit none
    private
    public :: contact_effective_masses, effective_mass_prepare, pair_effective_mass
@@ -24,7 +29,8 @@ module martello_effective_mass
 contains
 
    !> m* of every contact. A contact whose moving nodes carry no coupling sees a diagonal M,
-   !> m* = m_a m_b/(m_a + m_b) (or the moving side's mass); otherwise M is factored once
+   !> 1/m* = Σ coef²/m over its moving nodes (m_a m_b/(m_a + m_b) for a pair); otherwise M is
+   !> factored once
    !> (banded Cholesky, dpbtrf) and B M⁻¹ Bᵀ solved per contact. stat = MARTELLO_ERR_ARGUMENT
    !> (message says why) if M is not positive definite on the free nodes.
    subroutine contact_effective_masses(m, mstar, message, stat)
@@ -35,7 +41,7 @@ contains
       integer, allocatable :: dof(:)
       logical, allocatable :: coupled(:)
       real(dp), allocatable :: mb(:, :), x(:)
-      integer :: nf, kd, c, j, ia, ib, info
+      integer :: nf, kd, c, j, info
       call free_dofs(m, dof, nf, stat, message)
       if (stat /= MARTELLO_OK) return
       allocate (coupled(0:m%n), stat=stat)
@@ -70,21 +76,32 @@ contains
          end if
       end if
       do c = 1, m%ncontact
-         ia = dof(m%con_a(c)); ib = dof(m%con_b(c))   ! 0: ground or a fixed node
-         if (ia == 0 .and. ib == 0) then
-            mstar(c) = ieee_value(1.0_dp, ieee_positive_inf)
-         else if (.not. (coupled(m%con_a(c)) .or. coupled(m%con_b(c)))) then
-            mstar(c) = pair_effective_mass(m, m%con_a(c), m%con_b(c))
-         else
-            x = 0.0_dp
-            if (ia > 0) x(ia) = 1.0_dp
-            if (ib > 0) x(ib) = -1.0_dp
-            call dpbtrs('U', nf, kd, 1, mb, kd + 1, x, nf, info)
-            mstar(c) = 0.0_dp            ! B M⁻¹ Bᵀ = x_a − x_b over the moving sides
-            if (ia > 0) mstar(c) = x(ia)
-            if (ib > 0) mstar(c) = mstar(c) - x(ib)
-            mstar(c) = 1.0_dp/mstar(c)
-         end if
+         associate (nd => m%con%node(row_lo(m%con, c):row_hi(m%con, c)), &
+                    cf => m%con%coef(row_lo(m%con, c):row_hi(m%con, c)))
+            if (.not. any(dof(nd) > 0 .and. cf /= 0.0_dp)) then
+               mstar(c) = ieee_value(1.0_dp, ieee_positive_inf)     ! nothing of it moves
+            else if (size(nd) <= 2 .and. all(abs(cf) == 1.0_dp) .and. .not. any(coupled(nd))) then
+               ! a node pair or a node against the ground: m_a m_b/(m_a + m_b) or m_a, as ever
+               mstar(c) = pair_effective_mass(m, nd(1), merge(nd(size(nd)), 0, size(nd) == 2))
+            else if (.not. any(coupled(nd))) then
+               mstar(c) = 0.0_dp
+               do j = 1, size(nd)
+                  if (dof(nd(j)) > 0) mstar(c) = mstar(c) + cf(j)**2/m%mass(nd(j))
+               end do
+               mstar(c) = 1.0_dp/mstar(c)
+            else
+               x = 0.0_dp                ! B M⁻¹ Bᵀ = B x, x = M⁻¹ Bᵀ over the moving nodes
+               do j = 1, size(nd)
+                  if (dof(nd(j)) > 0) x(dof(nd(j))) = x(dof(nd(j))) + cf(j)
+               end do
+               call dpbtrs('U', nf, kd, 1, mb, kd + 1, x, nf, info)
+               mstar(c) = 0.0_dp
+               do j = 1, size(nd)
+                  if (dof(nd(j)) > 0) mstar(c) = mstar(c) + cf(j)*x(dof(nd(j)))
+               end do
+               mstar(c) = 1.0_dp/mstar(c)
+            end if
+         end associate
       end do
    end subroutine contact_effective_masses
 

@@ -14,8 +14,8 @@ module martello_element_rows
    use martello_kinds, only: dp
    implicit none
    private
-   public :: rows_t, rows_init, rows_append, rows_append_pair, row_dot, row_add, row_stencil, &
-      row_span, row_lo, row_hi, row_is_pair, row_pair, rows_terms, rows_move
+   public :: rows_t, rows_init, rows_append, rows_append_pair, row_dot, row_dot1, row_add, row_stencil, &
+      row_span, row_lo, row_hi, row_is_pair, row_pair, row_a, row_b, rows_terms, rows_move
 
    !> n rows in CSR form: row j's terms are first(j) … first(j + 1) − 1 of node and coef
    !> (first(1) = 1); the term arrays grow as rows are appended.
@@ -102,6 +102,18 @@ contains
       end do
    end function row_dot
 
+   !> Σ_k coef_k x(node_k) of row j for x indexed 1:n (no ground entry).
+   pure real(dp) function row_dot1(r, j, x) result(d)
+      type(rows_t), intent(in) :: r
+      integer, intent(in) :: j
+      real(dp), intent(in) :: x(:)
+      integer :: k
+      d = 0.0_dp
+      do k = r%first(j), r%first(j + 1) - 1
+         d = d + r%coef(k)*x(r%node(k))
+      end do
+   end function row_dot1
+
    !> y(node_k) += coef_k f over row j (the element's force on the nodes).
    pure subroutine row_add(r, j, f, y)
       type(rows_t), intent(in) :: r
@@ -186,6 +198,22 @@ contains
          end if
       end do
    end subroutine row_pair
+
+   !> A pair row's +1 node (0: the ground): for the methods that take pairs only.
+   pure integer function row_a(r, j) result(a)
+      type(rows_t), intent(in) :: r
+      integer, intent(in) :: j
+      integer :: b
+      call row_pair(r, j, a, b)
+   end function row_a
+
+   !> A pair row's −1 node (0: the ground).
+   pure integer function row_b(r, j) result(b)
+      type(rows_t), intent(in) :: r
+      integer, intent(in) :: j
+      integer :: a
+      call row_pair(r, j, a, b)
+   end function row_b
 
    !> The number of terms of all rows.
    pure integer function rows_terms(r)

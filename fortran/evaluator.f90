@@ -9,6 +9,7 @@ module martello_evaluator
    use martello_assembly
    use martello_band_matrix
    use martello_switching, only: switch_count, switching_choose, switching_functions
+   use martello_element_rows, only: row_dot, row_add
    implicit none
    private
    public :: evaluator_t, evaluator_init, evaluator_load, evaluator_acceleration, &
@@ -143,11 +144,11 @@ contains
    end subroutine evaluator_set_onset_speed
 
    !> The switches of the branches held (martello_switching): switch_count slots.
-   subroutine evaluator_switches(ev, na, nb, alpha, beta, gamma)
+   subroutine evaluator_switches(ev, el, alpha, beta, gamma)
       type(evaluator_t), intent(in) :: ev
-      integer, intent(out) :: na(:), nb(:)
+      integer, intent(out) :: el(:)
       real(dp), intent(out) :: alpha(:), beta(:), gamma(:)
-      call switching_functions(ev%m, ev%ms, na, nb, alpha, beta, gamma)
+      call switching_functions(ev%m, ev%ms, el, alpha, beta, gamma)
    end subroutine evaluator_switches
 
    !> The first time after t where a load of the scene has a kink (tf_next_breakpoint), or
@@ -175,7 +176,7 @@ contains
       logical, intent(out) :: ok
       real(dp) :: ltan(2, ev%m%nlink), ctan(2, ev%m%ncontact), acc(0:ev%m%n), fd(0:ev%m%n), &
                   fp(0:ev%m%n), eps
-      integer :: j, ia, ib
+      integer :: j
       associate (m => ev%m)
          call evaluator_load(ev, u, v)
          acc(0) = 0.0_dp; acc(1:) = a
@@ -185,21 +186,19 @@ contains
          call external_forces(m, ev%mrow, t - eps, fd)
          fd = (fp - fd)/(2.0_dp*eps)
          do j = 1, m%ncontact
-            ia = m%con_a(j); ib = m%con_b(j)
-            pen(j) = ev%u(ia) - ev%u(ib) - m%con_gap(j)
-            pen_rate(j) = ev%v(ia) - ev%v(ib)
+            pen(j) = row_dot(m%con, j, ev%u) - m%con_gap(j)
+            pen_rate(j) = row_dot(m%con, j, ev%v)
             force(j) = 0.0_dp; force_rate(j) = 0.0_dp
             if (.not. ev%ms%is_penalty(j)) cycle
             force(j) = ev%ms%con_f_trial(j)
-            force_rate(j) = ctan(1, j)*pen_rate(j) + ctan(2, j)*(acc(ia) - acc(ib))
-            fd(ia) = fd(ia) - force_rate(j); fd(ib) = fd(ib) + force_rate(j)
+            force_rate(j) = ctan(1, j)*pen_rate(j) + ctan(2, j)*row_dot(m%con, j, acc)
+            call row_add(m%con, j, -force_rate(j), fd)
          end do
          do j = 1, m%nlink
-            ia = m%link_a(j); ib = m%link_b(j)
-            du(j) = ev%u(ia) - ev%u(ib); dv(j) = ev%v(ia) - ev%v(ib)
+            du(j) = row_dot(m%lnk, j, ev%u); dv(j) = row_dot(m%lnk, j, ev%v)
             lf(j) = ev%ms%link_f_trial(j)
-            lf_rate(j) = ltan(1, j)*dv(j) + ltan(2, j)*(acc(ia) - acc(ib))
-            fd(ia) = fd(ia) - lf_rate(j); fd(ib) = fd(ib) + lf_rate(j)
+            lf_rate(j) = ltan(1, j)*dv(j) + ltan(2, j)*row_dot(m%lnk, j, acc)
+            call row_add(m%lnk, j, -lf_rate(j), fd)
          end do
          do j = 1, m%nblock
             associate (nd => m%block(j)%node)

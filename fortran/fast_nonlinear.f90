@@ -24,6 +24,7 @@ module martello_fast_nonlinear
    use martello_kinds, only: dp, i8
    use martello_status
    use martello_model, only: model_t
+   use martello_element_rows, only: rows_t, row_lo, row_hi
    use martello_links, only: LINK_SPRING, LINK_BAR, LINK_DASHPOT, LINK_BILINEAR, L_STIFF, L_DAMP
    use martello_assembly, only: internal_forces, external_forces, mech_commit, external_work, &
       mass_times
@@ -202,11 +203,11 @@ contains
       touched = .false.
       do j = 1, m%ncontact
          if (m%con_scheme(j) /= SCHEME_PENALTY) cycle
-         call mark(m%con_a(j)); call mark(m%con_b(j))
+         call mark_row(m%con, j)
       end do
       do j = 1, m%nlink
          if (m%link_kind(j) == LINK_FLUID_DAMPER .or. m%link_kind(j) == LINK_BILINEAR) then
-            call mark(m%link_a(j)); call mark(m%link_b(j))
+            call mark_row(m%lnk, j)
          end if
       end do
       self%sdof = pack([(j, j = 1, nf)], touched)
@@ -238,12 +239,15 @@ contains
       self%w = transpose(self%phis)
       if (self%ns > 0) call dgetrs('N', nf, self%ns, self%j0, nf, self%ipiv, self%w, nf, info)
    contains
-      subroutine mark(node)
-         integer, intent(in) :: node
-         if (node > 0) then
-            if (dof(node) > 0) touched(dof(node)) = .true.
-         end if
-      end subroutine mark
+      !> The free DOFs of a row's nodes carry a nonlinear force.
+      subroutine mark_row(rows, j)
+         type(rows_t), intent(in) :: rows
+         integer, intent(in) :: j
+         integer :: k
+         do k = row_lo(rows, j), row_hi(rows, j)
+            if (dof(rows%node(k)) > 0) touched(dof(rows%node(k))) = .true.
+         end do
+      end subroutine mark_row
    end subroutine newton_setup
 
    !> K_L and C_L of the linear part on the free DOFs (dof: node → DOF, 0 for fixed/ground).
@@ -256,9 +260,9 @@ contains
       do j = 1, m%nlink
          select case (m%link_kind(j))
          case (LINK_SPRING, LINK_BAR, LINK_BILINEAR)
-            call pair(kl, dof(m%link_a(j)), dof(m%link_b(j)), m%link_par(L_STIFF, j))
+            call add_row(kl, j, m%link_par(L_STIFF, j))
          case (LINK_DASHPOT)
-            call pair(cl, dof(m%link_a(j)), dof(m%link_b(j)), m%link_par(L_DAMP, j))
+            call add_row(cl, j, m%link_par(L_DAMP, j))
          end select
       end do
       do j = 1, m%nblock
@@ -274,16 +278,20 @@ contains
          end associate
       end do
    contains
-      subroutine pair(a, i, k, val)
+      !> a += val gᵀg over link j's row on the free DOFs.
+      subroutine add_row(a, j, val)
          real(dp), intent(inout) :: a(:, :)
-         integer, intent(in) :: i, k
+         integer, intent(in) :: j
          real(dp), intent(in) :: val
-         if (i > 0) a(i, i) = a(i, i) + val
-         if (k > 0) a(k, k) = a(k, k) + val
-         if (i > 0 .and. k > 0) then
-            a(i, k) = a(i, k) - val; a(k, i) = a(k, i) - val
-         end if
-      end subroutine pair
+         integer :: p, q, ip, iq
+         do p = row_lo(m%lnk, j), row_hi(m%lnk, j)
+            ip = dof(m%lnk%node(p))
+            do q = row_lo(m%lnk, j), row_hi(m%lnk, j)
+               iq = dof(m%lnk%node(q))
+               if (ip > 0 .and. iq > 0) a(ip, iq) = a(ip, iq) + val*m%lnk%coef(p)*m%lnk%coef(q)
+            end do
+         end do
+      end subroutine add_row
    end subroutine linear_part
 
    !> One step: the modal states advanced exactly for p linear over the step, p at the end

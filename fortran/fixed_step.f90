@@ -9,6 +9,7 @@ module martello_fixed_step
    use martello_kinds, only: dp, i8
    use martello_status
    use martello_model, only: model_t, model_initial_state
+   use martello_element_rows, only: row_dot
    use martello_assembly, only: mech_state_t, mech_init, load_pattern, assemble_mass, internal_forces, &
       external_forces, mech_commit
    use martello_band_matrix, only: band_t, band_zero, band_pin, band_solve
@@ -259,7 +260,7 @@ contains
          if (self%ms%is_penalty(k)) then
             self%pen(k) = self%ms%con_pen(k); self%force(k) = self%ms%con_f(k)
          else
-            self%pen(k) = self%u(m%con_a(k)) - self%u(m%con_b(k)) - m%con_gap(k)
+            self%pen(k) = row_dot(m%con, k, self%u) - m%con_gap(k)
             self%force(k) = rigid_force(k)
             if (present(impulse_step)) self%force(k) = rigid_force(k)/impulse_step
          end if

@@ -8,6 +8,7 @@ module martello_generalized_alpha
    use martello_kinds, only: dp, i8
    use martello_status
    use martello_model, only: model_t, model_bandwidth
+   use martello_element_rows, only: row_dot, row_add
    use martello_band_matrix
    use martello_assembly
    use martello_observer, only: observer_t, observer_work, observer_fail, free_side_crossing
@@ -324,15 +325,14 @@ contains
       subroutine first_switch(first, tau, kind)
          integer, intent(out) :: first, kind
          real(dp), intent(out) :: tau
-         integer :: j, ia, ib, sw, kj
+         integer :: j, sw, kj
          real(dp) :: sg, d0, r0, q0, d1, r1, tj, k, rho, r, fp, c0, round, kap
          first = 0; tau = huge(1.0_dp); kind = 0
          do j = 1, m%ncontact
             if (.not. self%ms%is_penalty(j) .or. .not. kinked_law(j)) cycle
-            ia = m%con_a(j); ib = m%con_b(j)
-            d0 = self%un(ia) - self%un(ib) - m%con_gap(j); d1 = self%u(ia) - self%u(ib) - m%con_gap(j)
-            r0 = self%vn(ia) - self%vn(ib); r1 = self%v(ia) - self%v(ib)
-            q0 = self%an(ia) - self%an(ib)
+            d0 = row_dot(m%con, j, self%un) - m%con_gap(j); d1 = row_dot(m%con, j, self%u) - m%con_gap(j)
+            r0 = row_dot(m%con, j, self%vn); r1 = row_dot(m%con, j, self%v)
+            q0 = row_dot(m%con, j, self%an)
             if (.not. self%ms%con_on(j)) then
                kj = SW_ONSET; sg = 1.0_dp                  ! g = δ
             else if (m%con_law(j) == LAW_JANKOWSKI) then
@@ -371,11 +371,10 @@ contains
          end do
          do j = 1, m%nlink
             if (m%link_kind(j) /= LINK_BILINEAR) cycle
-            ia = m%link_a(j); ib = m%link_b(j)
             k = m%link_par(L_STIFF, j); rho = m%link_par(L_HARDENING, j)
             if (rho >= 1.0_dp) cycle
             r = (1.0_dp - rho)*m%link_par(L_YIELD, j)
-            r0 = self%vn(ia) - self%vn(ib); q0 = self%an(ia) - self%an(ib)
+            r0 = row_dot(m%lnk, j, self%vn); q0 = row_dot(m%lnk, j, self%an)
             ! the branch committed: on a yield line (to the rounding of the return map's clamp)
             ! while loading outward, else in the elastic band
             fp = self%ms%link_fc(j) - rho*k*self%ms%link_u(j)
@@ -386,7 +385,7 @@ contains
             if (j == turned) sw = 0
             if (sw /= 0) then
                ! unloading: g = ∓du̇
-               tj = switch_time(-sw*r0, -sw*q0, 0.0_dp, -sw*(self%v(ia) - self%v(ib)), .false.)
+               tj = switch_time(-sw*r0, -sw*q0, 0.0_dp, -sw*row_dot(m%lnk, j, self%v), .false.)
                if (tj < tau) then
                   tau = tj; first = -j; kind = 0
                end if
@@ -394,7 +393,7 @@ contains
             end if
             ! yield: g = ±(f_n + k(du − u_n) − ρk du) − (1 − ρ)F_y, in force units
             c0 = self%ms%link_fc(j) - k*self%ms%link_u(j)
-            d0 = self%un(ia) - self%un(ib); d1 = self%u(ia) - self%u(ib)
+            d0 = row_dot(m%lnk, j, self%un); d1 = row_dot(m%lnk, j, self%u)
             do sw = 1, -1, -2
                tj = switch_time(sw*(c0 + (1.0_dp - rho)*k*d0) - r, sw*(1.0_dp - rho)*k*r0, &
                                 sw*(1.0_dp - rho)*k*q0, sw*(c0 + (1.0_dp - rho)*k*d1) - r, .false.)
@@ -437,8 +436,8 @@ contains
       real(dp) function onset_force(j) result(fplus)
          integer, intent(in) :: j
          real(dp) :: d, r, dfd, dfv
-         d = self%u(m%con_a(j)) - self%u(m%con_b(j)) - m%con_gap(j)
-         r = self%v(m%con_a(j)) - self%v(m%con_b(j))
+         d = row_dot(m%con, j, self%u) - m%con_gap(j)
+         r = row_dot(m%con, j, self%v)
          call contact_force(m%con_law(j), m%con_par(1, j), m%con_mstar(j), max(d, tiny(1.0_dp)), &
                             r, r, fplus, dfd, dfv)
       end function onset_force
@@ -466,17 +465,15 @@ contains
       !> if M is singular.
       logical function boundary_jump(j, kind) result(ok)
          integer, intent(in) :: j, kind
-         integer :: ia, ib
          real(dp) :: fplus
          ok = .true.
          if (kind == SW_TURN) return          ! a kink: the force is continuous there
-         ia = m%con_a(j); ib = m%con_b(j)
          fplus = 0.0_dp
          if (kind == SW_ONSET .or. kind == SW_REENGAGE) fplus = max(onset_force(j), 0.0_dp)
          self%ms%con_on(j) = kind /= SW_SEPARATION .and. kind /= SW_CUT_SEPARATION
          self%jump = 0.0_dp
-         self%jump(ia) = -(fplus - self%ms%con_f(j)); self%jump(ib) = fplus - self%ms%con_f(j)
-         self%fint(ia) = self%fint(ia) - self%jump(ia); self%fint(ib) = self%fint(ib) - self%jump(ib)
+         call row_add(m%con, j, -(fplus - self%ms%con_f(j)), self%jump)   ! −g ΔF on the nodes
+         self%fint = self%fint - self%jump
          self%fint(0) = 0.0_dp
          self%ms%con_f(j) = fplus
          call solve_free_mass(m, self%fixed_nodes, self%mband, self%jump, ok)

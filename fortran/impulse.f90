@@ -3,19 +3,23 @@
 !> LCPs w = W z + q, 0 ≤ w ⊥ z ≥ 0, their solvers, the projection onto held contacts, and the
 !> accumulation (Zeno) policy.
 !>
-!> Conventions (docs/impulse.md §1; Acary & Brogliato 2008, §3.1): contact k joins the sides
-!> sa_k, sb_k (nodes; 0 for the ground or an immobile node), its gap rate is ġ_k = B_k v =
-!> v_b − v_a (> 0 opening), a compressive impulse P_k ≥ 0 acts as B_kᵀ P_k. With the columns
+!> Conventions (docs/impulse.md §1; Acary & Brogliato 2008, §3.1): contact k's row B_k
+!> (martello_element_rows, rows b: the negative of its penetration row, so that for a node
+!> pair B_k = e_b − e_a) gives its gap rate ġ_k = B_k v (> 0 opening: v_b − v_a for a pair,
+!> the plan-point kinematics of two floors in general, docs/buildings.md); a compressive impulse
+!> P_k ≥ 0 acts as B_kᵀ P_k. A term on an immobile node is harmless: the columns below vanish
+!> there. With the columns
 !> C_k = A B_kᵀ of an inverse-mass action A (M⁻¹, or Moreau–Jean's Ŵ⁻¹), W = B A Bᵀ, W_kl =
 !> B_k C_l, and Δv = Σ_k P_k C_k. Matrices are column-major; band storage as LAPACK's general
 !> band with kl = ku = kw: W(i, j) lives in wb(kw + 1 + i − j, j).
 module martello_impulse
    use martello_kinds, only: dp
    use martello_lapack, only: dgbsv, dpotrf, dpotrs
+   use martello_element_rows, only: rows_t, row_lo, row_hi
    implicit none
    private
    public :: contact_graph_t, contact_graph, delassus_columns, delassus_bandwidth, &
-      delassus_diagonal_band, newton_impulses, contact_forces, apply_impulses, delassus_factor, &
+      delassus_diagonal_band, b_dot, newton_impulses, contact_forces, apply_impulses, delassus_factor, &
       project_factored, impulse_accumulation, flight_resolution, lcp_work_reals, LEMKE_MAX, IMPULSE_OK, &
       IMPULSE_INFEASIBLE, IMPULSE_NOT_CONVERGED, IMPULSE_SINGULAR, IMPULSE_NO_MEMORY
 
@@ -47,19 +51,21 @@ module martello_impulse
    end type contact_graph_t
 
 contains
-   !> The node → contact adjacency of the contacts with use(k) true (sides 0 are left out).
-   !> stat /= 0: g could not be allocated (n + 2 + 2m integers at most).
-   pure subroutine contact_graph(n, sa, sb, use, g, stat)
-      integer, intent(in) :: n, sa(:), sb(:)
+   !> The node → contact adjacency of the contacts with use(k) true (rows b).
+   !> stat /= 0: g could not be allocated (n + 2 + the terms at most).
+   pure subroutine contact_graph(n, b, use, g, stat)
+      integer, intent(in) :: n
+      type(rows_t), intent(in) :: b
       logical, intent(in) :: use(:)
       type(contact_graph_t), intent(out) :: g
       integer, intent(out) :: stat
-      integer :: cnt(0:n), k
+      integer :: cnt(0:n), k, q, node
       cnt = 0
-      do k = 1, size(sa)
+      do k = 1, size(use)
          if (.not. use(k)) cycle
-         cnt(sa(k)) = cnt(sa(k)) + 1
-         cnt(sb(k)) = cnt(sb(k)) + 1
+         do q = row_lo(b, k), row_hi(b, k)
+            cnt(b%node(q)) = cnt(b%node(q)) + 1
+         end do
       end do
       allocate (g%ptr(n + 2), g%con(max(1, sum(cnt(1:n)))), stat=stat)
       if (stat /= 0) return
@@ -68,43 +74,54 @@ contains
          g%ptr(k + 1) = g%ptr(k) + cnt(k)
       end do
       cnt = 0
-      do k = 1, size(sa)
+      do k = 1, size(use)
          if (.not. use(k)) cycle
-         if (sa(k) > 0) then
-            g%con(g%ptr(sa(k)) + cnt(sa(k))) = k; cnt(sa(k)) = cnt(sa(k)) + 1
-         end if
-         if (sb(k) > 0) then
-            g%con(g%ptr(sb(k)) + cnt(sb(k))) = k; cnt(sb(k)) = cnt(sb(k)) + 1
-         end if
+         do q = row_lo(b, k), row_hi(b, k)
+            node = b%node(q)
+            g%con(g%ptr(node) + cnt(node)) = k; cnt(node) = cnt(node) + 1
+         end do
       end do
    end subroutine contact_graph
 
-   !> W_kl = B_k C_l for the contacts k, l = 1..m with sides sa, sb and columns c(:, l) =
-   !> A B_lᵀ (any inverse-mass action: M⁻¹, consistent mass included, or Ŵ⁻¹).
-   pure subroutine delassus_columns(sa, sb, c, w)
-      integer, intent(in) :: sa(:), sb(:)
+   !> B_k x over the nodes 1..n (x(:) indexed by node).
+   pure real(dp) function b_dot(b, k, x) result(d)
+      type(rows_t), intent(in) :: b
+      integer, intent(in) :: k
+      real(dp), intent(in) :: x(:)
+      integer :: q
+      d = 0.0_dp
+      do q = row_lo(b, k), row_hi(b, k)
+         d = d + b%coef(q)*x(b%node(q))
+      end do
+   end function b_dot
+
+   !> W_kl = B_k C_l for the contacts list(k), list(l) of rows b and columns c(:, l) = A B_lᵀ
+   !> (any inverse-mass action: M⁻¹, consistent mass included, or Ŵ⁻¹).
+   pure subroutine delassus_columns(b, list, c, w)
+      type(rows_t), intent(in) :: b
+      integer, intent(in) :: list(:)
       real(dp), intent(in) :: c(:, :)
       real(dp), intent(out) :: w(:, :)
       integer :: k, l
-      do l = 1, size(sa)
-         do k = 1, size(sa)
-            w(k, l) = side(c(:, l), sb(k)) - side(c(:, l), sa(k))
+      do l = 1, size(list)
+         do k = 1, size(list)
+            w(k, l) = b_dot(b, list(k), c(:, l))
          end do
       end do
    end subroutine delassus_columns
 
    !> The bandwidth kw of W in the ordering act(1..m) of the contacts in an LCP (pos(c) = the
    !> position of contact c in act, 0 if absent): 1 for a chain of neighbours.
-   pure integer function delassus_bandwidth(g, sa, sb, act, pos) result(kw)
+   pure integer function delassus_bandwidth(g, b, act, pos) result(kw)
       type(contact_graph_t), intent(in) :: g
-      integer, intent(in) :: sa(:), sb(:), act(:), pos(:)
-      integer :: i, k, side_, node, jj
+      type(rows_t), intent(in) :: b
+      integer, intent(in) :: act(:), pos(:)
+      integer :: i, k, q, node, jj
       kw = 0
       do i = 1, size(act)
          k = act(i)
-         do side_ = 1, 2
-            node = merge(sa(k), sb(k), side_ == 1)
-            if (node == 0) cycle
+         do q = row_lo(b, k), row_hi(b, k)
+            node = b%node(q)
             do jj = g%ptr(node), g%ptr(node + 1) - 1
                if (pos(g%con(jj)) > 0) kw = max(kw, abs(pos(g%con(jj)) - i))
             end do
@@ -114,27 +131,28 @@ contains
 
    !> W in band storage (bandwidth kw from delassus_bandwidth; wb at least (2kw + 1, m)) for
    !> a diagonal A = diag(1/d) (Moreau–Jean's Ŵ of a lumped-mass chain without links): W_kl =
-   !> Σ over the nodes i that contacts k and l share of s_k(i) s_l(i)/d_i (s = −1 on the a
-   !> side, +1 on the b side): O(m) for a chain instead of the O(m²) of delassus_columns.
-   pure subroutine delassus_diagonal_band(g, sa, sb, act, pos, d, kw, wb)
+   !> Σ over the nodes i that contacts k and l share of b_k(i) b_l(i)/d_i: O(m) for a chain
+   !> instead of the O(m²) of delassus_columns.
+   pure subroutine delassus_diagonal_band(g, b, act, pos, d, kw, wb)
       type(contact_graph_t), intent(in) :: g
-      integer, intent(in) :: sa(:), sb(:), act(:), pos(:), kw
+      type(rows_t), intent(in) :: b
+      integer, intent(in) :: act(:), pos(:), kw
       real(dp), intent(in) :: d(:)
       real(dp), intent(inout) :: wb(:, :)
-      integer :: i, k, side_, node, jj, cj
-      real(dp) :: si
+      integer :: i, k, q, r, node, jj, cj
       wb(:, 1:size(act)) = 0.0_dp
       do i = 1, size(act)
          k = act(i)
-         do side_ = 1, 2
-            node = merge(sa(k), sb(k), side_ == 1)
-            if (node == 0) cycle
-            si = merge(-1.0_dp, 1.0_dp, side_ == 1)
+         do q = row_lo(b, k), row_hi(b, k)
+            node = b%node(q)
             do jj = g%ptr(node), g%ptr(node + 1) - 1
                cj = g%con(jj)
                if (pos(cj) == 0) cycle
-               wb(kw + 1 + i - pos(cj), pos(cj)) = wb(kw + 1 + i - pos(cj), pos(cj)) + &
-                  si*merge(-1.0_dp, 1.0_dp, sa(cj) == node)/d(node)
+               do r = row_lo(b, cj), row_hi(b, cj)      ! the other contact's term at this node
+                  if (b%node(r) /= node) cycle
+                  wb(kw + 1 + i - pos(cj), pos(cj)) = wb(kw + 1 + i - pos(cj), pos(cj)) + &
+                     b%coef(q)*b%coef(r)/d(node)
+               end do
             end do
          end do
       end do
@@ -211,15 +229,16 @@ contains
    !> by delassus_factor, P = W⁻¹ (target − B x) and x ← x + Σ P_k c(:, k). On the velocities
    !> with target 0 it is the plastic impulse of the held set; on the accelerations, the
    !> bilateral contact forces; on the displacements with target −gap, the return onto δ = 0.
-   subroutine project_factored(sa, sb, c, l, target, x, p)
-      integer, intent(in) :: sa(:), sb(:)
+   subroutine project_factored(b, list, c, l, target, x, p)
+      type(rows_t), intent(in) :: b
+      integer, intent(in) :: list(:)
       real(dp), intent(in) :: c(:, :), l(:, :), target(:)
       real(dp), intent(inout) :: x(:)
       real(dp), intent(out) :: p(:)
       integer :: k, m, info
-      m = size(sa)
+      m = size(list)
       do k = 1, m
-         p(k) = target(k) - (side(x, sb(k)) - side(x, sa(k)))
+         p(k) = target(k) - b_dot(b, list(k), x)
       end do
       if (m == 1) then
          p(1) = p(1)/l(1, 1)
@@ -550,11 +569,5 @@ contains
          end if
       end do
    end subroutine polish
-   !> x at a contact side (0: the ground or an immobile node, which does not move).
-   pure real(dp) function side(x, node)
-      real(dp), intent(in) :: x(:)
-      integer, intent(in) :: node
-      side = 0.0_dp
-      if (node > 0) side = x(node)
-   end function side
+
 end module martello_impulse

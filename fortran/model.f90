@@ -12,14 +12,17 @@ module martello_model
       L_STIFF, L_DAMP, L_YIELD, L_HARDENING
    use martello_registry, only: SCHEME_PENALTY, SCHEME_LAGRANGE, SCHEME_AUGMENTED, &
       SCHEME_RESTITUTION, registry_name
+   use martello_element_rows, only: rows_t, rows_init, rows_append, rows_append_pair, row_span, &
+      row_pair, row_lo, row_hi, rows_move
    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
    implicit none
    private
    public :: model_t, model_init, model_set_node, model_add_link, model_add_contact, &
       model_initial_state, model_u0, &
       model_add_mass_coupling, model_add_nodal_force, model_set_ground_acceleration, &
+      model_add_link_row, model_add_contact_row, rigid_contacts, &
       model_set_influence, model_influence, model_has_influence, &
-      model_add_stiffness_block, stiffness_block_t, model_bandwidth, rigid_contact_sides, &
+      model_add_stiffness_block, stiffness_block_t, model_bandwidth, &
       SCHEME_PENALTY, SCHEME_LAGRANGE, SCHEME_AUGMENTED, &
       SCHEME_RESTITUTION, scheme_name, chain_t, model_add_chain, model_expanded, &
       model_nlinks, model_ncontacts, model_link_index, model_contact_index, model_contact_at, &
@@ -60,11 +63,17 @@ module martello_model
       logical, allocatable :: fixed(:)
       ! links
       integer :: nlink = 0
-      integer, allocatable :: link_kind(:), link_a(:), link_b(:)
+      integer, allocatable :: link_kind(:)
+      !> each link's row: its elongation Σ coef·u(node) (a node pair: u_a − u_b), its force f
+      !> on the nodes coef·f (martello_element_rows)
+      type(rows_t) :: lnk
       real(dp), allocatable :: link_par(:, :)           !< (NPAR_LINK, nlink)
-      ! contacts: penetration δ = (u_a − u_b) − gap, compressive force pushes a back, b forward
+      ! contacts: penetration δ = Σ coef·u(node) − gap over the contact's row (a node pair:
+      ! u_a − u_b − gap), a compressive force f acts on the nodes as coef·f (pushes a back, b
+      ! forward); rows between plan points of floors: docs/buildings.md
       integer :: ncontact = 0
-      integer, allocatable :: con_a(:), con_b(:), con_scheme(:), con_law(:)
+      type(rows_t) :: con
+      integer, allocatable :: con_scheme(:), con_law(:)
       real(dp), allocatable :: con_gap(:), con_par(:, :) !< (NPAR_CONTACT, ncontact)
       !> effective mass 1/(B M⁻¹ Bᵀ) of each contact (+inf if neither side moves), and the
       !> damping derived from a target restitution: set by effective_mass_prepare before a run
@@ -181,9 +190,9 @@ contains
       end if
       m%n = n
       allocate (m%mass(n), m%u0(0), m%v0(0), m%influence(0), m%fixed(n), &
-                m%link_kind(max_links), m%link_a(max_links), m%link_b(max_links), &
+                m%link_kind(max_links), &
                 m%link_par(NPAR_LINK, max_links), &
-                m%con_a(max_contacts), m%con_b(max_contacts), m%con_scheme(max_contacts), &
+                m%con_scheme(max_contacts), &
                 m%con_law(max_contacts), m%con_gap(max_contacts), &
                 m%con_par(NPAR_CONTACT, max_contacts), m%con_mstar(max_contacts), &
                 m%force_node(max_forces), m%force_fn(max_forces), &
@@ -196,6 +205,14 @@ contains
                             + INT_BYTES*(2.0_dp*n + 3.0_dp*max_links + 4.0_dp*max_contacts &
                             + max_forces + 2.0_dp*max_couplings) &
                             + storage_size(m%force_fn)/8*real(max_forces, dp), &
+                            FIX_SMALLER_SCENE, stat, m%errmsg)
+         return
+      end if
+      if (stat == 0) call rows_init(m%lnk, max_links, 2, stat)
+      if (stat == 0) call rows_init(m%con, max_contacts, 2, stat)
+      if (stat /= 0) then
+         call out_of_memory('the rows of the links and contacts', &
+                            (REAL_BYTES + INT_BYTES)*2.0_dp*(real(max_links, dp) + max_contacts), &
                             FIX_SMALLER_SCENE, stat, m%errmsg)
          return
       end if
@@ -302,18 +319,78 @@ contains
       integer, intent(in) :: kind, a, b
       real(dp), intent(in) :: par(NPAR_LINK)
       integer, intent(out) :: stat
-      stat = MARTELLO_OK
-      if (m%nlink >= size(m%link_kind)) then
-         call fail(m, stat, 'add_link: more links than declared at model_create'); return
-      end if
-      call model_check_link(m, kind, a, b, par, stat)
-      if (stat /= MARTELLO_OK) return
-      m%nlink = m%nlink + 1
-      m%link_kind(m%nlink) = kind; m%link_a(m%nlink) = a; m%link_b(m%nlink) = b
-      m%link_par(:, m%nlink) = par
+      call link_room(m, 'add_link', stat)
+      if (stat == MARTELLO_OK) call model_check_link(m, kind, a, b, par, stat)
+      if (stat == MARTELLO_OK) call append_link(m, kind, [a, b], [1.0_dp, -1.0_dp], par, stat)
    end subroutine model_add_link
 
-   !> What add_link checks of one link (its nodes, kind and parameters); a chain's links too.
+   !> Add a link whose elongation is Σ coef(k)·u(node(k)) (node 0: the ground, left out): a
+   !> link between plan points of floors (docs/buildings.md), its force f acting as coef·f.
+   subroutine model_add_link_row(m, kind, node, coef, par, stat)
+      type(model_t), intent(inout) :: m
+      integer, intent(in) :: kind, node(:)
+      real(dp), intent(in) :: coef(:), par(NPAR_LINK)
+      integer, intent(out) :: stat
+      call link_room(m, 'add_link_row', stat)
+      if (stat == MARTELLO_OK) call check_row(m, 'add_link_row', node, coef, stat)
+      if (stat == MARTELLO_OK) call model_check_link(m, kind, 0, -1, par, stat)
+      if (stat == MARTELLO_OK) call append_link(m, kind, node, coef, par, stat)
+   end subroutine model_add_link_row
+
+   !> Room for one more link (the capacity of model_create).
+   subroutine link_room(m, what, stat)
+      type(model_t), intent(inout) :: m
+      character(len=*), intent(in) :: what
+      integer, intent(out) :: stat
+      stat = MARTELLO_OK
+      if (m%nlink >= size(m%link_kind)) call fail(m, stat, what//': more links than declared at model_create')
+   end subroutine link_room
+
+   !> A checked link appended: its row, kind and parameters.
+   subroutine append_link(m, kind, node, coef, par, stat)
+      type(model_t), intent(inout) :: m
+      integer, intent(in) :: kind, node(:)
+      real(dp), intent(in) :: coef(:), par(NPAR_LINK)
+      integer, intent(out) :: stat
+      call rows_append(m%lnk, node, coef, stat)
+      if (stat /= 0) then
+         call out_of_memory('a link row', (REAL_BYTES + INT_BYTES)*size(node), FIX_SMALLER_SCENE, &
+                            stat, m%errmsg)
+         return
+      end if
+      m%nlink = m%nlink + 1
+      m%link_kind(m%nlink) = kind
+      m%link_par(:, m%nlink) = par
+   end subroutine append_link
+
+   !> What a row needs: nodes of the model or 0 (the ground), finite coefficients, at least
+   !> one term on a node.
+   subroutine check_row(m, what, node, coef, stat)
+      type(model_t), intent(inout) :: m
+      character(len=*), intent(in) :: what
+      integer, intent(in) :: node(:)
+      real(dp), intent(in) :: coef(:)
+      integer, intent(out) :: stat
+      integer :: k
+      stat = MARTELLO_OK
+      if (size(node) /= size(coef)) then
+         call fail(m, stat, what//': as many coefficients as nodes'); return
+      end if
+      do k = 1, size(node)
+         if (.not. node_ok(m, node(k), .true.)) then
+            call fail(m, stat, what//': node out of range'); return
+         end if
+      end do
+      if (.not. all(ieee_is_finite(coef))) then
+         call fail(m, stat, what//': coefficients must be finite'); return
+      end if
+      if (.not. any(node > 0 .and. coef /= 0.0_dp)) then
+         call fail(m, stat, what//': the row has no term on a node (it joins nothing that moves)')
+      end if
+   end subroutine check_row
+
+   !> What add_link checks of one link (its nodes, kind and parameters; b = −1: a row's link,
+   !> its nodes checked by check_row); a chain's links too.
    subroutine model_check_link(m, kind, a, b, par, stat)
       type(model_t), intent(inout) :: m
       integer, intent(in) :: kind, a, b
@@ -323,8 +400,10 @@ contains
       if (.not. link_is_known(kind)) then
          call fail(m, stat, 'add_link: unknown link kind'); return
       end if
-      if (.not. (node_ok(m, a, .true.) .and. node_ok(m, b, .true.)) .or. a == b) then
-         call fail(m, stat, 'add_link: nodes out of range, or both ends on the same node'); return
+      if (b /= -1) then       ! b = −1: a row's link, its nodes checked by check_row
+         if (.not. (node_ok(m, a, .true.) .and. node_ok(m, b, .true.)) .or. a == b) then
+            call fail(m, stat, 'add_link: nodes out of range, or both ends on the same node'); return
+         end if
       end if
       if (.not. all(ieee_is_finite(par))) then
          call fail(m, stat, 'add_link: parameters must be finite'); return
@@ -336,30 +415,68 @@ contains
       integer, intent(in) :: a, b, scheme, law
       real(dp), intent(in) :: gap, par(NPAR_CONTACT)
       integer, intent(out) :: stat
+      call contact_room(m, 'add_contact', stat)
+      if (stat == MARTELLO_OK) call model_check_contact(m, a, b, gap, scheme, law, par, stat)
+      if (stat == MARTELLO_OK) call append_contact(m, [a, b], [1.0_dp, -1.0_dp], gap, scheme, law, &
+                                                   par, stat)
+   end subroutine model_add_contact
+
+   !> Add a contact whose penetration is Σ coef(k)·u(node(k)) − gap (node 0: the ground, left
+   !> out): a contact between plan points of floors (docs/buildings.md), its compressive force
+   !> f acting as coef·f on the nodes.
+   subroutine model_add_contact_row(m, node, coef, gap, scheme, law, par, stat)
+      type(model_t), intent(inout) :: m
+      integer, intent(in) :: node(:), scheme, law
+      real(dp), intent(in) :: coef(:), gap, par(NPAR_CONTACT)
+      integer, intent(out) :: stat
+      call contact_room(m, 'add_contact_row', stat)
+      if (stat == MARTELLO_OK) call check_row(m, 'add_contact_row', node, coef, stat)
+      if (stat == MARTELLO_OK) call model_check_contact(m, 0, -1, gap, scheme, law, par, stat)
+      if (stat == MARTELLO_OK) call append_contact(m, node, coef, gap, scheme, law, par, stat)
+   end subroutine model_add_contact_row
+
+   !> Room for one more contact (the capacity of model_create).
+   subroutine contact_room(m, what, stat)
+      type(model_t), intent(inout) :: m
+      character(len=*), intent(in) :: what
+      integer, intent(out) :: stat
       stat = MARTELLO_OK
-      if (m%ncontact >= size(m%con_a)) then
-         call fail(m, stat, 'add_contact: more contacts than declared at model_create'); return
+      if (m%ncontact >= size(m%con_scheme)) &
+         call fail(m, stat, what//': more contacts than declared at model_create')
+   end subroutine contact_room
+
+   !> A checked contact appended: its row, gap, scheme, law and parameters.
+   subroutine append_contact(m, node, coef, gap, scheme, law, par, stat)
+      type(model_t), intent(inout) :: m
+      integer, intent(in) :: node(:), scheme, law
+      real(dp), intent(in) :: coef(:), gap, par(NPAR_CONTACT)
+      integer, intent(out) :: stat
+      call rows_append(m%con, node, coef, stat)
+      if (stat /= 0) then
+         call out_of_memory('a contact row', (REAL_BYTES + INT_BYTES)*size(node), FIX_SMALLER_SCENE, &
+                            stat, m%errmsg)
+         return
       end if
-      call model_check_contact(m, a, b, gap, scheme, law, par, stat)
-      if (stat /= MARTELLO_OK) return
       m%ncontact = m%ncontact + 1
-      m%con_a(m%ncontact) = a; m%con_b(m%ncontact) = b; m%con_gap(m%ncontact) = gap
+      m%con_gap(m%ncontact) = gap
       m%con_scheme(m%ncontact) = scheme; m%con_law(m%ncontact) = law
       m%con_par(:, m%ncontact) = par
       m%con_mstar(m%ncontact) = 0.0_dp
-   end subroutine model_add_contact
+   end subroutine append_contact
 
-   !> What add_contact checks of one contact (its nodes, scheme, law and parameters); a
-   !> chain's contacts too.
+   !> What add_contact checks of one contact (its nodes, scheme, law and parameters; b = −1:
+   !> a row's contact, its nodes checked by check_row); a chain's contacts too.
    subroutine model_check_contact(m, a, b, gap, scheme, law, par, stat)
       type(model_t), intent(inout) :: m
       integer, intent(in) :: a, b, scheme, law
       real(dp), intent(in) :: gap, par(NPAR_CONTACT)
       integer, intent(out) :: stat
       stat = MARTELLO_OK
-      if (.not. (node_ok(m, a, .true.) .and. node_ok(m, b, .true.)) .or. a == b) then
-         call fail(m, stat, 'add_contact: nodes out of range, or both sides on the same node')
-         return
+      if (b /= -1) then
+         if (.not. (node_ok(m, a, .true.) .and. node_ok(m, b, .true.)) .or. a == b) then
+            call fail(m, stat, 'add_contact: nodes out of range, or both sides on the same node')
+            return
+         end if
       end if
       if (scheme < SCHEME_PENALTY .or. scheme > SCHEME_RESTITUTION) then
          call fail(m, stat, 'add_contact: unknown scheme'); return
@@ -525,10 +642,10 @@ contains
       integer :: j
       kd = 0
       do j = 1, m%nlink
-         if (m%link_a(j) > 0 .and. m%link_b(j) > 0) kd = max(kd, abs(m%link_a(j) - m%link_b(j)))
+         kd = max(kd, row_span(m%lnk, j))
       end do
       do j = 1, m%ncontact
-         if (m%con_a(j) > 0 .and. m%con_b(j) > 0) kd = max(kd, abs(m%con_a(j) - m%con_b(j)))
+         kd = max(kd, row_span(m%con, j))
       end do
       do j = 1, m%ncoupling
          kd = max(kd, abs(m%mc_a(j) - m%mc_b(j)))
@@ -543,25 +660,20 @@ contains
 
    !> For the impulse-level integrators: which contacts are rigid (restitution or Lagrange,
    !> solved by complementarity), their restitution (Lagrange without one: 0, plastic), and
-   !> their moving sides — a side on ground or on a fixed node does not move, so its column of
-   !> the constraint matrix B is left out (sa/sb = 0); movable = rigid with a moving side.
-   pure subroutine rigid_contact_sides(m, rigid, e, sa, sb, movable)
+   !> which can move — a rigid contact with a term on a free node (terms on a fixed node do not
+   !> move: the Delassus operator leaves them out).
+   pure subroutine rigid_contacts(m, rigid, e, movable)
       type(model_t), intent(in) :: m
       logical, intent(out) :: rigid(:), movable(:)
       real(dp), intent(out) :: e(:)
-      integer, intent(out) :: sa(:), sb(:)
-      integer :: c
+      integer :: c, k
       do c = 1, m%ncontact
          rigid(c) = m%con_scheme(c) /= SCHEME_PENALTY
          e(c) = max(m%con_par(P_RESTITUTION, c), 0.0_dp)
-         sa(c) = m%con_a(c); sb(c) = m%con_b(c)
-         if (sa(c) > 0) then
-            if (m%fixed(sa(c))) sa(c) = 0
-         end if
-         if (sb(c) > 0) then
-            if (m%fixed(sb(c))) sb(c) = 0
-         end if
-         movable(c) = rigid(c) .and. (sa(c) > 0 .or. sb(c) > 0)
+         movable(c) = .false.
+         do k = row_lo(m%con, c), row_hi(m%con, c)
+            if (.not. m%fixed(m%con%node(k)) .and. m%con%coef(k) /= 0.0_dp) movable(c) = rigid(c)
+         end do
       end do
-   end subroutine rigid_contact_sides
+   end subroutine rigid_contacts
 end module martello_model

@@ -31,7 +31,8 @@ module martello_moreau_jean
    use martello_kinds, only: dp, i8
    use martello_lapack, only: dgbtrf, dgbtrs
    use martello_status
-   use martello_model, only: model_t, model_bandwidth, rigid_contact_sides
+   use martello_model, only: model_t, model_bandwidth, rigid_contacts
+   use martello_element_rows, only: rows_t, rows_init, rows_append, row_lo, row_hi, row_dot
    use martello_band_matrix, only: band_t, band_init, band_matvec, band_pin
    use martello_assembly, only: internal_forces, external_forces, mech_commit, assemble_mass, mass_times
    use martello_observer, only: observer_t, observer_work, observer_fail, observer_open_phase, &
@@ -39,7 +40,7 @@ module martello_moreau_jean
    use martello_run_quantities, only: C_NEWTON, C_RESIDUALS, C_FACTORIZATIONS, C_EVENTS, C_JACOBIANS
    use martello_integrator_settings, only: integrator_settings_t
    use martello_fixed_step, only: stepper_t, stepper_start, contact_state
-   use martello_impulse, only: contact_graph_t, contact_graph, delassus_columns, &
+   use martello_impulse, only: contact_graph_t, contact_graph, delassus_columns, b_dot, &
       delassus_bandwidth, delassus_diagonal_band, newton_impulses, lcp_work_reals, IMPULSE_OK, &
       IMPULSE_NO_MEMORY
    use martello_linalg, only: lapack_status
@@ -53,7 +54,10 @@ module martello_moreau_jean
       logical :: thomas = .false.
       real(dp), allocatable :: fint(:), fint_n(:), fext(:), fext_n(:), rhs(:), work(:)
       real(dp), allocatable :: e_con(:), p(:), p_prev(:), ph_last(:)
-      integer, allocatable :: sa(:), sb(:), act(:), pos(:), ipiv(:)
+      integer, allocatable :: act(:), pos(:), ipiv(:)
+      !> each contact's row B_c (ġ_c = B_c v, martello_impulse): its penetration row negated,
+      !> the fixed nodes left out
+      type(rows_t) :: b
       type(contact_graph_t) :: graph   !< which rigid contacts share a node (martello_impulse)
       logical, allocatable :: rigid(:), movable(:)
       ! Delassus operator: dense (Lemke) and band (PGS), the columns Ŵ⁻¹Bᵀ (kd > 0), LCP data
@@ -87,18 +91,19 @@ contains
       self%kd = model_bandwidth(m)
       allocate (self%fint(0:n), self%fint_n(0:n), self%fext(0:n), self%fext_n(0:n), &
                 self%rhs(0:n), self%work(0:n), self%ipiv(n), &
-                self%e_con(nc), self%p(nc), self%p_prev(nc), self%ph_last(nc), self%sa(nc), &
-                self%sb(nc), self%act(nc), self%pos(nc), self%rigid(nc), self%movable(nc), stat=stat)
+                self%e_con(nc), self%p(nc), self%p_prev(nc), self%ph_last(nc), &
+                self%act(nc), self%pos(nc), self%rigid(nc), self%movable(nc), stat=stat)
       if (stat /= 0) call out_of_memory('the state of Moreau-Jean', REAL_BYTES*(6*(n + 1.0_dp) + &
                                         4.0_dp*nc) + INT_BYTES*(n + 6.0_dp*nc), FIX_SMALLER_SCENE, stat, msg)
       if (stat == MARTELLO_OK) call band_init(self%kband, n, self%kd, stat, msg)
       if (stat == MARTELLO_OK) call band_init(self%cband, n, self%kd, stat, msg)
       if (stat == MARTELLO_OK) call band_init(self%what, n, self%kd, stat, msg)
       if (stat == MARTELLO_OK) then
-         call rigid_contact_sides(m, self%rigid, self%e_con, self%sa, self%sb, self%movable)
-         call contact_graph(n, self%sa, self%sb, self%movable, self%graph, stat)
+         call rigid_contacts(m, self%rigid, self%e_con, self%movable)
+         call gap_rate_rows(stat)
+         if (stat == 0) call contact_graph(n, self%b, self%movable, self%graph, stat)
          if (stat /= 0) call out_of_memory('the contact graph of Moreau-Jean', &
-                                           INT_BYTES*(n + 2.0_dp + 2*nc), FIX_SMALLER_SCENE, stat, msg)
+                                           (INT_BYTES + REAL_BYTES)*(n + 2.0_dp + 2*nc), FIX_SMALLER_SCENE, stat, msg)
       end if
       if (stat /= MARTELLO_OK) then
          call observer_fail(o, MARTELLO_ERR_MEMORY, 0.0_dp, msg, stat)
@@ -114,6 +119,21 @@ contains
       o%counters(C_JACOBIANS) = o%counters(C_JACOBIANS) + 1_i8
       call contact_state(self, m, self%p, self%h)
 
+   contains
+
+      !> self%b: B_c = −(contact c's row) on its free nodes.
+      subroutine gap_rate_rows(st)
+         integer, intent(out) :: st
+         integer :: c, q
+         call rows_init(self%b, nc, 2, st)
+         do c = 1, nc
+            if (st /= 0) return
+            associate (nd => m%con%node(row_lo(m%con, c):row_hi(m%con, c)), &
+                       cf => m%con%coef(row_lo(m%con, c):row_hi(m%con, c)))
+               call rows_append(self%b, [(merge(0, nd(q), m%fixed(nd(q))), q = 1, size(nd))], -cf, st)
+            end associate
+         end do
+      end subroutine gap_rate_rows
    end subroutine init
 
    !> One step: free velocity, index set, impulses, positions; the smooth forces and their
@@ -124,7 +144,7 @@ contains
       real(dp), intent(in) :: t
       type(observer_t), intent(inout) :: o
       integer, intent(out) :: stat
-      integer :: n, nc, i, j, c, info, code
+      integer :: n, nc, i, j, c, q, info, code
       real(dp) :: h, t_prev, theta, hth, wdl, wll, wcl, dw, gdot_theta, d_theta
       character(len=512) :: msg
 
@@ -134,7 +154,7 @@ contains
       associate (u => self%u, v => self%v, un => self%un, vn => self%vn, a => self%a, &
                  fint => self%fint, fint_n => self%fint_n, fext => self%fext, &
                  fext_n => self%fext_n, rhs => self%rhs, work => self%work, p => self%p, &
-                 p_prev => self%p_prev, sa => self%sa, sb => self%sb, act => self%act, &
+                 p_prev => self%p_prev, act => self%act, &
                  na => self%na, kband => self%kband, cband => self%cband, what => self%what, &
                  fixed_nodes => self%fixed_nodes)
          fint_n = fint; fext_n = fext
@@ -175,8 +195,9 @@ contains
             work = 0.0_dp
             do j = 1, na
                c = act(j)
-               work(sa(c)) = work(sa(c)) - p(c)
-               work(sb(c)) = work(sb(c)) + p(c)
+               do q = row_lo(self%b, c), row_hi(self%b, c)
+                  work(self%b%node(q)) = work(self%b%node(q)) + self%b%coef(q)*p(c)
+               end do
             end do
             work(0) = 0.0_dp
             call solve_what(work(1:n))
@@ -207,7 +228,7 @@ contains
          call observer_work(o, external=dw)
          do j = 1, na
             c = act(j)
-            gdot_theta = theta*(v(sb(c)) - v(sa(c))) + (1.0_dp - theta)*(vn(sb(c)) - vn(sa(c)))
+            gdot_theta = theta*b_dot(self%b, c, v(1:)) + (1.0_dp - theta)*b_dot(self%b, c, vn(1:))
             call observer_work(o, impact=-gdot_theta*p(c))
          end do
          call observer_work(o, impact=d_theta)
@@ -282,8 +303,7 @@ contains
             pos = 0
             do k = 1, nc
                if (.not. self%movable(k)) cycle
-               dpred = (un(m%con_a(k)) + (0.5_dp*h)*vn(m%con_a(k))) &
-                       - (un(m%con_b(k)) + (0.5_dp*h)*vn(m%con_b(k))) - m%con_gap(k)
+               dpred = row_dot(m%con, k, un) + (0.5_dp*h)*row_dot(m%con, k, vn) - m%con_gap(k)
                if (dpred >= 0.0_dp) then
                   na = na + 1
                   act(na) = k
@@ -299,7 +319,7 @@ contains
          integer, intent(out) :: inf
          integer :: ii, jj, k
          associate (na => self%na, kw => self%kw, kd => self%kd, act => self%act, &
-                    pos => self%pos, sa => self%sa, sb => self%sb, v => self%v, vn => self%vn, &
+                    pos => self%pos, v => self%v, vn => self%vn, &
                     e_con => self%e_con, what => self%what, iters => self%iters, p => self%p, &
                     p_prev => self%p_prev)
             inf = 0
@@ -313,17 +333,17 @@ contains
             end if
             do ii = 1, na
                k = act(ii)
-               self%qlcp(ii) = v(sb(k)) - v(sa(k))
-               self%gref(ii) = vn(sb(k)) - vn(sa(k))
+               self%qlcp(ii) = b_dot(self%b, k, v(1:))
+               self%gref(ii) = b_dot(self%b, k, vn(1:))
                self%eact(ii) = e_con(k)
                self%zlcp(ii) = p_prev(k)                ! warm start from the last step (PGS)
             end do
             if (kd == 0) then
                ! Ŵ diagonal: W banded in the active ordering (tridiagonal for a chain)
-               kw = delassus_bandwidth(self%graph, sa, sb, act(1:na), pos)
+               kw = delassus_bandwidth(self%graph, self%b, act(1:na), pos)
                call ensure_band(kw, inf)
                if (inf /= 0) return
-               call delassus_diagonal_band(self%graph, sa, sb, act(1:na), pos, what%ab(1, :), kw, self%wb)
+               call delassus_diagonal_band(self%graph, self%b, act(1:na), pos, what%ab(1, :), kw, self%wb)
                call newton_impulses(self%qlcp(1:na), self%gref(1:na), self%eact(1:na), &
                                     self%zlcp(1:na), inf, iters, wb=self%wb, kw=kw)
             else
@@ -339,8 +359,9 @@ contains
                self%zcol(:, 1:na) = 0.0_dp
                do jj = 1, na
                   k = act(jj)
-                  if (sa(k) > 0) self%zcol(sa(k), jj) = -1.0_dp
-                  if (sb(k) > 0) self%zcol(sb(k), jj) = 1.0_dp
+                  do ii = row_lo(self%b, k), row_hi(self%b, k)
+                     self%zcol(self%b%node(ii), jj) = self%b%coef(ii)
+                  end do
                end do
                if (self%thomas) then
                   do jj = 1, na
@@ -351,7 +372,7 @@ contains
                end if
                call ensure_dense(inf)
                if (inf /= 0) return
-               call delassus_columns(sa(act(1:na)), sb(act(1:na)), self%zcol(:, 1:na), &
+               call delassus_columns(self%b, act(1:na), self%zcol(:, 1:na), &
                                      self%wd_(1:na, 1:na))
                call newton_impulses(self%qlcp(1:na), self%gref(1:na), self%eact(1:na), &
                                     self%zlcp(1:na), inf, iters, w=self%wd_(1:na, 1:na))
@@ -412,20 +433,19 @@ contains
       !> last one, t_off the switching instant of the last impulse step (a single-step impact
       !> has t_off = t_on: it is instantaneous).
       subroutine rigid_phases()
-         integer :: k, ia, ib
+         integer :: k
          real(dp) :: t_imp
          t_imp = t_prev + (1.0_dp - theta)*(t - t_prev)
          do k = 1, nc
             if (.not. self%rigid(k)) cycle
-            ia = m%con_a(k); ib = m%con_b(k)
             if (self%p(k) > 0.0_dp) then
                if (.not. o%ph_open(k)) then
-                  call observer_open_phase(o, k, t_imp, self%vn(ia) - self%vn(ib))
+                  call observer_open_phase(o, k, t_imp, row_dot(m%con, k, self%vn))
                   o%counters(C_EVENTS) = o%counters(C_EVENTS) + 1_i8
                end if
                self%ph_last(k) = t_imp
             else if (o%ph_open(k)) then
-               call observer_close_phase(o, k, self%ph_last(k), self%vn(ia) - self%vn(ib))
+               call observer_close_phase(o, k, self%ph_last(k), row_dot(m%con, k, self%vn))
             end if
          end do
       end subroutine rigid_phases

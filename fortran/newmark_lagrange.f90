@@ -33,7 +33,8 @@
 module martello_newmark_lagrange
    use martello_kinds, only: dp, i8
    use martello_status
-   use martello_model, only: model_t, model_bandwidth, rigid_contact_sides
+   use martello_model, only: model_t, model_bandwidth, rigid_contacts
+   use martello_element_rows, only: row_dot, row_add, row_lo, row_hi
    use martello_band_matrix, only: band_t, band_init
    use martello_assembly, only: internal_forces, external_forces, mech_commit, mass_times, &
       external_work
@@ -57,7 +58,6 @@ module martello_newmark_lagrange
       real(dp) :: tol_residual = 0.0_dp, tol_increment = 0.0_dp
       real(dp), allocatable :: fint(:), fint_n(:), fext(:), fext_n(:), ma(:), work(:), mdense(:, :)
       real(dp), allocatable :: e_con(:), lam(:), mstar(:)
-      integer, allocatable :: sa(:), sb(:)
       logical, allocatable :: pers(:), active(:), movable(:), rigid(:)
       type(band_t) :: kband, cband
    contains
@@ -96,7 +96,7 @@ contains
       self%tol_residual = s%tol_residual; self%tol_increment = s%tol_increment
       allocate (self%fint(0:n), self%fint_n(0:n), self%fext(0:n), self%fext_n(0:n), &
                 self%ma(0:n), self%work(0:n), self%mdense(n, n), &
-                self%e_con(nc), self%lam(nc), self%mstar(nc), self%sa(nc), self%sb(nc), &
+                self%e_con(nc), self%lam(nc), self%mstar(nc), &
                 self%rigid(nc), self%pers(nc), self%active(nc), self%movable(nc), stat=stat)
       if (stat /= 0) call out_of_memory('the state of Newmark-Lagrange', REAL_BYTES*(6*(n + 1.0_dp) &
                                         + real(n, dp)**2 + 3*nc) + INT_BYTES*6.0_dp*nc, &
@@ -115,7 +115,7 @@ contains
          call mass_times(m, self%work, self%ma)
          self%mdense(:, i) = self%ma(1:n)
       end do
-      call rigid_contact_sides(m, self%rigid, self%e_con, self%sa, self%sb, self%movable)
+      call rigid_contacts(m, self%rigid, self%e_con, self%movable)
       ! the model's effective mass of each contact, 1/(B M⁻¹ Bᵀ) (martello_effective_mass),
       ! for the impact energy loss; 0 where neither side moves
       self%mstar = merge(m%con_mstar(1:nc), 0.0_dp, self%movable)
@@ -161,7 +161,7 @@ contains
          kkt(1:n, 1:n) = self%mdense
          rhs = 0.0_dp
          rhs(1:n) = self%fext(1:n) - self%fint(1:n)
-         call kkt_constraints(self, kkt, idx, na)
+         call kkt_constraints(self, m, kkt, idx, na)
          rhs(fixed_nodes) = 0.0_dp
          call solve_symmetric_indefinite(kkt, rhs, rc, st, msg)
          o%counters(C_FACTORIZATIONS) = o%counters(C_FACTORIZATIONS) + 1_i8
@@ -186,20 +186,20 @@ contains
 
    !> In a KKT matrix of order n + na: the rows and columns ±1 of the active contacts idx(1:na)
    !> (B and Bᵀ), and the identity on the fixed nodes.
-   subroutine kkt_constraints(self, kkt, idx, na)
+   subroutine kkt_constraints(self, m, kkt, idx, na)
       class(newmark_lagrange_t), intent(in) :: self
+      type(model_t), intent(in) :: m
       real(dp), intent(inout) :: kkt(:, :)
       integer, intent(in) :: idx(:), na
-      integer :: j, k, n, i
+      integer :: j, k, n, i, q
       n = self%n
       do j = 1, na
          k = idx(j)
-         if (self%sa(k) > 0) then
-            kkt(self%sa(k), n + j) = 1.0_dp; kkt(n + j, self%sa(k)) = 1.0_dp
-         end if
-         if (self%sb(k) > 0) then
-            kkt(self%sb(k), n + j) = -1.0_dp; kkt(n + j, self%sb(k)) = -1.0_dp
-         end if
+         ! the row's terms (on fixed nodes too: their rows and columns are reset below)
+         do q = row_lo(m%con, k), row_hi(m%con, k)
+            kkt(m%con%node(q), n + j) = kkt(m%con%node(q), n + j) + m%con%coef(q)
+            kkt(n + j, m%con%node(q)) = kkt(n + j, m%con%node(q)) + m%con%coef(q)
+         end do
       end do
       do j = 1, size(self%fixed_nodes)
          i = self%fixed_nodes(j)
@@ -255,10 +255,10 @@ contains
          impact = .false.; imp_c = 0; best_alpha = huge(1.0_dp)
          do c = 1, nc
             if (.not. movable(c) .or. pers(c)) cycle
-            if (u(m%con_a(c)) - u(m%con_b(c)) - m%con_gap(c) > closed_tol(c)) then
-               d0 = un(m%con_a(c)) - un(m%con_b(c)) - m%con_gap(c)
-               dd0 = vn(m%con_a(c)) - vn(m%con_b(c))
-               ddd0 = an(m%con_a(c)) - an(m%con_b(c))
+            if (row_dot(m%con, c, u) - m%con_gap(c) > closed_tol(c)) then
+               d0 = row_dot(m%con, c, un) - m%con_gap(c)
+               dd0 = row_dot(m%con, c, vn)
+               ddd0 = row_dot(m%con, c, an)
                tau = 0.0_dp
                if (d0 < 0.0_dp) tau = free_side_crossing(d0, dd0, ddd0, 0.0_dp, h)
                if (tau/h < best_alpha) then
@@ -271,9 +271,9 @@ contains
             o%counters(C_REJECTED) = o%counters(C_REJECTED) + 1_i8
             c = imp_c
             alpha_imp = best_alpha
-            d0 = un(m%con_a(c)) - un(m%con_b(c)) - m%con_gap(c)
-            dd0 = vn(m%con_a(c)) - vn(m%con_b(c))
-            ddd0 = an(m%con_a(c)) - an(m%con_b(c))
+            d0 = row_dot(m%con, c, un) - m%con_gap(c)
+            dd0 = row_dot(m%con, c, vn)
+            ddd0 = row_dot(m%con, c, an)
             v_imp = dd0 + alpha_imp*h*ddd0
             e_eff = e_con(c)
             ! Zeno: the next rebound flight under the pressing acceleration δ̈_n is shorter than
@@ -294,7 +294,7 @@ contains
             active = pers
             do ci = 1, nc
                if (movable(ci) .and. .not. pers(ci) .and. &
-                   u(m%con_a(ci)) - u(m%con_b(ci)) - m%con_gap(ci) > closed_tol(ci)) active(ci) = .true.
+                   row_dot(m%con, ci, u) - m%con_gap(ci) > closed_tol(ci)) active(ci) = .true.
             end do
             call newmark_solve(beta, gamma, converged)
             if (.not. converged) return
@@ -302,7 +302,7 @@ contains
             do ci = 1, nc      ! other contacts closed in the same step: held from now on
                if (ci /= c .and. active(ci) .and. .not. pers(ci)) pers(ci) = .true.
             end do
-            call observer_work(o, impact=0.5_dp*self%mstar(c)*(v_imp**2 - (v(m%con_a(c)) - v(m%con_b(c)))**2))
+            call observer_work(o, impact=0.5_dp*self%mstar(c)*(v_imp**2 - (row_dot(m%con, c, v))**2))
          end if
 
          call mech_commit(m, self%ms, u, wdl, wll, wcl)
@@ -320,8 +320,12 @@ contains
       !> of an impact step leaves δ_{n+1} = 0 only to a few ulps of the coordinates.
       real(dp) function closed_tol(cc)
          integer, intent(in) :: cc
-         closed_tol = 8.0_dp*epsilon(1.0_dp)*(abs(self%u(m%con_a(cc))) + abs(self%u(m%con_b(cc))) + &
-                                              abs(m%con_gap(cc)))
+         integer :: k
+         closed_tol = abs(m%con_gap(cc))
+         do k = row_lo(m%con, cc), row_hi(m%con, cc)
+            closed_tol = closed_tol + abs(m%con%coef(k)*self%u(m%con%node(k)))
+         end do
+         closed_tol = 8.0_dp*epsilon(1.0_dp)*closed_tol
       end function closed_tol
 
       !> Newton on the constrained Newmark step: unknowns u_{n+1} and the multipliers λ of
@@ -329,12 +333,12 @@ contains
       subroutine newmark_solve(bt, gm, ok)
          real(dp), intent(in) :: bt, gm
          logical, intent(out) :: ok
-         integer :: it, na, j, k, row, col, st, idx(nc)
+         integer :: it, na, j, k, q, row, col, st, idx(nc)
          real(dp), allocatable :: kkt(:, :), rhs(:)
          real(dp) :: rnorm, cnorm, fscale, uscale, rc
          associate (u => self%u, un => self%un, vn => self%vn, an => self%an, a => self%a, &
                     v => self%v, fint => self%fint, fext => self%fext, ma => self%ma, &
-                    lam => self%lam, sa => self%sa, sb => self%sb, kd => self%kd, &
+                    lam => self%lam, kd => self%kd, &
                     kband => self%kband, cband => self%cband, fixed_nodes => self%fixed_nodes)
             na = 0
             do j = 1, nc
@@ -367,9 +371,10 @@ contains
                rhs(1:n) = ma(1:n) + fint(1:n) - fext(1:n)
                do j = 1, na
                   k = idx(j)
-                  if (sa(k) > 0) rhs(sa(k)) = rhs(sa(k)) + lam(k)
-                  if (sb(k) > 0) rhs(sb(k)) = rhs(sb(k)) - lam(k)
-                  rhs(n + j) = u(m%con_a(k)) - u(m%con_b(k)) - m%con_gap(k)
+                  do q = row_lo(m%con, k), row_hi(m%con, k)
+                     rhs(m%con%node(q)) = rhs(m%con%node(q)) + m%con%coef(q)*lam(k)
+                  end do
+                  rhs(n + j) = row_dot(m%con, k, u) - m%con_gap(k)
                end do
                rhs(fixed_nodes) = 0.0_dp
                rnorm = maxval(abs(rhs(1:n)))
@@ -395,7 +400,7 @@ contains
                                      gm/(bt*h)*cband%ab(2*kd + 1 + row - col, col)
                   end do
                end do
-               call kkt_constraints(self, kkt, idx, na)
+               call kkt_constraints(self, m, kkt, idx, na)
                rhs = -rhs
                call solve_symmetric_indefinite(kkt, rhs, rc, st, msg)
                o%counters(C_FACTORIZATIONS) = o%counters(C_FACTORIZATIONS) + 1_i8
@@ -431,15 +436,15 @@ contains
                     force => self%force)
             if (impact) then
                k = imp_c
-               if (o%ph_open(k)) call observer_close_phase(o, k, t_prev, vn(m%con_a(k)) - vn(m%con_b(k)))
+               if (o%ph_open(k)) call observer_close_phase(o, k, t_prev, row_dot(m%con, k, vn))
                call observer_open_phase(o, k, t_prev + alpha_imp*h, v_imp)
                o%counters(C_EVENTS) = o%counters(C_EVENTS) + 1_i8
                if (.not. pers(k)) call observer_close_phase(o, k, t_prev + alpha_imp*h, &
-                                                            v(m%con_a(k)) - v(m%con_b(k)), pen(k), force(k))
+                                                            row_dot(m%con, k, v), pen(k), force(k))
             end if
             do k = 1, nc
                if (o%ph_open(k) .and. .not. pers(k)) &
-                  call observer_close_phase(o, k, t_prev, vn(m%con_a(k)) - vn(m%con_b(k)), pen(k), force(k))
+                  call observer_close_phase(o, k, t_prev, row_dot(m%con, k, vn), pen(k), force(k))
             end do
          end associate
       end subroutine phases

@@ -11,6 +11,7 @@ module martello_stability
    use martello_links, only: LINK_SPRING, LINK_BAR, LINK_BILINEAR, L_STIFF
    use martello_contact_laws, only: LAW_LINEAR, LAW_KELVIN, P_STIFF
    use martello_status, only: MARTELLO_OK, out_of_memory, REAL_BYTES, INT_BYTES, FIX_SMALLER_SCENE
+   use martello_element_rows, only: rows_t, row_lo, row_hi
    implicit none
    private
    public :: omega_max, free_dofs, mass_band
@@ -48,13 +49,13 @@ contains
       do j = 1, m%nlink
          select case (m%link_kind(j))
          case (LINK_SPRING, LINK_BAR, LINK_BILINEAR)
-            call pair(dof(m%link_a(j)), dof(m%link_b(j)), m%link_par(L_STIFF, j))
+            call row(m%lnk, j, m%link_par(L_STIFF, j))
          end select
       end do
       do j = 1, m%ncontact
          if (m%con_scheme(j) /= SCHEME_PENALTY) cycle
          if (m%con_law(j) /= LAW_LINEAR .and. m%con_law(j) /= LAW_KELVIN) cycle
-         call pair(dof(m%con_a(j)), dof(m%con_b(j)), m%con_par(P_STIFF, j))
+         call row(m%con, j, m%con_par(P_STIFF, j))
       end do
       do j = 1, m%nblock
          call block(m%block(j)%node, m%block(j)%k)
@@ -64,15 +65,21 @@ contains
       if (info == 0 .and. nfound >= 1) w_max = sqrt(max(w(1), 0.0_dp))
 
    contains
-      subroutine pair(ia, ib, k)
-         integer, intent(in) :: ia, ib
+      !> ka += k gᵀg over a row's free DOFs (upper band, LAPACK's 'U' layout).
+      subroutine row(rows, j, k)
+         type(rows_t), intent(in) :: rows
+         integer, intent(in) :: j
          real(dp), intent(in) :: k
-         if (ia > 0) ka(kd + 1, ia) = ka(kd + 1, ia) + k
-         if (ib > 0) ka(kd + 1, ib) = ka(kd + 1, ib) + k
-         if (ia > 0 .and. ib > 0) &
-            ka(kd + 1 + min(ia, ib) - max(ia, ib), max(ia, ib)) = &
-            ka(kd + 1 + min(ia, ib) - max(ia, ib), max(ia, ib)) - k
-      end subroutine pair
+         integer :: p, q, ip, iq
+         do p = row_lo(rows, j), row_hi(rows, j)
+            ip = dof(rows%node(p))
+            do q = row_lo(rows, j), row_hi(rows, j)
+               iq = dof(rows%node(q))
+               if (ip > 0 .and. iq > 0 .and. ip <= iq) ka(kd + 1 + ip - iq, iq) = &
+                  ka(kd + 1 + ip - iq, iq) + k*rows%coef(p)*rows%coef(q)
+            end do
+         end do
+      end subroutine row
       !> a stiffness block's upper triangle on the free DOFs (fixed nodes drop out)
       subroutine block(nd, kb)
          integer, intent(in) :: nd(:)

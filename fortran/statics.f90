@@ -15,6 +15,7 @@ module martello_statics
    use martello_contact_laws, only: LAW_LINEAR, P_STIFF
    use martello_links, only: LINK_SPRING, LINK_BAR, LINK_DASHPOT, LINK_FLUID_DAMPER, L_STIFF
    use martello_linalg, only: solve_spd, solve_symmetric_indefinite
+   use martello_element_rows, only: rows_t, row_lo, row_hi
    use martello_time_functions, only: tf_value
    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
    implicit none
@@ -103,7 +104,7 @@ contains
       do j = 1, m%nlink
          if (m%link_kind(j) /= LINK_SPRING .and. m%link_kind(j) /= LINK_BAR) cycle
          kk = m%link_par(L_STIFF, j)
-         call add_pair(kfree, fext, dof, r%u, m%link_a(j), m%link_b(j), kk)
+         call add_row(kfree, fext, dof, r%u, m%lnk, j, kk)
       end do
       do j = 1, m%nblock
          call add_block(kfree, fext, dof, r%u, m%block(j)%node, m%block(j)%k)
@@ -179,20 +180,27 @@ contains
       end subroutine no_memory
 
       !> K(a,a) += s, K(b,b) += s, K(a,b) −= s for free ends; known displacements to the rhs.
-      subroutine add_pair(kmat, f, dof, u, a, b, s)
+      !> k += s gᵀg over a row's free DOFs; a term on a fixed node moves its known part to f
+      !> (u fixed there).
+      subroutine add_row(kmat, f, dof, u, rows, j, s)
          real(dp), intent(inout) :: kmat(:, :), f(:)
-         integer, intent(in) :: dof(0:), a, b
+         integer, intent(in) :: dof(0:), j
          real(dp), intent(in) :: u(:), s
-         integer :: ia, ib
-         ia = dof(a); ib = dof(b)
-         if (ia > 0) kmat(ia, ia) = kmat(ia, ia) + s
-         if (ib > 0) kmat(ib, ib) = kmat(ib, ib) + s
-         if (ia > 0 .and. ib > 0) then
-            kmat(ia, ib) = kmat(ia, ib) - s; kmat(ib, ia) = kmat(ib, ia) - s
-         end if
-         if (ia > 0 .and. b > 0 .and. ib == 0) f(ia) = f(ia) + s*u(b)
-         if (ib > 0 .and. a > 0 .and. ia == 0) f(ib) = f(ib) + s*u(a)
-      end subroutine add_pair
+         type(rows_t), intent(in) :: rows
+         integer :: p, q, ip, iq
+         do p = row_lo(rows, j), row_hi(rows, j)
+            ip = dof(rows%node(p))
+            if (ip == 0) cycle
+            do q = row_lo(rows, j), row_hi(rows, j)
+               iq = dof(rows%node(q))
+               if (iq > 0) then
+                  kmat(ip, iq) = kmat(ip, iq) + s*rows%coef(p)*rows%coef(q)
+               else
+                  f(ip) = f(ip) - s*rows%coef(p)*rows%coef(q)*u(rows%node(q))
+               end if
+            end do
+         end do
+      end subroutine add_row
 
       !> A stiffness block on the free DOFs; a fixed node's prescribed u moves to the rhs.
       subroutine add_block(kmat, f, dof, u, nd, kb)
@@ -214,18 +222,19 @@ contains
          end do
       end subroutine add_block
 
-      !> Every active contact adds a row: Bᵀu − c_j P_j = rhs_j, with B = +1 at a, −1 at b and
+      !> Every active contact adds a row: Bᵀu − c_j P_j = rhs_j, with B the contact's row (+1 at
+      !> a, −1 at b for a pair) and
       !>  lagrange: c = 0, rhs = d;  penalty: c = 1/ε, rhs = d  (the perturbed-Lagrangian form
       !>  of the penalty method: eliminating P gives K + εBBᵀ, but the condition stays bounded
       !>  as ε → ∞, so P and δ = P/ε keep their digits);  augmented: c = 1/ε, rhs = d − P_k/ε.
       !> Rows and P are scaled by kscale (unknown P/kscale) so the matrix is equilibrated.
       subroutine assemble_and_solve(st)
          integer, intent(out) :: st
-         integer :: dim, row, ia, ib, i, j, a, b
+         integer :: dim, row, i, j, k, ik
          real(dp) :: dknown
          nlag = 0; lag_row = 0
          do j = 1, nc
-            if (act(j) .and. (dof(m%con_a(j)) > 0 .or. dof(m%con_b(j)) > 0)) then
+            if (act(j) .and. any(dof(m%con%node(row_lo(m%con, j):row_hi(m%con, j))) > 0)) then
                nlag = nlag + 1; lag_row(j) = nf + nlag
             end if
          end do
@@ -242,18 +251,17 @@ contains
          do j = 1, nc
             row = lag_row(j)
             if (row == 0) cycle
-            a = m%con_a(j); b = m%con_b(j)
-            ia = dof(a); ib = dof(b)
-            ! gap minus the part of u_a − u_b that is known (fixed or ground ends)
+            ! gap minus the part of the row's Σ coef·u that is known (fixed ends)
             dknown = m%con_gap(j)
-            if (a > 0 .and. ia == 0) dknown = dknown - r%u(a)
-            if (b > 0 .and. ib == 0) dknown = dknown + r%u(b)
-            if (ia > 0) then
-               sys(ia, row) = kscale; sys(row, ia) = kscale
-            end if
-            if (ib > 0) then
-               sys(ib, row) = -kscale; sys(row, ib) = -kscale
-            end if
+            do k = row_lo(m%con, j), row_hi(m%con, j)
+               ik = dof(m%con%node(k))
+               if (ik == 0) then
+                  dknown = dknown - m%con%coef(k)*r%u(m%con%node(k))
+               else
+                  sys(ik, row) = sys(ik, row) + kscale*m%con%coef(k)
+                  sys(row, ik) = sys(row, ik) + kscale*m%con%coef(k)
+               end if
+            end do
             rhs(row) = kscale*dknown
             if (.not. is_lagrange(j)) then
                sys(row, row) = -kscale**2/m%con_par(P_STIFF, j)
@@ -288,11 +296,11 @@ contains
 
       real(dp) function penetration(j)
          integer, intent(in) :: j
-         real(dp) :: ua, ub
-         ua = 0.0_dp; ub = 0.0_dp
-         if (m%con_a(j) > 0) ua = r%u(m%con_a(j))
-         if (m%con_b(j) > 0) ub = r%u(m%con_b(j))
-         penetration = (ua - ub) - m%con_gap(j)
+         integer :: k
+         penetration = -m%con_gap(j)
+         do k = row_lo(m%con, j), row_hi(m%con, j)
+            penetration = penetration + m%con%coef(k)*r%u(m%con%node(k))
+         end do
       end function penetration
 
       logical function is_lagrange(j)
@@ -302,9 +310,11 @@ contains
 
       real(dp) function length_scale(j)
          integer, intent(in) :: j
+         integer :: k
          length_scale = abs(m%con_gap(j))
-         if (m%con_a(j) > 0) length_scale = length_scale + abs(r%u(m%con_a(j)))
-         if (m%con_b(j) > 0) length_scale = length_scale + abs(r%u(m%con_b(j)))
+         do k = row_lo(m%con, j), row_hi(m%con, j)
+            length_scale = length_scale + abs(m%con%coef(k)*r%u(m%con%node(k)))
+         end do
       end function length_scale
 
       subroutine update_active_set(chg)
@@ -336,7 +346,7 @@ contains
       subroutine assess_digits()
          real(dp) :: lost, ratio, kd, pen_rc
          real(dp), allocatable :: dummy(:), kpen(:, :)
-         integer :: k, st, ia, ib
+         integer :: k, st, q
          allocate (dummy(max(nf, 1)), kpen(nf, nf), stat=st)
          if (st /= 0) then
             call no_memory('the penalised stiffness of the static solve'//of_size(nf, 0), &
@@ -349,18 +359,13 @@ contains
          kpen = kfree
          do k = 1, nc
             if (.not. act(k) .or. m%con_scheme(k) /= SCHEME_PENALTY) cycle
-            ia = dof(m%con_a(k)); ib = dof(m%con_b(k))
             kd = 0.0_dp
-            if (ia > 0) kd = max(kd, kfree(ia, ia))
-            if (ib > 0) kd = max(kd, kfree(ib, ib))
+            do q = row_lo(m%con, k), row_hi(m%con, k)
+               if (dof(m%con%node(q)) > 0) kd = max(kd, kfree(dof(m%con%node(q)), dof(m%con%node(q))))
+            end do
             ratio = m%con_par(P_STIFF, k)/max(kd, tiny(1.0_dp))
             r%penalty_ratio = max(r%penalty_ratio, ratio)
-            if (ia > 0) kpen(ia, ia) = kpen(ia, ia) + m%con_par(P_STIFF, k)
-            if (ib > 0) kpen(ib, ib) = kpen(ib, ib) + m%con_par(P_STIFF, k)
-            if (ia > 0 .and. ib > 0) then
-               kpen(ia, ib) = kpen(ia, ib) - m%con_par(P_STIFF, k)
-               kpen(ib, ia) = kpen(ib, ia) - m%con_par(P_STIFF, k)
-            end if
+            call add_row(kpen, dummy, dof, r%u, m%con, k, m%con_par(P_STIFF, k))
          end do
          r%penalised_rcond = 1.0_dp
          if (r%penalty_ratio > 0.0_dp .and. nf > 0) then

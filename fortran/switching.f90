@@ -13,6 +13,7 @@
 module martello_switching
    use martello_kinds, only: dp
    use martello_model, only: model_t
+   use martello_element_rows, only: row_dot
    use martello_assembly, only: mech_state_t, CONTACT_FREE, CONTACT_OPEN, CONTACT_ON, CONTACT_CUT
    use martello_links, only: LINK_BILINEAR, LINK_FLUID_DAMPER, L_STIFF, L_DAMP, L_YIELD, &
       L_HARDENING, L_ALPHA, L_VREG, BRANCH_FREE, BRANCH_ELASTIC, BRANCH_UPPER, BRANCH_LOWER, &
@@ -37,22 +38,21 @@ contains
    !> k |dv| event_tol) is put back on the band's edge. smooth: the laws whose force is
    !> continuous at their switches (force_continuous contacts, bilinear links) are not held:
    !> they stay the whole law, whose kinks the integrator's error control takes
-   !> (docs/sundials-ode.md, events at size).
+   !> (docs/sundials-ode.md, events inside the steps).
    subroutine switching_choose(m, s, u, v, smooth)
       type(model_t), intent(in) :: m
       type(mech_state_t), intent(inout) :: s
       real(dp), intent(in) :: u(0:), v(0:)
       logical, intent(in), optional :: smooth
       logical :: free_continuous
-      integer :: j, a, b
+      integer :: j
       real(dp) :: du, dv, k, rho, r, back, fp, pen, g(2)
-      integer :: na(2), nb(2)
+      integer :: el(2)
       real(dp) :: al(2), be(2), ga(2)
       free_continuous = .false.
       if (present(smooth)) free_continuous = smooth
       do j = 1, m%nlink
-         a = m%link_a(j); b = m%link_b(j)
-         du = u(a) - u(b); dv = v(a) - v(b)
+         du = row_dot(m%lnk, j, u); dv = row_dot(m%lnk, j, v)
          select case (m%link_kind(j))
          case (LINK_BILINEAR)
             if (free_continuous) then             ! its force is continuous at yield
@@ -69,7 +69,7 @@ contains
                if (fp >= r .and. dv > 0.0_dp) s%link_branch(j) = BRANCH_UPPER
                if (fp <= -r .and. dv < 0.0_dp) s%link_branch(j) = BRANCH_LOWER
             else
-               call link_switch(m, s, j, na, nb, al, be, ga)
+               call link_switch(m, s, j, el, al, be, ga)
                g = al*du + be*dv + ga
                select case (s%link_branch(j))
                case (BRANCH_ELASTIC)
@@ -101,9 +101,8 @@ contains
             s%con_branch(j) = CONTACT_FREE
             cycle
          end if
-         a = m%con_a(j); b = m%con_b(j)
-         pen = u(a) - u(b) - m%con_gap(j)
-         dv = v(a) - v(b)
+         pen = row_dot(m%con, j, u) - m%con_gap(j)
+         dv = row_dot(m%con, j, v)
          if (.not. (pen > 0.0_dp)) then
             s%con_branch(j) = CONTACT_OPEN
          else if (kelvin_clipped(m, j)) then
@@ -118,18 +117,19 @@ contains
       end do
    end subroutine switching_choose
 
-   !> The switches of the branches held: slots 2j-1, 2j of link j, 2 nlink + j of contact j;
-   !> nodes 0-based for the C door (-1: the ground); an unused slot has alpha = beta = 0,
-   !> gamma = -1 (never crossed).
-   subroutine switching_functions(m, s, na, nb, alpha, beta, gamma)
+   !> The switches of the branches held: slots 2j-1, 2j of link j, 2 nlink + j of contact j.
+   !> A switch is g = alpha d + beta d' + gamma on the deformation d of its element el (0-based
+   !> for the C door: link j is el = j − 1, contact j el = nlink + j − 1, martello_element_rows;
+   !> −1 none); an unused slot has alpha = beta = 0, gamma = -1 (never crossed).
+   subroutine switching_functions(m, s, el, alpha, beta, gamma)
       type(model_t), intent(in) :: m
       type(mech_state_t), intent(in) :: s
-      integer, intent(out) :: na(:), nb(:)
+      integer, intent(out) :: el(:)
       real(dp), intent(out) :: alpha(:), beta(:), gamma(:)
       integer :: j, i
-      na = -1; nb = -1; alpha = 0.0_dp; beta = 0.0_dp; gamma = -1.0_dp
+      el = -1; alpha = 0.0_dp; beta = 0.0_dp; gamma = -1.0_dp
       do j = 1, m%nlink
-         call link_switch(m, s, j, na(2*j - 1:2*j), nb(2*j - 1:2*j), alpha(2*j - 1:2*j), &
+         call link_switch(m, s, j, el(2*j - 1:2*j), alpha(2*j - 1:2*j), &
                           beta(2*j - 1:2*j), gamma(2*j - 1:2*j))
       end do
       do j = 1, m%ncontact
@@ -137,7 +137,7 @@ contains
          if (.not. (s%is_penalty(j) .and. kelvin_clipped(m, j))) cycle
          if (s%con_branch(j) /= CONTACT_ON .and. s%con_branch(j) /= CONTACT_CUT) cycle
          ! the Kelvin force k delta + c delta' over k: its sign change is the cut-off
-         na(i) = m%con_a(j) - 1; nb(i) = m%con_b(j) - 1
+         el(i) = m%nlink + j - 1
          alpha(i) = 1.0_dp
          beta(i) = m%con_par(P_DAMPING, j)/m%con_par(P_STIFF, j)
          gamma(i) = -m%con_gap(j)
@@ -148,14 +148,14 @@ contains
    end subroutine switching_functions
 
    !> The two switch slots of link j on its branch (scaled to metres or metres per second).
-   pure subroutine link_switch(m, s, j, na, nb, alpha, beta, gamma)
+   pure subroutine link_switch(m, s, j, el, alpha, beta, gamma)
       type(model_t), intent(in) :: m
       type(mech_state_t), intent(in) :: s
       integer, intent(in) :: j
-      integer, intent(out) :: na(2), nb(2)
+      integer, intent(out) :: el(2)
       real(dp), intent(out) :: alpha(2), beta(2), gamma(2)
       real(dp) :: k, rho, r, c0, vreg
-      na = m%link_a(j) - 1; nb = m%link_b(j) - 1
+      el = j - 1
       alpha = 0.0_dp; beta = 0.0_dp; gamma = -1.0_dp
       select case (s%link_branch(j))
       case (BRANCH_ELASTIC)

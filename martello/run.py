@@ -17,6 +17,7 @@ from .paths import folder_replaced
 from .results import (ARRAYS_FILE, PHASE_FIELDS, ItemArrays, is_large)
 from .scene.chain import ChainContacts, ChainLinks
 from .scene.items import ItemTable, Listed, Names
+from .scene.rows import element_terms
 from .scene.spec import DEFAULT_METHODS
 
 # The names a link's type, a contact's scheme and law take (the library's tables); results
@@ -54,8 +55,8 @@ def link_arrays(links):
             par[idx, constant(slot)] = _column(links, idx, key)
         if name == "bar":
             par[idx, constant("L_STIFF")] = _column(links, idx, "EA") / _column(links, idx, "L")
-    a = np.fromiter((lk["a"] for lk in links), np.int32, n)
-    b = np.fromiter((lk["b"] for lk in links), np.int32, n)
+    a = np.fromiter((-1 if lk["a"] is None else lk["a"] for lk in links), np.int32, n)
+    b = np.fromiter((-1 if lk["b"] is None else lk["b"] for lk in links), np.int32, n)
     return kind, a, b, par
 
 
@@ -91,8 +92,8 @@ def contact_arrays(contacts):
             par[idx, constant("P_STIFF")] = _column(contacts, idx, "stiffness")
         else:
             par[idx, constant("P_RESTITUTION")] = _optional(contacts, idx, "restitution", -1.0)
-    a = np.fromiter((c["a"] for c in contacts), np.int32, n)
-    b = np.fromiter((c["b"] for c in contacts), np.int32, n)
+    a = np.fromiter((-1 if c["a"] is None else c["a"] for c in contacts), np.int32, n)
+    b = np.fromiter((-1 if c["b"] is None else c["b"] for c in contacts), np.int32, n)
     gap = np.fromiter((c["gap"] for c in contacts), np.float64, n)
     return a, b, gap, scheme, law, par
 
@@ -127,13 +128,40 @@ def segments(table):
 CHUNK = 1 << 16
 
 
+def _runs(items):
+    """A listed segment as runs of node pairs (a list) and single rows (a dict with
+    "terms": an element between plan points, martello.scene.rows), in order."""
+    run = []
+    for it in items:
+        if it.get("terms") is None:
+            run.append(it)
+            continue
+        if run:
+            yield run
+            run = []
+        yield it
+    if run:
+        yield run
+
+
+def _row(item):
+    """An element's row for the native door: 0-based nodes and their coefficients."""
+    nodes, coefs = zip(*element_terms(item))
+    return np.array(nodes, np.int32), np.array(coefs, np.float64)
+
+
 def link_chunks(segs):
     """(kind, a, b, par) arrays of links (segments of the scene's link table), in order, a
-    chunk at a time: a listed segment's from its dicts, a generated one's as it gives them."""
+    chunk at a time: a listed segment's from its dicts (a link between plan points as
+    ("row", kind, nodes, coefs, par)), a generated one's as it gives them."""
     for seg in segs:
         if isinstance(seg, list):
-            if seg:
-                yield link_arrays(seg)
+            for run in _runs(seg):
+                if isinstance(run, dict):
+                    kind, _, _, par = link_arrays([run])
+                    yield ("row", kind[0], *_row(run), par[0])
+                else:
+                    yield link_arrays(run)
         else:
             yield from seg.chunks(CHUNK)
 
@@ -144,8 +172,12 @@ def contact_chunks(segs):
     parameters, its template's."""
     for seg in segs:
         if isinstance(seg, list):
-            if seg:
-                yield contact_arrays(seg)
+            for run in _runs(seg):
+                if isinstance(run, dict):
+                    _, _, gap, scheme, law, par = contact_arrays([run])
+                    yield ("row", *_row(run), gap[0], scheme[0], law[0], par[0])
+                else:
+                    yield contact_arrays(run)
             continue
         _, _, _, scheme, law, row = contact_arrays([seg.template])
         for a, b, gap in seg.chunks(CHUNK):
@@ -205,9 +237,9 @@ def build_model(scene, chain_door=True):
     m.set_nodes(*node_arrays(scene.nodes))
     if not door:
         for chunk in link_chunks(link_segs):
-            m.add_links(*chunk)
+            _add(m.add_links, m.add_link_row, chunk)
     for chunk in contact_chunks(contact_segs):
-        m.add_contacts(*chunk)
+        _add(m.add_contacts, m.add_contact_row, chunk)
     # the link segments in order: a chain's at its call (after every listed contact, which
     # the scene numbers before the chains' contacts)
     for seg in link_segs if door else ():
@@ -215,7 +247,7 @@ def build_model(scene, chain_door=True):
             add_chain(m, seg.block)
         else:
             for chunk in link_chunks([seg]):
-                m.add_links(*chunk)
+                _add(m.add_links, m.add_link_row, chunk)
     for seg in segments(scene.couplings):
         if isinstance(seg, list):
             for mc in seg:
@@ -233,6 +265,15 @@ def build_model(scene, chain_door=True):
     if scene.ground is not None:
         m.set_ground_acceleration(*_function_args(scene.ground, scene.source))
     return m
+
+
+def _add(bulk, row, chunk):
+    """A chunk of link_chunks or contact_chunks to the model: pairs by the bulk door, an
+    element between plan points by its row door."""
+    if isinstance(chunk[0], str):
+        row(*chunk[1:])
+    else:
+        bulk(*chunk)
 
 
 def add_chain(model, b):

@@ -64,10 +64,18 @@ def build_by_element(scene):
     for i, n in enumerate(scene.nodes):
         m.set_node(i, n["mass"], n["u0"], n["v0"], n["fixed"])
     for lk in scene.links:
-        m.add_link(native.value("links", lk["type"]), lk["a"], lk["b"], _link_par(lk))
+        if lk.get("terms"):                 # a row over several DOFs (docs/buildings.md)
+            nodes, coefs = zip(*lk["terms"])
+            m.add_link_row(native.value("links", lk["type"]), nodes, coefs, _link_par(lk))
+        else:
+            m.add_link(native.value("links", lk["type"]), lk["a"], lk["b"], _link_par(lk))
     for c in scene.contacts:
         law, par = _contact_par(c)
-        m.add_contact(c["a"], c["b"], c["gap"], native.value("schemes", c["scheme"]), law, par)
+        if c.get("terms"):
+            nodes, coefs = zip(*c["terms"])
+            m.add_contact_row(nodes, coefs, c["gap"], native.value("schemes", c["scheme"]), law, par)
+        else:
+            m.add_contact(c["a"], c["b"], c["gap"], native.value("schemes", c["scheme"]), law, par)
     for mc in scene.couplings:
         m.add_mass_coupling(mc["a"], mc["b"], mc["value"])
     for b in scene.blocks:

@@ -28,7 +28,7 @@ def door():
     """The impulse door of c/martello_internal.h (not part of the public API)."""
     L = ctypes.CDLL(str(library_path()))
     ci, cd = ctypes.c_int, ctypes.c_double
-    topology = [ci, ci, _I, _I, _I, _I, _D]              # n, m, list, a, b, col, cols
+    topology = [ci, ci, _I, ctypes.POINTER(Rows), _I, _D]   # n, m, list, rows, col, cols
     L.martello_impulse_newton.argtypes = topology + [_D, _D, _D, ctypes.POINTER(ci)]
     L.martello_impulse_contact_forces.argtypes = topology + [_D, _D, _I, ctypes.POINTER(ci)]
     L.martello_impulse_delassus.argtypes = topology + [_D]
@@ -39,11 +39,29 @@ def door():
     return L
 
 
+class Rows(ctypes.Structure):
+    """martello_rows of c/martello_internal.h: contact j's penetration row G_j (terms
+    first[j] .. first[j+1]-1 of node and coef)."""
+    _fields_ = [("first", ctypes.POINTER(ctypes.c_int)), ("node", ctypes.POINTER(ctypes.c_int)),
+                ("coef", ctypes.POINTER(ctypes.c_double))]
+
+
 def _lists(a, b):
-    """The door's topology of contacts (a[j], b[j]) with column j: list, a, b, col."""
+    """The door's topology of node-pair contacts (a[j], b[j]) (−1: the ground), column j:
+    list, rows (G_j = e_a − e_b), col."""
     a, b = np.asarray(a, dtype=np.int32), np.asarray(b, dtype=np.int32)
     idx = np.arange(len(a), dtype=np.int32)
-    return idx, a, b, idx
+    first, node, coef = [0], [], []
+    for i, j in zip(a, b):
+        for n_, c in ((i, 1.0), (j, -1.0)):
+            if n_ >= 0:
+                node.append(n_); coef.append(c)
+        first.append(len(node))
+    arrays = (np.array(first, np.int32), np.array(node or [0], np.int32), np.array(coef or [0.0]))
+    rows = Rows(*(x.ctypes.data_as(ctypes.POINTER(t)) for x, t in
+                  zip(arrays, (ctypes.c_int, ctypes.c_int, ctypes.c_double))))
+    rows._keep = arrays                   # the arrays live as long as the struct
+    return idx, ctypes.byref(rows), idx, rows
 
 
 def lumped_columns(mass, a, b):
@@ -59,12 +77,12 @@ def lumped_columns(mass, a, b):
 
 def newton(door, mass, a, b, e, v):
     """Newton's law on all contacts at once: (status, impulses, v⁺)."""
-    lst, a, b, col = _lists(a, b)
+    lst, rows, col, _keep = _lists(a, b)
     cols = lumped_columns(mass, a, b)
     v = np.array(v, dtype=float, order="F")
     p = np.zeros(len(a), order="F")
     its = ctypes.c_int()
-    st = door.martello_impulse_newton(len(mass), len(a), lst, a, b, col, cols,
+    st = door.martello_impulse_newton(len(mass), len(a), lst, rows, col, cols,
                                       np.asfortranarray(e, dtype=float), v, p, ctypes.byref(its))
     return st, p, v
 
@@ -74,11 +92,11 @@ def contact_forces_of(door, W, q, held=False):
     the ground, so B = −I and the columns −W give W_kl = B_k C_l; the accelerations −q give
     B acc = q. With held: also the persistent-contact rule's flags."""
     m = len(q)
-    lst, a, b, col = _lists(np.arange(m), -np.ones(m))
+    lst, rows, col, _keep = _lists(np.arange(m), -np.ones(m))
     z = np.zeros(m, order="F")
     keep = np.zeros(m, dtype=np.int32)
     its = ctypes.c_int()
-    st = door.martello_impulse_contact_forces(m, m, lst, a, b, col, np.asfortranarray(-W),
+    st = door.martello_impulse_contact_forces(m, m, lst, rows, col, np.asfortranarray(-W),
                                               np.asfortranarray(-q), z, keep, ctypes.byref(its))
     return (st, z, keep) if held else (st, z)
 
@@ -199,13 +217,14 @@ def test_contact_forces_release_the_tensile_contact(door):
 def test_delassus_matrix_of_a_chain(door):
     # three masses, contacts (0, 1), (1, 2), (2, ground): W = B M⁻¹ Bᵀ written out
     mass = np.array([1.0, 2.0, 4.0])
-    lst, a, b, col = _lists([0, 1, 2], [1, 2, -1])
+    a, b = [0, 1, 2], [1, 2, -1]
+    lst, rows, col, _keep = _lists(a, b)
     W = np.zeros((3, 3), order="F")
-    assert door.martello_impulse_delassus(3, 3, lst, a, b, col, lumped_columns(mass, a, b), W) == OK
+    assert door.martello_impulse_delassus(3, 3, lst, rows, col, lumped_columns(mass, a, b), W) == OK
     # a sub-problem: contacts 2 and 0 of the topology, in that order
     sub = np.zeros((2, 2), order="F")
     lst2 = np.array([2, 0], dtype=np.int32)
-    assert door.martello_impulse_delassus(3, 2, lst2, a, b, col, lumped_columns(mass, a, b), sub) == OK
+    assert door.martello_impulse_delassus(3, 2, lst2, rows, col, lumped_columns(mass, a, b), sub) == OK
     np.testing.assert_array_equal(sub, W[np.ix_([2, 0], [2, 0])])
     ref = np.array([[1 + 1 / 2, -1 / 2, 0.0], [-1 / 2, 1 / 2 + 1 / 4, -1 / 4], [0.0, -1 / 4, 1 / 4]])
     np.testing.assert_array_equal(W, ref)

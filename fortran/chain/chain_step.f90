@@ -27,6 +27,7 @@ module martello_chain_step
    use martello_model, only: model_t, model_bandwidth, SCHEME_PENALTY, model_link_index, &
       model_initial_state, model_contact_index, model_contact_at, model_expanded, &
       model_has_influence
+   use martello_element_rows, only: row_a, row_b, row_is_pair
    use martello_links, only: LINK_SPRING, LINK_BAR, LINK_DASHPOT, LINK_BILINEAR, L_STIFF, L_DAMP, &
       L_YIELD, L_HARDENING, bilinear_return_map, bilinear_energy
    use martello_contact_laws, only: LAW_LINEAR, LAW_KELVIN, P_STIFF, P_DAMPING, P_CLIP, &
@@ -168,8 +169,10 @@ contains
          case default
             ok = .false.
          end select
+         if (.not. row_is_pair(m%lnk, j)) ok = .false.   ! the sweep takes node pairs
       end do
       do j = 1, m%ncontact
+         if (.not. row_is_pair(m%con, j)) ok = .false.
          if (m%con_scheme(j) /= SCHEME_PENALTY) ok = .false.
          if (m%con_law(j) /= LAW_LINEAR .and. m%con_law(j) /= LAW_KELVIN) ok = .false.
       end do
@@ -238,7 +241,7 @@ contains
          ! the bilinear springs start elastic, on k·Δu₀ (clamped into the band by the first
          ! step), as mech_init
          do i = 1, size(self%blk%bl)
-            self%bdu(i) = x(self%ou + m%link_a(self%blk%bl(i))) - x(self%ou + m%link_b(self%blk%bl(i)))
+            self%bdu(i) = x(self%ou + row_a(m%lnk, self%blk%bl(i))) - x(self%ou + row_b(m%lnk, self%blk%bl(i)))
             self%bfc(i) = m%link_par(L_STIFF, self%blk%bl(i))*self%bdu(i)
          end do
          x(self%orp + 1:self%orp + n) = 0.0_dp; x(self%ofe:self%ofe + n) = 0.0_dp
@@ -662,8 +665,8 @@ contains
       do idx = 1, size(self%blk%xg)
          j = self%blk%xg(idx)
          if (self%xbrc(idx) /= BRANCH_OFF) call observer_open_phase(o, self%blk%xc(idx), 0.0_dp, &
-                                                               self%store(self%ov + m%con_a(j)) - &
-                                                               self%store(self%ov + m%con_b(j)))
+                                                               self%store(self%ov + row_a(m%con, j)) - &
+                                                               self%store(self%ov + row_b(m%con, j)))
       end do
       call observer_begin(o, m, self%ms, self%store(self%ou:self%ou + self%n), &
                           self%store(self%ov:self%ov + self%n), self%store(self%oa:self%oa + self%n), &
@@ -735,7 +738,7 @@ contains
          end associate
          do idx = 1, size(self%blk%xg)
             j = self%blk%xg(idx)
-            pen = u(m%con_a(j)) - u(m%con_b(j)) - m%con_gap(j)
+            pen = u(row_a(m%con, j)) - u(row_b(m%con, j)) - m%con_gap(j)
             e(3) = e(3) + contact_elastic_energy(m%con_law(j), m%con_par(:, j), max(pen, 0.0_dp))
          end do
       end subroutine of_state

@@ -193,7 +193,8 @@ contains
             if (ch%link0 < j) g = g - ch%nlink
          end associate
       end do
-      kind = m%link_kind(g); a = m%link_a(g); b = m%link_b(g); par = m%link_par(:, g)
+      kind = m%link_kind(g); par = m%link_par(:, g)
+      call row_pair(m%lnk, g, a, b)             ! one added one by one: a node pair's row
    end subroutine model_link_at
 
    !> Contact number j of all the model's contacts (one by one or in a chain): nodes, gap,
@@ -217,7 +218,8 @@ contains
             if (ch%contact0 < j) g = g - ch%ncontact
          end associate
       end do
-      a = m%con_a(g); b = m%con_b(g); gap = m%con_gap(g); scheme = m%con_scheme(g)
+      call row_pair(m%con, g, a, b)             ! one added one by one: a node pair's row
+      gap = m%con_gap(g); scheme = m%con_scheme(g)
       law = m%con_law(g); par = m%con_par(:, g)
    end subroutine model_contact_at
 
@@ -231,22 +233,26 @@ contains
       integer, intent(out) :: stat
       character(len=*), intent(inout) :: message
       integer :: nl, nc, free_l, free_c, q, i, g, pos
-      integer, allocatable :: lk(:), la(:), lb(:), ca(:), cb(:), cs(:), cl(:)
+      integer, allocatable :: lk(:), cs(:), cl(:)
       real(dp), allocatable :: lpar(:, :), cg(:), cpar(:, :), cm(:)
+      type(rows_t) :: lr, cr
       character(len=96) :: what
       stat = MARTELLO_OK
       if (m%nchain == 0) return
       nl = model_nlinks(m); nc = model_ncontacts(m)
-      free_l = size(m%link_kind) - m%nlink; free_c = size(m%con_a) - m%ncontact
-      allocate (lk(nl + free_l), la(nl + free_l), lb(nl + free_l), lpar(NPAR_LINK, nl + free_l), &
-                ca(nc + free_c), cb(nc + free_c), cs(nc + free_c), cl(nc + free_c), &
+      free_l = size(m%link_kind) - m%nlink; free_c = size(m%con_scheme) - m%ncontact
+      allocate (lk(nl + free_l), lpar(NPAR_LINK, nl + free_l), &
+                cs(nc + free_c), cl(nc + free_c), &
                 cg(nc + free_c), cm(nc + free_c), cpar(NPAR_CONTACT, nc + free_c), stat=stat)
+      if (stat == 0) call rows_init(lr, nl + free_l, 2, stat)
+      if (stat == 0) call rows_init(cr, nc + free_c, 2, stat)
       if (stat /= 0) then
          write (what, '(a,i0,a,i0,a)') 'the chains as ', nl + free_l, ' links and ', nc + free_c, &
             ' contacts one by one'
          call out_of_memory(trim(what), REAL_BYTES*(NPAR_LINK*real(nl + free_l, dp) &
                             + (NPAR_CONTACT + 2.0_dp)*(nc + free_c)) &
-                            + INT_BYTES*(3.0_dp*(nl + free_l) + 4.0_dp*(nc + free_c)), &
+                            + (REAL_BYTES + INT_BYTES)*2.0_dp*(nl + free_l + nc + free_c) &
+                            + INT_BYTES*(real(nl + free_l, dp) + 2.0_dp*(nc + free_c)), &
                             FIX_SMALLER_SCENE, stat, message)
          return
       end if
@@ -257,12 +263,13 @@ contains
          associate (ch => m%chain(q))
             do while (g < ch%glink)
                g = g + 1; pos = pos + 1
-               lk(pos) = m%link_kind(g); la(pos) = m%link_a(g); lb(pos) = m%link_b(g)
-               lpar(:, pos) = m%link_par(:, g)
+               call copy_link(g, pos)
+               if (stat /= 0) exit
             end do
             do i = 1, ch%n
                pos = pos + 1
-               la(pos) = ch%first + i - 1; lb(pos) = 0; lpar(:, pos) = 0.0_dp
+               call rows_append_pair(lr, ch%first + i - 1, 0, stat)
+               lpar(:, pos) = 0.0_dp
                lk(pos) = LINK_SPRING; lpar(L_STIFF, pos) = ch%k(i)
                if (allocated(ch%fy)) then
                   lk(pos) = LINK_BILINEAR; lpar(L_YIELD, pos) = ch%fy(i)
@@ -271,15 +278,15 @@ contains
                if (.not. allocated(ch%c)) cycle
                if (.not. (ch%c(i) > 0.0_dp)) cycle
                pos = pos + 1
-               la(pos) = ch%first + i - 1; lb(pos) = 0; lpar(:, pos) = 0.0_dp
+               call rows_append_pair(lr, ch%first + i - 1, 0, stat)
+               lpar(:, pos) = 0.0_dp
                lk(pos) = LINK_DASHPOT; lpar(L_DAMP, pos) = ch%c(i)
             end do
          end associate
       end do
       do while (g < m%nlink)
          g = g + 1; pos = pos + 1
-         lk(pos) = m%link_kind(g); la(pos) = m%link_a(g); lb(pos) = m%link_b(g)
-         lpar(:, pos) = m%link_par(:, g)
+         call copy_link(g, pos)
       end do
       pos = 0; g = 0
       do q = 1, m%nchain
@@ -290,7 +297,8 @@ contains
             end do
             do i = 1, ch%ncontact
                pos = pos + 1
-               ca(pos) = ch%first + i - 1; cb(pos) = ch%first + i; cg(pos) = ch%gap(min(i, size(ch%gap)))
+               call rows_append_pair(cr, ch%first + i - 1, ch%first + i, stat)
+               cg(pos) = ch%gap(min(i, size(ch%gap)))
                cs(pos) = ch%scheme; cl(pos) = ch%law; cpar(:, pos) = ch%par
             end do
          end associate
@@ -299,18 +307,35 @@ contains
          g = g + 1; pos = pos + 1
          call copy_contact(g, pos)
       end do
-      call move_alloc(lk, m%link_kind); call move_alloc(la, m%link_a)
-      call move_alloc(lb, m%link_b); call move_alloc(lpar, m%link_par)
-      call move_alloc(ca, m%con_a); call move_alloc(cb, m%con_b); call move_alloc(cs, m%con_scheme)
+      if (stat /= 0) then
+         call out_of_memory('the rows of the chains one by one', &
+                            (REAL_BYTES + INT_BYTES)*2.0_dp*(nl + nc), FIX_SMALLER_SCENE, stat, message)
+         return
+      end if
+      call move_alloc(lk, m%link_kind); call move_alloc(lpar, m%link_par)
+      call move_alloc(cs, m%con_scheme)
       call move_alloc(cl, m%con_law); call move_alloc(cg, m%con_gap)
       call move_alloc(cpar, m%con_par); call move_alloc(cm, m%con_mstar)
+      call rows_move(lr, m%lnk); call rows_move(cr, m%con)
       m%nlink = nl; m%ncontact = nc
       deallocate (m%chain); m%nchain = 0
    contains
+      subroutine copy_link(from, to)
+         integer, intent(in) :: from, to
+         integer :: st
+         lk(to) = m%link_kind(from); lpar(:, to) = m%link_par(:, from)
+         call rows_append(lr, m%lnk%node(row_lo(m%lnk, from):row_hi(m%lnk, from)), &
+                          m%lnk%coef(row_lo(m%lnk, from):row_hi(m%lnk, from)), st)
+         if (st /= 0) stat = st
+      end subroutine copy_link
       subroutine copy_contact(from, to)
          integer, intent(in) :: from, to
-         ca(to) = m%con_a(from); cb(to) = m%con_b(from); cg(to) = m%con_gap(from)
+         integer :: st
+         cg(to) = m%con_gap(from)
          cs(to) = m%con_scheme(from); cl(to) = m%con_law(from); cpar(:, to) = m%con_par(:, from)
+         call rows_append(cr, m%con%node(row_lo(m%con, from):row_hi(m%con, from)), &
+                          m%con%coef(row_lo(m%con, from):row_hi(m%con, from)), st)
+         if (st /= 0) stat = st
       end subroutine copy_contact
    end subroutine model_expand_chains
 

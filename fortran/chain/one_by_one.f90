@@ -30,7 +30,7 @@ contains
          associate (par => m%link_par)
             do idx = 1, size(self%blk%bl)
                ! the return map from the committed state
-               j = self%blk%bl(idx); a = m%link_a(j); b = m%link_b(j)
+               j = self%blk%bl(idx); a = row_a(m%lnk, j); b = row_b(m%lnk, j)
                du = u(a) - u(b)
                call bilinear_return_map(par(L_STIFF, j), par(L_YIELD, j), par(L_HARDENING, j), &
                                         self%bfc(idx), self%bdu(idx), du, f, kt, yielding)
@@ -43,7 +43,7 @@ contains
                fe(a) = fe(a) + f; fe(b) = fe(b) - f
             end do
             do idx = 1, size(self%blk%xg)
-               j = self%blk%xg(idx); a = m%con_a(j); b = m%con_b(j)
+               j = self%blk%xg(idx); a = row_a(m%con, j); b = row_b(m%con, j)
                pen = u(a) - u(b) - m%con_gap(j)
                call contact_law(m, j, pen, v(a) - v(b), br, f)
                self%xbr(idx) = br
@@ -95,14 +95,14 @@ contains
          j = self%blk%bl(idx)
          k = m%link_par(L_STIFF, j)
          if (self%bbr(idx) /= B_ELASTIC) k = m%link_par(L_HARDENING, j)*k
-         call stencil(m%link_a(j), m%link_b(j), k, 0.0_dp)
+         call stencil(row_a(m%lnk, j), row_b(m%lnk, j), k, 0.0_dp)
       end do
       do idx = 1, size(self%blk%xg)
          j = self%blk%xg(idx)
          if (self%xbr(idx) /= BRANCH_ON) cycle
          c = 0.0_dp
          if (m%con_law(j) == LAW_KELVIN) c = m%con_par(P_DAMPING, j)
-         call stencil(m%con_a(j), m%con_b(j), m%con_par(P_STIFF, j), c)
+         call stencil(row_a(m%con, j), row_b(m%con, j), m%con_par(P_STIFF, j), c)
       end do
       self%xjd(0) = 0.0_dp; self%xcd(0) = 0.0_dp
    contains

@@ -35,7 +35,7 @@ contains
       if (st /= 0) return
       self%pair_links = .false.
       do j = 1, m%nlink
-         a = m%link_a(j); b = m%link_b(j)
+         a = row_a(m%lnk, j); b = row_b(m%lnk, j)
          if (m%link_kind(j) /= LINK_BILINEAR .and. a > 0 .and. b > 0) self%pair_links = .true.
       end do
       ! unused ones hold one entry: the kernels take them as arrays
@@ -45,7 +45,7 @@ contains
       self%kp = 0.0_dp; self%cp = 0.0_dp
       nb = 0
       do j = 1, m%nlink
-         a = m%link_a(j); b = m%link_b(j)
+         a = row_a(m%lnk, j); b = row_b(m%lnk, j)
          k = 0.0_dp; cd = 0.0_dp
          select case (m%link_kind(j))
          case (LINK_SPRING, LINK_BAR)
@@ -125,7 +125,7 @@ contains
             end associate
          end do
          do j = 1, m%ncontact
-            a = m%con_a(j); b = m%con_b(j)
+            a = row_a(m%con, j); b = row_b(m%con, j)
             if (a == 0 .or. b == 0) cycle
             lo = min(a, b)
             if (self%blk%number(lo) == 0) then

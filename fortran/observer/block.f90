@@ -10,6 +10,7 @@ submodule (martello_observer) block
    use martello_model, only: model_link_at, model_contact_at, model_nlinks, model_ncontacts, &
       model_link_index
    use martello_links, only: LINK_SPRING, LINK_BAR, LINK_DASHPOT, LINK_BILINEAR, L_STIFF, L_DAMP
+   use martello_element_rows, only: row_a, row_b
    use martello_contact_laws, only: LAW_KELVIN, P_STIFF, P_DAMPING, P_CLIP, BRANCH_OFF, &
       BRANCH_ON, AFFINE_LINEAR, AFFINE_KELVIN_CLIPPED, NPAR_CONTACT
    use martello_registry, only: TRACK_NODE_PEAKS, TRACK_LINK_PEAKS, TRACK_CONTACT_PEAKS, TRACK_PHASES
@@ -315,7 +316,7 @@ contains
       real(dp) :: pen, f, r1, d0, r0, f0, fr0, fr1, kc, cc
       logical :: on
       do idx = 1, size(blk%xg)
-         j = blk%xg(idx); a = m%con_a(j); b = m%con_b(j); c = blk%xc(idx)
+         j = blk%xg(idx); a = row_a(m%con, j); b = row_b(m%con, j); c = blk%xc(idx)
          pen = u(a) - u(b) - m%con_gap(j); r1 = v(a) - v(b)
          on = xbr(idx) /= BRANCH_OFF
          f = 0.0_dp
@@ -366,7 +367,7 @@ contains
       real(dp), intent(in) :: un(0:), vn(0:), v(0:), bf(:), bdu(:)
       integer :: idx, j, l, a, b
       do idx = 1, size(blk%blo)
-         j = blk%blo(idx); l = blk%bl(idx); a = m%link_a(l); b = m%link_b(l)
+         j = blk%blo(idx); l = blk%bl(idx); a = row_a(m%lnk, l); b = row_b(m%lnk, l)
          call raise_to(o%link_force_absmax(j), abs(bf(idx)))
          call raise_to(o%link_du_absmax(j), abs(bdu(idx)))
          if (loc) call link_step_extremum(LINK_BILINEAR, m%link_par(:, l), hl, un(a) - un(b), &
@@ -465,7 +466,7 @@ contains
       ground = .false.; gdamp = .false.; pair = .false.; pdamp = .false.
       do j = 1, m%nlink
          if (m%link_kind(j) == LINK_BILINEAR) cycle
-         if (m%link_a(j) > 0 .and. m%link_b(j) > 0) then
+         if (row_a(m%lnk, j) > 0 .and. row_b(m%lnk, j) > 0) then
             pair = .true.; pdamp = pdamp .or. m%link_kind(j) == LINK_DASHPOT
          else
             ground = .true.; gdamp = gdamp .or. m%link_kind(j) == LINK_DASHPOT
@@ -488,7 +489,7 @@ contains
       real(dp) :: umax, vmax
       if (.not. (allocated(o%gu) .and. tracks(o, TRACK_LINK_PEAKS) .and. o%nsamples >= 0)) return
       do j = 1, m%nlink
-         a = m%link_a(j); b = m%link_b(j)
+         a = row_a(m%lnk, j); b = row_b(m%lnk, j)
          select case (m%link_kind(j))
          case (LINK_SPRING, LINK_BAR, LINK_DASHPOT)
          case default

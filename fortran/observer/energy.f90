@@ -6,6 +6,7 @@
 !> working state.
 submodule (martello_observer) energy
    use martello_assembly, only: kinetic_energy, recoverable_energy, mass_times
+   use martello_element_rows, only: row_dot
    use martello_integrator_settings, only: integrator_name
    use martello_registry, only: TRACK_NODE_PEAKS, TRACK_CONTACT_PEAKS, TRACK_PHASES
    use martello_run_quantities, only: E_KINETIC, E_RECOVERABLE, E_INPUT, E_DAMPING, E_PLASTIC, &
@@ -56,14 +57,14 @@ contains
          e_kin = energies(1); o%e_links0 = energies(2); o%e_cont0 = energies(3)
       else
          if (o%smooth_steps) then
-            o%con_nodes = reshape([(m%con_a(c), m%con_b(c), c = 1, m%ncontact)], [2, m%ncontact])
+            o%con_rows = m%con; o%has_con_rows = .true.
          end if
          do c = 1, m%ncontact
-            if (ms%con_on(c)) call observer_open_phase(o, c, 0.0_dp, v(m%con_a(c)) - v(m%con_b(c)))
+            if (ms%con_on(c)) call observer_open_phase(o, c, 0.0_dp, row_dot(m%con, c, v))
             ! the force and its rate the first step's located peaks start from
             if (allocated(o%c_prev_f)) &
-               call contact_force_rate(m, ms, c, v(m%con_a(c)) - v(m%con_b(c)), &
-                                       a(m%con_a(c)) - a(m%con_b(c)), o%c_prev_f(c), o%c_prev_fr(c))
+               call contact_force_rate(m, ms, c, row_dot(m%con, c, v), &
+                                       row_dot(m%con, c, a), o%c_prev_f(c), o%c_prev_fr(c))
          end do
          e_kin = kinetic_energy(m, v, o%work)
          call recoverable_energy(m, ms, u, o%e_links0, o%e_cont0)

@@ -20,6 +20,7 @@ module martello_observer
    use martello_kinds, only: dp, i8
    use martello_status
    use martello_model, only: model_t
+   use martello_element_rows, only: rows_t
    use martello_assembly, only: mech_state_t
    use martello_links, only: NPAR_LINK
    use martello_integrator_settings, only: integrator_settings_t
@@ -125,10 +126,11 @@ module martello_observer
       logical :: smooth_steps = .false.
       !> per node (0:n): the time of the last phase change (onset, separation, impact) of a
       !> contact at it; the chatter resolutions at the previous sample (the jumps of the
-      !> forces a located peak of |a| must not straddle). con_nodes: each contact's nodes,
+      !> forces a located peak of |a| must not straddle). con_rows: each contact's nodes,
       !> for the phase changes the method does not name them at (observer_block does)
       real(dp), allocatable :: node_change(:)
-      integer, allocatable :: con_nodes(:, :)
+      type(rows_t) :: con_rows                 !< the contacts' rows: their nodes
+      logical :: has_con_rows = .false.
       integer(i8) :: chatter_prev = 0_i8
       !> per contact, for the general fixed-step path: its force and force rate at the
       !> previous sample (observer_block computes them again from the previous state)

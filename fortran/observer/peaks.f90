@@ -5,6 +5,7 @@
 !> hand theirs (observer_extremum, observer_peak).
 submodule (martello_observer) peaks
    use martello_assembly, only: load_breakpoint
+   use martello_element_rows, only: row_dot1
    use martello_links, only: link_force, LINK_SPRING, LINK_BAR, LINK_BILINEAR, LINK_DASHPOT, &
       LINK_FLUID_DAMPER, L_STIFF
    use martello_registry, only: TRACK_NODE_PEAKS, TRACK_LINK_PEAKS, TRACK_CONTACT_PEAKS, TRACK_PHASES
@@ -337,13 +338,6 @@ contains
       end do
    end subroutine cubic_hermite_extrema
 
-   !> x(i) of a node array on 1..n, 0 for the ground (i = 0)
-   pure real(dp) function nodal(x, i)
-      real(dp), intent(in) :: x(:)
-      integer, intent(in) :: i
-      nodal = 0.0_dp
-      if (i > 0) nodal = x(i)
-   end function nodal
 
    !> The peaks of every link inside a smooth fixed step of h from (un, vn, an) to (u, v, a)
    !> (nodes 1..n), f1 the link forces at its end (link_step_extremum): only a step where du̇
@@ -352,21 +346,20 @@ contains
       type(observer_t), intent(inout) :: o
       type(model_t), intent(in) :: m
       real(dp), intent(in) :: h, un(:), vn(:), an(:), u(:), v(:), a(:), f1(:)
-      integer :: j, ia, ib
+      integer :: j
       real(dp) :: dv0, dv1, da0, da1
       logical :: damper
       do j = 1, m%nlink
-         ia = m%link_a(j); ib = m%link_b(j)
-         dv0 = nodal(vn, ia) - nodal(vn, ib); dv1 = nodal(v, ia) - nodal(v, ib)
+         dv0 = row_dot1(m%lnk, j, vn); dv1 = row_dot1(m%lnk, j, v)
          damper = m%link_kind(j) == LINK_DASHPOT .or. m%link_kind(j) == LINK_FLUID_DAMPER
          da0 = 0.0_dp; da1 = 0.0_dp
          if (damper) then
-            da0 = nodal(an, ia) - nodal(an, ib); da1 = nodal(a, ia) - nodal(a, ib)
+            da0 = row_dot1(m%lnk, j, an); da1 = row_dot1(m%lnk, j, a)
          end if
          if (.not. (dv0*dv1 < 0.0_dp .or. da0*da1 < 0.0_dp)) cycle
          call link_step_extremum(m%link_kind(j), m%link_par(:, j), h, &
-                                 nodal(un, ia) - nodal(un, ib), dv0, da0, &
-                                 nodal(u, ia) - nodal(u, ib), dv1, da1, f1(j), &
+                                 row_dot1(m%lnk, j, un), dv0, da0, &
+                                 row_dot1(m%lnk, j, u), dv1, da1, f1(j), &
                                  o%link_force_absmax(j), o%link_du_absmax(j))
       end do
    end subroutine link_step_peaks

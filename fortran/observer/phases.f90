@@ -4,6 +4,7 @@
 !> side of the step (free_side_crossing) and the maxima inside it.
 submodule (martello_observer) phases
    use martello_registry, only: TRACK_CONTACT_PEAKS, TRACK_PHASES
+   use martello_element_rows, only: row_dot, row_lo, row_hi
    use martello_run_quantities, only: C_EVENTS
    use martello_contact_laws, only: contact_force, LAW_LINEAR, LAW_KELVIN, P_STIFF, P_DAMPING
    implicit none
@@ -41,7 +42,7 @@ contains
 
    !> Contact c changed phase at t: its nodes' forces jump or kink there (node_change, read
    !> by observer_a_parabolas). nodes: the contact's, where the method names them
-   !> (observer_block); else con_nodes.
+   !> (observer_block); else every node of its row (con_rows).
    subroutine node_change_at(o, c, t, nodes)
       type(observer_t), intent(inout) :: o
       integer, intent(in) :: c
@@ -50,16 +51,17 @@ contains
       integer :: k, j
       if (.not. allocated(o%node_change)) return
       if (size(o%node_change) < 2) return           ! node peaks not tracked
-      do k = 1, 2
-         if (present(nodes)) then
+      if (present(nodes)) then
+         do k = 1, 2
             j = nodes(k)
-         else if (allocated(o%con_nodes)) then
-            j = o%con_nodes(k, c)
-         else
-            return
-         end if
-         o%node_change(j) = max(o%node_change(j), t)
-      end do
+            o%node_change(j) = max(o%node_change(j), t)
+         end do
+      else if (o%has_con_rows) then
+         do k = row_lo(o%con_rows, c), row_hi(o%con_rows, c)
+            j = o%con_rows%node(k)
+            o%node_change(j) = max(o%node_change(j), t)
+         end do
+      end if
    end subroutine node_change_at
 
    !> Phases of the penalty contacts of a fixed step (t − h, t], from the committed state
@@ -70,25 +72,25 @@ contains
    !> On a smooth method's step (smooth_steps), a phase spanning the step also has its
    !> maxima located inside it (contact_step_peaks).
    module procedure observer_penalty_phases
-      integer :: c, ia, ib
+      integer :: c
       real(dp) :: f, fr
       logical :: located
       located = allocated(o%c_prev_f) .and. o%prev_t >= 0.0_dp .and. t > o%prev_t
       do c = 1, m%ncontact
          if (.not. ms%is_penalty(c)) cycle
-         ia = m%con_a(c); ib = m%con_b(c)
          if (located) then
-            call contact_force_rate(m, ms, c, v(ia) - v(ib), a(ia) - a(ib), f, fr)
+            call contact_force_rate(m, ms, c, row_dot(m%con, c, v), row_dot(m%con, c, a), f, fr)
             if (o%ph_open(c) .and. ms%con_on(c)) &
-               call contact_step_peaks(o, c, t - o%prev_t, un(ia) - un(ib) - m%con_gap(c), &
-                                       vn(ia) - vn(ib), o%c_prev_f(c), o%c_prev_fr(c), &
-                                       ms%con_pen(c), v(ia) - v(ib), f, fr)
+               call contact_step_peaks(o, c, t - o%prev_t, row_dot(m%con, c, un) - m%con_gap(c), &
+                                       row_dot(m%con, c, vn), o%c_prev_f(c), o%c_prev_fr(c), &
+                                       ms%con_pen(c), row_dot(m%con, c, v), f, fr)
             o%c_prev_f(c) = f; o%c_prev_fr(c) = fr
          end if
          if (ms%con_on(c) .neqv. o%ph_open(c)) &
             call phase_change(o, c, ms%con_on(c), ms%con_pen(c), ms%con_f(c), &
-                              un(ia) - un(ib) - m%con_gap(c), vn(ia) - vn(ib), an(ia) - an(ib), &
-                              u(ia) - u(ib) - m%con_gap(c), v(ia) - v(ib), a(ia) - a(ib), t, h)
+                              row_dot(m%con, c, un) - m%con_gap(c), row_dot(m%con, c, vn), &
+                              row_dot(m%con, c, an), row_dot(m%con, c, u) - m%con_gap(c), &
+                              row_dot(m%con, c, v), row_dot(m%con, c, a), t, h)
          if (tracks(o, TRACK_PHASES)) call phase_peaks(o%ph_open(c), ms%con_pen(c), ms%con_f(c), &
                                                        o%ph_pen(c), o%ph_f(c))
       end do

@@ -72,6 +72,9 @@ def lib():
         "martello_model_add_contacts": (c_int, [_VOID_P, c_int, _INT_P, _INT_P, _DOUBLE_P, _INT_P,
                                                 _INT_P, _DOUBLE_P]),
         "martello_model_add_mass_coupling": (c_int, [_VOID_P, c_int, c_int, c_double]),
+        "martello_model_add_link_row": (c_int, [_VOID_P, c_int, c_int, _INT_P, _DOUBLE_P, _DOUBLE_P]),
+        "martello_model_add_contact_row": (c_int, [_VOID_P, c_int, _INT_P, _DOUBLE_P, c_double, c_int,
+                                                   c_int, _DOUBLE_P]),
         "martello_model_add_chain": (c_int, [_VOID_P, c_int, c_int] + [_VOID_P] * 5
                                      + [c_int, c_int, _VOID_P]),
         "martello_model_add_stiffness_block": (c_int, [_VOID_P, c_int, _INT_P, _DOUBLE_P,
@@ -452,6 +455,20 @@ class Model(_Handle):
                                                   scheme, law, row), "chain")
         if gap is not None:
             self.n_contacts += n - 1
+
+    def add_link_row(self, kind, nodes, coef, par):
+        """A link whose elongation is Σ coef·u(node) (0-based nodes)."""
+        nodes, coef = _i32(nodes), _f64(coef)
+        self.check(lib().martello_model_add_link_row(self._h, kind, nodes.size, nodes, coef,
+                                                     _f64(par, constant("NPAR_LINK"))), "link")
+
+    def add_contact_row(self, nodes, coef, gap, scheme, law, par):
+        """A contact whose penetration is Σ coef·u(node) − gap (0-based nodes)."""
+        nodes, coef = _i32(nodes), _f64(coef)
+        self.check(lib().martello_model_add_contact_row(self._h, nodes.size, nodes, coef, gap, scheme,
+                                                        law, _f64(par, constant("NPAR_CONTACT"))),
+                   "contact")
+        self.n_contacts += 1
 
     def add_mass_coupling(self, a, b, value):
         self.check(lib().martello_model_add_mass_coupling(self._h, a, b, value), "mass coupling")

@@ -6,11 +6,11 @@ import inspect
 from functools import lru_cache
 
 from ..oracles import (integrators, linear_sdof, p1_p3_static, p2_bouncing, p4_rod_impact,
-                       p4_wave_theory, p5_contact_laws, p6_hysteresis, p9_davis, p10_frames, vendor)
+                       p4_wave_theory, p5_contact_laws, p6_hysteresis, p9_davis, p10_frames, p11_buildings, vendor)
 from . import dispatchers
 
 MODULES = (p1_p3_static, p2_bouncing, p4_rod_impact, p4_wave_theory, p5_contact_laws,
-           p6_hysteresis, p9_davis, p10_frames, vendor, linear_sdof, integrators, dispatchers)
+           p6_hysteresis, p9_davis, p10_frames, p11_buildings, vendor, linear_sdof, integrators, dispatchers)
 
 
 @lru_cache(maxsize=None)

@@ -98,8 +98,10 @@ class System:
         self.fsec = np.where(self.fvreg > 0, self.fc * np.where(self.fvreg > 0, self.fvreg, 1.0)
                              ** (self.falpha - 1.0), 0.0)
         self.blocks = [(ix, K, C) for _, ix, K, C in m.blocks]
-        self.ca = [c.a if c.a != GROUND else n for c in m.contacts]
-        self.cb = [c.b if c.b != GROUND else n for c in m.contacts]
+        # each contact's row (docs/buildings.md): its nodes (the ground as n, where the
+        # extended vectors hold 0) and coefficients; δ = Σ c x(node) − gap
+        self.cn = [np.array([i if i != GROUND else n for i, _ in c.terms], dtype=int) for c in m.contacts]
+        self.cc = [np.array([cf for _, cf in c.terms]) for c in m.contacts]
         self.nfev = 0
         # the largest speed met so far: the scale of the round-off of a velocity switch
         # (a velocity is 0 at its own switch, so its current size says nothing)
@@ -124,9 +126,17 @@ class System:
         (docs/scene-input.md "[[link]]")."""
         return np.where(modes.dreg == 0, self.fsec * dv, modes.dreg * self.fc * np.abs(dv) ** self.falpha)
 
+    def row(self, xE, j):
+        """Σ c x(node) over contact j's row (xE extended: the ground at n)."""
+        return float(xE[self.cn[j]] @ self.cc[j])
+
+    def row_size(self, xE, j):
+        """Σ |c x(node)|: the magnitude row() is computed from."""
+        return float(np.abs(xE[self.cn[j]] * self.cc[j]).sum())
+
     def contact_state(self, uE, vE, j):
         c = self.m.contacts[j]
-        return uE[self.ca[j]] - uE[self.cb[j]] - c.gap, vE[self.ca[j]] - vE[self.cb[j]]
+        return self.row(uE, j) - c.gap, self.row(vE, j)
 
     def contact_force(self, uE, vE, j, modes):
         if not modes.active[j] or self.m.contacts[j].scheme != "penalty":
@@ -169,8 +179,7 @@ class System:
             if modes.active[j] and c.scheme == "penalty":
                 p = self.contact_force(uE, vE, j, modes)
                 d, dd = self.contact_state(uE, vE, j)
-                f[self.ca[j]] -= p
-                f[self.cb[j]] += p
+                np.subtract.at(f, self.cn[j], self.cc[j] * p)
                 dcon += (p - c.elastic(d)) * dd
         fext = self.external(t)
         v = y[n:2 * n]
@@ -212,12 +221,12 @@ class System:
 
         def g(y):
             uE, _ = sysm.ext(y)
-            d = uE[sysm.ca[j]] - uE[sysm.cb[j]] - c.gap
-            return d, abs(uE[sysm.ca[j]]) + abs(uE[sysm.cb[j]]) + abs(c.gap) + sysm.uscale
+            d = sysm.row(uE, j) - c.gap
+            return d, sysm.row_size(uE, j) + abs(c.gap) + sysm.uscale
 
         def gdot(y, acc):
             _, vE = sysm.ext(y)
-            return vE[sysm.ca[j]] - vE[sysm.cb[j]]
+            return sysm.row(vE, j)
 
         if not modes.active[j]:
             # the onset and separation actions need the run's state: integrate() binds them
@@ -234,14 +243,14 @@ class System:
                 if c.law == "kelvin":
                     return val, abs(c.K * d) + abs(c.c * dd)
                 if c.law == "jankowski":
-                    return val, abs(vE[sysm.ca[j]]) + abs(vE[sysm.cb[j]]) + sysm.vscale
+                    return val, sysm.row_size(vE, j) + sysm.vscale
                 return val, 1.0 + abs(val - 1.0)
 
             def gbdot(y, acc, j=j):
                 uE, vE = sysm.ext(y)
                 aE = np.append(acc, 0.0)
                 d, dd = sysm.contact_state(uE, vE, j)
-                ddd = aE[sysm.ca[j]] - aE[sysm.cb[j]]
+                ddd = sysm.row(aE, j)
                 if c.law == "kelvin":
                     return c.K * dd + c.c * ddd
                 if c.law == "jankowski":
@@ -395,10 +404,9 @@ def integrate(m: Model, method: str = "DOP853", rtol: float = 1e-11, atol_scale:
                                   "persistent contact is not modelled")
             p = (1.0 + c.e) * c.mstar * dd
             y = y.copy()
-            if c.a != GROUND and sysm.free[c.a]:
-                y[n + c.a] -= p / m.mass[c.a]
-            if c.b != GROUND and sysm.free[c.b]:
-                y[n + c.b] += p / m.mass[c.b]
+            for i, cf in c.terms:         # Δv = −M⁻¹ gᵀ p on the free nodes
+                if i != GROUND and sysm.free[i]:
+                    y[n + i] -= cf * p / m.mass[i]
             impact[0] += 0.5 * (1.0 - c.e ** 2) * c.mstar * dd * dd
             run.impact_energy.append((t, impact[0]))
             run.phases[j].append({"t_on": t, "v_in": dd, "t_off": t, "v_out": -c.e * dd, "impulse": p})
@@ -488,7 +496,7 @@ def integrate(m: Model, method: str = "DOP853", rtol: float = 1e-11, atol_scale:
             def wv(tt, yy, kind=kind, i=i):
                 _, vE = sysm.ext(yy)
                 if kind == "contact":
-                    return vE[sysm.ca[i]] - vE[sysm.cb[i]]
+                    return sysm.row(vE, i)
                 return vE[sysm.ba[i]] - vE[sysm.bb[i]]
             wv.terminal = False
             wv.direction = 0.0

@@ -47,8 +47,7 @@ def jankowski_xi(e):
 @dataclass
 class ContactLaw:
     name: str
-    a: int
-    b: int
+    terms: list              # the contact's row: [(node index or GROUND, coefficient)]
     gap: float
     scheme: str              # penalty | restitution
     law: str | None
@@ -112,13 +111,13 @@ class ContactLaw:
         return "push"
 
 
-def contact_law(c: dict, a: int, b: int, mstar: float) -> ContactLaw:
+def contact_law(c: dict, terms: list, mstar: float) -> ContactLaw:
     """A [[contact]] table (docs/scene-input.md "[[contact]]") as a ContactLaw: the target
     restitution turned into the law's damping by its published formula."""
     scheme = c["scheme"]
     name, gap = c["name"], float(c.get("gap", 0.0))
     if scheme == "restitution":
-        return ContactLaw(name, a, b, gap, scheme, None, e=float(c["restitution"]), mstar=mstar)
+        return ContactLaw(name, terms, gap, scheme, None, e=float(c["restitution"]), mstar=mstar)
     if scheme != "penalty":
         raise Unsupported(f"contact {name}: scheme {scheme!r} (penalty and restitution only)")
     law = c.get("law", "linear")
@@ -139,5 +138,5 @@ def contact_law(c: dict, a: int, b: int, mstar: float) -> ContactLaw:
         val = damping if damping is not None else (hc_factor(law, e) if e is not None else 0.0)
     elif law == "jankowski":
         val = damping if damping is not None else (jankowski_xi(e) if e is not None else 0.0)
-    return ContactLaw(name, a, b, gap, scheme, law, K=K, n=n, c=float(val),
+    return ContactLaw(name, terms, gap, scheme, law, K=K, n=n, c=float(val),
                       clipped=bool(c.get("clipped", False)), mstar=mstar)

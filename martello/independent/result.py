@@ -67,8 +67,8 @@ class Quantities:
         s, c = self.s, self.m.contacts[j]
         uE = np.vstack([Y[:s.n], np.zeros(Y.shape[1])])
         vE = np.vstack([Y[s.n:2 * s.n], np.zeros(Y.shape[1])])
-        d = uE[s.ca[j]] - uE[s.cb[j]] - c.gap
-        dd = vE[s.ca[j]] - vE[s.cb[j]]
+        d = s.cc[j] @ uE[s.cn[j]] - c.gap              # the contact's row over the samples
+        dd = s.cc[j] @ vE[s.cn[j]]
         if not md.active[j] or c.scheme != "penalty":
             return d, np.zeros_like(d)
         p = np.array([c.force(x, xd, md.v_in[j], md.branch[j]) for x, xd in zip(d, dd)])

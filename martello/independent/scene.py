@@ -211,13 +211,23 @@ class Model:
         return sorted(b for b in bs if 0.0 < b < self.t_end)
 
 
-def effective_mass(mass, fixed, a, b):
-    """m* = m_a m_b/(m_a + m_b); a ground or fixed side is infinitely heavy
-    (docs/problems.md P5)."""
-    free = [mass[i] for i in (a, b) if i != GROUND and not fixed[i]]
-    if not free:
-        return math.inf
-    return free[0] if len(free) == 1 else free[0] * free[1] / (free[0] + free[1])
+def effective_mass(mass, fixed, terms):
+    """m* = 1/Σ c²/m over the contact's row on its free nodes: m_a m_b/(m_a + m_b) for a
+    node pair (docs/problems.md P5), 1/(1/m1 + r1²/J1 + 1/m2 + r2²/J2) between points of two
+    rigid floors (docs/buildings.md); a ground or fixed side is infinitely heavy."""
+    w = sum(c * c / mass[i] for i, c in terms if i != GROUND and not fixed[i])
+    return math.inf if w == 0.0 else 1.0 / w
+
+
+def contact_terms(c: dict, idx: dict) -> list:
+    """A contact's row [(node index, coefficient)] (docs/scene-input.md "[[contact]]"): its
+    terms, or (a, +1), (b, −1) of a node pair; GROUND kept (its displacement is 0)."""
+    if "terms" in c:
+        return [(idx[t["node"]], float(t["coef"])) for t in c["terms"]]
+    if isinstance(c["a"], dict) or isinstance(c["b"], dict):
+        raise Unsupported(f"contact {c['name']}: plan points of [[building]] floors (the engine "
+                          "models no buildings)")
+    return [(idx[c["a"]], 1.0), (idx[c["b"]], -1.0)]
 
 
 def model_from_dict(doc: dict, base: Path | None = None, t_end: float | None = None) -> Model:
@@ -243,6 +253,10 @@ def model_from_dict(doc: dict, base: Path | None = None, t_end: float | None = N
     springs, dashpots, bilinears, dampers = [], [], [], []
     to_ground_k = np.zeros(len(nodes))
     raw = doc.get("link", [])
+    for lk in raw:
+        if "terms" in lk or isinstance(lk.get("a"), dict) or isinstance(lk.get("b"), dict):
+            raise Unsupported(f"link {lk.get('name', '?')}: a row of several DOFs (the engine's "
+                              "links join two nodes)")
     for i, lk in enumerate(raw):
         a, b = idx[lk["a"]], idx[lk["b"]]
         kind = lk["type"]
@@ -273,8 +287,8 @@ def model_from_dict(doc: dict, base: Path | None = None, t_end: float | None = N
             raise Unsupported(f"link type {kind!r}")
     contacts = []
     for c in doc.get("contact", []):
-        a, b = idx[c["a"]], idx[c["b"]]
-        contacts.append(contact_law(c, a, b, effective_mass(mass, fixed, a, b)))
+        terms = contact_terms(c, idx)
+        contacts.append(contact_law(c, terms, effective_mass(mass, fixed, terms)))
     blocks = [(fb.name, np.array([idx[nm] for nm in fb.nodes]), fb.K, fb.C) for fb in frames]
     loads = doc.get("loads", {})
     forces = []

@@ -6,10 +6,16 @@ from ..paths import BENCHMARKS as ROOT
 from .loader import load
 
 
+# Folders under benchmarks/ that hold no catalogue scene: timing scripts (perf), study files
+# (studies), and the inputs of a case-study script (case_study: scenes without a closed form or
+# a reference of their own, run and reported by benchmarks/<problem>/case_study.py).
+NOT_CATALOGUE = ("perf", "studies", "case_study")
+
+
 def scene_files(root=ROOT):
-    """Scene files of the catalogue, sorted; benchmarks/perf holds timing scripts, not scenes."""
-    return sorted(p for p in root.rglob("*.toml") if "perf" not in p.relative_to(root).parts
-                  and "studies" not in p.relative_to(root).parts)
+    """Scene files of the catalogue, sorted (not those of the NOT_CATALOGUE folders)."""
+    return sorted(p for p in root.rglob("*.toml")
+                  if not set(NOT_CATALOGUE) & set(p.relative_to(root).parts))
 
 
 def find(path, root=ROOT):

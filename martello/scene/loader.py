@@ -16,6 +16,7 @@ from ..errors import SceneError
 from .bars import expand_bars
 from .chain import ChainContacts, ChainLinks, ChainNodes, expand_chains
 from .items import ItemTable, NameIndex, Names
+from .rows import is_point, plan_direction, row_terms, side_terms
 from .compatibility import COMPATIBLE
 from ..paths import MiB, UnreadableFile, check_regular, read_input
 from .fields import (ANY, MAX_DEPTH, NONNEG, POSITIVE, check_fields, choice, finite_everywhere,
@@ -164,10 +165,12 @@ def from_dict(data, source="<scene>", base_dir=Path("."), digest=None):
         from .frame import expand_frames        # numpy.linalg and the frame model: only here
         data, extras["frames"] = expand_frames(src, data)   # [[frame]]: condensed frames (P10)
     building_couplings = []
+    buildings = []            # [[building]]: what plan points of contacts and links refer to
     if "building" in data:
         from .building import expand_buildings   # the 3D model: only here
         # [[building]]: 3D buildings condensed to their floors' DOFs (P11)
         data, extras["buildings"], building_couplings = expand_buildings(src, data)
+        buildings = extras["buildings"]
 
     # nodes
     generated = [ChainNodes(b) for b in chains] + rods["node"]
@@ -227,9 +230,10 @@ def from_dict(data, source="<scene>", base_dir=Path("."), digest=None):
         kind = choice(src, f"{where}.type", tab["type"], list(LINK_TYPES))
         spec = dict(LINK_COMMON, **LINK_TYPES[kind])
         lk = check_fields(src, tab, where, spec)
-        lk["a"], lk["b"] = node_ref(f"{where}.a", lk["a"]), node_ref(f"{where}.b", lk["b"])
-        if lk["a"] == lk["b"]:
-            raise SceneError(src, f"{where}.b", "connects a node to itself", "name two different nodes")
+        _sides(src, where, lk, node_ref, buildings, "direction", "connects")
+        if lk.get("terms") is not None and kind == "dashpot" and lk["zeta"] is not None:
+            raise SceneError(src, f"{where}.zeta", "applies to a dashpot from a node to ground",
+                             "give c for a dashpot between plan points")
         lk["name"] = lk["name"] or f"link{i}"
         if link_names.add(lk["name"]) >= 0:
             raise SceneError(src, f"{where}.name", f"duplicate name {lk['name']!r}", "names must be unique")
@@ -259,7 +263,8 @@ def from_dict(data, source="<scene>", base_dir=Path("."), digest=None):
             pos += len(seg)
             continue
         for i, tab in enumerate(seg, start=pos):
-            seg[i - pos] = _contact(src, tab, i, node_ref, lambda nm: contact_names.add(nm) >= 0)
+            seg[i - pos] = _contact(src, tab, i, node_ref, lambda nm: contact_names.add(nm) >= 0,
+                                    buildings)
         pos += len(seg)
     contacts = ItemTable(contact_segments, contact_names)
 
@@ -385,7 +390,46 @@ def _unique(src, kind, pos, names, j):
                          "names must be unique")
 
 
-def _contact(src, tab, i, node_ref, duplicate):
+def _sides(src, where, item, node_ref, buildings, direction_key, verb):
+    """An element's sides a, b: two node names (indices; −1 the ground), or, where either is a
+    plan point (martello.scene.rows), the element's row item["terms"] along its plan
+    direction item[direction_key] (a and b then None)."""
+    a, b = item["a"], item["b"]
+    if item["terms"] is not None:
+        if a is not None or b is not None or item[direction_key] is not None:
+            key = "a" if a is not None else ("b" if b is not None else direction_key)
+            raise SceneError(src, f"{where}.{key}", "given together with terms",
+                             "give the row's terms alone, or the sides a and b")
+        item["terms"] = row_terms(src, f"{where}.terms", item["terms"], node_ref)
+        return
+    for key, side in (("a", a), ("b", b)):
+        if side is None:
+            raise SceneError(src, f"{where}.{key}", "missing",
+                             "a node name, a plan point { floor = …, x = …, y = … }, or give terms")
+    if not (is_point(a) or is_point(b)):
+        if item[direction_key] is not None:
+            raise SceneError(src, f"{where}.{direction_key}", "applies to plan points",
+                             "remove it: a node pair acts along the scene's axis")
+        item["a"], item["b"] = node_ref(f"{where}.a", a), node_ref(f"{where}.b", b)
+        if item["a"] == item["b"]:
+            raise SceneError(src, f"{where}.b", f"{verb} a node with itself", "name two different nodes or ground")
+        del item["terms"], item[direction_key]      # a node pair: the items a generator makes
+        return
+    n = plan_direction(src, f"{where}.{direction_key}", item[direction_key])
+    terms = {}
+    for key, side, sign in (("a", a, 1.0), ("b", b, -1.0)):
+        for node, coef in side_terms(src, f"{where}.{key}", side, node_ref, buildings, n, sign):
+            terms[node] = terms.get(node, 0.0) + coef
+    terms = [(node, coef) for node, coef in terms.items() if coef != 0.0]
+    if not terms:
+        raise SceneError(src, f"{where}.b", f"{verb} nothing that moves along {list(n)}",
+                         "two points of different floors, or a point and ground")
+    item["a"] = item["b"] = None
+    item["direction" if direction_key == "direction" else "normal"] = list(n)
+    item["terms"] = terms
+
+
+def _contact(src, tab, i, node_ref, duplicate, buildings=()):
     """One contact table validated as contact[i]; duplicate(name) says whether its name is
     taken (and takes it)."""
     where = f"contact[{i}]"
@@ -395,9 +439,7 @@ def _contact(src, tab, i, node_ref, duplicate):
     c = check_fields(src, tab, where, dict(CONTACT_COMMON, **CONTACT_SCHEMES[scheme]))
     if duplicate(c["name"]):
         raise SceneError(src, f"{where}.name", f"duplicate name {c['name']!r}", "names must be unique")
-    c["a"], c["b"] = node_ref(f"{where}.a", c["a"]), node_ref(f"{where}.b", c["b"])
-    if c["a"] == c["b"]:
-        raise SceneError(src, f"{where}.b", "pairs a node with itself", "name two different nodes or ground")
+    _sides(src, where, c, node_ref, buildings, "normal", "pairs")
     if scheme == "penalty":
         choice(src, f"{where}.law", c["law"], LAWS)
         if c["clipped"] and c["law"] != "kelvin":

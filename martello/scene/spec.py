@@ -17,7 +17,8 @@ NODE_KEYS = {
 }
 
 LINK_COMMON = {"name": ("str", False, None, None), "type": ("str", True, None, None),
-               "a": ("str", True, None, None), "b": ("str", True, None, None)}
+               "a": ("any", False, None, None), "b": ("any", False, None, None),
+               "direction": ("list", False, None, None), "terms": ("list", False, None, None)}
 LINK_TYPES = {
     "spring": {"k": ("float", True, POSITIVE, None)},
     "dashpot": {"c": ("float", False, POSITIVE, None),
@@ -34,8 +35,10 @@ SCHEMES = native.names("schemes")
 LAWS = native.names("laws")
 FIXED_EXPONENT = {r.name: r.values["exponent"] for r in native.registry("laws")
                   if r.values["exponent_fixed"]}
-CONTACT_COMMON = {"name": ("str", True, None, None), "a": ("str", True, None, None),
-                  "b": ("str", True, None, None), "gap": ("float", False, ANY, 0.0),
+CONTACT_COMMON = {"name": ("str", True, None, None), "a": ("any", False, None, None),
+                  "b": ("any", False, None, None), "normal": ("list", False, None, None),
+                  "terms": ("list", False, None, None),
+                  "gap": ("float", False, ANY, 0.0),
                   "scheme": ("str", True, None, None)}
 CONTACT_SCHEMES = {
     "penalty": {"law": ("str", False, None, "linear"),
