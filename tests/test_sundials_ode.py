@@ -219,9 +219,10 @@ def test_lagrange_contact_released_when_its_multiplier_turns_tensile(integrator)
     assert c["phase_max_force"][1] == pytest.approx(M * G - K * H, rel=1e-12)
 
 
-# --- events inside the steps (docs/sundials-ode.md, events inside the steps): IDA and CVODE step
-# across the laws whose force is continuous at onset and separation, their events located per
-# contact on the interpolant, without a root or a restart; ARKODE restarts at them ------------
+# --- events inside the steps (docs/sundials-ode.md, events inside the steps): CVODE steps across
+# the laws whose force is continuous at onset and separation, their events located per contact
+# on the interpolant, without a root or a restart; IDA and ARKODE restart at them (the same
+# events, the same closed forms) ----------------------------------------------------------------
 
 CONTINUOUS = [("linear", 1e6, None, None), ("hertz", 1e9, None, None),
               ("hunt-crossley", 1e9, 0.8, None), ("flores", 1e9, 0.5, None)]
@@ -253,8 +254,8 @@ def test_continuous_law_events_located_inside_the_steps(integrator, method, law,
 def test_a_touch_inside_one_step_is_found(integrator):
     # Verification against the free oscillation (closed form): m1 on a spring to ground leaves at
     # v0 towards m2 (heavy, stiffly held); its amplitude v0/ω passes the gap by 1e-10 m at
-    # t = π/(2ω), inside a step whose ends are both open. The extremum of the contact's own gap
-    # polynomial finds the touch: one onset and one separation centred on π/(2ω) (a contact of
+    # t = π/(2ω), inside a step whose ends are both open. CVODE finds the touch at the extremum
+    # of the contact's own gap polynomial, IDA by the root of the gap's rate: one onset and one separation centred on π/(2ω) (a contact of
     # stiffness 1 N/m does not move the oscillator measurably: 1e-10 N), and the peak penetration
     # 1e-10 m to 1 % (rtol 1e-12 on positions of 1e-2 m: 1e-14 m).
     k_sp, m, v0 = 100.0, 1.0, 0.1
