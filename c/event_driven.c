@@ -246,7 +246,9 @@ static int ed_jacobian(double t, const double y[], double *dfdy, double dfdt[], 
     double step, hh;
     if (w->fixed[j % n]) continue;
     step = sq * fmax(fmax(fabs(y[j]), 1e-3 * (j < n ? umax : vmax)), w->atol);
-    w->yj[j] = y[j] + step;
+    /* away from zero along y_j: the mirrored state (y -> -y) differences the mirrored way, so
+     * that a mirrored scene runs the mirrored steps to the bit (docs/invariance.md) */
+    w->yj[j] = y[j] + copysign(step, y[j]);
     hh = w->yj[j] - y[j];
     if (ed_rhs(t, w->yj, w->f1, w) != GSL_SUCCESS) return GSL_EBADFUNC;
     w->yj[j] = y[j];
@@ -911,7 +913,7 @@ static int peak_skip(void *ctx, int kind, int j) {
  * at t1 (docs/run-layer.md, located peaks): every quantity's value and rate at both ends
  * (the start's kept from the last stretch's end when nothing happened there: w->start_rates),
  * then c/located_peaks.c. */
-static int located_peaks(ed_t *w, double t0, double t1) {
+static int located_peaks(ed_t *w, double t0, double t1, int at_event) {
   const int n = w->n;
   martello_peak_ends e;
   int st;
@@ -924,6 +926,7 @@ static int located_peaks(ed_t *w, double t0, double t1) {
   martello_peak_ends_set(&e, 1, n, w->nc, w->nl, w->y + n, w->f1 + n, w->jk1, w->el1);
   e.skip = peak_skip;
   w->t_stretch = t0;
+  if (at_event && (st = martello_peak_fold_end(w->obs, &e, w)) != MARTELLO_OK) return st;
   return martello_locate_peaks(w->obs, &e, t0, t1, w->rtol, w->event_tol, peak_probe, w);
 }
 
@@ -1205,7 +1208,7 @@ static int ed_integrate(ed_t *w) {
       if (st != MARTELLO_OK) return fail_eval(w, st, te);
     }
     st = node_extrema(w, t0, ev == 1 ? te : t);
-    if (st == MARTELLO_OK) st = located_peaks(w, t0, ev == 1 ? te : t);
+    if (st == MARTELLO_OK) st = located_peaks(w, t0, ev == 1 ? te : t, ev == 1);
     if (st != MARTELLO_OK) return st;
     if (ev == 1) {
       t = te;

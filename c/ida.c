@@ -456,7 +456,7 @@ static int integrate(ida_problem *P, SUNContext sunctx, N_Vector yy, N_Vector yp
       if ((st = check(P, f0 < 0 ? f0 : f1, "IDAGetDky"))) break;
     }
     if ((st = oe_inner_events(E, t_last, t_r, N_VGetArrayPointer(yy))) != MARTELLO_OK) break;
-    if ((st = oe_stretch(E, t_last, t_r, N_VGetArrayPointer(yy))) != MARTELLO_OK) break;
+    if ((st = oe_stretch(E, t_last, t_r, N_VGetArrayPointer(yy), restart)) != MARTELLO_OK) break;
     oe_keep_end_rates(E, !restart);
     t_last = t_r;
     E->t_now = t_r;

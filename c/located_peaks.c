@@ -96,6 +96,19 @@ int martello_locate_peaks(martello_observer *obs, const martello_peak_ends *ends
   return MARTELLO_OK;
 }
 
+int martello_peak_fold_end(martello_observer *obs, const martello_peak_ends *ends, void *ctx) {
+  int kind, j, st;
+  for (kind = MARTELLO_PEAK_V; kind <= MARTELLO_PEAK_LINK_DU; kind++) {
+    const double *q1 = ends->q1[kind];
+    if (q1 == NULL) continue;
+    for (j = 0; j < ends->count[kind]; j++) {
+      if (ends->skip != NULL && ends->skip(ctx, kind, j)) continue;
+      if ((st = martello_observer_peak(obs, kind, j, q1[j])) != MARTELLO_OK) return st;
+    }
+  }
+  return MARTELLO_OK;
+}
+
 /* The block of kind's value (and, one block on, of its rate) in the packed element rates. */
 static const double *block(int kind, int nc, int nl, const double *el) {
   switch (kind) {

@@ -191,6 +191,12 @@ typedef int (*martello_peak_probe)(void *ctx, double t, int kind, int index, dou
 int martello_locate_peaks(martello_observer *obs, const martello_peak_ends *ends, double t0,
                           double t1, double rtol, double event_tol, martello_peak_probe probe,
                           void *ctx);
+/* The end of a smooth stretch that ends at an event (an impact, a closing, a release: the
+ * state jumps or kinks there, and the sample after it is the state past the event) is a peak
+ * candidate of its own: every quantity's value q1 there is handed to the observer. A peak
+ * where a velocity jumps -- a node's |v| just before an impact -- is no root of its rate and
+ * would otherwise be missed. */
+int martello_peak_fold_end(martello_observer *obs, const martello_peak_ends *ends, void *ctx);
 /* The rates of one state in the packed layout of the adaptive methods: el holds
  * martello_eval_rates' element outputs in its order (4 blocks of nc, then 4 of nl), jerk the
  * nodes'. */

@@ -447,7 +447,7 @@ static int peak_skip(void *ctx, int kind, int j) {
 /* The peaks inside [t0, t1] of the last step, on its interpolant (docs/run-layer.md, located
  * peaks): every quantity's value and rate at both ends (the start's kept from the last step's
  * end when the integrator went on: E->start_rates), then c/located_peaks.c. */
-static int located_peaks(ode_events *E, double t0, double t1) {
+static int located_peaks(ode_events *E, double t0, double t1, int at_event) {
   const size_t nb = sizeof(double) * (size_t)E->n;
   martello_peak_ends e;
   int st;
@@ -464,13 +464,14 @@ static int located_peaks(ode_events *E, double t0, double t1) {
   martello_peak_ends_set(&e, 0, E->n, E->nc, E->nl, E->pv0, E->pa0, E->pj0, E->el0);
   martello_peak_ends_set(&e, 1, E->n, E->nc, E->nl, E->pv1, E->pa1, E->pj1, E->el1);
   e.skip = peak_skip;
+  if (at_event && (st = martello_peak_fold_end(E->obs, &e, E)) != MARTELLO_OK) return st;
   return martello_locate_peaks(E->obs, &e, t0, t1, E->rtol, E->event_tol, peak_probe, E);
 }
 
-int oe_stretch(ode_events *E, double t0, double t1, const double *y1) {
+int oe_stretch(ode_events *E, double t0, double t1, const double *y1, int at_event) {
   int st = work_quadrature(E, t0, t1);
   if (st == MARTELLO_OK) st = node_extrema(E, t0, t1, y1);
-  if (st == MARTELLO_OK) st = located_peaks(E, t0, t1);
+  if (st == MARTELLO_OK) st = located_peaks(E, t0, t1, at_event);
   return st;
 }
 

@@ -197,8 +197,10 @@ int oe_commit(ode_events *E, const double *u, const double *v);
 /* The works since the last hand-over (once per commit). */
 int oe_hand_work(ode_events *E);
 /* The stretch [t0, t1] of the last step, on its interpolant: the works (3-point Gauss), the
- * node extrema against E->v_last (y1: the state at t1) and the located peaks. */
-int oe_stretch(ode_events *E, double t0, double t1, const double *y1);
+ * node extrema against E->v_last (y1: the state at t1) and the located peaks; at_event: the
+ * integrator restarts at t1 (its state jumps there), so the end is a peak candidate too
+ * (martello_peak_fold_end). */
+int oe_stretch(ode_events *E, double t0, double t1, const double *y1, int at_event);
 /* After a stretch: its end's rates are the next one's start unless the integrator restarts. */
 void oe_keep_end_rates(ode_events *E, int unchanged);
 /* The next stop after t: t_out, or a kink of the load before it. */

@@ -544,7 +544,7 @@ static int integrate(ode_problem *P, SUNContext ctx, N_Vector yy, SUNMatrix *Jp,
     }
     if (again && t_r < tret && (st = interpolant(P, t_r, 0, yy)) != MARTELLO_OK) break;
     if ((st = oe_inner_events(E, t_last, t_r, y)) != MARTELLO_OK) break;
-    if ((st = oe_stretch(E, t_last, t_r, y)) != MARTELLO_OK) break;
+    if ((st = oe_stretch(E, t_last, t_r, y, again)) != MARTELLO_OK) break;
     oe_keep_end_rates(E, !again);
     t_last = t_r;
     E->t_now = t_r;

@@ -346,9 +346,11 @@ contains
       type(model_t), intent(in) :: m
       integer, intent(in) :: j
       real(dp), intent(in) :: u(0:)
-      associate (nd => m%block(j)%node)
-         e = 0.5_dp*dot_product(u(nd), matmul(m%block(j)%k, u(nd)))
-      end associate
+      real(dp) :: x(size(m%block(j)%node))
+      ! the block's displacements as an array of its own (a vector subscript inside matmul
+      ! makes gfortran warn of an uninitialised temporary's descriptor)
+      x = u(m%block(j)%node)
+      e = 0.5_dp*dot_product(x, matmul(m%block(j)%k, x))
    end function block_energy
 
    !> Links whose work is damping (no recoverable energy): the energy balance's split.

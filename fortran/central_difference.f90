@@ -64,9 +64,9 @@ contains
       end if
       if (info == 0 .and. o%omega_max > 0.0_dp) o%dt_critical = 2.0_dp/o%omega_max
       if (s%check_stability .and. o%dt_critical > 0.0_dp .and. self%h > o%dt_critical) then
-         write (msg, '(a,es12.5,a,es12.5,a,es11.4,a)') 'central difference is unstable: dt = ', &
-            self%h, ' s exceeds dt_crit = 2/omega_max = ', o%dt_critical, ' s (omega_max = ', &
-            o%omega_max, ' rad/s, penalty stiffness included); reduce dt or use an implicit integrator'
+         write (msg, '(a,a,a,a,a,a,a)') 'central difference is unstable: dt = ', &
+            sci(self%h, 5), ' s exceeds dt_crit = 2/omega_max = ', sci(o%dt_critical, 5), &
+            ' s (omega_max = ', sci(o%omega_max, 4), ' rad/s, penalty stiffness included); reduce dt or use an implicit integrator'
          call observer_fail(o, MARTELLO_ERR_UNSTABLE, 0.0_dp, msg, stat)
          return
       end if

@@ -180,8 +180,12 @@ contains
 
       subroutine modal_load(pp)
          real(dp), intent(out) :: pp(:)
-         pp = matmul(transpose(self%phi), self%fext(self%free) - self%fint(self%free)) + &
-              self%w2*self%q + self%c*self%qd
+         real(dp) :: r(size(self%free))
+         ! step by step: as one expression gfortran warned of an uninitialised temporary's
+         ! descriptor (the same operations in the same order)
+         r = self%fext(self%free) - self%fint(self%free)
+         pp = matmul(transpose(self%phi), r)
+         pp = pp + self%w2*self%q + self%c*self%qd
       end subroutine modal_load
    end subroutine init
 
@@ -365,8 +369,8 @@ contains
          end if
          previous = change
       end do
-      write (msg, '(a,i0,a,es9.2,a)') 'fast-nonlinear: the pseudo-force iteration did not converge in ', &
-         self%max_iter, ' iterations (last relative change ', change/scale, &
+      write (msg, '(a,i0,a,a,a)') 'fast-nonlinear: the pseudo-force iteration did not converge in ', &
+         self%max_iter, ' iterations (last relative change ', sci(change/scale, 2), &
          '); reduce dt or raise max_newton'
       call stepper_fail(o, MARTELLO_ERR_NOT_CONVERGED, t, trim(msg), stat)
 
@@ -426,8 +430,12 @@ contains
    !> a = Φ q̈ with q̈ = p − c∘q̇ − ω²∘q: the equations of motion at the state.
    subroutine set_acceleration(self)
       class(fast_nonlinear_t), intent(inout) :: self
+      real(dp) :: qdd(size(self%q))
+      ! q̈ first (in the matmul, the expression made gfortran warn of an uninitialised
+      ! temporary's descriptor)
+      qdd = self%p - self%c*self%qd - self%w2*self%q
       self%a = 0.0_dp
-      self%a(self%free) = matmul(self%phi, self%p - self%c*self%qd - self%w2*self%q)
+      self%a(self%free) = matmul(self%phi, qdd)
    end subroutine set_acceleration
 
    !> The exact step of q̈ + c q̇ + ω² q = p(τ), p linear on [0, h]: (q, q̇)(h) =

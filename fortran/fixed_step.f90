@@ -311,7 +311,7 @@ contains
       character(len=*), intent(in) :: what
       integer, intent(out) :: stat
       character(len=len(what) + 32) :: msg
-      write (msg, '(a,a,es12.5,a)') what, ' (t = ', t, ' s)'
+      write (msg, '(a,a,a,a)') what, ' (t = ', sci(t, 5), ' s)'
       call observer_fail(o, code, t, msg, stat)
    end subroutine stepper_fail
 end module martello_fixed_step

@@ -155,10 +155,10 @@ contains
          if (info /= 0 .or. o%omega_max <= 0.0_dp) return
          o%dt_critical = limit/o%omega_max
          if (.not. check .or. h <= o%dt_critical) return
-         write (msg, '(a,es10.3,a,es10.3,a,es12.5,a,es12.5,a,es11.4,a)') 'newmark with beta = ', beta, &
-            ' < gamma/2 (gamma = ', gamma, ') is unstable: dt = ', h, &
-            ' s exceeds dt_crit = 1/(omega_max sqrt(gamma/2 - beta)) = ', o%dt_critical, &
-            ' s (omega_max = ', o%omega_max, ' rad/s, penalty stiffness included); reduce dt or'// &
+         write (msg, '(a,a,a,a,a,a,a,a,a,a,a)') 'newmark with beta = ', sci(beta, 3), &
+            ' < gamma/2 (gamma = ', sci(gamma, 3), ') is unstable: dt = ', sci(h, 5), &
+            ' s exceeds dt_crit = 1/(omega_max sqrt(gamma/2 - beta)) = ', sci(o%dt_critical, 5), &
+            ' s (omega_max = ', sci(o%omega_max, 4), ' rad/s, penalty stiffness included); reduce dt or'// &
             ' take beta >= gamma/2'
          call observer_fail(o, MARTELLO_ERR_UNSTABLE, 0.0_dp, msg, stat)
       end subroutine newmark_stability
@@ -558,9 +558,9 @@ contains
             o%counters(C_CHATTER) = o%counters(C_CHATTER) + 1_i8
          end do
          if (.not. converged) then
-            write (msg, '(a,es12.5,a,i0,a,es9.2,a,es9.2,a)') 'Newton did not converge at t = ', t, &
-               ' s after ', self%max_newton, ' iterations (residual ', rnorm/fscale, &
-               ' of the force scale, tolerance ', self%tol_residual, '); reduce dt'
+            write (msg, '(a,a,a,i0,a,a,a,a,a)') 'Newton did not converge at t = ', sci(t, 5), &
+               ' s after ', self%max_newton, ' iterations (residual ', sci(rnorm/fscale, 2), &
+               ' of the force scale, tolerance ', sci(self%tol_residual, 2), '); reduce dt'
             call observer_fail(o, MARTELLO_ERR_NOT_CONVERGED, t, msg, stat)
          end if
       end subroutine newton_step

@@ -6,7 +6,7 @@
 module martello_integrator_settings
    use, intrinsic :: iso_c_binding, only: c_int, c_double, c_bool
    use martello_kinds, only: dp
-   use martello_status, only: MARTELLO_OK, MARTELLO_ERR_ARGUMENT
+   use martello_status, only: MARTELLO_OK, MARTELLO_ERR_ARGUMENT, sci
    use martello_registry, only: INT_NEWMARK, INT_HHT, INT_GENERALIZED_ALPHA, &
       INT_CENTRAL_DIFFERENCE, INT_MOREAU_JEAN, INT_NEWMARK_LAGRANGE, INT_RKF45, INT_RK8PD, &
       INT_MSBDF, INT_IDA, INT_LAST, SETTINGS, INTEGRATORS, setting_t, NSETTINGS, S_DT, S_T_END, &
@@ -102,7 +102,7 @@ contains
          if (SETTINGS(i)%type == T_INT) then
             write (num, '(i0)') nint(setting_value(s, i))
          else
-            write (num, '(es11.4)') setting_value(s, i)
+            num = sci(setting_value(s, i), 4)
          end if
          message = 'settings.'//trim(SETTINGS(i)%name)//' = '//trim(adjustl(num))// &
             ' is invalid for '//integrator_name(s%kind)//': set it to '//trim(SETTINGS(i)%text)
@@ -118,7 +118,7 @@ contains
          end if
       end if
       if (s%max_steps /= aint(s%max_steps)) then
-         write (num, '(es11.4)') s%max_steps
+         num = sci(s%max_steps, 4)
          message = 'settings.max_steps = '//trim(adjustl(num))//' is invalid for '// &
             integrator_name(s%kind)//': set it to '//trim(SETTINGS(S_MAX_STEPS)%text)
          return

@@ -10,6 +10,8 @@ module martello_model
    use martello_contact_laws, only: NPAR_CONTACT, law_is_known, P_RESTITUTION, P_CLIP
    use martello_links, only: NPAR_LINK, link_is_known, LINK_SPRING, LINK_DASHPOT, LINK_BILINEAR, &
       L_STIFF, L_DAMP, L_YIELD, L_HARDENING
+   use martello_parameter_domains, only: link_domain_problem, contact_domain_problem, &
+      function_domain_problem
    use martello_registry, only: SCHEME_PENALTY, SCHEME_LAGRANGE, SCHEME_AUGMENTED, &
       SCHEME_RESTITUTION, registry_name
    use martello_element_rows, only: rows_t, rows_init, rows_append, rows_append_pair, row_span, &
@@ -408,7 +410,16 @@ contains
       if (.not. all(ieee_is_finite(par))) then
          call fail(m, stat, 'add_link: parameters must be finite'); return
       end if
+      call fail_unless_empty(m, stat, 'add_link: ', link_domain_problem(kind, par))
    end subroutine model_check_link
+
+   !> fail with prefix//problem unless problem is '' (martello_parameter_domains).
+   subroutine fail_unless_empty(m, stat, prefix, problem)
+      type(model_t), intent(inout) :: m
+      integer, intent(inout) :: stat
+      character(len=*), intent(in) :: prefix, problem
+      if (len(problem) > 0) call fail(m, stat, prefix//problem)
+   end subroutine fail_unless_empty
 
    subroutine model_add_contact(m, a, b, gap, scheme, law, par, stat)
       type(model_t), intent(inout) :: m
@@ -491,11 +502,7 @@ contains
          call fail(m, stat, 'add_contact: par[5] and above are reserved and must be 0 (the'// &
                    ' effective mass m* is computed by the library from the masses)'); return
       end if
-      if (scheme == SCHEME_PENALTY .and. par(P_RESTITUTION) >= 0.0_dp) then
-         if (par(P_RESTITUTION) > 1.0_dp) then
-            call fail(m, stat, 'add_contact: target restitution must lie in [0, 1]'); return
-         end if
-      end if
+      call fail_unless_empty(m, stat, 'add_contact: ', contact_domain_problem(scheme, law, par))
    end subroutine model_check_contact
 
    subroutine model_add_mass_coupling(m, a, b, value, stat)
@@ -594,6 +601,8 @@ contains
                  all(ieee_is_finite(y)))) then
          call fail(m, stat, 'time function: values must be finite'); return
       end if
+      call fail_unless_empty(m, stat, 'time function: ', function_domain_problem(kind, par))
+      if (stat /= MARTELLO_OK) return
       if (kind == TF_TABLE) then
          if (size(t) < 2 .or. size(t) /= size(y)) then
             call fail(m, stat, 'time function: a table needs >= 2 (t, y) pairs'); return

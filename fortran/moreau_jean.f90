@@ -382,8 +382,8 @@ contains
                call no_memory('the work arrays of the LCP solver', REAL_BYTES*lcp_work_reals(na))
                return
             else if (inf /= IMPULSE_OK) then
-               write (msg, '(a,i0,a,es12.5,a,i0,a)') 'Moreau-Jean: the impulse LCP on ', na, &
-                  ' active contacts failed at t = ', t, ' s (', iters, &
+               write (msg, '(a,i0,a,a,a,i0,a)') 'Moreau-Jean: the impulse LCP on ', na, &
+                  ' active contacts failed at t = ', sci(t, 5), ' s (', iters, &
                   ' iterations; redundant constraints or a contact between immobile sides?)'
                call observer_fail(o, MARTELLO_ERR_NOT_CONVERGED, t_prev, msg, stat)
                return

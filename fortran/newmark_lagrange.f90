@@ -409,7 +409,7 @@ contains
                   call observer_fail(o, st, t_prev, msg, stat)
                   return
                else if (st /= MARTELLO_OK) then
-                  write (why, '(a,es12.5,a)') 'Newmark-Lagrange: singular KKT system at t = ', t, &
+                  write (why, '(a,a,a)') 'Newmark-Lagrange: singular KKT system at t = ', sci(t, 5), &
                      ' s ('//trim(msg)//')'
                   call observer_fail(o, st, t_prev, why, stat)
                   return
@@ -420,8 +420,8 @@ contains
                end do
             end do
             if (.not. ok) then
-               write (msg, '(a,es12.5,a,i0,a)') 'Newmark-Lagrange: Newton did not converge at t = ', &
-                  t, ' s after ', self%max_newton, ' iterations; reduce dt'
+               write (msg, '(a,a,a,i0,a)') 'Newmark-Lagrange: Newton did not converge at t = ', &
+                  sci(t, 5), ' s after ', self%max_newton, ' iterations; reduce dt'
                call observer_fail(o, MARTELLO_ERR_NOT_CONVERGED, t_prev, msg, stat)
             end if
          end associate

@@ -162,8 +162,8 @@ contains
          if (change <= tol*max(fscale, maxval(abs(p_shift)))) exit
          if (outer == max_iter) then
             stat = MARTELLO_ERR_NOT_CONVERGED
-            write (m%errmsg, '(a,i0,a,es9.2)') 'augmented-lagrange (Uzawa) did not reach tol in ', &
-               max_iter, ' iterations; last multiplier change ', change
+            write (m%errmsg, '(a,i0,a,a)') 'augmented-lagrange (Uzawa) did not reach tol in ', &
+               max_iter, ' iterations; last multiplier change ', sci(change, 2)
             return
          end if
       end do
@@ -384,8 +384,8 @@ contains
          r%digits_lost = min(lost, -log10(epsilon(1.0_dp)))
          if (r%digits_lost > 8.0_dp) then
             stat = MARTELLO_ILL_CONDITIONED
-            write (m%errmsg, '(a,es8.1,a,f4.1,a)') 'ill-conditioned: penalty stiffness eps/k = ', &
-               r%penalty_ratio, ' swamps the structure: K + eps*B*B'' loses about ', &
+            write (m%errmsg, '(a,a,a,f4.1,a)') 'ill-conditioned: penalty stiffness eps/k = ', &
+               sci(r%penalty_ratio, 1), ' swamps the structure: K + eps*B*B'' loses about ', &
                r%digits_lost, ' of 16 significant digits (u cannot resolve the penetration);'// &
                ' lower eps or use scheme lagrange / augmented-lagrange'
          end if

@@ -7,7 +7,7 @@ module martello_status
    use martello_kinds, only: dp
    implicit none
    private
-   public :: out_of_memory, memory_message, REAL_BYTES, INT_BYTES, FIX_SMALLER_SCENE
+   public :: out_of_memory, memory_message, REAL_BYTES, INT_BYTES, FIX_SMALLER_SCENE, sci
    public :: MARTELLO_OK, MARTELLO_ILL_CONDITIONED, MARTELLO_ROOT_FOUND, &
       MARTELLO_ERR_ARGUMENT, MARTELLO_ERR_MEMORY, MARTELLO_ERR_SINGULAR, &
       MARTELLO_ERR_NOT_CONVERGED, MARTELLO_ERR_DIVERGED, MARTELLO_ERR_UNSUPPORTED, &
@@ -86,4 +86,23 @@ contains
       end if
       line = 'out of memory allocating '//what//' ('//trim(amount)//'): '//fix
    end function memory_message
+   !> x in scientific notation with `digits` digits after the point, as messages give numbers:
+   !> what ESw.d writes for it ("1.23450E-01", no padding), with the E of an exponent of
+   !> three digits kept ("1.23450E-303"; ESw.d writes "1.23450-303", which reads as a
+   !> subtraction).
+   pure function sci(x, digits) result(text)
+      real(dp), intent(in) :: x
+      integer, intent(in) :: digits
+      character(len=:), allocatable :: text
+      character(len=48) :: buf, edit
+      integer :: e
+      write (edit, '(a,i0,a)') '(es48.', max(0, min(digits, 30)), 'e3)'
+      write (buf, edit) x
+      text = trim(adjustl(buf))
+      e = index(text, 'E', back=.true.)
+      ! "E+012" -> "E+12": two digits as ESw.d gives when they suffice
+      if (e > 0 .and. len(text) == e + 4) then
+         if (text(e + 2:e + 2) == '0') text = text(:e + 1)//text(e + 3:)
+      end if
+   end function sci
 end module martello_status

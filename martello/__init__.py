@@ -9,7 +9,8 @@ The Python API (docs/python-api.md)::
     martello.closed_forms.newton_impact(1.0, 1.0, 1.0, 0.0, 0.5)
 
 ``load``, ``Scene`` (``Scene.from_dict``), ``run`` -> ``Result``, ``read``, ``reference``,
-``compare``, ``catalogue``, ``closed_forms``, ``__version__`` and the exceptions
+``compare``, ``study``, ``check``, ``plot``, ``catalogue``, ``closed_forms``, ``__version__``
+and the exceptions
 (``MartelloError``, ``SceneError``, ``SolverError``, ``DivergenceError``) are attributes of
 the package, loaded the first time they are used: ``import martello`` itself loads no other
 module of the package, nor numpy or scipy (tests/test_api.py).
@@ -38,13 +39,16 @@ import sys
 # `import martello` (python -X importtime); importlib is imported when a name is first used
 _ModuleType = type(sys)
 
-__all__ = ["DivergenceError", "MartelloError", "Result", "Scene", "SceneError", "SolverError",
-           "catalogue", "closed_forms", "compare", "load", "read", "reference", "run"]
+__all__ = ["CheckResult", "DivergenceError", "MartelloError", "Result", "Scene", "SceneError",
+           "SolverError", "StudyResult", "catalogue", "check", "closed_forms", "compare", "load",
+           "plot", "read", "reference", "run", "study"]
 
 # name -> (module, attribute); attribute None: the module itself
 _LAZY = {"load": ("martello.api", "load"), "read": ("martello.api", "read"),
          "Scene": ("martello.api", "Scene"),
          "Result": ("martello.api", "Result"), "catalogue": ("martello.api", "catalogue"),
+         "StudyResult": ("martello.api", "StudyResult"), "check": ("martello.api", "check"),
+         "CheckResult": ("martello.api", "CheckResult"),
          "closed_forms": ("martello.closed_forms", None),
          "MartelloError": ("martello.errors", "MartelloError"),
          "SceneError": ("martello.errors", "SceneError"),
@@ -76,7 +80,7 @@ def __dir__():
 
 
 class _CallableModule(_ModuleType):
-    """martello.run, martello.reference, martello.compare: a module of the package that is
+    """martello.run, .reference, .compare, .study, .plot: a module of the package that is
     also the API function of its name (martello.api.run, ...). The module is what it was
     (``from martello.run import run_full``); calling it calls the function."""
 
@@ -120,6 +124,8 @@ class _Package(_ModuleType):
     run = _callable_submodule("run")
     reference = _callable_submodule("reference")
     compare = _callable_submodule("compare")
+    study = _callable_submodule("study")
+    plot = _callable_submodule("plot")
 
 
 sys.modules[__name__].__class__ = _Package

@@ -12,12 +12,15 @@ imports what it needs (the run layer, the checks, scipy) when it is first called
 * ``reference(scene)``: the Reference the scene is scored against;
 * ``compare(history, against)``: another code's history scored against a scene's reference,
   as ``martello compare`` does;
+* ``study(file)`` -> ``StudyResult``, ``check(scenes)`` -> ``CheckResult``, ``plot(folder)``:
+  what ``martello study``, ``martello check`` and ``martello plot`` do, their rows given back;
 * ``catalogue()``: the catalogue's scene files.
 
 (``martello.closed_forms``, the oracles by name, is a module of its own: martello/closed_forms.py.)
 
-``martello.run``, ``martello.reference`` and ``martello.compare`` are also the names of the
-package's modules (martello/run.py, martello/reference/, martello/compare.py): the package
+``martello.run``, ``martello.reference``, ``martello.compare``, ``martello.study`` and
+``martello.plot`` are also the names of the package's modules (martello/run.py,
+martello/reference/, martello/compare.py, martello/study/, martello/plot.py): the package
 gives back those modules made callable (martello/__init__.py), and a call goes to the
 function of the same name here, so ``martello.run(scene)`` runs a scene and
 ``from martello.run import run_full`` keeps working."""
@@ -36,7 +39,8 @@ from .scene.loader import Scene
 # The run layer (the native library), the checks, the references and compare (scipy) are
 # imported by the functions that need them: martello.load and martello.Scene stay light.
 
-__all__ = ["Result", "Scene", "catalogue", "compare", "load", "read", "reference", "run"]
+__all__ = ["CheckResult", "Result", "Scene", "StudyResult", "catalogue", "check", "compare", "load",
+           "plot", "read", "reference", "run", "study"]
 
 
 def catalogue():
@@ -232,3 +236,95 @@ def compare(history, against):
             write_history(path, history.columns, history.data)
             return _compare_history(path, against)
     return _compare_history(history, against)
+
+
+class StudyResult:
+    """What ``martello.study`` gives back: ``rows`` (one dict per run, the columns of
+    runs.csv — or of atlas.csv for an atlas), ``orders`` (the measured orders of orders.csv;
+    for an atlas, its stability boundaries), ``folder`` (where it wrote them, with study.md and
+    the plots) and ``kind`` ("study" or "atlas")."""
+
+    def __init__(self, kind, rows, orders, folder):
+        self.kind, self.rows, self.orders, self.folder = kind, rows, orders, Path(folder)
+
+    def __repr__(self):
+        return f"<martello.StudyResult: {self.kind}, {len(self.rows)} runs in {self.folder}>"
+
+
+def study(file, output=None, *, jobs=0, plots=True, scheduler=None, stream=None):
+    """Run a study or atlas file (docs/studies.md) as ``martello study FILE -o OUTPUT`` does;
+    a ``StudyResult``.
+
+    ``output`` defaults to the study's ``output`` key, else out/studies/<file name>; ``jobs``
+    worker processes (0: every core); ``scheduler`` a Dask scheduler's address to run on
+    instead (a study file's own ``scheduler`` key is never used from here: pass it);
+    progress on ``stream`` (default stderr). Interrupted (Ctrl-C, SIGTERM), it keeps the
+    finished rows in ``output`` and raises martello.errors.Stopped; the same call resumes it
+    (docs/studies.md, "A study stops when asked and resumes")."""
+    from .study import atlas as _atlas, sweep as _sweep
+    from .study.study_file import file_kind, load_study
+    path = Path(file)
+    if file_kind(path) == "atlas":
+        if scheduler:
+            raise MartelloError(f"{path}: a stability atlas runs on the local cores, not on a "
+                                "Dask cluster (leave scheduler out)")
+        spec = _atlas.load_atlas(path)
+        out = _atlas.output_folder(path, spec, output)
+        rows, bounds = _atlas.run_atlas(spec, out, jobs=jobs, plots=plots, stream=stream)
+        return StudyResult("atlas", rows, bounds, out)
+    s = load_study(path)
+    out = _sweep.output_folder(path, s, output)
+    if scheduler:
+        from .study.cluster import dask_executor
+        origin = "given to martello.study"
+        with dask_executor(scheduler, origin) as (executor, workers):
+            rows, orders = _sweep.run_study(s, out, plots=plots, stream=stream, executor=executor,
+                                            where=f"the Dask cluster at {scheduler} ({origin}; "
+                                                  f"{workers} worker(s))")
+    else:
+        rows, orders = _sweep.run_study(s, out, jobs=jobs, plots=plots, stream=stream)
+    return StudyResult("study", rows, orders, out)
+
+
+class CheckResult:
+    """What ``martello.check`` gives back: ``ok`` (no check failed), ``rows`` (the
+    verification table, verification.csv as dicts) and ``folder`` (report.md, the runs, the
+    plots)."""
+
+    def __init__(self, ok, rows, folder):
+        self.ok, self.rows, self.folder = ok, rows, Path(folder)
+
+    def __repr__(self):
+        return (f"<martello.CheckResult: {'ok' if self.ok else 'FAILED'}, {len(self.rows)} rows "
+                f"in {self.folder}>")
+
+
+def check(scenes=None, output="out/check", *, plots=False, stream=None):
+    """Verify scenes against their closed forms and reference data as ``martello check``
+    does (docs/coverage.md): ``scenes`` scene files or catalogue paths (default: the
+    whole catalogue; a scene named must have something to verify); the table is printed on
+    ``stream`` (default stdout) and report.md, verification.csv (and with ``plots`` the PNGs)
+    written in ``output``. A ``CheckResult``."""
+    import csv
+    import sys
+    from .report import check_catalogue
+    files = [_catalogue.find(p) for p in scenes] if scenes else _catalogue.scene_files()
+    out = Path(output)
+    ok = check_catalogue(files, out, plots=plots, stream=stream or sys.stdout,
+                         require_checks=bool(scenes))
+    table = out / "verification.csv"
+    rows = []
+    if table.exists():
+        with open(table, newline="") as fh:
+            rows = list(csv.DictReader(fh))
+    return CheckResult(ok, rows, out)
+
+
+def plot(folder, output=None, *, formats=("png", "svg"), nodes=None, contacts=None, metric=None):
+    """The pictures ``martello plot FOLDER`` draws of a run folder (histories, phase
+    portraits, force against penetration, hysteresis loops, energy terms) or a study folder
+    (error against the step, work-precision), in ``output`` (default FOLDER/plots); the list
+    of files written (docs/plot.md)."""
+    from .plot import plot_folder
+    return plot_folder(folder, output, tuple(formats), nodes=nodes, contacts=contacts,
+                       metric=metric)[1]

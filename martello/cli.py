@@ -62,8 +62,15 @@ def cmd_run(args):
     check_output_folder(out, "summary.json", ResultError)   # refused before the run, not after it
     show = sys.stderr.isatty() if args.progress is None else args.progress
     line = ProgressLine(sys.stderr) if show else None
+    pace = None if args.force or s.analysis["type"] != "dynamic" else PaceLimit(
+        s, s.analysis["integrator"] in native.adaptive_integrators())
+    reporters = [r for r in (pace, line) if r is not None]
+
+    def report(t, t_end, steps, elapsed):
+        for r in reporters:
+            r(t, t_end, steps, elapsed)
     try:
-        with native.reporting(line):
+        with native.reporting(report if reporters else None):
             summary, history = run_measured(s)   # with the problem's measures (P4), as check does
     finally:
         if line:
@@ -78,6 +85,39 @@ def cmd_run(args):
     if args.print:
         print(json.dumps(summary, indent=2, default=float))
     return 0
+
+
+class PaceLimit:
+    """The estimate of a dynamic run's time from its pace, the budget of `martello run` that
+    no count of steps gives up front for an adaptive integrator (its steps are its own) nor
+    for a costly step: once a run has gone PILOT_S seconds, the time it would take at its
+    pace so far (elapsed x t_end / t) is checked once; past BUDGET_S the run is stopped with
+    a SceneError naming the setting to change, unless --force (then this is not called)."""
+
+    PILOT_S, BUDGET_S = 10.0, 3600.0
+
+    def __init__(self, scene, adaptive):
+        self.scene, self.adaptive, self.checked, self.last = scene, adaptive, False, -1.0
+
+    def __call__(self, t, t_end, steps, elapsed):
+        if elapsed < self.last:          # the next run of the same command (P4's measures)
+            self.checked = False
+        self.last = elapsed
+        if self.checked or elapsed < self.PILOT_S:
+            return
+        self.checked = True
+        projected = elapsed * t_end / t if t > 0 else float("inf")
+        if projected <= self.BUDGET_S:
+            return
+        key = "rtol" if self.adaptive else "dt"
+        fix = ("loosen rtol, cap the step (h_max) or take another integrator"
+               if self.adaptive else "raise dt, shorten t_end or take a cheaper integrator")
+        raise errors.SceneError(
+            self.scene.source, f"analysis.{key}",
+            f"at its pace over its first {elapsed:.0f} s (t = {t:.4g} of {t_end:.4g} s, "
+            f"{steps} steps) the run would take about {_duration(projected)}, more than the "
+            f"{_duration(self.BUDGET_S)} a run may take without --force",
+            f"{fix}; --force runs it anyway")
 
 
 class ProgressLine:
@@ -277,7 +317,8 @@ def main(argv=None):
     p.add_argument("-o", "--output", type=_path, help="output folder (default: out/<scene name>)")
     p.add_argument("--print", action="store_true", help="also print the summary")
     p.add_argument("--force", action="store_true",
-                   help="run even if it needs more than 1e9 node-steps or writes more than 1 GB")
+                   help="run even if it needs more than 1e9 node-steps, writes more than 1 GB, or "
+                   "at its pace over its first 10 s would take more than an hour")
     p.add_argument("--progress", action=argparse.BooleanOptionalAction, default=None,
                    help="a progress line on stderr for a run longer than a second (default: "
                    "when stderr is a terminal)")

@@ -21,7 +21,7 @@ import numpy as np
 
 from .checks.verify import digits, lookup, oracle_values
 from .errors import MartelloError
-from .history import history_dict
+from .history import history_dict, parse_csv
 from .paths import MiB, UnreadableFile, check_regular, read_input, write_text_atomic
 from .metrics.from_history import summary_from_history
 from .metrics.score import COST_KEYS, history_errors, score
@@ -72,57 +72,15 @@ def _check_names(path, header, scene, hline):
 def read_history(path, scene=None):
     """Read and validate a history CSV; returns (columns, 2D array). Lines starting with #
     are comments. Errors name the line: a missing t column, a column that names no node or
-    contact of the scene, a non-numeric or non-finite value, times that do not increase."""
+    contact of the scene, a non-numeric or non-finite value, times that do not increase
+    (martello.history.parse_csv)."""
     path = Path(path)
     try:
         raw = read_input(path, HISTORY_LIMIT)
     except UnreadableFile as exc:
         raise HistoryError(path, exc.problem, exc.fix) from None
-    try:
-        text = raw.decode("utf-8-sig")
-    except UnicodeDecodeError as exc:
-        line = raw.count(b"\n", 0, exc.start) + 1
-        raise HistoryError(path, f"byte {exc.start + 1} is not UTF-8 text",
-                           "a history is a UTF-8 (or ASCII) CSV file", row=line) from None
-    lines = [(i + 1, ln) for i, ln in enumerate(text.splitlines())
-             if ln.strip() and not ln.lstrip().startswith("#")]
-    if not lines:
-        raise HistoryError(path, "is empty", "a header row (t,u:<node>,...) and data rows")
-    hline, header = lines[0][0], [c.strip() for c in next(csv.reader([lines[0][1]]))]
-    if "t" not in header:
-        raise HistoryError(path, "missing column t", "the first row must name the columns, "
-                           "one of them t (time in s); see docs/compare.md", row=hline)
-    if len(set(header)) != len(header):
-        dup = sorted({c for c in header if header.count(c) > 1})
-        raise HistoryError(path, f"duplicate column(s) {', '.join(dup)}", row=hline)
-    _check_names(path, header, scene, hline)
-    rows = []
-    for lineno, ln in lines[1:]:
-        cells = next(csv.reader([ln]))
-        if len(cells) != len(header):
-            raise HistoryError(path, f"{len(cells)} values for {len(header)} columns", row=lineno)
-        vals = []
-        for c, cell in zip(header, cells):
-            try:
-                x = float(cell)
-            except ValueError:
-                raise HistoryError(path, f"column {c}: {cell.strip()!r} is not a number", row=lineno) from None
-            if not math.isfinite(x):
-                raise HistoryError(path, f"column {c} is {cell.strip()} (NaN or inf)",
-                                   "a history must be finite; cut it before the solver failed", row=lineno)
-            vals.append(x)
-        rows.append((lineno, vals))
-    if len(rows) < 2:
-        raise HistoryError(path, f"{len(rows)} data row(s)", "a history needs at least two times")
-    data = np.array([v for _, v in rows], float)
-    t = data[:, header.index("t")]
-    bad = np.nonzero(np.diff(t) <= 0)[0]
-    if len(bad):
-        i = int(bad[0]) + 1
-        raise HistoryError(path, f"t = {float(t[i])!r} does not follow t = {float(t[i - 1])!r}",
-                           "times must increase strictly: remove repeated or unsorted rows",
-                           row=rows[i][0])
-    return header, data
+    return parse_csv(raw, lambda problem, fix, row: HistoryError(path, problem, fix, row=row),
+                     check_header=lambda header, line: _check_names(path, header, scene, line))
 
 
 def is_recorder_file(path):

@@ -4,6 +4,9 @@ reference at times that are not samples of both)."""
 
 from __future__ import annotations
 
+import csv
+import math
+
 import numpy as np
 
 # Columns of a history, by prefix (martello's own history.csv; docs/compare.md).
@@ -72,3 +75,80 @@ def history_dict(history):
     columns, data = history
     data = np.asarray(data, float).reshape(-1, len(columns))
     return {c: data[:, i] for i, c in enumerate(columns)}
+
+
+def parse_csv(raw, error, finite=True, check_header=None):
+    """(columns, 2D array) of the bytes of a history CSV (martello's history.csv, a
+    reference's, another code's: docs/compare.md): a header row naming the columns, one of
+    them t, then rows of one number per column, t increasing strictly; lines starting with #
+    are comments. Anything else is error(problem, fix, line) (the caller's exception naming
+    its file, raised here), never numpy's or Python's own: text that is not UTF-8, a missing
+    or repeated column, a row of the wrong length, a value that is not a number or, with
+    finite=True, not finite (NaN is a value of martello's own histories where an integrator
+    does not report a link). check_header(header, line), if given, sees the columns before
+    the rows are read. The caller reads the file (martello.paths.read_input: bounded, a
+    regular file)."""
+    try:
+        text = raw.decode("utf-8-sig")
+    except UnicodeDecodeError as exc:
+        line = raw.count(b"\n", 0, exc.start) + 1
+        raise error(f"byte {exc.start + 1} is not UTF-8 text",
+                    "a history is a UTF-8 (or ASCII) CSV file", line) from None
+    lines = [(i + 1, ln) for i, ln in enumerate(text.splitlines())
+             if ln.strip() and not ln.lstrip().startswith("#")]
+    if not lines:
+        raise error("is empty", "a header row (t,u:<node>,...) and data rows", None)
+    hline, header = lines[0][0], [c.strip() for c in next(csv.reader([lines[0][1]]))]
+    if "t" not in header:
+        raise error("missing column t", "the first row must name the columns, one of them t "
+                    "(time in s); see docs/compare.md", hline)
+    if len(set(header)) != len(header):
+        dup = sorted({c for c in header if header.count(c) > 1})
+        raise error(f"duplicate column(s) {', '.join(dup)}", None, hline)
+    if check_header is not None:
+        check_header(header, hline)
+    body = lines[1:]
+    data = None
+    try:        # numpy's parser first (fast); the loop below says what is wrong, and where
+        data = np.loadtxt([ln for _, ln in body], delimiter=",", ndmin=2, dtype=float)
+        if data.shape != (len(body), len(header)):
+            data = None
+    except ValueError:
+        data = None
+    if data is not None:
+        if finite and not np.isfinite(data).all():
+            i, j = np.argwhere(~np.isfinite(data))[0]
+            cell = next(csv.reader([body[i][1]]))[j].strip()
+            raise error(f"column {header[j]} is {cell} (NaN or inf)",
+                        "a history must be finite; cut it before the solver failed", body[i][0])
+        return _increasing(header, data, [n for n, _ in body], error)
+    rows = []
+    for lineno, ln in body:
+        cells = next(csv.reader([ln]))
+        if len(cells) != len(header):
+            raise error(f"{len(cells)} values for {len(header)} columns", None, lineno)
+        vals = []
+        for c, cell in zip(header, cells):
+            try:
+                x = float(cell)
+            except ValueError:
+                raise error(f"column {c}: {cell.strip()!r} is not a number", None, lineno) from None
+            if finite and not math.isfinite(x):
+                raise error(f"column {c} is {cell.strip()} (NaN or inf)",
+                            "a history must be finite; cut it before the solver failed", lineno)
+            vals.append(x)
+        rows.append((lineno, vals))
+    return _increasing(header, np.array([v for _, v in rows], float), [n for n, _ in rows], error)
+
+
+def _increasing(header, data, lines, error):
+    """(header, data) once its times are checked: at least two, increasing strictly."""
+    if len(data) < 2:
+        raise error(f"{len(data)} data row(s)", "a history needs at least two times", None)
+    t = data[:, header.index("t")]
+    bad = np.nonzero(~(np.diff(t) > 0))[0]
+    if len(bad):
+        i = int(bad[0]) + 1
+        raise error(f"t = {float(t[i])!r} does not follow t = {float(t[i - 1])!r}",
+                    "times must increase strictly: remove repeated or unsorted rows", lines[i])
+    return header, data

@@ -19,6 +19,8 @@ from pathlib import Path
 import numpy as np
 
 from .errors import MartelloError
+from .history import parse_csv
+from .paths import MiB, UnreadableFile, read_input
 from .study.output import slug
 from .study.sweep import METRIC_LABELS
 
@@ -46,6 +48,13 @@ def _pyplot():
 
 
 def _save(fig, outdir, stem, formats):
+    # made at the first picture, once the inputs are read: a folder that cannot be plotted
+    # leaves nothing behind
+    try:
+        outdir.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise PlotError(f"{outdir}: cannot create the folder for the pictures: "
+                        f"{exc.strerror or exc}") from None
     paths = []
     for fmt in formats:
         p = outdir / f"{stem}.{fmt}"
@@ -73,18 +82,70 @@ def _finish(fig, title, outdir, stem, formats):
     return _save(fig, outdir, stem, formats)
 
 
+# what a run folder's files may weigh to be read here (a large scene writes its per-item
+# results as arrays, not in summary.json: docs/results.md)
+SUMMARY_LIMIT, HISTORY_LIMIT = 1024 * MiB, 4096 * MiB
+RERUN = "written by martello run: run the scene again to write it whole"
+
+
+def _bytes(path, limit):
+    try:
+        return read_input(path, limit)
+    except UnreadableFile as exc:
+        raise PlotError(f"{path}: {exc}") from None
+
+
 def read_run_history(path):
     """history.csv of a run as (columns, {column: values}); NaN is allowed (link columns of
-    an integrator that does not report links)."""
-    with open(path) as fh:
-        header = fh.readline().strip().split(",")
-    if not header or header[0] != "t":
-        raise PlotError(f"{path}: not a martello history (the first column must be t)")
-    data = np.loadtxt(path, delimiter=",", skiprows=1, ndmin=2)
-    if data.shape[1] != len(header) or len(data) < 2:
-        raise PlotError(f"{path}: {len(data)} row(s) of {data.shape[1]} values for {len(header)} "
-                        "columns: a history needs at least two rows of one value per column")
+    an integrator that does not report links). A file cut short or edited is one PlotError
+    naming the line (martello.history.parse_csv)."""
+    def error(problem, fix, line):
+        where = f"{path}:{line}" if line else str(path)
+        return PlotError(f"{where}: {problem} ({fix or RERUN})")
+    header, data = parse_csv(_bytes(path, HISTORY_LIMIT), error, finite=False)
     return header, {c: data[:, i] for i, c in enumerate(header)}
+
+
+def read_run_summary(path):
+    """summary.json of a run as a dict; PlotError if it is not one (cut short, edited)."""
+    try:
+        summary = json.loads(_bytes(path, SUMMARY_LIMIT))
+    except (ValueError, UnicodeDecodeError) as exc:
+        raise PlotError(f"{path}: not valid JSON ({' '.join(str(exc).split())}) ({RERUN})") from None
+    if not isinstance(summary, dict):
+        raise PlotError(f"{path}: holds a {type(summary).__name__}, not a run's summary ({RERUN})")
+    return summary
+
+
+def read_table(path, required):
+    """The rows of a study's CSV (runs.csv, orders.csv) as dicts; PlotError naming the file
+    and line if it is not one: not UTF-8 text, a column of `required` missing, a row cut
+    short or with more cells than the header."""
+    try:
+        text = _bytes(path, SUMMARY_LIMIT).decode("utf-8")
+    except UnicodeDecodeError as exc:
+        raise PlotError(f"{path}: byte {exc.start + 1} is not UTF-8 text (written by martello "
+                        "study: run the study again to write it whole)") from None
+    reader = csv.DictReader(text.splitlines())
+    missing = [c for c in required if c not in (reader.fieldnames or [])]
+    if missing:
+        raise PlotError(f"{path}: no column {', '.join(missing)}: not a file written by martello "
+                        "study (run the study again to write it whole)")
+    rows = []
+    for row in reader:
+        if None in row or None in row.values():
+            raise PlotError(f"{path}:{reader.line_num}: the row has "
+                            f"{'more' if None in row else 'fewer'} cells than the header (the file "
+                            "was cut short or edited: run the study again to write it whole)")
+        rows.append(row)
+    return rows
+
+
+def _table(d, key):
+    """d[key] if it is a table (a dict), else an empty one: what plot_run reads of a summary
+    is labels, and a label that is missing or edited is left out, not an error."""
+    v = d.get(key) if isinstance(d, dict) else None
+    return v if isinstance(v, dict) else {}
 
 
 def _names(columns, kind):
@@ -104,17 +165,18 @@ def _select(available, wanted, what, limit):
 def plot_run(folder, outdir, formats=FORMATS, nodes=None, contacts=None, limit=6):
     """The pictures of one run; returns the files written."""
     folder = Path(folder)
-    summary = json.loads((folder / "summary.json").read_text())
+    summary = read_run_summary(folder / "summary.json")
     if not (folder / "history.csv").exists():
         raise PlotError(f"{folder}: a static run (summary.json, no history.csv): nothing to plot "
                         "over time; its numbers are in summary.json")
     columns, h = read_run_history(folder / "history.csv")
     plt = _pyplot()
     t = h["t"]
-    an = summary.get("analysis", {})
+    an = _table(summary, "analysis")
     spacing = float(np.median(np.diff(t)))
+    dt = an.get("dt")
     title = (f"{summary.get('title', folder.name)}\n{an.get('integrator', '')}"
-             + (f", Δt = {an['dt']:g} s" if "dt" in an else "")
+             + (f", Δt = {dt:g} s" if isinstance(dt, (int, float)) else "")
              + f", samples every {spacing:.3g} s — {summary.get('status', '')}")
     all_nodes, all_contacts = _names(columns, "u"), _names(columns, "force")
     node_sel = _select(all_nodes, nodes, "nodes", limit)
@@ -172,7 +234,7 @@ def plot_run(folder, outdir, formats=FORMATS, nodes=None, contacts=None, limit=6
             ax.ticklabel_format(axis="x", style="sci", scilimits=(-2, 3), useMathText=True)
             ax.set_xlabel(f"penetration δ of {c} [m] (> 0 in contact)")
             ax.set_ylabel("contact force P [N]")
-            law = summary.get("contacts", {}).get(c, {})
+            law = _table(_table(summary, "contacts"), c)
             ax.set_title(f"{c}: {law.get('scheme', '')} {law.get('law') or ''}, "
                          f"{len(edges) // 2} contact phase(s)", fontsize=9)
             ax.grid(True, alpha=0.3)
@@ -186,7 +248,7 @@ def plot_run(folder, outdir, formats=FORMATS, nodes=None, contacts=None, limit=6
         for ax, ln in zip(axes, links):
             ax.plot(h[f"elongation:{ln}"], h[f"link_force:{ln}"], lw=0.9)
             ax.ticklabel_format(style="sci", scilimits=(-2, 4), useMathText=True)
-            kind = summary.get("links", {}).get(ln, {}).get("type", "")
+            kind = _table(_table(summary, "links"), ln).get("type", "")
             ax.set_xlabel("elongation u_a − u_b [m]")
             ax.set_ylabel("link force f [N]")
             ax.set_title(f"{ln} ({kind})", fontsize=9)
@@ -227,8 +289,7 @@ def plot_study(folder, outdir, formats=FORMATS, metric="max_rel_error"):
     """The pictures of a study folder, from its runs.csv (and orders.csv): per case, error
     against Δt and work-precision. Returns the files written."""
     folder = Path(folder)
-    with open(folder / "runs.csv", newline="") as fh:
-        runs = list(csv.DictReader(fh))
+    runs = read_table(folder / "runs.csv", ("case", "method", "classification", "dt", "rtol"))
     if not runs:
         raise PlotError(f"{folder / 'runs.csv'}: no runs")
     if metric not in runs[0]:
@@ -237,8 +298,7 @@ def plot_study(folder, outdir, formats=FORMATS, metric="max_rel_error"):
                         + ", ".join(metrics))
     orders = []
     if (folder / "orders.csv").exists():
-        with open(folder / "orders.csv", newline="") as fh:
-            orders = list(csv.DictReader(fh))
+        orders = read_table(folder / "orders.csv", ("case", "method", "metric", "order"))
     plt = _pyplot()
     files = []
     study = runs[0].get("study", folder.name)
@@ -246,6 +306,8 @@ def plot_study(folder, outdir, formats=FORMATS, metric="max_rel_error"):
     for case in dict.fromkeys(r["case"] for r in runs):
         mine = [r for r in runs if r["case"] == case]
         digits = _num(mine[0].get("reference_digits"))
+        if not abs(digits) < 300:      # not a number of digits a reference can have
+            digits = math.nan
         fig, axes = plt.subplots(1, 3, figsize=(15, 4.6))
         for mi, method in enumerate(dict.fromkeys(r["method"] for r in mine)):
             rs = [r for r in mine if r["method"] == method and r["classification"] == "ok"]
@@ -316,7 +378,6 @@ def plot_folder(folder, output=None, formats=FORMATS, **options):
     else:
         raise PlotError(f"{folder}: neither a run folder (summary.json and history.csv, written by "
                         "martello run) nor a study folder (runs.csv, written by martello study)")
-    outdir.mkdir(parents=True, exist_ok=True)
     return kind, fn(folder, outdir, formats, **{k: v for k, v in options.items() if v is not None})
 
 

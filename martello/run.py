@@ -186,8 +186,10 @@ def contact_chunks(segs):
                    np.repeat(row, m, axis=0))
 
 
-def _function_args(fn, source="<scene>"):
-    """A validated function table -> (kind, par[NPAR_TF], t, y) for the native library."""
+def _function_args(fn, source="<scene>", t_end=None):
+    """A validated function table -> (kind, par[NPAR_TF], t, y) for the native library. A
+    record must start within the run, [0, t_end): one that starts before t = 0 would lose
+    its beginning, one that starts at or after t_end would be no load at all."""
     par = np.zeros(constant("NPAR_TF"))
     kind = fn["type"]
     if kind == "constant":
@@ -210,6 +212,15 @@ def _function_args(fn, source="<scene>"):
             if "given" not in fn:
                 raise
             raise exc.within(source, fn["where"], fn["given"]) from None
+        where, given = fn.get("where", "record"), fn.get("given", fn["file"])
+        if rec.t[0] < 0:
+            raise SceneError(source, where, f"{given} starts at t = {float(rec.t[0])!r} s, before "
+                             "the run's t = 0: its samples before 0 would be left out",
+                             "shift its times to start at 0 or later")
+        if t_end is not None and rec.t[0] >= t_end:
+            raise SceneError(source, where, f"{given} starts at t = {float(rec.t[0])!r} s, not "
+                             f"before the run's t_end = {t_end!r} s: the run would see none of it",
+                             "shift its times, or raise analysis.t_end")
         par[0] = 1.0
         return constant("TF_TABLE"), par, rec.t, rec.accel
     raise AssertionError(kind)
@@ -263,7 +274,8 @@ def build_model(scene, chain_door=True):
     for f in scene.forces:
         m.add_nodal_force(f["node"], *_function_args(f["function"], scene.source))
     if scene.ground is not None:
-        m.set_ground_acceleration(*_function_args(scene.ground, scene.source))
+        m.set_ground_acceleration(*_function_args(scene.ground, scene.source,
+                                                  scene.analysis.get("t_end")))
     return m
 
 

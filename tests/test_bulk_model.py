@@ -150,5 +150,6 @@ def test_a_bad_entry_is_named_by_its_index():
             m.set_nodes([1.0, 1.0, 0.0, 1.0], [0.0] * 4, [0.0] * 4, [0, 0, 0, 0])
         m.set_nodes([1.0] * 4, [0.0] * 4, [0.0] * 4, [0] * 4)
         par = np.zeros((2, constant("NPAR_LINK")))
+        par[:, constant("L_STIFF")] = 1.0            # a valid spring (k > 0)
         with pytest.raises(SolverError, match=r"entry 1: add_link: nodes out of range"):
             m.add_links([native.value("links", "spring")] * 2, [0, 1], [1, 1], par)

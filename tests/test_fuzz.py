@@ -137,4 +137,23 @@ def test_the_campaign_cases_are_reproducible():
     assert (a.argv, a.files) == (b.argv, b.files)
     kinds = {mutations.make_case(campaign.RandomChooser(f"seed:{i}")).label.split(":")[0]
              for i in range(300)}
-    assert kinds == {"run", "check", "compare", "study", "argv"}
+    assert kinds == {"run", "check", "compare", "study", "argv", "plot"}
+
+
+def test_the_fast_targeted_cases_have_their_outcome(tmp_path):
+    """A sample of the targeted campaign (benchmarks/fuzz/targeted.py; all of it:
+    scripts/fuzz --targeted): the cases that end in about a second, each with the outcome it
+    must have."""
+    import argparse
+    from benchmarks.fuzz import targeted
+    fast = [c for c in targeted.cases() if c.sigint_after is None and c.timeout <= 60
+            and c.argv[0] in ("run", "plot") and "--progress" not in c.argv]
+    assert len(fast) >= 10
+    args = argparse.Namespace(python=sys.executable, memory=4.0, keep=False, out=str(tmp_path / "r"))
+    env = dict(ENV, MARTELLO_LIB=str(ROOT / "build" / "libmartello.so"))
+    real = targeted.cases
+    targeted.cases = lambda: fast
+    try:
+        assert campaign.targeted_campaign(args, env, tmp_path / "work") == 0
+    finally:
+        targeted.cases = real

@@ -402,3 +402,73 @@ def test_a_bug_in_one_scene_does_not_stop_martello_check(tmp_path, monkeypatch):
     text = out.getvalue()
     assert not ok and "internal error: KeyError: 'a bug'" in text
     assert "P1 mass on plane" in text and "1 failure(s); 2 scenes" in text
+
+
+# --- the bad inputs of a later review (issue "one line for every bad input") -----------------
+
+def test_a_subnormal_at2_step_is_refused(tmp_path):
+    rec = PEER.read_text().splitlines()
+    rec[3] = "NPTS=   10, DT= 5e-324 SEC"
+    (tmp_path / "r.AT2").write_text("\n".join(rec[:4] + ["0.1 0.2 0.3 0.4 0.5"] * 2) + "\n")
+    run_fails(tmp_path, sdof_record("r.AT2"), "loads.ground_acceleration.file: r.AT2:4:",
+              "DT=5e-324 s is no sampling step of an accelerogram")
+
+
+@pytest.mark.parametrize("times, words", [
+    ((-1.0, 0.0, 0.01), "r.csv starts at t = -1.0 s, before the run's t = 0"),
+    ((0.05, 0.06, 0.07), "r.csv starts at t = 0.05 s, not before the run's t_end = 0.04 s")])
+def test_a_record_that_starts_outside_the_run_is_refused(tmp_path, times, words):
+    (tmp_path / "r.csv").write_text("".join(f"{t}, 0.5\n" for t in times))
+    run_fails(tmp_path, sdof_record("r.csv"), "s.toml: loads.ground_acceleration.file: " + words)
+
+
+@pytest.mark.parametrize("width", ["1e300", "1e-300"])
+def test_frame_lengths_past_the_doubles_are_one_line(tmp_path, width):
+    text = (ROOT / "benchmarks" / "p10" / "p10_bare.toml").read_text()
+    text = "\n".join(f"bay_width = {width}" if ln.startswith("bay_width") else ln
+                     for ln in text.splitlines())
+    run_fails(tmp_path, text, "s.toml: frame[0]: the condensed stiffness is not finite")
+
+
+def test_a_chain_damping_past_the_doubles_names_the_field_in_one_line(tmp_path):
+    """[[chain]] k = 1e308, mass = 1e5: c = 2 zeta sqrt(k m) overflows. One line naming the
+    chain's zeta (it printed numpy's RuntimeWarnings, then the library's message)."""
+    text = (ROOT / "benchmarks" / "p7" / "p7_chain_10.toml").read_text()
+    text = "\n".join("k = 1e308" if ln.startswith("k = [") else ln for ln in text.splitlines())
+    line = run_fails(tmp_path, text, "s.toml: chain[0].zeta: the damping c = 2 zeta sqrt(k m) of "
+                     "node b1 is not a finite number")
+    assert "RuntimeWarning" not in line
+
+
+STUDY_OF_DATA = """
+title = "data reference"
+[[scene]]
+file = "{scene}"
+reference = {{ data = "{data}" }}
+t_end = 0.1
+[[integrator]]
+name = "newmark"
+dt = [1e-3]
+"""
+
+
+@pytest.mark.parametrize("meta, history, words", [
+    ("{}", "t,u:mass\n0,0\n1,1\n", "reference.json: t_end: None is not a time > 0"),
+    ("[1, 2]", "t,u:mass\n0,0\n1,1\n", "reference.json: holds a list"),
+    ('{"t_end": 1.0}', "t,u:mass\n0,0\n1,x\n", "history.csv:3: column u:mass: 'x' is not a number"),
+    ('{"t_end": 1.0}', "t,u:mass\n0,0\n1", "history.csv:3: 1 values for 2 columns"),
+    ('{"t_end": 1.0, "events": [3]}', "t,u:mass\n0,0\n1,1\n", "reference.json: events: must be a table"),
+    ('{"t_end": 1', "t,u:mass\n0,0\n1,1\n", "reference.json: not valid JSON")])
+def test_a_malformed_reference_named_by_a_study_is_one_line(tmp_path, meta, history, words):
+    """A study's `reference = { data = DIR }`, resolved beside the study file, holding what
+    martello does not write: one line naming the study, the case and the file, nothing
+    written (it was a KeyError, a TypeError or a ValueError)."""
+    (tmp_path / "ref").mkdir()
+    (tmp_path / "ref" / "reference.json").write_text(meta)
+    (tmp_path / "ref" / "history.csv").write_text(history)
+    study = write(tmp_path / "study.toml", STUDY_OF_DATA.format(
+        scene=ROOT / "benchmarks" / "p2" / "p2_penalty_linear.toml", data="ref"))
+    r = martello("study", study, "-o", tmp_path / "out", "--no-plots", cwd=ROOT)
+    one_line_error(r, "study.toml: reference of ", f"{tmp_path / 'ref'}/" + words.split(":")[0],
+                   words.partition(": ")[2] if ": " in words else words)
+    assert not (tmp_path / "out").exists()

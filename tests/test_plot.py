@@ -140,3 +140,38 @@ def test_a_static_run_has_nothing_over_time(tmp_path, capsys):
                  str(tmp_path)]) == 0
     assert main(["plot", str(tmp_path)]) == 1
     assert "a static run" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("name, damage, message", [
+    ("summary.json", lambda t: t[:300], "summary.json: not valid JSON"),
+    ("summary.json", lambda t: "[1, 2]", "summary.json: holds a list, not a run's summary"),
+    ("history.csv", lambda t: t[:len(t) // 2].rsplit(",", 1)[0], "values for"),
+    ("history.csv", lambda t: t.replace("\n0.", "\nx.", 1), "is not a number"),
+    ("history.csv", lambda t: "", "history.csv: is empty"),
+])
+def test_a_run_folder_cut_short_or_edited_is_one_line_and_nothing_drawn(p7_run, tmp_path, capsys,
+                                                                        name, damage, message):
+    """A run folder whose summary.json or history.csv was cut short or edited: one line
+    naming the file (and line), exit 1, no pictures folder (it was a JSONDecodeError or
+    numpy's ValueError)."""
+    folder = tmp_path / "run"
+    folder.mkdir()
+    for f in ("summary.json", "history.csv"):
+        text = (p7_run / f).read_text()
+        (folder / f).write_text(damage(text) if f == name else text)
+    assert main(["plot", str(folder), "-o", str(tmp_path / "pics")]) == 1
+    err = capsys.readouterr().err
+    assert message in err and len(err.strip().splitlines()) == 1, err
+    assert "internal error" not in err and not (tmp_path / "pics").exists()
+
+
+def test_a_study_folder_cut_short_or_edited_is_one_line(tmp_path, capsys):
+    folder = tmp_path / "study"
+    folder.mkdir()
+    (folder / "runs.csv").write_text("case,method,classification,dt,rtol\na,b,ok,0.1,\nc,d\n")
+    assert main(["plot", str(folder), "-o", str(tmp_path / "pics")]) == 1
+    assert "runs.csv:3: the row has fewer cells than the header" in capsys.readouterr().err
+    (folder / "runs.csv").write_bytes(b"\xff\xfe binary")
+    assert main(["plot", str(folder)]) == 1
+    assert "runs.csv: byte 1 is not UTF-8 text" in capsys.readouterr().err
+    assert not (tmp_path / "pics").exists() and not (folder / "plots").exists()

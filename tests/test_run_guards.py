@@ -164,3 +164,66 @@ def test_a_run_let_past_its_stability_limit_says_so_first(tmp_path):
     assert res.status == "MARTELLO_OK"
     assert res.summary["stability"]["dt_critical"] == pytest.approx(0.2, rel=1e-12)
     assert "past the stability limit dt_crit = 0.2 s" in res.summary["warnings"][0]
+
+
+def test_the_pace_limit_stops_a_run_that_would_take_past_the_budget():
+    """martello run's estimate from the pace (cli.PaceLimit): checked once, PILOT_S into a
+    run; past BUDGET_S the run is stopped naming the setting (rtol for an adaptive
+    integrator, dt for a fixed step) and --force; a run within the budget goes on; the next
+    run of the same command (P4's measures) is checked again."""
+    from martello.cli import PaceLimit
+    from martello.errors import SceneError
+
+    class S:
+        source = "s.toml"
+    lim = PaceLimit(S(), adaptive=True)
+    lim(1e-4, 1.0, 10, 5.0)                         # before the pilot: nothing said
+    with pytest.raises(SceneError, match=r"s.toml: analysis.rtol: at its pace over its first "
+                       r"10 s \(t = 0.001 of 1 s, 100 steps\) the run would take about 2.8 h, "
+                       r"more than the 60 min a run may take without --force \(loosen rtol.*"
+                       r"--force runs it anyway\)"):
+        lim(1e-3, 1.0, 100, 10.0)                   # 10 s for 1/1000 of the run: 2.8 h
+    lim(2e-3, 1.0, 200, 20.0)                       # checked once only
+    fixed = PaceLimit(S(), adaptive=False)
+    fixed(0.5, 1.0, 100, 10.0)                      # 20 s in all: goes on
+    fixed(0.01, 1.0, 100, 0.5)                      # the next run: elapsed starts again
+    with pytest.raises(SceneError, match=r"analysis.dt: .* would take about unknown.*raise dt"):
+        fixed(0.0, 1.0, 5, 10.0)                    # not advanced at all in 10 s
+
+
+def test_a_run_past_the_budget_is_stopped_early_in_one_line(tmp_path, monkeypatch, capsys):
+    """IDA on a 1e14 N/m spring with no step cap (a review measured it running 300 s with
+    no word): stopped once its pilot shows the budget passed, one line, nothing written.
+    The pilot and budget are shortened here (10 s and 1 h in martello run)."""
+    from martello.cli import PaceLimit, main
+    monkeypatch.setattr(PaceLimit, "PILOT_S", 0.5)
+    monkeypatch.setattr(PaceLimit, "BUDGET_S", 30.0)
+    d = {"node": [{"name": "m", "mass": 1.0, "u0": 0.01}],
+         "link": [{"type": "spring", "a": "m", "b": "ground", "k": 1e14}],
+         "analysis": {"type": "dynamic", "integrator": "ida", "dt": 1e-3, "t_end": 10.0}}
+    t0 = time.perf_counter()
+    assert main(["run", str(_write(tmp_path, d)), "-o", str(tmp_path / "o")]) == 1
+    err = capsys.readouterr().err
+    assert time.perf_counter() - t0 < 30, "not stopped early"
+    assert "scene.toml: analysis.rtol: at its pace over its first" in err and "--force" in err
+    assert len(err.strip().splitlines()) == 1 and not (tmp_path / "o").exists()
+
+
+def test_a_slow_step_reports_at_once():
+    """The library looks at the clock after every sample while samples come more than 1 ms
+    apart (observer_watch's stride): msbdf on the 100-element P4 rod, whose first steps take
+    around a second, reports within its first steps (it reported every 32)."""
+    import tomllib
+    scene = martello.load("p4/p4_equal_rods_rk8pd_restitution_e0.toml")
+    d = tomllib.loads(open(scene.source).read().replace('integrator = "rk8pd"',
+                                                        'integrator = "msbdf"'))
+    d.pop("check", None)
+    steps = []
+
+    def reporter(t, t_end, n, elapsed):
+        steps.append(n)
+        if len(steps) == 3:
+            raise KeyboardInterrupt
+    with pytest.raises(KeyboardInterrupt), native.reporting(reporter):
+        martello.run(d)
+    assert steps[0] < 32 and steps == sorted(steps), steps

@@ -183,3 +183,62 @@ def test_progress_bar_plain_text():
         p.update(ok=i != 3)
     lines = buf.getvalue().splitlines()
     assert 5 <= len(lines) <= 11 and "20/20 runs" in lines[-1] and "1 not ok" in lines[-1]
+
+
+DATA_STUDY = """
+title = "own reference data"
+[[scene]]
+file = "{scene}"
+reference = {reference}
+t_end = 0.5
+[[integrator]]
+name = "newmark"
+dt = [1e-3]
+"""
+
+
+def _copy_reference(src, dest, **meta):
+    import json
+    import shutil
+    shutil.copytree(src, dest)
+    m = json.loads((dest / "reference.json").read_text())
+    m.update(meta)
+    (dest / "reference.json").write_text(json.dumps(m))
+
+
+def test_a_reference_folder_is_found_beside_the_study_file(tmp_path, capsys):
+    """`reference = { data = DIR }` relative to the study file's folder (it was resolved in
+    the repository, or site-packages once installed)."""
+    from martello.cli import main
+    _copy_reference(ROOT / "reference" / "p7_two_oscillators", tmp_path / "mine")
+    study = write(tmp_path, DATA_STUDY.format(scene=ROOT / "benchmarks" / "p7" / "p7_two_oscillators.toml",
+                                              reference='{ data = "mine" }'))
+    assert main(["study", str(study), "-o", str(tmp_path / "out"), "-j", "1", "--no-plots"]) == 0
+    row = next(csv.DictReader(open(tmp_path / "out" / "runs.csv")))
+    assert row["reference"] == "reference/mine" and float(row["max_rel_error"]) < 1e-2
+
+
+def test_a_study_uses_the_reference_martello_reference_cached(tmp_path, monkeypatch, capsys):
+    """A scene with no closed form and no stored data: the study scores it against the
+    reference `martello reference` cached for its physics (it reported "no reference")."""
+    from martello import load
+    from martello.cli import main
+    from martello.reference import cache
+    from martello.reference.store import physics_digest
+    scene = tmp_path / "heavier.toml"
+    scene.write_text((ROOT / "benchmarks" / "p7" / "p7_two_oscillators.toml").read_text()
+                     .replace("mass = 1.0", "mass = 1.25", 1))
+    monkeypatch.setenv(cache.ENV_CACHE, str(tmp_path / "cache"))
+    s = load(scene)
+    assert s.nodes[0]["mass"] == 1.25
+    # a stand-in for what `martello reference heavier.toml` writes (its numbers are not
+    # checked here: the test is which reference the study takes)
+    _copy_reference(ROOT / "reference" / "p7_two_oscillators",
+                    tmp_path / "cache" / "references" / cache.cache_key(s),
+                    physics_sha256=physics_digest(s), format=cache.FORMAT)
+    study = write(tmp_path, DATA_STUDY.format(scene=scene, reference='"auto"'))
+    assert main(["study", str(study), "-o", str(tmp_path / "out"), "-j", "1", "--no-plots"]) == 0
+    err = capsys.readouterr().err
+    row = next(csv.DictReader(open(tmp_path / "out" / "runs.csv")))
+    assert row["reference"].startswith("computed reference " + cache.cache_key(s)), row["reference"]
+    assert "cached by martello reference" in err and row["max_rel_error"]

@@ -102,7 +102,8 @@ def classify(case, proc, before, after, folder):
             and not err.strip():
         return "clean error", "check failed: " + proc.stdout.strip().splitlines()[-1][:160]
     lines = [ln for ln in err.splitlines() if ln.strip()]
-    extra = [ln for ln in lines if not ln.startswith(("warning:", "usage:", "  ", "note:", "["))]
+    # besides the error: warnings, usage, notes, progress bars ([...]) and lines ("t = ...")
+    extra = [ln for ln in lines if not ln.startswith(("warning:", "usage:", "  ", "note:", "[", "t = "))]
     one = len(extra) == 1 and "error:" in extra[0]
     if case.argv[:1] in (["check"], ["study"]) and one:
         return "clean error", extra[0][:200]       # their reports are written by design
@@ -122,7 +123,12 @@ def _limit_memory(gib):
 
 
 def run_case(i, args, env, work):
-    case = mutations.make_case(RandomChooser(f"{args.seed}:{i}"))
+    return run_one(i, mutations.make_case(RandomChooser(f"{args.seed}:{i}")), args, env, work)
+
+
+def run_one(i, case, args, env, work):
+    """Run one Case (`case.env`, if it has one, is added to the environment)."""
+    env = dict(env, **getattr(case, "env", {}))
     folder = Path(work) / f"case{i:06d}"
     folder.mkdir(parents=True)
     try:
@@ -148,6 +154,170 @@ def run_case(i, args, env, work):
             shutil.rmtree(folder, ignore_errors=True)
 
 
+# --- the loader campaign: scenes mutated in this process, no command line ------------------
+
+LOADER_CLASSES = ("loads", "clean error", "several lines", "warning", "internal error", "hang")
+
+
+class _Hang(BaseException):
+    pass
+
+
+def loader_case(i, seed, scenes, tmp):
+    """One mutated scene through the loader (as tests/test_fuzz.py's property, drawn from
+    random.Random): (class, label, detail)."""
+    import warnings
+    from martello.errors import MartelloError
+    from martello.scene.loader import from_dict, load
+    ch = RandomChooser(f"{seed}:loader:{i}")
+    name = ch.choice(scenes)
+    d = mutations.scene_dict(name)
+    how = ch.integer(0, 9)
+    src = mutations.BENCHMARKS / f"{name}.toml"
+    if how <= 4:
+        d, label = mutations.mutate_dict(ch, d), "mutated dict"
+    elif how <= 7:
+        label = ch.choice(sorted(mutations.TARGETED))
+        try:
+            mutations.TARGETED[label](d, ch)
+        except (AttributeError, TypeError, IndexError, KeyError):
+            pass
+        if isinstance(d.get("description"), mutations.Deep):
+            d["description"] = "x"      # deep nesting is the text cases' (a dict cannot hold it)
+    else:
+        label = "damaged text"
+        (tmp / "s.toml").write_bytes(mutations.mutate_text(ch, src.read_text()))
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        try:
+            if label == "damaged text":
+                load(tmp / "s.toml")
+            else:
+                from_dict(d, source=str(src), base_dir=src.parent)
+            cls, detail = "loads", ""
+        except MartelloError as exc:
+            msg = str(exc)
+            cls, detail = ("clean error" if msg and "\n" not in msg else "several lines"), msg[:200]
+        except _Hang:
+            cls, detail = "hang", "no end within the timeout"
+        except RecursionError as exc:
+            cls, detail = "internal error", f"RecursionError: {exc}"[:200]
+        except Exception as exc:                         # noqa: BLE001 - what is counted
+            cls, detail = "internal error", f"{type(exc).__name__}: {exc}"[:200]
+    if caught and cls != "internal error":
+        cls, detail = "warning", f"{caught[0].category.__name__}: {caught[0].message}"[:200]
+    return cls, f"{name}: {label}", detail
+
+
+def loader_campaign(args):
+    """--loader N: N scenes of the catalogue mutated (dict edits, the targeted values, damaged
+    text) through the loader in this process, each within --timeout seconds (SIGALRM)."""
+    import signal as _signal
+    from martello.scene import catalogue
+    scenes = [str(f.relative_to(mutations.BENCHMARKS).with_suffix("")) for f in catalogue.scene_files()]
+    counts, examples = Counter(), defaultdict(list)
+    t0 = time.perf_counter()
+
+    def alarm(signum, frame):
+        raise _Hang
+
+    _signal.signal(_signal.SIGALRM, alarm)
+    with tempfile.TemporaryDirectory(prefix="martello-loader-fuzz-") as tmp:
+        for i in range(args.loader):
+            _signal.setitimer(_signal.ITIMER_REAL, args.timeout)
+            try:
+                cls, label, detail = loader_case(i, args.seed, scenes, Path(tmp))
+            finally:
+                _signal.setitimer(_signal.ITIMER_REAL, 0)
+            counts[cls] += 1
+            if cls not in ("loads", "clean error") and len(examples[cls]) < 25:
+                examples[cls].append({"case": i, "label": label, "detail": detail})
+            if (i + 1) % 2000 == 0:
+                print(f"  {i + 1} scenes, {time.perf_counter() - t0:.0f} s: "
+                      + ", ".join(f"{counts[c]} {c}" for c in LOADER_CLASSES if counts[c]),
+                      file=sys.stderr, flush=True)
+    elapsed = time.perf_counter() - t0
+    out = Path(args.out)
+    out.mkdir(parents=True, exist_ok=True)
+    report = {"kind": "loader", "seed": args.seed, "scenes": args.loader,
+              "elapsed_s": round(elapsed, 1), "counts": {c: counts[c] for c in LOADER_CLASSES},
+              "examples": examples}
+    (out / "loader.json").write_text(json.dumps(report, indent=1) + "\n")
+    print(f"{args.loader} scenes through the loader in {elapsed:.0f} s: "
+          + ", ".join(f"{counts[c]} {c}" for c in LOADER_CLASSES))
+    for c in LOADER_CLASSES[2:]:
+        for r in examples[c][:5]:
+            print(f"  {c}: case {r['case']} ({r['label']}): {r['detail']}")
+    return 1 if any(counts[c] for c in LOADER_CLASSES[2:]) else 0
+
+
+# --- the targeted campaign: each review finding with the outcome it must have ---------------
+
+def targeted_campaign(args, env, work):
+    """--targeted: the cases of targeted.py, one by one, each classified as the random
+    campaign's are and compared with the outcome it must have."""
+    import re
+    if __package__:
+        from . import targeted
+    else:
+        import targeted  # noqa: E402
+    results, t_start = [], time.perf_counter()
+    for i, case in enumerate(targeted.cases()):
+        folder = Path(work) / f"targeted{i:03d}"
+        folder.mkdir(parents=True)
+        mutations.lay_out(case, folder)
+        before = snapshot(folder)
+        t0 = time.perf_counter()
+        p = subprocess.Popen([args.python, "-m", "martello", *case.argv], cwd=folder,
+                             env=dict(env, **case.env), stdout=subprocess.PIPE,
+                             stderr=subprocess.PIPE, text=True, errors="replace",
+                             stdin=subprocess.DEVNULL, start_new_session=True,
+                             preexec_fn=lambda: _limit_memory(args.memory))
+        try:
+            if case.sigint_after is not None:
+                time.sleep(case.sigint_after)
+                try:
+                    os.killpg(p.pid, signal.SIGINT)
+                except ProcessLookupError:
+                    pass
+            out, err = p.communicate(timeout=case.timeout)
+            proc = subprocess.CompletedProcess(case.argv, p.returncode, out, err)
+            lines = [ln for ln in err.splitlines()
+                     if ln.strip() and not ln.startswith(("t = ", "[", "warning:", "note:"))]
+            if case.expect == "interrupted" and p.returncode == 130:
+                # one line says it, the last (a study's header line comes before)
+                ok1 = (sum("interrupted" in ln for ln in lines) == 1 and "interrupted" in lines[-1]
+                       and "Traceback" not in err and "error" not in err)
+                got, detail = ("interrupted" if ok1 else "unclean interrupt"), (lines[-1] if lines else "")[:200]
+            elif case.expect == "interrupted" and p.returncode == 0:
+                got, detail = "interrupted", "ended before the signal (exit 0)"
+            else:
+                got, detail = classify(mutations.Case(case.label, case.argv, case.files, case.output),
+                                       proc, before, snapshot(folder), folder)
+            if case.forbid and re.search(case.forbid, err):
+                got, detail = "forbidden text", f"{case.forbid!r} in {err.strip()[-160:]}"
+        except subprocess.TimeoutExpired:
+            os.killpg(p.pid, signal.SIGKILL)
+            p.communicate()
+            got, detail, err = "hang", f"no end within {case.timeout:g} s", ""
+        finally:
+            if not args.keep:
+                shutil.rmtree(folder, ignore_errors=True)
+        wall = time.perf_counter() - t0
+        results.append({"case": case.label, "expected": case.expect, "got": got,
+                        "passed": got == case.expect, "detail": detail, "wall_s": round(wall, 2),
+                        "stderr": err[-400:]})
+        print(f"{'ok  ' if got == case.expect else 'FAIL'} {case.label[:70]:<70} {got:<14} "
+              f"{wall:6.1f} s  {detail[:90]}", flush=True)
+    out = Path(args.out)
+    out.mkdir(parents=True, exist_ok=True)
+    (out / "targeted.json").write_text(json.dumps(results, indent=1) + "\n")
+    bad = [r for r in results if not r["passed"]]
+    print(f"{len(results)} targeted cases in {time.perf_counter() - t_start:.0f} s: "
+          f"{len(results) - len(bad)} as expected, {len(bad)} not")
+    return 1 if bad else 0
+
+
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0],
                                  formatter_class=argparse.RawDescriptionHelpFormatter)
@@ -165,7 +335,15 @@ def main(argv=None):
     ap.add_argument("--only", type=int, nargs="*", help="run only these case numbers")
     ap.add_argument("--keep", action="store_true", help="keep each case's folder")
     ap.add_argument("--out", default="out/fuzz", help="report folder (default out/fuzz)")
+    ap.add_argument("--loader", type=int, metavar="N",
+                    help="instead: N mutated scenes through the loader in this process "
+                    "(no command line; --timeout per scene)")
+    ap.add_argument("--targeted", action="store_true",
+                    help="instead: the command lines of targeted.py, each with the outcome it "
+                    "must have (the bad inputs reviews found, one by one)")
     args = ap.parse_args(argv)
+    if args.loader:
+        return loader_campaign(args)
 
     root = Path(args.root).resolve()
     env = dict(os.environ, PYTHONPATH=str(root), PYTHONDONTWRITEBYTECODE="1",
@@ -174,6 +352,12 @@ def main(argv=None):
                                 else root / "build" / "libmartello.so"))
     env.pop("MARTELLO_DEBUG", None)
     work = tempfile.mkdtemp(prefix="martello-fuzz-")
+    if args.targeted:
+        try:
+            return targeted_campaign(args, env, work)
+        finally:
+            if not args.keep:
+                shutil.rmtree(work, ignore_errors=True)
     cases = args.only if args.only else range(args.n)
     counts, by_label, examples, results = Counter(), defaultdict(Counter), defaultdict(list), []
     t0 = time.perf_counter()

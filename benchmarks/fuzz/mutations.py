@@ -209,6 +209,13 @@ TARGETED = {
                                           "provenance.libraries", "cost"]),
                      "oracle": ch.choice(["restitution", "contact_time", "nope"]),
                      "rtol": 1e-3, "why": "fuzz"}]}),
+    # a later review's findings: lengths and products past the doubles
+    "frame lengths past the doubles": lambda d, ch: d.update(frame=[dict(
+        _P10_FRAME, prefix="fz", **{ch.choice(["bay_width", "storey_height"]):
+                                    ch.choice([1e300, 1e-300, 1e200, 5e-324])})]),
+    "chain damping overflow": lambda d, ch: d.update(chain=[{
+        "prefix": "q", "n": 3, "mass": ch.choice([1e5, 1e300]), "k": ch.choice([1e308, 1e300, 1e-300]),
+        "zeta": ch.choice([0.05, 9.0])}]),
     "record path": lambda d, ch: d.setdefault("loads", {}).__setitem__(
         "ground_acceleration", {"type": "record", "file": ch.choice(
             ["../../etc/passwd", "/dev/zero", "fifo.csv", ".", "records", "missing.AT2",
@@ -216,6 +223,10 @@ TARGETED = {
                                 **ch.choice([{}, {"format": "csv"}, {"format": "at2"},
                                              {"format": "wav"}, {"units": "furlongs"}])}),
 }
+
+
+# a planar frame's table ([[frame]] of P10), to place with extreme dimensions
+_P10_FRAME = {k: v for k, v in scene_dict("p10/p10_bare")["frame"][0].items() if k != "prefix"}
 
 
 def mutate_text(ch, text):
@@ -387,6 +398,7 @@ def study_case(ch):
 
 def argv_case(ch):
     argv = ch.choice([["run"], ["run", "--nope"], ["frobnicate"], ["run", "-o"], ["--version"],
+                      ["run", "a/b/scene.toml", "-o", ""], ["study", "x.toml", "-o", ""],
                       ["list", "extra"], ["check", "--no-plots", "-o", "afile"],
                       ["compare", "x.csv"], ["study"], ["run", "\udcff.toml"], ["-h"],
                       ["run", "a/b/scene.toml", "--force", "-o", "out/run"]])
@@ -394,8 +406,80 @@ def argv_case(ch):
     return Case("argv: " + " ".join(argv)[:30], list(argv), files, None)
 
 
+# A run folder and a study folder as martello writes them (small), for plot to draw once
+# damaged.
+RUN_SUMMARY = {"title": "fuzz", "status": "MARTELLO_OK",
+               "analysis": {"integrator": "newmark", "dt": 1e-3},
+               "contacts": {"c": {"scheme": "penalty", "law": "linear"}}, "links": {}}
+RUN_HISTORY = "t,u:m,v:m,penetration:c,force:c,energy:kinetic\n" + "".join(
+    f"{i * 1e-3:.6g},{0.01 * i:.6g},0.1,{0.001 * (i % 3) - 0.001:.6g},{10.0 * (i % 3):.6g},"
+    f"{0.5 * i:.6g}\n" for i in range(40))
+RUNS_CSV = ("run,study,case,method,integrator,dt,rtol,status,classification,max_rel_error,"
+            "wall_time_s,residual_evaluations,reference,reference_digits\n" + "".join(
+                f"{i},fuzz,P2,newmark,newmark,{1e-3 / 2 ** i!r},,MARTELLO_OK,ok,{1e-2 / 4 ** i!r},"
+                f"{0.01 * 2 ** i!r},{100 * 2 ** i},closed form,13.0\n" for i in range(5)))
+
+
+def plot_case(ch):
+    """martello plot on a run or study folder, one of its files cut short, edited or replaced."""
+    run = ch.coin(0.6)
+    files = ({"f/summary.json": json.dumps(RUN_SUMMARY).encode(), "f/history.csv": RUN_HISTORY.encode()}
+             if run else {"f/runs.csv": RUNS_CSV.encode()})
+    name = ch.choice(sorted(files))
+    text = files[name].decode()
+    op = ch.integer(0, 5)
+    if op == 0:
+        files[name] = text[:ch.integer(0, len(text))].encode()
+    elif op == 1:
+        files[name] = mutate_text(ch, text)
+    elif op == 2 and name.endswith(".json"):
+        files[name] = json.dumps(mutate_dict(ch, copy.deepcopy(RUN_SUMMARY), 2),
+                                 default=str).encode()
+    elif op == 2:
+        files[name] = mutate_record(ch, text)
+    elif op == 3:
+        files[name] = ch.choice([b"", b"[]", b"null", b"\xff\xfe\x00", b"t\n1\n", b"{}"])
+    elif op == 4:
+        files[name] = "dir"
+    argv = ["plot", "f", "-o", "out/plots", "--format", ch.choice(["png", "svg", "png,svg"])]
+    if ch.coin(0.3):
+        argv += [ch.choice(["--nodes", "--contacts", "--metric"]),
+                 ch.choice(["m", "c", "x", "", ",", "max_rel_error", "wall_time_s"])]
+    return Case(f"plot: damaged {name.rpartition('/')[2]}", argv, files, "out/plots")
+
+
+def reference_case(ch):
+    """A study whose `reference = { data = DIR }` holds what martello does not write."""
+    meta = {"t_end": 1.0, "digits": {"u:mass": 9.0}, "events": {}, "peaks": {}}
+    hist = "t,u:mass\n" + "".join(f"{i * 0.01:.6g},{0.05 - 1e-4 * i:.6g}\n" for i in range(101))
+    op = ch.integer(0, 3)
+    meta_bytes = json.dumps(mutate_dict(ch, meta, 2) if op == 0 else meta, default=str).encode()
+    hist_bytes = hist.encode()
+    if op == 1:
+        meta_bytes = meta_bytes[:ch.integer(0, len(meta_bytes))]
+    elif op == 2:
+        hist_bytes = mutate_record(ch, hist)
+    elif op == 3:
+        meta_bytes = ch.choice([b"[]", b"{}", b"1e999", b"\xff", b'{"t_end": "x"}', b'{"t_end": -1}'])
+    study = study_text("[1e-3]").decode().replace(
+        "[[integrator]]", 'reference = { data = "ref" }\nt_end = 0.1\n[[integrator]]', 1)
+    return Case("study: malformed reference data", ["study", "st.toml", "-o", "out/study",
+                                                    "--no-plots", "-j", "1"],
+                {"st.toml": study.encode(), "ref/reference.json": meta_bytes,
+                 "ref/history.csv": hist_bytes}, "out/study")
+
+
+def scheduler_case(ch):
+    """A study file that names a scheduler: never connected to without --use-study-scheduler
+    (nothing listens at 127.0.0.1:9: a connection would fail)."""
+    address = ch.choice(['"tcp://127.0.0.1:9"', '"cluster.json"', '""', "5", '"tcp://[::1]:9"'])
+    return Case("study: scheduler in the file", ["study", "st.toml", "-o", "out/study",
+                                                  "--no-plots", "-j", "1"],
+                {"st.toml": study_text(extra=f"scheduler = {address}\n")}, None)
+
+
 KINDS = [(scene_case, 70), (path_case, 6), (check_case, 8), (compare_case, 9), (study_case, 3),
-         (argv_case, 4)]
+         (argv_case, 4), (plot_case, 6), (reference_case, 3), (scheduler_case, 1)]
 
 
 def make_case(ch):
@@ -415,7 +499,9 @@ def lay_out(case, folder):
     for rel, data in case.files.items():
         p = folder / rel
         p.parent.mkdir(parents=True, exist_ok=True)
-        if data == "fifo":
+        if isinstance(data, str) and data.startswith("->"):       # a symbolic link
+            p.symlink_to(data[2:])
+        elif data == "fifo":
             if not p.exists():
                 os.mkfifo(p)
         elif data == "dir":

@@ -68,7 +68,7 @@ contains
          checks = checks + 1
          if (stat /= MARTELLO_OK .or. abs(got(j) - expected(j)) > rtol*abs(expected(j))) then
             failures = failures + 1
-            print '(a,a,i0,a,i0,2(a,es24.16),a,i0)', 'FAIL ', label//' ne=', ne, ' value ', j, &
+            print '(a,a,i0,a,i0,2(a,es25.16e3),a,i0)', 'FAIL ', label//' ne=', ne, ' value ', j, &
                ': got ', got(j), ' want ', expected(j), ' status ', stat
          end if
       end do

@@ -133,16 +133,27 @@ contains
       kc = o%ke_aMa*dot_product(a(1:m%n), o%work(1:m%n))
    end function kinetic_correction
 
-   !> Whether the next sample, at grid point k, evaluates the energy terms: where recorded,
-   !> every energy_interval-th sample and once a work is not finite (a method that hands
-   !> its energies to the sample computes them then).
+   !> Whether the next sample, at grid point k, evaluates the energy terms: on the energy
+   !> grid (energy_grid) and where recorded, for the history row (a method that hands its
+   !> energies to the sample computes them then).
    module procedure observer_energy_due
-      due = recorded(o, k) .or. mod(o%nsamples + 1, int(o%energy_interval, i8)) == 0 .or. &
-            .not. ieee_is_finite(o%w_last + o%d_damp + o%d_links + o%d_contact + o%d_impact)
+      due = energy_grid(o, k) .or. recorded(o, k)
    end procedure observer_energy_due
 
-   !> The energy terms at the committed state (u, v, a; ms, or the method's energies), its
-   !> largest |balance| so far, and e_mech = KE + E_rec for the divergence test.
+   !> Whether the next sample, at grid point k (−1: off the grid), is on the energy grid,
+   !> where the largest |balance| is taken and the divergence test made: t = 0, every
+   !> energy_interval-th grid point (of a sample off the grid: every energy_interval-th
+   !> sample), the last grid point and once a work is not finite. Never the recorded rows as
+   !> such: no result depends on how the run is recorded (docs/invariance.md).
+   module procedure energy_grid
+      grid = k == 0 .or. k >= o%n_grid .or. &
+             mod(merge(k, o%nsamples + 1, k >= 0), int(o%energy_interval, i8)) == 0 .or. &
+             .not. ieee_is_finite(o%w_last + o%d_damp + o%d_links + o%d_contact + o%d_impact)
+   end procedure energy_grid
+
+   !> The energy terms at the committed state (u, v, a; ms, or the method's energies), on
+   !> the energy grid (grid) its largest |balance| so far, and e_mech = KE + E_rec for the
+   !> divergence test.
    module procedure energy_at
       real(dp) :: e_kin, e_links, e_cont, kc
       if (present(energies)) then
@@ -154,7 +165,7 @@ contains
       kc = kinetic_correction(o, m, a)
       o%energy = energy_terms(o%e0, o%w_ext, e_kin, e_links, e_cont, o%e_links0, o%e_cont0, &
                               o%d_damp, o%d_links, o%d_contact, o%d_impact, kc, o%ke_corr0)
-      o%energy_balance_max = max(o%energy_balance_max, abs(o%energy(E_BALANCE)))
+      if (grid) o%energy_balance_max = max(o%energy_balance_max, abs(o%energy(E_BALANCE)))
       e_mech = e_kin + e_links + e_cont
    end procedure energy_at
 
@@ -192,18 +203,18 @@ contains
       else if (-(o%energy(E_CONTACT) + o%energy(E_IMPACT)) > CREATED_BOUND*(o%e0 + o%w_abs) &
                + ENERGY_FLOOR .and. o%e0 + o%w_abs > 0.0_dp) then
          ! a passive contact only takes energy out: the realised restitution exceeds 1
-         write (o%message, '(a,a,es12.5,a,es10.3,a,es10.3,a,a)') integrator_name(o%kind), &
-            ' created energy at its contacts by t = ', t, ' s: ', &
-            -(o%energy(E_CONTACT) + o%energy(E_IMPACT)), ' J, more than 1 % of the initial'// &
-            ' energy + input work (', o%e0 + o%w_abs, ' J): a passive contact cannot'// &
+         write (o%message, '(a,a,a,a,a,a,a,a,a)') integrator_name(o%kind), &
+            ' created energy at its contacts by t = ', sci(t, 5), ' s: ', &
+            sci(-(o%energy(E_CONTACT) + o%energy(E_IMPACT)), 3), ' J, more than 1 % of the initial'// &
+            ' energy + input work (', sci(o%e0 + o%w_abs, 3), ' J): a passive contact cannot'// &
             ' (restitution > 1); ', o%advice
          stat = MARTELLO_ERR_DIVERGED
          call observer_finish(o, t)
       else if (e_mech > o%divergence_factor*(o%e0 + o%w_abs) + ENERGY_FLOOR .and. &
                o%e0 + o%w_abs > 0.0_dp) then
-         write (o%message, '(a,a,es12.5,a,es10.3,a,es10.3,a,a)') integrator_name(o%kind), &
-            ' diverged at t = ', t, ' s: mechanical energy ', e_mech, ' J exceeds ', &
-            o%divergence_factor*(o%e0 + o%w_abs), &
+         write (o%message, '(a,a,a,a,a,a,a,a,a)') integrator_name(o%kind), &
+            ' diverged at t = ', sci(t, 5), ' s: mechanical energy ', sci(e_mech, 3), ' J exceeds ', &
+            sci(o%divergence_factor*(o%e0 + o%w_abs), 3), &
             ' J (divergence_factor x (initial energy + input work)); ', o%advice
          stat = MARTELLO_ERR_DIVERGED
          call observer_finish(o, t)

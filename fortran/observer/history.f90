@@ -41,12 +41,13 @@ contains
       o%every = max(s%every, 1); o%divergence_factor = s%divergence_factor
       o%t_end = s%t_end; o%max_steps = s%max_steps; o%max_wall = s%max_wall
       call system_clock(o%clock0, o%clock_rate)
-      o%clock_last = o%clock0
+      o%clock_last = o%clock0; o%clock_watched = o%clock0
+      o%watch_stride = 1; o%watch_count = 0
       steps = 1.0_dp
       if (s%dt > 0.0_dp .and. s%t_end > 0.0_dp) steps = max(1.0_dp, s%t_end/s%dt*(1.0_dp - 1.0e-12_dp))
       if (steps > o%max_steps .or. .not. ieee_is_finite(steps)) then
-         write (o%message, '(a,a,es10.3,a,es10.3,a)') integrator_name(o%kind), ': the run needs at least ', &
-            steps, ' steps (t_end/dt), more than max_steps = ', o%max_steps, &
+         write (o%message, '(a,a,a,a,a,a)') integrator_name(o%kind), ': the run needs at least ', &
+            sci(steps, 3), ' steps (t_end/dt), more than max_steps = ', sci(o%max_steps, 3), &
             ': raise dt, shorten t_end or raise max_steps'
          stat = MARTELLO_ERR_LIMIT
          steps = 1.0_dp
@@ -112,9 +113,9 @@ contains
    end procedure observer_phase_lists
 
    !> An accepted state at t (once per accepted step and at t = 0, after the step's phase
-   !> changes): phase maxima and peaks; the energy terms and the divergence test where
-   !> recorded, every energy_interval-th sample and once a work is not finite; a history row
-   !> where recorded. k: the grid point t = k·dt of the state, or −1. u, v, a on nodes 0:n;
+   !> changes): phase maxima and peaks; the energy terms where recorded and on the energy
+   !> grid (energy_grid), the largest |balance| and the divergence test on the grid alone;
+   !> a history row where recorded. k: the grid point t = k·dt of the state, or −1. u, v, a on nodes 0:n;
    !> u_prev … the previous state if the method keeps it (saves a copy). stat:
    !> MARTELLO_ERR_DIVERGED, with the message, when the run must stop.
    !> folded: the state has been measured item by item already (observer_block, which hands
@@ -123,9 +124,10 @@ contains
    !> element states (no ms), where observer_energy_due.
    module procedure observer_sample_i8
       real(dp) :: e_mech
-      logical :: due, measured
+      logical :: due, grid, measured
       stat = MARTELLO_OK
-      due = observer_energy_due(o, k)
+      grid = energy_grid(o, k)
+      due = grid .or. recorded(o, k)
       o%nsamples = o%nsamples + 1
       measured = .false.
       if (present(folded)) measured = folded
@@ -140,14 +142,14 @@ contains
       ! the next step's start
       if (o%smooth_steps) o%chatter_prev = o%counters(C_CHATTER)
       o%prev_t = t
-      if (due) call energy_at(o, m, ms, u, v, a, energies, e_mech)
+      if (due) call energy_at(o, m, ms, u, v, a, grid, energies, e_mech)
       if (recorded(o, k)) then
          call record(o, t, u(1:), v(1:), a(1:), pen, force, link_f, link_du, stat)
          if (stat /= MARTELLO_OK) then
             call observer_finish(o, t); return
          end if
       end if
-      if (due) call check_divergence(o, t, e_mech, u, v, stat)
+      if (grid) call check_divergence(o, t, e_mech, u, v, stat)
       if (stat == MARTELLO_OK) call observer_watch(o, t, stat)
    end procedure observer_sample_i8
 

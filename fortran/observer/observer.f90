@@ -88,13 +88,14 @@ module martello_observer
       integer :: kind = 0, every = 1
       integer(i8) :: n_grid = 1                 !< output grid points t = k·dt, k = 1 … n_grid
       real(dp) :: divergence_factor = 10.0_dp
-      ! energy: evaluated every energy_interval-th sample (and where recorded)
+      ! energy: evaluated every energy_interval-th sample (energy_grid) and where recorded
       integer :: energy_interval = 1
       integer(i8) :: nsamples = -1              !< accepted steps so far (t = 0 is sample 0)
       ! the budget (max_steps, max_wall [s], 0: none) and the caller's progress callback,
-      ! watched every WATCH_EVERY samples (observer_watch)
+      ! watched every watch_stride samples (observer_watch: 1 to WATCH_EVERY, by the pace)
       real(dp) :: t_end = 0.0_dp, max_steps = huge(1.0_dp), max_wall = 0.0_dp
       integer(i8) :: clock0 = 0, clock_last = 0, clock_rate = 1
+      integer(i8) :: clock_watched = 0, watch_stride = 1, watch_count = 0
       type(c_funptr) :: progress = c_null_funptr
       type(c_ptr) :: progress_user = c_null_ptr
       character(len=:), allocatable :: advice   !< ends a divergence message: what to change
@@ -438,11 +439,16 @@ module martello_observer
          type(observer_t), intent(in) :: o
          integer(i8), intent(in) :: k
       end function observer_energy_due
-      module subroutine energy_at(o, m, ms, u, v, a, energies, e_mech)
+      module logical function energy_grid(o, k) result(grid)
+         type(observer_t), intent(in) :: o
+         integer(i8), intent(in) :: k
+      end function energy_grid
+      module subroutine energy_at(o, m, ms, u, v, a, grid, energies, e_mech)
          type(observer_t), intent(inout) :: o
          type(model_t), intent(in) :: m
          type(mech_state_t), intent(in) :: ms
          real(dp), intent(in) :: u(0:), v(0:), a(0:)
+         logical, intent(in) :: grid
          real(dp), intent(in), optional :: energies(3)
          real(dp), intent(out) :: e_mech
       end subroutine energy_at

@@ -67,10 +67,10 @@ contains
       real(dp), intent(in) :: measured, tol
       if (ok) then
          npass = npass + 1
-         write (output_unit, '(a, a, a, es10.3, a, es10.3)') 'pass  ', label, ': ', measured, '  tol ', tol
+         write (output_unit, '(a, a, a, es11.3e3, a, es11.3e3)') 'pass  ', label, ': ', measured, '  tol ', tol
       else
          nfail = nfail + 1
-         write (output_unit, '(a, a, a, es10.3, a, es10.3)') 'FAIL  ', label, ': ', measured, '  tol ', tol
+         write (output_unit, '(a, a, a, es11.3e3, a, es11.3e3)') 'FAIL  ', label, ': ', measured, '  tol ', tol
       end if
    end subroutine check
 
@@ -439,7 +439,7 @@ contains
       call two_body(LAW_KELVIN, par, m1, m2, v1, v2, 0.5_dp*h, e2, t2, dm)
       call check(abs(e1 - 0.5_dp) <= 1.0e-6_dp, 'RK4 kelvin unclipped target 0.5: |e - 0.5|', abs(e1 - 0.5_dp), &
                  1.0e-6_dp)
-      write (output_unit, '(a, es10.3, a, es10.3, a, es10.3)') '      N = 1000: |e-0.5| ', abs(e1 - 0.5_dp), &
+      write (output_unit, '(a, es11.3e3, a, es11.3e3, a, es11.3e3)') '      N = 1000: |e-0.5| ', abs(e1 - 0.5_dp), &
          '   N = 2000: ', abs(e2 - 0.5_dp), '   |t_c - pi/omega_d|/t_c ', abs(t2 - td)/td
       call check(abs(t2 - td) <= 1.0e-9_dp*td, 'RK4 kelvin unclipped contact time = pi/omega_d', abs(t2 - td)/td, &
                  1.0e-9_dp)
@@ -465,7 +465,7 @@ contains
       th = 2.9432751843_dp*dmax/v0
       call two_body(LAW_HERTZ, par, m1, m2, v1, v2, th/4000.0_dp, e1, t1, dm)
       call two_body(LAW_HERTZ, par, m1, m2, v1, v2, th/8000.0_dp, e2, t2, dm)
-      write (output_unit, '(a, es10.3, a, es10.3)') '      hertz: |e-1| N=4000 ', abs(e1 - 1.0_dp), &
+      write (output_unit, '(a, es11.3e3, a, es11.3e3)') '      hertz: |e-1| N=4000 ', abs(e1 - 1.0_dp), &
          '  N=8000 ', abs(e2 - 1.0_dp)
       ! delta^(3/2) is not smooth at the ends of contact, so RK4 loses order there; the
       ! step halving shows ~1e-11, well inside 1e-8; t_c is quoted to 11 digits
@@ -481,7 +481,7 @@ contains
          h = hertz_time(par, mstar, v0)/4000.0_dp
          call two_body(LAW_HUNT_CROSSLEY, par, m1, m2, v1, v2, h, e1, t1, dm)
          call two_body(LAW_HUNT_CROSSLEY, par, m1, m2, v1, v2, 0.5_dp*h, e2, t2, dm)
-         write (output_unit, '(a, f4.2, a, es10.3, a, es10.3)') '      HC exact n = ', par(P_EXPONENT), &
+         write (output_unit, '(a, f4.2, a, es11.3e3, a, es11.3e3)') '      HC exact n = ', par(P_EXPONENT), &
             ': |e-0.65| N=4000 ', abs(e1 - 0.65_dp), '  N=8000 ', abs(e2 - 0.65_dp)
          call check(abs(e2 - 0.65_dp) <= 1.0e-6_dp, 'RK4 hunt_crossley with exact_hc_factor(0.65), n = ' &
                     //trim(fmt_f(par(P_EXPONENT))), abs(e2 - 0.65_dp), 1.0e-6_dp)
@@ -504,7 +504,7 @@ contains
       h = hertz_time(par, mstar, v0)/8000.0_dp
       call two_body(LAW_JANKOWSKI, par, m1, m2, v1, v2, h, e1, t1, dm)
       call two_body(LAW_JANKOWSKI, par, m1, m2, v1, v2, 0.5_dp*h, e2, t2, dm)
-      write (output_unit, '(a, f12.9, a, es10.3)') '      jankowski target 0.65 realises ', e2, &
+      write (output_unit, '(a, f12.9, a, es11.3e3)') '      jankowski target 0.65 realises ', e2, &
          '; N=8000 vs N=16000 differ by ', abs(e1 - e2)
       call check(abs(e2 - 0.647_dp) <= 5.0e-4_dp, 'RK4 jankowski target 0.65 realises 0.647 (3 digits)', e2, 5.0e-4_dp)
       ! e depends on xi only (scaling delta ~ v0^(4/5), t ~ v0^(-1/5)): with h scaled the

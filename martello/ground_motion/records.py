@@ -299,6 +299,9 @@ def read_csv_record(path, *, units=None, g=STANDARD_GRAVITY) -> Record:
 
 # --------------------------------------------------------------------------- PEER AT2
 
+# The smallest DT taken (1 MHz): accelerographs and shake tables sample at 50 Hz to 10 kHz,
+# and a subnormal DT would put a whole record into the first femtoseconds of a run.
+MIN_DT = 1e-6
 _AT2_FORMS = ("'NPTS=  5590, DT=   .0050 SEC', 'NPTS= 5590 DT= 0.0050 SEC' "
               "or '  5590    .0050    NPTS, DT'")
 _NPTS_KEYED_RE = re.compile(r"\bNPTS\s*=\s*([^\s,]*)", re.IGNORECASE)
@@ -331,6 +334,10 @@ def _parse_npts_dt(path, line):
     if not dt > 0:
         raise RecordError(path, f"DT={dt_txt} is not positive", line=4,
                           fix="DT is the time step in seconds and must be > 0")
+    if dt < MIN_DT:
+        raise RecordError(path, f"DT={dt_txt} s is no sampling step of an accelerogram", line=4,
+                          fix=f"DT is the time step in seconds, at least {MIN_DT:g} s (instruments "
+                              "sample at 50 Hz to 10 kHz): is the header misread?")
     return int(npts), dt
 
 

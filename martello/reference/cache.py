@@ -191,6 +191,17 @@ def _publish(tmp, folder):
     shutil.rmtree(old, ignore_errors=True)
 
 
+def cached_reference(scene):
+    """The reference `martello reference` cached for the scene's physics, if one serves it
+    (long enough), else None; nothing is computed."""
+    if scene.analysis.get("type") != "dynamic":
+        return None
+    folder = cache_root() / "references" / cache_key(scene)
+    if _usable(folder, scene, None) is None:
+        return None
+    return _named(load_reference(folder), folder)
+
+
 def reference_for_file(scene_path, refresh=False, every=None, jobs=0, stream=None):
     """The reference of the scene in scene_path, from the cache or computed (then cached).
 

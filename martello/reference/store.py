@@ -5,12 +5,14 @@ from __future__ import annotations
 
 import hashlib
 import json
+import math
 import tomllib
 from pathlib import Path
 
 import numpy as np
 
-from ..paths import REFERENCE_ROOT, REPO
+from ..history import parse_csv
+from ..paths import MiB, REFERENCE_ROOT, REPO, UnreadableFile, read_input
 from ..scene.items import ItemTable
 from .base import Reference, ReferenceError
 
@@ -60,24 +62,78 @@ def manifest(root=REFERENCE_ROOT):
     return out
 
 
+# what a reference's files may weigh to be read (a reference of 20 000 samples of a few
+# columns is a few MB)
+META_LIMIT, HISTORY_LIMIT = 64 * MiB, 1024 * MiB
+REWRITE = ("reference data are written by martello reference or scripts/regenerate_reference: "
+           "write them again")
+
+
+def _bad(path, problem, line=None):
+    return ReferenceError(f"{path}{f':{line}' if line else ''}: {problem} ({REWRITE})")
+
+
+def _number(x):
+    return isinstance(x, (int, float)) and not isinstance(x, bool) and math.isfinite(x)
+
+
+def _description(path):
+    """reference.json as a dict whose fields the scoring reads are of their kinds; a
+    ReferenceError naming the file and field otherwise."""
+    try:
+        meta = json.loads(read_input(path, META_LIMIT))
+    except UnreadableFile as exc:
+        raise _bad(path, str(exc)) from None
+    except (ValueError, UnicodeDecodeError) as exc:
+        raise _bad(path, f"not valid JSON ({' '.join(str(exc).split())})") from None
+    if not isinstance(meta, dict):
+        raise _bad(path, f"holds a {type(meta).__name__}, not a reference's description")
+    if not (_number(meta.get("t_end")) and meta["t_end"] > 0):
+        raise _bad(path, f"t_end: {meta.get('t_end')!r} is not a time > 0")
+    if "event_horizon" in meta and not (_number(meta["event_horizon"]) or meta["event_horizon"] is None):
+        raise _bad(path, f"event_horizon: {meta['event_horizon']!r} is not a time")
+    for key in ("events", "peaks", "masses", "digits"):
+        table = meta.get(key, {})
+        if not isinstance(table, dict):
+            raise _bad(path, f"{key}: must be a table")
+        for name, v in table.items():
+            if key in ("masses", "digits"):
+                ok = _number(v)
+            elif key == "peaks":
+                ok = isinstance(v, dict) and all(_number(x) or x is None for x in v.values())
+            else:
+                ok = isinstance(v, dict) and all(
+                    isinstance(x, list) and all(_number(y) or y is None for y in x) for x in v.values())
+            if not ok:
+                raise _bad(path, f"{key}.{name}: {str(v)[:60]} is not of the form martello "
+                                 "writes (numbers" + (")" if key in ("masses", "digits") else
+                                                      " by name)"))
+    return meta
+
+
 def load_reference(folder):
-    """Reference data from reference/<name>/ (reference.json + history.csv)."""
+    """Reference data from reference/<name>/ (reference.json + history.csv). Files that are
+    not what martello writes (cut short, edited, another kind of file, too large) are one
+    ReferenceError naming the file, the line or field."""
     folder = Path(folder)
     meta_path, hist_path = folder / "reference.json", folder / "history.csv"
     if not meta_path.exists() or not hist_path.exists():
         raise ReferenceError(f"{folder}: no reference data (reference.json and history.csv); "
                              "build it with scripts/regenerate_reference")
-    meta = json.loads(meta_path.read_text())
-    with open(hist_path) as fh:
-        header = fh.readline().strip().split(",")
-    data = np.loadtxt(hist_path, delimiter=",", skiprows=1, ndmin=2)
+    meta = _description(meta_path)
+    try:
+        raw = read_input(hist_path, HISTORY_LIMIT)
+    except UnreadableFile as exc:
+        raise _bad(hist_path, str(exc)) from None
+    header, data = parse_csv(raw, lambda problem, fix, line: _bad(hist_path, problem, line))
     samples = {c: data[:, i] for i, c in enumerate(header)}
     times = samples.pop("t")
+    horizon = meta.get("event_horizon")
     return Reference(name=f"reference/{folder.name}", kind="data", t_end=float(meta["t_end"]),
                      columns=tuple(samples), times=times, samples=samples,
                      events=meta.get("events", {}), peaks=meta.get("peaks", {}),
                      masses=meta.get("masses", {}), digits=meta.get("digits", {}),
-                     event_horizon=float(meta.get("event_horizon", meta["t_end"])),
+                     event_horizon=float(meta["t_end"] if horizon is None else horizon),
                      provenance=meta)
 
 

@@ -116,8 +116,10 @@ def expand_frames(src, data):
         try:
             with np.errstate(all="ignore"):
                 K, G = frame.condensed()
-        except np.linalg.LinAlgError:
-            K = G = np.array([[np.nan]])         # a singular condensation: refused just below
+        except (np.linalg.LinAlgError, OverflowError, ZeroDivisionError):
+            # a singular condensation, or lengths whose powers leave the doubles (a bay of
+            # 1e300 m or 1e-300 m): refused just below, naming the frame
+            K = G = np.array([[np.nan]])
         _check_stiffness(src, w, K, G, mass)
         R = frame.recovery(G)
         C = np.zeros_like(K)

@@ -318,8 +318,8 @@ def from_dict(data, source="<scene>", base_dir=Path("."), digest=None):
     for i, lk in listed:
         if lk["type"] == "dashpot" and lk["zeta"] is not None:
             lk["c"] = _dashpot_from_zeta(src, i, lk, ground_k, nodes, chains)
-    for b in chains:
-        b.c = _chain_dampers(b, ground_k)
+    for ci, b in enumerate(chains):
+        b.c = _chain_dampers(src, f"chain[{ci}]", b, ground_k)
 
     check = data.get("check")
     if check is not None:
@@ -564,9 +564,10 @@ def _chain_k(chains, node):
     return 0.0
 
 
-def _chain_dampers(b, ground_k):
+def _chain_dampers(src, where, b, ground_k):
     """c = 2ζ√(k m) of a chain's dampers: k its spring plus the written springs from the node
-    to ground (which come before it in the scene's links; ground_k)."""
+    to ground (which come before it in the scene's links; ground_k). SceneError naming the
+    chain's zeta if one is not a finite number (k m past the doubles)."""
     d = b.dampers
     if not len(d):
         return np.zeros(0)
@@ -577,7 +578,21 @@ def _chain_dampers(b, ground_k):
             k[np.searchsorted(d, i)] = kw + b.k[i]
     # float_power is libm's pow, as `** 0.5` of the listed dashpots (np.sqrt and np.power
     # round differently in the last bit now and then)
-    return 2.0 * b.zeta[d] * np.float_power(k * b.mass[d], 0.5)
+    with np.errstate(over="ignore", invalid="ignore"):
+        c = 2.0 * b.zeta[d] * np.float_power(k * b.mass[d], 0.5)
+    _finite_damping(src, f"{where}.zeta", c, k, b.mass[d], [f"{b.prefix}{i + 1}" for i in d])
+    return c
+
+
+def _finite_damping(src, where, c, k, mass, names):
+    """SceneError unless every c = 2ζ√(k m) is a finite number."""
+    bad = np.flatnonzero(~np.isfinite(np.atleast_1d(c)))
+    if len(bad):
+        i = int(bad[0])
+        raise SceneError(src, where, f"the damping c = 2 zeta sqrt(k m) of node {names[i]} is not a "
+                         f"finite number (k = {float(np.atleast_1d(k)[i]):.6g} N/m, m = "
+                         f"{float(np.atleast_1d(mass)[i]):.6g} kg)",
+                         "give k and the mass in N/m and kg, or c directly")
 
 
 def _dashpot_from_zeta(src, i, lk, ground_k, nodes, chains=()):
@@ -596,7 +611,9 @@ def _dashpot_from_zeta(src, i, lk, ground_k, nodes, chains=()):
     if k <= 0:
         raise SceneError(src, where, "the node has no spring to ground to define a frequency",
                          "give c directly")
-    return 2.0 * lk["zeta"] * (k * nodes[node]["mass"]) ** 0.5
+    c = 2.0 * lk["zeta"] * (k * nodes[node]["mass"]) ** 0.5
+    _finite_damping(src, where, c, k, nodes[node]["mass"], [nodes[node]["name"]])
+    return c
 
 
 def _check_table(src, check):

@@ -477,13 +477,19 @@ def _markdown(atlas, rows, bounds, pngs, elapsed, path, of=None):
     path.write_text("\n".join(lines) + "\n")
 
 
+def output_folder(path, atlas, output=None):
+    """The folder an atlas writes (as a study's: martello.study.sweep.output_folder)."""
+    if output:
+        return Path(output)
+    return OUTPUT_ROOT / atlas["output"] if atlas["output"] else Path("out") / "studies" / Path(path).stem
+
+
 def main(args):
     if getattr(args, "scheduler", None):
         raise StudyError(args.study, "--scheduler", "a stability atlas runs on the local cores; "
                          "only sweep studies run on a Dask cluster", "drop --scheduler (use -j)")
     atlas = load_atlas(args.study)
-    out = Path(args.output) if args.output else (OUTPUT_ROOT / atlas["output"] if atlas["output"]
-                                                 else Path("out") / "studies" / Path(args.study).stem)
+    out = output_folder(args.study, atlas, args.output)
     rows, bounds = run_atlas(atlas, out, jobs=getattr(args, "jobs", 0) or 0,
                              plots=not getattr(args, "no_plots", False))
     counts = {}

@@ -11,7 +11,7 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import StudyError
-from ..paths import MiB, UnreadableFile, read_input
+from ..paths import REPO, MiB, UnreadableFile, read_input
 from ..scene.fields import finite_everywhere
 from ..scene.spec import ADAPTIVE, INTEGRATORS
 from ..scene.variants import override_contacts
@@ -111,6 +111,26 @@ def _check_keys(src, where, table, valid):
             raise StudyError(src, f"{where}.{k}", "unknown key", "valid: " + ", ".join(sorted(valid)))
 
 
+def _reference(path, where, ref):
+    """A case's `reference`: "auto", { closed_form = NAME, params = {...} } or { data = DIR }
+    with DIR relative to the study file's folder (a path that is not there but names one of
+    martello's stored references, reference/<name>, is that one)."""
+    if ref in (None, "auto"):
+        return "auto"
+    if isinstance(ref, dict) and set(ref) == {"data"} and isinstance(ref["data"], str) and ref["data"]:
+        p = Path(ref["data"])
+        if not p.is_absolute():
+            beside = path.parent / p
+            p = beside if beside.exists() or not (REPO / p).exists() else REPO / p
+        return {"data": str(p.resolve())}
+    if isinstance(ref, dict) and isinstance(ref.get("closed_form"), str) \
+            and set(ref) <= {"closed_form", "params"} and isinstance(ref.get("params", {}), dict):
+        return ref
+    raise StudyError(path, where, f"invalid value {ref!r}"[:160],
+                     'give "auto", { closed_form = NAME, params = { ... } } or { data = "DIR" } '
+                     "(a folder of reference.json and history.csv, relative to the study file)")
+
+
 def method_label(name, params):
     fam = [f"{k}={params[k]}" for k in FAMILY_KEYS if k in params]
     return name + (f" ({', '.join(fam)})" if fam else "")
@@ -188,6 +208,7 @@ def load_study(path):
             # the scene's reference is for its own contacts: an override brings its own
             ref = sc.get("reference", "auto") if sc.get("contact") else \
                 sc.get("reference", st.get("reference", "auto"))
+            ref = _reference(path, f"{where}.reference", ref)
             cases.append(Case(label=f"{slabel} | {sc.get('label', 'scheme')}" if len(schemes) > 1 else slabel,
                               scene_label=slabel, scheme_label=sc.get("label", "as in the scene"),
                               scene_file=f, scene_dict=d, reference=ref, t_end=t_end))

@@ -23,9 +23,10 @@ import numpy as np
 
 from ..batch import run_specs
 from ..binding import native
-from ..errors import MartelloError, SceneError
+from ..errors import MartelloError, SceneError, StudyError
 from ..metrics.score import COST_KEYS, cost, score
 from ..paths import OUTPUT_ROOT, REPO, check_output_folder
+from ..reference.cache import cache_root, cached_reference
 from ..reference.selection import reference_for_scene
 from ..scene.loader import from_dict
 from ..scene.spec import ADAPTIVE
@@ -60,13 +61,22 @@ def build_specs(study):
     references of its cases."""
     specs, refs, notes = [], {}, []
     for ci, case in enumerate(study.cases):
+        named = isinstance(case.reference, dict)      # the study file names it: it must load
         try:
             rs = runnable_scene(case.scene_dict, case.scene_file, case.t_end)
             ref = reference_for_scene(rs, spec=case.reference)
             if ref is None:
-                notes.append(f"{case.label}: no reference (no closed form and no reference data): "
-                             "only energy and cost are reported")
+                ref = cached_reference(rs)      # one `martello reference` computed for it
+                if ref is not None:
+                    notes.append(f"{case.label}: scored against {ref.name}, cached by martello "
+                                 f"reference in {cache_root()}")
+            if ref is None:
+                notes.append(f"{case.label}: no reference (no closed form, no reference data, "
+                             "none cached by martello reference): only energy and cost are "
+                             "reported")
         except (MartelloError, SceneError) as exc:
+            if named:
+                raise StudyError(study.path, f"reference of {case.label}", str(exc)) from None
             ref = None
             notes.append(f"{case.label}: reference unavailable: {exc}")
         refs[ci] = ref
@@ -421,11 +431,19 @@ def scheduler_of(args, study, stream=None):
     return address, f"the scheduler of {study.path}, used by --use-study-scheduler"
 
 
+def output_folder(path, study, output=None):
+    """The folder a study writes: `output` if given, else the study's `output` key (relative
+    to the repository in a checkout, to the working folder once installed), else
+    out/studies/<file name>."""
+    if output:
+        return Path(output)
+    return OUTPUT_ROOT / study.output if study.output else Path("out") / "studies" / Path(path).stem
+
+
 def main(args):
     path = Path(args.study)
     study = load_study(path)
-    out = Path(args.output) if args.output else (OUTPUT_ROOT / study.output if study.output
-                                                 else Path("out") / "studies" / path.stem)
+    out = output_folder(path, study, args.output)
     scheduler, origin = scheduler_of(args, study)
     plots = not getattr(args, "no_plots", False)
     if scheduler:

@@ -1,0 +1,332 @@
+"""Relations that need no oracle (docs/invariance.md): a result does not depend on how it is
+recorded (output invariance), nor on how the scene is written down (metamorphic relations).
+
+Output invariance. A scene run again with another `output.every`, another output interval
+(the adaptive integrators), other recorded nodes, contacts and links, other tracking, or no
+history at all, must give every summary number again. A fixed-step run is the same sequence
+of steps whatever is recorded: bit for bit. An adaptive run also stops at every output time,
+and a stop changes the step sequence after it, so two runs differ by the errors of two step
+sequences, each within the run's own tolerance: the tolerance of a number is ADAPTIVE_FACTOR
+times how much it moves when the run's rtol and atol are made 10 times looser (`own_error`,
+`loose_scene`), plus the rounding of the number.
+
+Metamorphic relations (`mirrored`, `rescaled`, `renamed`, `chains_as_lists`) map a scene to
+another whose summary follows from the first's by a known map; `metamorphic_mismatches`
+applies the map and compares.
+
+Used by tests/test_output_invariance.py and tests/test_metamorphic.py (a sample per kind)
+and by benchmarks/invariance/sweep.py (the whole catalogue)."""
+
+from __future__ import annotations
+
+import copy
+import math
+import tomllib
+from pathlib import Path
+
+import numpy as np
+
+from martello.run import run_full
+from martello.scene.loader import from_dict
+
+ADAPTIVE = ("rkf45", "rk8pd", "msbdf", "ida", "cvode", "arkode")
+# An adaptive run's own tolerance on a number: how much the number moves when the run's
+# tolerance (rtol, atol, event_tol) is made 3 and 10 times looser (LOOSER), the larger of the
+# two. Two step sequences (other stops) at the same tolerance differ by their two errors; a
+# looser run's error is a few times the run's (the global error goes as rtol^0.8 ... rtol^1,
+# docs/event-driven.md), so its distance bounds that difference, with ADAPTIVE_FACTOR for the
+# scatter of errors with where the steps fall (two looser runs: one sample alone was small by
+# chance on the work integrals, which ride outside the error control).
+LOOSER = (3.0, 10.0)
+ADAPTIVE_FACTOR = 2.0
+# One sample of that distance can be small by chance (P2 on IDA at rtol 1e-12: 1.0e-12 on the
+# first impact speed, where another output interval moved it by 9e-12): the global error of
+# an adaptive run is also allowed as GLOBAL_RTOL × rtol of the number (measured on the
+# catalogue: IDA's impact times within 12 rtol, docs/ida.md; msbdf's events within 300 rtol,
+# docs/event-driven.md).
+GLOBAL_RTOL = 100.0
+# the rounding of a number computed from the state (a few hundred operations)
+ROUNDING = 1e3 * np.finfo(float).eps
+# summary entries that describe the run, not its result
+NOT_RESULTS = ("title", "problem", "analysis", "integrator", "status", "message", "warnings",
+               "tracked", "cost", "provenance")
+
+
+def read(path):
+    """The scene file as a dict (its [check] dropped: the relations compare runs) and its
+    folder, where record files are found."""
+    path = Path(path)
+    with open(path, "rb") as f:
+        data = tomllib.load(f)
+    data.pop("check", None)
+    return data, path.parent
+
+
+def run(data, base_dir="."):
+    """(summary, history columns, history rows) of a scene dict."""
+    summary, history = run_full(from_dict(data, base_dir=base_dir))
+    columns, rows = history if history is not None else ([], np.zeros((0, 0)))
+    return summary, columns, rows
+
+
+def numbers(summary):
+    """Every number of a summary's results as {path: value}; lists are indexed
+    (contacts.plane.impact_times.3), None and strings are kept as they are."""
+    out = {}
+
+    def walk(x, path):
+        if isinstance(x, dict):
+            for k, v in x.items():
+                walk(v, f"{path}.{k}" if path else str(k))
+        elif isinstance(x, (list, tuple)):
+            out[path + ".#"] = len(x)
+            for i, v in enumerate(x):
+                walk(v, f"{path}.{i}")
+        else:
+            out[path] = x
+
+    walk({k: v for k, v in summary.items() if k not in NOT_RESULTS}, "")
+    return out
+
+
+def _same(a, b):
+    if isinstance(a, float) and isinstance(b, float) and math.isnan(a) and math.isnan(b):
+        return True
+    return a == b
+
+
+def _list_of(path):
+    """contacts.plane.impact_times.3 -> contacts.plane.impact_times (None for a scalar)."""
+    head, _, last = path.rpartition(".")
+    return head if last.isdigit() else None
+
+
+def own_error(base, loose):
+    """The run's own tolerance on each number of base: its distance to the loose run's. An
+    entry of a list is given the largest of its list (events resolved one by one carry the
+    errors of those before them, and a looser run may resolve fewer of them)."""
+    err = {}
+    lists = {}
+    for p, x in base.items():
+        y = loose.get(p)
+        if isinstance(x, (int, float)) and not isinstance(x, bool) and \
+                isinstance(y, (int, float)) and not isinstance(y, bool) and \
+                math.isfinite(x) and math.isfinite(y):
+            err[p] = abs(x - y)
+            head = _list_of(p)
+            if head is not None:
+                lists[head] = max(lists.get(head, 0.0), err[p])
+    for p in base:
+        head = _list_of(p)
+        if head is not None:
+            err[p] = max(err.get(p, 0.0), lists.get(head, 0.0))
+    return err
+
+
+# the families of numbers that share a scale (mismatches), by the last name of the path
+FAMILIES = {"u_max": "L", "u_min": "L", "u_absmax": "L", "u_final": "L", "u_peak": "L",
+            "max_penetration": "L", "penetration_final": "L", "phase_max_penetration": "L",
+            "max_abs_elongation": "L", "v_absmax": "V", "v_final": "V", "approach_speeds": "V",
+            "separation_speeds": "V", "a_absmax": "A"}
+
+
+def _family(path):
+    if path == "energy.balance_relative":
+        return "1"
+    if path.startswith("energy."):
+        return "E"
+    name = _list_of(path) or path
+    return FAMILIES.get(name.rpartition(".")[2])
+
+
+def mismatches(base, other, error=None, rtol=0.0, exact=None, factor=ADAPTIVE_FACTOR):
+    """The numbers present in both summaries (as `numbers`) that differ: bit for bit (exact;
+    by default when no error is given), or by more than factor × the run's own error (error:
+    {path: error}, or None), GLOBAL_RTOL × the relative tolerance rtol of the number, and the
+    rounding. Counts (the `#` entries, integers) must agree exactly. Returns
+    [(path, base, other, allowed)]."""
+    if exact is None:
+        exact = error is None
+    error = error or {}
+    bad = []
+    # a number rounds on the scale of the numbers it is a difference of: an energy term on
+    # the largest energy, a penetration or a final displacement on the largest displacement,
+    # a final velocity on the largest speed (FAMILIES); an adaptive run integrates the works
+    # outside its error control, and the error it reports on them is its energy balance
+    scales = {fam: max([abs(v) for k, v in base.items() if _family(k) == fam
+                        and isinstance(v, float) and math.isfinite(v)] + [0.0])
+              for fam in set(FAMILIES.values()) | {"E"}}
+    scales["1"] = 1.0           # balance_relative: a fraction of the energy scale
+    balance = max(abs(base.get("energy.balance_max") or 0.0),
+                  abs(other.get("energy.balance_max") or 0.0)) if error else 0.0
+    for p, x in base.items():
+        if p not in other:
+            continue
+        y = other[p]
+        if exact or not (isinstance(x, float) and isinstance(y, float)):
+            if not _same(x, y):
+                bad.append((p, x, y, 0.0))
+            continue
+        if not (math.isfinite(x) and math.isfinite(y)):
+            if not _same(x, y):
+                bad.append((p, x, y, 0.0))
+            continue
+        scale = max(abs(x), abs(y), scales.get(_family(p), 0.0))
+        allowed = factor * error.get(p, 0.0) + (GLOBAL_RTOL * rtol + ROUNDING) * scale
+        if _family(p) == "E":
+            allowed += factor * balance
+        elif _family(p) == "1" and scales["E"] > 0:
+            allowed += factor * balance / scales["E"]
+        if abs(x - y) > allowed:
+            bad.append((p, x, y, allowed))
+    return bad
+
+
+# the final state of a node or contact is read from the history's last row: only for the
+# recorded ones (docs/results.md)
+FROM_HISTORY = (".u_final", ".v_final", ".penetration_final", ".force_final", ".lambda_final")
+
+
+def missing(base, other):
+    """Result paths of base absent from other that recording cannot remove: every number but
+    the final states read from the history (FROM_HISTORY)."""
+    return [p for p in base if p not in other and not p.endswith(FROM_HISTORY)]
+
+
+# ---- output variants ----------------------------------------------------------------------
+
+def _output(data):
+    an = data.setdefault("analysis", {})
+    return an.setdefault("output", {})
+
+
+def output_variants(data, adaptive):
+    """(name, scene dict) of the same scene recorded otherwise. The base is the scene with
+    track = ["all"] (every quantity kept), so that a variant's numbers are a subset."""
+    an = data["analysis"]
+    every = int(an.get("output", {}).get("every", 1))
+    nodes = [n["name"] for n in data.get("node", [])]
+    contacts = [c["name"] for c in data.get("contact", []) if "name" in c]
+
+    def variant(**out):
+        d = copy.deepcopy(data)
+        o = _output(d)
+        o.setdefault("track", ["all"])
+        for k, v in out.items():
+            if k == "dt":
+                d["analysis"]["dt"] = v
+            else:
+                o[k] = v
+        return d
+
+    yield "every 7", variant(every=every * 7)
+    yield "every 1000", variant(every=every * 1000)
+    yield "no history", variant(nodes=[], contacts=[], links=[])
+    if len(nodes) > 1 or len(contacts) > 1:
+        yield "some outputs, reordered", variant(nodes=nodes[::-2], contacts=contacts[::-2])
+    yield "track contact_peaks", variant(track=["contact_peaks"])
+    yield "track node_peaks, phases", variant(track=["node_peaks", "phases"])
+    yield "track link_peaks", variant(track=["link_peaks"])
+    if adaptive:
+        dt, t_end = float(an["dt"]), float(an["t_end"])
+        yield "output interval x 0.37", variant(dt=dt * 0.37)
+        if 3 * dt <= t_end:
+            yield "output interval x 3", variant(dt=dt * 3)
+
+
+def base_scene(data):
+    d = copy.deepcopy(data)
+    _output(d).setdefault("track", ["all"])
+    return d
+
+
+def run_rtol(data):
+    """The scene's rtol (the library's default when not given)."""
+    from martello.binding import native
+    return float(data["analysis"].get("rtol", native.settings_defaults()["rtol"]))
+
+
+# the integrators that solve a nonlinear system a step by Newton's method, and the tolerances
+# they solve it to (the last: the relative tolerance of the solution)
+NEWTON = {"newmark": ("tol_residual", "tol_increment"), "hht": ("tol_residual", "tol_increment"),
+          "generalized-alpha": ("tol_residual", "tol_increment"),
+          "newmark-lagrange": ("tol_residual", "tol_increment"),
+          "fast-nonlinear": ("tol_residual",)}
+
+
+def loose_scene(data, factor):
+    """The same run solved to a factor times looser tolerance: an adaptive run's rtol, atol
+    and event_tol, a Newton method's tol_residual and tol_increment (the library's defaults
+    when not given); None for a method that solves its steps exactly."""
+    from martello.binding import native
+    d = base_scene(data)
+    an = d["analysis"]
+    integrator = an["integrator"]
+    keys = ("rtol", "atol", "event_tol") if integrator in ADAPTIVE else NEWTON.get(integrator, ())
+    if not keys:
+        return None
+    defaults = native.settings_defaults()
+    for k in keys:
+        an[k] = float(an.get(k, defaults[k])) * factor
+    return d
+
+
+def free_scene(data):
+    """The run with one output at the end: an adaptive stepper's steps limited by nothing but
+    its tolerance (the output times are stops)."""
+    d = base_scene(data)
+    d["analysis"]["dt"] = float(d["analysis"]["t_end"])
+    return d
+
+
+def tolerance_error(data, base, base_dir, mapped=None):
+    """The run's own error on each number of base (own_error over the LOOSER runs; empty for
+    a method that solves its steps exactly), and its relative tolerance (rtol for an
+    adaptive run, tol_increment for a Newton method, else 0); mapped maps the errors into
+    another scene's terms (a metamorphic relation's expectation). An adaptive run is probed
+    twice, as given and with its steps free of output stops (free_scene): stops bound the
+    steps, so loosening the tolerance of a run with dense outputs moves little, while the
+    same run recorded sparsely takes the long steps its tolerance allows (P6 on CVODE at rtol
+    1e-12: |a| max moved 1.5e-10 with every = 1000, 0 with the tolerance 10 times looser)."""
+    error = {}
+    an = data["analysis"]
+    probes = [(data, base)]
+    if an["integrator"] in ADAPTIVE:
+        free = free_scene(data)
+        probes.append((free, numbers(run(free, base_dir)[0])))
+    for scene, ref in probes:
+        for f in LOOSER:
+            loose = loose_scene(scene, f)
+            if loose is None:
+                break
+            for p, e in own_error(ref, numbers(run(loose, base_dir)[0])).items():
+                error[p] = max(error.get(p, 0.0), e)
+    from martello.binding import native
+    rtol = 0.0
+    if an["integrator"] in ADAPTIVE:
+        rtol = run_rtol(data)
+    elif an["integrator"] in NEWTON:
+        key = NEWTON[an["integrator"]][-1]
+        rtol = float(an.get(key, native.settings_defaults()[key]))
+    return (mapped(error) if mapped else error), rtol
+
+
+def output_invariance(path_or_data, base_dir=None):
+    """Run a scene and its output variants; returns (kind, [(variant, mismatches, missing)]),
+    kind = (integrator, adaptive)."""
+    if isinstance(path_or_data, (str, Path)):
+        data, base_dir = read(path_or_data)
+    else:
+        data = path_or_data
+    base_dir = base_dir or "."
+    integrator = data["analysis"]["integrator"]
+    adaptive = integrator in ADAPTIVE
+    base = numbers(run(base_scene(data), base_dir)[0])
+    error, rtol = tolerance_error(data, base, base_dir) if adaptive else (None, 0.0)
+    found = []
+    for name, d in output_variants(data, adaptive):
+        other = numbers(run(d, base_dir)[0])
+        # tracking chooses which quantities are kept: a tracked subset is no loss
+        lost = [] if name.startswith("track") else missing(base, other)
+        found.append((name, mismatches(base, other, error, rtol), lost))
+    return (integrator, adaptive), found

@@ -1,0 +1,64 @@
+"""Metamorphic relations (docs/invariance.md; benchmarks/invariance/metamorphic.py): a scene
+mirrored (the axis flipped, every contact's and link's sides swapped), in other units (mass,
+length and time scaled by powers of 2), with its items renamed and listed in reverse, or with
+its [[chain]] written out as lists, gives the summary the relation predicts from the
+original's: node displacements negated, numbers scaled by their dimension, the same numbers
+under the new names. Mirroring is exact in floating point, so it is checked bit for bit; the
+others to the rounding, or to what the method solves to (a Newton step's tol_increment, an
+adaptive run's own tolerance). An identity of the physics: no oracle. A sample here; the
+catalogue sweep is `benchmarks/invariance/sweep.py --metamorphic`."""
+
+from pathlib import Path
+
+import pytest
+
+from benchmarks.invariance import metamorphic
+
+ROOT = Path(__file__).resolve().parents[1] / "benchmarks"
+
+# one scene per integrator family and scheme, with loads of every kind the relations map
+# (gravity, a sine force, a sine ground acceleration), and the chains of P7
+SCENES = {
+    "p2/laws/p2_linear_newmark.toml": ("mirrored", "rescaled", "renamed"),
+    "p2/laws/p2_hertz_newmark.toml": ("mirrored", "rescaled", "renamed"),
+    "p2/laws/p2_linear_central_difference.toml": ("mirrored", "rescaled", "renamed"),
+    "p2/laws/p2_linear_msbdf.toml": ("mirrored", "rescaled", "renamed"),
+    "p5/p5_kelvin.toml": ("mirrored", "renamed"),
+    "p5/p5_moreau_jean_e03.toml": ("mirrored", "rescaled", "renamed"),
+    "p5/p5_newmark_lagrange_e03.toml": ("mirrored", "rescaled", "renamed"),
+    "p2/p2_restitution_e08.toml": ("mirrored", "rescaled", "renamed"),
+    "p2/p2_ida_lagrange.toml": ("mirrored", "rescaled", "renamed"),
+    "p9/p9_davis_restitution.toml": ("mirrored", "rescaled", "renamed"),
+    "sdof/sdof_sine_hht.toml": ("mirrored", "rescaled", "renamed"),
+    "p7/p7_chain_10.toml": ("chains_as_lists",),
+    "p7/p7_two_oscillators.toml": ("chains_as_lists",),
+}
+CASES = [(scene, rel) for scene, rels in SCENES.items() for rel in rels]
+
+
+@pytest.mark.parametrize("scene,relation", CASES, ids=[f"{s.rsplit('/', 1)[1][:-5]}-{r}" for s, r in CASES])
+def test_relation_holds(scene, relation):
+    bad = metamorphic.check(ROOT / scene, relation)
+    assert not bad, bad[:5]
+
+
+def test_relations_are_not_vacuous():
+    # a relation applied to the wrong map is caught: the mirrored scene compared without
+    # negating the displacements, and a rescaled one compared unscaled
+    from benchmarks.invariance import relations as R
+    data, base_dir = R.read(ROOT / "p2/laws/p2_linear_newmark.toml")
+    data = R.base_scene(data)
+    base = R.numbers(R.run(data, base_dir)[0])
+    for relation in ("mirrored", "rescaled"):
+        other, _ = metamorphic.RELATIONS[relation](data)
+        assert R.mismatches(base, R.numbers(R.run(other, base_dir)[0]), exact=True)
+
+
+def test_unsupported_is_said():
+    # a relation that cannot map a scene says what it does not know, never passes silently
+    data = {"chain": [{"prefix": "b", "n": 2, "mass": 1.0, "k": 1.0}], "analysis": {}}
+    for relation in ("mirrored", "rescaled", "renamed"):
+        with pytest.raises(metamorphic.Unsupported):
+            metamorphic.RELATIONS[relation](data)
+    with pytest.raises(metamorphic.Unsupported):
+        metamorphic.chains_as_lists({"node": [], "analysis": {}})
