@@ -99,7 +99,7 @@ int martello_eval_commit(martello_eval *ev, const double *u, const double *v);
 int martello_eval_use_branches(martello_eval *ev, int *nsw);
 /* As martello_eval_use_branches, but only the laws whose force jumps at a switch are held:
  * penalty contacts whose force is continuous at onset and separation (linear, Hertz, the
- * Hunt-Crossley family) and bilinear links stay whole, their kinks inside the integrator's steps
+ * Hunt-Crossley family) stay whole, their kinks inside the integrator's steps
  * (docs/sundials-ode.md, events inside the steps); continuous[j] = 1 for those contacts (n_contacts
  * values). */
 int martello_eval_use_smooth_branches(martello_eval *ev, int *nsw, int *continuous);

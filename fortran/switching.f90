@@ -36,7 +36,7 @@ contains
    !> (g > 0) moves to the next branch (a bilinear one only while loading outward);
    !> CONTACT_FREE and BRANCH_FREE are chosen from the state. A bilinear force left outside its band by the located crossing (by at most
    !> k |dv| event_tol) is put back on the band's edge. smooth: the laws whose force is
-   !> continuous at their switches (force_continuous contacts, bilinear links) are not held:
+   !> continuous at their switches (force_continuous contacts) are not held:
    !> they stay the whole law, whose kinks the integrator's error control takes
    !> (docs/sundials-ode.md, events inside the steps).
    subroutine switching_choose(m, s, u, v, smooth)
@@ -55,10 +55,6 @@ contains
          du = row_dot(m%lnk, j, u); dv = row_dot(m%lnk, j, v)
          select case (m%link_kind(j))
          case (LINK_BILINEAR)
-            if (free_continuous) then             ! its force is continuous at yield
-               s%link_branch(j) = BRANCH_FREE
-               cycle
-            end if
             k = m%link_par(L_STIFF, j); rho = m%link_par(L_HARDENING, j)
             if (rho >= 1.0_dp) cycle
             r = (1.0_dp - rho)*m%link_par(L_YIELD, j)

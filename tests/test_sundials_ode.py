@@ -14,6 +14,7 @@ few hundred steps of a phase for BDF, whose global error grows fastest); 1e-7 le
 of 100 above that."""
 
 import math
+from pathlib import Path
 
 import numpy as np
 
@@ -24,6 +25,8 @@ from martello.errors import SceneError
 from martello.run import run
 from martello.scene.loader import from_dict
 from tests.dynamics_helpers import dynamic, execute, two_bodies
+
+ROOT = Path(__file__).resolve().parents[1]
 
 METHODS = [("cvode", None), ("cvode", "adams"), ("arkode", None), ("arkode", "verner-8-5-6"),
            ("arkode", "sdirk-5-3-4"), ("arkode", "ark548l2sa-8-4-5")]
@@ -272,3 +275,16 @@ def test_a_touch_inside_one_step_is_found(integrator):
     t_peak = math.pi / 2 / math.sqrt(k_sp / m)
     assert (c["impact_times"][0] + c["separation_times"][0]) / 2 == pytest.approx(t_peak, rel=1e-6)
     assert c["max_penetration"] == pytest.approx(1e-10, rel=1e-2)
+
+
+@pytest.mark.xfail(strict=True, reason="open: CVODE stepping across a kink (the error estimate assumes a "
+                   "smooth solution) leaves a global error that depends on the stop times: P2's u_min moves "
+                   "by 1.9e-9 m at rtol 1e-12 with the output interval x 3 (restarted: within 5e-10)")
+def test_events_inside_the_steps_keep_output_invariance():
+    # Identity of the method (no oracle): the relation of benchmarks/invariance/relations.py on
+    # P2's linear plane on CVODE, whose contact is stepped across.
+    import sys
+    sys.path.insert(0, str(ROOT / "benchmarks" / "invariance"))
+    import relations
+    _, found = relations.output_invariance(ROOT / "benchmarks/p2/laws/p2_linear_cvode.toml")
+    assert not [name for name, bad, lost in found if bad or lost]
