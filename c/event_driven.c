@@ -246,9 +246,10 @@ static int ed_jacobian(double t, const double y[], double *dfdy, double dfdt[], 
     double step, hh;
     if (w->fixed[j % n]) continue;
     step = sq * fmax(fmax(fabs(y[j]), 1e-3 * (j < n ? umax : vmax)), w->atol);
-    /* away from zero along y_j: the mirrored state (y -> -y) differences the mirrored way, so
-     * that a mirrored scene runs the mirrored steps to the bit (docs/invariance.md) */
-    w->yj[j] = y[j] + copysign(step, y[j]);
+    /* away from zero along y_j (along its rate where y_j is 0: a mirrored scene's zeros are
+     * not negated): the mirrored state (y -> -y) differences the mirrored way, so that a
+     * mirrored scene runs the mirrored steps to the bit (docs/invariance.md) */
+    w->yj[j] = y[j] + copysign(step, y[j] != 0.0 ? y[j] : w->fj[j]);
     hh = w->yj[j] - y[j];
     if (ed_rhs(t, w->yj, w->f1, w) != GSL_SUCCESS) return GSL_EBADFUNC;
     w->yj[j] = y[j];

@@ -228,6 +228,7 @@ typedef struct martello_settings {
   double max_wall;          /* wall-clock seconds a run may take (0: no limit) */
   bool event_split;         /* Newmark family: split a step at a penalty onset/separation */
   int method;               /* cvode, arkode: a value of the table "methods" (0: the default) */
+  int modal_vectors;        /* fast-nonlinear: 0 all modes; m > 0: m load-dependent Ritz vectors */
 } martello_settings;
 
 /* Indices of martello_run_counters, martello_run_energy and the values of

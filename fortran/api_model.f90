@@ -3,6 +3,7 @@
 !> and calls martello_model / martello_statics. Nothing is computed here.
 module martello_api_model
    use, intrinsic :: iso_c_binding
+   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
    use martello_kinds, only: dp
    use martello_status
    use martello_model
@@ -312,7 +313,9 @@ contains
       mp => get_model(handle)
       c_model_set_gravity = MARTELLO_ERR_ARGUMENT
       if (.not. associated(mp)) return
-      if (g /= g .or. abs(g) > huge(g)) then
+      ! ieee_is_finite, not g /= g .or. abs(g) > huge(g): an ordered comparison with a NaN
+      ! raises IEEE invalid, a trap under scripts/fpe-trap
+      if (.not. ieee_is_finite(g)) then
          mp%errmsg = 'set_gravity: g must be finite'; return
       end if
       mp%gravity = g
@@ -326,11 +329,17 @@ contains
       real(c_double), intent(in) :: par(NPAR_TF), t(*), y(*)
       type(model_t), pointer :: mp
       integer :: stat
+      real(dp) :: no_table(0)
       mp => get_model(handle)
       if (.not. associated(mp) .or. ntab < 0) then
          c_model_add_nodal_force = MARTELLO_ERR_ARGUMENT; return
       end if
-      call model_add_nodal_force(mp, int(node) + 1, int(kind), par, t(1:ntab), y(1:ntab), stat)
+      ! a caller with no table (ntab = 0) may pass NULL: t and y are then not touched
+      if (ntab == 0) then
+         call model_add_nodal_force(mp, int(node) + 1, int(kind), par, no_table, no_table, stat)
+      else
+         call model_add_nodal_force(mp, int(node) + 1, int(kind), par, t(1:ntab), y(1:ntab), stat)
+      end if
       c_model_add_nodal_force = stat
    end function c_model_add_nodal_force
 
@@ -341,11 +350,17 @@ contains
       real(c_double), intent(in) :: par(NPAR_TF), t(*), y(*)
       type(model_t), pointer :: mp
       integer :: stat
+      real(dp) :: no_table(0)
       mp => get_model(handle)
       if (.not. associated(mp) .or. ntab < 0) then
          c_model_set_ground_acceleration = MARTELLO_ERR_ARGUMENT; return
       end if
-      call model_set_ground_acceleration(mp, int(kind), par, t(1:ntab), y(1:ntab), stat)
+      ! a caller with no table (ntab = 0) may pass NULL: t and y are then not touched
+      if (ntab == 0) then
+         call model_set_ground_acceleration(mp, int(kind), par, no_table, no_table, stat)
+      else
+         call model_set_ground_acceleration(mp, int(kind), par, t(1:ntab), y(1:ntab), stat)
+      end if
       c_model_set_ground_acceleration = stat
    end function c_model_set_ground_acceleration
 

@@ -19,7 +19,8 @@ module martello_impulse
    implicit none
    private
    public :: contact_graph_t, contact_graph, delassus_columns, delassus_bandwidth, &
-      delassus_diagonal_band, b_dot, newton_impulses, contact_forces, apply_impulses, delassus_factor, &
+      delassus_diagonal_band, b_dot, newton_impulses, newton_impulses_band, kkt_bandwidth, contact_forces, &
+      apply_impulses, delassus_factor, &
       project_factored, impulse_accumulation, flight_resolution, lcp_work_reals, LEMKE_MAX, IMPULSE_OK, &
       IMPULSE_INFEASIBLE, IMPULSE_NOT_CONVERGED, IMPULSE_SINGULAR, IMPULSE_NO_MEMORY
 
@@ -31,6 +32,9 @@ module martello_impulse
    !> finish makes the solution exact to round-off before that)
    real(dp), parameter :: PGS_TOL = 1.0e-14_dp
    integer, parameter :: PGS_MAX_SWEEPS = 100000
+   !> newton_impulses_band: a sign is wrong when it is wrong by more than KKT_TOL of the
+   !> scale of q or z (the band solve is exact to a few ulps of that scale)
+   real(dp), parameter :: KKT_TOL = 1.0e-12_dp
    !> A flight of an impact sequence is resolved when the method locates its end to this
    !> fraction of its length (flight_resolution, docs/impulse.md §4)
    real(dp), parameter :: RESOLVED_FRACTION = 1.0e-2_dp
@@ -171,6 +175,175 @@ contains
       integer, intent(in), optional :: kw
       call solve_lcp(g_free + e*g_ref, p, info, iterations, w, wb, kw)
    end subroutine newton_impulses
+
+   !> The half-bandwidth of the saddle-point matrix of newton_impulses_band, [[Ŵ, −Bᵀ], [B, 0]]
+   !> on the contacts act of rows b, for a band Ŵ of n nodes and half-bandwidth kd: each
+   !> multiplier is ordered right after the last node of its row (kkt_order). 2 for a chain of
+   !> neighbours; the band solve costs O((n + m) kk²).
+   pure integer function kkt_bandwidth(b, act, n, kd) result(kk)
+      type(rows_t), intent(in) :: b
+      integer, intent(in) :: act(:), n, kd
+      integer :: pv(n), pz(size(act)), i, j, q
+      call kkt_order(b, act, n, pv, pz)
+      kk = 0
+      do i = 1, n - kd
+         kk = max(kk, pv(i + kd) - pv(i))
+      end do
+      do j = 1, size(act)
+         do q = row_lo(b, act(j)), row_hi(b, act(j))
+            kk = max(kk, pz(j) - pv(b%node(q)))
+         end do
+      end do
+   end function kkt_bandwidth
+
+   !> The unknowns of the saddle-point system in the order v_1, the multipliers of the rows
+   !> whose last node is 1, v_2, …: pv(i) the position of node i, pz(j) that of contact act(j).
+   pure subroutine kkt_order(b, act, n, pv, pz)
+      type(rows_t), intent(in) :: b
+      integer, intent(in) :: act(:), n
+      integer, intent(out) :: pv(n), pz(:)
+      integer :: cnt(0:n), last(size(act)), i, j, at
+      cnt = 0
+      do j = 1, size(act)
+         last(j) = max(0, maxval(b%node(row_lo(b, act(j)):row_hi(b, act(j)))))
+         cnt(last(j)) = cnt(last(j)) + 1
+      end do
+      at = cnt(0)                     ! rows on no free node first (singular: never in act)
+      cnt(0) = 0
+      do i = 1, n
+         at = at + 1
+         pv(i) = at
+         at = at + cnt(i)
+         cnt(i) = pv(i)               ! the next multiplier after node i goes to cnt(i) + 1
+      end do
+      do j = 1, size(act)
+         cnt(last(j)) = cnt(last(j)) + 1
+         pz(j) = cnt(last(j))
+      end do
+   end subroutine kkt_order
+
+   !> Newton's law (as newton_impulses) on the contacts act(1..m) of rows b when the inverse-mass
+   !> action is A = Ŵ⁻¹ of a band matrix Ŵ (Moreau–Jean with links or a consistent mass):
+   !> W = B Ŵ⁻¹ Bᵀ is then dense and is never formed. Block principal pivoting (Júdice & Pires
+   !> 1994) on the saddle-point form of W_JJ z_J = −q_J,
+   !>
+   !>    [ Ŵ     −s B_Jᵀ ] [ Δv ]   [   0    ]
+   !>    [ s B_J    0    ] [ z/s] = [ −s q_J ],   w = q + B Δv,
+   !>
+   !> a band solve of half-bandwidth kkt_bandwidth (2 on a chain: O(n + m) a round instead of
+   !> the O(n m) columns, O(m²) matrix and O(m³) finish of the dense W); s scales each row to Ŵ's
+   !> diagonal on its nodes. J starts from the support of p (the warm start) and the contacts
+   !> not separating (q ≤ KKT_TOL·max|q|); a round flips every wrong sign (z_j < 0 on J, w_j < 0 off it) while their number falls,
+   !> else, after three rounds without progress, only the wrong sign of the least index
+   !> (Murty's rule: finite for the P-matrix of independent contacts). Accepted when no sign is
+   !> wrong by more than KKT_TOL of the scale of q or z; impulses within KKT_TOL of that scale
+   !> are set to zero (round-off, not impacts). wab: Ŵ in LAPACK band storage with
+   !> A(i, j) at wab(size(wab, 1) − kd + i − j, j) (kd + 1 + i − j in 2kd + 1 rows, or dgbtrf's
+   !> 3kd + 1). info: IMPULSE_SINGULAR when the saddle-point matrix is (dependent contacts),
+   !> IMPULSE_NOT_CONVERGED after 3m + 20 rounds, IMPULSE_NO_MEMORY; p unchanged then (the
+   !> caller falls back to the dense W).
+   subroutine newton_impulses_band(wab, kd, b, act, g_free, g_ref, e, p, info, rounds)
+      real(dp), intent(in) :: wab(:, :)
+      integer, intent(in) :: kd
+      type(rows_t), intent(in) :: b
+      integer, intent(in) :: act(:)
+      real(dp), intent(in) :: g_free(:), g_ref(:), e(:)
+      real(dp), intent(inout) :: p(:)
+      integer, intent(out) :: info, rounds
+      real(dp), allocatable :: ab(:, :), x(:)
+      integer, allocatable :: ipiv(:), pv(:), pz(:)
+      real(dp) :: q(size(act)), s(size(act)), z(size(act)), w, qscale, zscale
+      logical :: inj(size(act)), wrong(size(act))
+      integer :: n, m, nn, kk, ld, dg, i, j, c, r, st, nwrong, best, stalled
+      n = size(wab, 2); m = size(act); dg = size(wab, 1) - kd
+      rounds = 0
+      info = IMPULSE_OK
+      if (m == 0) return
+      q = g_free + e*g_ref
+      kk = kkt_bandwidth(b, act, n, kd)
+      nn = n + m; ld = 3*kk + 1
+      info = IMPULSE_NO_MEMORY
+      allocate (ab(ld, nn), x(nn), ipiv(nn), pv(n), pz(m), stat=st)
+      if (st /= 0) return
+      info = IMPULSE_OK
+      call kkt_order(b, act, n, pv, pz)
+      do j = 1, m
+         c = act(j)
+         s(j) = 0.0_dp
+         do r = row_lo(b, c), row_hi(b, c)
+            s(j) = max(s(j), abs(wab(dg, b%node(r))))
+         end do
+         s(j) = max(s(j), tiny(1.0_dp))
+      end do
+      qscale = maxval(abs(q))
+      ! the warm start and every contact not separating: a contact at rest in a touching row
+      ! (Newton's cradle) is in J from the first round, not one neighbour a round
+      inj = p > 0.0_dp .or. q <= KKT_TOL*qscale
+      best = m + 1; stalled = 0
+      do rounds = 1, 3*m + 20
+         ! the saddle-point band in dgbsv's storage: entry (r, col) at ab(2kk + 1 + r − col, col)
+         ab = 0.0_dp; x = 0.0_dp
+         do j = 1, n
+            do i = max(1, j - kd), min(n, j + kd)
+               ab(2*kk + 1 + pv(i) - pv(j), pv(j)) = wab(dg + i - j, j)
+            end do
+         end do
+         do j = 1, m
+            c = act(j)
+            if (.not. inj(j)) then
+               ab(2*kk + 1, pz(j)) = 1.0_dp
+               cycle
+            end if
+            do r = row_lo(b, c), row_hi(b, c)
+               i = pv(b%node(r))
+               ab(2*kk + 1 + i - pz(j), pz(j)) = -s(j)*b%coef(r)
+               ab(2*kk + 1 + pz(j) - i, i) = s(j)*b%coef(r)
+            end do
+            x(pz(j)) = -s(j)*q(j)
+         end do
+         call dgbsv(nn, kk, kk, 1, ab, ld, ipiv, x, nn, st)
+         if (st /= 0) then
+            info = IMPULSE_SINGULAR; return
+         end if
+         ! z on J, w = q + B Δv off J; the wrong signs
+         z = 0.0_dp
+         do j = 1, m
+            if (inj(j)) z(j) = s(j)*x(pz(j))
+         end do
+         zscale = max(maxval(abs(z)), tiny(1.0_dp))
+         do j = 1, m
+            if (inj(j)) then
+               wrong(j) = z(j) < -KKT_TOL*zscale
+            else
+               c = act(j)
+               w = q(j)
+               do r = row_lo(b, c), row_hi(b, c)
+                  w = w + b%coef(r)*x(pv(b%node(r)))
+               end do
+               wrong(j) = w < -KKT_TOL*qscale
+            end if
+         end do
+         nwrong = count(wrong)
+         if (nwrong == 0) then
+            ! an impulse within the solution's round-off is none (no impact of 1e-18 N s)
+            p = merge(z, 0.0_dp, z > KKT_TOL*zscale)
+            return
+         end if
+         if (nwrong < best) then
+            best = nwrong; stalled = 0
+         else
+            stalled = stalled + 1
+         end if
+         if (stalled < 3) then
+            where (wrong) inj = .not. inj
+         else
+            j = findloc(wrong, .true., dim=1)
+            inj(j) = .not. inj(j)
+         end if
+      end do
+      rounds = 3*m + 20
+      info = IMPULSE_NOT_CONVERGED
+   end subroutine newton_impulses_band
 
    !> The contact forces λ of contacts at zero gap and zero gap rate: Signorini's law at the
    !> acceleration level, 0 ≤ g̈ ⊥ λ ≥ 0 with g̈ = g̈_free + W λ (Pfeiffer & Glocker 1996, §5.3).

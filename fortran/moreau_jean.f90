@@ -41,8 +41,8 @@ module martello_moreau_jean
    use martello_integrator_settings, only: integrator_settings_t
    use martello_fixed_step, only: stepper_t, stepper_start, contact_state
    use martello_impulse, only: contact_graph_t, contact_graph, delassus_columns, b_dot, &
-      delassus_bandwidth, delassus_diagonal_band, newton_impulses, lcp_work_reals, IMPULSE_OK, &
-      IMPULSE_NO_MEMORY
+      delassus_bandwidth, delassus_diagonal_band, newton_impulses, newton_impulses_band, kkt_bandwidth, &
+      lcp_work_reals, LEMKE_MAX, IMPULSE_OK, IMPULSE_NO_MEMORY
    use martello_linalg, only: lapack_status
    implicit none
    private
@@ -62,6 +62,9 @@ module martello_moreau_jean
       logical, allocatable :: rigid(:), movable(:)
       ! Delassus operator: dense (Lemke) and band (PGS), the columns Ŵ⁻¹Bᵀ (kd > 0), LCP data
       real(dp), allocatable :: wd_(:, :), wb(:, :), zcol(:, :), qlcp(:), zlcp(:), gref(:), eact(:)
+      !> Ŵ before its factorisation (kd > 0 and more than LEMKE_MAX contacts): the band of the
+      !> saddle-point form of the LCP (newton_impulses_band)
+      real(dp), allocatable :: w0(:, :)
       type(band_t) :: kband, cband, what
    contains
       procedure :: init
@@ -173,6 +176,16 @@ contains
          end do
          rhs(0) = 0.0_dp
          rhs(fixed_nodes) = 0.0_dp
+         if (self%kd > 0 .and. nc > LEMKE_MAX) then
+            if (.not. allocated(self%w0)) then
+               allocate (self%w0, mold=what%ab, stat=info)
+               if (info /= 0) then
+                  call no_memory('the step matrix copy', REAL_BYTES*size(what%ab))
+                  return
+               end if
+            end if
+            self%w0 = what%ab
+         end if
          call factorise(info)
          if (info /= 0) then
             call lapack_status('dgbtrf', info, code, msg)
@@ -317,7 +330,8 @@ contains
       !> impulses. ġ_free = B v_free, ġ_ref = B v_k.
       subroutine impulses(inf)
          integer, intent(out) :: inf
-         integer :: ii, jj, k
+         integer :: ii, jj, k, kk
+         logical :: banded
          associate (na => self%na, kw => self%kw, kd => self%kd, act => self%act, &
                     pos => self%pos, v => self%v, vn => self%vn, &
                     e_con => self%e_con, what => self%what, iters => self%iters, p => self%p, &
@@ -338,6 +352,7 @@ contains
                self%eact(ii) = e_con(k)
                self%zlcp(ii) = p_prev(k)                ! warm start from the last step (PGS)
             end do
+            banded = .false.
             if (kd == 0) then
                ! Ŵ diagonal: W banded in the active ordering (tridiagonal for a chain)
                kw = delassus_bandwidth(self%graph, self%b, act(1:na), pos)
@@ -347,6 +362,24 @@ contains
                call newton_impulses(self%qlcp(1:na), self%gref(1:na), self%eact(1:na), &
                                     self%zlcp(1:na), inf, iters, wb=self%wb, kw=kw)
             else
+               ! beyond Lemke's size, when its band is narrow (a chain), the saddle-point form:
+               ! O(n + na) a round where the dense W below costs O(n na + na³)
+               if (na > LEMKE_MAX) then
+                  kk = kkt_bandwidth(self%b, act(1:na), n, kd)
+                  if (real(n + na, dp)*(kk + 1)**2 <= real(n, dp)*na*(kd + 1)) then
+                     call newton_impulses_band(self%w0, kd, self%b, act(1:na), self%qlcp(1:na), &
+                                               self%gref(1:na), self%eact(1:na), self%zlcp(1:na), inf, iters)
+                     banded = inf == IMPULSE_OK
+                     o%counters(C_NEWTON) = o%counters(C_NEWTON) + int(iters, i8)
+                     iters = 0
+                     if (inf == IMPULSE_NO_MEMORY) then
+                        call no_memory('the saddle-point band of the LCP', REAL_BYTES*(3*kk + 3.0_dp)*(n + na))
+                        return
+                     end if
+                  end if
+               end if
+            end if
+            if (kd > 0 .and. .not. banded) then
                ! W = B Ŵ⁻¹ Bᵀ from the columns Ŵ⁻¹ B_jᵀ (one multi-right-hand-side solve)
                if (allocated(self%zcol)) then
                   if (size(self%zcol, 2) < na) deallocate (self%zcol)

@@ -2,10 +2,15 @@
 line of martello.cli, with a Ctrl-C while its modules load ending as one line, exit 130, like
 a Ctrl-C at any later moment (martello.cli.run_command)."""
 
+import signal
 import sys
+
+from . import errors
 
 
 def main():
+    if signal.getsignal(signal.SIGINT) is signal.default_int_handler:
+        signal.signal(signal.SIGINT, errors.record_sigint)
     try:
         from .cli import main as command_line
         return command_line()

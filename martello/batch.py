@@ -157,7 +157,7 @@ def run_specs(specs, jobs=0, progress=None, *, fn=None, retries=RETRIES, executo
     for s in specs:
         if "status" in s:
             if progress:
-                progress.update(False)
+                progress.update(False, not_run=True)
             yield dict(s)
     jobs = jobs or os.cpu_count() or 1
     stopped = stop.is_set if stop is not None else (lambda: False)

@@ -122,6 +122,19 @@ class Split:
 
 
 @dataclass
+class Slab:
+    """The in-plane slab panel of a flexible floor over the rectangle x0..x1 × y0..y1 of the
+    plan grid, its corners member ends at that floor: a membrane of `thickness`, E and ν in
+    plane stress on the corners' ux, uy."""
+    floor: int
+    x: tuple                 # (x0, x1)
+    y: tuple                 # (y0, y1)
+    thickness: float
+    E: float
+    nu: float
+
+
+@dataclass
 class Floor:
     mass: float
     centre: tuple            # mass centre (x, y)
@@ -161,6 +174,7 @@ class Building:
     base: str = "fixed"               # "fixed" or "pinned"
     reference: tuple | None = None    # one plan point for every rigid floor; None: mass centres
     grid_masses: dict | None = None   # flexible floors: {floor: {line name: mass}}
+    slabs: list = field(default_factory=list)   # Slab panels of flexible floors
 
     def __post_init__(self):
         if self.model not in ("shear", "frame"):
@@ -226,6 +240,11 @@ class Building:
         if splits:
             (ln, s), sp = next(iter(splits.items()))
             raise ValueError(f"split {sp.name}: line {ln} has no member in storey {s}")
+        for sl in self.slabs:
+            if self.floors[sl.floor - 1].rigid:
+                raise ValueError(f"slab at floor {sl.floor}: a rigid floor's slab is the diaphragm")
+            for p in ((sl.x[0], sl.y[0]), (sl.x[1], sl.y[0]), (sl.x[1], sl.y[1]), (sl.x[0], sl.y[1])):
+                self._node_at(sl.floor, p, at)
         if self.model == "shear" and self.beams:
             raise ValueError("beams: a shear-type building has none (model = \"frame\")")
         for bm in self.beams:
@@ -376,6 +395,18 @@ class Building:
             coords, A = self._element_map(e)
             B = T @ A
             K[np.ix_(coords, coords)] += B.T @ k @ B
+        for sl in self.slabs:
+            k = membrane_stiffness(sl.x[1] - sl.x[0], sl.y[1] - sl.y[0], sl.thickness, sl.E, sl.nu)
+            corners = [self._node_at(sl.floor, p, self._at) for p in
+                       ((sl.x[0], sl.y[0]), (sl.x[1], sl.y[0]), (sl.x[1], sl.y[1]), (sl.x[0], sl.y[1]))]
+            rows = [self.rows[nd][d] for nd in corners for d in (0, 1)]
+            coords = sorted({c for r in rows for c in r})
+            pos = {c: i for i, c in enumerate(coords)}
+            A = np.zeros((8, len(coords)))
+            for p, r in enumerate(rows):
+                for c, v in r.items():
+                    A[p, pos[c]] = v
+            K[np.ix_(coords, coords)] += A.T @ k @ A
         return K
 
     def condensed(self):
@@ -458,6 +489,36 @@ class Building:
             S[3 * (s - 1) + 1] += F[1]
             S[3 * (s - 1) + 2] += (top.x - xo) * F[1] - (top.y - yo) * F[0] + Mz
         return S
+
+
+# --- slabs -------------------------------------------------------------------------------------
+
+def membrane_stiffness(lx, ly, t, E, nu):
+    """The 8 x 8 in-plane stiffness of an lx × ly rectangular slab panel of thickness t in plane
+    stress, on (ux, uy) of its corners counterclockwise from (x0, y0): the bilinear element with
+    Wilson's incompatible modes 1 − ξ², 1 − η² condensed (Q6: Wilson, Taylor, Doherty &
+    Ghaboussi, Incompatible displacement models, 1973; Cook, Malkus, Plesha & Witt, Concepts and
+    Applications of Finite Element Analysis, §6.7), 2 × 2 Gauss points. On a rectangle it
+    passes the patch test and is exact in pure in-plane bending, which the bilinear element
+    alone (shear locking) is not: one panel per bay models a slab bending in its plane."""
+    D = E / (1 - nu * nu) * np.array([[1.0, nu, 0.0], [nu, 1.0, 0.0], [0.0, 0.0, (1 - nu) / 2]])
+    hx, hy = lx / 2, ly / 2
+    xi_n, eta_n = (-1.0, 1.0, 1.0, -1.0), (-1.0, -1.0, 1.0, 1.0)
+    g = 1 / np.sqrt(3.0)
+    K = np.zeros((12, 12))                     # 8 corner DOFs, then 4 incompatible ones
+    for xi in (-g, g):
+        for eta in (-g, g):
+            dx = [xn * (1 + eta * en) / 4 / hx for xn, en in zip(xi_n, eta_n)] + [-2 * xi / hx, 0.0]
+            dy = [en * (1 + xi * xn) / 4 / hy for xn, en in zip(xi_n, eta_n)] + [0.0, -2 * eta / hy]
+            B = np.zeros((3, 12))
+            for a in range(6):
+                B[0, 2 * a] = dx[a]
+                B[1, 2 * a + 1] = dy[a]
+                B[2, 2 * a], B[2, 2 * a + 1] = dy[a], dx[a]
+            K += t * hx * hy * B.T @ D @ B     # Gauss weights 1, |J| = hx hy
+    Kcc, Kci, Kii = K[:8, :8], K[:8, 8:], K[8:, 8:]
+    Ks = Kcc - Kci @ np.linalg.solve(Kii, Kci.T)
+    return 0.5 * (Ks + Ks.T)
 
 
 # --- modes ------------------------------------------------------------------------------------

@@ -240,6 +240,8 @@ def _path(text):
 
 
 def _caused_by_interrupt(exc):
+    if errors.sigint_seen:       # the exception came while a Ctrl-C was being delivered
+        return True
     seen = set()
     while exc is not None and id(exc) not in seen:
         if isinstance(exc, KeyboardInterrupt):

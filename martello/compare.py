@@ -3,11 +3,12 @@ metrics martello uses on its own runs (martello.metrics), so a researcher can ve
 against martello's closed forms and reference data. The CSV format is documented in
 docs/compare.md: a header row, then one row per time; column t (s) and any of u:<node>,
 v:<node>, a:<node> (m, m/s, m/s²), penetration:<contact> (m, > 0 in contact), force:<contact>
-(N, compressive > 0) and energy:kinetic, energy:recoverable (J) — exactly as in martello's own
-history.csv, so a martello run can be fed back as a self-check. OpenSees node recorder files
-(whitespace-separated, a time column, no header) are read too, their columns named on the
-command line (read_recorder). A scene with neither a closed form nor stored reference data
-gets a reference computed on demand and cached (martello.reference.cache)."""
+(N, compressive > 0), link_force:<link>, elongation:<link> (N, m) and energy:kinetic,
+energy:recoverable (J) — exactly as in martello's own history.csv, so a martello run can be
+fed back as a self-check. OpenSees node recorder files (whitespace-separated, a time column,
+no header) are read too, their columns named on the command line (read_recorder). A scene
+with neither a closed form nor stored reference data gets a reference computed on demand and
+cached (martello.reference.cache)."""
 
 from __future__ import annotations
 
@@ -30,6 +31,9 @@ from .scene.loader import load
 
 NODE_KINDS = ("u", "v", "a")
 CONTACT_KINDS = ("penetration", "force")
+# martello's own history.csv also records each link's state (docs/results.md): accepted so
+# a martello run can be fed back, and scored wherever the reference records the same column
+LINK_KINDS = ("link_force", "elongation")
 # A history to compare is at most this large (a million rows of 50 columns).
 HISTORY_LIMIT = 1024 * MiB
 ENERGY_COLUMNS = ("energy:kinetic", "energy:recoverable", "energy:input", "energy:damping",
@@ -52,14 +56,16 @@ def _check_names(path, header, scene, hline):
         return
     nodes = {n["name"] for n in scene.nodes}
     contacts = {c["name"] for c in scene.contacts}
+    links = scene.links.names
     for c in header:
         kind, sep, name = c.partition(":")
         if c == "t" or c in ENERGY_COLUMNS:
             continue
-        if not sep or kind not in NODE_KINDS + CONTACT_KINDS:
+        if not sep or kind not in NODE_KINDS + CONTACT_KINDS + LINK_KINDS:
             raise HistoryError(path, f"unknown column {c!r}",
                                "valid: t, u:<node>, v:<node>, a:<node>, penetration:<contact>, "
-                               "force:<contact>, energy:kinetic, energy:recoverable, ...", row=hline)
+                               "force:<contact>, link_force:<link>, elongation:<link>, "
+                               "energy:kinetic, energy:recoverable, ...", row=hline)
         if kind in NODE_KINDS and name not in nodes:
             raise HistoryError(path, f"column {c!r} names no node of {scene.source}",
                                "nodes: " + ", ".join(sorted(nodes)), row=hline)
@@ -67,6 +73,9 @@ def _check_names(path, header, scene, hline):
             raise HistoryError(path, f"column {c!r} names no contact of {scene.source}",
                                "contacts: " + ", ".join(sorted(contacts)) if contacts else "it has none",
                                row=hline)
+        if kind in LINK_KINDS and name not in links:
+            raise HistoryError(path, f"column {c!r} names no link of {scene.source}",
+                               "links without a name are link<i>", row=hline)
 
 
 def read_history(path, scene=None):
@@ -218,7 +227,8 @@ def read_histories(paths, columns=None, scene=None):
 
 def comparable(columns, ref):
     """The columns of a history that the reference also has, u first."""
-    order = {"u": 0, "v": 1, "a": 2, "penetration": 3, "force": 4, "energy": 5}
+    order = {"u": 0, "v": 1, "a": 2, "penetration": 3, "force": 4, "link_force": 5, "elongation": 6,
+             "energy": 7}
     cols = [c for c in columns if c != "t" and c in ref.columns]
     return sorted(cols, key=lambda c: (order.get(c.partition(":")[0], 9), c))
 

@@ -5,6 +5,19 @@ request to report it (martello.cli.main; the traceback with --debug). `debug` is
 --debug, for the layers that catch errors of their own (martello check, per scene)."""
 
 debug = False
+# Set by the `martello` command's first SIGINT handler (martello.__main__): a Ctrl-C while
+# modules load may come back as another exception (numpy turns it into an ImportError that
+# does not chain it), which the command line then reports as the interrupt it was.
+sigint_seen = False
+
+
+def record_sigint(signum, frame):
+    """The `martello` command's SIGINT handler until a layer installs its own: Python's
+    default (KeyboardInterrupt), the signal recorded in sigint_seen."""
+    global sigint_seen
+    sigint_seen = True
+    import signal
+    signal.default_int_handler(signum, frame)
 
 
 class MartelloError(Exception):

@@ -110,9 +110,10 @@ def parse_csv(raw, error, finite=True, check_header=None):
     body = lines[1:]
     data = None
     try:        # numpy's parser first (fast); the loop below says what is wrong, and where
-        data = np.loadtxt([ln for _, ln in body], delimiter=",", ndmin=2, dtype=float)
-        if data.shape != (len(body), len(header)):
-            data = None
+        if body:    # (no rows: numpy would warn; the loop gives the empty array)
+            data = np.loadtxt([ln for _, ln in body], delimiter=",", ndmin=2, dtype=float)
+            if data.shape != (len(body), len(header)):
+                data = None
     except ValueError:
         data = None
     if data is not None:

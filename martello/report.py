@@ -155,7 +155,8 @@ def headline(rows, failures, n_scenes, elapsed):
     return (f"verification: {c['verification_passed']} of {c['verification']} distinct rows passed "
             f"({c['verification_closed_form']} vs closed form, {c['verification_independent']} vs "
             f"independent reference; tolerance < 1 %); {c['cells_verified']} of {c['cells']} cells "
-            f"verified, {c['cells_partly']} partly, {c['cells_wrong']} wrong; not counted: {c['loose_passed']} of {c['loose']} "
+            f"verified, {c['cells_partly']} partly, {c['cells_not_verified']} not verified, "
+            f"{c['cells_wrong']} wrong; not counted: {c['loose_passed']} of {c['loose']} "
             f"loose rows (tolerance 1-10 %) passed, {c['unconverged']} unconverged (no bound: "
             f"nothing asserted), {c['repeat']} repeats of identical elements, "
             f"{c['regression_passed']} of {c['regression']} regression rows passed; "
@@ -317,7 +318,8 @@ def readme_counts(c):
             f"against closed forms, {c['verification_independent']} against the independent "
             f"engine; each with a tolerance below 1 %); {c['cells_verified']} of {c['cells']} problem × "
             f"law/scheme × integrator cells are verified ([docs/coverage.md](docs/coverage.md)), "
-            f"{c['cells_partly']} partly, {c['cells_wrong']} wrong. Not counted: {c['loose']} loose "
+            f"{c['cells_partly']} partly, {c['cells_not_verified']} not verified, {c['cells_wrong']} "
+            f"wrong. Not counted: {c['loose']} loose "
             f"rows (1-10 %), {c['unconverged']} unconverged, {c['repeat']} repeats of identical "
             f"elements, {c['regression']} regression rows.")
 
@@ -391,8 +393,10 @@ def _tol(r):
     return "exact" if t == 0.0 else f"{t:.0e}"
 
 
-def _problem_table(rows):
-    """Per problem: scenes, rows by kind, and the fewest digits of its verification rows."""
+def _problem_table(rows, n_scenes):
+    """Per problem: the scenes with rows, rows by kind, and the fewest digits of its
+    verification rows; a last line sums them (the headline's counts; the scenes without
+    rows are the list below it)."""
     by = {}
     for r in rows:
         key = r.get("problem") or r["scene"].split()[0]
@@ -403,13 +407,18 @@ def _problem_table(rows):
         d["failed"] += kinds.failed(r)
         if kind == kinds.VERIFICATION:
             d["min"] = r["digits"] if d["min"] is None else min(d["min"], r["digits"])
-    lines = ["| problem | scenes | verification | loose | unconverged | repeat | regression | failed | "
+    lines = ["| problem | scenes with rows | verification | loose | unconverged | repeat | regression | failed | "
              "fewest digits (verification rows) |", "|---|---|---|---|---|---|---|---|---|"]
     for k in sorted(by):
         d = by[k]
         low = "-" if d["min"] is None else f"{d['min']:.1f}"
         lines.append(f"| {k} | {len(d['scenes'])} | {d['verification']} | {d['loose']} | {d['unconverged']} | "
                      f"{d['repeat']} | {d['regression']} | {d['failed']} | {low} |")
+    total = {k: sum(d[k] for d in by.values()) for k in (*kinds.KINDS, "failed")}
+    lows = [d["min"] for d in by.values() if d["min"] is not None]
+    lines.append(f"| all | {sum(len(d['scenes']) for d in by.values())} of {n_scenes} | "
+                 f"{total['verification']} | {total['loose']} | {total['unconverged']} | {total['repeat']} | "
+                 f"{total['regression']} | {total['failed']} | {f'{min(lows):.1f}' if lows else '-'} |")
     return "\n".join(lines)
 
 
@@ -450,7 +459,7 @@ def _write_markdown(rows, failures, pngs, path, elapsed, n_scenes, unchecked=())
              "nothing below 10 %: the error and the order are shown, nothing is asserted; "
              "*repeat* — the row of a contact identical to an earlier one of the scene (counted "
              "once); *regression* — drift from stored data made by martello itself.", "",
-             _problem_table(rows), "", "## Scenes not verified", ""]
+             _problem_table(rows, n_scenes), "", "## Scenes not verified", ""]
     missing = not_verified_scenes(rows, unchecked)
     lines += [f"{len(missing)} of {n_scenes} scenes have no verification row:", ""] + \
         [f"- `{stem}` ({title}): {why}" for stem, title, why in missing]

@@ -638,7 +638,7 @@ def building_results(b, columns, hist):
     applied to every recorded sample: exact at output.every = 1): signed extremes of every
     member's end forces (N, V2, V3, T, M2, M3 at ends i and j; a rigid floor's beams carry no
     in-plane forces, so no N, V3, M2) with their times and the largest biaxial moment
-    √(M2² + M3²) at each end; per storey the shears along x and y and the torque about the
+    √(M2² + M3²) at each end and its time; per storey the shears along x and y and the torque about the
     floor's reference point; per requested plan point its ux, uy. Also the member histories
     (M2, M3 at both ends, by column name)."""
     col = {name: i for i, name in enumerate(columns)}
@@ -660,6 +660,7 @@ def building_results(b, columns, hist):
                     series[f"{q}_{end}:{b['prefix']}.{m.name}"] = x
             res = np.hypot(F[:, 12 * e + off + 4], F[:, 12 * e + off + 5])
             out[f"M_{end}_resultant_max"] = float(res.max()) if len(res) else None
+            out[f"M_{end}_resultant_t"] = float(t[int(np.argmax(res))]) if len(res) else None
         members[m.name] = out
     S = U @ b["storey"].T
     storeys = {str(s + 1): {q: _extremes(S[:, 3 * s + k], t) for k, q in enumerate(("shear_x", "shear_y", "torque"))}

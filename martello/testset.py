@@ -17,6 +17,7 @@ from pathlib import Path
 from .errors import MartelloError
 from .independent.laws import contact_law
 from .independent.scene import effective_mass
+from .scene.rows import element_terms
 
 SCHEMA = 1
 REGRESSION_RTOL = 1e-9
@@ -52,19 +53,25 @@ def model(scene):
     name = lambda i: "ground" if i < 0 else scene.nodes[i]["name"]      # noqa: E731
     links = []
     for lk in scene.links:
-        d = {k: v for k, v in lk.items() if k not in ("name", "type", "a", "b") and v is not None}
-        links.append({"name": lk["name"], "type": lk["type"], "a": name(lk["a"]), "b": name(lk["b"]),
-                      **{k: _num(v) for k, v in d.items()}})
+        d = {k: v for k, v in lk.items() if k not in ("name", "type", "a", "b", "terms", "direction")
+             and v is not None}
+        sides = ({"a": name(lk["a"]), "b": name(lk["b"])} if lk.get("terms") is None else
+                 {"terms": [{"node": name(i), "coef": cf} for i, cf in lk["terms"]]})
+        links.append({"name": lk["name"], "type": lk["type"], **sides, **{k: _num(v) for k, v in d.items()}})
     mass = [n["mass"] for n in scene.nodes]
     fixed = [n["fixed"] for n in scene.nodes]
     contacts = []
     for c in scene.contacts:
-        d = {"name": c["name"], "a": name(c["a"]), "b": name(c["b"]), "gap": c["gap"],
-             "scheme": c["scheme"]}
+        # a node pair by its sides; a row (plan points of rigid floors) by its terms
+        # (docs/buildings.md): δ = Σ coef u(node) − gap
+        terms = element_terms(c)
+        d = ({"name": c["name"], "a": name(c["a"]), "b": name(c["b"])} if c.get("terms") is None else
+             {"name": c["name"], "terms": [{"node": name(i), "coef": cf} for i, cf in terms]})
+        d.update(gap=c["gap"], scheme=c["scheme"])
         if c["scheme"] == "penalty":
-            mstar = effective_mass(mass, fixed, c["a"], c["b"])
+            mstar = effective_mass(mass, fixed, terms)
             # the target e resolved by the law's published formula, as the kernel does
-            law = contact_law({k: v for k, v in c.items() if v is not None}, c["a"], c["b"], mstar)
+            law = contact_law({k: v for k, v in c.items() if v is not None}, terms, mstar)
             d.update(law=law.law, stiffness=law.K, exponent=law.n, damping=law.c,
                      clipped=law.clipped, effective_mass=_num(mstar) if math.isfinite(mstar) else None,
                      target_restitution=c.get("restitution"))
@@ -162,7 +169,8 @@ def page(p):
              "## Description", "", p["description"] or "(none)", "",
              "## Mathematical description", "",
              "M ü + f_links(u, u̇) + f_contacts(δ, δ̇) = M·1·(g − ü_g(t)) + f(t), with δ = u_a − u_b − gap "
-             "> 0 in contact and the contact laws below (docs/problems.md; SI units).", "",
+             "> 0 in contact (a contact given as a row: δ = Σ coef·u(node) − gap, its force −coef·P "
+             "on each node, docs/buildings.md) and the contact laws below (docs/problems.md; SI units).", "",
              "| node | mass [kg] | u0 [m] | v0 [m/s] | fixed |", "|---|---|---|---|---|"]
     shown = m["nodes"][:20]
     lines += [f"| {n['name']} | {n['mass']:.10g} | {n['u0']:g} | {n['v0']:g} | {n['fixed']} |" for n in shown]
@@ -172,7 +180,9 @@ def page(p):
         lines += ["", "| contact | a | b | gap [m] | scheme | law | stiffness | exponent | damping |",
                   "|---|---|---|---|---|---|---|---|---|"]
         for c in m["contacts"][:20]:
-            lines.append(f"| {c['name']} | {c['a']} | {c['b']} | {c['gap']:g} | {c['scheme']} | "
+            a, b = (c["a"], c["b"]) if "terms" not in c else \
+                (" ".join(f"{t['coef']:+g}·u({t['node']})" for t in c["terms"]), "(the row)")
+            lines.append(f"| {c['name']} | {a} | {b} | {c['gap']:g} | {c['scheme']} | "
                          f"{c.get('law', '-')} | {c.get('stiffness', '-')} | {c.get('exponent', '-')} | "
                          f"{c.get('damping', '-')} |")
     if m["links"]:

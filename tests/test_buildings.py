@@ -228,6 +228,11 @@ def test_symmetric_building_is_the_planar_frame():
             for j in (0, 1, 2):
                 mb = rb["buildings"]["B"]["members"][f"C{s_}.{line}.{j}"]["M3_i"]
                 assert mb["max"] == pytest.approx(-mp["min"] / 3, rel=1e-8)
+    # no M2 here: the biaxial resultant's peak is |M3|'s, at its time
+    c = rb["buildings"]["B"]["members"]["C1.0.0"]
+    peak = max(c["M3_i"]["max"], -c["M3_i"]["min"])
+    at = c["M3_i"]["t_max"] if c["M3_i"]["max"] >= -c["M3_i"]["min"] else c["M3_i"]["t_min"]
+    assert c["M_i_resultant_max"] == pytest.approx(peak, rel=1e-12) and c["M_i_resultant_t"] == at
 
 
 def test_reference_point_and_ground_direction_change_nothing_physical():
@@ -340,6 +345,57 @@ def test_flexible_floors_are_the_planar_frame_with_joint_masses():
             assert np.abs(up - ub).max() < 1e-9 * np.abs(up).max()
 
 
+def test_a_slab_panel_is_exact_in_constant_strain_and_pure_bending():
+    """The flexible floor's slab panel (martello.building3d.membrane_stiffness) against the
+    strain energy of elasticity written here: a uniform strain state, t A εᵀDε/2 (the patch
+    test), and pure in-plane bending u = κxy, v = −κ(x² + νy²)/2 about the centre,
+    E κ² t lx ly³/24 (Timoshenko & Goodier, Theory of Elasticity, §22) — exact for the
+    incompatible-mode element on a rectangle, not for the bilinear one (which locks in
+    bending). Rigid motions carry no force."""
+    from martello.building3d import membrane_stiffness
+    lx, ly, t, nu = 5.0, 4.5, 0.2, 0.2
+    K = membrane_stiffness(lx, ly, t, E, nu)
+    X, Y = np.array([0.0, lx, lx, 0.0]), np.array([0.0, 0.0, ly, ly])
+    D = E / (1 - nu**2) * np.array([[1, nu, 0], [nu, 1, 0], [0, 0, (1 - nu) / 2]])
+    eps = np.array([1e-4, -3e-5, 2e-5])
+    u = np.ravel(np.column_stack([eps[0] * X + eps[2] / 2 * Y, eps[1] * Y + eps[2] / 2 * X]))
+    assert u @ K @ u / 2 == pytest.approx(t * lx * ly * eps @ D @ eps / 2, rel=1e-12)
+    x, y, k = X - lx / 2, Y - ly / 2, 1e-4
+    u = np.ravel(np.column_stack([k * x * y, -k / 2 * (x**2 + nu * y**2)]))
+    assert u @ K @ u / 2 == pytest.approx(E * k**2 * t * lx * ly**3 / 24, rel=1e-12)
+    rigid = np.ravel(np.column_stack([1.0 - 0.3 * Y, 2.0 + 0.3 * X]))
+    assert np.abs(K @ rigid).max() < 1e-12 * np.abs(K).max() * lx
+
+
+def test_a_stiff_slab_makes_a_flexible_floor_rigid():
+    """Flexible floors of a 2-storey frame building with a slab of growing E: the periods
+    converge to those of the rigid-diaphragm building with the same mass and the rotational
+    inertia of the lumped joint masses, the difference falling as 1/E_slab (identity of the
+    method in the limit; without the slab the floors are held in plane by the beams alone).
+    The columns' St Venant torsion and the beams' in-plane bending are made negligible: a
+    rigid floor ties its joints' θz to rz, a membrane (no drilling DOF) leaves them free, so
+    with them the torsional modes would converge to a limit of their own (4e-4, 1.6e-3 here)."""
+    gx, gy = [0.0, 5.0, 10.0], [0.0, 4.5, 9.0]
+    column = {"E": E, "A": 0.12, "I2": 0.4 * 0.3**3 / 12, "I3": 0.3 * 0.4**3 / 12, "J": 1e-12}
+    beam = {"E": E, "A": 0.15, "I2": 1e-12, "I3": 0.3 * 0.5**3 / 12, "J": 2.6e-3}
+    base = dict(storeys=2, model="frame", grid_x=gx, grid_y=gy, mass=[2e5, 1.5e5],
+                column=column, beam=beam, mass_centre=[5.0, 4.5])
+    tx = np.array([2.5, 5.0, 2.5]) / 10
+    ty = np.array([2.25, 4.5, 2.25]) / 9
+    r2 = sum(tx[i] * ty[j] * ((gx[i] - 5.0) ** 2 + (gy[j] - 4.5) ** 2) for i in range(3) for j in range(3))
+    rigid = from_dict(scene(building(**base, inertia=[2e5 * r2, 1.5e5 * r2]))).extras["buildings"][0]["modes"]
+    T_rigid = np.array([m["period"] for m in rigid])
+
+    def periods(**kw):
+        md = from_dict(scene(building(**base, diaphragm=False, **kw))).extras["buildings"][0]["modes"]
+        return np.array([m["period"] for m in md[:6]])
+    errs = [np.abs(periods(slab={"E": E * f, "thickness": 0.2}) / T_rigid - 1).max() for f in (1e2, 1e4)]
+    assert errs[1] < 2e-7 and 50 < errs[0] / errs[1] < 200
+    loose = np.abs(periods() / T_rigid - 1).max()
+    real = np.abs(periods(slab={"E": E, "thickness": 0.2}) / T_rigid - 1).max()
+    assert errs[0] < real < loose
+
+
 def test_bad_buildings_are_refused_with_the_field():
     cases = [({"model": "solid"}, "building[0].model"),
              ({"grid_x": [0.0, 0.0]}, "building[0].grid_x"),
@@ -348,7 +404,9 @@ def test_bad_buildings_are_refused_with_the_field():
              ({"split": [{"name": "S", "line": "9.9", "storey": 1, "height": 1.0, "mass": 1.0}]},
               "building[0].split[0].line"),
              ({"column": {"E": E, "b2": 0.3}}, "building[0].column.b3"),
-             ({"column": None, "member": []}, "building[0]")]
+             ({"column": None, "member": []}, "building[0]"),
+             ({"slab": {"E": E, "thickness": 0.2}}, "building[0].slab"),
+             ({"diaphragm": False, "slab": {"E": E}}, "building[0].slab.thickness")]
     for change, where in cases:
         b = building(**{k: v for k, v in change.items() if v is not None})
         if change.get("column", 1) is None:

@@ -67,6 +67,43 @@ def test_check_passes_on_catalogue_and_writes_report(tmp_path):
     assert "FAIL" not in r.stdout
     assert (tmp_path / "report.md").exists() and (tmp_path / "verification.csv").exists()
     assert (tmp_path / "digits.png").stat().st_size > 1000
+    # one set of counts: stdout's headline is report.md's, coverage.md's counts are the
+    # headline's, and the committed docs/coverage.md (hence the README's block,
+    # tests/test_generated_docs.py) is this run's, cell by cell
+    head = next(l for l in r.stdout.splitlines() if l.startswith("verification: ")).split(" Report: ")[0]
+    assert f"**{head}**" in (tmp_path / "report.md").read_text()
+    fresh = (tmp_path / "coverage.md").read_text()
+    assert "**" + head.rsplit(";", 1)[0] + ".**" in fresh
+    _assert_coverage_current(fresh, (ROOT / "docs" / "coverage.md").read_text())
+
+
+def _coverage_cells(text):
+    """{(problem, law, integrator): (evidence, digits, tolerance, rows by kind, state)} of a
+    coverage page's matrix."""
+    out = {}
+    for line in text.splitlines():
+        f = [x.strip() for x in line.split("|")[1:-1]]
+        if len(f) == 8 and f[7] in ("verified", "partly verified", "not verified", "WRONG"):
+            num = lambda x: None if x in ("—", "exact") else float(x)
+            out[tuple(f[:3])] = (f[3], num(f[4]), num(f[5]), f[6], f[7])
+    return out
+
+
+def _assert_coverage_current(fresh, committed):
+    """The committed page against a fresh one: the same counts, cells, evidence, rows by kind
+    and states; digits to their printed 0.1, tolerances (printed to one digit) within 20 %."""
+    from martello.report import coverage_counts
+    again = "docs/coverage.md is stale: run scripts/regenerate_docs coverage (under the heavy lock) " \
+            "and commit docs/coverage.md README.md"
+    assert coverage_counts(committed) == coverage_counts(fresh), again
+    a, b = _coverage_cells(committed), _coverage_cells(fresh)
+    assert a.keys() == b.keys(), (again, sorted(set(a) ^ set(b)))
+    for key in a:
+        (ev, d, tol, k, s), (ev2, d2, tol2, k2, s2) = a[key], b[key]
+        assert (ev, k, s) == (ev2, k2, s2), (again, key, a[key], b[key])
+        assert (d is None) == (d2 is None) and (d is None or abs(d - d2) <= 0.11), (again, key, d, d2)
+        assert (tol is None) == (tol2 is None) and (tol is None or abs(tol - tol2) <= 0.2 * tol), \
+            (again, key, tol, tol2)
 
 
 def test_check_fails_on_a_wrong_reference(tmp_path):

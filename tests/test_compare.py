@@ -81,6 +81,29 @@ def test_a_martello_run_against_stored_reference_data(tmp_path):
     assert worse["metrics"]["max_rel_error"] > rep["metrics"]["max_rel_error"]
 
 
+def test_a_martello_history_with_links_is_read_back_and_scored(tmp_path):
+    # martello's own history.csv carries link_force:<link> and elongation:<link> columns
+    # (docs/results.md): fed back to compare, they are accepted, not refused as unknown.
+    # P2 Kelvin on a 1e-5 step (the catalogue's 1e-6 is too long for a unit test), its
+    # spring named and recorded.
+    from martello.run import run_full, write_results
+    text = KELVIN.read_text().replace('[[link]]\ntype = "spring"', '[[link]]\nname = "spring"\ntype = "spring"')
+    text = text.replace("dt = 1.0e-6", "dt = 1.0e-5").replace("every = 10", "every = 1\nlinks = [\"spring\"]")
+    scene = tmp_path / "kelvin_link.toml"
+    scene.write_text(text)
+    summary, hist = run_full(load(scene))
+    assert {"link_force:spring", "elongation:spring"} <= set(hist[0])
+    write_results(summary, tmp_path / "run", hist)
+    rep = compare.compare(tmp_path / "run" / "history.csv", scene)
+    assert rep["reference_kind"] == "closed-form" and "u:mass" in rep["compared_columns"]
+    # the closed form has no link columns: they are read, not scored
+    assert not any(c.startswith(("link_force:", "elongation:")) for c in rep["compared_columns"])
+    # average acceleration at 1e-5 s, eps/m = 1e6 (contact period 6.3 ms, 630 steps): a
+    # second-order phase error, of order (ω Δt)² ~ 1e-4 per contact, grown over the 0.7 s
+    # (measured 6.6e-4); a wrong column mapping would be O(1)
+    assert rep["metrics"]["max_rel_error"] < 1e-2
+
+
 def test_cli_writes_strict_json(tmp_path, exact_kelvin):
     csv_ = write_csv(tmp_path / "h.csv", *exact_kelvin)
     r = subprocess.run([sys.executable, "-m", "martello", "compare", csv_, "--against", KELVIN,
@@ -104,14 +127,17 @@ GOOD = "t,u:mass\n0,0\n0.1,0.04\n0.2,0.05\n"
     ("t,u:floor\n0,0\n1,1\n", "names no node"),
     ("t,force:wall\n0,0\n1,1\n", "names no contact"),
     ("t,w:mass\n0,0\n1,1\n", "unknown column 'w:mass'"),
+    ("t,link_force:b1.s1\n0,0\n1,1\n", "names no link"),
     ("t,u:mass\n0,0\n0.1,nan\n0.2,0\n", r":3: column u:mass is nan \(NaN or inf\)"),
     ("t,u:mass\n0,0\n0.1,0.01\n0.1,0.02\n", r":4: t = 0.1 does not follow t = 0.1"),
     ("t,u:mass\n0,0\n0.2,0.01\n0.1,0.02\n", "does not follow"),
     ("t,u:mass\n0,0\n0.1,abc\n", "'abc' is not a number"),
     ("t,u:mass\n0,0\n0.1\n", "1 values for 2 columns"),
     ("t,u:mass\n0,0\n", "1 data row"),
+    ("t,u:mass\n", "0 data row"),        # numpy warned before the error (a second line)
     ("t,a:mass\n0,0\n0.1,0\n", None),
 ])
+@pytest.mark.filterwarnings("error")
 def test_malformed_histories_are_clear_errors(tmp_path, text, match):
     p = tmp_path / "their.csv"
     p.write_text(text)

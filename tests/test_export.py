@@ -175,9 +175,10 @@ def test_integrators_map_onto_opensees_conventions():
     (integ,) = [c.args for c in m.commands if c.name == "integrator"]
     rho = 0.8                      # Chung & Hulbert (1993) eq. 25, weights of the new state
     am, af = 1 - (2 * rho - 1) / (rho + 1), 1 - rho / (rho + 1)
-    assert integ == ("GeneralizedAlpha", pytest.approx(am), pytest.approx(af),
-                     pytest.approx(0.5 + am - af), pytest.approx(0.25 * (1 + am - af) ** 2))
+    # the two-number form (OpenSees' four-number form swaps γ and β: docs/opensees.md)
+    assert integ == ("GeneralizedAlpha", pytest.approx(am), pytest.approx(af))
     assert any("interpolated state" in d for d in m.differences)
+    assert any("first-order accurate" in d for d in m.differences)
     m = opensees_model(from_dict(two_bodies("kelvin"), source="tb"),
                        analysis={"integrator": "newmark", "beta": 1 / 6})
     assert [c.args for c in m.commands if c.name == "integrator"] == [("Newmark", 0.5, 1 / 6)]
@@ -223,6 +224,31 @@ def test_static_mass_coupling_and_central_difference_refusals():
     d = two_bodies("kelvin", integrator="central-difference", restitution=0.5)
     with pytest.raises(ExportError, match="velocity-dependent forces \\(c\\)"):
         opensees_model(from_dict(d, source="tb"))
+
+
+def test_a_building_is_refused_naming_it_and_why():
+    """[[building]] (docs/buildings.md) is a 3D model condensed to its floors' DOFs: the
+    exporter writes none, and says so before the building's mass couplings could be blamed."""
+    b = {"prefix": "B", "storeys": 1, "storey_height": 3.0, "grid_x": [0.0, 6.0], "grid_y": [0.0, 4.0],
+         "column": {"E": 3e10, "b2": 0.3, "b3": 0.5}, "mass": 2.0e5}
+    d = {"building": [b], "analysis": {"type": "dynamic", "integrator": "newmark", "dt": 1e-3, "t_end": 0.1}}
+    with pytest.raises(ExportError, match=r"\[\[building\]\]: cannot be exported.*3D model.*rigidDiaphragm.*"
+                                          r"buildings B: a planar \[\[frame\]\]"):
+        opensees_model(from_dict(d, source="bd"))
+
+
+def test_a_row_of_terms_is_refused_naming_the_contact():
+    """A contact between plan points or written as terms (docs/buildings.md) deforms by a row
+    Σ c·u over several DOFs: no zeroLength element is that, and the exporter says so."""
+    d = {"node": [{"name": "A.ux", "mass": 2e5, "v0": 0.3}, {"name": "A.rz", "mass": 3e6},
+                  {"name": "B.ux", "mass": 1.5e5}],
+         "contact": [{"name": "c", "terms": [{"node": "A.ux", "coef": 1.0}, {"node": "A.rz", "coef": -4.0},
+                                            {"node": "B.ux", "coef": -1.0}],
+                      "gap": 0.01, "scheme": "penalty", "law": "linear", "stiffness": 1e8}],
+         "analysis": {"type": "dynamic", "integrator": "newmark", "dt": 1e-4, "t_end": 0.1}}
+    with pytest.raises(ExportError, match=r"contact\[0\] \(c\)\.terms: cannot be exported.*zeroLength acts "
+                                          r"between two nodes"):
+        opensees_model(from_dict(d, source="rows"))
 
 
 def test_a_full_kelvin_is_never_mapped_onto_a_half_kelvin_silently(tmp_path):

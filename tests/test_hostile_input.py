@@ -472,3 +472,29 @@ def test_a_malformed_reference_named_by_a_study_is_one_line(tmp_path, meta, hist
     one_line_error(r, "study.toml: reference of ", f"{tmp_path / 'ref'}/" + words.split(":")[0],
                    words.partition(": ")[2] if ": " in words else words)
     assert not (tmp_path / "out").exists()
+
+
+def test_a_storey_mass_past_the_doubles_is_one_line_naming_the_masses(tmp_path):
+    """A storey of 1e-300 kg: the stiffness over the masses overflows (it was numpy's
+    LinAlgError 'Eigenvalues did not converge' from the Rayleigh damping; loader fuzz case)."""
+    text = (ROOT / "benchmarks" / "p10" / "p10_bare.toml").read_text()
+    text = "\n".join("mass = [195000.0, 1e-300]" if ln.startswith("mass = [195000.0, 150000.0]")
+                     else ln for ln in text.splitlines())
+    assert "1e-300" in text
+    run_fails(tmp_path, text, "s.toml: frame[0].mass: the stiffness over the masses")
+
+
+def test_an_error_raised_while_a_ctrl_c_is_delivered_is_the_interrupt(monkeypatch, capsys):
+    """A Ctrl-C while numpy imports came back as numpy's ImportError, not chaining the
+    KeyboardInterrupt ('PyCapsule_Import could not import module "datetime"'), and was
+    reported as a bug: the command's first SIGINT handler (martello.__main__) records it."""
+    from types import SimpleNamespace
+    from martello import errors
+
+    def importing(args):
+        raise ImportError('PyCapsule_Import could not import module "datetime"')
+    args = SimpleNamespace(func=importing, debug=False)
+    assert cli.run_command(args) == 1 and "internal error" in capsys.readouterr().err
+    monkeypatch.setattr(errors, "sigint_seen", True)
+    assert cli.run_command(args) == 130
+    assert capsys.readouterr().err == "martello: interrupted\n"

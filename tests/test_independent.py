@@ -218,6 +218,56 @@ def test_the_engines_frame_and_the_front_ends_agree():
         assert np.max(np.abs(fb.C - fr["C"])) <= 1e-12 * np.max(np.abs(fr["C"]))
 
 
+# --- [[building]]: the engine's own shear-type storeys (martello/independent/building.py) ------
+
+def test_the_engines_storeys_are_the_textbook_one_storey_system():
+    # verification against the closed form of P11's one-storey eccentric system (the
+    # catalogue's p11_eccentric_storey.toml: its members' 12EI/h³ and GJ/h worked out by hand,
+    # martello.oracles.p11_buildings.one_storey_periods) on the engine's own storey matrix
+    import tomllib
+    from pathlib import Path
+    from scipy.linalg import eigh
+    from martello.independent.building import building_block
+    from martello.oracles.p11_buildings import one_storey_periods
+    root = Path(__file__).resolve().parent.parent
+    d = tomllib.loads((root / "benchmarks" / "p11" / "p11_eccentric_storey.toml").read_text())
+    bb = building_block(d["building"][0])
+    assert bb.nodes == ["B1.ux", "B1.uy", "B1.rz"]
+    w2 = eigh(bb.K, np.diag(bb.mass), eigvals_only=True)
+    want = one_storey_periods(**d["check"]["params"])
+    got = sorted(2 * np.pi / np.sqrt(w2), reverse=True)
+    assert got == pytest.approx([want["T1"], want["T2"], want["T3"]], rel=1e-12)
+
+
+def test_the_engines_buildings_and_the_front_ends_agree():
+    # two codes of one model (the engine's martello/independent/building.py and the front
+    # end's martello.building3d condensing its 3D beam-columns): K, C, masses, the ground's
+    # influence and the plan-point rows of P11's shear-type pair, to round-off
+    from pathlib import Path
+    from martello.independent.scene import load_model
+    from martello.scene.loader import load
+    path = Path(__file__).resolve().parent.parent / "benchmarks" / "p11" / "p11_shear_pounding.toml"
+    sc, m = load(path), load_model(path)
+    for b, (name, nodes, K, C) in zip(sc.extras["buildings"], m.blocks):
+        assert [m.names[i] for i in nodes] == b["nodes"]
+        assert np.max(np.abs(K - b["K"])) <= 1e-12 * np.max(np.abs(b["K"]))
+        assert np.max(np.abs(C - b["C"])) <= 1e-12 * np.max(np.abs(b["C"]))
+        assert np.allclose(np.diag(b["M"]), m.mass[nodes], rtol=1e-15, atol=0)
+        assert np.array_equal(m.influence[nodes], b["influence"])
+    names = [n["name"] for n in sc.nodes]
+    for c, law in zip(sc.contacts, m.contacts):
+        front = {names[i]: v for i, v in c["terms"]}
+        assert {m.names[i]: v for i, v in law.terms} == pytest.approx(front, rel=1e-15)
+    fD = {lk[0]: row for lk, row in zip(m.dampers, m.damper_rows)}
+    for lk in sc.links:
+        assert {m.names[i]: v for i, v in fD[lk["name"]]} == pytest.approx(
+            {names[i]: v for i, v in lk["terms"]}, rel=1e-15)
+    # what the engine's storeys do not model is refused, never approximated
+    frame = Path(__file__).resolve().parent.parent / "benchmarks" / "p11" / "case_study" / "p11_A.toml"
+    with pytest.raises(independent.Unsupported, match="frame"):
+        load_model(frame)
+
+
 def test_the_engine_reads_peer_at2_records():
     # a user's ground motion as PEER gives it: the engine's own reader (martello/independent/
     # scene.py) and the front end's (martello.ground_motion.records) read the same samples in

@@ -23,6 +23,9 @@ SCENES = {
     "p2/laws/p2_hertz_newmark.toml": ("mirrored", "rescaled", "renamed"),
     "p2/laws/p2_linear_central_difference.toml": ("mirrored", "rescaled", "renamed"),
     "p2/laws/p2_linear_msbdf.toml": ("mirrored", "rescaled", "renamed"),
+    # two bodies, one starting at u = 0 (a zero the mirror does not negate): msbdf's difference
+    # Jacobian steps such a component along its rate (found by sweep.py --metamorphic)
+    "p5/laws/p5_hertz_msbdf.toml": ("mirrored",),
     "p5/p5_kelvin.toml": ("mirrored", "renamed"),
     "p5/p5_moreau_jean_e03.toml": ("mirrored", "rescaled", "renamed"),
     "p5/p5_newmark_lagrange_e03.toml": ("mirrored", "rescaled", "renamed"),

@@ -251,6 +251,31 @@ def test_chain_of_touching_bodies_simultaneous_impact(n, e):
     assert v.sum() == pytest.approx(1.0, abs=64 * EPS)
 
 
+@pytest.mark.parametrize("e", [0.0, 1.0])
+def test_linked_chain_of_touching_bodies_band_lcp(e):
+    """The cradle above with springs between neighbours (Ŵ tridiagonal, so W = BŴ⁻¹Bᵀ is
+    dense) and 99 contacts, beyond Lemke's 64: the LCP is solved on the band of its
+    saddle-point form (docs/impulse.md §2). One step: the springs are internal (1ᵀK = 0), so
+    momentum is kept, and every contact holds, so Newton's law gives the struck chain one
+    velocity: newton_impact(1, n − 1, …) exactly as without springs (their impulse within the
+    step only shares the load between the contacts). Tolerance 64ε: n roundings in the band
+    solve (measured ≤ 4ε)."""
+    n = 100
+    nodes = [{"name": f"b{i}", "mass": 1.0, "v0": 1.0 if i == 0 else 0.0} for i in range(n)]
+    links = [{"type": "spring", "a": f"b{i}", "b": f"b{i + 1}", "k": 10.0} for i in range(n - 1)]
+    contacts = [{"name": f"c{i}", "a": f"b{i}", "b": f"b{i + 1}", "gap": 0.0,
+                 "scheme": "restitution", "restitution": e} for i in range(n - 1)]
+    s, h = execute({"node": nodes, "link": links, "contact": contacts,
+                    "analysis": {"type": "dynamic", "integrator": "moreau-jean", "dt": 1e-3,
+                                 "t_end": 1e-3,
+                                 "output": {"every": 1, "nodes": [x["name"] for x in nodes]}}})
+    v = np.array([h[f"v:b{i}"][-1] for i in range(n)])
+    ref = newton_impact(1.0, n - 1.0, 1.0, 0.0, e)
+    assert v[0] == pytest.approx(ref.v1, abs=64 * EPS)
+    np.testing.assert_allclose(v[1:], ref.v2, rtol=0, atol=64 * EPS)
+    assert all(c["impacts"] == 1 for c in s["contacts"].values())
+
+
 def test_banded_step_matrix_energy_identity():
     """Two masses joined by a spring (Ŵ tridiagonal, so W comes from Ŵ⁻¹Bᵀ columns) bounce
     elastically between two walls: with θ = ½ and e = 1 the discrete energy identity makes

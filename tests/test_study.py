@@ -183,6 +183,15 @@ def test_progress_bar_plain_text():
         p.update(ok=i != 3)
     lines = buf.getvalue().splitlines()
     assert 5 <= len(lines) <= 11 and "20/20 runs" in lines[-1] and "1 not ok" in lines[-1]
+    assert "not run" not in lines[-1]
+
+
+def test_progress_counts_combinations_that_do_not_apply_apart_from_failures():
+    buf = io.StringIO()
+    p = Progress(10, stream=buf)
+    for i in range(10):
+        p.update(ok=i != 9, not_run=i < 3)
+    assert "10/10 runs" in buf.getvalue() and "1 not ok, 3 not run" in buf.getvalue()
 
 
 DATA_STUDY = """

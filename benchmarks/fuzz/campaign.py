@@ -47,6 +47,12 @@ ROOT = mutations.ROOT
 CLASSES = ("ok", "clean error", "unclean error", "traceback", "crash", "hang", "suspicious ok")
 
 
+def progress(t0, done, total):
+    """Seconds so far and, at the pace so far, about how many are left."""
+    elapsed = time.perf_counter() - t0
+    return f"{elapsed:.0f} s (about {elapsed * (total - done) / done:.0f} s left)"
+
+
 class RandomChooser:
     def __init__(self, seed):
         self.r = random.Random(seed)
@@ -233,7 +239,7 @@ def loader_campaign(args):
             if cls not in ("loads", "clean error") and len(examples[cls]) < 25:
                 examples[cls].append({"case": i, "label": label, "detail": detail})
             if (i + 1) % 2000 == 0:
-                print(f"  {i + 1} scenes, {time.perf_counter() - t0:.0f} s: "
+                print(f"  {i + 1} scenes, {progress(t0, i + 1, args.loader)}: "
                       + ", ".join(f"{counts[c]} {c}" for c in LOADER_CLASSES if counts[c]),
                       file=sys.stderr, flush=True)
     elapsed = time.perf_counter() - t0
@@ -369,8 +375,8 @@ def main(argv=None):
                 by_label[r["label"]][r["class"]] += 1
                 if r["class"] not in ("ok", "clean error") and len(examples[r["class"]]) < 25:
                     examples[r["class"]].append(r)
-                if k % 500 == 0:
-                    print(f"  {k} runs, {time.perf_counter() - t0:.0f} s: "
+                if k % 100 == 0:
+                    print(f"  {k} runs, {progress(t0, k, len(cases))}: "
                           + ", ".join(f"{counts[c]} {c}" for c in CLASSES if counts[c]),
                           file=sys.stderr, flush=True)
     finally:

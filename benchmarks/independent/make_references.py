@@ -1,4 +1,4 @@
-"""Write the independent engine's references (docs/independent-reference.md) for P2, P7-P10
+"""Write the independent engine's references (docs/independent-reference.md) for P2, P7-P11
 into reference/independent/<name>.json: strict JSON, each with its trusted digits.
 
     .venv/bin/python benchmarks/independent/make_references.py [NAME ...]
@@ -59,6 +59,10 @@ REFERENCES = {
     "p10_bare": ("benchmarks/p10/p10_bare.toml", None),
     "p10_A": ("benchmarks/p10/p10_A.toml", None),
     "p10_B": ("benchmarks/p10/p10_B.toml", None),
+    # P11's shear-type buildings on rigid floors (the engine's own storeys and plan-point
+    # rows, martello/independent/building.py), 4 s of a sine: eccentric gaps, dampers between
+    # plan points
+    "p11_shear_pounding": ("benchmarks/p11/p11_shear_pounding.toml", None),
 }
 # stored, but not used by `martello check` (docs/independent-reference.md): the P7 Kelvin
 # pair of p7_two_oscillators.toml (p7_two_kelvin, of the same physics, serves the catalogue's

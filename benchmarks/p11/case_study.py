@@ -609,7 +609,10 @@ records* are five others matching the same code spectrum.
 are stated assumptions (the table above); the core is sized so that the modal order resembles the
 seed's, not from drawings. Members are linear (as in the seed's FNA): the moments are demands, not
 capped by yielding. The comparison is of trends and orders of magnitude, never of the seed's exact
-figures."""
+figures. These frame buildings have no independent reference: the OpenSees cross-check of
+[buildings.md](buildings.md#opensees-cross-check) solves the same discrete equations on a smaller
+pair, and the independent engine models only shear-type storeys (its P11 scene,
+`benchmarks/p11/p11_shear_pounding.toml`, 56 of 56 rows verified)."""
 
 
 def check():

@@ -27,7 +27,10 @@ OpenSeesPy runs in an environment of the caller's (--opensees-python PY, a Pytho
 openseespy: `python -m venv DIR && DIR/bin/pip install openseespy`, outside the checkout); the
 script installs nothing, and without one it measures martello alone and says so. Everything
 it writes goes into the folder -o names (scenes, runs, the compiled programs, the JSON
-results). The machine is shared: the load average is printed with every figure.
+results); --docs NAME also keeps them as docs/perf/<name>.json and their table in
+docs/performance.md (benchmarks/perf/measured_docs.py; --check: the page's tables are their
+records', in CI). The machine is shared: the load average is printed with every figure, and
+the CPU time beside the wall time.
 
 --library measures the library alone instead: benchmarks/perf/chain_native.c (compiled here
 against build/libmartello.so) builds the same chain through the C API, as a chain held per node
@@ -38,6 +41,9 @@ keeps only what it lists (martello_run_set_tracking).
 
     .venv/bin/python benchmarks/perf/chain_vs_opensees.py -o DIR [--n 1000 10000 100000]
         [--steps 8000] [--repeats 3] [--opensees-python PY] [--opensees-max-n 10000]
+        [--docs NAME]
+    .venv/bin/python benchmarks/perf/chain_vs_opensees.py --docs NAME --from DIR/chain_vs_opensees.json
+    .venv/bin/python benchmarks/perf/chain_vs_opensees.py --check
     .venv/bin/python benchmarks/perf/chain_vs_opensees.py -o DIR --library [--items]
         [--track node_peaks,contact_peaks] --n 1000 10000 100000 1000000 --steps 8000
 """
@@ -53,6 +59,12 @@ import time
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[2]
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+import measured_docs  # noqa: E402
+
+# the measured tables of docs/performance.md this script writes (--docs NAME): the side by
+# side with OpenSees, and a million oscillators alone
+DOCS = ("chain_vs_opensees", "chain_1e6")
 M, K1, K2, ZETA, GAP, EPS, AMP, OMEGA, DT = 1.0, 100.0, 400.0, 0.05, 0.01, 1.0e5, 3.0, 8.0, 1e-3
 
 
@@ -132,12 +144,12 @@ def opensees_one(n, steps, dt, out):
     ops.algorithm("Newton")
     ops.integrator("Newmark", 0.5, 0.25)
     ops.analysis("Transient")
-    t0 = time.perf_counter()
+    t0, c0 = time.perf_counter(), time.process_time()
     ok = ops.analyze(steps, dt)
-    loop = time.perf_counter() - t0
+    loop, loop_cpu = time.perf_counter() - t0, time.process_time() - c0
     ops.wipe()                                  # flushes the recorder
     rows = [list(map(float, line.split())) for line in env.read_text().split("\n") if line.strip()]
-    print(json.dumps({"ok": ok == 0, "loop_s": loop, "setup_s": t0 - t_start,
+    print(json.dumps({"ok": ok == 0, "loop_s": loop, "loop_cpu_s": loop_cpu, "setup_s": t0 - t_start,
                       "absmax": rows[2] if len(rows) >= 3 else None}))
 
 
@@ -214,15 +226,21 @@ def load():
     return os.getloadavg()[0]
 
 
-def library_alone(a, out):
-    """The chain through the C API alone (chain_native.c): per n, the median of the repeats
-    of the library's ns per DOF-step (its clock and the process' CPU time), the model's and
-    the run's resident bytes per DOF, and the cost exponent of the time loop in n."""
+def chain_native(out):
+    """benchmarks/perf/chain_native.c compiled into out against build/libmartello.so."""
     exe = out / "chain_native"
     lib = ROOT / "build"
     subprocess.run(["cc", "-O2", "-I", str(ROOT / "c"), "-I", str(lib / "include"),
                     str(Path(__file__).with_name("chain_native.c")), "-o", str(exe),
                     f"-L{lib}", "-lmartello", f"-Wl,-rpath,{lib}", "-lm"], check=True)
+    return exe
+
+
+def library_alone(a, out):
+    """The chain through the C API alone (chain_native.c): per n, the median of the repeats
+    of the library's ns per DOF-step (its clock and the process' CPU time), the model's and
+    the run's resident bytes per DOF, and the cost exponent of the time loop in n."""
+    exe = chain_native(out)
     opts = (["--items"] if a.items else []) + (["--track", a.track] if a.track is not None else [])
     print(f"the library alone ({'links and contacts' if a.items else 'a chain held per node'}; "
           f"tracking {a.track or 'all'}); {os.cpu_count()} cores")
@@ -276,12 +294,29 @@ def main():
     ap.add_argument("--track", help="what the run keeps (node_peaks,link_peaks,contact_peaks,"
                                     "phases,all; default: --library all, else the scene's "
                                     "default and node_peaks where OpenSees runs)")
+    ap.add_argument("--docs", metavar="NAME", choices=DOCS, help="keep the results as "
+                    "docs/perf/<name>.json and their table in docs/performance.md (NAME: "
+                    + ", ".join(DOCS) + ")")
+    ap.add_argument("--from", dest="source", help="with --docs: a finished run's chain_vs_opensees.json")
+    ap.add_argument("--check", action="store_true", help="the page's tables are their records' (CI)")
     ap.add_argument("--opensees-one", nargs=4, help=argparse.SUPPRESS)
     a = ap.parse_args()
     if a.opensees_one:
         n, steps, dt, out = a.opensees_one
         opensees_one(int(n), int(steps), float(dt), out)
         return
+    if a.check:
+        problems = [p for p in (measured_docs.check(name, render) for name in DOCS) if p]
+        print("\n".join(problems) or "docs/performance.md: the tables of " + ", ".join(DOCS)
+              + " are their records'")
+        return 1 if problems else 0
+    if a.source:
+        if not a.docs:
+            ap.error("--from records a finished run: give --docs NAME")
+        result = json.loads(Path(a.source).read_text())
+        print(render(result))
+        measured_docs.record(a.docs, result, render(result))
+        return 0
     if not a.out:
         ap.error("give -o DIR, the folder everything is written into")
     out = Path(a.out)
@@ -293,9 +328,11 @@ def main():
     py = opensees_python(a.opensees_python) if wants else None
     sys.path.insert(0, str(ROOT))
     from martello.binding import native
+    start = time.strftime("%Y-%m-%d %H:%M", time.gmtime())
     print(f"martello {native.version()}; {os.cpu_count()} cores; "
           f"{os.uname().machine} {os.uname().release}; load {load():.2f}")
     gbs = triad_gbs(out)
+    exe = chain_native(out) if py else None
     print(f"triad (STREAM-like, 3 x 160 MB): {gbs:.1f} GB/s -> {140 / gbs:.1f} ns per DOF-step "
           f"at 140 B/DOF/step (a tridiagonal implicit step with contacts and peaks)")
     rows = []
@@ -312,7 +349,7 @@ def main():
         if with_os:         # the two codes' peak |u| compared
             track = sorted(set(track or ["contact_peaks"]) | {"node_peaks"})
         scene.write_text(scene_toml(n, a.steps, track=track))
-        mr, orr = [], []
+        mr, orr, lib = [], [], []
         loads = []
         for rep in range(a.repeats):
             loads.append(load())
@@ -323,6 +360,10 @@ def main():
                 elif with_os:
                     (d / "opensees").mkdir(exist_ok=True)
                     orr.append(opensees_once(py, n, a.steps, d / "opensees"))
+                    # the same time loop's CPU time (the library alone, tracking as the
+                    # scene): beside OpenSees' CPU time, a ratio the load moves little
+                    r = run_child([exe, n, a.steps, "--track", ",".join(track)])
+                    lib.append(json.loads(r["out"]))
         dofsteps = n * a.steps
         m_ns = statistics.median(r["native"] for r in mr) / dofsteps * 1e9
         m_wall = statistics.median(r["wall"] for r in mr)
@@ -331,7 +372,8 @@ def main():
         row = {"n": n, "steps": a.steps, "martello_ns_per_dof_step": m_ns, "martello_process_s": m_wall,
                "martello_peak_rss_bytes_per_dof": m_rss, "python_share": share,
                "fused_steps": mr[-1]["fused"], "load": statistics.median(loads),
-               "martello_native_s": [r["native"] for r in mr]}
+               "martello_native_s": [r["native"] for r in mr],
+               "martello_process_s_all": [r["wall"] for r in mr], "martello_process_cpu_s": [r["cpu"] for r in mr]}
         o_ns = o_rss = agree = below = ratio = None
         if orr:
             o_ns = statistics.median(r["loop_s"] for r in orr) / dofsteps * 1e9
@@ -340,7 +382,10 @@ def main():
             om = orr[-1]["absmax"]
             agree, below = peak_agreement(mr[-1]["absmax"], om)
             row.update(opensees_ns_per_dof_step=o_ns, ratio=ratio, opensees_peak_rss_bytes_per_dof=o_rss,
-                       peak_u_max_rel_diff=agree, peak_u_martello_below=below, opensees_loop_s=[r["loop_s"] for r in orr])
+                       peak_u_max_rel_diff=agree, peak_u_martello_below=below, opensees_loop_s=[r["loop_s"] for r in orr],
+                       opensees_loop_cpu_s=[r["loop_cpu_s"] for r in orr],
+                       library_loop_cpu_s=[r["cpu_s"] for r in lib],
+                       cpu_ratio=statistics.median(o["loop_cpu_s"] / m["cpu_s"] for o, m in zip(orr, lib)))
         rows.append(row)
         f = lambda x, fmt: format(x, fmt) if x is not None else "-"
         print(f"{n:>8} {a.steps:>5} {m_ns:>11.1f} {f(o_ns, '11.1f'):>11} {f(ratio, '6.1f'):>6} "
@@ -355,10 +400,56 @@ def main():
         print(f"cost exponent (time loop ~ n^p, n = {big[0]['n']} ... {big[-1]['n']}): p = {slope:.3f}")
     if not a.skip_pounding:
         pounding(py, out, a.repeats, rows)
-    (out / "chain_vs_opensees.json").write_text(json.dumps(
-        {"triad_gbs": gbs, "rows": rows, "machine": os.uname()._asdict() if hasattr(os.uname(), "_asdict")
-         else list(os.uname())}, indent=1))
+    result = {"triad_gbs": gbs, "rows": rows, "machine": list(os.uname()),
+              "martello": native.version(), "commit": measured_docs.commit(), "track": a.track,
+              "date_utc": [start, time.strftime("%Y-%m-%d %H:%M", time.gmtime())],
+              "load_end": load()}
+    (out / "chain_vs_opensees.json").write_text(json.dumps(result, indent=1))
     print(f"results: {out / 'chain_vs_opensees.json'}")
+    if a.docs:
+        measured_docs.record(a.docs, result, render(result))
+
+
+def render(result):
+    """The table of a run's results (chain_vs_opensees.json): per n, martello's time loop
+    per DOF-step, OpenSees' and their ratios where it ran (wall; CPU against the library
+    alone on the same chain), martello's whole process (wall and CPU), its peak memory per
+    DOF and the load; medians of the repeats."""
+    med = statistics.median
+    rows = [r for r in result["rows"] if "n" in r]
+    with_os = any(r.get("ratio") is not None for r in rows)
+    dates = result["date_utc"]
+    track = result["track"] or "the scene's default (node peaks too where OpenSees runs)"
+    head = (f"{dates[0]} – {dates[1][-5:]} UTC, martello {result['martello']} at commit "
+            f"{result['commit']}, tracking {track}; medians of {len(rows[0]['martello_native_s'])} "
+            f"run(s){', the codes alternating' if with_os else ''}; load at the start of each "
+            f"size in the table, {result['load_end']:.1f} at the end; triad {result['triad_gbs']:.1f} GB/s")
+    cols = ["n", "steps", "martello time loop ns/DOF-step (wall)"]
+    if with_os:
+        cols += ["OpenSees ns/DOF-step (its CPU/wall)", "OpenSees/martello, wall",
+                 "OpenSees/martello, CPU (the library alone's ns/DOF-step)"]
+    cols += ["martello process s (CPU s)", "peak B/DOF"]
+    if with_os:
+        cols += ["peak \\|u\\| rel. diff"]
+    cols += ["load"]
+    lines = [head, "", "| " + " | ".join(cols) + " |", "|" + "---|" * len(cols)]
+    for r in rows:
+        cells = [f"{r['n']}", f"{r['steps']}", f"{r['martello_ns_per_dof_step']:.1f}"]
+        if with_os:
+            cells += ["–"] * 3
+            if r.get("ratio") is not None:
+                share = med(c / w for c, w in zip(r["opensees_loop_cpu_s"], r["opensees_loop_s"]))
+                lib_ns = med(r["library_loop_cpu_s"]) / (r["n"] * r["steps"]) * 1e9
+                cells[-3:] = [f"{r['opensees_ns_per_dof_step']:.0f} ({share:.2f})", f"{r['ratio']:.0f}×",
+                              f"**{r['cpu_ratio']:.0f}×** ({lib_ns:.1f})"]
+        cells += [f"{r['martello_process_s']:.1f} ({med(r['martello_process_cpu_s']):.1f})",
+                  f"{r['martello_peak_rss_bytes_per_dof']:.0f}"]
+        if with_os:
+            d = r.get("peak_u_max_rel_diff")
+            cells += [f"{d:.1e}" if d is not None else "–"]
+        cells += [f"{r['load']:.1f}"]
+        lines.append("| " + " | ".join(cells) + " |")
+    return "\n".join(lines)
 
 
 def pounding(py, out, repeats, rows):

@@ -3,10 +3,11 @@
 !> the library's fused chain step against. Newmark average acceleration on n oscillators
 !> (m = 1 kg, k alternating 100 and 400 N/m, a dashpot to ground of 5 % damping, linear
 !> contacts ε = 1e5 N/m through 10 mm gaps between neighbours, ground acceleration 3 sin 8t),
-!> the same equations and the same Newton iteration as fortran/chain/kernels.f90 on the same
-!> chain: the residual linearised about the committed state, forward-substituted with the kept
-!> factors J = L D Lᵀ (reciprocal pivots), a backward sweep for Δu, u, v, a and the elements,
-!> and a refactorisation where a contact changed branch. Nothing else: no works, no peaks, no
+!> the same equations and the same Newton iteration as the fused step on the same chain
+!> (fortran/chain/chain_step.f90, its sweeps forward_sweep.inc and back_sweep.inc): the
+!> residual linearised about the committed state, forward-substituted with the kept factors
+!> J = L D Lᵀ (reciprocal pivots), a backward sweep for Δu, u, v, a and the elements, and a
+!> refactorisation where a contact changed branch. Nothing else: no works, no peaks, no
 !> observer, no flags or strides, every parameter a constant. Its ten per-node arrays lie in
 !> one block, 256 B apart modulo a 4 kB page, as the library's (arrays allocated one by one
 !> would start at the same page offset and their streams share L1 sets: cachegrind, n = 1e5,
@@ -14,8 +15,8 @@
 !>
 !>     lean_chain N STEPS
 !>
-!> prints one JSON line: the wall seconds of the time loop, ns per DOF-step, the solves and
-!> factorisations, and u of the first and last node at the end (the library's history gives
+!> prints one JSON line: the wall and CPU seconds of the time loop, ns per DOF-step, the solves
+!> and factorisations, and u of the first and last node at the end (the library's history gives
 !> the same to round-off: the same computation).
 program lean_chain
    use, intrinsic :: iso_fortran_env, only: int8, int64, output_unit
@@ -30,7 +31,7 @@ program lean_chain
    integer, parameter :: U_ = 1, V_ = 2, A_ = 3, UN_ = 4, VN_ = 5, AN_ = 6, RP_ = 7, FE_ = 8, &
                          KG_ = 9, CG_ = 10
    integer(int64) :: c0, c1, rate, solves, factorisations
-   real(dp) :: cm, cv, ca, cb, acc, t
+   real(dp) :: cm, cv, ca, cb, acc, t, cpu0, cpu1
    real(dp), allocatable :: blk(:)
    integer(int8), allocatable :: br(:), brf(:)
    logical :: flipped, factored
@@ -51,6 +52,7 @@ program lean_chain
    end do
    factored = .false.; solves = 0; factorisations = 0
    call system_clock(c0, rate)
+   call cpu_time(cpu0)
    do k = 1, steps
       tmp = at(U_); at(U_) = at(UN_); at(UN_) = tmp
       tmp = at(V_); at(V_) = at(VN_); at(VN_) = tmp
@@ -80,8 +82,9 @@ program lean_chain
       if (flipped .or. .not. factored) error stop 'lean_chain: a step did not settle in 8 solves'
    end do
    call system_clock(c1)
-   write (output_unit, '(a,i0,a,i0,a,es14.7,a,es14.7,a,i0,a,i0,a,es25.17,a,es25.17,a)') &
-      '{"n": ', n, ', "steps": ', steps, ', "wall_s": ', real(c1 - c0, dp)/rate, &
+   call cpu_time(cpu1)
+   write (output_unit, '(a,i0,a,i0,a,es14.7,a,es14.7,a,es14.7,a,i0,a,i0,a,es25.17,a,es25.17,a)') &
+      '{"n": ', n, ', "steps": ', steps, ', "wall_s": ', real(c1 - c0, dp)/rate, ', "cpu_s": ', cpu1 - cpu0, &
       ', "ns_per_dof_step": ', real(c1 - c0, dp)/rate/(real(n, dp)*steps)*1.0e9_dp, &
       ', "solves": ', solves, ', "factorizations": ', factorisations, ', "u_first": ', &
       blk(at(U_) + 1), ', "u_last": ', blk(at(U_) + n), '}'

@@ -85,6 +85,12 @@ def wait_rows(proc, out, k):
         time.sleep(0.02)
 
 
+def differing(a, b, skip=()):
+    """Columns where two rows of runs.csv files differ (a column only one file has reads as
+    empty in the other: a partial output lacks the columns of rows it does not hold)."""
+    return sorted(k for k in set(a) | set(b) if k not in skip and a.get(k, "") != b.get(k, ""))
+
+
 def last_line(text):
     lines = text.strip().splitlines()
     return lines[-1] if lines else ""
@@ -96,6 +102,8 @@ def main(argv=None):
     ap.add_argument("-o", "--out", type=Path, required=True, help="folder for the outputs")
     ap.add_argument("-j", "--jobs", type=int, default=1)
     ap.add_argument("--interrupts", type=int, default=3)
+    ap.add_argument("--reuse-whole", action="store_true",
+                    help="take the uninterrupted run from -o/whole when it is there")
     a = ap.parse_args(argv)
     a.out.mkdir(parents=True, exist_ok=True)
     study = a.study.resolve()
@@ -103,12 +111,17 @@ def main(argv=None):
 
     say(f"[1/3] uninterrupted run of {a.study} (-j {a.jobs})")
     t0 = time.monotonic()
-    p = start(study, a.out / "whole", a.jobs)
-    _, err = p.communicate()
-    whole_s = time.monotonic() - t0
-    if p.returncode != 0:
-        raise SystemExit(f"the uninterrupted study failed ({p.returncode}): {err}")
-    whole = rows(a.out / "whole" / "runs.csv")
+    if a.reuse_whole and (a.out / "whole" / "runs.csv").is_file():
+        whole = rows(a.out / "whole" / "runs.csv")
+        whole_s = sum(float(r["wall_time_s"] or 0) for r in whole)
+        say(f"      reused {a.out / 'whole'} (its runs' own times: {whole_s:.0f} s)")
+    else:
+        p = start(study, a.out / "whole", a.jobs)
+        _, err = p.communicate()
+        whole_s = time.monotonic() - t0
+        if p.returncode != 0:
+            raise SystemExit(f"the uninterrupted study failed ({p.returncode}): {err}")
+        whole = rows(a.out / "whole" / "runs.csv")
     n = len(whole)
     say(f"      {n} runs in {whole_s:.1f} s; the rest takes about {2 * whole_s:.0f} s")
 
@@ -126,7 +139,7 @@ def main(argv=None):
         stopped = time.monotonic() - t1
         left = seconds_to_die(p.pid, 5.0)
         part = rows(out / "runs.csv")
-        changed = [r["run"] for r in part if r["run"] in kept and r != kept[r["run"]]]
+        changed = [r["run"] for r in part if r["run"] in kept and differing(r, kept[r["run"]])]
         say(f"      interrupt {i + 1}: exit {p.returncode} after {stopped:.2f} s, "
             f"{len(part)} of {n} rows kept, group alive after: {'no' if left is not None else 'YES'}, "
             f"kept rows changed: {len(changed)}; last line: {last_line(err)}")
@@ -141,9 +154,8 @@ def main(argv=None):
     final = rows(out / "runs.csv")
     resumed = [ln for ln in err.splitlines() if ln.startswith("resuming")]
     order = [r["run"] for r in final] == [str(k) for k in range(n)]
-    diff = [(b["run"], k) for b, c in zip(final, whole) for k in b
-            if k not in TIMED and b[k] != c.get(k)]
-    rerun = [r["run"] for r in final if r["run"] in kept and r != kept[r["run"]]]
+    diff = [(b["run"], k) for b, c in zip(final, whole) for k in differing(b, c, TIMED)]
+    rerun = [r["run"] for r in final if r["run"] in kept and differing(r, kept[r["run"]])]
     say(f"      resumed: exit {p.returncode}; {resumed[0] if resumed else 'no resume line'}")
     say(f"      rows: {len(final)} of {n}, each once in order: {order}; columns differing from "
         f"the uninterrupted run (all but {sorted(TIMED)}): {len(diff)}; kept rows run again: "

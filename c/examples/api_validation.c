@@ -91,6 +91,8 @@ int main(void) {
   double k_chain[3] = {100.0, 100.0, 100.0}, gaps[2] = {0.01, 0.01}, c_bad[3] = {1.0, -1.0, 1.0};
   int two[2] = {0, 1}, same[2] = {1, 1}, kinds[2] = {MARTELLO_LINK_SPRING, MARTELLO_LINK_SPRING};
   int ground[2] = {MARTELLO_GROUND, MARTELLO_GROUND};
+  int row_nodes[3] = {0, 1, 2};
+  double row_coef[3] = {1.0, -0.5, -0.5};
   double links2[2 * MARTELLO_NPAR_LINK] = {100.0, 0, 0, 0, 0, 0, -100.0, 0, 0, 0, 0, 0};
 
   /* model_create and set_node */
@@ -209,6 +211,40 @@ int main(void) {
   expect("contact: a == b", m,
          martello_model_add_contact(m, 2, 2, 0.0, MARTELLO_SCHEME_PENALTY, 1, cp),
          MARTELLO_ERR_ARGUMENT, "same node");
+  martello_model_free(&m);
+
+  /* rows (a contact or link on a combination of DOFs): the same parameter domains as the
+   * pair doors, checked by the same code */
+  m = model();
+  cp[MARTELLO_P_EXPONENT] = 0.0;
+  expect("contact row: hertz exponent 0", m,
+         martello_model_add_contact_row(m, 3, row_nodes, row_coef, 0.01, MARTELLO_SCHEME_PENALTY,
+                                        MARTELLO_LAW_HERTZ, cp),
+         MARTELLO_ERR_ARGUMENT, "penalty: par[MARTELLO_P_EXPONENT]");
+  cp[MARTELLO_P_EXPONENT] = 1.5;
+  expect("contact row: valid hertz", m,
+         martello_model_add_contact_row(m, 3, row_nodes, row_coef, 0.01, MARTELLO_SCHEME_PENALTY,
+                                        MARTELLO_LAW_HERTZ, cp), MARTELLO_OK, NULL);
+  cp[MARTELLO_P_RESTITUTION] = 1.5;
+  expect("contact row: restitution e 1.5", m,
+         martello_model_add_contact_row(m, 3, row_nodes, row_coef, 0.01,
+                                        MARTELLO_SCHEME_RESTITUTION, 0, cp),
+         MARTELLO_ERR_ARGUMENT, "par[MARTELLO_P_RESTITUTION]");
+  cp[MARTELLO_P_RESTITUTION] = -1.0;
+  lp[MARTELLO_L_STIFF] = 0.0;
+  expect("link row: spring k 0", m,
+         martello_model_add_link_row(m, MARTELLO_LINK_SPRING, 3, row_nodes, row_coef, lp),
+         MARTELLO_ERR_ARGUMENT, "spring: par[MARTELLO_L_STIFF]");
+  lp[MARTELLO_L_STIFF] = 100.0;
+  lp[MARTELLO_L_DAMP] = 1.0;
+  lp[MARTELLO_L_ALPHA] = 3.0;
+  expect("link row: fluid damper alpha 3", m,
+         martello_model_add_link_row(m, MARTELLO_LINK_FLUID_DAMPER, 3, row_nodes, row_coef, lp),
+         MARTELLO_ERR_ARGUMENT, "par[MARTELLO_L_ALPHA]");
+  lp[MARTELLO_L_ALPHA] = 0.5;
+  expect("link row: valid fluid damper", m,
+         martello_model_add_link_row(m, MARTELLO_LINK_FLUID_DAMPER, 3, row_nodes, row_coef, lp),
+         MARTELLO_OK, NULL);
   martello_model_free(&m);
 
   /* chains: each link and contact as the doors check it, named by its entry */

@@ -17,6 +17,7 @@ from pathlib import Path
 
 import numpy as np
 
+from .. import errors
 from ..errors import MartelloError, SolverError, DivergenceError, Interrupted
 from ..paths import LIBRARIES
 _DOUBLE_P = np.ctypeslib.ndpointer(dtype=np.float64, flags="C_CONTIGUOUS")
@@ -693,7 +694,8 @@ def _watch():
     callback = PROGRESS_FN(progress)
     old = None
     if (threading.current_thread() is threading.main_thread()
-            and signal.getsignal(signal.SIGINT) is signal.default_int_handler):
+            and signal.getsignal(signal.SIGINT) in (signal.default_int_handler,
+                                                    errors.record_sigint)):
         old = signal.signal(signal.SIGINT, on_sigint)
     try:
         yield callback

@@ -100,7 +100,7 @@ def half_kelvin_e(xi):
 def _law(c, mstar):
     """A penalty contact's law with its damping resolved from a target e by the law's
     published formula, as the kernel does (martello.independent.laws.contact_law)."""
-    return contact_law({k: v for k, v in c.items() if v is not None}, c["a"], c["b"], mstar)
+    return contact_law({k: v for k, v in c.items() if v is not None}, [(c["a"], 1.0), (c["b"], -1.0)], mstar)
 
 
 class _Builder:
@@ -134,6 +134,21 @@ class _Builder:
                         "(fast nonlinear) integrator",
                         "give --integrator newmark, hht, generalized-alpha or central-difference "
                         "and --dt")
+        buildings = s.extras.get("buildings", [])
+        if buildings:
+            self.refuse("[[building]]", "the exporter writes chains of nodes and planar frames; a "
+                        "building is a 3D model condensed to its floors' ux, uy, rz, which OpenSees "
+                        "would take as 6-DOF nodes with rigidDiaphragm floors (docs/buildings.md), a "
+                        "model the exporter does not write",
+                        "buildings " + ", ".join(b["prefix"] for b in buildings) + ": a planar "
+                        "[[frame]] per building exports where the plan is symmetric")
+        for kind, items in (("contact", s.contacts), ("link", s.links)):
+            for i, it in enumerate(items):
+                if it.get("terms") is not None:
+                    self.refuse(f"{kind}[{i}] ({it['name']}).terms",
+                                "a row Σ c·u over several DOFs (plan points of rigid floors or "
+                                "written terms): OpenSees' zeroLength acts between two nodes along "
+                                "one direction", "give the element two nodes a and b")
         if s.couplings:
             self.refuse("mass_coupling", "OpenSees nodal masses are diagonal and martello's "
                         "couplings are general off-diagonal terms",
@@ -364,7 +379,7 @@ class _Builder:
         fixed = [n["fixed"] for n in s.nodes]
         for ci, c in enumerate(s.contacts):
             a, b = c["a"], c["b"]
-            mstar = effective_mass(mass, fixed, a, b)
+            mstar = effective_mass(mass, fixed, [(a, 1.0), (b, -1.0)])
             law = _law(c, mstar)                     # the target e resolved by the published formula
             name, gap = c["name"], float(c["gap"])
             mat_kind = self.materials.get(law.law, DEFAULT_MATERIAL[law.law])
@@ -426,8 +441,12 @@ class _Builder:
         if k == "constant":
             self.add("timeSeries", "Constant", tag, "-factor", fn["value"])
         elif k == "sine":
-            # Trig: factor·sin(2π(t − tStart)/period + shift) on [tStart, tEnd], both included
-            self.add("timeSeries", "Trig", tag, fn["t_start"], fn["t_end"], 2.0 * math.pi / fn["omega"],
+            # Trig: factor·sin(2π(t − tStart)/period + shift) on [tStart, tEnd], both included.
+            # An open-ended sine ends two steps after the analysis (never evaluated later):
+            # UniformExcitation integrates its series over [tStart, tEnd] when it is built, and
+            # an end at 1e300 makes OpenSees print "Ran out of memory" there
+            t1 = min(float(fn["t_end"]), float(self.an["t_end"]) + 2.0 * float(self.an.get("dt") or 0.0))
+            self.add("timeSeries", "Trig", tag, fn["t_start"], t1, 2.0 * math.pi / fn["omega"],
                      "-factor", fn["amplitude"], "-shift", fn["phase"])
         elif k == "half_sine":
             self.add("timeSeries", "Trig", tag, fn["t_start"], fn["t_end"],
@@ -531,7 +550,7 @@ class _Builder:
         mass_l, fixed = list(m), [nd["fixed"] for nd in s.nodes]
         for c in s.contacts:
             a, b = c["a"], c["b"]
-            law = _law(c, effective_mass(mass_l, fixed, a, b))
+            law = _law(c, effective_mass(mass_l, fixed, [(a, 1.0), (b, -1.0)]))
             d = at(a, 0) - at(b, 0) - c["gap"]
             if d > 0:
                 rate = vt(a, 0) - vt(b, 0)
@@ -551,11 +570,14 @@ class _Builder:
             f -= m * self.value_at_zero(s.ground)
         for fo in s.forces:
             f[fo["node"]] += self.value_at_zero(fo["function"])
+        self.accelerated = []               # free nodes with a_0 ≠ 0 (central difference's start)
         for i, nd in enumerate(s.nodes):
             if nd["fixed"]:
                 continue
             tag = self.node_tag[i]
             a0 = f[i] / m[i]
+            if a0 != 0.0:
+                self.accelerated.append(nd["name"])
             if u[i] != 0.0:
                 self.add("setNodeDisp", tag, 1, float(u[i]), "-commit")
             if v[i] != 0.0:
@@ -591,6 +613,12 @@ class _Builder:
             self.add("algorithm", "Linear")
             self.add("integrator", "CentralDifference")
             what = "CentralDifference (explicit: no Newton iteration)"
+            if self.accelerated:
+                self.diff.append(
+                    "central-difference: OpenSees starts from u_{-1} = u_0, i.e. from a_0 = 0 "
+                    "(CentralDifference::domainChanged); here a_0 != 0 at "
+                    f"{', '.join(self.accelerated[:4])} (gravity or a load at t = 0): its velocities "
+                    "carry an error a_0·Δt/2 from the first step on, first order in Δt")
         else:
             self.add("test", "NormDispIncr", tol, iters)
             self.add("algorithm", "Newton")
@@ -606,9 +634,18 @@ class _Builder:
             else:
                 rho = an["rho_inf"]
                 am, af = (2.0 - rho) / (1.0 + rho), 1.0 / (1.0 + rho)
-                gamma, beta = 0.5 + am - af, 0.25 * (1.0 + am - af) ** 2
-                self.add("integrator", "GeneralizedAlpha", am, af, gamma, beta)
-                what = f"GeneralizedAlpha alphaM = {am:.17g}, alphaF = {af:.17g} (ρ∞ = {rho:g})"
+                # the two-number form: its constructor sets Chung & Hulbert's γ = ½ + αM − αF,
+                # β = ¼(1 + αM − αF)²; the four-number form hands "$gamma $beta" to a
+                # constructor (αM, αF, β, γ), i.e. swapped (docs/opensees.md "Integrators")
+                self.add("integrator", "GeneralizedAlpha", am, af)
+                what = (f"GeneralizedAlpha alphaM = {am:.17g}, alphaF = {af:.17g} (ρ∞ = {rho:g}; γ, β "
+                        "of Chung & Hulbert set by OpenSees)")
+            if name == "generalized-alpha":
+                self.diff.append(
+                    "generalized-alpha: OpenSees' GeneralizedAlpha forms the inertia with a_{n+1} "
+                    "while its tangent carries alphaM (GeneralizedAlpha::update sets the response "
+                    "(u_{n+αF}, v_{n+αF}, a_{n+1})): its solution is first-order accurate, "
+                    "martello's Chung–Hulbert second order (docs/opensees.md \"Integrators\")")
             if name in ("hht", "generalized-alpha"):
                 self.diff.append(
                     f"{name}: OpenSees evaluates the internal and external forces at the "

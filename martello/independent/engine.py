@@ -91,7 +91,13 @@ class System:
         self.bk = np.array([x[3] for x in m.bilinears])
         self.bfy = np.array([x[4] for x in m.bilinears])
         self.brho = np.array([x[5] for x in m.bilinears])
-        self.fa, self.fb = idx(m.dampers, 1), idx(m.dampers, 2)
+        # each fluid damper's row (a node pair: e_a − e_b; between plan points of rigid floors
+        # its terms, docs/buildings.md): du̇ = D v, its force F acts on the nodes as −Dᵀ F
+        self.fD = np.zeros((len(m.dampers), n + 1))
+        for k, terms in enumerate(m.damper_rows):
+            for i, c in terms:
+                if i != GROUND:
+                    self.fD[k, i] += c
         self.fc = np.array([x[3] for x in m.dampers])
         self.falpha = np.array([x[4] for x in m.dampers])
         self.fvreg = np.array([x[5] for x in m.dampers])
@@ -147,6 +153,8 @@ class System:
     def external(self, t):
         m = self.m
         f = m.mass * (m.gravity - m.ground(t))
+        if m.influence is not None:          # a building's floors: (cos α, sin α, 0) of the motion
+            f = f * m.influence
         for i, fn in m.forces:
             f[i] += fn(t)
         return np.where(self.free, f, 0.0)
@@ -162,13 +170,14 @@ class System:
         dub = uE[self.ba] - uE[self.bb]
         dvb = vE[self.ba] - vE[self.bb]
         fb, fp = self.bilinear_force(dub, modes)
-        dvf = vE[self.fa] - vE[self.fb]
+        dvf = self.fD @ vE
         ff = self.damper_force(dvf, modes)
-        for a, b, w in ((self.sa, self.sb, fs), (self.da, self.db, fd), (self.ba, self.bb, fb),
-                        (self.fa, self.fb, ff)):
+        for a, b, w in ((self.sa, self.sb, fs), (self.da, self.db, fd), (self.ba, self.bb, fb)):
             if len(w):
                 f -= np.bincount(a, w, n + 1)
                 f += np.bincount(b, w, n + 1)
+        if len(ff):
+            f -= self.fD.T @ ff
         dblock = 0.0
         for ix, K, C in self.blocks:          # [[frame]]: f = K u + C v on its nodes
             fc = C @ vE[ix]
@@ -312,11 +321,11 @@ class System:
 
         def dv_of(y):
             _, vE = sysm.ext(y)
-            return vE[sysm.fa[i]] - vE[sysm.fb[i]], abs(vE[sysm.fa[i]]) + abs(vE[sysm.fb[i]]) + vreg + sysm.vscale
+            return float(sysm.fD[i] @ vE), float(np.abs(sysm.fD[i] * vE).sum()) + vreg + sysm.vscale
 
         def gdot(y, acc):
             aE = np.append(acc, 0.0)
-            return aE[sysm.fa[i]] - aE[sysm.fb[i]]
+            return float(sysm.fD[i] @ aE)
 
         def make(level, direction, target):
             def g(y):
@@ -357,7 +366,7 @@ def initial_modes(sysm: System, y0) -> Modes:
     dub = uE[sysm.ba] - uE[sysm.bb]
     if np.any(sysm.bk * np.abs(dub) > sysm.bfy):
         raise Unsupported("a bilinear link starts beyond yield")
-    dvf = vE[sysm.fa] - vE[sysm.fb]
+    dvf = sysm.fD @ vE
     modes.dreg[:] = np.where(dvf >= sysm.fvreg, 1, np.where(dvf <= -sysm.fvreg, -1, 0)) if len(dvf) else []
     for i in range(len(dvf)):
         if sysm.fvreg[i] == 0.0:

@@ -91,9 +91,9 @@ class Quantities:
                 np.full_like(du, md.reg[i] * (1 - s.brho[i]) * s.bfy[i])
             out.append((lk[0], du, s.brho[i] * s.bk[i] * du + fp))
         for i, lk in enumerate(self.m.dampers):
-            dv = vE[s.fa[i]] - vE[s.fb[i]]
+            dv = s.fD[i] @ vE
             f = s.fsec[i] * dv if md.dreg[i] == 0 else md.dreg[i] * s.fc[i] * np.abs(dv) ** s.falpha[i]
-            out.append((lk[0], uE[s.fa[i]] - uE[s.fb[i]], f))
+            out.append((lk[0], s.fD[i] @ uE, f))
         return out
 
 

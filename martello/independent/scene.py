@@ -16,6 +16,7 @@ from pathlib import Path
 
 import numpy as np
 
+from .building import building_block, point_terms
 from .errors import Unsupported
 from .frame import FrameBlock, frame_block
 from .laws import ContactLaw, contact_law
@@ -195,13 +196,15 @@ class Model:
     springs: list            # (name, a, b, k)
     dashpots: list           # (name, a, b, c)
     bilinears: list          # (name, a, b, k, fy, rho)
-    dampers: list            # (name, a, b, c, alpha, v_reg)
+    dampers: list            # (name, a, b, c, alpha, v_reg); a, b unused for a row's
     contacts: list           # ContactLaw
     gravity: float
     ground: TimeFunction
     forces: list             # (node index, TimeFunction)
     t_end: float
-    blocks: list = field(default_factory=list)   # (name, node indices, K, C): [[frame]]
+    blocks: list = field(default_factory=list)   # (name, node indices, K, C): [[frame]], [[building]]
+    damper_rows: list = field(default_factory=list)   # each damper's [(node index, coefficient)]
+    influence: np.ndarray | None = None          # the ground motion's share on each node (1)
 
     @property
     def breaks(self):
@@ -219,15 +222,25 @@ def effective_mass(mass, fixed, terms):
     return math.inf if w == 0.0 else 1.0 / w
 
 
-def contact_terms(c: dict, idx: dict) -> list:
-    """A contact's row [(node index, coefficient)] (docs/scene-input.md "[[contact]]"): its
-    terms, or (a, +1), (b, −1) of a node pair; GROUND kept (its displacement is 0)."""
+def contact_terms(c: dict, idx: dict, buildings=(), direction="normal") -> list:
+    """An element's row [(node index, coefficient)] (docs/scene-input.md "[[contact]]"): its
+    terms; (a, +1), (b, −1) of a node pair, GROUND kept (its displacement is 0); or, where a
+    side is a plan point of a building's rigid floor, n·u(P_a) − n·u(P_b) along the plan
+    direction n (docs/buildings.md "Contacts between plan points")."""
     if "terms" in c:
         return [(idx[t["node"]], float(t["coef"])) for t in c["terms"]]
-    if isinstance(c["a"], dict) or isinstance(c["b"], dict):
-        raise Unsupported(f"contact {c['name']}: plan points of [[building]] floors (the engine "
-                          "models no buildings)")
-    return [(idx[c["a"]], 1.0), (idx[c["b"]], -1.0)]
+    if not (isinstance(c["a"], dict) or isinstance(c["b"], dict)):
+        return [(idx[c["a"]], 1.0), (idx[c["b"]], -1.0)]
+    nx, ny = c.get(direction) or (1.0, 0.0)
+    norm = math.hypot(nx, ny)
+    n = (nx / norm, ny / norm)
+    terms = {}
+    for side, sign in ((c["a"], 1.0), (c["b"], -1.0)):
+        part = point_terms(side, buildings, idx, n, sign) if isinstance(side, dict) else \
+            ([] if side == "ground" else [(idx[side], sign)])
+        for i, cf in part:
+            terms[i] = terms.get(i, 0.0) + cf
+    return [(i, cf) for i, cf in terms.items() if cf != 0.0]
 
 
 def model_from_dict(doc: dict, base: Path | None = None, t_end: float | None = None) -> Model:
@@ -235,9 +248,10 @@ def model_from_dict(doc: dict, base: Path | None = None, t_end: float | None = N
     if doc.get("mass_coupling") or doc.get("bar"):
         raise Unsupported("bars and mass couplings (the engine takes a diagonal mass matrix)")
     frames = [frame_block(tab) for tab in doc.get("frame", [])]
-    if frames:
+    buildings = [building_block(tab) for tab in doc.get("building", [])]
+    if frames or buildings:
         doc = dict(doc)
-        doc["node"] = list(doc.get("node", [])) + [{"name": nm, "mass": float(mm)} for fb in frames
+        doc["node"] = list(doc.get("node", [])) + [{"name": nm, "mass": float(mm)} for fb in frames + buildings
                                                     for nm, mm in zip(fb.nodes, fb.mass)]
     an = doc.get("analysis", {})
     if an.get("type") != "dynamic" and t_end is None:
@@ -253,11 +267,21 @@ def model_from_dict(doc: dict, base: Path | None = None, t_end: float | None = N
     springs, dashpots, bilinears, dampers = [], [], [], []
     to_ground_k = np.zeros(len(nodes))
     raw = doc.get("link", [])
-    for lk in raw:
-        if "terms" in lk or isinstance(lk.get("a"), dict) or isinstance(lk.get("b"), dict):
-            raise Unsupported(f"link {lk.get('name', '?')}: a row of several DOFs (the engine's "
-                              "links join two nodes)")
+    damper_rows = []
+
+    def is_row(lk):
+        return "terms" in lk or isinstance(lk.get("a"), dict) or isinstance(lk.get("b"), dict)
     for i, lk in enumerate(raw):
+        if is_row(lk):
+            if lk["type"] != "fluid_damper":
+                raise Unsupported(f"link {lk.get('name', '?')}: a {lk['type']} between plan points or "
+                                  "with terms (the engine takes fluid dampers there)")
+            damper_rows.append(contact_terms(lk, idx, buildings, "direction"))
+            dampers.append((lk.get("name", f"link{i}"), GROUND, GROUND, float(lk["c"]),
+                            float(lk.get("alpha", 1.0)), float(lk.get("v_reg", 1e-6))))
+    for i, lk in enumerate(raw):
+        if is_row(lk):
+            continue
         a, b = idx[lk["a"]], idx[lk["b"]]
         kind = lk["type"]
         k = {"spring": lambda: lk["k"], "bar": lambda: lk["EA"] / lk["L"],
@@ -265,6 +289,8 @@ def model_from_dict(doc: dict, base: Path | None = None, t_end: float | None = N
         if GROUND in (a, b) and k:
             to_ground_k[a if a != GROUND else b] += k
     for i, lk in enumerate(raw):
+        if is_row(lk):
+            continue
         name = lk.get("name", f"link{i}")
         a, b = idx[lk["a"]], idx[lk["b"]]
         kind = lk["type"]
@@ -282,14 +308,18 @@ def model_from_dict(doc: dict, base: Path | None = None, t_end: float | None = N
         elif kind == "bilinear":
             bilinears.append((name, a, b, float(lk["k"]), float(lk["fy"]), float(lk.get("hardening", 0.0))))
         elif kind == "fluid_damper":
+            damper_rows.append([(a, 1.0), (b, -1.0)])
             dampers.append((name, a, b, float(lk["c"]), float(lk.get("alpha", 1.0)), float(lk.get("v_reg", 1e-6))))
         else:
             raise Unsupported(f"link type {kind!r}")
     contacts = []
     for c in doc.get("contact", []):
-        terms = contact_terms(c, idx)
+        terms = contact_terms(c, idx, buildings)
         contacts.append(contact_law(c, terms, effective_mass(mass, fixed, terms)))
-    blocks = [(fb.name, np.array([idx[nm] for nm in fb.nodes]), fb.K, fb.C) for fb in frames]
+    blocks = [(fb.name, np.array([idx[nm] for nm in fb.nodes]), fb.K, fb.C) for fb in frames + buildings]
+    influence = np.ones(len(nodes))
+    for bb in buildings:
+        influence[[idx[nm] for nm in bb.nodes]] = bb.influence
     loads = doc.get("loads", {})
     forces = []
     for f in loads.get("force", []):
@@ -299,7 +329,8 @@ def model_from_dict(doc: dict, base: Path | None = None, t_end: float | None = N
                  springs=springs, dashpots=dashpots, bilinears=bilinears, dampers=dampers,
                  contacts=contacts, gravity=float(loads.get("gravity", 0.0)),
                  ground=time_function(loads.get("ground_acceleration"), base), forces=forces,
-                 t_end=float(t_end if t_end is not None else an["t_end"]), blocks=blocks)
+                 t_end=float(t_end if t_end is not None else an["t_end"]), blocks=blocks,
+                 damper_rows=damper_rows, influence=influence)
 
 
 def load_model(scene, t_end: float | None = None, contact: dict | None = None,

@@ -7,7 +7,7 @@ loader keeps what the results need (recovery operators, modes) in scene.extras["
 
 import numpy as np
 
-from ..building3d import (Beam, Building, Floor, Line, Section, Split, column_section,
+from ..building3d import (Beam, Building, Floor, Line, Section, Slab, Split, column_section,
                           beam_section, modal_damping, modal_table, rayleigh_coefficients)
 from ..errors import SceneError
 from .fields import ANY, MAX_GENERATED, POSITIVE, check_fields, choice, kind_ok, per_item
@@ -28,6 +28,7 @@ BUILDING_KEYS = {"prefix": ("str", True, None, None),
                  "inertia": ("any", False, None, None),
                  "reference": ("list", False, None, None),
                  "diaphragm": ("any", False, None, True),
+                 "slab": ("table", False, None, None),
                  "base": ("str", False, None, "fixed"),
                  "zeta": ("float", False, (lambda x: 0 <= x < 1, "a number in [0, 1)"), 0.0),
                  "damping": ("str", False, None, "rayleigh"),
@@ -54,6 +55,8 @@ BEAM_KEYS = {"name": ("str", True, None, None), "floors": ("any", False, None, N
 SPLIT_KEYS = {"name": ("str", True, None, None), "line": ("str", True, None, None),
               "storey": ("int", True, POSITIVE, None), "height": ("float", True, POSITIVE, None),
               "mass": ("float", True, POSITIVE, None)}
+SLAB_KEYS = {"E": ("float", True, POSITIVE, None), "thickness": ("float", True, POSITIVE, None),
+             "nu": ("float", False, (lambda x: 0 <= x < 0.5, "a number in [0, 0.5)"), 0.2)}
 POINT_KEYS = {"name": ("str", True, None, None), "floor": ("int", True, POSITIVE, None),
               "x": ("float", True, ANY, None), "y": ("float", True, ANY, None)}
 MODELS = ["shear", "frame"]
@@ -256,9 +259,25 @@ def parse_building(src, w, tab):
                 raise SceneError(src, f"{w}.diaphragm[{s - 1}]", "a flexible floor with no grid column",
                                  "its mass is lumped at the grid columns' joints")
             grid_masses[s] = {k: masses[s - 1] * v / total for k, v in wts.items()}
+    slabs = []
+    if f["slab"] is not None:
+        if all(rigid):
+            raise SceneError(src, f"{w}.slab", "applies to flexible floors (a rigid floor's slab is "
+                             "the diaphragm)", "set diaphragm = false (or a list), or remove slab")
+        sl = check_fields(src, f["slab"], f"{w}.slab", SLAB_KEYS)
+        joints = {(ln.name, s) for ln in lines if ln.kind == "column" for s in range(1, ns + 1)
+                  if ln.sections[s - 1] is not None or (s < ns and ln.sections[s] is not None)}
+        for s in range(1, ns + 1):
+            if rigid[s - 1]:
+                continue
+            for i in range(len(gx) - 1):
+                for j in range(len(gy) - 1):
+                    if all((f"{a}.{b}", s) in joints for a, b in ((i, j), (i + 1, j), (i + 1, j + 1), (i, j + 1))):
+                        slabs.append(Slab(s, (gx[i], gx[i + 1]), (gy[j], gy[j + 1]), sl["thickness"], sl["E"], sl["nu"]))
     try:
         b = Building(heights=heights, floors=floors, lines=lines, beams=beams, splits=splits,
-                     model=f["model"], base=f["base"], reference=reference, grid_masses=grid_masses)
+                     model=f["model"], base=f["base"], reference=reference, grid_masses=grid_masses,
+                     slabs=slabs)
     except ValueError as exc:
         raise SceneError(src, w, str(exc), "check the members, beams and splits") from None
     points = []

@@ -124,11 +124,21 @@ def expand_frames(src, data):
         R = frame.recovery(G)
         C = np.zeros_like(K)
         a0 = a1 = 0.0
-        if f["zeta"] > 0 and f["damping"] == "modal":
-            C = modal_damping(K, mass, f["zeta"])
-        elif f["zeta"] > 0:
-            a0, a1 = rayleigh_coefficients(K, mass, f["zeta"], tuple(modes))
-            C = a0 * np.diag(mass) + a1 * K
+        try:
+            if f["zeta"] > 0 and f["damping"] == "modal":
+                C = modal_damping(K, mass, f["zeta"])
+            elif f["zeta"] > 0:
+                a0, a1 = rayleigh_coefficients(K, mass, f["zeta"], tuple(modes))
+                C = a0 * np.diag(mass) + a1 * K
+        except np.linalg.LinAlgError:
+            raise SceneError(src, f"{w}.mass", "the frequencies of the frame could not be "
+                             "computed (masses and stiffness too disparate for double precision)",
+                             "give storey masses in kg and sections in SI units of a real "
+                             "frame") from None
+        if not np.all(np.isfinite(C)):
+            raise SceneError(src, f"{w}.zeta", "the damping matrix is not finite (masses and "
+                             "stiffness too disparate for double precision)",
+                             "give storey masses in kg and sections in SI units of a real frame")
         nodes += [{"name": n, "mass": float(m)} for n, m in zip(names, mass)]
         frames.append({"prefix": f["prefix"], "frame": frame, "nodes": names, "K": K, "C": C,
                        "rayleigh": (a0, a1), "zeta": f["zeta"], "recovery": R,
@@ -152,6 +162,15 @@ def _check_stiffness(src, where, K, G, mass):
         raise SceneError(src, where, "the condensed stiffness is not positive definite (a "
                          "mechanism, or sections too disparate for double precision)",
                          "give sections and dimensions in SI units of a real frame") from None
+    # the eigenproblem K phi = w^2 M phi (damping, frequencies) is solved on M^-1/2 K M^-1/2:
+    # masses far from the stiffness's scale (a storey of 1e-300 kg) overflow it
+    with np.errstate(all="ignore"):
+        s = 1 / np.sqrt(np.asarray(mass, float))
+        scaled = s[:, None] * K * s[None, :]
+    if not np.all(np.isfinite(scaled)):
+        raise SceneError(src, f"{where}.mass", "the stiffness over the masses (K/m, the "
+                         "squared frequencies) leaves the double-precision range",
+                         "give storey masses in kg of a real frame")
 
 
 def frame_blocks(frames, index):

@@ -123,6 +123,7 @@ ANALYSIS_TYPES = {
                 "max_wall": _setting("float", "max_wall"),
                 "event_split": _setting("bool", "event_split"),
                 "method": ("str", False, None, None),
+                "modal_vectors": _setting("int", "modal_vectors"),
                 "output": ("table", False, None, None)},
 }
 OUTPUT_KEYS = {"every": _setting("int", "every"), "nodes": ("list", False, None, None),

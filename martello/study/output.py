@@ -15,17 +15,20 @@ class Progress:
         self.total, self.label, self.width = max(total, 1), label, width
         self.stream = stream or sys.stderr
         self.done, self.bad, self.t0, self.last = 0, 0, time.perf_counter(), -1
+        self.not_run = 0          # specs not run: a combination that does not apply, no reference
         self.tty = hasattr(self.stream, "isatty") and self.stream.isatty()
 
-    def update(self, ok=True):
+    def update(self, ok=True, not_run=False):
         self.done += 1
-        self.bad += 0 if ok else 1
+        self.not_run += 1 if not_run else 0
+        self.bad += 0 if ok or not_run else 1
         frac = self.done / self.total
         el = time.perf_counter() - self.t0
         eta = el / frac - el if frac > 0 else 0.0
         bar = "#" * int(self.width * frac) + "." * (self.width - int(self.width * frac))
         line = (f"[{bar}] {self.done}/{self.total} {self.label}, {el:5.1f} s elapsed, "
-                f"~{eta:5.1f} s left, {self.bad} not ok")
+                f"~{eta:5.1f} s left, {self.bad} not ok"
+                + (f", {self.not_run} not run" if self.not_run else ""))
         if self.tty:
             self.stream.write("\r" + line)
             if self.done == self.total:

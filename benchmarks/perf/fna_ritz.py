@@ -1,0 +1,136 @@
+#!/usr/bin/env python3
+"""Fast nonlinear analysis with Wilson's load-dependent Ritz vectors (analysis.modal_vectors = m)
+against all modes: accuracy and cost as the scene grows (docs/integrators.md "fast nonlinear
+analysis").
+
+Scene `row` (size-independent local dynamics, global coupling): n oscillators of m = 1e5 kg on
+springs to ground (k alternating 2e7 / 5e7 N/m) with 5 % dashpots to ground, neighbours joined by
+weak springs (1e6 N/m: the linear part couples every node, half-bandwidth 1), a 3 m/s² sine
+ground acceleration at 2 Hz, and 4 linear penalty contacts (1e9 N/m, 2 mm gaps) between
+neighbours at n/5, 2n/5, 3n/5, 4n/5: the oscillators' different frequencies close them.
+fast-nonlinear, dt 1 ms, t_end 0.5 s, tol_residual 1e-10.
+
+For each n: all modes where n <= --modes-max (the reference; its dense eigensolve is O(n³)),
+then each m of --m: CPU seconds of the run (getrusage of a child process: its own), the basis
+size kept, Newton passes a step, and the error against all modes — max |u − u_all| over every
+node and output time / max |u_all|, and the contacts' largest force, relative. The exponents
+are least-squares slopes of CPU per simulated second over n. Writes nothing unless --out DIR.
+
+Usage: benchmarks/perf/fna_ritz.py [--n 300 1000 3000 10000] [--m 10 20 40] [--modes-max 1000]
+       [--t-end 0.5] [--out DIR]"""
+
+import argparse
+import json
+import math
+import os
+import resource
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[2]
+sys.path.insert(0, str(ROOT))
+
+from benchmarks.perf.integrators_at_size import fit  # noqa: E402  (the log-log slope, one definition)
+
+
+def scene(n, m, t_end):
+    nodes = [{"name": f"b{i}", "mass": 1.0e5} for i in range(1, n + 1)]
+    links = []
+    for i in range(1, n + 1):
+        k = 2.0e7 if i % 2 else 5.0e7
+        links.append({"type": "spring", "a": f"b{i}", "b": "ground", "k": k})
+        links.append({"type": "dashpot", "a": f"b{i}", "b": "ground", "c": 2 * 0.05 * math.sqrt(k * 1.0e5)})
+        if i < n:
+            links.append({"type": "spring", "a": f"b{i}", "b": f"b{i + 1}", "k": 1.0e6})
+    contacts = [{"name": f"gap{j}", "a": f"b{j * n // 5}", "b": f"b{j * n // 5 + 1}", "gap": 2.0e-3,
+                 "scheme": "penalty", "law": "linear", "stiffness": 1.0e9} for j in range(1, 5)]
+    every = max(1, int(round(t_end / 1e-3 / 50)))
+    return {"title": f"row n={n} m={m}", "node": nodes, "link": links, "contact": contacts,
+            "loads": {"ground_acceleration": {"type": "sine", "amplitude": 3.0, "omega": 4 * math.pi}},
+            "analysis": {"type": "dynamic", "integrator": "fast-nonlinear", "dt": 1e-3, "t_end": t_end,
+                         "tol_residual": 1e-10, "max_newton": 100, "modal_vectors": m,
+                         "output": {"every": every, "nodes": [x["name"] for x in nodes],
+                                    "contacts": [c["name"] for c in contacts]}}}
+
+
+def one(n, m, t_end, dump):
+    import numpy as np
+    from martello.run import run_full
+    from martello.scene.loader import from_dict
+    s = from_dict(scene(n, m, t_end))
+    r0 = resource.getrusage(resource.RUSAGE_SELF)
+    summary, hist = run_full(s, raise_on_failure=False)
+    r1 = resource.getrusage(resource.RUSAGE_SELF)
+    cpu = (r1.ru_utime - r0.ru_utime) + (r1.ru_stime - r0.ru_stime)
+    cols = [i for i, k in enumerate(hist[0]) if k.startswith("u:")]
+    np.save(dump, np.asarray(hist[1])[:, cols])
+    print(json.dumps({"n": n, "m": m, "status": summary["status"], "cpu_s": cpu,
+                      "cpu_per_sim_s": cpu / t_end, "cost": summary["cost"],
+                      "forces": {k: c["max_force"] for k, c in summary["contacts"].items()},
+                      "load": os.getloadavg()[0]}))
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--n", type=int, nargs="*", default=[300, 1000, 3000, 10000])
+    ap.add_argument("--m", type=int, nargs="*", default=[10, 20, 40])
+    ap.add_argument("--modes-max", type=int, default=1000)
+    ap.add_argument("--t-end", type=float, default=0.5)
+    ap.add_argument("--out")
+    ap.add_argument("--one", nargs=3, help=argparse.SUPPRESS)
+    args = ap.parse_args()
+    if args.one:
+        one(int(args.one[0]), int(args.one[1]), args.t_end, args.one[2])
+        return
+    import tempfile
+    import numpy as np
+    from martello.binding import native
+    print(f"martello {native.version()}; {os.cpu_count()} cores; scene row, fast-nonlinear, dt 1 ms, "
+          f"t_end {args.t_end} s")
+    print(f"{'n':>6} {'m':>5} {'kept':>5} {'status':>12} {'CPU s':>8} {'CPU/sim s':>10} {'passes/step':>11} "
+          f"{'u error':>9} {'force error':>11} {'load':>5}")
+    rows = []
+    with tempfile.TemporaryDirectory() as tmp:
+        for n in args.n:
+            ref = None
+            for m in ([0] if n <= args.modes_max else []) + args.m:
+                if m > n:
+                    continue
+                dump = os.path.join(tmp, f"u_{n}_{m}.npy")
+                p = subprocess.run([sys.executable, __file__, "--one", str(n), str(m), dump,
+                                    "--t-end", str(args.t_end)], capture_output=True, text=True)
+                line = next((ln for ln in p.stdout.splitlines() if ln.startswith("{")), None)
+                if line is None:
+                    print(f"{n:>6} {m:>5} failed: {p.stderr.strip().splitlines()[-1:]}")
+                    continue
+                row = json.loads(line)
+                u = np.load(dump)
+                if m == 0:
+                    ref = (u, row["forces"])
+                uerr = ferr = float("nan")
+                if ref is not None and u.shape == ref[0].shape:
+                    uerr = float(np.abs(u - ref[0]).max() / np.abs(ref[0]).max())
+                    fmax = max(ref[1].values())
+                    ferr = max(abs(row["forces"][k] - ref[1][k]) for k in ref[1]) / fmax if fmax > 0 else float("nan")
+                row.update(u_error=uerr, force_error=ferr)
+                rows.append(row)
+                c = row["cost"]
+                print(f"{n:>6} {m if m else 'all':>5} {c['modes']:>5} {row['status']:>12} {row['cpu_s']:8.3g} "
+                      f"{row['cpu_per_sim_s']:10.4g} {c['newton_iterations'] / max(c['steps'], 1):11.2f} "
+                      f"{uerr:9.2e} {ferr:11.2e} {row['load']:5.2f}", flush=True)
+    print("\nexponents of CPU per simulated second in n (least squares over the sizes run):")
+    for m in [0] + args.m:
+        mine = [r for r in rows if r["m"] == m and r["status"] == "MARTELLO_OK"]
+        if len(mine) >= 2:
+            print(f"  m = {m if m else 'all':>4}: n^{fit([r['n'] for r in mine], [r['cpu_per_sim_s'] for r in mine]):.2f}"
+                  f" over n = {', '.join(str(r['n']) for r in mine)}")
+    if args.out:
+        out = Path(args.out)
+        out.mkdir(parents=True, exist_ok=True)
+        (out / "fna_ritz.json").write_text(json.dumps(rows, indent=1))
+
+
+if __name__ == "__main__":
+    main()
