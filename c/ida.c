@@ -433,6 +433,7 @@ static int integrate(ida_problem *P, SUNContext sunctx, N_Vector yy, N_Vector yp
       break;
     }
     E->nan_seen = 0;
+    oe_new_step(E, tret);
     if (++steps > MAX_STEPS) {
       st = fail(P, MARTELLO_ERR_NOT_CONVERGED, "IDA: more than %ld steps before t = %.9e s", MAX_STEPS, tret);
       break;

@@ -326,12 +326,13 @@ int oe_commit(ode_events *E, const double *u, const double *v) {
   int st = martello_eval_commit(E->ev, u, v);
   if (st == MARTELLO_OK && E->nsw > 0)
     st = martello_eval_switches(E->ev, E->sw_el, E->sw_al, E->sw_be, E->sw_ga);
-  /* the onset speeds located inside the stretch replace the commit's interpolated ones */
-  for (int k = 0; k < E->nev && st == MARTELLO_OK; k++) {
-    int j = E->ev_j[k];
+  /* the onset speeds located inside the step replace the commit's interpolated ones */
+  for (int k = 0; k < E->nvin && st == MARTELLO_OK; k++) {
+    int j = E->vin_j[k];
     if (E->vin[j] > 0.0) st = martello_eval_set_onset_speed(E->ev, j, E->vin[j]);
     E->vin[j] = 0.0;
   }
+  E->nvin = 0;
   E->nev = 0;
   return st;
 }
@@ -375,7 +376,7 @@ static int work_quadrature(ode_events *E, double t0, double t1) {
  * velocity changes sign against E->v_last gets the root of v located by bisection on the
  * interpolant (of the method's order: the error of the step) and u there (docs/run-layer.md,
  * located extrema). */
-static int taylor(ode_events *E, double t1);
+static int taylor(ode_events *E);
 static double tay(const double *c, int n, int i, int q, double s, int deriv);
 
 static int node_extrema(ode_events *E, double t0, double t1, const double *y1) {
@@ -389,12 +390,12 @@ static int node_extrema(ode_events *E, double t0, double t1, const double *y1) {
     double lo = t0, hi = t1, u = y1[E->iu[i]];
     if (E->degree) {
       /* on the node's own Taylor coefficients: O(degree) an iteration, not O(n) */
-      if ((st = taylor(E, t1)) != MARTELLO_OK) return st;
+      if ((st = taylor(E)) != MARTELLO_OK) return st;
       for (int it = 0; it < 200 && hi - lo > fmax(E->event_tol, 4.0 * DBL_EPSILON * fabs(hi)); it++) {
         const double tm = 0.5 * (lo + hi);
-        if ((tay(E->tay_v, E->n, i, E->tay_q, tm - t1, 0) > 0.0) == (v0 > 0.0)) lo = tm; else hi = tm;
+        if ((tay(E->tay_v, E->n, i, E->tay_q, tm - E->t_step, 0) > 0.0) == (v0 > 0.0)) lo = tm; else hi = tm;
       }
-      if (hi < t1) u = tay(E->tay_u, E->n, i, E->tay_q, hi - t1, 0);
+      if (hi < t1) u = tay(E->tay_u, E->n, i, E->tay_q, hi - E->t_step, 0);
     } else {
       for (int it = 0; it < 200 && hi - lo > fmax(E->event_tol, 4.0 * DBL_EPSILON * fabs(hi)); it++) {
         const double tm = 0.5 * (lo + hi);
@@ -485,10 +486,35 @@ void oe_keep_end_rates(ode_events *E, int unchanged) {
   tmp = E->pa0; E->pa0 = E->pa1; E->pa1 = tmp;
 }
 
-double oe_next_stop(ode_events *E, double t, double t_out) {
+double oe_next_stop(ode_events *E, double t, double t_to) {
   double tb = DBL_MAX;
   if (martello_eval_next_breakpoint(E->ev, t, &tb) != MARTELLO_OK) tb = DBL_MAX;
-  return fmin(tb, t_out);
+  return fmin(tb, t_to);
+}
+
+double oe_output_time(const ode_events *E, int k) {
+  double t = fmin((double)(k * E->every) * E->dt, E->t_end);   /* t = k dt, as on GSL */
+  return E->t_end - t <= 1e-9 * E->out_dt ? E->t_end : t;
+}
+
+int oe_rows_inside(ode_events *E, double *t_last, double t1, int *k_out, double *t_out) {
+  int st;
+  while (*t_out < t1) {
+    const double t = *t_out;
+    if ((st = E->dky(E->ctx, t, 0, E->yrow)) != MARTELLO_OK) return st;
+    const double *y = N_VGetArrayPointer(E->yrow);
+    if ((st = oe_inner_events(E, *t_last, t, y)) != MARTELLO_OK) return st;
+    if ((st = oe_stretch(E, *t_last, t, y, 0)) != MARTELLO_OK) return st;
+    oe_keep_end_rates(E, 1);
+    oe_gather(E, y, E->u, E->v);
+    if ((st = oe_commit(E, E->u, E->v)) != MARTELLO_OK) return oe_fail(E, st, "%s: commit failed", E->name);
+    if ((st = oe_hand_work(E)) != MARTELLO_OK) return st;
+    if ((st = E->sample(E->ctx, t, y, *k_out * E->every)) != MARTELLO_OK) return st;
+    oe_accepted(E, y);
+    *t_last = t;
+    *t_out = oe_output_time(E, ++*k_out);
+  }
+  return MARTELLO_OK;
 }
 
 int oe_add_counts(ode_events *E, const long c[9]) {
@@ -768,10 +794,11 @@ int oe_restart_progress(ode_events *E, double t) {
  * interpolant, O(n)), make each evaluation of one gap O(degree). An event thus costs O(1), not a
  * restart of the whole state. */
 
-/* The Taylor coefficients y^(k)(t1)/k! of every node's u and v at t1, k = 0 .. degree, once a
- * stretch. */
-static int taylor(ode_events *E, double t1) {
-  if (E->tay_ready && E->tay_t == t1) return MARTELLO_OK;
+/* The Taylor coefficients y^(k)(t_step)/k! of every node's u and v at the end of the last step,
+ * k = 0 .. degree, once a step (the same polynomial for every stretch of the step). */
+static int taylor(ode_events *E) {
+  if (E->tay_ready) return MARTELLO_OK;
+  const double t1 = E->t_step;
   int q = E->degree(E->ctx);
   if (q > OE_QMAX) q = OE_QMAX;
   if (q < 1) q = 1;
@@ -788,7 +815,6 @@ static int taylor(ode_events *E, double t1) {
     }
   }
   E->tay_q = q;
-  E->tay_t = t1;
   E->tay_ready = 1;
   return MARTELLO_OK;
 }
@@ -806,7 +832,7 @@ static double tay(const double *c, int n, int i, int q, double s, int deriv) {
 
 /* Contact j's gap (what = 0) or its rate (1) at t on the interpolant (taylor ready). */
 static double gap_at(const ode_events *E, int j, double t, int what) {
-  const double s = t - E->tay_t, *c = what == 0 ? E->tay_u : E->tay_v;
+  const double s = t - E->t_step, *c = what == 0 ? E->tay_u : E->tay_v;
   double x = 0.0;
   for (int k = E->con.first[j]; k < E->con.first[j + 1]; k++)
     x += E->con.coef[k] * tay(c, E->n, E->con.node[k], E->tay_q, s, 0);
@@ -837,7 +863,6 @@ static int by_time(const void *x, const void *y) {
 
 int oe_inner_events(ode_events *E, double t0, double t1, const double *y1) {
   int st;
-  E->tay_ready = 0;   /* a new step: its interpolant's coefficients are read again */
   E->nev = 0;
   if (!E->smooth || !(t1 > t0)) return MARTELLO_OK;
   oe_gather(E, y1, E->uq, E->vq);
@@ -850,7 +875,7 @@ int oe_inner_events(ode_events *E, double t0, double t1, const double *y1) {
      * or the reverse while in contact at both */
     const int turn = in0 == in1 && (in0 ? (r0 < 0.0 && r1 >= 0.0) : (r0 > 0.0 && r1 <= 0.0));
     if (in0 == in1 && !turn) continue;
-    if ((st = taylor(E, t1)) != MARTELLO_OK) return st;
+    if ((st = taylor(E)) != MARTELLO_OK) return st;
     if (in0 != in1) {
       add_event(E, crossing(E, j, 0, t0, t1), j, in1);
       continue;
@@ -890,10 +915,17 @@ int oe_inner_events(ode_events *E, double t0, double t1, const double *y1) {
     const double w = gap_at(E, j, t, 1);
     if ((st = martello_observer_set_phase(E->obs, j, E->ev_k[k], t, w)) != MARTELLO_OK)
       return oe_fail(E, st, "%s: martello_observer_set_phase failed", E->name);
-    E->vin[j] = E->ev_k[k] ? fmax(w, DBL_MIN) : 0.0;   /* for the commit (Hunt-Crossley's v_in) */
+    if (E->vin[j] == 0.0) E->vin_j[E->nvin++] = j;     /* listed once until the commit */
+    /* for the commit (Hunt-Crossley's v_in); -1: listed, no onset */
+    E->vin[j] = E->ev_k[k] ? fmax(w, DBL_MIN) : -1.0;
     E->events++;
   }
   return MARTELLO_OK;
+}
+
+void oe_new_step(ode_events *E, double t_step) {
+  E->t_step = t_step;
+  E->tay_ready = 0;
 }
 
 void oe_accepted(ode_events *E, const double *y) {
@@ -913,6 +945,7 @@ int oe_use_smooth(ode_events *E) {
   E->d_last = oe_take(ucn, sizeof(double), &failed);
   E->r_last = oe_take(ucn, sizeof(double), &failed);
   E->vin = oe_take(ucn, sizeof(double), &failed);
+  E->vin_j = oe_take(ucn, sizeof(int), &failed);
   E->ev_t = oe_take(3 * ucn, sizeof(double), &failed);
   E->ev_j = oe_take(3 * ucn, sizeof(int), &failed);
   E->ev_k = oe_take(3 * ucn, sizeof(int), &failed);
@@ -936,7 +969,7 @@ void oe_release(ode_events *E) {
                  E->sw_el, E->sw_al, E->sw_be, E->sw_ga, E->lc, E->dlc, E->Wc, E->ar,
                  E->lr, E->lamtol, E->v_last, E->el0, E->el1, E->elc, E->pv0, E->pa0, E->pj0,
                  E->pv1, E->pa1, E->pj1, E->ua, E->va, E->aa, E->jk, E->cont, E->d_last,
-                 E->r_last, E->vin, E->tay_u, E->tay_v, E->ev_t, E->ev_j, E->ev_k};
+                 E->r_last, E->vin, E->vin_j, E->tay_u, E->tay_v, E->ev_t, E->ev_j, E->ev_k};
   for (size_t k = 0; k < sizeof all / sizeof all[0]; k++) free(all[k]);
   if (E->ev) martello_eval_free(&E->ev);
   martello_accumulation_free(&E->acc);
