@@ -511,8 +511,6 @@ static int integrate(ode_problem *P, SUNContext ctx, N_Vector yy, SUNMatrix *Jp,
         break;
       }
       if (!again) again = root_stays_zero(P, y, found);
-      for (int s = 0; s < E->nsw && !again; s++)
-        if (found[2 * E->nc + s]) again = 1;
     }
     /* a kink of the load: restart across it */
     if (!again && flag == (P->ark ? ARK_TSTOP_RETURN : CV_TSTOP_RETURN) && tret == t_stop &&
