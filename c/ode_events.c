@@ -123,11 +123,13 @@ static double switch_value(const ode_events *E, int s, const double *u, const do
 }
 
 /* The root finder reports a switch where g has changed sign or is exactly 0 (an exact zero is
- * a root), but the commit leaves a branch only past its surface (g > 0): a restart exactly on
- * it would keep the branch, and the root, 0 at the restart, is not reported again -- the branch
- * would change at the next commit, a whole step late (docs/sundials-ode.md, events and
- * restarts). Switch s, reported rising, is moved strictly past its surface by the smallest shift
- * of one free node of its element: its u where g depends on u, else its v. */
+ * a root), and the located state may sit on the surface within its rounding. The commit leaves
+ * a branch only past its surface (g > 0 as the kernels compute it again from the committed
+ * state, fortran/switching.f90): a restart on the surface would keep the branch, and the root,
+ * 0 there, is not reported again, so the branch would change at the next commit, a whole step
+ * late (docs/sundials-ode.md, events and restarts). Switch s, reported rising, is moved past its
+ * surface beyond that rounding (16 eps of its terms, as c/event_driven.c's switch_rounding) by
+ * the smallest shift of one free node of its element: its u where g depends on u, else its v. */
 static void past_switch(ode_events *E, int s, double *u, double *v) {
   const int e = E->sw_el[s];
   const double al = E->sw_al[s], be = E->sw_be[s];
@@ -140,14 +142,13 @@ static void past_switch(ode_events *E, int s, double *u, double *v) {
       c = E->elem.coef[k];
     }
   if (node < 0) return;
-  double eta = 4.0 * DBL_EPSILON *
-                   (fabs(al) * martello_rows_abs(&E->elem, e, u) +
-                    fabs(be) * martello_rows_abs(&E->elem, e, v) + fabs(E->sw_ga[s])) + DBL_MIN;
   for (int k = 0; k < 80; k++) {
-    double g = switch_value(E, s, u, v);
-    if (g > 0.0) return;
-    x[node] += (fabs(g) + eta) / (a * c);
-    eta *= 2.0;
+    const double rounding = 16.0 * DBL_EPSILON *
+                            (fabs(al) * martello_rows_abs(&E->elem, e, u) +
+                             fabs(be) * martello_rows_abs(&E->elem, e, v) + fabs(E->sw_ga[s])) + DBL_MIN;
+    const double g = switch_value(E, s, u, v);
+    if (g > rounding) return;
+    x[node] += ldexp(rounding - g + rounding, k) / (a * c);
   }
 }
 
