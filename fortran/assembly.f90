@@ -17,7 +17,7 @@ module martello_assembly
    private
    public :: mech_state_t, mech_init, internal_forces, external_forces, mech_commit, &
       element_power, recoverable_energy, mass_times, external_work, kinetic_energy, &
-      assemble_mass, uniform_acceleration, load_breakpoint, load_pattern, ONSET_SPEED_FLOOR
+      assemble_mass, uniform_acceleration, load_breakpoint, load_pattern, swap, ONSET_SPEED_FLOOR
 
    !> Hunt–Crossley-type laws scale damping by 1/v_in; a contact first seen while δ̇ ≤ 0
    !> (grazing, or a step that lands inside) uses this floor [m/s] instead of a division by 0.
@@ -359,6 +359,7 @@ contains
       is_damper = kind == LINK_DASHPOT .or. kind == LINK_FLUID_DAMPER
    end function is_damper
 
+   !> x ↔ y, the arrays moved, not copied (a committed state and its trial)
    subroutine swap(x, y)
       real(dp), allocatable, intent(inout) :: x(:), y(:)
       real(dp), allocatable :: tmp(:)

@@ -82,14 +82,26 @@ def read_history(path, scene=None):
     """Read and validate a history CSV; returns (columns, 2D array). Lines starting with #
     are comments. Errors name the line: a missing t column, a column that names no node or
     contact of the scene, a non-numeric or non-finite value, times that do not increase
-    (martello.history.parse_csv)."""
+    (martello.history.parse_csv). A link_force:/elongation: column that is NaN in every row
+    is read: the run did not record it (docs/results.md); compare reports it so."""
     path = Path(path)
     try:
         raw = read_input(path, HISTORY_LIMIT)
     except UnreadableFile as exc:
         raise HistoryError(path, exc.problem, exc.fix) from None
     return parse_csv(raw, lambda problem, fix, row: HistoryError(path, problem, fix, row=row),
-                     check_header=lambda header, line: _check_names(path, header, scene, line))
+                     check_header=lambda header, line: _check_names(path, header, scene, line),
+                     unrecorded=LINK_KINDS)
+
+
+def split_unrecorded(columns, data):
+    """(columns, data) without the link columns that are NaN in every row, and their names:
+    an integrator that does not report links writes NaN there (docs/results.md), so the run
+    did not record them; a NaN among finite values is an error of read_history's."""
+    gone = [j for j, c in enumerate(columns)
+            if c.partition(":")[0] in LINK_KINDS and np.isnan(data[:, j]).all()]
+    keep = [j for j in range(len(columns)) if j not in gone]
+    return [columns[j] for j in keep], data[:, keep], [columns[j] for j in gone]
 
 
 def is_recorder_file(path):
@@ -243,7 +255,7 @@ def compare(history_path, scene_path, columns=None, compute=True, stream=None):
     if sc.analysis.get("type") != "dynamic":
         raise MartelloError(f"{scene_path}: a static scene has no time history to compare with "
                             "(compare its nodal values with `martello check`)")
-    columns, data = read_histories(history_path, columns, sc)
+    columns, data, unrecorded = split_unrecorded(*read_histories(history_path, columns, sc))
     history_path = ", ".join(map(str, history_path)) if isinstance(history_path, (list, tuple)) \
         else history_path
     ref = reference_for_scene(sc)
@@ -262,7 +274,9 @@ def compare(history_path, scene_path, columns=None, compute=True, stream=None):
                             "scripts/regenerate_reference; or `martello reference` to compute one)")
     cols = comparable(columns, ref)
     if not cols:
-        raise HistoryError(history_path, "no column can be compared with the reference",
+        raise HistoryError(history_path, "no column can be compared with the reference"
+                           + (f" ({', '.join(unrecorded)}: not recorded by this run, NaN throughout)"
+                              if unrecorded else ""),
                            "the reference has " + ", ".join(c for c in ref.columns))
     h = history_dict((columns, data))
     t = h["t"]
@@ -303,7 +317,7 @@ def compare(history_path, scene_path, columns=None, compute=True, stream=None):
     span = [float(t[0]), float(min(t[-1], ref.t_end))]
     return {"history": str(history_path), "scene": str(scene_path), "reference": ref.name,
             "reference_kind": ref.kind, "reference_digits": ref.trusted_digits(u_cols),
-            "compared_columns": cols, "time_span": span, "rows": int(len(t)),
+            "compared_columns": cols, "unrecorded_columns": unrecorded, "time_span": span, "rows": int(len(t)),
             "score_scd": m.get("scd"), "metrics": {k: v for k, v in m.items() if k not in COST_KEYS},
             "per_column": per_column, "checks": checks, "computed_reference": computed,
             "derived_events": {k: {kk: v[kk] for kk in ("impact_times", "restitution",
@@ -344,6 +358,9 @@ def print_report(rep, stream=sys.stdout):
     print(f"reference: {rep['reference']} (trusted to {rep['reference_digits']:.1f} digits); "
           f"{rep['rows']} rows over [{rep['time_span'][0]:g}, {rep['time_span'][1]:g}] s; "
           f"compared: {', '.join(rep['compared_columns'])}", file=stream)
+    if rep["unrecorded_columns"]:
+        print(f"not recorded by this run (NaN throughout): {', '.join(rep['unrecorded_columns'])}",
+              file=stream)
     print(f"{'metric':<26} {'value':>14}  meaning", file=stream)
     print("-" * 100, file=stream)
     for key, what in DESCRIPTIONS:

@@ -5,7 +5,6 @@ reference at times that are not samples of both)."""
 from __future__ import annotations
 
 import csv
-import math
 
 import numpy as np
 
@@ -77,7 +76,7 @@ def history_dict(history):
     return {c: data[:, i] for i, c in enumerate(columns)}
 
 
-def parse_csv(raw, error, finite=True, check_header=None):
+def parse_csv(raw, error, finite=True, check_header=None, unrecorded=()):
     """(columns, 2D array) of the bytes of a history CSV (martello's history.csv, a
     reference's, another code's: docs/compare.md): a header row naming the columns, one of
     them t, then rows of one number per column, t increasing strictly; lines starting with #
@@ -85,9 +84,10 @@ def parse_csv(raw, error, finite=True, check_header=None):
     its file, raised here), never numpy's or Python's own: text that is not UTF-8, a missing
     or repeated column, a row of the wrong length, a value that is not a number or, with
     finite=True, not finite (NaN is a value of martello's own histories where an integrator
-    does not report a link). check_header(header, line), if given, sees the columns before
-    the rows are read. The caller reads the file (martello.paths.read_input: bounded, a
-    regular file)."""
+    does not report a link); a column of a kind in unrecorded (e.g. "link_force") that is NaN
+    in every row is such a column, not an error. check_header(header, line), if given, sees
+    the columns before the rows are read. The caller reads the file
+    (martello.paths.read_input: bounded, a regular file)."""
     try:
         text = raw.decode("utf-8-sig")
     except UnicodeDecodeError as exc:
@@ -116,13 +116,24 @@ def parse_csv(raw, error, finite=True, check_header=None):
                 data = None
     except ValueError:
         data = None
-    if data is not None:
-        if finite and not np.isfinite(data).all():
-            i, j = np.argwhere(~np.isfinite(data))[0]
+    if data is None:
+        data = _rows(header, body, error)
+    if finite:
+        ok = np.isfinite(data)
+        for j, c in enumerate(header):
+            if c.partition(":")[0] in unrecorded and np.isnan(data[:, j]).all():
+                ok[:, j] = True         # not recorded by that run (docs/results.md)
+        if not ok.all():
+            i, j = np.argwhere(~ok)[0]
             cell = next(csv.reader([body[i][1]]))[j].strip()
             raise error(f"column {header[j]} is {cell} (NaN or inf)",
                         "a history must be finite; cut it before the solver failed", body[i][0])
-        return _increasing(header, data, [n for n, _ in body], error)
+    return _increasing(header, data, [n for n, _ in body], error)
+
+
+def _rows(header, body, error):
+    """The rows of body [(line, text)] one by one, once numpy's parser has refused them: the
+    error names the line and the cell."""
     rows = []
     for lineno, ln in body:
         cells = next(csv.reader([ln]))
@@ -131,15 +142,11 @@ def parse_csv(raw, error, finite=True, check_header=None):
         vals = []
         for c, cell in zip(header, cells):
             try:
-                x = float(cell)
+                vals.append(float(cell))
             except ValueError:
                 raise error(f"column {c}: {cell.strip()!r} is not a number", None, lineno) from None
-            if finite and not math.isfinite(x):
-                raise error(f"column {c} is {cell.strip()} (NaN or inf)",
-                            "a history must be finite; cut it before the solver failed", lineno)
-            vals.append(x)
-        rows.append((lineno, vals))
-    return _increasing(header, np.array([v for _, v in rows], float), [n for n, _ in rows], error)
+        rows.append(vals)
+    return np.array(rows, float).reshape(len(rows), len(header))
 
 
 def _increasing(header, data, lines, error):

@@ -465,6 +465,8 @@ def _dynamic(scene, model, raise_on_failure=True):
                         "may be wrong although no guard stopped it")
     if dense_note(an, len(scene.nodes)):
         warnings.append(dense_note(an, len(scene.nodes)))
+    if atol_note(scene):
+        warnings.append(atol_note(scene))
     if st >= 0 and energy["balance_relative"] > 1e-2:
         warnings.append(f"energy balance error {100 * energy['balance_relative']:.1f} % of the energy put in: "
                         "the step is too large for this scene (the result is inaccurate)")
@@ -829,6 +831,43 @@ def dense_note(an, nodes):
             '"cvode" (the same variable-order BDF, analytic band Jacobian, O(n))')
 
 
+def state_scale(scene):
+    """The size of a scene's state before it moves: the largest |u0|, |v0| of its nodes and
+    |gap| of its contacts (m, m/s)."""
+    scale = 0.0
+    for seg in scene.nodes.segments:
+        u0, v0 = ((np.array([n["u0"] for n in seg]), np.array([n["v0"] for n in seg]))
+                  if isinstance(seg, list) else seg.arrays()[1:3])
+        scale = max(scale, float(np.max(np.abs(u0), initial=0.0)), float(np.max(np.abs(v0), initial=0.0)))
+    for seg in scene.contacts.segments:
+        gap = np.array([c["gap"] for c in seg]) if isinstance(seg, list) else seg.block.gap
+        scale = max(scale, float(np.max(np.abs(gap), initial=0.0)))
+    return scale
+
+
+# IDA's error weight of a component is rtol |y| + atol: where one crosses zero it is atol
+# alone, and the arithmetic on a state of size S resolves no better than a few rounding units
+# of it (the sum of a few terms of size S: 4 eps S), so an atol below that asks the error test
+# for what the arithmetic cannot give (docs/ida.md "Failures")
+ATOL_ROUNDING = 4.0 * np.finfo(float).eps
+
+
+def atol_note(scene):
+    """The warning a dynamic scene on IDA gets, before its run, when analysis.atol is below the
+    rounding of its state's size as it starts (state_scale), or None. The state may grow past
+    that size in the run: IDA's failure message then says the same afterwards."""
+    an = scene.analysis
+    if an.get("type") != "dynamic" or an.get("integrator") != "ida" or "atol" not in an:
+        return None
+    floor = ATOL_ROUNDING * state_scale(scene)
+    if an["atol"] >= floor:
+        return None
+    return (f"analysis.atol = {an['atol']!r} is below the rounding of the state (4 eps x its size "
+            f"{state_scale(scene):.3g} at the start = {floor:.2g}): where a component crosses zero "
+            "IDA's error weight is atol alone, and its error test may fail at every step "
+            f"(docs/ida.md \"Failures\"); set analysis.atol to at least {floor:.2g}")
+
+
 def check_budget(scene, force=False):
     """Refuse (SceneError naming the field) a run that needs more than MAX_WORK node-steps or
     would write more than OUTPUT_LIMIT, unless force; return the warnings to print (output
@@ -837,6 +876,8 @@ def check_budget(scene, force=False):
     nodes = max(1, len(scene.nodes))
     if dense_note(an, nodes):
         warnings.append(dense_note(an, nodes))
+    if atol_note(scene):
+        warnings.append(atol_note(scene))
     if est["steps"] * nodes > MAX_WORK:
         adaptive = an["type"] == "dynamic" and an["integrator"] in native.adaptive_integrators()
         key = "h_max" if adaptive and an.get("h_max") else "dt"

@@ -104,6 +104,35 @@ def test_a_martello_history_with_links_is_read_back_and_scored(tmp_path):
     assert rep["metrics"]["max_rel_error"] < 1e-2
 
 
+def test_link_columns_nan_throughout_are_not_recorded_not_an_error(tmp_path, exact_kelvin):
+    """An integrator that does not report links writes NaN in every row of link_force: and
+    elongation: (docs/results.md): compare reads such a history, scores the other columns as
+    without them, and names the two as not recorded; a NaN among finite values stays an error
+    naming its line, and so does a node column that is NaN throughout."""
+    cols, data = exact_kelvin
+    plain = compare.compare(write_csv(tmp_path / "plain.csv", cols, data), KELVIN)
+    nan = np.full((len(data), 2), np.nan)
+    with_links = write_csv(tmp_path / "links.csv", cols + ["link_force:link0", "elongation:link0"],
+                           np.column_stack([data, nan]))
+    rep = compare.compare(with_links, KELVIN)
+    assert rep["unrecorded_columns"] == ["link_force:link0", "elongation:link0"]
+    assert rep["compared_columns"] == plain["compared_columns"] and plain["unrecorded_columns"] == []
+    assert rep["metrics"]["max_rel_error"] == plain["metrics"]["max_rel_error"]
+    r = subprocess.run([sys.executable, "-m", "martello", "compare", with_links, "--against", KELVIN],
+                       cwd=ROOT, capture_output=True, text=True, timeout=300)
+    assert r.returncode == 0, r.stderr
+    assert "not recorded by this run (NaN throughout): link_force:link0, elongation:link0" in r.stdout
+    nan[3, 0] = 1.0                                     # one finite value: the NaN are errors
+    bad = write_csv(tmp_path / "bad.csv", cols + ["link_force:link0", "elongation:link0"],
+                    np.column_stack([data, nan]))
+    with pytest.raises(MartelloError, match=r"bad.csv:2: column link_force:link0 is nan \(NaN or inf\)"):
+        compare.compare(bad, KELVIN)
+    u_nan = data.copy()
+    u_nan[:, cols.index("u:mass")] = np.nan
+    with pytest.raises(MartelloError, match=r":2: column u:mass is nan"):
+        compare.compare(write_csv(tmp_path / "u.csv", cols, u_nan), KELVIN)
+
+
 def test_cli_writes_strict_json(tmp_path, exact_kelvin):
     csv_ = write_csv(tmp_path / "h.csv", *exact_kelvin)
     r = subprocess.run([sys.executable, "-m", "martello", "compare", csv_, "--against", KELVIN,

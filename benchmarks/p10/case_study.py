@@ -20,7 +20,7 @@ docs/p10/*.png.
 from __future__ import annotations
 
 import argparse
-import copy
+import os
 import sys
 import time
 import tomllib
@@ -114,7 +114,7 @@ def scene_dict(config, record=1):
          "frame": [frame_table("A"), frame_table("B")],
          "contact": [{"name": f"gap{f}", "a": f"A{f}.{BAYS}", "b": f"B{f}.0", "gap": JOINT,
                       "scheme": "penalty", "law": "linear", "stiffness": GAP_K} for f in (1, 2)],
-         "loads": {"ground_acceleration": {"type": "record", "file": f"../p8/records/opcm3274_z2_C_{record}.csv",
+         "loads": {"ground_acceleration": {"type": "record", "file": record_file(record, HERE),
                                            "format": "csv", "units": "m/s2"}},
          "analysis": {"type": "dynamic", "integrator": "newmark", "dt": DT, "t_end": T_END,
                       "output": {"links": []}}}
@@ -139,38 +139,48 @@ def toml_value(v):
     raise TypeError(v)
 
 
-def write_scene(config, path):
-    d = scene_dict(config)
+def scene_toml(d, arrays):
+    """A case-study scene dict as TOML text (also P11's): title, problem and description, the
+    arrays of tables named in arrays (an item's "member" list as [[<array>.member]] after it),
+    the ground motion, the analysis and its output."""
     lines = [f"{k} = {toml_value(d[k])}" for k in ("title", "problem", "description")]
-    for key in ("frame", "contact", "link"):
+    for key in arrays:
         for item in d[key]:
-            lines += ["", f"[[{key}]]"] + [f"{k} = {toml_value(v)}" for k, v in item.items()]
+            lines += ["", f"[[{key}]]"] + [f"{k} = {toml_value(v)}" for k, v in item.items() if k != "member"]
+            for m in item.get("member", []):
+                lines += ["", f"[[{key}.member]]"] + [f"{k} = {toml_value(v)}" for k, v in m.items()]
     lines += ["", "[loads.ground_acceleration]"] + \
              [f"{k} = {toml_value(v)}" for k, v in d["loads"]["ground_acceleration"].items()]
     an = dict(d["analysis"]); out = an.pop("output")
     lines += ["", "[analysis]"] + [f"{k} = {toml_value(v)}" for k, v in an.items()]
     lines += ["", "[analysis.output]"] + [f"{k} = {toml_value(v)}" for k, v in out.items()]
-    path.write_text("\n".join(lines) + "\n")
+    return "\n".join(lines) + "\n"
+
+
+def render_scene(config):
+    return scene_toml(scene_dict(config), ("frame", "contact", "link"))
+
+
+def record_file(record, folder):
+    """Record `record` of benchmarks/p8/records as a scene file in folder names it."""
+    return os.path.relpath(RECORDS / f"opcm3274_z2_C_{record}.csv", folder)
+
+
+def retargeted(path, rendered, record, **analysis):
+    """The case-study scene file at path (also P11's), re-targeted to record, analysis keys
+    overridden; exits if the file is not `rendered`, what the script writes now."""
+    text = path.read_text()
+    if text != rendered:
+        sys.exit(f"{path} is out of date with case_study.py: run it with --write-scenes")
+    d = tomllib.loads(text)
+    d["loads"]["ground_acceleration"]["file"] = record_file(record, path.parent)
+    d["analysis"].update(analysis)
+    return from_dict(d, base_dir=path.parent, source=str(path))
 
 
 def scene_for(config, record, **analysis):
     """The catalogue file of config, re-targeted to record, analysis keys overridden."""
-    path = HERE / f"p10_{config}.toml"
-    d = tomllib.loads(path.read_text())
-    if d != tomllib.loads(_rendered(config)):
-        sys.exit(f"{path} is out of date with case_study.py: run it with --write-scenes")
-    d = copy.deepcopy(d)
-    d["loads"]["ground_acceleration"]["file"] = f"../p8/records/opcm3274_z2_C_{record}.csv"
-    d["analysis"].update(analysis)
-    return from_dict(d, base_dir=HERE, source=str(path))
-
-
-def _rendered(config):
-    import tempfile
-    with tempfile.TemporaryDirectory() as tmp:
-        p = Path(tmp) / "s.toml"
-        write_scene(config, p)
-        return p.read_text()
+    return retargeted(HERE / f"p10_{config}.toml", render_scene(config), record, **analysis)
 
 
 # ================================================================================= analysis
@@ -209,18 +219,19 @@ def run_all():
 
 
 def mean_over_records(res, config, fn):
+    """The mean over the records of fn(summary) of a configuration's runs (also P11's)."""
     return float(np.mean([fn(res[config, r]["summary"]) for r in range(1, N_RECORDS + 1)]))
 
 
-def fna_check(config="A", record=1):
-    """The seed's method: FNA against Newmark on one scene, same step."""
+def fna_check(scene_of):
+    """The seed's method: FNA against Newmark on one scene at the same step (also P11's);
+    scene_of(**analysis) is the scene with those analysis keys overridden."""
     out = {}
     for integ in ("newmark", "fast-nonlinear"):
         an = {"integrator": integ}
         if integ == "fast-nonlinear":
             an.update(tol_residual=1e-10, max_newton=100)
-        s = run_full(scene_for(config, record, **an))[0]
-        out[integ] = s
+        out[integ] = run_full(scene_of(**an))[0]
     return out
 
 
@@ -442,11 +453,11 @@ def main(argv=None):
         return check_report()
     if args.write_scenes:
         for c in CONFIGS:
-            write_scene(c, HERE / f"p10_{c}.toml")
+            (HERE / f"p10_{c}.toml").write_text(render_scene(c))
             print(f"wrote {HERE / f'p10_{c}.toml'}")
         return
     res, wall = run_all()
-    fna = fna_check()
+    fna = fna_check(lambda **an: scene_for("A", 1, **an))   # configuration A, record 1
     plots(res)
     report(res, wall, fna)
 

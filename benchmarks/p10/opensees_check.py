@@ -25,18 +25,21 @@ one if it does; the script installs nothing, and prints a skip message without o
 
 import argparse
 import json
-import subprocess
 import sys
 from pathlib import Path
 
 HERE = Path(__file__).resolve().parent
 ROOT = HERE.parent.parent
+sys.path.insert(0, str(ROOT))
+
+# the interpreter, the run of the OpenSees half, the gap and the analysis: shared with P11's check
+from benchmarks.opensees.crosscheck import (SKIPPED, gap_element, newmark_transient,  # noqa: E402
+                                            opensees_python, run_opensees_half, steps, version)
 
 
 # --- the OpenSees half (runs under the openseespy interpreter; no martello import) -------------
 
 def opensees_worker(params_file, out_file):
-    import numpy as np
     import openseespy.opensees as ops
     P = json.loads(Path(params_file).read_text())
     ops.wipe()
@@ -80,47 +83,23 @@ def opensees_worker(params_file, out_file):
         masses[fr["prefix"]] = True
     gaps = []
     for g in P["gaps"]:
-        mat = len(gaps) + 1
-        # ElasticPPGap: E, Fy, gap; a compression gap has negative Fy and gap
-        ops.uniaxialMaterial("ElasticPPGap", mat, g["k"], -1e30, -g["gap"])
         tag["ele"] += 1
         ni, nj = node_of["A", g["floor"], g["line_a"]], node_of["B", g["floor"], g["line_b"]]
-        ops.element("zeroLength", tag["ele"], ni, nj, "-mat", mat, "-dir", 1)
+        gap_element(ops, len(gaps) + 1, tag["ele"], ni, nj, g["k"], g["gap"])
         gaps.append((ni, nj, g["gap"]))
-    t, acc = np.array(P["record_t"]), np.array(P["record_a"])
-    ops.timeSeries("Path", 1, "-time", *t.tolist(), "-values", *acc.tolist())
-    ops.pattern("UniformExcitation", 1, 1, "-accel", 1)
-    ops.constraints("Plain")
-    ops.numberer("RCM")
-    ops.system("UmfPack")
-    ops.test("NormDispIncr", 1e-12, 50)
-    ops.algorithm("Newton")
-    ops.integrator("Newmark", 0.5, 0.25)
-    ops.analysis("Transient")
+    newmark_transient(ops, P["record_t"], P["record_a"], "Plain")
     mpeak = {c: 0.0 for c in columns}
     pen = [0.0] * len(gaps)
-    steps = int(round(P["t_end"] / P["dt"]))
-    for k in range(steps):
-        if ops.analyze(1, P["dt"]) != 0:
-            raise SystemExit(f"OpenSees failed at step {k + 1}")
+    for _ in steps(ops, P["t_end"], P["dt"]):
         for c, e in columns.items():
             f = ops.eleResponse(e, "localForce")
             mpeak[c] = max(mpeak[c], abs(f[2]), abs(f[5]))
         for g, (ni, nj, gap) in enumerate(gaps):
             pen[g] = max(pen[g], ops.nodeDisp(ni, 1) - ops.nodeDisp(nj, 1) - gap)
-    Path(out_file).write_text(json.dumps({"moments": mpeak, "penetration": pen,
-                                          "version": ops.version() if hasattr(ops, "version") else "?"}))
+    Path(out_file).write_text(json.dumps({"moments": mpeak, "penetration": pen, "version": version(ops)}))
 
 
 # --- the martello half --------------------------------------------------------------------------
-
-def opensees_python(given):
-    """The interpreter of the OpenSees half: given, else this one; None if it cannot import
-    openseespy (nothing is installed here)."""
-    py = given or sys.executable
-    ok = subprocess.run([py, "-c", "import openseespy.opensees"], capture_output=True).returncode == 0
-    return py if ok else None
-
 
 def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
@@ -137,14 +116,13 @@ def main():
         return opensees_worker(*args.opensees_worker)
     if not args.out:
         ap.error("give -o DIR, the folder the run's files are written into")
-    sys.path.insert(0, str(ROOT)); sys.path.insert(0, str(HERE))
+    sys.path.insert(0, str(HERE))
     import case_study as cs
     from martello.ground_motion.records import read_record
     from martello.run import run_full
     py = opensees_python(args.python)
     if py is None:
-        print("SKIPPED: no openseespy here: give --python with an interpreter that has it "
-              "(python -m venv DIR && DIR/bin/pip install openseespy)")
+        print(SKIPPED)
         return 0
     sc = cs.scene_for("bare", args.record, dt=args.dt, t_end=args.t_end, tol_residual=1e-12)
     s, _ = run_full(sc)
@@ -163,13 +141,9 @@ def main():
               "record_t": rec.t.tolist(), "record_a": rec.accel.tolist()}
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
-    (out / "params.json").write_text(json.dumps(params))
-    r = subprocess.run([py, __file__, "--opensees-worker", str(out / "params.json"), str(out / "result.json")],
-                       capture_output=True, text=True)
-    if r.returncode != 0:
-        print("OpenSees run failed:\n" + r.stdout[-2000:] + r.stderr[-2000:])
+    os_res = run_opensees_half(py, __file__, params, out)
+    if os_res is None:
         return 1
-    os_res = json.loads((out / "result.json").read_text())
     lines = []
     emit = lines.append      # the table is printed and written to docs/p10
     emit(f"P10 bare, record {args.record}, Newmark (1/2, 1/4), dt = {args.dt:g} s, t_end = {args.t_end:g} s; "

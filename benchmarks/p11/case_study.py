@@ -25,10 +25,8 @@ says where. --check regenerates the page into a temporary folder from stored run
 from __future__ import annotations
 
 import argparse
-import copy
 import sys
 import time
-import tomllib
 from pathlib import Path
 
 import numpy as np
@@ -41,13 +39,14 @@ SCENES = HERE / "case_study"
 if str(ROOT) not in sys.path:
     sys.path.insert(0, str(ROOT))
 
+# P10's pieces, defined there once: the records, the configurations, the seed's Table 1, the
+# scene files' writing and re-targeting, the means over the records, the FNA check
+from benchmarks.p10.case_study import (CONFIGS, N_RECORDS, SEED_TABLE1, fna_check,  # noqa: E402
+                                       mean_over_records, record_file, retargeted, scene_toml)
 from martello.binding import native  # noqa: E402
 from martello.run import run_full  # noqa: E402
 from martello.scene.loader import from_dict  # noqa: E402
 
-RECORDS = ROOT / "benchmarks" / "p8" / "records"
-N_RECORDS = 5
-CONFIGS = ("bare", "A", "B")
 PAGE = "p11-case-study.md"
 
 # ====================================================================================== model
@@ -155,7 +154,7 @@ def scene_dict(config, record=1):
                       "b": {"floor": f"B{f}", "x": XB, "y": y}, "normal": [1.0, 0.0], "gap": JOINT,
                       "scheme": "penalty", "law": "linear", "stiffness": GAP_K}
                      for f in (1, 2) for j, y in enumerate(LINES_Y)],
-         "loads": {"ground_acceleration": {"type": "record", "file": f"../../p8/records/opcm3274_z2_C_{record}.csv",
+         "loads": {"ground_acceleration": {"type": "record", "file": record_file(record, SCENES),
                                            "format": "csv", "units": "m/s2"}},
          "analysis": {"type": "dynamic", "integrator": "newmark", "dt": DT, "t_end": T_END,
                       "output": {"links": []}}}
@@ -170,48 +169,13 @@ def scene_dict(config, record=1):
 
 # --- scenes as files ---------------------------------------------------------------------------
 
-def toml_value(v):
-    if isinstance(v, bool):
-        return "true" if v else "false"
-    if isinstance(v, str):
-        return '"' + v + '"'
-    if isinstance(v, (int, float)):
-        return repr(float(v)) if isinstance(v, float) else str(v)
-    if isinstance(v, list):
-        return "[" + ", ".join(toml_value(x) for x in v) + "]"
-    if isinstance(v, dict):
-        return "{ " + ", ".join(f"{k} = {toml_value(x)}" for k, x in v.items()) + " }"
-    raise TypeError(v)
-
-
 def render_scene(config):
-    d = scene_dict(config)
-    lines = [f"{k} = {toml_value(d[k])}" for k in ("title", "problem", "description")]
-    for b in d["building"]:
-        lines += ["", "[[building]]"] + [f"{k} = {toml_value(v)}" for k, v in b.items() if k != "member"]
-        for m in b.get("member", []):
-            lines += ["", "[[building.member]]"] + [f"{k} = {toml_value(v)}" for k, v in m.items()]
-    for key in ("contact", "link"):
-        for item in d[key]:
-            lines += ["", f"[[{key}]]"] + [f"{k} = {toml_value(v)}" for k, v in item.items()]
-    lines += ["", "[loads.ground_acceleration]"] + \
-             [f"{k} = {toml_value(v)}" for k, v in d["loads"]["ground_acceleration"].items()]
-    an = dict(d["analysis"]); out = an.pop("output")
-    lines += ["", "[analysis]"] + [f"{k} = {toml_value(v)}" for k, v in an.items()]
-    lines += ["", "[analysis.output]"] + [f"{k} = {toml_value(v)}" for k, v in out.items()]
-    return "\n".join(lines) + "\n"
+    return scene_toml(scene_dict(config), ("building", "contact", "link"))
 
 
 def scene_for(config, record, **analysis):
     """The catalogue file of config, re-targeted to record, analysis keys overridden."""
-    path = SCENES / f"p11_{config}.toml"
-    text = path.read_text()
-    if text != render_scene(config):
-        sys.exit(f"{path} is out of date with case_study.py: run it with --write-scenes")
-    d = copy.deepcopy(tomllib.loads(text))
-    d["loads"]["ground_acceleration"]["file"] = f"../../p8/records/opcm3274_z2_C_{record}.csv"
-    d["analysis"].update(analysis)
-    return from_dict(d, base_dir=SCENES, source=str(path))
+    return retargeted(SCENES / f"p11_{config}.toml", render_scene(config), record, **analysis)
 
 
 # ================================================================================= analysis
@@ -240,15 +204,11 @@ def column_peaks(summary, building, quantity="M3"):
     return out
 
 
-# The seed's Table 1 and two readings of its column numbers (Fig. 8 is not in the text): the
+# The seed's Table 1 (SEED_TABLE1, P10's) and two readings of its column numbers (Fig. 8 is not in the text): the
 # 3D reading — the joint-face columns of B (grid line x = 0 of B) on the frames at y = 6.75,
 # 11.25 (central) and 15.75 (next to the lift core), storeys 2–4, numbered storey by storey,
 # so that 5 and 8 are the central line's storeys 3 and 4 and 6 the storey-3 column next to the
 # core, as the seed says; and P10's reading, the central frame's three lines along x.
-SEED_TABLE1 = {1: (21.5, 5.9), 2: (1.6, 6.1), 3: (37.7, 27.2), 4: (21.2, 17.6), 5: (41.0, 36.1),
-               6: (14.1, 21.3), 7: (32.1, 30.1), 8: (48.3, 45.9), 9: (8.9, 3.2)}
-
-
 def seed_columns(reading="3d"):
     """{seed number: member name of B}."""
     if reading == "3d":
@@ -289,12 +249,10 @@ def torsional_share(cols, hist, scene, prefix):
 def without_gaps(record):
     """The bare scene with its gap elements removed: how much of a column's moment the
     pounding makes."""
-    path = SCENES / "p11_bare.toml"
-    d = copy.deepcopy(tomllib.loads(path.read_text()))
+    d = scene_dict("bare", record)
     d.pop("contact")
-    d["loads"]["ground_acceleration"]["file"] = f"../../p8/records/opcm3274_z2_C_{record}.csv"
     d["analysis"]["output"] = {"links": [], "contacts": []}
-    return from_dict(d, base_dir=SCENES, source=str(path))
+    return from_dict(d, base_dir=SCENES, source=str(SCENES / "p11_bare.toml"))
 
 
 def run_all():
@@ -314,21 +272,6 @@ def run_all():
                 res[config, r]["hist"] = {c: hist[:, cols.index(c)].tolist() for c in keep}
             print(f"  {config} record {r}: {s['cost']['wall_time_s']:.2f} s", flush=True)
     return res, time.perf_counter() - t0
-
-
-def mean_over_records(res, config, fn):
-    return float(np.mean([fn(res[config, r]["summary"]) for r in range(1, N_RECORDS + 1)]))
-
-
-def fna_check(config="A", record=1):
-    """The seed's method on the 3D scene: FNA against Newmark at the same step."""
-    out = {}
-    for integ in ("newmark", "fast-nonlinear"):
-        an = {"integrator": integ}
-        if integ == "fast-nonlinear":
-            an.update(tol_residual=1e-10, max_newton=100)
-        out[integ] = run_full(scene_for(config, record, **an))[0]
-    return out
 
 
 # ==================================================================================== output
@@ -655,7 +598,7 @@ def main():
         ap.error("say where to write: -o DIR or --docs")
     out = ROOT / "docs" if args.docs else Path(args.output)
     res, wall = run_all()
-    fna = fna_check()
+    fna = fna_check(lambda **an: scene_for("A", 1, **an))   # configuration A, record 1
     plots(res, scene, out / "p11")
     (out / PAGE).write_text(report(res, wall, fna, scene, out / "p11"))
     print(f"wrote {out / PAGE}")

@@ -22,18 +22,23 @@ Printed: the peak |ux|, |rz| of every floor, the peak penetration of every gap a
 |M3| of the joint-side columns from both codes, with their relative differences; with -o the
 same table is also written to DIR/opensees_check.txt. openseespy is not a requirement of
 martello: the OpenSees half runs under the interpreter given by --python (a venv of your own,
-e.g. python -m venv /work/venvs/opensees && .../pip install openseespy numpy)."""
+e.g. python -m venv /work/venvs/opensees && .../pip install openseespy numpy), else under this
+one if it imports openseespy; without one the script prints a skip message."""
 
 from __future__ import annotations
 
 import argparse
 import json
-import subprocess
 import sys
 import tempfile
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[2]
+sys.path.insert(0, str(ROOT))
+
+# the interpreter, the run of the OpenSees half, the gap and the analysis: shared with P10's check
+from benchmarks.opensees.crosscheck import (SKIPPED, gap_element, newmark_transient,  # noqa: E402
+                                            opensees_python, run_opensees_half, steps, version)
 
 E = 3.0e10
 G = E / 2.4
@@ -152,28 +157,14 @@ def opensees_worker(params_file, out_file):
                    "-rayleigh", a0, 0.0, 0.0, 0.0)
     gaps = []
     for g in P["gaps"]:
-        mat = len(gaps) + 1
-        ops.uniaxialMaterial("ElasticPPGap", mat, g["k"], -1e30, -g["gap"])
         ni, nj = node_at["A", g["line_a"], g["floor"]], node_at["B", g["line_b"], g["floor"]]
-        e = new("ele")
-        ops.element("zeroLength", e, ni, nj, "-mat", mat, "-dir", 1)
+        gap_element(ops, len(gaps) + 1, new("ele"), ni, nj, g["k"], g["gap"])
         gaps.append((g["name"], ni, nj, g["gap"]))
-    ops.timeSeries("Path", 1, "-time", *P["t"], "-values", *P["a"])
-    ops.pattern("UniformExcitation", 1, 1, "-accel", 1)
-    ops.constraints("Transformation")
-    ops.numberer("RCM")
-    ops.system("UmfPack")
-    ops.test("NormDispIncr", 1e-12, 50)
-    ops.algorithm("Newton")
-    ops.integrator("Newmark", 0.5, 0.25)
-    ops.analysis("Transient")
+    newmark_transient(ops, P["t"], P["a"], "Transformation")
     peak = {k: 0.0 for k in [f"{p}{s}.{q}" for (p, s) in masters for q in ("ux", "rz")]}
     pen = {name: 0.0 for name, *_ in gaps}
     mom = {c: 0.0 for c in columns}
-    steps = int(round(P["t_end"] / P["dt"]))
-    for k in range(steps):
-        if ops.analyze(1, P["dt"]) != 0:
-            raise SystemExit(f"OpenSees failed at step {k + 1}")
+    for _ in steps(ops, P["t_end"], P["dt"]):
         for (p, s), mn in masters.items():
             peak[f"{p}{s}.ux"] = max(peak[f"{p}{s}.ux"], abs(ops.nodeDisp(mn, 1)))
             peak[f"{p}{s}.rz"] = max(peak[f"{p}{s}.rz"], abs(ops.nodeDisp(mn, 6)))
@@ -183,13 +174,12 @@ def opensees_worker(params_file, out_file):
             f = ops.eleResponse(e, "localForce")     # N Vy Vz T My Mz at i, then j
             mom[c] = max(mom[c], abs(f[5]), abs(f[11]))
     Path(out_file).write_text(json.dumps({"peak": peak, "penetration": pen, "moments": mom,
-                                          "version": ops.version() if hasattr(ops, "version") else "?"}))
+                                          "version": version(ops)}))
 
 
 # --- the martello half ------------------------------------------------------------------------
 
 def section_props(sec, kind):
-    sys.path.insert(0, str(ROOT))
     from martello.scene.building import section
     s = section("<check>", "section", sec, kind)
     return {"E": s.E, "G": s.G, "A": s.A, "I2": s.I2, "I3": s.I3, "J": s.J}
@@ -197,7 +187,7 @@ def section_props(sec, kind):
 
 def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--python", help="an interpreter with openseespy (required for the OpenSees half)")
+    ap.add_argument("--python", help="an interpreter with openseespy (default: this one)")
     ap.add_argument("--dt", type=float, default=1e-3)
     ap.add_argument("--t-end", type=float, default=6.0)
     ap.add_argument("--no-contacts", action="store_true", help="the two buildings alone (no gaps)")
@@ -206,10 +196,10 @@ def main():
     args = ap.parse_args()
     if args.opensees_worker:
         return opensees_worker(*args.opensees_worker)
-    if not args.python:
-        print("SKIPPED: give --python with an interpreter that has openseespy")
+    py = opensees_python(args.python)
+    if py is None:
+        print(SKIPPED)
         return 0
-    sys.path.insert(0, str(ROOT))
     import numpy as np
     from martello.binding import native
     from martello.run import run_full
@@ -237,14 +227,9 @@ def main():
     params = {"buildings": buildings, "gaps": gaps, "H": H, "dt": args.dt, "t_end": args.t_end,
               "t": t.tolist(), "a": acc.tolist()}
     with tempfile.TemporaryDirectory() as tmp:
-        pf, of = Path(tmp) / "params.json", Path(tmp) / "result.json"
-        pf.write_text(json.dumps(params))
-        r = subprocess.run([args.python, __file__, "--opensees-worker", str(pf), str(of)],
-                           capture_output=True, text=True)
-        if r.returncode != 0:
-            print("OpenSees run failed:\n" + r.stdout[-2000:] + r.stderr[-2000:])
-            return 1
-        os_res = json.loads(of.read_text())
+        os_res = run_opensees_half(py, __file__, params, tmp)
+    if os_res is None:
+        return 1
     lines = [f"P11 OpenSees cross-check (benchmarks/p11/opensees_check.py --dt {args.dt:g} --t-end {args.t_end:g}"
              f"{' --no-contacts' if args.no_contacts else ''}): martello {native.version()}, "
              f"OpenSees {os_res['version']} (openseespy); Newmark (1/2, 1/4), sine 4 m/s2 at 8 rad/s along x",

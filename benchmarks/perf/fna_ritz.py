@@ -23,16 +23,14 @@ import argparse
 import json
 import math
 import os
-import resource
-import subprocess
 import sys
-import time
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[2]
 sys.path.insert(0, str(ROOT))
 
-from benchmarks.perf.integrators_at_size import fit  # noqa: E402  (the log-log slope, one definition)
+# the log-log slope, the timed run and the child process: defined there once
+from benchmarks.perf.integrators_at_size import child, fit, timed_run  # noqa: E402
 
 
 def scene(n, m, t_end):
@@ -57,13 +55,7 @@ def scene(n, m, t_end):
 
 def one(n, m, t_end, dump):
     import numpy as np
-    from martello.run import run_full
-    from martello.scene.loader import from_dict
-    s = from_dict(scene(n, m, t_end))
-    r0 = resource.getrusage(resource.RUSAGE_SELF)
-    summary, hist = run_full(s, raise_on_failure=False)
-    r1 = resource.getrusage(resource.RUSAGE_SELF)
-    cpu = (r1.ru_utime - r0.ru_utime) + (r1.ru_stime - r0.ru_stime)
+    summary, hist, cpu, _ = timed_run(scene(n, m, t_end))
     cols = [i for i, k in enumerate(hist[0]) if k.startswith("u:")]
     np.save(dump, np.asarray(hist[1])[:, cols])
     print(json.dumps({"n": n, "m": m, "status": summary["status"], "cpu_s": cpu,
@@ -99,13 +91,10 @@ def main():
                 if m > n:
                     continue
                 dump = os.path.join(tmp, f"u_{n}_{m}.npy")
-                p = subprocess.run([sys.executable, __file__, "--one", str(n), str(m), dump,
-                                    "--t-end", str(args.t_end)], capture_output=True, text=True)
-                line = next((ln for ln in p.stdout.splitlines() if ln.startswith("{")), None)
-                if line is None:
-                    print(f"{n:>6} {m:>5} failed: {p.stderr.strip().splitlines()[-1:]}")
+                row, err = child([__file__, "--one", n, m, dump, "--t-end", args.t_end])
+                if row is None:
+                    print(f"{n:>6} {m:>5} failed: {err}")
                     continue
-                row = json.loads(line)
                 u = np.load(dump)
                 if m == 0:
                     ref = (u, row["forces"])

@@ -66,16 +66,34 @@ def scene(n, integrator, kind, t_end, max_wall):
     return {"title": f"{name} n={n}", "chain": [chain], "loads": loads, "analysis": an}
 
 
-def one(n, integrator, kind, t_end, max_wall):
+def timed_run(scene_dict):
+    """run_full of a scene dict (a failure is returned, not raised), its CPU seconds
+    (getrusage of this process: run one scene per child process) and wall seconds (also
+    benchmarks/perf/fna_ritz.py's worker)."""
     from martello.run import run_full
     from martello.scene.loader import from_dict
-    s = from_dict(scene(n, integrator, kind, t_end, max_wall))
+    s = from_dict(scene_dict)
     r0 = resource.getrusage(resource.RUSAGE_SELF)
     t0 = time.perf_counter()
-    r = run_full(s, raise_on_failure=False)[0]   # max_wall stops a slow one: its rate stands
+    summary, hist = run_full(s, raise_on_failure=False)
     wall = time.perf_counter() - t0
     r1 = resource.getrusage(resource.RUSAGE_SELF)
-    cpu = (r1.ru_utime - r0.ru_utime) + (r1.ru_stime - r0.ru_stime)
+    return summary, hist, (r1.ru_utime - r0.ru_utime) + (r1.ru_stime - r0.ru_stime), wall
+
+
+def child(args):
+    """A script's --one worker run in a child process (args after the interpreter): the JSON
+    line it prints as a dict, else None and the last line of its stderr."""
+    p = subprocess.run([sys.executable, *map(str, args)], capture_output=True, text=True)
+    line = next((ln for ln in p.stdout.splitlines() if ln.startswith("{")), None)
+    if line is None:
+        return None, p.stderr.strip().splitlines()[-1:]
+    return json.loads(line), None
+
+
+def one(n, integrator, kind, t_end, max_wall):
+    # max_wall stops a slow one: its rate stands
+    r, _, cpu, wall = timed_run(scene(n, integrator, kind, t_end, max_wall))
     c = r["cost"]
     t_reached = r.get("t_reached", t_end) or t_end
     print(json.dumps({"n": n, "integrator": integrator, "scene": kind, "status": r["status"],
@@ -114,14 +132,11 @@ def main():
     rows = []
     for integ in args.integrators:
         for n in args.n:
-            p = subprocess.run([sys.executable, __file__, "--one", str(n), integ, "--scene", args.scene,
-                                "--t-end", str(args.t_end), "--max-wall", str(args.max_wall)],
-                               capture_output=True, text=True)
-            line = next((ln for ln in p.stdout.splitlines() if ln.startswith("{")), None)
-            if line is None:
-                print(f"{integ:>16} {n:>6} failed: {p.stderr.strip().splitlines()[-1:]}")
+            row, err = child([__file__, "--one", n, integ, "--scene", args.scene,
+                              "--t-end", args.t_end, "--max-wall", args.max_wall])
+            if row is None:
+                print(f"{integ:>16} {n:>6} failed: {err}")
                 continue
-            row = json.loads(line)
             rows.append(row)
             c, ev = row["cost"], max(row["cost"]["events"], 1)
             print(f"{integ:>16} {n:>6} {row['status']:>7} {row['t_reached']:9.4g} {row['cpu_s']:8.3g} "

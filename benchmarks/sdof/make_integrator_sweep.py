@@ -54,20 +54,25 @@ integrator = "{integ}"
 {settings}
 t_end = 2.0
 
-[check]
-closed_form = "sdof_sine_ground_final"
-params = {{ m = 2.0, k = 800.0, zeta = 0.05, ag_amp = 3.0, omega_g = 13.0, t_end = 2.0 }}
-[[check.compare]]
-result = "nodes.m.u_final"
-oracle = "u"
-rtol = {rtol_check:.0e}
-why = "{why}"
-[[check.compare]]
-result = "nodes.m.v_final"
-oracle = "v"
-rtol = {rtol_check:.0e}
-why = "{why}"
-'''
+{check_block("sdof_sine_ground_final",
+              "{ m = 2.0, k = 800.0, zeta = 0.05, ag_amp = 3.0, omega_g = 13.0, t_end = 2.0 }",
+              [("nodes.m.u_final", "u"), ("nodes.m.v_final", "v")], rtol_check, why)}'''
+
+
+def check_block(closed_form, params, pairs, rtol, why, fmt=".0e"):
+    """The [check] block of a sweep's scene (also benchmarks/p6 and benchmarks/p10's sweeps):
+    the closed form with params (an inline table's text), and each (result, oracle) of pairs
+    compared to rtol (written with fmt) for one reason, why."""
+    return (f'[check]\nclosed_form = "{closed_form}"\nparams = {params}\n'
+            + "".join(f'[[check.compare]]\nresult = "{result}"\noracle = "{oracle}"\n'
+                      f'rtol = {rtol:{fmt}}\nwhy = "{why}"\n' for result, oracle in pairs))
+
+
+def adaptive_settings(rtol):
+    """An event-locating integrator's tolerances in these sweeps (also benchmarks/p6's):
+    atol = 1e-4 rtol [m]: the scenes' displacements are millimetres or more, so the relative
+    test governs."""
+    return f"rtol = {rtol:.0e}\natol = {rtol * 1e-4:.0e}"
 
 
 def scenes():
@@ -78,7 +83,7 @@ def scenes():
             "1.0e-6 (Moreau–Jean θ = ½), 1.4e-7 (fast nonlinear analysis)")
     for integ, (rtol, factor) in ADAPTIVE.items():
         out[f"sdof_sine_{integ}"] = scene(
-            integ, f"rtol = {rtol:.0e}\natol = {rtol * 1e-4:.0e}\ndt = 1.0e-3", factor * rtol,
+            integ, adaptive_settings(rtol) + "\ndt = 1.0e-3", factor * rtol,
             f"the error follows rtol = {rtol:.0e}: bound {factor} rtol (benchmarks/sdof/make_integrator_sweep.py)")
     return out
 

@@ -34,7 +34,8 @@ module martello_chain_step
       P_RESTITUTION, NPAR_CONTACT, contact_elastic_energy, damping_from_restitution, BRANCH_OFF, &
       BRANCH_ON, BRANCH_CLIPPED, AFFINE_LINEAR, AFFINE_KELVIN, AFFINE_KELVIN_CLIPPED
    use martello_effective_mass, only: pair_effective_mass, effective_mass_prepare
-   use martello_assembly, only: external_forces, uniform_acceleration, internal_forces, mech_commit
+   use martello_assembly, only: external_forces, uniform_acceleration, internal_forces, mech_commit, &
+      swap
    use martello_time_functions, only: tf_value
    use martello_observer, only: observer_t, node_block_t, observer_fail, observer_failed, &
       observer_work, observer_begin, observer_block, observer_open_phase, observer_energy_due
@@ -381,23 +382,15 @@ contains
    subroutine back_usual_start(n, cm, cv, c1, c2, h, gm, rp, u, v, a, un, vn, an, mass, fe, kg, &
                                cg, kp, cp, psgn, pgap, pk, pc, plaw, pbr, pbrc, pbrf, xjo, fixed, &
                                mdu, wd, wl, wc, flip)
-      integer, intent(in), value :: n
-      real(dp), intent(in), value :: cm, cv, c1, c2, h, gm
-      logical, parameter :: from_start = .true., pl = .false., pcs = .true., kel = .false., &
-                            oth = .false., fx = .false.
-      integer, parameter :: ss = 0, sg = 0, sk = 0, sc = 0, sl = 0, sm = 0
-      include 'back_sweep.inc'
+      logical, parameter :: from_start = .true.
+      include 'back_usual.inc'
    end subroutine back_usual_start
 
    subroutine back_usual_iterate(n, cm, cv, c1, c2, h, gm, rp, u, v, a, un, vn, an, mass, fe, kg, &
                                  cg, kp, cp, psgn, pgap, pk, pc, plaw, pbr, pbrc, pbrf, xjo, fixed, &
                                  mdu, wd, wl, wc, flip)
-      integer, intent(in), value :: n
-      real(dp), intent(in), value :: cm, cv, c1, c2, h, gm
-      logical, parameter :: from_start = .false., pl = .false., pcs = .true., kel = .false., &
-                            oth = .false., fx = .false.
-      integer, parameter :: ss = 0, sg = 0, sk = 0, sc = 0, sl = 0, sm = 0
-      include 'back_sweep.inc'
+      logical, parameter :: from_start = .false.
+      include 'back_usual.inc'
    end subroutine back_usual_iterate
 
    !> The committed state becomes the start of the next step by swapping the buffers: the
@@ -782,12 +775,6 @@ contains
       integer :: tmp
       tmp = x; x = y; y = tmp
    end subroutine swap_at
-
-   subroutine swap(x, y)
-      real(dp), allocatable, intent(inout) :: x(:), y(:)
-      real(dp), allocatable :: tmp(:)
-      call move_alloc(x, tmp); call move_alloc(y, x); call move_alloc(tmp, y)
-   end subroutine swap
 
    subroutine swap_int8(x, y)
       integer(int8), allocatable, intent(inout) :: x(:), y(:)

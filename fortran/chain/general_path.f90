@@ -13,12 +13,7 @@ contains
    !> one: their numbers are those of all the model's items) and handed the committed state
    !> each time: the element states from ours (a contact we hold open has no force), f_ext at
    !> t_n.
-   module subroutine general_step(self, m, t, o, stat)
-      class(chain_step_t), intent(inout) :: self
-      type(model_t), intent(in) :: m
-      real(dp), intent(in) :: t
-      type(observer_t), intent(inout) :: o
-      integer, intent(out) :: stat
+   module procedure general_step
       self%factored = .false.
       if (m%nchain > 0) then
          if (.not. allocated(self%gm)) then
@@ -118,5 +113,5 @@ contains
          if (law == LAW_KELVIN .and. par(P_CLIP) > 0.5_dp .and. self%gen%ms%con_f(j) == 0.0_dp) &
             br = BRANCH_CLIPPED
       end function branch_of
-   end subroutine general_step
+   end procedure general_step
 end submodule general_path

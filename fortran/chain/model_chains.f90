@@ -16,12 +16,7 @@ contains
    !> and add_contact check it; the first bad one stops the call, and the message names it
    !> (`chain entry i`, 0-based node of the chain). Items added one by one and chains are
    !> numbered in the order of the calls.
-   module subroutine model_add_chain(m, first, n, k, c, fy, rho, gap, scheme, law, par, stat)
-      type(model_t), intent(inout) :: m
-      integer, intent(in) :: first, n, scheme, law
-      real(dp), intent(in) :: k(:), par(NPAR_CONTACT)
-      real(dp), intent(in), optional :: c(:), fy(:), rho(:), gap(:)
-      integer, intent(out) :: stat
+   module procedure model_add_chain
       type(chain_t), allocatable :: grown(:)
       type(chain_t) :: new
       real(dp) :: lp(NPAR_LINK)
@@ -104,9 +99,10 @@ contains
          call move_alloc(from%fy, to%fy); call move_alloc(from%rho, to%rho)
          call move_alloc(from%gap, to%gap)
       end subroutine move_chain
-   end subroutine model_add_chain
+   end procedure model_add_chain
 
-   !> A chain refused: msg says why (as martello_model's fail)
+   !> A chain refused: msg says why (martello_model's fail, which gfortran does not export to
+   !> a submodule: a private procedure of the parent's object)
    subroutine refuse(m, stat, msg)
       type(model_t), intent(inout) :: m
       integer, intent(out) :: stat
@@ -116,54 +112,34 @@ contains
    end subroutine refuse
 
    !> Links of the model: added one by one and in chains.
-   pure module integer function model_nlinks(m) result(nl)
-      type(model_t), intent(in) :: m
-      integer :: j
+   module procedure model_nlinks
       nl = m%nlink
-      do j = 1, m%nchain
-         nl = nl + m%chain(j)%nlink
-      end do
-   end function model_nlinks
+      if (m%nchain > 0) nl = nl + sum(m%chain(1:m%nchain)%nlink)
+   end procedure model_nlinks
 
    !> Contacts of the model: added one by one and in chains.
-   pure module integer function model_ncontacts(m) result(nc)
-      type(model_t), intent(in) :: m
-      integer :: j
+   module procedure model_ncontacts
       nc = m%ncontact
-      do j = 1, m%nchain
-         nc = nc + m%chain(j)%ncontact
-      end do
-   end function model_ncontacts
+      if (m%nchain > 0) nc = nc + sum(m%chain(1:m%nchain)%ncontact)
+   end procedure model_ncontacts
 
-   !> The number of link j added one by one among all the model's links.
-   pure module integer function model_link_index(m, j) result(idx)
-      type(model_t), intent(in) :: m
-      integer, intent(in) :: j
-      integer :: q
+   !> The number of link j added one by one among all the model's links (the chains added
+   !> before it count theirs).
+   module procedure model_link_index
       idx = j
-      do q = 1, m%nchain
-         if (m%chain(q)%glink < j) idx = idx + m%chain(q)%nlink
-      end do
-   end function model_link_index
+      if (m%nchain > 0) idx = idx + sum(m%chain(1:m%nchain)%nlink, m%chain(1:m%nchain)%glink < j)
+   end procedure model_link_index
 
    !> The number of contact j added one by one among all the model's contacts.
-   pure module integer function model_contact_index(m, j) result(idx)
-      type(model_t), intent(in) :: m
-      integer, intent(in) :: j
-      integer :: q
+   module procedure model_contact_index
       idx = j
-      do q = 1, m%nchain
-         if (m%chain(q)%gcontact < j) idx = idx + m%chain(q)%ncontact
-      end do
-   end function model_contact_index
+      if (m%nchain > 0) &
+         idx = idx + sum(m%chain(1:m%nchain)%ncontact, m%chain(1:m%nchain)%gcontact < j)
+   end procedure model_contact_index
 
    !> Link number j of all the model's links (one by one or in a chain): kind, nodes and
    !> parameters.
-   pure module subroutine model_link_at(m, j, kind, a, b, par)
-      type(model_t), intent(in) :: m
-      integer, intent(in) :: j
-      integer, intent(out) :: kind, a, b
-      real(dp), intent(out) :: par(NPAR_LINK)
+   module procedure model_link_at
       integer :: q, i, pos, g
       g = j
       do q = 1, m%nchain
@@ -195,15 +171,11 @@ contains
       end do
       kind = m%link_kind(g); par = m%link_par(:, g)
       call row_pair(m%lnk, g, a, b)             ! one added one by one: a node pair's row
-   end subroutine model_link_at
+   end procedure model_link_at
 
    !> Contact number j of all the model's contacts (one by one or in a chain): nodes, gap,
    !> scheme, law and parameters.
-   pure module subroutine model_contact_at(m, j, a, b, gap, scheme, law, par)
-      type(model_t), intent(in) :: m
-      integer, intent(in) :: j
-      integer, intent(out) :: a, b, scheme, law
-      real(dp), intent(out) :: gap, par(NPAR_CONTACT)
+   module procedure model_contact_at
       integer :: q, g
       g = j
       do q = 1, m%nchain
@@ -221,17 +193,14 @@ contains
       call row_pair(m%con, g, a, b)             ! one added one by one: a node pair's row
       gap = m%con_gap(g); scheme = m%con_scheme(g)
       law = m%con_law(g); par = m%con_par(:, g)
-   end subroutine model_contact_at
+   end procedure model_contact_at
 
    !> The chains as links and contacts one by one, numbered as model_add_chain says, for the
    !> methods that take items one by one (a run's integrator, the static solve); the free
    !> capacity of model_create is kept.
    !> stat, message: as martello_status out_of_memory if they cannot be allocated (the model
    !> is left as it was).
-   module subroutine model_expand_chains(m, stat, message)
-      type(model_t), intent(inout) :: m
-      integer, intent(out) :: stat
-      character(len=*), intent(inout) :: message
+   module procedure model_expand_chains
       integer :: nl, nc, free_l, free_c, q, i, g, pos
       integer, allocatable :: lk(:), cs(:), cl(:)
       real(dp), allocatable :: lpar(:, :), cg(:), cpar(:, :), cm(:)
@@ -261,11 +230,7 @@ contains
       pos = 0; g = 0
       do q = 1, m%nchain
          associate (ch => m%chain(q))
-            do while (g < ch%glink)
-               g = g + 1; pos = pos + 1
-               call copy_link(g, pos)
-               if (stat /= 0) exit
-            end do
+            call copy_links(ch%glink)
             do i = 1, ch%n
                pos = pos + 1
                call rows_append_pair(lr, ch%first + i - 1, 0, stat)
@@ -284,17 +249,11 @@ contains
             end do
          end associate
       end do
-      do while (g < m%nlink)
-         g = g + 1; pos = pos + 1
-         call copy_link(g, pos)
-      end do
+      call copy_links(m%nlink)
       pos = 0; g = 0
       do q = 1, m%nchain
          associate (ch => m%chain(q))
-            do while (g < ch%gcontact)
-               g = g + 1; pos = pos + 1
-               call copy_contact(g, pos)
-            end do
+            call copy_contacts(ch%gcontact)
             do i = 1, ch%ncontact
                pos = pos + 1
                call rows_append_pair(cr, ch%first + i - 1, ch%first + i, stat)
@@ -303,10 +262,7 @@ contains
             end do
          end associate
       end do
-      do while (g < m%ncontact)
-         g = g + 1; pos = pos + 1
-         call copy_contact(g, pos)
-      end do
+      call copy_contacts(m%ncontact)
       if (stat /= 0) then
          call out_of_memory('the rows of the chains one by one', &
                             (REAL_BYTES + INT_BYTES)*2.0_dp*(nl + nc), FIX_SMALLER_SCENE, stat, message)
@@ -320,34 +276,39 @@ contains
       m%nlink = nl; m%ncontact = nc
       deallocate (m%chain); m%nchain = 0
    contains
-      subroutine copy_link(from, to)
-         integer, intent(in) :: from, to
+      !> The links added one by one after link g up to link last, into the rows after pos
+      !> (g, pos: the last copied and written); stops at a failure (stat)
+      subroutine copy_links(last)
+         integer, intent(in) :: last
          integer :: st
-         lk(to) = m%link_kind(from); lpar(:, to) = m%link_par(:, from)
-         call rows_append(lr, m%lnk%node(row_lo(m%lnk, from):row_hi(m%lnk, from)), &
-                          m%lnk%coef(row_lo(m%lnk, from):row_hi(m%lnk, from)), st)
-         if (st /= 0) stat = st
-      end subroutine copy_link
-      subroutine copy_contact(from, to)
-         integer, intent(in) :: from, to
+         do while (g < last .and. stat == 0)
+            g = g + 1; pos = pos + 1
+            lk(pos) = m%link_kind(g); lpar(:, pos) = m%link_par(:, g)
+            call rows_append(lr, m%lnk%node(row_lo(m%lnk, g):row_hi(m%lnk, g)), &
+                             m%lnk%coef(row_lo(m%lnk, g):row_hi(m%lnk, g)), st)
+            if (st /= 0) stat = st
+         end do
+      end subroutine copy_links
+      !> The contacts added one by one after contact g up to contact last, as copy_links
+      subroutine copy_contacts(last)
+         integer, intent(in) :: last
          integer :: st
-         cg(to) = m%con_gap(from)
-         cs(to) = m%con_scheme(from); cl(to) = m%con_law(from); cpar(:, to) = m%con_par(:, from)
-         call rows_append(cr, m%con%node(row_lo(m%con, from):row_hi(m%con, from)), &
-                          m%con%coef(row_lo(m%con, from):row_hi(m%con, from)), st)
-         if (st /= 0) stat = st
-      end subroutine copy_contact
-   end subroutine model_expand_chains
+         do while (g < last .and. stat == 0)
+            g = g + 1; pos = pos + 1
+            cg(pos) = m%con_gap(g)
+            cs(pos) = m%con_scheme(g); cl(pos) = m%con_law(g); cpar(:, pos) = m%con_par(:, g)
+            call rows_append(cr, m%con%node(row_lo(m%con, g):row_hi(m%con, g)), &
+                             m%con%coef(row_lo(m%con, g):row_hi(m%con, g)), st)
+            if (st /= 0) stat = st
+         end do
+      end subroutine copy_contacts
+   end procedure model_expand_chains
 
    !> A copy of the model that the caller owns with its chains made into links and contacts
    !> one by one (model_expand_chains): what a method that takes items one by one runs on,
    !> so that running a model never changes it. stat, message: as out_of_memory if the
    !> copy cannot be made (copy is then not allocated).
-   module subroutine model_expanded(m, copy, stat, message)
-      type(model_t), intent(in) :: m
-      type(model_t), allocatable, intent(out) :: copy
-      integer, intent(out) :: stat
-      character(len=*), intent(inout) :: message
+   module procedure model_expanded
       allocate (copy, source=m, stat=stat)
       if (stat /= 0) then
          call out_of_memory('a copy of the model with its chains as links and contacts', &
@@ -356,5 +317,5 @@ contains
       end if
       call model_expand_chains(copy, stat, message)
       if (stat /= MARTELLO_OK) deallocate (copy)
-   end subroutine model_expanded
+   end procedure model_expanded
 end submodule chains

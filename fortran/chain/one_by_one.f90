@@ -9,10 +9,7 @@ contains
 
    !> The bilinear links and the other contacts at the iterate, one by one (after the sweep:
    !> fe holds the rest): forces into fe, branches, works.
-   module subroutine others(self, m, flipped)
-      class(chain_step_t), intent(inout) :: self
-      type(model_t), intent(in) :: m
-      logical, intent(inout) :: flipped
+   module procedure others
       integer :: n
       n = self%n
       associate (x => self%store)
@@ -56,7 +53,7 @@ contains
             fe(0) = 0.0_dp
          end associate
       end subroutine at_state
-   end subroutine others
+   end procedure others
 
    !> Contact j's force f at δ = pen, δ̇ = rate and its branch br: on its whole law, or on
    !> the given branch on (the committed one).
@@ -85,9 +82,7 @@ contains
 
    !> The other elements' tangents on their current branches, per node: xjd, xjo of
    !> K_t + c_v C_t and C_t alone in xcd, xco (what the factors are made with).
-   module subroutine others_tangent(self, m)
-      class(chain_step_t), intent(inout) :: self
-      type(model_t), intent(in) :: m
+   module procedure others_tangent
       integer :: idx, j
       real(dp) :: k, c
       self%xjd = 0.0_dp; self%xjo = 0.0_dp; self%xcd = 0.0_dp; self%xco = 0.0_dp
@@ -120,5 +115,5 @@ contains
             self%xco(min(i, l)) = self%xco(min(i, l)) - c
          end if
       end subroutine stencil
-   end subroutine others_tangent
+   end procedure others_tangent
 end submodule one_by_one

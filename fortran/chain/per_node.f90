@@ -18,10 +18,7 @@ contains
    !> linear links summed per node and per pair, the first contact of each pair in the pair
    !> arrays (one value for the chain where all pairs share it), the rest one by one.
    !> st > 0: an allocation failed (the state is then incomplete).
-   module subroutine per_node(self, m, st)
-      class(chain_step_t), intent(inout) :: self
-      type(model_t), intent(in) :: m
-      integer, intent(out) :: st
+   module procedure per_node
       integer :: n, j, a, b, lo, nb, nx, q, i, c
       real(dp) :: k, cd
       logical, allocatable :: pair(:)
@@ -141,7 +138,7 @@ contains
             end if
          end if
       end subroutine number_pairs
-   end subroutine per_node
+   end procedure per_node
 
    !> The per-node arrays of the step in one block (store), each starting in its own slot of
    !> WAY/SLOTS bytes of the L1 cache's way, away from the model's k and c that the sweeps

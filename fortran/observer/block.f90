@@ -33,7 +33,7 @@ contains
    module procedure observer_block
       type(mech_state_t) :: none
       real(dp), allocatable :: pen(:), force(:), lf(:), ld(:)
-      integer :: n, p, nch, q, st, changed(CHANGES)
+      integer :: n, p, nch, st, changed(CHANGES)
       logical :: loc
       n = size(u) - 1
       loc = o%smooth_steps .and. o%prev_t >= 0.0_dp .and. t > o%prev_t
@@ -54,9 +54,7 @@ contains
                            blk%sg, blk%sk, blk%sc, blk%sl, blk%sgn, blk%gap, blk%k, blk%c, blk%law, &
                            br, un, vn, an, u, v, a, o%pen_max, o%force_max, o%ph_open, o%ph_pen, &
                            o%ph_f, changed, nch)
-            do q = 1, nch
-               call pair_change(o, blk, changed(q), t, h, un, vn, an, u, v, a, br)
-            end do
+            if (nch > 0) call pair_changes(o, blk, n, changed(1:nch), t, h, un, vn, an, u, v, a, br)
          end do
       end if
       call other_contacts(o, m, t, h, loc, blk, un, vn, an, u, v, a, xbr)
@@ -101,13 +99,13 @@ contains
       integer, intent(inout) :: pend(*), npend
       integer :: i, p
       real(dp) :: hl, x, du, dv, dvn
-      logical :: raised, turns
+      logical :: raised, turns, find
       hl = t - t_prev                    ! the step the extrema are located on
+      find = loc .and. (nodes .or. gu_on .or. gv_on)
       do i = 1, n
-         ! the node's v or a changes sign in the step (rare): its extrema inside it (vn, an
-         ! read only where a node's peaks are tracked)
+         ! the node's v or a changes sign in the step (rare): its extrema inside it
          turns = .false.
-         if (loc .and. (nodes .or. gu_on .or. gv_on)) turns = node_turns(vn(i), an(i), v(i), a(i))
+         if (find) turns = node_turns(vn(i), an(i), v(i), a(i))
          if (nodes) then
             call node_samples(t, u(i), v(i), a(i), umax(i), umin(i), vmax(i), amax(i), uabs(i), &
                               tabs(i), raised)
@@ -134,9 +132,11 @@ contains
             end if
             if (x > gv(i)) gv(i) = x
          end if
-         if (i == 1) cycle
-         ! the pair (i − 1, i)
-         p = i - 1
+      end do
+      ! the pairs (p, p + 1), in a loop of their own (a chain has no links between nodes)
+      if (.not. (pu_on .or. pv_on)) return
+      do p = 1, n - 1
+         i = p + 1
          if (pu_on) then
             du = u(p) - u(i); dv = v(p) - v(i); dvn = vn(p) - vn(i)
             x = abs(du)
@@ -157,11 +157,12 @@ contains
    !> state and, while its phase spans the step (open before and after it, δ > 0 at both
    !> ends), inside it (step_maxima: the force and its rate at the start computed again from
    !> the state there), and its open phase's maxima. A pair whose phase changes in the step
-   !> is listed in changed (nch of them) for pair_change, and the pass stops at the CHANGES-th
-   !> (p: where to go on). hl: the step from the previous sample; step: there is one. A
-   !> contact open before and after the step (most of them, most steps) costs its δ and one
-   !> comparison, in a loop of its own where the chain is of one kind (every pair a contact
-   !> numbered in order, one sign and gap); the others are closed_pair's.
+   !> is listed in changed (nch of them) for pair_changes. hl: the step from the previous
+   !> sample; step: there is one. A contact open before and after the step (most of them,
+   !> most steps) costs its δ and one comparison in a scan that lists the others (busy: at
+   !> most CHANGES, where the pass stops; p: where to go on), each then closed_pair's; the
+   !> scan takes the chain of one kind (every pair a contact numbered in order, one sign
+   !> and gap) in a loop of its own.
    subroutine pair_pass(p, n, hl, loc, step, contacts, phases, kel, first, number, ss, sg, sk, &
                         sc, sl, sgn, gap, kk, cc, law, br, un, vn, an, u, v, a, pen_max, &
                         force_max, ph_open, ph_pen, ph_f, changed, nch)
@@ -176,53 +177,35 @@ contains
       real(dp), intent(inout) :: pen_max(*), force_max(*), ph_pen(*), ph_f(*)
       logical, intent(in) :: ph_open(*)
       integer, intent(out) :: changed(CHANGES), nch
-      integer :: q, c
-      real(dp) :: s, gp, pen
-      logical :: full
+      integer :: q, j, nb, busy(CHANGES)
+      real(dp) :: s, gp
       nch = 0
-      if (first >= 0 .and. ss == 0 .and. sg == 0) then
-         s = sgn(0); gp = gap(0)
-         do q = p, n - 1
-            c = first + q
-            pen = s*(u(q) - u(q + 1)) - gp
-            if (br(q) == BRANCH_OFF .and. .not. ph_open(c)) then
-               if (contacts .and. pen > pen_max(c)) pen_max(c) = pen
-            else
-               call closed_pair(q, c, s, gp, pen, full)
-               if (full) return
-            end if
-         end do
-      else
-         do q = p, n - 1
-            if (first >= 0) then
-               c = first + q
-            else
-               c = number(q)
-               if (c == 0) cycle
-            end if
-            s = sgn(q*ss); gp = gap(q*sg)
-            pen = s*(u(q) - u(q + 1)) - gp
-            if (br(q) == BRANCH_OFF .and. .not. ph_open(c)) then
-               if (contacts .and. pen > pen_max(c)) pen_max(c) = pen
-            else
-               call closed_pair(q, c, s, gp, pen, full)
-               if (full) return
-            end if
-         end do
-      end if
-      p = n
+      call scan_pairs(p, n, first, number, ss, sg, sgn, gap, contacts, br, u, ph_open, pen_max, &
+                      busy, nb)
+      do j = 1, nb
+         q = busy(j); s = sgn(q*ss); gp = gap(q*sg)
+         call closed_pair(q, contact_of(q), s, gp, s*(u(q) - u(q + 1)) - gp)
+      end do
    contains
+      !> The contact of pair q (0: none).
+      integer function contact_of(q) result(c)
+         integer, intent(in) :: q
+         if (first >= 0) then
+            c = first + q
+         else
+            c = number(q)
+         end if
+      end function contact_of
+
       !> pair q (contact c, its sign s and gap gp; δ = pen at the state) closed at the start or
-      !> the end of the step; full: the list of changes is full, p where to go on
-      subroutine closed_pair(q, c, s, gp, pen, full)
+      !> the end of the step
+      subroutine closed_pair(q, c, s, gp, pen)
          integer, intent(in) :: q, c
          real(dp), intent(in) :: s, gp, pen
-         logical, intent(out) :: full
          integer :: i
          integer(int8) :: lw
          real(dp) :: f, kp, cp, d0, r0, q0, r1, q1, f0, fr0, fr1, dm, fm
          logical :: on, was
-         full = .false.
          i = q + 1
          kp = kk(q*sk); cp = 0.0_dp; lw = AFFINE_LINEAR
          if (kel) then
@@ -237,12 +220,9 @@ contains
          on = br(q) /= BRANCH_OFF
          was = ph_open(c)
          if (step .and. (on .neqv. was)) then
-            ! its phase opens or closes (pair_change); its run maxima at the state here
+            ! its phase opens or closes (pair_changes); its run maxima at the state here
             if (contacts) call contact_peaks(pen, f, pen_max(c), force_max(c))
             nch = nch + 1; changed(nch) = q
-            if (nch == CHANGES) then
-               p = q + 1; full = .true.
-            end if
             return
          end if
          if (on .and. was .and. loc .and. (contacts .or. phases) .and. pen > 0.0_dp) then
@@ -271,35 +251,114 @@ contains
       end subroutine closed_pair
    end subroutine pair_pass
 
-   !> The phase change of pair contact p (nodes p, p + 1) in the step (t − h, t], listed by
-   !> pair_pass: located on the free side of the step from its δ, δ̇, δ̈ at both ends
-   !> (phase_change), then the open phase's maxima at the state.
-   subroutine pair_change(o, blk, p, t, h, un, vn, an, u, v, a, br)
+   !> pair_pass's scan of the pairs from p to n − 1 (their contacts, signs and gaps as
+   !> there): a contact open before and after the step has its run maximum raised (where
+   !> contacts are tracked); the others are listed in busy (nb of them) up to CHANGES, where
+   !> the scan stops (p: where to go on). Small and apart, so that its loop keeps what it
+   !> reads in registers; the chain of one kind in a loop of its own (one_kind).
+   subroutine scan_pairs(p, n, first, number, ss, sg, sgn, gap, contacts, br, u, ph_open, &
+                         pen_max, busy, nb)
+      integer, intent(inout) :: p
+      integer, intent(in), value :: n, first, ss, sg
+      logical, intent(in), value :: contacts
+      integer, intent(in) :: number(0:*)
+      real(dp), intent(in) :: sgn(0:*), gap(0:*), u(0:n)
+      integer(int8), intent(in) :: br(0:n)
+      logical, intent(in) :: ph_open(*)
+      real(dp), intent(inout) :: pen_max(*)
+      integer, intent(out) :: busy(CHANGES), nb
+      integer :: q, c
+      nb = 0
+      if (first >= 0 .and. ss == 0 .and. sg == 0) then
+         call one_kind(p, n, first, sgn(0), gap(0), contacts, br, u, ph_open, pen_max, busy, nb)
+         return
+      end if
+      do q = p, n - 1
+         c = first + q
+         if (first < 0) c = number(q)
+         if (c == 0) cycle
+         if (stays_open(br(q), ph_open(c), sgn(q*ss)*(u(q) - u(q + 1)) - gap(q*sg), contacts, &
+                        pen_max(c))) cycle
+         if (list_full(q, busy, nb)) exit
+      end do
+      p = min(q + 1, n)
+   end subroutine scan_pairs
+
+   !> scan_pairs on a chain of one kind: every pair q a contact, first + q, of sign s and
+   !> gap gp; its phase and run maximum are open(q) and pmax(q) (the observer's ph_open and
+   !> pen_max from their element 1 − first: no index sum in the loop).
+   subroutine one_kind(p, n, first, s, gp, contacts, br, u, open, pmax, busy, nb)
+      integer, intent(inout) :: p, nb
+      integer, intent(in), value :: n, first
+      real(dp), intent(in), value :: s, gp
+      logical, intent(in), value :: contacts
+      integer(int8), intent(in) :: br(0:n)
+      real(dp), intent(in) :: u(0:n)
+      logical, intent(in) :: open(1 - first:*)
+      real(dp), intent(inout) :: pmax(1 - first:*)
+      integer, intent(inout) :: busy(CHANGES)
+      integer(i8) :: q                  ! (the loop then keeps no default-integer copy of it)
+      do q = p, n - 1
+         if (stays_open(br(q), open(q), s*(u(q) - u(q + 1)) - gp, contacts, pmax(q))) cycle
+         if (list_full(int(q), busy, nb)) exit
+      end do
+      p = int(min(q + 1, int(n, i8)))
+   end subroutine one_kind
+
+   !> A pair contact on branch b whose phase was open (was), δ = pen at the state: whether
+   !> it stays open over the step (open before and after it); its run maximum pmax raised
+   !> then, where tracked (contacts).
+   logical function stays_open(b, was, pen, contacts, pmax) result(open)
+      integer(int8), intent(in) :: b
+      logical, intent(in) :: was, contacts
+      real(dp), intent(in) :: pen
+      real(dp), intent(inout) :: pmax
+      open = b == BRANCH_OFF .and. .not. was
+      if (open .and. contacts) then
+         if (pen > pmax) pmax = pen
+      end if
+   end function stays_open
+
+   !> Pair q listed in busy (nb entries); whether the list is full.
+   logical function list_full(q, busy, nb) result(full)
+      integer, intent(in) :: q
+      integer, intent(inout) :: busy(CHANGES), nb
+      nb = nb + 1; busy(nb) = q
+      full = nb == CHANGES
+   end function list_full
+
+   !> The phase changes of the pair contacts pair_pass listed (pairs, nodes p, p + 1) in the
+   !> step (t − h, t], handed over as one list: each located on the free side of the step
+   !> from its δ, δ̇, δ̈ at both ends (phase_change), then its open phase's maxima at the
+   !> state.
+   subroutine pair_changes(o, blk, n, pairs, t, h, un, vn, an, u, v, a, br)
       type(observer_t), intent(inout) :: o
       type(node_block_t), intent(in) :: blk
-      integer, intent(in) :: p
-      real(dp), intent(in) :: t, h, un(0:), vn(0:), an(0:), u(0:), v(0:), a(0:)
-      integer(int8), intent(in) :: br(0:)
-      integer :: c, i
+      integer, intent(in) :: n, pairs(:)
+      real(dp), intent(in) :: t, h, un(0:n), vn(0:n), an(0:n), u(0:n), v(0:n), a(0:n)
+      integer(int8), intent(in) :: br(0:n)
+      integer :: j, p, c, i
       real(dp) :: s, gp, pen, f
-      logical :: on
-      i = p + 1
-      c = blk%first + p
-      if (blk%first < 0) c = blk%number(p)
-      s = blk%sgn(p*blk%ss); gp = blk%gap(p*blk%sg)
-      pen = s*(u(p) - u(i)) - gp
-      f = 0.0_dp
-      if (br(p) == BRANCH_ON) then
-         f = blk%k(p*blk%sk)*pen
-         if (blk%kelvin) then
-            if (blk%law(p*blk%sl) /= AFFINE_LINEAR) f = f + blk%c(p*blk%sc)*(s*(v(p) - v(i)))
+      logical :: on, phases
+      phases = tracks(o, TRACK_PHASES)
+      do j = 1, size(pairs)
+         p = pairs(j); i = p + 1
+         c = pair_number(blk, p)
+         s = blk%sgn(p*blk%ss); gp = blk%gap(p*blk%sg)
+         pen = s*(u(p) - u(i)) - gp
+         f = 0.0_dp
+         if (br(p) == BRANCH_ON) then
+            f = blk%k(p*blk%sk)*pen
+            if (blk%kelvin) then
+               if (blk%law(p*blk%sl) /= AFFINE_LINEAR) f = f + blk%c(p*blk%sc)*(s*(v(p) - v(i)))
+            end if
          end if
-      end if
-      on = br(p) /= BRANCH_OFF
-      call phase_change(o, c, on, pen, f, s*(un(p) - un(i)) - gp, s*(vn(p) - vn(i)), &
-                        s*(an(p) - an(i)), pen, s*(v(p) - v(i)), s*(a(p) - a(i)), t, h, [p, i])
-      if (tracks(o, TRACK_PHASES)) call phase_peaks(on, pen, f, o%ph_pen(c), o%ph_f(c))
-   end subroutine pair_change
+         on = br(p) /= BRANCH_OFF
+         call phase_change(o, c, on, pen, f, s*(un(p) - un(i)) - gp, s*(vn(p) - vn(i)), &
+                           s*(an(p) - an(i)), pen, s*(v(p) - v(i)), s*(a(p) - a(i)), t, h, [p, i])
+         if (phases) call phase_peaks(on, pen, f, o%ph_pen(c), o%ph_f(c))
+      end do
+   end subroutine pair_changes
 
    !> The method's other contacts, one by one (the model's linear and Kelvin laws on their
    !> committed branches xbr), as the pair contacts: maxima inside the step while the phase
