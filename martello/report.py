@@ -51,7 +51,7 @@ def check_catalogue(files, outdir, plots=True, stream=sys.stdout, require_checks
             # closed form where the scene names one, else the stored reference data (reference/)
             rows_here = verify(s, summary) if s.check is not None else []
             for r in rows_here:
-                r.setdefault("evidence", "closed form")
+                r.setdefault("evidence", kinds.CLOSED_FORM)
             if history is not None:
                 # accuracy against the independent engine where it has the scene; else the
                 # stored reference data, which only show drift (regression, not verification)
@@ -133,8 +133,9 @@ def summary_counts(rows, failures, n_scenes):
             "scenes_with_rows": len({r.get("file") for r in rows}),
             "verification": len(by[kinds.VERIFICATION]),
             "verification_passed": sum(bool(r["passed"]) for r in by[kinds.VERIFICATION]),
-            "verification_closed_form": sum(r["evidence"] == "closed form" for r in by[kinds.VERIFICATION]),
-            "verification_independent": sum(r["evidence"] == "independent reference"
+            "verification_closed_form": sum(r["evidence"] == kinds.CLOSED_FORM for r in by[kinds.VERIFICATION]),
+            "verification_published": sum(r["evidence"] == kinds.PUBLISHED for r in by[kinds.VERIFICATION]),
+            "verification_independent": sum(r["evidence"] == kinds.INDEPENDENT_ENGINE
                                             for r in by[kinds.VERIFICATION]),
             "loose": len(by[kinds.LOOSE]), "loose_passed": sum(bool(r["passed"]) for r in by[kinds.LOOSE]),
             "unconverged": len(by[kinds.UNCONVERGED]), "repeat": len(by[kinds.REPEAT]),
@@ -153,8 +154,8 @@ def headline(rows, failures, n_scenes, elapsed):
     verification; the other kinds are counted apart."""
     c = summary_counts(rows, failures, n_scenes)
     return (f"verification: {c['verification_passed']} of {c['verification']} distinct rows passed "
-            f"({c['verification_closed_form']} vs closed form, {c['verification_independent']} vs "
-            f"independent reference; tolerance < 1 %); {c['cells_verified']} of {c['cells']} cells "
+            f"({c['verification_closed_form']} vs closed form, {c['verification_published']} vs published "
+            f"value, {c['verification_independent']} vs independent reference; tolerance < 1 %); {c['cells_verified']} of {c['cells']} cells "
             f"verified, {c['cells_partly']} partly, {c['cells_not_verified']} not verified, "
             f"{c['cells_wrong']} wrong; not counted: {c['loose_passed']} of {c['loose']} "
             f"loose rows (tolerance 1-10 %) passed, {c['unconverged']} unconverged (no bound: "
@@ -192,7 +193,7 @@ def coverage(rows):
     for (problem, laws, integ), c in sorted(cells.items()):
         n = c["kinds"]
         has = n[kinds.VERIFICATION] > 0
-        evidence = next((k for k in VERIFICATION if k in c["evidence"]), None)
+        evidence = ", ".join(k for k in VERIFICATION if k in c["evidence"])
         parts = []
         if n[kinds.LOOSE]:
             parts.append(f"{n[kinds.LOOSE]} loose")
@@ -248,7 +249,9 @@ One cell per problem × contact law (or scheme) × integrator; the kind of every
 (martello/checks/kinds.py) says whether it counts:
 
 * **verification**: an oracle independent of the solvers — a `[check]` closed form of
-  `martello.oracles`, or the independent engine `martello.independent`
+  `martello.oracles`, a value published in a vendor's verification manual to its printed
+  digits (*published value*: the `printed_*` fields of `martello.oracles.vendor`,
+  [vendor-problems.md](vendor-problems.md)), or the independent engine `martello.independent`
   ([independent-reference.md](independent-reference.md): digits = min(the run's digits against
   it, the reference's trusted digits)) — with a tolerance below 1 % of the quantity (relative
   to the reference, or to the comparison's `scale` where the reference is 0), and, against the
@@ -315,7 +318,8 @@ def readme_counts(c):
     markers), from the counts of docs/coverage.md."""
     return (f"`martello check` ({c['scenes']} scenes): {c['verification_passed']} of "
             f"{c['verification']} distinct verification rows pass ({c['verification_closed_form']} "
-            f"against closed forms, {c['verification_independent']} against the independent "
+            f"against closed forms, {c['verification_published']} against values published in "
+            f"vendors' verification manuals, {c['verification_independent']} against the independent "
             f"engine; each with a tolerance below 1 %); {c['cells_verified']} of {c['cells']} problem × "
             f"law/scheme × integrator cells are verified ([docs/coverage.md](docs/coverage.md)), "
             f"{c['cells_partly']} partly, {c['cells_not_verified']} not verified, {c['cells_wrong']} "
@@ -450,7 +454,8 @@ def _write_markdown(rows, failures, pngs, path, elapsed, n_scenes, unchecked=())
              "digits = −log10 of the relative error (16 = exact to round-off).", "",
              "**" + headline(rows, failures, n_scenes, elapsed) + "**", "",
              "Kinds of rows (martello/checks/kinds.py, docs/coverage.md): *verification* — an "
-             "oracle independent of the solvers (a closed form; the independent engine, "
+             "oracle independent of the solvers (a closed form; a value published in a vendor's "
+             "manual, docs/vendor-problems.md; the independent engine, "
              "docs/independent-reference.md: digits = min(the run's, the reference's trusted "
              "digits)), a tolerance below 1 % of the quantity, and for rows against the "
              "engine, reruns at 2Δt and 4Δt (adaptive: 100 and 10⁴ × rtol) that converge at "

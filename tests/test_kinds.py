@@ -100,8 +100,25 @@ def test_the_headline_counts_verification_rows_only():
     c = summary_counts(rows, [], 5)
     assert (c["verification"], c["loose"], c["unconverged"], c["regression"], c["repeat"]) == (1, 1, 1, 1, 1)
     text = headline(rows, [], 5, 1.0)
-    assert text.startswith("verification: 1 of 1 distinct rows passed (1 vs closed form, 0 vs independent")
+    assert text.startswith("verification: 1 of 1 distinct rows passed (1 vs closed form, 0 vs published value, "
+                           "0 vs independent")
     assert "1 of 1 loose rows" in text and "5 scenes" in text
+
+
+def test_a_printed_value_is_verification_of_its_own_evidence():
+    # a value printed in a vendor's manual (the closed form's `printed_*` fields,
+    # martello.oracles.vendor) is an oracle independent of the solvers: verification,
+    # counted apart from the closed forms; a cell holding both names both
+    from martello.checks.kinds import evidence_of
+    assert evidence_of("printed_t_impact") == "published value" and evidence_of("t_impact") == "closed form"
+    base = {"problem": "vendor", "laws": "linear", "integrator": "rk8pd"}
+    rows = [row(**base), row(evidence="published value", **base), row(evidence="published value", rtol=0.05, **base)]
+    c = summary_counts(rows, [], 1)
+    assert (c["verification"], c["verification_closed_form"], c["verification_published"], c["loose"]) == (2, 1, 1, 1)
+    assert "(1 vs closed form, 1 vs published value, 0 vs independent reference" in headline(rows, [], 1, 1.0)
+    cell = coverage(rows)[0]
+    assert cell["evidence"] == "closed form, published value: not verification: 1 loose"
+    assert cell["state"] == "partly verified"
 
 
 def test_a_cell_is_verified_only_when_every_row_is_verification():

@@ -122,7 +122,8 @@ def test_the_headline_counts_only_verification():
              "digits": 9.0},
             {"evidence": "regression", "passed": True}]
     text = headline(rows, [], 3, 1.0)
-    assert text.startswith("verification: 2 of 2 distinct rows passed (1 vs closed form, 1 vs independent reference")
+    assert text.startswith("verification: 2 of 2 distinct rows passed (1 vs closed form, 0 vs published value, "
+                           "1 vs independent reference")
     assert "0 of 1 regression rows passed" not in text and "1 of 1 regression rows passed" in text
 
 

@@ -120,11 +120,13 @@ def test_the_installed_check_verifies_every_reference(venv, tmp_path):
           for k in ("verification", "loose", "unconverged", "repeat", "regression")}
     assert len(rows) == sum(map(len, by.values()))
     ver = by["verification"]
-    assert ver and all(row["evidence"] in ("closed form", "independent reference")
+    assert ver and all(row["evidence"] in ("closed form", "published value", "independent reference")
                        and float(row["tolerance_relative"]) < 0.01 for row in ver)
     closed = sum(row["evidence"] == "closed form" for row in ver)
+    published = sum(row["evidence"] == "published value" for row in ver)
     assert (f"verification: {len(ver)} of {len(ver)} distinct rows passed ({closed} vs closed form, "
-            f"{len(ver) - closed} vs independent reference; tolerance < 1 %)") in r.stdout
+            f"{published} vs published value, {len(ver) - closed - published} vs independent reference; "
+            "tolerance < 1 %)") in r.stdout
     n = {k: len(v) for k, v in by.items()}
     assert (f"not counted: {n['loose']} of {n['loose']} loose rows (tolerance 1-10 %) passed, "
             f"{n['unconverged']} unconverged (no bound: nothing asserted), {n['repeat']} repeats of "

@@ -2,7 +2,8 @@
 "Kinds of rows").
 
 A row is **verification** when its oracle is independent of the solvers (a closed form of
-martello.oracles, the independent engine martello.independent), its tolerance is below 1 %
+martello.oracles, a value published in a vendor's verification manual and its stated digits,
+the independent engine martello.independent: the row's `evidence`), its tolerance is below 1 %
 of the quantity (LOOSE_AT), and, where the tolerance is an error bound of the run itself
 (the rows against the independent engine: reruns at 2Δt and 4Δt, or 100 and 10⁴ × rtol),
 the run converges at the method's formal order (martello.checks.independent_rows,
@@ -27,10 +28,20 @@ import math
 VERIFICATION, LOOSE, UNCONVERGED, REPEAT, REGRESSION = (
     "verification", "loose", "unconverged", "repeat", "regression")
 KINDS = (VERIFICATION, LOOSE, UNCONVERGED, REPEAT, REGRESSION)
-# the oracles independent of the solvers (the `evidence` of a row)
-INDEPENDENT = ("closed form", "independent reference")
+# the oracles independent of the solvers (the `evidence` of a row): a closed form, a value
+# printed in a vendor's manual (an oracle field `printed_*`, martello.oracles.vendor:
+# docs/vendor-problems.md), the independent engine's solution
+CLOSED_FORM, PUBLISHED, INDEPENDENT_ENGINE = "closed form", "published value", "independent reference"
+INDEPENDENT = (CLOSED_FORM, PUBLISHED, INDEPENDENT_ENGINE)
+PRINTED = "printed_"
 LOOSE_AT = 0.01          # a tolerance of 1 % of the quantity or more is not verification
 UNRESOLVED_AT = 0.10     # ... and of 10 % or more is no check at all
+
+
+def evidence_of(oracle) -> str:
+    """The evidence of a `[check]` row by the closed form's field it compares with: a printed
+    value (`printed_*`) is a published value, any other field the closed form's own."""
+    return PUBLISHED if oracle.startswith(PRINTED) else CLOSED_FORM
 
 
 def relative_tolerance(row) -> float:

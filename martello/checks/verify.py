@@ -8,6 +8,7 @@ import math
 
 from ..errors import SceneError
 from ..results import KINDS, ItemArrays
+from . import kinds
 from .oracle_names import closed_form
 
 DIGITS_CAP = 16.0   # a double carries ~15.95 digits; an exact match is reported as 16
@@ -117,5 +118,6 @@ def verify(scene, summary):
             "rel_error": err / abs(reference) if reference != 0 else float("nan"),
             "digits": digits(value, reference), "rtol": rtol, "atol": atol,
             "scale": item.get("scale") or abs(reference),
-            "passed": bool(err <= atol + rtol * abs(reference)), "why": item["why"]})
+            "passed": bool(err <= atol + rtol * abs(reference)), "why": item["why"],
+            "evidence": kinds.evidence_of(item["oracle"])})
     return rows
