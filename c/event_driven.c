@@ -44,6 +44,8 @@ enum { ROOT_IMPACT,      /* unilateral gap closing: delta >= 0                  
 
 /* events without time advancing before the run is declared stuck */
 #define MAX_EVENTS_AT_ONCE 1000
+/* two stops closer than this many units of rounding of their time are one (ed_integrate) */
+#define STOP_ROUNDING (16.0 * DBL_EPSILON)
 
 typedef struct {
   martello_model *model;
@@ -1178,10 +1180,15 @@ static int ed_integrate(ed_t *w) {
     const double t0 = t;
     unsigned long failed = w->drv->e->failed_steps;
     double hs = (w->h_max > 0.0) ? fmin(h, w->h_max) : h, te, t_stop;
-    int ev, k = -1;
-    /* a kink of the load is a stop (docs/event-driven.md, time events) */
+    int ev, k = -1, kink;
+    /* a kink of the load is a stop (docs/event-driven.md, time events); one within rounding
+     * of an output time (a record sampled at 0.01 s, outputs every 0.015 s: k 0.015 and
+     * the sample's time differ by an ulp or two) is the same stop, never a step of an ulp,
+     * and a kink restarts the stepper whether or not it is also an output time */
     martello_eval_next_breakpoint(w->ev, t, &t_stop);
-    t_stop = fmin(t_stop, t_out);
+    if (t_stop - t <= STOP_ROUNDING * fabs(t)) martello_eval_next_breakpoint(w->ev, t_stop, &t_stop);
+    kink = t_stop <= t_out + STOP_ROUNDING * fabs(t_out);
+    t_stop = (t_stop < t_out - STOP_ROUNDING * fabs(t_out)) ? t_stop : t_out;
     /* msbdf lowers its order whenever a step is less than half the steps before it (GSL's
      * stability heuristic), and a step cut short by a stop is such a step: with a stop every
      * few steps the order never rises and BDF1's damping takes a few % of the speed a flight
@@ -1226,10 +1233,10 @@ static int ed_integrate(ed_t *w) {
                     "event-driven: events accumulate without time advancing (an unresolved "
                     "Zeno point or chattering contact)");
     }
-    else if (t >= t_stop && t_stop < t_out) {
+    else if (t >= t_stop && kink) {
       gsl_odeiv2_driver_reset(w->drv);   /* across a kink of the load: start afresh */
     }
-    keep_end_rates(w, ev == 0 && !(t >= t_stop && t_stop < t_out));
+    keep_end_rates(w, ev == 0 && !(t >= t_stop && kink));
     st = commit(w, t, w->y0 + 2 * n);
     if (st != MARTELLO_OK) return st;
     if (t >= t_out) {   /* on the output grid: the observer records it */
