@@ -72,6 +72,7 @@ typedef struct {
   gsl_odeiv2_driver *rdrv;        /* msbdf: adaptive rk4imp from the step start */
   double *scale_abs;
   double *y, *y0, *yb, *ybest, *yc, *yerr, *fstart, *f, *f1, *fj, *yj, *fint, *fext;
+  double *jf0, *jf1;               /* ed_jacobian's own RHS values (msbdf, rk4imp) */
   /* contact kinematics at the step start (0), the step end (1) and the current state */
   double *pen0, *rate0, *acc0, *pen1, *rate1, *acc1, *pen, *rate, *force;
   double *lam, *lam0, *lam1, *lamtol;
@@ -229,7 +230,10 @@ static int ed_rhs(double t, const double y[], double dydt[], void *params) {
 }
 
 /* Jacobian for msbdf and rk4imp: forward differences of the RHS, dense, row-major
- * dfdy[i*dim + j] (GSL's layout); 2n + 2 RHS evaluations; u' = v is set exactly. */
+ * dfdy[i*dim + j] (GSL's layout); 2n + 2 RHS evaluations; u' = v is set exactly. Its RHS
+ * values have buffers of their own (jf0, jf1): rk4imp calls it while a step's end is held in
+ * f1 (the event and peak location re-integrate), and a rate taken from a clobbered f1 missed
+ * the |v| and |a| peaks of msbdf whenever an extremum of u was located in the same step. */
 static int ed_jacobian(double t, const double y[], double *dfdy, double dfdt[], void *params) {
   ed_t *w = params;
   const size_t n = (size_t)w->n, dim = w->dim;
@@ -237,7 +241,7 @@ static int ed_jacobian(double t, const double y[], double *dfdy, double dfdt[], 
   double umax = 0.0, vmax = 0.0, ht;
   size_t i, j;
   w->cnt[MARTELLO_COUNTER_JACOBIAN_EVALUATIONS]++;
-  if (ed_rhs(t, y, w->fj, w) != GSL_SUCCESS) return GSL_EBADFUNC;
+  if (ed_rhs(t, y, w->jf0, w) != GSL_SUCCESS) return GSL_EBADFUNC;
   for (i = 0; i < n; i++) {
     umax = fmax(umax, fabs(y[i]));
     vmax = fmax(vmax, fabs(y[n + i]));
@@ -251,17 +255,17 @@ static int ed_jacobian(double t, const double y[], double *dfdy, double dfdt[], 
     /* away from zero along y_j (along its rate where y_j is 0: a mirrored scene's zeros are
      * not negated): the mirrored state (y -> -y) differences the mirrored way, so that a
      * mirrored scene runs the mirrored steps to the bit (docs/invariance.md) */
-    w->yj[j] = y[j] + copysign(step, y[j] != 0.0 ? y[j] : w->fj[j]);
+    w->yj[j] = y[j] + copysign(step, y[j] != 0.0 ? y[j] : w->jf0[j]);
     hh = w->yj[j] - y[j];
-    if (ed_rhs(t, w->yj, w->f1, w) != GSL_SUCCESS) return GSL_EBADFUNC;
+    if (ed_rhs(t, w->yj, w->jf1, w) != GSL_SUCCESS) return GSL_EBADFUNC;
     w->yj[j] = y[j];
-    for (i = n; i < dim; i++) dfdy[i * dim + j] = (w->f1[i] - w->fj[i]) / hh;
+    for (i = n; i < dim; i++) dfdy[i * dim + j] = (w->jf1[i] - w->jf0[i]) / hh;
   }
   for (i = 0; i < n; i++)
     if (!w->fixed[i]) dfdy[i * dim + n + i] = 1.0;
   ht = sq * fmax(fabs(t), w->dt_out);
-  if (ed_rhs(t + ht, y, w->f1, w) != GSL_SUCCESS) return GSL_EBADFUNC;
-  for (i = 0; i < dim; i++) dfdt[i] = (w->f1[i] - w->fj[i]) / ht;
+  if (ed_rhs(t + ht, y, w->jf1, w) != GSL_SUCCESS) return GSL_EBADFUNC;
+  for (i = 0; i < dim; i++) dfdt[i] = (w->jf1[i] - w->jf0[i]) / ht;
   return GSL_SUCCESS;
 }
 
@@ -974,7 +978,7 @@ static int observe(ed_t *w, double t, int k) {
 static void ed_free(ed_t *w) {
   void *bufs[] = {w->mass, w->gap, w->e, w->fixed, w->el_first, w->el_node, w->el_coef, w->scheme, w->is_pen,
                   w->uni, w->inert, w->Cm, w->scale_abs, w->y, w->y0, w->yb, w->ybest, w->yc,
-                  w->yerr, w->fstart, w->f, w->f1, w->fj, w->yj, w->fint, w->fext,
+                  w->yerr, w->fstart, w->f, w->f1, w->fj, w->jf0, w->jf1, w->yj, w->fint, w->fext,
                   w->pen0, w->rate0, w->acc0, w->pen1, w->rate1, w->acc1, w->pen, w->rate,
                   w->force, w->lam, w->lam0, w->lam1, w->lamtol, w->hlist, w->held, w->Wh,
                   w->rh, w->ilist, w->hk, w->Wl, w->ql, w->pl, w->wl, w->sl, w->el, w->tg, 
@@ -1038,7 +1042,7 @@ static int ed_setup(ed_t *w) {
   if (!(ALLOC(w->Cm, (size_t)n * (size_t)w->nu) && ALLOC(w->scale_abs, dim) && ALLOC(w->y, dim) &&
         ALLOC(w->y0, dim) && ALLOC(w->yb, dim) && ALLOC(w->ybest, dim) && ALLOC(w->yc, dim) &&
         ALLOC(w->yerr, dim) && ALLOC(w->fstart, dim) && ALLOC(w->f, dim) && ALLOC(w->f1, dim) &&
-        ALLOC(w->fj, dim) && ALLOC(w->yj, dim) && ALLOC(w->fint, n) && ALLOC(w->fext, n) &&
+        ALLOC(w->fj, dim) && ALLOC(w->jf0, dim) && ALLOC(w->jf1, dim) && ALLOC(w->yj, dim) && ALLOC(w->fint, n) && ALLOC(w->fext, n) &&
         ALLOC(w->pen0, nc) && ALLOC(w->rate0, nc) && ALLOC(w->acc0, nc) &&
         ALLOC(w->pen1, nc) && ALLOC(w->rate1, nc) && ALLOC(w->acc1, nc) && ALLOC(w->pen, nc) &&
         ALLOC(w->rate, nc) && ALLOC(w->force, nc) && ALLOC(w->lam, nc) && ALLOC(w->lam0, nc) &&
