@@ -73,6 +73,7 @@ typedef struct {
   double *scale_abs;
   double *y, *y0, *yb, *ybest, *yc, *yerr, *fstart, *f, *f1, *fj, *yj, *fint, *fext;
   double *jf0, *jf1;               /* ed_jacobian's own RHS values (msbdf, rk4imp) */
+  double *jh;                      /* a jerk projected for the held forces' rates (rates) */
   /* contact kinematics at the step start (0), the step end (1) and the current state */
   double *pen0, *rate0, *acc0, *pen1, *rate1, *acc1, *pen, *rate, *force;
   double *lam, *lam0, *lam1, *lamtol;
@@ -854,6 +855,11 @@ static int node_extrema(ed_t *w, double t0, double t1) {
     hermite_t p;
     double lo = 0.0, hi = 1.0, tm, uc, vc, ac, tau;
     if (w->fixed[i]) continue;
+    /* a turn inside the velocity's own tolerance is not resolved: its sign is the error's
+     * (the precursor of a wave in a lumped rod, u ~ 1e-150 m ahead of the front, turned
+     * back and forth with the step sequence and made local maxima of u come and go with
+     * the output stops; docs/results.md, u_peak) */
+    if (!(fmax(fabs(v0), fabs(v1)) > w->atol)) continue;
     if (v0 > 0.0 && v1 <= 0.0) is_max = 1;
     else if (v0 < 0.0 && v1 >= 0.0) is_max = 0;
     else continue;
@@ -886,9 +892,23 @@ static int node_extrema(ed_t *w, double t0, double t1) {
 
 /* The rates of the peak quantities at the state (t, y) with accelerations acc: elements into
  * e (c/located_peaks.c's packed layout), node jerks into jerk. */
-static int rates(ed_t *w, double t, const double *y, const double *acc, double *e, double *jerk) {
-  int st = martello_peak_rates(w->ev, t, y, y + w->n, acc, w->nc, w->nl, e, jerk);
-  return st == MARTELLO_OK ? st : fail_eval(w, st, t);
+static int rates(ed_t *w, double t, const double *y, const double *acc, const double *lam,
+                 double *e, double *jerk) {
+  int k, st = martello_peak_rates(w->ev, t, y, y + w->n, acc, w->nc, w->nl, e, jerk);
+  if (st != MARTELLO_OK) return fail_eval(w, st, t);
+  if (w->nh == 0) return MARTELLO_OK;
+  /* a held contact's force is its multiplier P (lam at this state), and its rate the
+   * multiplier of the jerk, W_H P' = -B_H j (the constraint is linear, the mass constant):
+   * its peaks are located inside the steps like a penalty force's (c/located_peaks.c's
+   * layout: the contact forces at 2 nc, their rates at 3 nc) */
+  memcpy(w->jh, jerk, (size_t)w->n * sizeof *jerk);
+  st = martello_impulse_project(w->n, w->nh, w->hlist, TOPOLOGY(w), w->Wh, NULL, w->jh, w->rh);
+  if (st != MARTELLO_OK) return fail(w, st, t, "event-driven: the rate of a held contact's force");
+  for (k = 0; k < w->nh; k++) {
+    e[2 * w->nc + w->hlist[k]] = lam[w->hlist[k]];
+    e[3 * w->nc + w->hlist[k]] = w->rh[k];
+  }
+  return MARTELLO_OK;
 }
 
 /* The probe of c/located_peaks.c: quantity kind of item j at t inside the stretch, on the
@@ -900,17 +920,19 @@ static int peak_probe(void *ctx, double t, int kind, int j, double *q, double *r
   if (st != MARTELLO_OK) return st;
   st = eval_point(w, t, w->yc, w->fj, NULL);
   if (st != MARTELLO_OK) return fail_eval(w, st, t);
-  if (kind != MARTELLO_PEAK_V && (st = rates(w, t, w->yc, w->fj + n, w->elc, w->fp)) != MARTELLO_OK)
+  if (kind != MARTELLO_PEAK_V &&
+      (st = rates(w, t, w->yc, w->fj + n, w->lam, w->elc, w->fp)) != MARTELLO_OK)
     return st;
   martello_peak_pick(kind, j, w->nc, w->nl, w->yc + n, w->fj + n, w->fp, w->elc, q, r);
   return MARTELLO_OK;
 }
 
 /* Items without a peak of their own here: fixed nodes, contacts that are not penalty ones
- * or not in a phase. */
+ * or not in a phase (but the force of a held contact, its multiplier). */
 static int peak_skip(void *ctx, int kind, int j) {
   ed_t *w = ctx;
   if (kind == MARTELLO_PEAK_V || kind == MARTELLO_PEAK_A) return w->fixed[j];
+  if (kind == MARTELLO_PEAK_FORCE && w->held[j]) return 0;
   if (kind == MARTELLO_PEAK_PEN || kind == MARTELLO_PEAK_FORCE)
     return !w->is_pen[j] || !martello_observer_in_phase(w->obs, j);
   return 0;
@@ -925,9 +947,10 @@ static int located_peaks(ed_t *w, double t0, double t1, int at_event) {
   martello_peak_ends e;
   int st;
   if (!(t1 - t0 > 0.0)) return MARTELLO_OK;
-  if (!w->start_rates && (st = rates(w, t0, w->y0, w->fstart + n, w->el0, w->jk0)) != MARTELLO_OK)
+  if (!w->start_rates &&
+      (st = rates(w, t0, w->y0, w->fstart + n, w->lam0, w->el0, w->jk0)) != MARTELLO_OK)
     return st;
-  if ((st = rates(w, t1, w->y, w->f1 + n, w->el1, w->jk1)) != MARTELLO_OK) return st;
+  if ((st = rates(w, t1, w->y, w->f1 + n, w->lam1, w->el1, w->jk1)) != MARTELLO_OK) return st;
   memset(&e, 0, sizeof e);
   martello_peak_ends_set(&e, 0, n, w->nc, w->nl, w->y0 + n, w->fstart + n, w->jk0, w->el0);
   martello_peak_ends_set(&e, 1, n, w->nc, w->nl, w->y + n, w->f1 + n, w->jk1, w->el1);
@@ -978,7 +1001,7 @@ static int observe(ed_t *w, double t, int k) {
 static void ed_free(ed_t *w) {
   void *bufs[] = {w->mass, w->gap, w->e, w->fixed, w->el_first, w->el_node, w->el_coef, w->scheme, w->is_pen,
                   w->uni, w->inert, w->Cm, w->scale_abs, w->y, w->y0, w->yb, w->ybest, w->yc,
-                  w->yerr, w->fstart, w->f, w->f1, w->fj, w->jf0, w->jf1, w->yj, w->fint, w->fext,
+                  w->yerr, w->fstart, w->f, w->f1, w->fj, w->jf0, w->jf1, w->jh, w->yj, w->fint, w->fext,
                   w->pen0, w->rate0, w->acc0, w->pen1, w->rate1, w->acc1, w->pen, w->rate,
                   w->force, w->lam, w->lam0, w->lam1, w->lamtol, w->hlist, w->held, w->Wh,
                   w->rh, w->ilist, w->hk, w->Wl, w->ql, w->pl, w->wl, w->sl, w->el, w->tg, 
@@ -1042,7 +1065,7 @@ static int ed_setup(ed_t *w) {
   if (!(ALLOC(w->Cm, (size_t)n * (size_t)w->nu) && ALLOC(w->scale_abs, dim) && ALLOC(w->y, dim) &&
         ALLOC(w->y0, dim) && ALLOC(w->yb, dim) && ALLOC(w->ybest, dim) && ALLOC(w->yc, dim) &&
         ALLOC(w->yerr, dim) && ALLOC(w->fstart, dim) && ALLOC(w->f, dim) && ALLOC(w->f1, dim) &&
-        ALLOC(w->fj, dim) && ALLOC(w->jf0, dim) && ALLOC(w->jf1, dim) && ALLOC(w->yj, dim) && ALLOC(w->fint, n) && ALLOC(w->fext, n) &&
+        ALLOC(w->fj, dim) && ALLOC(w->jf0, dim) && ALLOC(w->jf1, dim) && ALLOC(w->jh, n) && ALLOC(w->yj, dim) && ALLOC(w->fint, n) && ALLOC(w->fext, n) &&
         ALLOC(w->pen0, nc) && ALLOC(w->rate0, nc) && ALLOC(w->acc0, nc) &&
         ALLOC(w->pen1, nc) && ALLOC(w->rate1, nc) && ALLOC(w->acc1, nc) && ALLOC(w->pen, nc) &&
         ALLOC(w->rate, nc) && ALLOC(w->force, nc) && ALLOC(w->lam, nc) && ALLOC(w->lam0, nc) &&
@@ -1215,8 +1238,8 @@ static int ed_integrate(ed_t *w) {
     kinematics(w, w->y, w->f1 + n, w->pen1, w->rate1, w->acc1);
     ev = locate(w, t0, t, &te);
     if (ev < 0) return ev;
-    if (ev == 1) {   /* the smooth stretch ends at the event: its RHS there */
-      st = eval_point(w, te, w->y, w->f1, NULL);
+    if (ev == 1) {   /* the smooth stretch ends at the event: its RHS and multipliers there */
+      st = eval_point(w, te, w->y, w->f1, w->lam1);
       if (st != MARTELLO_OK) return fail_eval(w, st, te);
     }
     st = node_extrema(w, t0, ev == 1 ? te : t);
