@@ -436,9 +436,6 @@ static int integrate(ida_problem *P, SUNContext sunctx, N_Vector yy, N_Vector yp
         break;
       }
       if (!restart) restart = root_stays_zero(P, N_VGetArrayPointer(yy), found);
-      /* a branch of a law left: the commit at the root changes it, IDA restarts there */
-      for (int s = 0; s < E->nsw && !restart; s++)
-        if (found[2 * E->nc + s]) restart = 1;
     }
     /* a kink of the load (docs/ida.md, time events): IDA restarts across it */
     if (!restart && flag == IDA_TSTOP_RETURN && tret == t_stop && t_stop < t_out) restart = 1;

@@ -114,6 +114,44 @@ void oe_nudge(ode_events *E, int j, int sgn, double *u) {
   }
 }
 
+/* The value of switch slot s on (u, v): g > 0 once its branch is left (fortran/switching.f90). */
+static double switch_value(const ode_events *E, int s, const double *u, const double *v) {
+  const int e = E->sw_el[s];
+  const double du = e >= 0 ? martello_rows_dot(&E->elem, e, u) : 0.0;
+  const double dv = e >= 0 ? martello_rows_dot(&E->elem, e, v) : 0.0;
+  return E->sw_al[s] * du + E->sw_be[s] * dv + E->sw_ga[s];
+}
+
+/* The root finder reports a switch where g has changed sign or is exactly 0 (an exact zero is
+ * a root), and the located state may sit on the surface within its rounding. The commit leaves
+ * a branch only past its surface (g > 0 as the kernels compute it again from the committed
+ * state, fortran/switching.f90): a restart on the surface would keep the branch, and the root,
+ * 0 there, is not reported again, so the branch would change at the next commit, a whole step
+ * late (docs/sundials-ode.md, events and restarts). Switch s, reported rising, is moved past its
+ * surface beyond that rounding (16 eps of its terms, as c/event_driven.c's switch_rounding) by
+ * the smallest shift of one free node of its element: its u where g depends on u, else its v. */
+static void past_switch(ode_events *E, int s, double *u, double *v) {
+  const int e = E->sw_el[s];
+  const double al = E->sw_al[s], be = E->sw_be[s];
+  if (e < 0 || (al == 0.0 && be == 0.0)) return;
+  double *x = al != 0.0 ? u : v, a = al != 0.0 ? al : be, c = 0.0;
+  int node = -1;
+  for (int k = E->elem.first[e]; k < E->elem.first[e + 1] && node < 0; k++)
+    if (!E->fixed[E->elem.node[k]] && E->elem.coef[k] != 0.0) {
+      node = E->elem.node[k];
+      c = E->elem.coef[k];
+    }
+  if (node < 0) return;
+  for (int k = 0; k < 80; k++) {
+    const double rounding = 16.0 * DBL_EPSILON *
+                            (fabs(al) * martello_rows_abs(&E->elem, e, u) +
+                             fabs(be) * martello_rows_abs(&E->elem, e, v) + fabs(E->sw_ga[s])) + DBL_MIN;
+    const double g = switch_value(E, s, u, v);
+    if (g > rounding) return;
+    x[node] += ldexp(rounding - g + rounding, k) / (a * c);
+  }
+}
+
 /* ---- the impulse problem of the rigid contacts -------------------------------------------- */
 
 /* M^-1 B_r^T of every rigid contact, once (the mass matrix does not change). */
@@ -499,12 +537,7 @@ int oe_roots(ode_events *E, double t, const double *u, const double *v, double *
       g[2 * j + 1] = oe_rate(E, j, v);
     }
   }
-  for (int s = 0; s < E->nsw; s++) {
-    const int e = E->sw_el[s];
-    const double du = e >= 0 ? martello_rows_dot(&E->elem, e, u) : 0.0;
-    const double dv = e >= 0 ? martello_rows_dot(&E->elem, e, v) : 0.0;
-    g[2 * E->nc + s] = E->sw_al[s] * du + E->sw_be[s] * dv + E->sw_ga[s];
-  }
+  for (int s = 0; s < E->nsw; s++) g[2 * E->nc + s] = switch_value(E, s, u, v);
   return 0;
 }
 
@@ -573,6 +606,12 @@ int oe_classify_roots(ode_events *E, double t_last, double tret, const double *y
     }
     any |= E->act[j] != ACT_NONE;
   }
+  /* a branch of a law left: the restart at the root commits the next one */
+  for (int s = 0; s < E->nsw; s++)
+    if (found[2 * E->nc + s]) {
+      E->sw_hit[s] = found[2 * E->nc + s];
+      any = 1;
+    }
   *t_r = tret;
   return any;
 }
@@ -641,6 +680,10 @@ int oe_boundary_events(ode_events *E, double t_last, double tret, const double *
 int oe_prepare_restart(ode_events *E, double t, double *u, double *v) {
   int st, any_rigid = 0;
   double ke0 = 0.0, ke1 = 0.0, dummy;
+  for (int s = 0; s < E->nsw; s++) {
+    if (E->sw_hit[s] > 0) past_switch(E, s, u, v);
+    E->sw_hit[s] = 0;
+  }
   if ((st = martello_eval_energy(E->ev, u, v, &ke0, &dummy)) != MARTELLO_OK)
     return oe_fail(E, st, "%s: energy evaluation failed", E->name);
   for (int r = 0; r < E->nr; r++) E->opened[r] = 0;
@@ -743,7 +786,7 @@ void oe_release(ode_events *E) {
                  E->rig_con, E->iu, E->iv, E->closed, E->act, E->opened, E->was_closed, E->hit,
                  E->cand, E->q, E->w0, E->w_in, E->w_out, E->u, E->v, E->a, E->x, E->uq, E->vq,
                  E->fint, E->fext, E->force, E->lam, E->S, E->rhs, E->cols, E->dc, E->aset,
-                 E->sw_el, E->sw_al, E->sw_be, E->sw_ga, E->lc, E->dlc, E->Wc, E->ar,
+                 E->sw_el, E->sw_al, E->sw_be, E->sw_ga, E->sw_hit, E->lc, E->dlc, E->Wc, E->ar,
                  E->lr, E->lamtol, E->v_last, E->el0, E->el1, E->elc, E->pv0, E->pa0, E->pj0,
                  E->pv1, E->pa1, E->pj1, E->ua, E->va, E->aa, E->jk};
   for (size_t k = 0; k < sizeof all / sizeof all[0]; k++) free(all[k]);
@@ -861,6 +904,7 @@ int oe_setup(ode_events *E, martello_model *model, martello_run *run, const char
   E->sw_al = oe_take((size_t)E->nsw, sizeof(double), &failed);
   E->sw_be = oe_take((size_t)E->nsw, sizeof(double), &failed);
   E->sw_ga = oe_take((size_t)E->nsw, sizeof(double), &failed);
+  E->sw_hit = oe_take((size_t)E->nsw, sizeof(int), &failed);
   if (failed > 0.0) return oe_fail_memory(E, what, failed);
   if (E->nsw > 0 &&
       (st = martello_eval_switches(E->ev, E->sw_el, E->sw_al, E->sw_be, E->sw_ga)) != MARTELLO_OK)

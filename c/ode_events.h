@@ -64,6 +64,8 @@ typedef struct {
    * roots 2 nc .. 2 nc + nsw - 1 */
   int nsw, *sw_el;
   double *sw_al, *sw_be, *sw_ga;
+  int *sw_hit;   /* per slot: the root finder's direction of a switch reported at the restart
+                    time (oe_classify_roots), put past its surface by oe_prepare_restart */
   martello_accumulation acc; /* the accumulation rule's phases (c/accumulation.c) */
   /* the release roots: the closed set at the last restart (its rigid contacts lc[0..mc), their
    * door list dlc and W factored in Wc), the free accelerations ar and the signed multipliers
@@ -137,8 +139,8 @@ int oe_closed_multipliers(ode_events *E, double t, const double *u, const double
 /* Accelerations a with the closed set's forces: a <- a + M^-1 B_H^T lambda, W_H lambda = -B_H a
  * (lambda into E->x; linear in a, so a sum of parts may be constrained part by part). */
 int oe_constrain(ode_events *E, double *a);
-/* What the roots reported at tret mean: 1 (with *t_r and E->act) if the integrator restarts,
- * 0 if they were extrema of gaps, < 0 on failure. */
+/* What the roots reported at tret mean: 1 (with *t_r, E->act and E->sw_hit) if the integrator
+ * restarts (a contact event or a law's switch), 0 if they were extrema of gaps, < 0 on failure. */
 int oe_classify_roots(ode_events *E, double t_last, double tret, const double *y,
                       const int *found, double *t_r);
 /* A reported root of an open or penalty contact exactly 0 at the return (identical

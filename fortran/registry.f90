@@ -326,6 +326,11 @@ module martello_registry
       method_t('trbdf2-3-3-2', 202, INT_ARKODE, METHOD_DIRK, 'TR-BDF2 as an ESDIRK, order 2'), &
       method_t('kvaerno-4-2-3', 203, INT_ARKODE, METHOD_DIRK, 'ESDIRK, order 3'), &
       method_t('sdirk-5-3-4', 207, INT_ARKODE, METHOD_DIRK, 'SDIRK, order 4'), &
+      method_t('kvaerno-5-3-4', 208, INT_ARKODE, METHOD_DIRK, 'ESDIRK, order 4'), &
+      method_t('kvaerno-7-4-5', 210, INT_ARKODE, METHOD_DIRK, 'ESDIRK, order 5'), &
+      method_t('ark324l2sa-4-2-3', 300, INT_ARKODE, METHOD_IMEX, 'ImEx additive RK, order 3'), &
+      method_t('ark436l2sa-6-3-4', 301, INT_ARKODE, METHOD_IMEX, 'ImEx additive RK, order 4'), &
+      method_t('ark437l2sa-7-3-4', 302, INT_ARKODE, METHOD_IMEX, 'ImEx additive RK, order 4'), &
       method_t('ark548l2sa-8-4-5', 303, INT_ARKODE, METHOD_IMEX, &
                'ImEx additive RK, order 5: loads explicit, internal forces implicit'), &
       method_t('ark548l2sab-8-4-5', 304, INT_ARKODE, METHOD_IMEX, 'ImEx additive RK, order 5')]

@@ -33,6 +33,8 @@ SCENES = {
     "p2/p2_ida_lagrange.toml": ("mirrored", "rescaled", "renamed"),
     "p9/p9_davis_restitution.toml": ("mirrored", "rescaled", "renamed"),
     "sdof/sdof_sine_hht.toml": ("mirrored", "rescaled", "renamed"),
+    # contacts written as rows of several DOFs (terms): coefficients negated, terms renamed
+    "p11/p11_eccentric_impact.toml": ("mirrored", "renamed"),
     "p7/p7_chain_10.toml": ("chains_as_lists",),
     "p7/p7_two_oscillators.toml": ("chains_as_lists",),
 }

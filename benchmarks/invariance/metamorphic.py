@@ -48,7 +48,7 @@ def _negate_function(fn):
 
 
 def mirrored(data):
-    for key in ("chain", "bar", "frame", "mass_coupling"):
+    for key in ("chain", "bar", "frame", "building", "mass_coupling"):
         if key in data:
             raise Unsupported(f"[{key}] (its orientation is the generator's)")
     d = copy.deepcopy(data)
@@ -57,7 +57,11 @@ def mirrored(data):
             if k in n:
                 n[k] = -n[k]
     for item in d.get("link", []) + d.get("contact", []):
-        item["a"], item["b"] = item["b"], item["a"]
+        if "terms" in item:                 # a row Σ coef·u: the same δ with every coef negated
+            for term in item["terms"]:
+                term["coef"] = -term["coef"]
+        else:
+            item["a"], item["b"] = item["b"], item["a"]
     loads = d.get("loads", {})
     if "gravity" in loads:
         loads["gravity"] = -loads["gravity"]
@@ -111,7 +115,7 @@ UNITS = {"u_max": "L", "u_min": "L", "u_absmax": "L", "u_final": "L", "v_absmax"
 
 def rescaled(data, M=4.0, L=0.5, T=2.0):
     """The scene in units where mass, length and time numbers are M, L, T times larger."""
-    for key in ("chain", "bar", "frame", "mass_coupling"):
+    for key in ("chain", "bar", "frame", "building", "mass_coupling"):
         if key in data:
             raise Unsupported(f"[{key}]")
     d = copy.deepcopy(data)
@@ -214,7 +218,7 @@ def _scale_function(fn, value_scale, T):
 # ---- renamed and reordered ----------------------------------------------------------------------
 
 def renamed(data, prefix="r_"):
-    for key in ("chain", "bar", "frame", "mass_coupling"):
+    for key in ("chain", "bar", "frame", "building", "mass_coupling"):
         if key in data:
             raise Unsupported(f"[{key}] (its items are named by the generator)")
     d = copy.deepcopy(data)
@@ -226,7 +230,11 @@ def renamed(data, prefix="r_"):
     names = {}
     for kind in ("link", "contact"):
         for i, item in enumerate(d.get(kind, [])):
-            item["a"], item["b"] = ref(item["a"]), ref(item["b"])
+            if "terms" in item:
+                for term in item["terms"]:
+                    term["node"] = ref(term["node"])
+            else:
+                item["a"], item["b"] = ref(item["a"]), ref(item["b"])
             old = item.get("name", f"link{i}" if kind == "link" else None)
             if old is not None:
                 item["name"] = prefix + old
