@@ -118,6 +118,14 @@ static int interpolant(void *ctx, double t, int k, N_Vector out) {
   return MARTELLO_OK;
 }
 
+/* The degree of that interpolant: the order IDA last used (IDAGetDky answers k up to it). */
+static int degree(void *ctx) {
+  ida_problem *P = ctx;
+  int k = 1;
+  if (IDAGetLastOrder(P->mem, &k) != IDA_SUCCESS || k < 1) k = 1;
+  return k;
+}
+
 static void error_handler(int code, const char *module, const char *function, char *msg,
                           void *data) {
   ida_problem *P = data;
@@ -254,10 +262,13 @@ static int setup(ida_problem *P, martello_model *model, martello_run *run) {
   double failed = 0.0;
   P->run = run;
   E->dky = interpolant;
+  E->degree = degree;
   E->ctx = P;
   int st = oe_setup(E, model, run, "IDA");
   if (st != MARTELLO_OK) return st;
   E->restarts = 1;   /* IDAReInit: BDF from order 1 */
+  /* IDA restarts at every switch, also where CVODE steps across (docs/sundials-ode.md, events
+   * inside the steps: stepping across, P8's errors at 100 and 1e4 x rtol lose their order) */
   P->ip = oe_take((size_t)E->nr, sizeof(sunindextype), &failed);
   P->im = oe_take((size_t)E->nr, sizeof(sunindextype), &failed);
   if (failed > 0.0) return oe_fail_memory(E, "an array of the IDA state", failed);
@@ -380,7 +391,7 @@ static int integrate(ida_problem *P, SUNContext sunctx, N_Vector yy, N_Vector yp
   int k_out = 1;
   double t_out = fmin((double)E->every * E->dt, E->t_end), t_last = 0.0;
   if ((st = observe(P, 0.0, N_VGetArrayPointer(yy), N_VGetArrayPointer(yp), 0)) != MARTELLO_OK) return st;
-  for (int i = 0; i < n; i++) E->v_last[i] = N_VGetArrayPointer(yy)[E->iv[i]];
+  oe_accepted(E, N_VGetArrayPointer(yy));
   double t_stop = oe_next_stop(E, 0.0, t_out);
   if ((st = check(P, IDASetStopTime(mem, t_stop), "IDASetStopTime"))) return st;
   const size_t n_found = (size_t)(oe_nroots(E) + 1);
@@ -422,6 +433,7 @@ static int integrate(ida_problem *P, SUNContext sunctx, N_Vector yy, N_Vector yp
       break;
     }
     E->nan_seen = 0;
+    oe_new_step(E, tret);
     if (++steps > MAX_STEPS) {
       st = fail(P, MARTELLO_ERR_NOT_CONVERGED, "IDA: more than %ld steps before t = %.9e s", MAX_STEPS, tret);
       break;
@@ -452,6 +464,7 @@ static int integrate(ida_problem *P, SUNContext sunctx, N_Vector yy, N_Vector yp
       int f0 = IDAGetDky(mem, t_r, 0, yy), f1 = IDAGetDky(mem, t_r, 1, yp);
       if ((st = check(P, f0 < 0 ? f0 : f1, "IDAGetDky"))) break;
     }
+    if ((st = oe_inner_events(E, t_last, t_r, N_VGetArrayPointer(yy))) != MARTELLO_OK) break;
     if ((st = oe_stretch(E, t_last, t_r, N_VGetArrayPointer(yy), restart)) != MARTELLO_OK) break;
     oe_keep_end_rates(E, !restart);
     t_last = t_r;
@@ -475,7 +488,7 @@ static int integrate(ida_problem *P, SUNContext sunctx, N_Vector yy, N_Vector yp
     if ((st = observe(P, t_r, N_VGetArrayPointer(yy), N_VGetArrayPointer(yp),
                       at_output ? k_out * E->every : -1)) != MARTELLO_OK)
       break;
-    for (int i = 0; i < n; i++) E->v_last[i] = N_VGetArrayPointer(yy)[E->iv[i]];   /* after a restart's jumps */
+    oe_accepted(E, N_VGetArrayPointer(yy));   /* after a restart's jumps */
     if (at_output) {
       if (t_out >= E->t_end) {
         t_last = E->t_end;

@@ -364,6 +364,14 @@ int oe_commit(ode_events *E, const double *u, const double *v) {
   int st = martello_eval_commit(E->ev, u, v);
   if (st == MARTELLO_OK && E->nsw > 0)
     st = martello_eval_switches(E->ev, E->sw_el, E->sw_al, E->sw_be, E->sw_ga);
+  /* the onset speeds located inside the step replace the commit's interpolated ones */
+  for (int k = 0; k < E->nvin && st == MARTELLO_OK; k++) {
+    int j = E->vin_j[k];
+    if (E->vin[j] > 0.0) st = martello_eval_set_onset_speed(E->ev, j, E->vin[j]);
+    E->vin[j] = 0.0;
+  }
+  E->nvin = 0;
+  E->nev = 0;
   return st;
 }
 
@@ -406,6 +414,9 @@ static int work_quadrature(ode_events *E, double t0, double t1) {
  * velocity changes sign against E->v_last gets the root of v located by bisection on the
  * interpolant (of the method's order: the error of the step) and u there (docs/run-layer.md,
  * located extrema). */
+static int taylor(ode_events *E);
+static double tay(const double *c, int n, int i, int q, double s, int deriv);
+
 static int node_extrema(ode_events *E, double t0, double t1, const double *y1) {
   for (int i = 0; i < E->n; i++) {
     const double v0 = E->v_last[i], v1 = y1[E->iv[i]];
@@ -415,14 +426,24 @@ static int node_extrema(ode_events *E, double t0, double t1, const double *y1) {
     else if (v0 < 0.0 && v1 >= 0.0) is_max = 0;
     else continue;
     double lo = t0, hi = t1, u = y1[E->iu[i]];
-    for (int it = 0; it < 200 && hi - lo > fmax(E->event_tol, 4.0 * DBL_EPSILON * fabs(hi)); it++) {
-      const double tm = 0.5 * (lo + hi);
-      if ((st = E->dky(E->ctx, tm, 0, E->ytmp)) != MARTELLO_OK) return st;
-      if ((N_VGetArrayPointer(E->ytmp)[E->iv[i]] > 0.0) == (v0 > 0.0)) lo = tm; else hi = tm;
-    }
-    if (hi < t1) {
-      if ((st = E->dky(E->ctx, hi, 0, E->ytmp)) != MARTELLO_OK) return st;
-      u = N_VGetArrayPointer(E->ytmp)[E->iu[i]];
+    if (E->degree) {
+      /* on the node's own Taylor coefficients: O(degree) an iteration, not O(n) */
+      if ((st = taylor(E)) != MARTELLO_OK) return st;
+      for (int it = 0; it < 200 && hi - lo > fmax(E->event_tol, 4.0 * DBL_EPSILON * fabs(hi)); it++) {
+        const double tm = 0.5 * (lo + hi);
+        if ((tay(E->tay_v, E->n, i, E->tay_q, tm - E->t_step, 0) > 0.0) == (v0 > 0.0)) lo = tm; else hi = tm;
+      }
+      if (hi < t1) u = tay(E->tay_u, E->n, i, E->tay_q, hi - E->t_step, 0);
+    } else {
+      for (int it = 0; it < 200 && hi - lo > fmax(E->event_tol, 4.0 * DBL_EPSILON * fabs(hi)); it++) {
+        const double tm = 0.5 * (lo + hi);
+        if ((st = E->dky(E->ctx, tm, 0, E->ytmp)) != MARTELLO_OK) return st;
+        if ((N_VGetArrayPointer(E->ytmp)[E->iv[i]] > 0.0) == (v0 > 0.0)) lo = tm; else hi = tm;
+      }
+      if (hi < t1) {
+        if ((st = E->dky(E->ctx, hi, 0, E->ytmp)) != MARTELLO_OK) return st;
+        u = N_VGetArrayPointer(E->ytmp)[E->iu[i]];
+      }
     }
     st = martello_observer_extremum(E->obs, i, hi, u, is_max);
     if (st != MARTELLO_OK) return oe_fail(E, st, "%s: martello_observer_extremum failed", E->name);
@@ -503,10 +524,35 @@ void oe_keep_end_rates(ode_events *E, int unchanged) {
   tmp = E->pa0; E->pa0 = E->pa1; E->pa1 = tmp;
 }
 
-double oe_next_stop(ode_events *E, double t, double t_out) {
+double oe_next_stop(ode_events *E, double t, double t_to) {
   double tb = DBL_MAX;
   if (martello_eval_next_breakpoint(E->ev, t, &tb) != MARTELLO_OK) tb = DBL_MAX;
-  return fmin(tb, t_out);
+  return fmin(tb, t_to);
+}
+
+double oe_output_time(const ode_events *E, int k) {
+  double t = fmin((double)(k * E->every) * E->dt, E->t_end);   /* t = k dt, as on GSL */
+  return E->t_end - t <= 1e-9 * E->out_dt ? E->t_end : t;
+}
+
+int oe_rows_inside(ode_events *E, double *t_last, double t1, int *k_out, double *t_out) {
+  int st;
+  while (*t_out < t1) {
+    const double t = *t_out;
+    if ((st = E->dky(E->ctx, t, 0, E->yrow)) != MARTELLO_OK) return st;
+    const double *y = N_VGetArrayPointer(E->yrow);
+    if ((st = oe_inner_events(E, *t_last, t, y)) != MARTELLO_OK) return st;
+    if ((st = oe_stretch(E, *t_last, t, y, 0)) != MARTELLO_OK) return st;
+    oe_keep_end_rates(E, 1);
+    oe_gather(E, y, E->u, E->v);
+    if ((st = oe_commit(E, E->u, E->v)) != MARTELLO_OK) return oe_fail(E, st, "%s: commit failed", E->name);
+    if ((st = oe_hand_work(E)) != MARTELLO_OK) return st;
+    if ((st = E->sample(E->ctx, t, y, *k_out * E->every)) != MARTELLO_OK) return st;
+    oe_accepted(E, y);
+    *t_last = t;
+    *t_out = oe_output_time(E, ++*k_out);
+  }
+  return MARTELLO_OK;
 }
 
 int oe_add_counts(ode_events *E, const long c[9]) {
@@ -532,6 +578,8 @@ int oe_roots(ode_events *E, double t, const double *u, const double *v, double *
     if (r >= 0 && E->closed[r]) {
       g[2 * j] = E->lr[r] + E->lamtol[r];
       g[2 * j + 1] = 1.0;
+    } else if (E->smooth && E->cont[j]) {
+      g[2 * j] = g[2 * j + 1] = 1.0;   /* located inside the steps, never a root */
     } else {
       g[2 * j] = oe_pen(E, j, u);
       g[2 * j + 1] = oe_rate(E, j, v);
@@ -644,7 +692,7 @@ int oe_boundary_events(ode_events *E, double t_last, double tret, const double *
   double wtol = 10.0 * (E->rtol * vmax + E->atol);
   for (int j = 0; j < E->nc; j++) {
     int r = E->rig[j], want = ACT_NONE, touching = martello_observer_in_phase(E->obs, j);
-    if (r >= 0 && E->closed[r]) continue;
+    if ((r >= 0 && E->closed[r]) || (E->smooth && E->cont[j])) continue;
     double d = oe_pen(E, j, E->u), w = oe_rate(E, j, E->v);
     /* on the surface within round-off of the gap, or of the time */
     double on = 64.0 * DBL_EPSILON *
@@ -779,6 +827,181 @@ int oe_restart_progress(ode_events *E, double t) {
   return MARTELLO_OK;
 }
 
+/* ---- events inside the steps (docs/sundials-ode.md, events inside the steps) -------------------------
+ * Where a law's force is continuous at its switches, the integrator steps across them and its
+ * error control takes the kink (a jump of a higher derivative); nothing stops or restarts. After
+ * each step the gap of every such contact is compared at the two ends of the stretch (O(1) a
+ * contact); where it changes sign, or its rate does with an extremum that may cross, the
+ * crossing is found on the interpolant of the step, restricted to the contact's two nodes: the
+ * Taylor coefficients of y at the stretch's end, read once a step (degree + 1 calls of the
+ * interpolant, O(n)), make each evaluation of one gap O(degree). An event thus costs O(1), not a
+ * restart of the whole state. */
+
+/* The Taylor coefficients y^(k)(t_step)/k! of every node's u and v at the end of the last step,
+ * k = 0 .. degree, once a step (the same polynomial for every stretch of the step). */
+static int taylor(ode_events *E) {
+  if (E->tay_ready) return MARTELLO_OK;
+  const double t1 = E->t_step;
+  int q = E->degree(E->ctx);
+  if (q > OE_QMAX) q = OE_QMAX;
+  if (q < 1) q = 1;
+  double fact = 1.0;
+  for (int k = 0; k <= q; k++) {
+    if (k > 0) fact *= (double)k;
+    int st = E->dky(E->ctx, t1, k, E->ytmp);
+    if (st != MARTELLO_OK) return st;
+    const double *y = N_VGetArrayPointer(E->ytmp);
+    double *cu = E->tay_u + (size_t)k * (size_t)E->n, *cv = E->tay_v + (size_t)k * (size_t)E->n;
+    for (int i = 0; i < E->n; i++) {
+      cu[i] = y[E->iu[i]] / fact;
+      cv[i] = y[E->iv[i]] / fact;
+    }
+  }
+  E->tay_q = q;
+  E->tay_ready = 1;
+  return MARTELLO_OK;
+}
+
+/* Node i's polynomial (coefficients c, stride n) at s = t - t1 (deriv 0) or its derivative. */
+static double tay(const double *c, int n, int i, int q, double s, int deriv) {
+  double p = 0.0;
+  if (deriv == 0) {
+    for (int k = q; k >= 0; k--) p = p * s + c[(size_t)k * (size_t)n + (size_t)i];
+  } else {
+    for (int k = q; k >= 1; k--) p = p * s + (double)k * c[(size_t)k * (size_t)n + (size_t)i];
+  }
+  return p;
+}
+
+/* Contact j's gap (what = 0) or its rate (1) at t on the interpolant (taylor ready). */
+static double gap_at(const ode_events *E, int j, double t, int what) {
+  const double s = t - E->t_step, *c = what == 0 ? E->tay_u : E->tay_v;
+  double x = 0.0;
+  for (int k = E->con.first[j]; k < E->con.first[j + 1]; k++)
+    x += E->con.coef[k] * tay(c, E->n, E->con.node[k], E->tay_q, s, 0);
+  return what == 0 ? x - E->gap[j] : x;
+}
+
+/* The time in [lo, hi] where contact j's gap (what = 0) or rate (1) changes sign, positive at
+ * the side `positive_hi` says, by bisection to event_tol: the first time on the far side. */
+static double crossing(const ode_events *E, int j, int what, double lo, double hi) {
+  const int lo_positive = gap_at(E, j, lo, what) > 0.0;
+  for (int it = 0; it < 200 && hi - lo > fmax(E->event_tol, 4.0 * DBL_EPSILON * fabs(hi)); it++) {
+    const double tm = 0.5 * (lo + hi);
+    if ((gap_at(E, j, tm, what) > 0.0) == lo_positive) lo = tm; else hi = tm;
+  }
+  return hi;
+}
+
+static void add_event(ode_events *E, double t, int j, int open) {
+  E->ev_t[E->nev] = t;
+  E->ev_j[E->nev] = j;
+  E->ev_k[E->nev++] = open;
+}
+
+static int by_time(const void *x, const void *y) {
+  const double *a = x, *b = y;
+  return (*a > *b) - (*a < *b);
+}
+
+int oe_inner_events(ode_events *E, double t0, double t1, const double *y1) {
+  int st;
+  E->nev = 0;
+  if (!E->smooth || !(t1 > t0)) return MARTELLO_OK;
+  oe_gather(E, y1, E->uq, E->vq);
+  for (int j = 0; j < E->nc; j++) {
+    if (!E->cont[j]) continue;
+    const double d0 = E->d_last[j], r0 = E->r_last[j];
+    const double d1 = oe_pen(E, j, E->uq), r1 = oe_rate(E, j, E->vq);
+    const int in0 = d0 > 0.0, in1 = d1 > 0.0;
+    /* an extremum inside that may cross: approaching then receding while open at both ends,
+     * or the reverse while in contact at both */
+    const int turn = in0 == in1 && (in0 ? (r0 < 0.0 && r1 >= 0.0) : (r0 > 0.0 && r1 <= 0.0));
+    if (in0 == in1 && !turn) continue;
+    if ((st = taylor(E)) != MARTELLO_OK) return st;
+    if (in0 != in1) {
+      add_event(E, crossing(E, j, 0, t0, t1), j, in1);
+      continue;
+    }
+    const double tx = crossing(E, j, 1, t0, t1), dx = gap_at(E, j, tx, 0);
+    if ((dx > 0.0) == in0) continue;          /* the extremum stays on its side */
+    add_event(E, crossing(E, j, 0, t0, tx), j, !in0);
+    if (!in0) add_event(E, tx, j, -1);        /* the peak penetration of the touch */
+    add_event(E, crossing(E, j, 0, tx, t1), j, in0);
+  }
+  /* in time order (an event's three fields sort together) */
+  if (E->nev > 1) {
+    double *rows = malloc(sizeof(double) * 3 * (size_t)E->nev);
+    if (!rows) return oe_fail_memory(E, "the events of a step", 3.0 * sizeof(double) * E->nev);
+    for (int k = 0; k < E->nev; k++) {
+      rows[3 * k] = E->ev_t[k];
+      rows[3 * k + 1] = E->ev_j[k];
+      rows[3 * k + 2] = E->ev_k[k];
+    }
+    qsort(rows, (size_t)E->nev, 3 * sizeof(double), by_time);
+    for (int k = 0; k < E->nev; k++) {
+      E->ev_t[k] = rows[3 * k];
+      E->ev_j[k] = (int)rows[3 * k + 1];
+      E->ev_k[k] = (int)rows[3 * k + 2];
+    }
+    free(rows);
+  }
+  for (int k = 0; k < E->nev; k++) {
+    const int j = E->ev_j[k], touching = martello_observer_in_phase(E->obs, j);
+    const double t = E->ev_t[k];
+    if (E->ev_k[k] < 0) {
+      if (touching && (st = martello_observer_peak(E->obs, MARTELLO_PEAK_PEN, j, gap_at(E, j, t, 0))) != MARTELLO_OK)
+        return oe_fail(E, st, "%s: martello_observer_peak failed", E->name);
+      continue;
+    }
+    if (E->ev_k[k] == touching) continue;     /* the observer has it already */
+    const double w = gap_at(E, j, t, 1);
+    if ((st = martello_observer_set_phase(E->obs, j, E->ev_k[k], t, w)) != MARTELLO_OK)
+      return oe_fail(E, st, "%s: martello_observer_set_phase failed", E->name);
+    if (E->vin[j] == 0.0) E->vin_j[E->nvin++] = j;     /* listed once until the commit */
+    /* for the commit (Hunt-Crossley's v_in); -1: listed, no onset */
+    E->vin[j] = E->ev_k[k] ? fmax(w, DBL_MIN) : -1.0;
+    E->events++;
+  }
+  return MARTELLO_OK;
+}
+
+void oe_new_step(ode_events *E, double t_step) {
+  E->t_step = t_step;
+  E->tay_ready = 0;
+}
+
+void oe_accepted(ode_events *E, const double *y) {
+  oe_gather(E, y, E->uq, E->vq);
+  memcpy(E->v_last, E->vq, sizeof(double) * (size_t)E->n);
+  if (!E->smooth) return;
+  for (int j = 0; j < E->nc; j++) {
+    E->d_last[j] = oe_pen(E, j, E->uq);
+    E->r_last[j] = oe_rate(E, j, E->vq);
+  }
+}
+
+int oe_use_smooth(ode_events *E) {
+  double failed = 0.0;
+  const size_t ucn = (size_t)E->nc;
+  E->cont = oe_take(ucn, sizeof(int), &failed);
+  E->d_last = oe_take(ucn, sizeof(double), &failed);
+  E->r_last = oe_take(ucn, sizeof(double), &failed);
+  E->vin = oe_take(ucn, sizeof(double), &failed);
+  E->vin_j = oe_take(ucn, sizeof(int), &failed);
+  E->ev_t = oe_take(3 * ucn, sizeof(double), &failed);
+  E->ev_j = oe_take(3 * ucn, sizeof(int), &failed);
+  E->ev_k = oe_take(3 * ucn, sizeof(int), &failed);
+  if (failed > 0.0) return oe_fail_memory(E, "the events inside the steps", failed);
+  int st = martello_eval_use_smooth_branches(E->ev, &E->nsw, E->cont);
+  if (st != MARTELLO_OK) return oe_fail(E, st, "%s: martello_eval_use_smooth_branches failed", E->name);
+  E->smooth = 1;
+  if (E->nsw > 0 &&
+      (st = martello_eval_switches(E->ev, E->sw_el, E->sw_al, E->sw_be, E->sw_ga)) != MARTELLO_OK)
+    return oe_fail(E, st, "%s: martello_eval_switches failed", E->name);
+  return MARTELLO_OK;
+}
+
 /* ---- set-up --------------------------------------------------------------------------------- */
 
 void oe_release(ode_events *E) {
@@ -788,7 +1011,8 @@ void oe_release(ode_events *E) {
                  E->fint, E->fext, E->force, E->lam, E->S, E->rhs, E->cols, E->dc, E->aset,
                  E->sw_el, E->sw_al, E->sw_be, E->sw_ga, E->sw_hit, E->lc, E->dlc, E->Wc, E->ar,
                  E->lr, E->lamtol, E->v_last, E->el0, E->el1, E->elc, E->pv0, E->pa0, E->pj0,
-                 E->pv1, E->pa1, E->pj1, E->ua, E->va, E->aa, E->jk};
+                 E->pv1, E->pa1, E->pj1, E->ua, E->va, E->aa, E->jk, E->cont, E->d_last,
+                 E->r_last, E->vin, E->vin_j, E->tay_u, E->tay_v, E->ev_t, E->ev_j, E->ev_k};
   for (size_t k = 0; k < sizeof all / sizeof all[0]; k++) free(all[k]);
   if (E->ev) martello_eval_free(&E->ev);
   martello_accumulation_free(&E->acc);
@@ -878,6 +1102,9 @@ int oe_setup(ode_events *E, martello_model *model, martello_run *run, const char
                          &E->pj1, &E->ua, &E->va, &E->aa, &E->jk};
   for (size_t k = 0; k < sizeof per_node / sizeof per_node[0]; k++)
     *per_node[k] = oe_take(un, sizeof(double), &failed);
+  /* the interpolant's Taylor coefficients (node extrema, events inside the steps) */
+  E->tay_u = oe_take((OE_QMAX + 1) * un, sizeof(double), &failed);
+  E->tay_v = oe_take((OE_QMAX + 1) * un, sizeof(double), &failed);
   if (failed > 0.0) return oe_fail_memory(E, what, failed);
   if (martello_accumulation_init(&E->acc, nc, E->t_end) != MARTELLO_OK) {
     snprintf(what, sizeof what, "the accumulation phases of the %s run", name);

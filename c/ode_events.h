@@ -26,6 +26,14 @@ enum { ACT_NONE, ACT_ONSET, ACT_SEPARATION, ACT_IMPACT, ACT_RELEASE };
 /* The integrator's interpolant of its last step: the k-th derivative of y at t into out.
  * MARTELLO_OK, or a status once the run has failed with the integrator's message. */
 typedef int (*ode_interpolant)(void *ctx, double t, int k, N_Vector out);
+/* The polynomial degree of that interpolant (the highest k it answers). */
+typedef int (*ode_degree)(void *ctx);
+/* The adapter's sample of the observer: the state y (its own layout) at t, an output row k of
+ * the grid (k dt) or -1 (docs/sundials-ode.md, output rows). */
+typedef int (*ode_sample)(void *ctx, double t, const double *y, int k);
+
+/* The highest degree of an interpolant the events inside a step read (CVODE's Adams: 12). */
+#define OE_QMAX 12
 
 typedef struct {
   martello_model *model;
@@ -33,7 +41,20 @@ typedef struct {
   martello_eval *ev;
   const char *name;           /* "IDA", "CVODE", "ARKODE": what the messages say */
   ode_interpolant dky;        /* the adapter's interpolant, called with ctx */
+  ode_degree degree;          /* its degree (the events inside a step; NULL: not smooth) */
   void *ctx;
+  /* events inside the steps (docs/sundials-ode.md, events inside the steps): smooth = 1 when the laws
+   * whose force is continuous at their switches are not held on branches; cont[j] = 1 for
+   * such a penalty contact, whose onsets and separations are located after each step on the
+   * interpolant, contact by contact (no root, no restart); d_last, r_last its gap and rate at
+   * the last accepted state; vin[j] > 0: the onset speed located in the stretch, for the
+   * commit, its contact listed in vin_j[0..nvin) until then; the interpolant's Taylor
+   * coefficients at the end t_step of the integrator's last step (tay_u, tay_v: k-th coefficient
+   * of node i at k n + i, degree tay_q, ready when tay_ready) */
+  int smooth, *cont, tay_ready, tay_q, nev, *vin_j, nvin;
+  double *d_last, *r_last, *vin, *tay_u, *tay_v, t_step;
+  double *ev_t;               /* the stretch's events: time, contact, kind (2 nc at most) */
+  int *ev_j, *ev_k;
   /* scene (martello_model_topology) */
   int n, nc, nr, ncoupling, nl;
   double *mass, *gap, *rest;
@@ -79,6 +100,10 @@ typedef struct {
   int start_rates;
   double *el0, *el1, *elc, *pv0, *pa0, *pj0, *pv1, *pa1, *pj1, *ua, *va, *aa, *jk;
   N_Vector ytmp, ytd;         /* the interpolant's outputs (the adapter creates them) */
+  /* output rows on the interpolant (docs/sundials-ode.md, output rows): the adapter's sample and
+   * the state of a row (created by an adapter that steps past its output times) */
+  ode_sample sample;
+  N_Vector yrow;
   /* settings */
   double rtol, atol, event_tol, t_end, h_max, out_dt, dt;
   int restarts;               /* 1: the integrator restarts at order 1 after an event (BDF;
@@ -162,6 +187,33 @@ int oe_prepare_restart(ode_events *E, double t, double *u, double *v);
  * time without progress. */
 int oe_restart_progress(ode_events *E, double t);
 
+/* ---- events inside the steps ---------------------------------------------------------------- */
+/* Hold on branches only the laws whose force jumps (martello_eval_use_smooth_branches): the
+ * continuous contacts lose their roots, their events are located by oe_inner_events. Call after
+ * oe_setup, before the first restart; the adapter sets E->degree. */
+int oe_use_smooth(ode_events *E);
+/* The onsets and separations of the continuous contacts inside [t0, t1] (y1: the state at t1),
+ * each located on the interpolant of the last step by a scalar search on its own gap (its
+ * Taylor coefficients at t1, O(degree) an evaluation), handed to the observer in time order;
+ * a contact that touches and leaves inside the stretch also gets its peak penetration. */
+int oe_inner_events(ode_events *E, double t0, double t1, const double *y1);
+/* An accepted state y (after the observer's sample): the node velocities and the gaps and
+ * rates the next stretch starts from. */
+void oe_accepted(ode_events *E, const double *y);
+/* The integrator has taken a step ending at t_step: its interpolant is new (call once a step,
+ * before its stretches). */
+void oe_new_step(ode_events *E, double t_step);
+
+/* ---- output rows on the interpolant (docs/sundials-ode.md, output rows) ------------------------ */
+/* The output time of grid row k (k every dt, t_end for the last row). */
+double oe_output_time(const ode_events *E, int k);
+/* The output rows at *t_out < t1 inside the last step, for an adapter whose integrator steps past
+ * them: each row's state on the interpolant (into E->yrow), the stretch [*t_last, row] (inner
+ * events, extrema, peaks, works), committed and sampled as if a step had ended there (no root
+ * lies before t1, so the branches are those of the step: a commit there and one at t1 leave
+ * what one at t1 leaves). Moves *t_last, *k_out and *t_out on. */
+int oe_rows_inside(ode_events *E, double *t_last, double t1, int *k_out, double *t_out);
+
 /* ---- what the observer is handed ---------------------------------------------------------- */
 /* Commit (u, v) in the evaluator and read the switches again (the branches may change). */
 int oe_commit(ode_events *E, const double *u, const double *v);
@@ -174,8 +226,8 @@ int oe_hand_work(ode_events *E);
 int oe_stretch(ode_events *E, double t0, double t1, const double *y1, int at_event);
 /* After a stretch: its end's rates are the next one's start unless the integrator restarts. */
 void oe_keep_end_rates(ode_events *E, int unchanged);
-/* The next stop after t: t_out, or a kink of the load before it. */
-double oe_next_stop(ode_events *E, double t, double t_out);
+/* The next stop after t: t_to (an output time or t_end), or a kink of the load before it. */
+double oe_next_stop(ode_events *E, double t, double t_to);
 /* The integrator's counters now (MARTELLO_COUNTER_* order; events and chatter ignored): their
  * increase since the last hand-over, and the events, to the run. */
 int oe_add_counts(ode_events *E, const long c[9]);

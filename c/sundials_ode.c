@@ -24,10 +24,14 @@
  * once, the accumulation rule of c/accumulation.c. At an event the state is made consistent,
  * committed on the new branches, and the integrator restarts there (CVodeReInit; ARKStepReset,
  * which keeps the last step as the first: a one-step method has no history to rebuild).
- * Output times and the kinks of the loads are stop times, so every history row is an
- * accepted, committed state. Steps are taken one at a time (CV_ONE_STEP, ARK_ONE_STEP); every
- * accepted state is a sample of the run's observer, with the works, the node extrema and the
- * located peaks of the step on the interpolant (c/ode_events.c). */
+ * The kinks of the loads and t_end are stop times (properties of the scene). CVODE steps past
+ * the output times of a scene without rigid contacts: a history row inside a step is its state
+ * on the step's interpolant (CVodeGetDky, of the method's order), so the steps, and every
+ * result, do not depend on the output interval (docs/sundials-ode.md, output rows). Otherwise
+ * (ARKODE, rigid contacts) the output times are stop times too, so its rows are accepted,
+ * committed states. Steps are taken one at a time
+ * (CV_ONE_STEP, ARK_ONE_STEP); every accepted state is a sample of the run's observer, with the
+ * works, the node extrema and the located peaks of the step on the interpolant (c/ode_events.c). */
 #include <float.h>
 #include <math.h>
 #include <stdio.h>
@@ -58,6 +62,7 @@ enum { KIND_BDF = 1, KIND_ADAMS = 2, KIND_ERK = 3, KIND_DIRK = 4, KIND_IMEX = 5 
 typedef struct {
   ode_events E;            /* contacts, events, the observer's hand-overs (c/ode_events.c) */
   int ark;                 /* 0: CVODE, 1: ARKODE */
+  int rows_inside;         /* 1: output rows on the interpolant, no stop at output times */
   int kind;                /* KIND_* */
   int erk_id, dirk_id;     /* ARKODE tables (ARKODE_*_NONE when absent) */
   const char *name;        /* "CVODE" or "ARKODE": what the messages say */
@@ -246,6 +251,18 @@ static int interpolant(void *ctx, double t, int k, N_Vector out) {
   return MARTELLO_OK;
 }
 
+/* The degree of the interpolant: the order CVODE used in its last step (its Nordsieck array's,
+ * which CVodeGetDky differentiates up to; the order of the next step is set only when it
+ * starts); ARKODE's Hermite interpolant of the highest degree it has (set at its creation),
+ * whose derivatives past its degree are 0. */
+static int degree(void *ctx) {
+  ode_problem *P = ctx;
+  int q = 1;
+  if (P->ark) return ARK_INTERP_MAX_DEGREE;
+  if (CVodeGetLastOrder(P->mem, &q) != CV_SUCCESS || q < 1) return 1;
+  return q;
+}
+
 /* ---- what the observer is handed ------------------------------------------------------------- */
 
 /* An accepted, committed state at t as a sample (a from the right-hand side there, with the
@@ -261,6 +278,11 @@ static int observe(ode_problem *P, double t, const double *y, int k) {
     E->force[j] = r >= 0 && E->closed[r] ? E->lr[r] : 0.0;
   }
   return martello_observer_sample(E->obs, E->ev, t, E->u, E->v, E->ar, E->force, k);
+}
+
+/* An output row on the interpolant (c/ode_events.c oe_rows_inside). */
+static int sample(void *ctx, double t, const double *y, int k) {
+  return observe(ctx, t, y, k);
 }
 
 /* The state at a restart made consistent (c/ode_events.c), into y. */
@@ -333,12 +355,22 @@ static int setup(ode_problem *P, martello_model *model, martello_run *run) {
   P->name = P->ark ? "ARKODE" : "CVODE";
   E->name = P->name;
   E->dky = interpolant;
+  E->sample = sample;
   E->ctx = P;
   if ((st = choose_method(P, s.method)) != MARTELLO_OK) return st;
   if ((st = oe_setup(E, model, run, P->name)) != MARTELLO_OK) return st;
   /* CVODE restarts its BDF or Adams history at order 1; ARKODE's one-step tables lose
    * nothing at a restart (the accumulation rule's resolution, docs/impulse.md §4) */
   E->restarts = !P->ark;
+  E->degree = degree;
+  /* CVODE steps past the output times; not with rigid contacts: a closed one holds its nodes
+   * still, so nothing bounds the steps but the stops, while its multiplier, driven by the loads,
+   * may change sign twice inside one step unseen (docs/sundials-ode.md, output rows) */
+  P->rows_inside = !P->ark && E->nr == 0;
+  /* CVODE steps across the laws whose force is continuous at their switches, their events
+   * located inside the steps; ARKODE restarts at them, which costs it less (docs/sundials-ode.md,
+   * events inside the steps) */
+  if (!P->ark && (st = oe_use_smooth(E)) != MARTELLO_OK) return st;
   P->N = 2 * (sunindextype)E->n;
   for (int i = 0; i < E->n; i++) {
     E->iu[i] = 2 * (sunindextype)i;
@@ -475,10 +507,12 @@ static int integrate(ode_problem *P, SUNContext ctx, N_Vector yy, SUNMatrix *Jp,
   if ((st = create(P, ctx, yy, Jp, LSp)) != MARTELLO_OK) return st;
 
   int k_out = 1;
-  double t_out = fmin((double)E->every * E->dt, E->t_end), t_last = 0.0;
+  double t_out = oe_output_time(E, k_out), t_last = 0.0;
   if ((st = observe(P, 0.0, y, 0)) != MARTELLO_OK) return st;
-  for (int i = 0; i < n; i++) E->v_last[i] = y[2 * i + 1];
-  double t_stop = oe_next_stop(E, 0.0, t_out);
+  oe_accepted(E, y);
+  /* where the integrator must stop: the next output time, or only t_end */
+#define T_TO (P->rows_inside ? E->t_end : t_out)
+  double t_stop = oe_next_stop(E, 0.0, T_TO);
   if ((st = check(P, be_stop(P, t_stop), "SetStopTime"))) return st;
   const size_t n_found = (size_t)(oe_nroots(E) + 1);
   int *found = calloc(n_found, sizeof(int));
@@ -487,8 +521,8 @@ static int integrate(ode_problem *P, SUNContext ctx, N_Vector yy, SUNMatrix *Jp,
   st = MARTELLO_OK;
   while (t_last < E->t_end) {
     double tret = t_last;
-    int flag = P->ark ? ARKStepEvolve(P->mem, t_out, yy, &tret, ARK_ONE_STEP)
-                      : CVode(P->mem, t_out, yy, &tret, CV_ONE_STEP);
+    int flag = P->ark ? ARKStepEvolve(P->mem, T_TO, yy, &tret, ARK_ONE_STEP)
+                      : CVode(P->mem, T_TO, yy, &tret, CV_ONE_STEP);
     if (flag < 0) {
       double tcur = t_last;
       if ((P->ark ? ARKStepGetCurrentTime(P->mem, &tcur) : CVodeGetCurrentTime(P->mem, &tcur)) < 0)
@@ -505,6 +539,7 @@ static int integrate(ode_problem *P, SUNContext ctx, N_Vector yy, SUNMatrix *Jp,
       break;
     }
     E->nan_seen = 0;
+    oe_new_step(E, tret);
     if (++steps > MAX_STEPS) {
       st = fail(P, MARTELLO_ERR_NOT_CONVERGED, "%s: more than %ld steps before t = %.9e s", P->name, MAX_STEPS, tret);
       break;
@@ -524,7 +559,7 @@ static int integrate(ode_problem *P, SUNContext ctx, N_Vector yy, SUNMatrix *Jp,
     }
     /* a kink of the load: restart across it */
     if (!again && flag == (P->ark ? ARK_TSTOP_RETURN : CV_TSTOP_RETURN) && tret == t_stop &&
-        t_stop < t_out)
+        t_stop < T_TO)
       again = 1;
     if (!again) {
       again = oe_boundary_events(E, t_last, tret, y, be_last_step(P), &t_r);
@@ -534,6 +569,8 @@ static int integrate(ode_problem *P, SUNContext ctx, N_Vector yy, SUNMatrix *Jp,
       }
     }
     if (again && t_r < tret && (st = interpolant(P, t_r, 0, yy)) != MARTELLO_OK) break;
+    if (P->rows_inside && (st = oe_rows_inside(E, &t_last, t_r, &k_out, &t_out)) != MARTELLO_OK) break;
+    if ((st = oe_inner_events(E, t_last, t_r, y)) != MARTELLO_OK) break;
     if ((st = oe_stretch(E, t_last, t_r, y, again)) != MARTELLO_OK) break;
     oe_keep_end_rates(E, !again);
     t_last = t_r;
@@ -552,15 +589,13 @@ static int integrate(ode_problem *P, SUNContext ctx, N_Vector yy, SUNMatrix *Jp,
     }
     int at_output = t_r == t_out || (again && t_out - t_r <= 16.0 * DBL_EPSILON * t_out);
     if ((st = observe(P, t_r, y, at_output ? k_out * E->every : -1)) != MARTELLO_OK) break;
-    for (int i = 0; i < n; i++) E->v_last[i] = y[2 * i + 1];
+    oe_accepted(E, y);
     if (at_output) {
       if (t_out >= E->t_end) {
         t_last = E->t_end;
         break;
       }
-      k_out++;
-      t_out = fmin((double)(k_out * E->every) * E->dt, E->t_end);
-      if (E->t_end - t_out <= 1e-9 * E->out_dt) t_out = E->t_end;
+      t_out = oe_output_time(E, ++k_out);
     }
     /* ARKODE 6.4.1 with an implicit table does not continue correctly from a stop time: on
      * a free oscillator (docs/sundials-ode.md) 30 output stops left u off by 1e-7 .. 2e-5
@@ -572,10 +607,11 @@ static int integrate(ode_problem *P, SUNContext ctx, N_Vector yy, SUNMatrix *Jp,
     if (arkode_stop && (st = flush_counts(P)) != MARTELLO_OK) break;
     if ((again || arkode_stop) && (st = restart(P, t_r, yy)) != MARTELLO_OK) break;
     if (again || at_output || tret >= t_stop) {
-      t_stop = oe_next_stop(E, t_r, t_out);
+      t_stop = oe_next_stop(E, t_r, T_TO);
       if ((st = check(P, be_stop(P, t_stop), "SetStopTime"))) break;
     }
   }
+#undef T_TO
   free(found);
   int st2 = flush_counts(P);
   if (st == MARTELLO_OK) st = st2;
@@ -604,7 +640,8 @@ int martello_ode_run(martello_model *model, martello_run *run) {
     yy = N_VNew_Serial(P->N, ctx);
     E->ytmp = N_VNew_Serial(P->N, ctx);
     E->ytd = N_VNew_Serial(P->N, ctx);
-    if (!yy || !E->ytmp || !E->ytd) st = oe_fail_memory(E, "the ODE state vectors", -1.0);
+    E->yrow = N_VNew_Serial(P->N, ctx);
+    if (!yy || !E->ytmp || !E->ytd || !E->yrow) st = oe_fail_memory(E, "the ODE state vectors", -1.0);
   }
   if (st == MARTELLO_OK) st = integrate(P, ctx, yy, &J, &LS);
   if (P->mem) {
@@ -615,6 +652,7 @@ int martello_ode_run(martello_model *model, martello_run *run) {
   if (yy) N_VDestroy(yy);
   if (E->ytmp) N_VDestroy(E->ytmp);
   if (E->ytd) N_VDestroy(E->ytd);
+  if (E->yrow) N_VDestroy(E->yrow);
   if (ctx) SUNContext_Free(&ctx);
   release(P);
   return st;

@@ -7,7 +7,7 @@ module martello_api_internal
    use martello_status
    use martello_model
    use martello_evaluator
-   use martello_switching, only: switch_count
+   use martello_switching, only: switch_count, force_continuous
    use martello_contact_laws, only: P_RESTITUTION
    use martello_element_rows, only: row_dot, rows_terms
    use martello_integrator_settings, only: integrator_settings_t
@@ -230,6 +230,43 @@ contains
       nsw = switch_count(ep%m)
       c_eval_use_branches = MARTELLO_OK
    end function c_eval_use_branches
+
+   !> Adaptive integrators that step across continuous kinks (docs/sundials-ode.md, events
+   !> inside the steps): only the laws whose force jumps at a switch are held on branches; continuous(j) = 1
+   !> for each penalty contact left whole (its onsets and separations are the caller's to
+   !> locate), 0 for the others.
+   integer(c_int) function c_eval_use_smooth_branches(handle, nsw, continuous) &
+      bind(C, name='martello_eval_use_smooth_branches')
+      type(c_ptr), value :: handle
+      integer(c_int), intent(out) :: nsw
+      integer(c_int), intent(out) :: continuous(*)
+      type(evaluator_t), pointer :: ep
+      integer :: j
+      ep => get_eval(handle)
+      nsw = 0
+      c_eval_use_smooth_branches = MARTELLO_ERR_ARGUMENT
+      if (.not. associated(ep)) return
+      call evaluator_use_branches(ep, smooth=.true.)
+      nsw = switch_count(ep%m)
+      do j = 1, ep%m%ncontact
+         continuous(j) = merge(1, 0, ep%ms%is_penalty(j) .and. force_continuous(ep%m, j))
+      end do
+      c_eval_use_smooth_branches = MARTELLO_OK
+   end function c_eval_use_smooth_branches
+
+   integer(c_int) function c_eval_set_onset_speed(handle, contact, v) &
+      bind(C, name='martello_eval_set_onset_speed')
+      type(c_ptr), value :: handle
+      integer(c_int), value :: contact
+      real(c_double), value :: v
+      type(evaluator_t), pointer :: ep
+      ep => get_eval(handle)
+      c_eval_set_onset_speed = MARTELLO_ERR_ARGUMENT
+      if (.not. associated(ep)) return
+      if (contact < 0 .or. contact >= ep%m%ncontact) return
+      call evaluator_set_onset_speed(ep, int(contact) + 1, v)
+      c_eval_set_onset_speed = MARTELLO_OK
+   end function c_eval_set_onset_speed
 
    integer(c_int) function c_eval_switches(handle, el, alpha, beta, gamma) &
       bind(C, name='martello_eval_switches')

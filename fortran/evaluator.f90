@@ -15,6 +15,7 @@ module martello_evaluator
    public :: evaluator_t, evaluator_init, evaluator_load, evaluator_acceleration, &
       evaluator_forces, evaluator_solve_mass, evaluator_commit, &
       evaluator_energy, evaluator_power, evaluator_use_branches, evaluator_switches, &
+      evaluator_set_onset_speed, &
       evaluator_next_breakpoint, evaluator_rates, evaluator_tangent
 
    type :: evaluator_t
@@ -25,6 +26,8 @@ module martello_evaluator
       integer, allocatable :: fixed_nodes(:)
       !> laws held on smooth branches between located switches (martello_switching)
       logical :: branches = .false.
+      !> ... except those whose force is continuous at their switches (switching_choose)
+      logical :: smooth = .false.
    end type evaluator_t
 
 contains
@@ -116,16 +119,29 @@ contains
       call evaluator_load(ev, u, v)
       call internal_forces(ev%m, ev%ms, ev%u, ev%v, ev%f)
       call mech_commit(ev%m, ev%ms, ev%u)
-      if (ev%branches) call switching_choose(ev%m, ev%ms, ev%u, ev%v)
+      if (ev%branches) call switching_choose(ev%m, ev%ms, ev%u, ev%v, ev%smooth)
    end subroutine evaluator_commit
 
    !> From now on the laws are held on smooth branches, chosen at the committed state and
    !> changed at commits past their switches (docs/event-driven.md, switching surfaces).
-   subroutine evaluator_use_branches(ev)
+   !> smooth: only the laws whose force jumps at a switch are held (switching_choose).
+   subroutine evaluator_use_branches(ev, smooth)
       type(evaluator_t), intent(inout) :: ev
+      logical, intent(in), optional :: smooth
       ev%branches = .true.
-      call switching_choose(ev%m, ev%ms, ev%u, ev%v)
+      if (present(smooth)) ev%smooth = smooth
+      call switching_choose(ev%m, ev%ms, ev%u, ev%v, ev%smooth)
    end subroutine evaluator_use_branches
+
+   !> The approach speed at the located onset of penalty contact j's phase (the Hunt-Crossley
+   !> family's v_in, chi = a/v_in), for a contact committed in contact: an integrator that
+   !> steps across the onset knows it only after the step, on its interpolant.
+   subroutine evaluator_set_onset_speed(ev, j, v)
+      type(evaluator_t), intent(inout) :: ev
+      integer, intent(in) :: j
+      real(dp), intent(in) :: v
+      if (ev%ms%con_on(j)) ev%ms%con_vin(j) = max(v, ONSET_SPEED_FLOOR)
+   end subroutine evaluator_set_onset_speed
 
    !> The switches of the branches held (martello_switching): switch_count slots.
    subroutine evaluator_switches(ev, el, alpha, beta, gamma)

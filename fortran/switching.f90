@@ -18,10 +18,11 @@ module martello_switching
    use martello_links, only: LINK_BILINEAR, LINK_FLUID_DAMPER, L_STIFF, L_DAMP, L_YIELD, &
       L_HARDENING, L_ALPHA, L_VREG, BRANCH_FREE, BRANCH_ELASTIC, BRANCH_UPPER, BRANCH_LOWER, &
       BRANCH_LINEAR, BRANCH_POWER_POS, BRANCH_POWER_NEG
-   use martello_contact_laws, only: LAW_KELVIN, P_STIFF, P_DAMPING, P_CLIP
+   use martello_contact_laws, only: LAW_KELVIN, LAW_LINEAR, LAW_HERTZ, LAW_HUNT_CROSSLEY, &
+      LAW_LANKARANI_NIKRAVESH, LAW_FLORES, LAW_GONTHIER, LAW_HERTZDAMP, P_STIFF, P_DAMPING, P_CLIP
    implicit none
    private
-   public :: switch_count, switching_choose, switching_functions
+   public :: switch_count, switching_choose, switching_functions, force_continuous
 
 contains
 
@@ -34,15 +35,22 @@ contains
    !> After a commit at the state (u, v) (0:n, 0 = ground): every branch whose switch is past
    !> (g > 0) moves to the next branch (a bilinear one only while loading outward);
    !> CONTACT_FREE and BRANCH_FREE are chosen from the state. A bilinear force left outside its band by the located crossing (by at most
-   !> k |dv| event_tol) is put back on the band's edge.
-   subroutine switching_choose(m, s, u, v)
+   !> k |dv| event_tol) is put back on the band's edge. smooth: the laws whose force is
+   !> continuous at their switches (force_continuous contacts) are not held:
+   !> they stay the whole law, whose kinks the integrator's error control takes
+   !> (docs/sundials-ode.md, events inside the steps).
+   subroutine switching_choose(m, s, u, v, smooth)
       type(model_t), intent(in) :: m
       type(mech_state_t), intent(inout) :: s
       real(dp), intent(in) :: u(0:), v(0:)
+      logical, intent(in), optional :: smooth
+      logical :: free_continuous
       integer :: j
       real(dp) :: du, dv, k, rho, r, back, fp, pen, g(2)
       integer :: el(2)
       real(dp) :: al(2), be(2), ga(2)
+      free_continuous = .false.
+      if (present(smooth)) free_continuous = smooth
       do j = 1, m%nlink
          du = row_dot(m%lnk, j, u); dv = row_dot(m%lnk, j, v)
          select case (m%link_kind(j))
@@ -85,6 +93,10 @@ contains
       end do
       do j = 1, m%ncontact
          if (.not. s%is_penalty(j)) cycle
+         if (free_continuous .and. force_continuous(m, j)) then
+            s%con_branch(j) = CONTACT_FREE
+            cycle
+         end if
          pen = row_dot(m%con, j, u) - m%con_gap(j)
          dv = row_dot(m%con, j, v)
          if (.not. (pen > 0.0_dp)) then
@@ -162,6 +174,23 @@ contains
          beta(1) = 1.0_dp; gamma(1) = m%link_par(L_VREG, j)
       end select
    end subroutine link_switch
+
+   !> Whether penalty contact j's force is continuous where it starts and ends (F = 0 at
+   !> delta = 0 both ways, and no other jump): linear, Hertz and the Hunt-Crossley family (whose
+   !> damping factor 1 + chi delta' is clipped at 0). Kelvin jumps by c delta' at its onset (and,
+   !> unclipped, at its separation); Jankowski's damping grows as delta^(1/4), a force continuous
+   !> at the onset but with an unbounded rate that no error control takes in one step.
+   pure logical function force_continuous(m, j)
+      type(model_t), intent(in) :: m
+      integer, intent(in) :: j
+      select case (m%con_law(j))
+      case (LAW_LINEAR, LAW_HERTZ, LAW_HUNT_CROSSLEY, LAW_LANKARANI_NIKRAVESH, LAW_FLORES, &
+            LAW_GONTHIER, LAW_HERTZDAMP)
+         force_continuous = .true.
+      case default
+         force_continuous = .false.
+      end select
+   end function force_continuous
 
    pure logical function kelvin_clipped(m, j)
       type(model_t), intent(in) :: m

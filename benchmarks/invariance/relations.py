@@ -4,7 +4,8 @@ recorded (output invariance), nor on how the scene is written down (metamorphic 
 Output invariance. A scene run again with another `output.every`, another output interval
 (the adaptive integrators), other recorded nodes, contacts and links, other tracking, or no
 history at all, must give every summary number again. A fixed-step run is the same sequence
-of steps whatever is recorded: bit for bit. An adaptive run also stops at every output time,
+of steps whatever is recorded: bit for bit. An adaptive run also stops at every output time
+(but CVODE without rigid contacts, whose rows lie on its interpolant, docs/sundials-ode.md),
 and a stop changes the step sequence after it, so two runs differ by the errors of two step
 sequences, each within the run's own tolerance: the tolerance of a number is ADAPTIVE_FACTOR
 times how much it moves when the run's rtol and atol are made 10 times looser (`own_error`,
