@@ -268,6 +268,13 @@ int martello_run_set_phase_lists(martello_run *run, int max_contacts);
 enum { MARTELLO_TRACK_NODE_PEAKS = 1, MARTELLO_TRACK_LINK_PEAKS = 2,
        MARTELLO_TRACK_CONTACT_PEAKS = 4, MARTELLO_TRACK_PHASES = 8, MARTELLO_TRACK_ALL = 15 };
 int martello_run_set_tracking(martello_run *run, int what);
+/* Linear functionals q = R.u of the state tracked at every accepted sample, whatever the
+ * history records (docs/results.md, "Frames and buildings"): n rows of R in compressed rows
+ * (ptr[n+1] with ptr[0] = 0, col[ptr[n]] the 0-based nodes, val the coefficients), and np
+ * pairs of rows (pairs[2 np], 0-based) whose resultant sqrt(q_a^2 + q_b^2) is tracked.
+ * Their extremes: martello_run_functionals. n = 0 (the default): none. */
+int martello_run_set_functionals(martello_run *run, int n, const int *ptr, const int *col,
+                                 const double *val, int np, const int *pairs);
 /* ---- closed forms of catalogue problems (docs/c-api.md "Closed forms") ------------------
  * The closed form `name` at the n_par parameters par: out (4 values) receives its *n_out
  * values. MARTELLO_ERR_ARGUMENT for an unknown name, a wrong parameter count or parameters
@@ -313,6 +320,11 @@ int martello_run_energy(const martello_run *run, double energy[MARTELLO_NENERGY]
 /* Per link: max |force| and max |elongation| over the run (NaN if the integrator does not
  * report link states, or the run does not track them). NULL: not written. */
 int martello_run_link_peaks(const martello_run *run, double *force_absmax, double *elongation_absmax);
+/* Per functional (martello_run_set_functionals): its largest and smallest value and their
+ * times, at the samples and inside the stretches between them (the cubic Hermite of (q, R.v));
+ * per pair the largest resultant at the samples and its time. Times -1: no sample. */
+int martello_run_functionals(const martello_run *run, double *q_max, double *t_max, double *q_min,
+                             double *t_min, double *res_max, double *t_res);
 
 #ifdef __cplusplus
 }

@@ -177,4 +177,24 @@ contains
       end associate
       c_run_link_peaks = MARTELLO_OK
    end function c_run_link_peaks
+
+   !> Per tracked functional (martello_run_set_functionals): the largest and smallest value
+   !> and their times (times −1: no sample); per pair the largest resultant and its time.
+   integer(c_int) function c_run_functionals(handle, qmax, tmax, qmin, tmin, resmax, tres) &
+      bind(C, name='martello_run_functionals')
+      type(c_ptr), value :: handle
+      real(c_double), intent(out) :: qmax(*), tmax(*), qmin(*), tmin(*), resmax(*), tres(*)
+      type(run_t), pointer :: rp
+      integer :: n, np
+      rp => get_run(handle)
+      c_run_functionals = MARTELLO_ERR_ARGUMENT
+      if (.not. associated(rp)) return
+      associate (f => rp%results%fq)
+         if (.not. allocated(f%q_max)) return
+         n = f%n; np = size(f%res_max)
+         qmax(1:n) = f%q_max; tmax(1:n) = f%t_max; qmin(1:n) = f%q_min; tmin(1:n) = f%t_min
+         resmax(1:np) = f%res_max; tres(1:np) = f%t_res
+      end associate
+      c_run_functionals = MARTELLO_OK
+   end function c_run_functionals
 end module martello_api_results

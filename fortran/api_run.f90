@@ -88,6 +88,37 @@ contains
       c_run_set_link_outputs = MARTELLO_OK
    end function c_run_set_link_outputs
 
+   !> Linear functionals q = R·u of the state the run tracks at every accepted sample
+   !> (docs/results.md, "Frames and buildings"): n rows of R in compressed rows (ptr[n+1],
+   !> col[ptr[n]] nodes, val; 0-based) and np pairs of rows (pairs[2 np]) whose resultant
+   !> √(q_a² + q_b²) is tracked; n = 0: none.
+   integer(c_int) function c_run_set_functionals(handle, n, ptr, col, val, np, pairs) &
+      bind(C, name='martello_run_set_functionals')
+      type(c_ptr), value :: handle
+      integer(c_int), value :: n, np
+      integer(c_int), intent(in) :: ptr(*), col(*), pairs(*)
+      real(c_double), intent(in) :: val(*)
+      type(run_t), pointer :: rp
+      integer :: nnz
+      rp => get_run(handle)
+      c_run_set_functionals = MARTELLO_ERR_ARGUMENT
+      if (.not. associated(rp) .or. n < 0 .or. np < 0) return
+      nnz = 0
+      if (n > 0) nnz = ptr(n + 1)
+      if (n > 0) then
+         if (ptr(1) /= 0 .or. any(ptr(2:n + 1) < ptr(1:n))) return
+      end if
+      if (np > 0) then
+         if (any(pairs(1:2*np) < 0 .or. pairs(1:2*np) >= n)) return
+      end if
+      rp%fq%n = int(n)
+      rp%fq%ptr = ptr(1:n + 1) + 1
+      rp%fq%col = col(1:nnz) + 1
+      rp%fq%val = val(1:nnz)
+      rp%fq%pair = reshape(pairs(1:2*np) + 1, [2, int(np)])
+      c_run_set_functionals = MARTELLO_OK
+   end function c_run_set_functionals
+
    !> Every contact's phases are listed while the model has at most max_contacts contacts
    !> (< 0: always); past it the output contacts' (martello_run_set_outputs), and the
    !> others keep their first and last phase (docs/results.md).

@@ -9,7 +9,8 @@ module martello_run
    use martello_integrator_settings
    use martello_effective_mass, only: effective_mass_prepare
    use martello_run_checks, only: check_schemes
-   use martello_observer, only: observer_t, observer_init, observer_phase_lists, observer_close
+   use martello_observer, only: observer_t, observer_init, observer_phase_lists, observer_close, &
+      functionals_t, functionals_start
    use martello_registry, only: TRACK_ALL
    use martello_fixed_step, only: run_fixed_step, stepper_t
    use martello_generalized_alpha, only: generalized_alpha_t
@@ -52,6 +53,8 @@ module martello_run
       integer :: phase_lists = PHASE_LISTS
       !> what the run tracks (TRACK_* bits; martello_run_set_tracking)
       integer :: tracking = TRACK_ALL
+      !> the linear functionals of the state the run tracks (martello_run_set_functionals)
+      type(functionals_t) :: fq
       logical :: configured = .false., done = .false.
       !> the caller's progress callback and its argument (martello_run_set_progress)
       type(c_funptr) :: progress = c_null_funptr
@@ -95,6 +98,19 @@ contains
                          rp%out_contacts, cap, nl, rp%out_links, stat, rp%tracking)
       rp%results%progress = rp%progress; rp%results%progress_user = rp%progress_user
       if (stat == MARTELLO_OK) call observer_phase_lists(rp%results, rp%phase_lists, stat)
+      if (stat == MARTELLO_OK .and. rp%fq%n > 0) then
+         if (any(rp%fq%col < 1 .or. rp%fq%col > mp%n)) then
+            rp%results%message = 'dynamic_run: a functional''s node is out of range'
+            stat = MARTELLO_ERR_ARGUMENT
+         else
+            rp%results%fq = rp%fq
+            call functionals_start(rp%results%fq, stat)
+            if (stat /= 0) then
+               rp%results%message = 'dynamic_run: no memory for the tracked functionals'
+               stat = MARTELLO_ERR_MEMORY
+            end if
+         end if
+      end if
       ! the chains held per node stay so for the fused chain step, which takes them whole;
       ! every other method takes their links and contacts one by one, from a copy
       m => mp

@@ -384,6 +384,9 @@ def _dynamic(scene, model, raise_on_failure=True):
         # nothing for the rest
         tracked = an["output"]["track"]
         r.set_tracking(*tracked)
+        structures = _structure_functionals(scene)
+        if structures.rows:
+            r.set_functionals(structures.matrix(), structures.nodes, structures.pairs)
         t0 = time.perf_counter()
         st = r.execute(model) if raise_on_failure else r.status_of(model)
         if st == native.constant("MARTELLO_ERR_INTERRUPTED"):
@@ -399,6 +402,8 @@ def _dynamic(scene, model, raise_on_failure=True):
         link_f, link_du = r.link_peaks(len(scene.links)) if "link_peaks" in tracked else (None, None)
         counters = r.counters()
         message = r.message()
+        if structures.rows:
+            structures.read(r)
 
     columns = native.history_columns(an["output"]["nodes"], an["output"]["contacts"],
                                      an["output"]["links"])
@@ -472,13 +477,13 @@ def _dynamic(scene, model, raise_on_failure=True):
                         "the step is too large for this scene (the result is inaccurate)")
     frames = {}
     for fr in scene.extras.get("frames", []):
-        frames[fr["prefix"]], extra_cols = frame_results(fr, columns, hist)
+        frames[fr["prefix"]], extra_cols = frame_results(fr, columns, hist, structures.of(fr["prefix"]))
         if fr["histories"] and len(hist):
             columns = columns + list(extra_cols)
             hist = np.hstack([hist, np.column_stack(list(extra_cols.values()))])
     buildings = {}
     for b in scene.extras.get("buildings", []):
-        buildings[b["prefix"]], extra_cols = building_results(b, columns, hist)
+        buildings[b["prefix"]], extra_cols = building_results(b, columns, hist, structures.of(b["prefix"]))
         if b["histories"] and len(hist):
             columns = columns + list(extra_cols)
             hist = np.hstack([hist, np.column_stack(list(extra_cols.values()))])
@@ -586,45 +591,94 @@ def _codes(table, key, categories):
     return np.concatenate(parts) if parts else np.zeros(0, np.int8)
 
 
-def frame_results(fr, columns, hist):
-    """A frame's peaks from the recorded lateral displacements (the recovery operators of
-    martello.frame2d, applied to every recorded sample: peaks are over the samples, exact at
-    output.every = 1): signed extremes of every member's end moments and shears with their
-    times, of every storey's drifts and shear. Also the member histories, by column name."""
-    col = {name: i for i, name in enumerate(columns)}
-    t = hist[:, col["t"]] if len(hist) else np.zeros(0)
-    U = hist[:, [col[f"u:{n}"] for n in fr["nodes"]]] if len(hist) else np.zeros((0, len(fr["nodes"])))
-    F = U @ fr["recovery"].T                       # samples x 6·members
-    frame = fr["frame"]
+class _Functionals:
+    """The linear functionals of the state a run's frames and buildings track at every
+    accepted sample (martello_run_set_functionals; docs/results.md, "Frames and buildings"):
+    per structure (by prefix) its operator blocks stacked into rows over its nodes, and the
+    pairs of rows whose resultant is tracked (a building's M2, M3 at each member end)."""
 
-    def extremes(x):
-        if not len(x):
-            return {"max": None, "min": None, "t_max": None, "t_min": None}
-        i, j = int(np.argmax(x)), int(np.argmin(x))
-        return {"max": float(x[i]), "min": float(x[j]), "t_max": float(t[i]), "t_min": float(t[j])}
+    def __init__(self):
+        self.blocks, self.nodes, self.pairs, self.rows = [], [], [], 0
+        self.at = {}
+
+    def add(self, prefix, nodes, operators, pairs=()):
+        """The structure's operators (dense, rows x len(nodes)) stacked; pairs: rows of the
+        stack (0-based in it)."""
+        R = np.vstack(operators) if operators else np.zeros((0, len(nodes)))
+        self.blocks.append((R, len(self.nodes)))
+        self.at[prefix] = (self.rows, self.rows + R.shape[0], len(self.pairs), len(self.pairs) + len(pairs))
+        self.pairs += [(self.rows + i, self.rows + j) for i, j in pairs]
+        self.nodes += list(nodes)
+        self.rows += R.shape[0]
+
+    def matrix(self):
+        """The stacked rows over all the structures' nodes (block diagonal)."""
+        M = np.zeros((self.rows, len(self.nodes)))
+        r = 0
+        for R, c in self.blocks:
+            M[r:r + R.shape[0], c:c + R.shape[1]] = R
+            r += R.shape[0]
+        return M
+
+    def read(self, run):
+        self.values = run.functionals(self.rows, len(self.pairs))
+
+    def of(self, prefix):
+        """(q_max, t_max, q_min, t_min, res_max, t_res) of one structure's rows and pairs."""
+        r0, r1, p0, p1 = self.at[prefix]
+        return [x[r0:r1] for x in self.values[:4]] + [x[p0:p1] for x in self.values[4:]]
+
+
+def _structure_functionals(scene):
+    """The functionals of every frame and building of the scene (their rows in the order
+    frame_results and building_results read them)."""
+    fq = _Functionals()
+    for fr in scene.extras.get("frames", []):
+        fq.add(fr["prefix"], [scene.index[n] for n in fr["nodes"]],
+               [fr["recovery"], fr["drift"], fr["shear"]])
+    for b in scene.extras.get("buildings", []):
+        bd = b["building"]
+        ops = [b["recovery"], b["storey"]] + [bd.point_operator(p["floor"], p["x"], p["y"])
+                                             for p in b["points"]]
+        pairs = [(12 * e + off + 4, 12 * e + off + 5) for e in range(len(bd.elements)) for off in (0, 6)]
+        fq.add(b["prefix"], [scene.index[n] for n in b["nodes"]], ops, pairs)
+    return fq
+
+
+def _tracked_extremes(values, row):
+    """Signed extremes of tracked row `row` and their times (None without a sample)."""
+    q_max, t_max, q_min, t_min = (x[row] for x in values[:4])
+    if not t_max >= 0:
+        return {"max": None, "min": None, "t_max": None, "t_min": None}
+    return {"max": float(q_max), "min": float(q_min), "t_max": float(t_max), "t_min": float(t_min)}
+
+
+def frame_results(fr, columns, hist, tracked):
+    """A frame's peaks: signed extremes of every member's end moments and shears with their
+    times, of every storey's drifts and shear — linear functionals of the state the run
+    tracked at every accepted sample and inside the steps whatever it records (tracked:
+    _Functionals.of; docs/results.md, "Frames and buildings"). Also the member histories, by
+    column name (martello.frame2d's recovery operators on the recorded samples)."""
+    col = {name: i for i, name in enumerate(columns)}
+    U = hist[:, [col[f"u:{n}"] for n in fr["nodes"]]] if len(hist) else np.zeros((0, len(fr["nodes"])))
+    frame = fr["frame"]
+    n_rec = fr["recovery"].shape[0]
     members, series = {}, {}
     for e, m in enumerate(frame.members):
         members[m.name] = {"kind": m.kind}
         for k, q in enumerate(("N_i", "V_i", "M_i", "N_j", "V_j", "M_j")):
             if q.startswith("N") and m.kind == "beam" and frame.mass_model == "diaphragm":
                 continue          # a rigid diaphragm's beams have no axial deformation
-            members[m.name][q] = extremes(F[:, 6 * e + k])
+            members[m.name][q] = _tracked_extremes(tracked, 6 * e + k)
             if q in ("M_i", "M_j", "V_i"):
-                series[f"{q}:{fr['prefix']}.{m.name}"] = F[:, 6 * e + k]
-    drift, shear = U @ fr["drift"].T, U @ fr["shear"].T
+                series[f"{q}:{fr['prefix']}.{m.name}"] = U @ fr["recovery"][6 * e + k]
     nl = frame.bays + 1
-    storeys = {str(s + 1): {"drift": {str(i): extremes(drift[:, s * nl + i]) for i in range(nl)},
-                            "shear": extremes(shear[:, s])} for s in range(frame.storeys)}
+    n_drift = fr["drift"].shape[0]
+    storeys = {str(s + 1): {"drift": {str(i): _tracked_extremes(tracked, n_rec + s * nl + i) for i in range(nl)},
+                            "shear": _tracked_extremes(tracked, n_rec + n_drift + s)}
+               for s in range(frame.storeys)}
     return {"members": members, "storeys": storeys,
             "rayleigh": {"a0": fr["rayleigh"][0], "a1": fr["rayleigh"][1], "zeta": fr["zeta"]}}, series
-
-
-def _extremes(x, t):
-    """Signed extremes of a sampled series and their times (None without samples)."""
-    if not len(x):
-        return {"max": None, "min": None, "t_max": None, "t_min": None}
-    i, j = int(np.argmax(x)), int(np.argmin(x))
-    return {"max": float(x[i]), "min": float(x[j]), "t_max": float(t[i]), "t_min": float(t[j])}
 
 
 def building_description(b):
@@ -635,43 +689,44 @@ def building_description(b):
             "ground_angle": b["ground_angle"]}
 
 
-def building_results(b, columns, hist):
-    """A building's peaks from the recorded floor DOFs (martello.building3d's operators
-    applied to every recorded sample: exact at output.every = 1): signed extremes of every
-    member's end forces (N, V2, V3, T, M2, M3 at ends i and j; a rigid floor's beams carry no
-    in-plane forces, so no N, V3, M2) with their times and the largest biaxial moment
-    √(M2² + M3²) at each end and its time; per storey the shears along x and y and the torque about the
-    floor's reference point; per requested plan point its ux, uy. Also the member histories
-    (M2, M3 at both ends, by column name)."""
+def building_results(b, columns, hist, tracked):
+    """A building's peaks: signed extremes of every member's end forces (N, V2, V3, T, M2,
+    M3 at ends i and j; a rigid floor's beams carry no in-plane forces, so no N, V3, M2)
+    with their times and the largest biaxial moment √(M2² + M3²) at each end and its time;
+    per storey the shears along x and y and the torque about the floor's reference point;
+    per requested plan point its ux, uy — linear functionals of the state (martello.building3d's
+    operators) the run tracked at every accepted sample whatever it records, the resultant at
+    the samples (tracked: _Functionals.of; docs/results.md, "Frames and buildings"). Also the
+    member histories (M2, M3 at both ends, by column name) on the recorded samples."""
     col = {name: i for i, name in enumerate(columns)}
-    t = hist[:, col["t"]] if len(hist) else np.zeros(0)
     U = hist[:, [col[f"u:{n}"] for n in b["nodes"]]] if len(hist) else np.zeros((0, len(b["nodes"])))
-    F = U @ b["recovery"].T
     bd = b["building"]
+    res_max, t_res = tracked[4], tracked[5]
     members, series = {}, {}
     for e, m in enumerate(bd.elements):
         rigid_beam = m.kind == "beam" and bd.floors[m.storey - 1].rigid
         out = {"kind": m.kind, "storey" if m.kind != "beam" else "floor": m.storey}
-        for end, off in (("i", 0), ("j", 6)):
+        for p, (end, off) in enumerate((("i", 0), ("j", 6))):
             for k, q in enumerate(("N", "V2", "V3", "T", "M2", "M3")):
                 if rigid_beam and q in ("N", "V3", "M2"):
                     continue
-                x = F[:, 12 * e + off + k]
-                out[f"{q}_{end}"] = _extremes(x, t)
+                out[f"{q}_{end}"] = _tracked_extremes(tracked, 12 * e + off + k)
                 if q in ("M2", "M3"):
-                    series[f"{q}_{end}:{b['prefix']}.{m.name}"] = x
-            res = np.hypot(F[:, 12 * e + off + 4], F[:, 12 * e + off + 5])
-            out[f"M_{end}_resultant_max"] = float(res.max()) if len(res) else None
-            out[f"M_{end}_resultant_t"] = float(t[int(np.argmax(res))]) if len(res) else None
+                    series[f"{q}_{end}:{b['prefix']}.{m.name}"] = U @ b["recovery"][12 * e + off + k]
+            has = t_res[2 * e + p] >= 0
+            out[f"M_{end}_resultant_max"] = float(res_max[2 * e + p]) if has else None
+            out[f"M_{end}_resultant_t"] = float(t_res[2 * e + p]) if has else None
         members[m.name] = out
-    S = U @ b["storey"].T
-    storeys = {str(s + 1): {q: _extremes(S[:, 3 * s + k], t) for k, q in enumerate(("shear_x", "shear_y", "torque"))}
+    n_rec = b["recovery"].shape[0]
+    storeys = {str(s + 1): {q: _tracked_extremes(tracked, n_rec + 3 * s + k)
+                            for k, q in enumerate(("shear_x", "shear_y", "torque"))}
                for s in range(bd.storeys)}
+    n_st = b["storey"].shape[0]
     points = {}
-    for p in b["points"]:
-        P = U @ bd.point_operator(p["floor"], p["x"], p["y"]).T
+    for i, p in enumerate(b["points"]):
+        r = n_rec + n_st + 2 * i
         points[p["name"]] = {"floor": p["floor"], "x": p["x"], "y": p["y"],
-                             "ux": _extremes(P[:, 0], t), "uy": _extremes(P[:, 1], t)}
+                             "ux": _tracked_extremes(tracked, r), "uy": _tracked_extremes(tracked, r + 1)}
     return building_description(b) | {"members": members, "storeys": storeys, "points": points}, series
 
 

@@ -270,7 +270,10 @@ def test_rayleigh_damping_of_the_block_decays_the_first_mode_at_zeta():
 
 def test_member_peaks_are_signed_and_located():
     """The summary's peaks of a member force are the extremes of the recovered history, with
-    their times; histories = true appends the member histories to the run's history."""
+    their times, or located inside a step next to them (docs/results.md, "Frames and
+    buildings": the cubic Hermite of (q, q̇), which can only raise them, by at most the
+    step's sampling error (ω h)²/8 of the peak, ω = 12 rad/s the load's); histories = true
+    appends the member histories to the run's history."""
     d = frame_scene(storeys=2, bays=2, zeta=0.05, histories=True,
                     analysis={"type": "dynamic", "integrator": "newmark", "dt": 1e-3, "t_end": 1.0})
     d["loads"] = {"ground_acceleration": {"type": "sine", "amplitude": 2.0, "omega": 12.0}}
@@ -278,8 +281,11 @@ def test_member_peaks_are_signed_and_located():
     m = s["frames"]["F"]["members"]["C1.0"]["M_i"]
     x = hist[:, cols.index("M_i:F.C1.0")]
     t = hist[:, cols.index("t")]
-    assert m["max"] == x.max() and m["min"] == x.min() and m["min"] < 0 < m["max"]
-    assert t[np.argmax(x)] == m["t_max"]
+    assert m["min"] < 0 < m["max"]
+    sampling = (12.0 * 1e-3) ** 2 / 8 * np.abs(x).max()
+    assert x.max() <= m["max"] <= x.max() + sampling
+    assert x.min() - sampling <= m["min"] <= x.min()
+    assert abs(t[np.argmax(x)] - m["t_max"]) <= 1e-3 and abs(t[np.argmin(x)] - m["t_min"]) <= 1e-3
 
 
 def test_bad_blocks_and_frames_are_refused_with_the_field():

@@ -139,6 +139,7 @@ contains
             call contact_peaks(pen, force, o%pen_max(1:size(pen)), o%force_max(1:size(pen)))
          call track(o, m, t, u(1:), v(1:), a(1:), link_f, link_du, u_prev, v_prev, a_prev)
       end if
+      if (o%fq%n > 0) call functionals_track(o%fq, t, u(1:), v(1:), a(1:), o%fixed_steps)
       ! the next step's start
       if (o%smooth_steps) o%chatter_prev = o%counters(C_CHATTER)
       o%prev_t = t

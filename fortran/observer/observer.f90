@@ -14,7 +14,8 @@
 !>   peaks   — located peaks of nodes, contacts and links, inside the steps;
 !>   block   — the bulk entry of a method that measures itself;
 !>   energy  — the start of the run, works and energy terms, divergence;
-!>   budget  — max_steps, max_wall, the progress callback, failure and finish.
+!>   budget  — max_steps, max_wall, the progress callback, failure and finish;
+!>   functionals — linear functionals R·u of the state (a frame's or building's forces).
 module martello_observer
    use, intrinsic :: iso_fortran_env, only: int8
    use martello_kinds, only: dp, i8
@@ -30,7 +31,9 @@ module martello_observer
       c_double, c_long_long
    implicit none
    private
-   public :: results_t, observer_t, node_block_t, progress_callback, tracks
+   public :: results_t, observer_t, node_block_t, functionals_t, progress_callback, tracks
+   ! linear functionals of the state (functionals)
+   public :: functionals_start, functionals_track
    ! a run's sizes and what it lists (history)
    public :: observer_init, observer_phase_lists, observer_sample, observer_block, &
       observer_energy_due, observer_events
@@ -42,12 +45,30 @@ module martello_observer
    public :: observer_fail, observer_failed, observer_fail_nonfinite, observer_finish, &
       observer_close
 
+   !> Linear functionals q = R·u of the state, tracked at every accepted sample whatever
+   !> the history records (docs/results.md, "Frames and buildings": a frame's or building's
+   !> member end forces, drifts, storey forces, plan points). R in compressed rows: row f has
+   !> val(ptr(f):ptr(f+1)-1) on the nodes col(…) (1..n). Their signed extremes and times, over
+   !> the samples and inside each stretch between two samples where the rate R·v changes
+   !> sign (on the cubic Hermite of (q, R·v)); per pair of rows (pair(:, p)) the largest
+   !> resultant √(q_a² + q_b²) over the samples and its time. t0 < 0: no sample yet.
+   type :: functionals_t
+      integer :: n = 0
+      integer, allocatable :: ptr(:), col(:), pair(:, :)
+      real(dp), allocatable :: val(:)
+      real(dp), allocatable :: q_max(:), q_min(:), t_max(:), t_min(:), res_max(:), t_res(:)
+      real(dp), allocatable :: q0(:), r0(:), a0(:)
+      real(dp) :: t0 = -1.0_dp
+   end type functionals_t
+
    type :: results_t
       !> what the run tracks (TRACK_* bits, martello_run_set_tracking): the arrays of what it
       !> does not track have no entries (the accessors give NaN), its phases no rows;
       !> impacts are always counted
       integer :: tracking = TRACK_ALL
       integer :: n_nodes = 0, n_contacts = 0, n_links = 0
+      !> the linear functionals tracked (martello_run_set_functionals)
+      type(functionals_t) :: fq
       ! history: hist(:, k) = [t, (u, v, a of each output node), (δ, P of each output
       ! contact), (force, elongation of each output link), energy(1:NENERGY)]
       integer :: ncol = 0, nrec = 0
@@ -388,6 +409,10 @@ module martello_observer
          real(dp), intent(in) :: h, d0, r0, f0, fr0, d1, r1, f1, fr1
          real(dp), intent(out) :: dm, fm
       end subroutine step_maxima
+      pure module subroutine cubic_hermite_extrema(h, u0, v0, u1, v1, s, p)
+         real(dp), intent(in) :: h, u0, v0, u1, v1
+         real(dp), intent(out) :: s(2), p(2)
+      end subroutine cubic_hermite_extrema
       elemental module real(dp) function step_absmax(h, q0, r0, q1, r1) result(x)
          real(dp), intent(in) :: h, q0, r0, q1, r1
       end function step_absmax
@@ -485,5 +510,19 @@ module martello_observer
          type(observer_t), intent(inout) :: o
          real(dp), intent(in) :: t_reached
       end subroutine observer_finish
+
+      ! ---- functionals ----------------------------------------------------------------
+      !> Size the results of the functionals f holds (functionals.f90); stat /= 0: no memory.
+      module subroutine functionals_start(f, stat)
+         type(functionals_t), intent(inout) :: f
+         integer, intent(out) :: stat
+      end subroutine functionals_start
+      !> The functionals at the accepted state (u, v, a on nodes 1..n) at t of a fixed-step
+      !> method or not.
+      module subroutine functionals_track(f, t, u, v, a, fixed_steps)
+         type(functionals_t), intent(inout) :: f
+         real(dp), intent(in) :: t, u(:), v(:), a(:)
+         logical, intent(in) :: fixed_steps
+      end subroutine functionals_track
    end interface
 end module martello_observer

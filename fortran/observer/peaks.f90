@@ -312,7 +312,7 @@ contains
 
    !> The stationary points s (in units of h; outside (0, 1) if none) and values p of the
    !> cubic Hermite interpolant of y with derivative d at both ends of a step of length h.
-   pure subroutine cubic_hermite_extrema(h, u0, v0, u1, v1, s, p)
+   pure module subroutine cubic_hermite_extrema(h, u0, v0, u1, v1, s, p)
       real(dp), intent(in) :: h, u0, v0, u1, v1
       real(dp), intent(out) :: s(2), p(2)
       real(dp) :: qa, qb, qc, disc, r(2), x

@@ -111,6 +111,8 @@ def lib():
         "martello_run_set_tracking": (c_int, [_VOID_P, c_int]),
         "martello_run_link_peaks": (c_int, [_VOID_P] * 3),
         "martello_run_abs_peaks": (c_int, [_VOID_P] * 3),
+        "martello_run_set_functionals": (c_int, [_VOID_P, c_int, _INT_P, _INT_P, _DOUBLE_P, c_int, _INT_P]),
+        "martello_run_functionals": (c_int, [_VOID_P] * 7),
         "martello_memory_message": (None, [c_char_p, c_double, c_char_p, c_char_p, c_int]),
         "martello_write_csv": (c_int, [c_char_p, c_char_p, _DOUBLE_P, ctypes.c_int64, c_int]),
     }
@@ -565,6 +567,29 @@ class Run(_Handle):
         for w in what:
             flags |= value("tracking", w)
         self._check(lib().martello_run_set_tracking(self._h, flags), "tracking")
+
+    def set_functionals(self, R, nodes, pairs=()):
+        """Track the rows of R (dense, rows x len(nodes); column c on the 0-based node
+        nodes[c]) as linear functionals of the state at every accepted sample, and the
+        resultant of each pair of its rows (c/martello.h, martello_run_set_functionals)."""
+        R = np.asarray(R, dtype=np.float64).reshape(-1, len(nodes))
+        rows, cols = np.nonzero(R)                   # row by row: compressed rows
+        ptr = np.zeros(R.shape[0] + 1, np.int32)
+        np.cumsum(np.bincount(rows, minlength=R.shape[0]), out=ptr[1:])
+        col = np.ascontiguousarray(np.asarray(nodes, dtype=np.int32)[cols], dtype=np.int32)
+        val = np.ascontiguousarray(R[rows, cols])
+        pr = np.ascontiguousarray(np.asarray(pairs, dtype=np.int32).reshape(-1))
+        # ctypes wants a buffer even where nothing is read
+        self._check(lib().martello_run_set_functionals(
+            self._h, R.shape[0], ptr, col if col.size else np.zeros(1, np.int32),
+            val if val.size else np.zeros(1), pr.size // 2, pr if pr.size else np.zeros(2, np.int32)),
+            "functionals")
+
+    def functionals(self, n, n_pairs):
+        """(q_max, t_max, q_min, t_min, res_max, t_res) of the tracked functionals."""
+        out = [np.zeros(max(n, 1)) for _ in range(4)] + [np.zeros(max(n_pairs, 1)) for _ in range(2)]
+        self._check(lib().martello_run_functionals(self._h, *(o.ctypes.data for o in out)), "functionals")
+        return [o[:n] for o in out[:4]] + [o[:n_pairs] for o in out[4:]]
 
     def link_peaks(self, n_links):
         f, du = np.zeros(max(n_links, 1)), np.zeros(max(n_links, 1))

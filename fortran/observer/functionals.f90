@@ -1,0 +1,129 @@
+!> Linear functionals q = R·u of the state tracked by the observer (docs/results.md, "Frames
+!> and buildings"): a frame's or building's member end forces, drifts, storey forces and plan
+!> points are such rows of the state, so their peaks are taken like a node's — at every
+!> accepted sample whatever the history records, and inside each stretch between two
+!> samples where the rate q̇ = R·v changes sign: on a fixed step at the extremum of the cubic
+!> Hermite of (q, q̇) (O(h⁴) in q, as a node's), on an adaptive method's step, whose ends
+!> fall where its error control puts them, on the quintic Hermite of (q, q̇, q̈) (O(h⁶):
+!> below the method's own error, so the peak moves with the steps no more than the state
+!> does; docs/results.md). The resultant of a pair of rows at the samples.
+submodule (martello_observer) functionals
+   implicit none
+
+contains
+
+   !> The results' arrays of the rows and pairs f holds: extremes at ∓huge, times −1.
+   module procedure functionals_start
+      integer :: n, np
+      n = f%n; np = 0
+      if (allocated(f%pair)) np = size(f%pair, 2)
+      if (allocated(f%q_max)) deallocate (f%q_max, f%q_min, f%t_max, f%t_min, f%q0, f%r0, f%a0, &
+                                          f%res_max, f%t_res)
+      allocate (f%q_max(n), f%q_min(n), f%t_max(n), f%t_min(n), f%q0(n), f%r0(n), f%a0(n), &
+                f%res_max(np), f%t_res(np), stat=stat)
+      if (stat /= 0) return
+      f%q_max = -huge(1.0_dp); f%q_min = huge(1.0_dp); f%t_max = -1.0_dp; f%t_min = -1.0_dp
+      f%res_max = -1.0_dp; f%t_res = -1.0_dp; f%q0 = 0.0_dp; f%r0 = 0.0_dp; f%a0 = 0.0_dp
+      f%t0 = -1.0_dp
+   end procedure functionals_start
+
+   !> Each row at the sample (q, q̇ at t), its extremum inside the stretch from the last
+   !> sample (at t0) where q̇ changes sign, then the pairs' resultants at the sample. The
+   !> first of equal values keeps its time (as the samples in order would).
+   module procedure functionals_track
+      integer :: f_, k, p
+      real(dp) :: q, r, acc, h, s(2), pk(2), x
+      if (f%n == 0) return
+      h = t - f%t0
+      do f_ = 1, f%n
+         q = 0.0_dp; r = 0.0_dp; acc = 0.0_dp
+         do k = f%ptr(f_), f%ptr(f_ + 1) - 1
+            q = q + f%val(k)*u(f%col(k))
+            r = r + f%val(k)*v(f%col(k))
+            acc = acc + f%val(k)*a(f%col(k))
+         end do
+         if (f%t0 >= 0.0_dp .and. h > 0.0_dp .and. f%r0(f_)*r < 0.0_dp) then
+            if (fixed_steps) then
+               call cubic_hermite_extrema(h, f%q0(f_), f%r0(f_), q, r, s, pk)
+               do k = 1, 2
+                  if (.not. (s(k) > 0.0_dp .and. s(k) < 1.0_dp)) cycle
+                  call raise(f_, f%t0 + s(k)*h, pk(k))
+               end do
+            else
+               call quintic_extremum(h, f%q0(f_), f%r0(f_), f%a0(f_), q, r, acc, s(1), pk(1))
+               call located(f_, f%t0 + s(1)*h, pk(1), f%q0(f_), q, f%r0(f_) > 0.0_dp)
+            end if
+         end if
+         call raise(f_, t, q)
+         f%q0(f_) = q; f%r0(f_) = r; f%a0(f_) = acc
+      end do
+      f%t0 = t
+      if (.not. allocated(f%pair)) return
+      do p = 1, size(f%pair, 2)
+         x = hypot(f%q0(f%pair(1, p)), f%q0(f%pair(2, p)))
+         if (x > f%res_max(p)) then
+            f%res_max(p) = x; f%t_res(p) = t
+         end if
+      end do
+   contains
+      subroutine raise(i, tq, y)
+         integer, intent(in) :: i
+         real(dp), intent(in) :: tq, y
+         if (y > f%q_max(i)) then
+            f%q_max(i) = y; f%t_max(i) = tq
+         end if
+         if (y < f%q_min(i)) then
+            f%q_min(i) = y; f%t_min(i) = tq
+         end if
+      end subroutine raise
+      !> The extremum of a stretch whose rate changes sign (a maximum if rising) located at
+      !> tq with value y: the stretch's extremum is inside it, so it takes the located time
+      !> even where an end's sample (q0, q1) is above the interpolant's value by the
+      !> interpolant's error — else the time would be that of a step's end near the
+      !> extremum, which moves with the steps (a time is known to √(error/|q̈|) there).
+      subroutine located(i, tq, y, q0, q1, rising)
+         integer, intent(in) :: i
+         real(dp), intent(in) :: tq, y, q0, q1
+         logical, intent(in) :: rising
+         real(dp) :: w
+         if (rising) then
+            w = max(y, q0, q1)
+            if (w >= f%q_max(i)) then
+               f%q_max(i) = w; f%t_max(i) = tq
+            end if
+         else
+            w = min(y, q0, q1)
+            if (w <= f%q_min(i)) then
+               f%q_min(i) = w; f%t_min(i) = tq
+            end if
+         end if
+      end subroutine located
+   end procedure functionals_track
+
+   !> The extremum inside a step of h where the rate changes sign (r0·r1 < 0) on the quintic
+   !> Hermite of (q, q̇, q̈) at both ends: its abscissa s in (0, 1) (bisection on the rate,
+   !> which changes sign there) and value p.
+   pure subroutine quintic_extremum(h, q0, r0, a0, q1, r1, a1, s, p)
+      real(dp), intent(in) :: h, q0, r0, a0, q1, r1, a1
+      real(dp), intent(out) :: s, p
+      real(dp) :: d0, d1, e0, e1, c3, c4, c5, lo, hi, x, rate
+      integer :: it
+      d0 = h*r0; d1 = h*r1; e0 = h*h*a0; e1 = h*h*a1
+      ! q(x) = q0 + d0 x + e0 x²/2 + c3 x³ + c4 x⁴ + c5 x⁵, matching q1, d1, e1 at x = 1
+      c3 = 10.0_dp*(q1 - q0) - 6.0_dp*d0 - 4.0_dp*d1 - 1.5_dp*e0 + 0.5_dp*e1
+      c4 = -15.0_dp*(q1 - q0) + 8.0_dp*d0 + 7.0_dp*d1 + 1.5_dp*e0 - e1
+      c5 = 6.0_dp*(q1 - q0) - 3.0_dp*(d0 + d1) - 0.5_dp*(e0 - e1)
+      lo = 0.0_dp; hi = 1.0_dp
+      do it = 1, 60
+         x = 0.5_dp*(lo + hi)
+         rate = d0 + x*(e0 + x*(3.0_dp*c3 + x*(4.0_dp*c4 + x*5.0_dp*c5)))
+         if ((rate > 0.0_dp) .eqv. (r0 > 0.0_dp)) then
+            lo = x
+         else
+            hi = x
+         end if
+      end do
+      s = 0.5_dp*(lo + hi)
+      p = q0 + s*(d0 + s*(0.5_dp*e0 + s*(c3 + s*(c4 + s*c5))))
+   end subroutine quintic_extremum
+end submodule functionals
