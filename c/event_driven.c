@@ -44,6 +44,8 @@ enum { ROOT_IMPACT,      /* unilateral gap closing: delta >= 0                  
 
 /* events without time advancing before the run is declared stuck */
 #define MAX_EVENTS_AT_ONCE 1000
+/* two stops closer than this many units of rounding of their time are one (ed_integrate) */
+#define STOP_ROUNDING (16.0 * DBL_EPSILON)
 
 typedef struct {
   martello_model *model;
@@ -70,6 +72,8 @@ typedef struct {
   gsl_odeiv2_driver *rdrv;        /* msbdf: adaptive rk4imp from the step start */
   double *scale_abs;
   double *y, *y0, *yb, *ybest, *yc, *yerr, *fstart, *f, *f1, *fj, *yj, *fint, *fext;
+  double *jf0, *jf1;               /* ed_jacobian's own RHS values (msbdf, rk4imp) */
+  double *jh;                      /* a jerk projected for the held forces' rates (rates) */
   /* contact kinematics at the step start (0), the step end (1) and the current state */
   double *pen0, *rate0, *acc0, *pen1, *rate1, *acc1, *pen, *rate, *force;
   double *lam, *lam0, *lam1, *lamtol;
@@ -227,7 +231,10 @@ static int ed_rhs(double t, const double y[], double dydt[], void *params) {
 }
 
 /* Jacobian for msbdf and rk4imp: forward differences of the RHS, dense, row-major
- * dfdy[i*dim + j] (GSL's layout); 2n + 2 RHS evaluations; u' = v is set exactly. */
+ * dfdy[i*dim + j] (GSL's layout); 2n + 2 RHS evaluations; u' = v is set exactly. Its RHS
+ * values have buffers of their own (jf0, jf1): rk4imp calls it while a step's end is held in
+ * f1 (the event and peak location re-integrate), and a rate taken from a clobbered f1 missed
+ * the |v| and |a| peaks of msbdf whenever an extremum of u was located in the same step. */
 static int ed_jacobian(double t, const double y[], double *dfdy, double dfdt[], void *params) {
   ed_t *w = params;
   const size_t n = (size_t)w->n, dim = w->dim;
@@ -235,7 +242,7 @@ static int ed_jacobian(double t, const double y[], double *dfdy, double dfdt[], 
   double umax = 0.0, vmax = 0.0, ht;
   size_t i, j;
   w->cnt[MARTELLO_COUNTER_JACOBIAN_EVALUATIONS]++;
-  if (ed_rhs(t, y, w->fj, w) != GSL_SUCCESS) return GSL_EBADFUNC;
+  if (ed_rhs(t, y, w->jf0, w) != GSL_SUCCESS) return GSL_EBADFUNC;
   for (i = 0; i < n; i++) {
     umax = fmax(umax, fabs(y[i]));
     vmax = fmax(vmax, fabs(y[n + i]));
@@ -249,17 +256,17 @@ static int ed_jacobian(double t, const double y[], double *dfdy, double dfdt[], 
     /* away from zero along y_j (along its rate where y_j is 0: a mirrored scene's zeros are
      * not negated): the mirrored state (y -> -y) differences the mirrored way, so that a
      * mirrored scene runs the mirrored steps to the bit (docs/invariance.md) */
-    w->yj[j] = y[j] + copysign(step, y[j] != 0.0 ? y[j] : w->fj[j]);
+    w->yj[j] = y[j] + copysign(step, y[j] != 0.0 ? y[j] : w->jf0[j]);
     hh = w->yj[j] - y[j];
-    if (ed_rhs(t, w->yj, w->f1, w) != GSL_SUCCESS) return GSL_EBADFUNC;
+    if (ed_rhs(t, w->yj, w->jf1, w) != GSL_SUCCESS) return GSL_EBADFUNC;
     w->yj[j] = y[j];
-    for (i = n; i < dim; i++) dfdy[i * dim + j] = (w->f1[i] - w->fj[i]) / hh;
+    for (i = n; i < dim; i++) dfdy[i * dim + j] = (w->jf1[i] - w->jf0[i]) / hh;
   }
   for (i = 0; i < n; i++)
     if (!w->fixed[i]) dfdy[i * dim + n + i] = 1.0;
   ht = sq * fmax(fabs(t), w->dt_out);
-  if (ed_rhs(t + ht, y, w->f1, w) != GSL_SUCCESS) return GSL_EBADFUNC;
-  for (i = 0; i < dim; i++) dfdt[i] = (w->f1[i] - w->fj[i]) / ht;
+  if (ed_rhs(t + ht, y, w->jf1, w) != GSL_SUCCESS) return GSL_EBADFUNC;
+  for (i = 0; i < dim; i++) dfdt[i] = (w->jf1[i] - w->jf0[i]) / ht;
   return GSL_SUCCESS;
 }
 
@@ -848,6 +855,11 @@ static int node_extrema(ed_t *w, double t0, double t1) {
     hermite_t p;
     double lo = 0.0, hi = 1.0, tm, uc, vc, ac, tau;
     if (w->fixed[i]) continue;
+    /* a turn inside the velocity's own tolerance is not resolved: its sign is the error's
+     * (the precursor of a wave in a lumped rod, u ~ 1e-150 m ahead of the front, turned
+     * back and forth with the step sequence and made local maxima of u come and go with
+     * the output stops; docs/results.md, u_peak) */
+    if (!(fmax(fabs(v0), fabs(v1)) > w->atol)) continue;
     if (v0 > 0.0 && v1 <= 0.0) is_max = 1;
     else if (v0 < 0.0 && v1 >= 0.0) is_max = 0;
     else continue;
@@ -880,9 +892,23 @@ static int node_extrema(ed_t *w, double t0, double t1) {
 
 /* The rates of the peak quantities at the state (t, y) with accelerations acc: elements into
  * e (c/located_peaks.c's packed layout), node jerks into jerk. */
-static int rates(ed_t *w, double t, const double *y, const double *acc, double *e, double *jerk) {
-  int st = martello_peak_rates(w->ev, t, y, y + w->n, acc, w->nc, w->nl, e, jerk);
-  return st == MARTELLO_OK ? st : fail_eval(w, st, t);
+static int rates(ed_t *w, double t, const double *y, const double *acc, const double *lam,
+                 double *e, double *jerk) {
+  int k, st = martello_peak_rates(w->ev, t, y, y + w->n, acc, w->nc, w->nl, e, jerk);
+  if (st != MARTELLO_OK) return fail_eval(w, st, t);
+  if (w->nh == 0) return MARTELLO_OK;
+  /* a held contact's force is its multiplier P (lam at this state), and its rate the
+   * multiplier of the jerk, W_H P' = -B_H j (the constraint is linear, the mass constant):
+   * its peaks are located inside the steps like a penalty force's (c/located_peaks.c's
+   * layout: the contact forces at 2 nc, their rates at 3 nc) */
+  memcpy(w->jh, jerk, (size_t)w->n * sizeof *jerk);
+  st = martello_impulse_project(w->n, w->nh, w->hlist, TOPOLOGY(w), w->Wh, NULL, w->jh, w->rh);
+  if (st != MARTELLO_OK) return fail(w, st, t, "event-driven: the rate of a held contact's force");
+  for (k = 0; k < w->nh; k++) {
+    e[2 * w->nc + w->hlist[k]] = lam[w->hlist[k]];
+    e[3 * w->nc + w->hlist[k]] = w->rh[k];
+  }
+  return MARTELLO_OK;
 }
 
 /* The probe of c/located_peaks.c: quantity kind of item j at t inside the stretch, on the
@@ -894,17 +920,19 @@ static int peak_probe(void *ctx, double t, int kind, int j, double *q, double *r
   if (st != MARTELLO_OK) return st;
   st = eval_point(w, t, w->yc, w->fj, NULL);
   if (st != MARTELLO_OK) return fail_eval(w, st, t);
-  if (kind != MARTELLO_PEAK_V && (st = rates(w, t, w->yc, w->fj + n, w->elc, w->fp)) != MARTELLO_OK)
+  if (kind != MARTELLO_PEAK_V &&
+      (st = rates(w, t, w->yc, w->fj + n, w->lam, w->elc, w->fp)) != MARTELLO_OK)
     return st;
   martello_peak_pick(kind, j, w->nc, w->nl, w->yc + n, w->fj + n, w->fp, w->elc, q, r);
   return MARTELLO_OK;
 }
 
 /* Items without a peak of their own here: fixed nodes, contacts that are not penalty ones
- * or not in a phase. */
+ * or not in a phase (but the force of a held contact, its multiplier). */
 static int peak_skip(void *ctx, int kind, int j) {
   ed_t *w = ctx;
   if (kind == MARTELLO_PEAK_V || kind == MARTELLO_PEAK_A) return w->fixed[j];
+  if (kind == MARTELLO_PEAK_FORCE && w->held[j]) return 0;
   if (kind == MARTELLO_PEAK_PEN || kind == MARTELLO_PEAK_FORCE)
     return !w->is_pen[j] || !martello_observer_in_phase(w->obs, j);
   return 0;
@@ -919,9 +947,10 @@ static int located_peaks(ed_t *w, double t0, double t1, int at_event) {
   martello_peak_ends e;
   int st;
   if (!(t1 - t0 > 0.0)) return MARTELLO_OK;
-  if (!w->start_rates && (st = rates(w, t0, w->y0, w->fstart + n, w->el0, w->jk0)) != MARTELLO_OK)
+  if (!w->start_rates &&
+      (st = rates(w, t0, w->y0, w->fstart + n, w->lam0, w->el0, w->jk0)) != MARTELLO_OK)
     return st;
-  if ((st = rates(w, t1, w->y, w->f1 + n, w->el1, w->jk1)) != MARTELLO_OK) return st;
+  if ((st = rates(w, t1, w->y, w->f1 + n, w->lam1, w->el1, w->jk1)) != MARTELLO_OK) return st;
   memset(&e, 0, sizeof e);
   martello_peak_ends_set(&e, 0, n, w->nc, w->nl, w->y0 + n, w->fstart + n, w->jk0, w->el0);
   martello_peak_ends_set(&e, 1, n, w->nc, w->nl, w->y + n, w->f1 + n, w->jk1, w->el1);
@@ -972,7 +1001,7 @@ static int observe(ed_t *w, double t, int k) {
 static void ed_free(ed_t *w) {
   void *bufs[] = {w->mass, w->gap, w->e, w->fixed, w->el_first, w->el_node, w->el_coef, w->scheme, w->is_pen,
                   w->uni, w->inert, w->Cm, w->scale_abs, w->y, w->y0, w->yb, w->ybest, w->yc,
-                  w->yerr, w->fstart, w->f, w->f1, w->fj, w->yj, w->fint, w->fext,
+                  w->yerr, w->fstart, w->f, w->f1, w->fj, w->jf0, w->jf1, w->jh, w->yj, w->fint, w->fext,
                   w->pen0, w->rate0, w->acc0, w->pen1, w->rate1, w->acc1, w->pen, w->rate,
                   w->force, w->lam, w->lam0, w->lam1, w->lamtol, w->hlist, w->held, w->Wh,
                   w->rh, w->ilist, w->hk, w->Wl, w->ql, w->pl, w->wl, w->sl, w->el, w->tg, 
@@ -1036,7 +1065,7 @@ static int ed_setup(ed_t *w) {
   if (!(ALLOC(w->Cm, (size_t)n * (size_t)w->nu) && ALLOC(w->scale_abs, dim) && ALLOC(w->y, dim) &&
         ALLOC(w->y0, dim) && ALLOC(w->yb, dim) && ALLOC(w->ybest, dim) && ALLOC(w->yc, dim) &&
         ALLOC(w->yerr, dim) && ALLOC(w->fstart, dim) && ALLOC(w->f, dim) && ALLOC(w->f1, dim) &&
-        ALLOC(w->fj, dim) && ALLOC(w->yj, dim) && ALLOC(w->fint, n) && ALLOC(w->fext, n) &&
+        ALLOC(w->fj, dim) && ALLOC(w->jf0, dim) && ALLOC(w->jf1, dim) && ALLOC(w->jh, n) && ALLOC(w->yj, dim) && ALLOC(w->fint, n) && ALLOC(w->fext, n) &&
         ALLOC(w->pen0, nc) && ALLOC(w->rate0, nc) && ALLOC(w->acc0, nc) &&
         ALLOC(w->pen1, nc) && ALLOC(w->rate1, nc) && ALLOC(w->acc1, nc) && ALLOC(w->pen, nc) &&
         ALLOC(w->rate, nc) && ALLOC(w->force, nc) && ALLOC(w->lam, nc) && ALLOC(w->lam0, nc) &&
@@ -1178,10 +1207,15 @@ static int ed_integrate(ed_t *w) {
     const double t0 = t;
     unsigned long failed = w->drv->e->failed_steps;
     double hs = (w->h_max > 0.0) ? fmin(h, w->h_max) : h, te, t_stop;
-    int ev, k = -1;
-    /* a kink of the load is a stop (docs/event-driven.md, time events) */
+    int ev, k = -1, kink;
+    /* a kink of the load is a stop (docs/event-driven.md, time events); one within rounding
+     * of an output time (a record sampled at 0.01 s, outputs every 0.015 s: k 0.015 and
+     * the sample's time differ by an ulp or two) is the same stop, never a step of an ulp,
+     * and a kink restarts the stepper whether or not it is also an output time */
     martello_eval_next_breakpoint(w->ev, t, &t_stop);
-    t_stop = fmin(t_stop, t_out);
+    if (t_stop - t <= STOP_ROUNDING * fabs(t)) martello_eval_next_breakpoint(w->ev, t_stop, &t_stop);
+    kink = t_stop <= t_out + STOP_ROUNDING * fabs(t_out);
+    t_stop = (t_stop < t_out - STOP_ROUNDING * fabs(t_out)) ? t_stop : t_out;
     /* msbdf lowers its order whenever a step is less than half the steps before it (GSL's
      * stability heuristic), and a step cut short by a stop is such a step: with a stop every
      * few steps the order never rises and BDF1's damping takes a few % of the speed a flight
@@ -1204,8 +1238,8 @@ static int ed_integrate(ed_t *w) {
     kinematics(w, w->y, w->f1 + n, w->pen1, w->rate1, w->acc1);
     ev = locate(w, t0, t, &te);
     if (ev < 0) return ev;
-    if (ev == 1) {   /* the smooth stretch ends at the event: its RHS there */
-      st = eval_point(w, te, w->y, w->f1, NULL);
+    if (ev == 1) {   /* the smooth stretch ends at the event: its RHS and multipliers there */
+      st = eval_point(w, te, w->y, w->f1, w->lam1);
       if (st != MARTELLO_OK) return fail_eval(w, st, te);
     }
     st = node_extrema(w, t0, ev == 1 ? te : t);
@@ -1226,10 +1260,10 @@ static int ed_integrate(ed_t *w) {
                     "event-driven: events accumulate without time advancing (an unresolved "
                     "Zeno point or chattering contact)");
     }
-    else if (t >= t_stop && t_stop < t_out) {
+    else if (t >= t_stop && kink) {
       gsl_odeiv2_driver_reset(w->drv);   /* across a kink of the load: start afresh */
     }
-    keep_end_rates(w, ev == 0 && !(t >= t_stop && t_stop < t_out));
+    keep_end_rates(w, ev == 0 && !(t >= t_stop && kink));
     st = commit(w, t, w->y0 + 2 * n);
     if (st != MARTELLO_OK) return st;
     if (t >= t_out) {   /* on the output grid: the observer records it */

@@ -49,9 +49,10 @@ def one(path):
         (integrator, adaptive), found = relations.output_invariance(path)
         failed = [{"variant": name, "mismatches": [[p, repr(x), repr(y), a] for p, x, y, a in bad[:8]],
                    "n_mismatches": len(bad), "missing": lost[:8], "n_missing": len(lost)}
-                  for name, bad, lost in found if bad or lost]
+                  for name, bad, lost, _ in found if bad or lost]
+        tied = sorted({p for _, _, _, ties in found for p, *_ in ties})
         return {"scene": str(path), "seconds": time.perf_counter() - t0, "variants": len(found),
-                "failed": failed}
+                "failed": failed, "tied": tied}
     except Exception as exc:              # a scene that fails to run is a finding too
         return {"scene": str(path), "seconds": time.perf_counter() - t0, "variants": 0,
                 "failed": [{"variant": "(run)", "error": f"{type(exc).__name__}: {exc}"}]}
