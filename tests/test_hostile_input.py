@@ -498,3 +498,74 @@ def test_an_error_raised_while_a_ctrl_c_is_delivered_is_the_interrupt(monkeypatc
     monkeypatch.setattr(errors, "sigint_seen", True)
     assert cli.run_command(args) == 130
     assert capsys.readouterr().err == "martello: interrupted\n"
+
+
+def _edited(name, path, value):
+    d = scene_dict(name)
+    node = d
+    for p in path[:-1]:
+        node = node[p]
+    node[path[-1]] = value
+    return d
+
+
+@pytest.mark.parametrize("name, path, value, words", [
+    # the condensation's powers of a storey height leave the doubles (ZeroDivisionError at
+    # 1e-300 m, OverflowError at 1e300 m)
+    ("p11/p11_eccentric_storey", ("building", 0, "storey_height"), 1e-300,
+     "building[0]: the condensed stiffness is not finite"),
+    ("p11/p11_eccentric_storey", ("building", 0, "storey_height"), 1e300,
+     "building[0]: the condensed stiffness is not finite"),
+    # z = cumsum(heights) overflows (numpy's RuntimeWarning, then NaN)
+    ("p11/p11_shear_pounding", ("building", 0, "storey_height"), [1e308, 1e308],
+     "building[0].storey_height: the building's height leaves the doubles"),
+    # b2 b3³/12 of a 1e300 m side (OverflowError)
+    ("p11/p11_eccentric_storey", ("building", 0, "column", "b2"), 1e300,
+     "building[0].column: the rectangle's area, second moments or torsion constant"),
+    # m (lx² + ly²)/12 of a grid 1e300 m wide (OverflowError)
+    ("p11/p11_eccentric_storey", ("building", 0, "grid_x", 1), 1e300,
+     "building[0].inertia: the floors' polar inertia"),
+    # K M^-1 overflows (numpy's RuntimeWarning in the modal table)
+    ("p11/p11_eccentric_storey", ("building", 0, "mass"), 1e-300,
+     "building[0].mass: the frequencies of the building could not be computed"),
+    # masses 1e17 apart: a computed ω² <= 0 was clipped to a zero frequency, then 0/0 in the
+    # Rayleigh coefficients (NaN damping, numpy's RuntimeWarning)
+    ("p11/p11_shear_pounding", ("building", 0, "mass", 0), 1e-12,
+     "building[0].mass: the frequencies of the building could not be computed"),
+    ("p10/p10_bare", ("frame", 0, "mass", 1), 1e-12,
+     "frame[0].mass: the frequencies of the frame could not be computed"),
+    ("p10/p10_bare", ("frame", 1, "bay_width"), 1e308,
+     "frame[1].bay_width: the frame's height or width leaves the doubles"),
+])
+def test_buildings_and_frames_past_the_doubles_are_one_line_naming_the_field(name, path, value, words):
+    """Loader fuzz of every [[building]] and [[frame]] field (session 5): these raised
+    ZeroDivisionError / OverflowError, or loaded with numpy's RuntimeWarnings and NaN or
+    clipped frequencies. Now a SceneError naming the field, and no warning."""
+    import warnings
+    src = ROOT / "benchmarks" / f"{name}.toml"
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        with pytest.raises(SceneError) as e:
+            from_dict(_edited(name, path, value), source=str(src), base_dir=src.parent)
+    msg = str(e.value)
+    assert "\n" not in msg and words in msg, msg
+
+
+def test_a_building_past_the_doubles_is_one_line_on_the_command_line(tmp_path):
+    run_fails(tmp_path, _edited("p11/p11_eccentric_storey", ("building", 0, "storey_height"), 1e-300),
+              "s.toml: building[0]: the condensed stiffness is not finite")
+
+
+def test_modes_refuse_a_frequency_that_is_not_positive():
+    """building3d.modes: K and M positive definite, so a computed ω² <= 0 or NaN is round-off
+    past the problem's conditioning (the p11 case above): LinAlgError, where it was clipped
+    to a zero frequency."""
+    import numpy as np
+    from martello.building3d import modes
+    K = np.array([[2.0, -1.0], [-1.0, 1.0]]) * 1e9
+    w, phi = modes(K, np.array([1e5, 2e5]))
+    assert np.all(w > 0) and np.allclose(phi.T @ np.diag([1e5, 2e5]) @ phi, np.eye(2))
+    for bad_K, M in ((np.diag([1.0, -1.0]), np.ones(2)), (np.diag([1.0, 0.0]), np.eye(2)),
+                     (K, np.array([1e5, 1e-320]))):
+        with pytest.raises(np.linalg.LinAlgError):
+            modes(bad_K, M)
