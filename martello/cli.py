@@ -190,7 +190,38 @@ def cmd_check(args):
 
 def cmd_export(args):
     from . import export
+    _check_export_flags(args)
     return export.main(args)
+
+
+# The [analysis] keys `martello export` overrides, each with the integrator whose own key it
+# is (None: every integrator's): checked against the scene spec's own domains (a scene with
+# that value would be refused the same way), and not given to another integrator.
+EXPORT_OVERRIDES = {"dt": None, "t_end": None, "beta": "newmark", "gamma": "newmark",
+                    "alpha": "hht", "rho_inf": "generalized-alpha"}
+
+
+def _check_export_flags(args):
+    """The overrides of `martello export` one by one: finite, in the range a scene's
+    [analysis] key has, for the integrator --integrator names; --tol > 0."""
+    import math
+    from .scene.spec import ANALYSIS_TYPES
+    dynamic = ANALYSIS_TYPES["dynamic"]
+    for key, owner in EXPORT_OVERRIDES.items():
+        value = getattr(args, key)
+        if value is None:
+            continue
+        flag = "--" + key.replace("_", "-")
+        check, text = dynamic[key][2]
+        if not (math.isfinite(value) and check(value)):
+            raise errors.ExportError(f"{flag}: invalid value {value!r} (must be {text}, as "
+                                     f"analysis.{key} of a scene)")
+        if owner and args.integrator is not None and args.integrator != owner:
+            raise errors.ExportError(f"{flag}: applies to --integrator {owner}, not "
+                                     f"{args.integrator} (remove it, or give --integrator {owner})")
+    if args.tol is not None and not (math.isfinite(args.tol) and args.tol > 0):
+        raise errors.ExportError(f"--tol: invalid value {args.tol!r} (must be a number > 0: "
+                                 "OpenSees' NormDispIncr tolerance in m)")
 
 
 def cmd_testset(args):

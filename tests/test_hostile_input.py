@@ -569,3 +569,35 @@ def test_modes_refuse_a_frequency_that_is_not_positive():
                      (K, np.array([1e5, 1e-320]))):
         with pytest.raises(np.linalg.LinAlgError):
             modes(bad_K, M)
+
+
+@pytest.mark.parametrize("flags, words", [
+    (["--dt", "0"], "--dt: invalid value 0.0 (must be a number > 0"),          # ZeroDivisionError
+    (["--dt", "-1"], "--dt: invalid value -1.0"),                               # was written
+    (["--dt", "nan"], "--dt: invalid value nan"),                               # ValueError
+    (["--t-end", "inf"], "--t-end: invalid value inf"),                         # OverflowError
+    (["--integrator", "newmark", "--beta", "-1"], "--beta: invalid value -1.0"),  # was written
+    (["--integrator", "hht", "--alpha", "5"], "--alpha: invalid value 5.0 (must be a number in [-1/3, 0]"),
+    (["--integrator", "generalized-alpha", "--rho-inf", "2"], "--rho-inf: invalid value 2.0"),
+    (["--integrator", "hht", "--alpha", "-0.1", "--beta", "0.3"],
+     "--beta: applies to --integrator newmark, not hht"),                       # was ignored
+    (["--tol", "0"], "--tol: invalid value 0.0 (must be a number > 0"),         # was written
+    (["--tol", "1e400"], "--tol: invalid value inf"),                           # ValueError
+])
+def test_export_overrides_are_checked_as_the_scene_keys_they_replace(tmp_path, capsys, flags, words):
+    """`martello export`'s --dt, --t-end, --beta, --gamma, --alpha, --rho-inf and --tol
+    (CLI fuzz of export, session 5): an internal error, or a model.py written with the bad
+    value. Now one line naming the flag and the range of the scene key it replaces, nothing
+    written."""
+    out = tmp_path / "ex"
+    assert cli.main(["export", str(P5), "-o", str(out), *flags]) == 1
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and err.startswith("martello: error: ") and words in err, err
+    assert not out.exists()
+
+
+def test_export_overrides_in_range_still_export(tmp_path, capsys):
+    out = tmp_path / "ex"
+    assert cli.main(["export", str(P5), "-o", str(out), "--integrator", "hht", "--alpha", "-0.1",
+                     "--dt", "1e-5", "--tol", "1e-9"]) == 0
+    assert "HHT" in (out / "model.py").read_text()
