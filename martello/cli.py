@@ -3,6 +3,7 @@
 import argparse
 import json
 import os
+import re
 import sys
 from pathlib import Path
 
@@ -244,7 +245,25 @@ class _Parser(argparse.ArgumentParser):
     """Usage errors in one line, exit code 1, like every other error."""
 
     def error(self, message):
-        self.exit(1, f"{self.prog}: error: {_one_line(message)} (see {self.prog} --help)\n")
+        self.exit(1, f"{self.prog}: error: {_one_line(message)}{_dash_hint(message)} "
+                     f"(see {self.prog} --help)\n")
+
+
+_ARGV = []       # the command line main() parses, for _dash_hint
+
+
+def _dash_hint(message):
+    """`--columns -u:a` (a documented value: a leading - flips the sign) reads to argparse as
+    an option with no value: say how to write it."""
+    m = re.match(r"argument (\S+): expected one argument", message)
+    if not m:
+        return ""
+    names = m.group(1).split("/")
+    for flag, value in zip(_ARGV, _ARGV[1:]):
+        # a value, not another option (-o, --force): -u:a, -1e-3
+        if flag in names and re.match(r"-[^-]", value) and not re.fullmatch(r"-[A-Za-z]", value):
+            return f" (a value that starts with '-' is written {names[-1]}={value})"
+    return ""
 
 
 def _one_line(text):
@@ -473,6 +492,7 @@ def main(argv=None):
     for p in sub.choices.values():      # --debug after the command too
         p.add_argument("--debug", action="store_true", default=argparse.SUPPRESS,
                        help=argparse.SUPPRESS)
+    _ARGV[:] = sys.argv[1:] if argv is None else list(argv)
     args = parser.parse_args(argv)
     if args.version:
         args.command, args.func = "version", _print_version

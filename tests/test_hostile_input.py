@@ -601,3 +601,17 @@ def test_export_overrides_in_range_still_export(tmp_path, capsys):
     assert cli.main(["export", str(P5), "-o", str(out), "--integrator", "hht", "--alpha", "-0.1",
                      "--dt", "1e-5", "--tol", "1e-9"]) == 0
     assert "HHT" in (out / "model.py").read_text()
+
+
+def test_a_value_starting_with_a_dash_is_shown_how_to_write_it(capsys):
+    """`--columns -u:s2` (a leading - flips the sign, as its help says) reads to argparse as an
+    option without its value: the usage error says to write --columns=-u:s2 (it said only
+    'expected one argument'); an option where the value should be gets no such hint."""
+    for argv, hint in ((["compare", "h.csv", "--against", "s.toml", "--columns", "-u:s2"],
+                        "(a value that starts with '-' is written --columns=-u:s2)"),
+                       (["run", "s.toml", "-o", "--force"], None)):
+        with pytest.raises(SystemExit) as e:
+            cli.main(argv)
+        err = capsys.readouterr().err
+        assert e.value.code == 1 and err.count("\n") == 1 and "expected one argument" in err, err
+        assert (hint in err) if hint else "written" not in err, err
