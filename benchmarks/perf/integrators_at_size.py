@@ -11,14 +11,28 @@ Scenes (one process per run, so that its CPU time is its own):
   closed   the same row with every contact pre-compressed by 1 mm under a 3 m/s² ground pulse:
            every contact stays closed (moreau-jean, fast-nonlinear, and the others for
            comparison).
+Integrators: ida, cvode, arkode (their default methods: BDF, Dormand–Prince 5(4)), msbdf, rk8pd,
+rkf45, newmark-general (fused_chain = false), newmark-fused, moreau-jean, fast-nonlinear (all
+modes) and fast-nonlinear:M (M load-dependent Ritz vectors, analysis.modal_vectors = M).
 Each run is cut at max_wall (default 60 s): the cost per simulated second is then its CPU
-time over the time it reached. The exponents are least-squares slopes of log cost over log n.
-Prints the machine load with each row (a shared machine: CPU time, not wall time, and ratios
-within one run). Writes nothing unless --out is given.
+time over the time it reached — not comparable (the events fall late in the window), so such a
+run is marked and left out of the exponents. The exponents are least-squares slopes of log cost
+over log n, over the full windows. Every row keeps the machine load before and after the run,
+the process' nice value and the commit measured (a shared machine: CPU time of the run's own
+process, not wall time). The counts (steps, RHS, Jacobians, factorisations, events) do not
+depend on the load.
+
+Writes nothing unless told: --out DIR keeps the rows as DIR/integrators_at_size_<scene>.json;
+--docs keeps them (with --from, the rows of finished runs, .json or .jsonl, several files merged)
+in docs/perf/integrators_at_size.json, a new row replacing the record's row of the same scene,
+integrator and n, and writes their table into docs/performance.md
+(benchmarks/perf/measured_docs.py); --check finds the page's table the same as its record's (CI).
 
 Usage: benchmarks/perf/integrators_at_size.py [--n 300 1000 3000 10000]
-       [--integrators ida cvode arkode newmark-general moreau-jean fast-nonlinear]
-       [--scene closing|closed] [--t-end 0.1] [--max-wall 60] [--out DIR]"""
+       [--integrators ida cvode arkode newmark-general moreau-jean fast-nonlinear:40 ...]
+       [--scene closing|closed] [--t-end 0.1] [--max-wall 60] [--out DIR] [--docs]
+       benchmarks/perf/integrators_at_size.py --docs --from DIR/a.json DIR/b.json ...
+       benchmarks/perf/integrators_at_size.py --check"""
 
 import argparse
 import json
@@ -32,6 +46,10 @@ from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[2]
 sys.path.insert(0, str(ROOT))
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+import measured_docs  # noqa: E402
+
+NAME = "integrators_at_size"  # its record docs/perf/integrators_at_size.json, its fence in docs/performance.md
 
 ADAPTIVE = {"ida", "cvode", "arkode", "rk8pd", "rkf45", "msbdf"}
 
@@ -56,6 +74,9 @@ def scene(n, integrator, kind, t_end, max_wall):
     an = {"type": "dynamic", "t_end": t_end, "max_wall": max_wall,
           "output": {"every": 1000000, "nodes": ["b1"], "contacts": []}}
     name = integrator
+    integrator, _, m = integrator.partition(":")
+    if m:
+        an["modal_vectors"] = int(m)
     if integrator in ADAPTIVE:
         an.update(integrator=integrator, dt=t_end, rtol=1e-8, atol=1e-12)
     elif integrator in ("newmark-general", "newmark-fused"):
@@ -92,14 +113,23 @@ def child(args):
 
 
 def one(n, integrator, kind, t_end, max_wall):
-    # max_wall stops a slow one: its rate stands
-    r, _, cpu, wall = timed_run(scene(n, integrator, kind, t_end, max_wall))
+    from martello.scene.spec import DEFAULT_METHODS
+    # max_wall stops a slow one: its rate stands, marked as cut
+    load0 = os.getloadavg()[0]
+    sc = scene(n, integrator, kind, t_end, max_wall)
+    r, _, cpu, wall = timed_run(sc)
     c = r["cost"]
     t_reached = r.get("t_reached", t_end) or t_end
+    an = sc["analysis"]
     print(json.dumps({"n": n, "integrator": integrator, "scene": kind, "status": r["status"],
-                      "t_reached": t_reached, "cpu_s": cpu, "wall_s": wall,
-                      "cpu_per_sim_s": cpu / max(t_reached, 1e-300), "cost": c,
-                      "load": os.getloadavg()[0]}))
+                      "t_end": t_end, "t_reached": t_reached, "cut": t_reached < t_end * (1 - 1e-9),
+                      "cpu_s": cpu, "wall_s": wall, "cpu_per_sim_s": cpu / max(t_reached, 1e-300),
+                      "cost": c, "method": DEFAULT_METHODS.get(an["integrator"]),
+                      "setting": {k: an[k] for k in ("preset", "dt", "rtol", "atol", "modal_vectors")
+                                  if k in an and not (k == "dt" and "rtol" in an)},
+                      "contact": sc["chain"][0]["contact"], "load": [load0, os.getloadavg()[0]],
+                      "nice": os.nice(0), "commit": measured_docs.commit(),
+                      "date_utc": time.strftime("%Y-%m-%d %H:%M", time.gmtime())}))
 
 
 def fit(ns, ys):
@@ -110,6 +140,91 @@ def fit(ns, ys):
     return sum((x - mx) * (y - my) for x, y in zip(xs, ls)) / den if den > 0 else float("nan")
 
 
+LABEL = {"ida": "IDA (BDF)", "cvode": "CVODE BDF", "arkode": "ARKODE Dormand–Prince 5(4)",
+         "newmark-general": "Newmark general path", "newmark-fused": "Newmark fused chain step",
+         "moreau-jean": "Moreau–Jean", "fast-nonlinear": "fast nonlinear, all modes",
+         "msbdf": "GSL msbdf", "rk8pd": "GSL rk8pd", "rkf45": "GSL rkf45"}
+GOAL = 1.3   # the exponent the cost per simulated second should not exceed (docs/performance.md)
+
+
+def label(row):
+    """What was run: integrator, method, step or tolerance, the scene and its contacts."""
+    integ, _, m = row["integrator"].partition(":")
+    name = f"fast nonlinear, {m} Ritz vectors" if m else LABEL.get(integ, integ)
+    st = row["setting"]
+    how = (f"rtol {st['rtol']:g}, atol {st['atol']:g}" if "rtol" in st
+           else f"Δt {st['dt']:g} s" + (f", {st['preset']}" if "preset" in st else ""))
+    c = row["contact"]
+    law = (f"restitution e = {c['restitution']:g}" if c["scheme"] == "restitution"
+           else f"{c['scheme']} {c['law']} {c['stiffness']:g} N/m")
+    return f"{name}; {how}; `{row['scene']}`, {law}"
+
+
+def merged(rows):
+    """Rows keyed by (scene, integrator, n), a later row replacing an earlier one, in the order
+    the integrators and sizes first appear."""
+    out = {}
+    for r in rows:
+        out[r["scene"], r["integrator"], r["n"]] = r
+    order = list(dict.fromkeys((r["scene"], r["integrator"]) for r in rows))
+    return [out[k] for k in sorted(out, key=lambda k: (order.index(k[:2]), k[2]))]
+
+
+def _i(x):
+    return f"{x:,}".replace(",", " ")
+
+
+def _g(x):
+    return f"{x:,.3g}".replace(",", " ") if x < 1e3 else f"{x:,.0f}".replace(",", " ")
+
+
+def render(rows):
+    """The table of the rows (docs/perf/integrators_at_size.json) and the exponents."""
+    rows = merged(rows)
+    lines = ["| integrator; step or tolerance; scene, contacts | n | t_end s | CPU s per sim. s | CPU s "
+             "| steps | RHS | Jacobians | factorisations | events | steps / event | RHS / event "
+             "| load (nice) | commit, UTC |",
+             "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
+    for r in rows:
+        c, ev = r["cost"], r["cost"]["events"]
+        per = (lambda k: _g(c[k] / ev)) if ev else (lambda k: "–")
+        lo, hi = r["load"]
+        lines.append(f"| {label(r)} | {_i(r['n'])} | {r['t_end']:g} | {_g(r['cpu_per_sim_s'])}"
+                     f"{'*' if r['cut'] else ''} | {_g(r['cpu_s'])} | {_i(c['steps'])} "
+                     f"| {_i(c['residual_evaluations'])} | {_i(c['jacobian_evaluations'])} "
+                     f"| {_i(c['factorizations'])} | {_i(ev)} | {per('steps')} | {per('residual_evaluations')} "
+                     f"| {lo:.1f}–{hi:.1f} ({r['nice']}) | {r['commit']}, {r['date_utc'][5:]} |")
+    lines += ["", "| integrator; scene | exponent of CPU s per sim. s in n (least squares) | n → n' "
+              "(pairwise) | ≤ 1.3 |", "|---|---|---|---|"]
+    for key in dict.fromkeys((r["scene"], r["integrator"]) for r in rows):
+        mine = [r for r in rows if (r["scene"], r["integrator"]) == key and not r["cut"]]
+        if len(mine) < 2:
+            continue
+        ns, ys = [r["n"] for r in mine], [r["cpu_per_sim_s"] for r in mine]
+        e = fit(ns, ys)
+        pw = ", ".join(f"{a}→{b}: {fit([a, b], [ya, yb]):.2f}"
+                       for a, b, ya, yb in zip(ns, ns[1:], ys, ys[1:]))
+        name = label(mine[0]).split(";")[0]
+        lines.append(f"| {name}; `{key[0]}` | n^{e:.2f} over n = {', '.join(map(str, ns))} | {pw} "
+                     f"| {'yes' if e <= GOAL else '**no**'} |")
+    return "\n".join(lines)
+
+
+def read_rows(path):
+    """The rows of a run: its .json list or its .jsonl lines (kept as they came)."""
+    text = Path(path).read_text()
+    return [json.loads(ln) for ln in text.splitlines() if ln.strip()] if path.endswith(".jsonl") else json.loads(text)
+
+
+def keep(rows):
+    """The record docs/perf/integrators_at_size.json merged with rows (a new row replaces the
+    record's row of the same scene, integrator and n) and its table in docs/performance.md."""
+    path = measured_docs.RECORDS / f"{NAME}.json"
+    old = json.loads(path.read_text()) if path.exists() else []
+    rows = merged(old + list(rows))
+    measured_docs.record(NAME, rows, render(rows))
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--n", type=int, nargs="*", default=[300, 1000, 3000, 10000])
@@ -118,12 +233,28 @@ def main():
     ap.add_argument("--scene", choices=("closing", "closed"), default="closing")
     ap.add_argument("--t-end", type=float, default=0.1)
     ap.add_argument("--max-wall", type=float, default=60.0)
-    ap.add_argument("--out")
+    ap.add_argument("-o", "--out", help="the folder the rows are written into")
+    ap.add_argument("--docs", action="store_true", help="keep the rows as docs/perf/integrators_at_size.json "
+                    "and their table in docs/performance.md")
+    ap.add_argument("--from", dest="source", nargs="*", help="finished runs' JSON rows (no run), merged")
+    ap.add_argument("--check", action="store_true", help="the page's table is its record's (CI)")
     ap.add_argument("--one", nargs=2, help=argparse.SUPPRESS)
     args = ap.parse_args()
     if args.one:
         one(int(args.one[0]), args.one[1], args.scene, args.t_end, args.max_wall)
-        return
+        return 0
+    if args.check:
+        problem = measured_docs.check(NAME, render)
+        print(problem or f"docs/performance.md: the table of {NAME} is its record's")
+        return 1 if problem else 0
+    if args.source:
+        rows = merged([r for f in args.source for r in read_rows(f)])
+        print(render(rows))
+        if args.docs:
+            keep(rows)
+        return 0
+    if not (args.out or args.docs):
+        print("(nothing is written: -o DIR keeps the rows, --docs the table)")
     from martello.binding import native
     print(f"martello {native.version()} ({native.library_versions()}); {os.cpu_count()} cores; "
           f"scene {args.scene}, t_end {args.t_end} s, max_wall {args.max_wall} s")
@@ -134,6 +265,10 @@ def main():
         for n in args.n:
             row, err = child([__file__, "--one", n, integ, "--scene", args.scene,
                               "--t-end", args.t_end, "--max-wall", args.max_wall])
+            if row is not None and args.out:   # kept as it comes: a long sweep stopped keeps its rows
+                Path(args.out).mkdir(parents=True, exist_ok=True)
+                with open(Path(args.out) / f"integrators_at_size_{args.scene}.jsonl", "a") as f:
+                    f.write(json.dumps(row) + "\n")
             if row is None:
                 print(f"{integ:>16} {n:>6} failed: {err}")
                 continue
@@ -142,7 +277,7 @@ def main():
             print(f"{integ:>16} {n:>6} {row['status']:>7} {row['t_reached']:9.4g} {row['cpu_s']:8.3g} "
                   f"{row['cpu_per_sim_s']:10.4g} {c['steps']:8d} {c['residual_evaluations']:9d} "
                   f"{c['events']:7d} {c['steps'] / ev:8.3g} {c['residual_evaluations'] / ev:8.3g} "
-                  f"{c['factorizations']:7d} {row['load']:5.2f}", flush=True)
+                  f"{c['factorizations']:7d} {row['load'][1]:5.2f}", flush=True)
     print("\nexponents of CPU per simulated second in n (least squares over the sizes run):")
     for integ in args.integrators:
         mine = [r for r in rows if r["integrator"] == integ and r["cpu_per_sim_s"] > 0]
@@ -154,7 +289,10 @@ def main():
         out = Path(args.out)
         out.mkdir(parents=True, exist_ok=True)
         (out / f"integrators_at_size_{args.scene}.json").write_text(json.dumps(rows, indent=1))
+    if args.docs:
+        keep(rows)
+    return 0
 
 
 if __name__ == "__main__":
-    main()
+    sys.exit(main())
