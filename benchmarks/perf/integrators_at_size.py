@@ -11,6 +11,9 @@ Scenes (one process per run, so that its CPU time is its own):
   closed   the same row with every contact pre-compressed by 1 mm under a 3 m/s² ground pulse:
            every contact stays closed (moreau-jean, fast-nonlinear, and the others for
            comparison).
+  row      fast-nonlinear only: benchmarks/perf/fna_ritz.py's row (4 contacts among n
+           oscillators, weak neighbour springs, a 2 Hz ground sine; dt 1 ms), where a few Ritz
+           vectors are accurate (that script measures their error against all modes).
 Integrators: ida, cvode, arkode (their default methods: BDF, Dormand–Prince 5(4)), msbdf, rk8pd,
 rkf45, newmark-general (fused_chain = false), newmark-fused, moreau-jean, fast-nonlinear (all
 modes) and fast-nonlinear:M (M load-dependent Ritz vectors, analysis.modal_vectors = M).
@@ -30,7 +33,7 @@ integrator and n, and writes their table into docs/performance.md
 
 Usage: benchmarks/perf/integrators_at_size.py [--n 300 1000 3000 10000]
        [--integrators ida cvode arkode newmark-general moreau-jean fast-nonlinear:40 ...]
-       [--scene closing|closed] [--t-end 0.1] [--max-wall 60] [--out DIR] [--docs]
+       [--scene closing|closed|row] [--t-end 0.1] [--max-wall 60] [--out DIR] [--docs]
        benchmarks/perf/integrators_at_size.py --docs --from DIR/a.json DIR/b.json ...
        benchmarks/perf/integrators_at_size.py --check"""
 
@@ -54,7 +57,36 @@ NAME = "integrators_at_size"  # its record docs/perf/integrators_at_size.json, i
 ADAPTIVE = {"ida", "cvode", "arkode", "rk8pd", "rkf45", "msbdf"}
 
 
+def row(n, m, t_end, record_all=True):
+    """Scene `row` (benchmarks/perf/fna_ritz.py states it) on fast-nonlinear with m Ritz vectors
+    (0: all modes), dt 1 ms; every node and contact recorded ~50 times unless record_all is false."""
+    nodes = [{"name": f"b{i}", "mass": 1.0e5} for i in range(1, n + 1)]
+    links = []
+    for i in range(1, n + 1):
+        k = 2.0e7 if i % 2 else 5.0e7
+        links.append({"type": "spring", "a": f"b{i}", "b": "ground", "k": k})
+        links.append({"type": "dashpot", "a": f"b{i}", "b": "ground", "c": 2 * 0.05 * math.sqrt(k * 1.0e5)})
+        if i < n:
+            links.append({"type": "spring", "a": f"b{i}", "b": f"b{i + 1}", "k": 1.0e6})
+    contacts = [{"name": f"gap{j}", "a": f"b{j * n // 5}", "b": f"b{j * n // 5 + 1}", "gap": 2.0e-3,
+                 "scheme": "penalty", "law": "linear", "stiffness": 1.0e9} for j in range(1, 5)]
+    every = max(1, int(round(t_end / 1e-3 / 50)))
+    output = ({"every": every, "nodes": [x["name"] for x in nodes], "contacts": [c["name"] for c in contacts]}
+              if record_all else {"every": 1000000, "nodes": ["b1"], "contacts": []})
+    return {"title": f"row n={n} m={m}", "node": nodes, "link": links, "contact": contacts,
+            "loads": {"ground_acceleration": {"type": "sine", "amplitude": 3.0, "omega": 4 * math.pi}},
+            "analysis": {"type": "dynamic", "integrator": "fast-nonlinear", "dt": 1e-3, "t_end": t_end,
+                         "tol_residual": 1e-10, "max_newton": 100, "modal_vectors": m, "output": output}}
+
+
 def scene(n, integrator, kind, t_end, max_wall):
+    if kind == "row":
+        base, _, m = integrator.partition(":")
+        if base != "fast-nonlinear":
+            raise SystemExit("scene row is for fast-nonlinear and fast-nonlinear:M")
+        sc = row(n, int(m or 0), t_end, record_all=False)
+        sc["analysis"]["max_wall"] = max_wall
+        return sc
     k = [2.0e7 if i % 2 == 0 else 5.0e7 for i in range(n)]
     chain = {"prefix": "b", "n": n, "mass": 1.0e5, "k": k, "zeta": 0.05,
              "contact": {"scheme": "penalty", "law": "linear", "stiffness": 1.0e9}}
@@ -127,7 +159,8 @@ def one(n, integrator, kind, t_end, max_wall):
                       "cost": c, "method": DEFAULT_METHODS.get(an["integrator"]),
                       "setting": {k: an[k] for k in ("preset", "dt", "rtol", "atol", "modal_vectors")
                                   if k in an and not (k == "dt" and "rtol" in an)},
-                      "contact": sc["chain"][0]["contact"], "load": [load0, os.getloadavg()[0]],
+                      "contact": sc["chain"][0]["contact"] if "chain" in sc else
+                      {k: sc["contact"][0][k] for k in ("scheme", "law", "stiffness")}, "load": [load0, os.getloadavg()[0]],
                       "nice": os.nice(0), "commit": measured_docs.commit(),
                       "date_utc": time.strftime("%Y-%m-%d %H:%M", time.gmtime())}))
 
@@ -157,7 +190,8 @@ def label(row):
     c = row["contact"]
     law = (f"restitution e = {c['restitution']:g}" if c["scheme"] == "restitution"
            else f"{c['scheme']} {c['law']} {c['stiffness']:g} N/m")
-    return f"{name}; {how}; `{row['scene']}`, {law}"
+    where = "`row` (4 contacts)" if row["scene"] == "row" else f"`{row['scene']}`"
+    return f"{name}; {how}; {where}, {law}"
 
 
 def merged(rows):
@@ -230,7 +264,7 @@ def main():
     ap.add_argument("--n", type=int, nargs="*", default=[300, 1000, 3000, 10000])
     ap.add_argument("--integrators", nargs="*",
                     default=["ida", "cvode", "arkode", "newmark-general", "newmark-fused"])
-    ap.add_argument("--scene", choices=("closing", "closed"), default="closing")
+    ap.add_argument("--scene", choices=("closing", "closed", "row"), default="closing")
     ap.add_argument("--t-end", type=float, default=0.1)
     ap.add_argument("--max-wall", type=float, default=60.0)
     ap.add_argument("-o", "--out", help="the folder the rows are written into")
