@@ -119,10 +119,11 @@ def render(result):
     1e-12) of a run's figures (accuracy.json)."""
     lo, hi = result["load"]
     lines = [f"{result['date_utc']} UTC, commit {result['commit']}, load {lo:.1f}–{hi:.1f} (nice "
-             f"{result['nice']}); worst relative error; native = the library's wall time of the run "
-             f"(`cost.wall_time_s`), the minimum of {REPEATS} runs, beside the CPU time of the whole "
-             f"`api.run` (set-up and summary included), the minimum of the same runs", "",
-             "| scene (8 s) | integrator | rtol 1e-8 | rtol 1e-10 | rtol 1e-12 | slope (1e-6…1e-12) | native at 1e-12 (CPU of the whole run) |",
+             f"{result['nice']}); worst relative error; CPU = the CPU time of the whole `api.run` "
+             f"(set-up and summary included), native = the library's wall clock of the run "
+             f"(`cost.wall_time_s`, which counts the waits of a loaded machine), each the minimum "
+             f"of {REPEATS} runs", "",
+             "| scene (8 s) | integrator | rtol 1e-8 | rtol 1e-10 | rtol 1e-12 | slope (1e-6…1e-12) | CPU at 1e-12 (native wall) |",
              "|---|---|---|---|---|---|---|"]
     last = None
     for c in result["curves"]:
@@ -131,7 +132,8 @@ def render(result):
         at = {k: e for k, e in zip(c["knobs"], c["errors"])}
         cell = lambda r: f"{at[r]:.1e}".replace("e-0", "e-") if r in at else "—"   # noqa: E731
         k12 = c["knobs"].index(1e-12) if 1e-12 in c["knobs"] else None
-        wall = f"{1e3 * c['wall_s'][k12]:.3g} ms ({1e3 * c['cpu_s'][k12]:.3g} ms)" if k12 is not None else "—"
+        ms = lambda x: f"{1e3 * x:.3g}" if x < 0.1 else f"{1e3 * x:.0f}"   # noqa: E731
+        wall = f"{ms(c['cpu_s'][k12])} ms ({ms(c['wall_s'][k12])} ms)" if k12 is not None else "—"
         first = LABELS.get(c["scene"], c["scene"]) if c["scene"] != last else ""
         last = c["scene"]
         lines.append(f"| {first} | {c['integrator']} | {cell(1e-8)} | {cell(1e-10)} | {cell(1e-12)} "
