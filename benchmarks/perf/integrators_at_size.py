@@ -162,11 +162,12 @@ def one(n, integrator, kind, t_end, max_wall, active=None, spread=0.1):
     sc = scene(n, integrator, kind, t_end, max_wall, active, spread)
     r, _, cpu, wall = timed_run(sc)
     c = r["cost"]
-    t_reached = r.get("t_reached", t_end) or t_end
+    t_reached = r.get("t_reached", t_end)    # 0 for a run stopped before its first step
     an = sc["analysis"]
     print(json.dumps({"n": n, "integrator": integrator, "scene": variant(kind, active, spread), "status": r["status"],
-                      "t_end": t_end, "t_reached": t_reached, "cut": t_reached < t_end * (1 - 1e-9),
-                      "cpu_s": cpu, "wall_s": wall, "cpu_per_sim_s": cpu / max(t_reached, 1e-300),
+                      "t_end": t_end, "t_reached": t_reached,
+                      "cut": r["status"] != "MARTELLO_OK" or t_reached < t_end * (1 - 1e-9),
+                      "cpu_s": cpu, "wall_s": wall, "cpu_per_sim_s": cpu / t_reached if t_reached > 0 else None,
                       "cost": c, "method": DEFAULT_METHODS.get(an["integrator"]),
                       "setting": {k: an[k] for k in ("preset", "dt", "rtol", "atol", "modal_vectors")
                                   if k in an and not (k == "dt" and "rtol" in an)},
@@ -245,8 +246,9 @@ def table(rows):
         c, ev = r["cost"], r["cost"]["events"]
         per = (lambda k: _g(c[k] / ev)) if ev else (lambda k: "–")
         lo, hi = r["load"]
-        lines.append(f"| {label(r)} | {_i(r['n'])} | {r['t_end']:g} | {_g(r['cpu_per_sim_s'])}"
-                     f"{'*' if r['cut'] else ''} | {_g(r['cpu_s'])} | {_i(c['steps'])} "
+        rate = (_g(r["cpu_per_sim_s"]) + ("*" if r["cut"] else "") if r["cpu_per_sim_s"]
+                else f"no step in {r['wall_s']:.0f} s of wall clock")
+        lines.append(f"| {label(r)} | {_i(r['n'])} | {r['t_end']:g} | {rate} | {_g(r['cpu_s'])} | {_i(c['steps'])} "
                      f"| {_i(c['residual_evaluations'])} | {_i(c['jacobian_evaluations'])} "
                      f"| {_i(c['factorizations'])} | {_i(ev)} | {per('steps')} | {per('residual_evaluations')} "
                      f"| {lo:.1f}–{hi:.1f} ({r['nice']}) | {r['commit']}, {r['date_utc'][5:]} |")
@@ -262,7 +264,7 @@ def render(rows):
     lines += ["", "| integrator; scene | exponent of CPU s per sim. s in n (least squares) | n → n' "
               "(pairwise) | ≤ 1.3 |", "|---|---|---|---|"]
     for key in dict.fromkeys((r["scene"], r["integrator"], window(r)) for r in main):
-        mine = [r for r in main if (r["scene"], r["integrator"], window(r)) == key]
+        mine = [r for r in main if (r["scene"], r["integrator"], window(r)) == key and r["cpu_per_sim_s"]]
         if len(mine) < 2:
             continue
         ns, ys = [r["n"] for r in mine], [r["cpu_per_sim_s"] for r in mine]
@@ -350,12 +352,12 @@ def main():
             rows.append(row)
             c, ev = row["cost"], max(row["cost"]["events"], 1)
             print(f"{integ:>16} {n:>6} {row['status']:>7} {row['t_reached']:9.4g} {row['cpu_s']:8.3g} "
-                  f"{row['cpu_per_sim_s']:10.4g} {c['steps']:8d} {c['residual_evaluations']:9d} "
+                  f"{row['cpu_per_sim_s'] or float('nan'):10.4g} {c['steps']:8d} {c['residual_evaluations']:9d} "
                   f"{c['events']:7d} {c['steps'] / ev:8.3g} {c['residual_evaluations'] / ev:8.3g} "
                   f"{c['factorizations']:7d} {row['load'][1]:5.2f}", flush=True)
     print("\nexponents of CPU per simulated second in n (least squares over the sizes run):")
     for integ in args.integrators:
-        mine = [r for r in rows if r["integrator"] == integ and r["cpu_per_sim_s"] > 0]
+        mine = [r for r in rows if r["integrator"] == integ and r["cpu_per_sim_s"] and not r["cut"]]
         if len(mine) >= 2:
             ns = [r["n"] for r in mine]
             print(f"  {integ:>16}: n^{fit(ns, [r['cpu_per_sim_s'] for r in mine]):.2f} "
