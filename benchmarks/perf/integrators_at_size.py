@@ -246,8 +246,8 @@ def table(rows):
         c, ev = r["cost"], r["cost"]["events"]
         per = (lambda k: _g(c[k] / ev)) if ev else (lambda k: "–")
         lo, hi = r["load"]
-        rate = (_g(r["cpu_per_sim_s"]) + ("*" if r["cut"] else "") if r["cpu_per_sim_s"]
-                else f"no step in {r['wall_s']:.0f} s of wall clock")
+        rate = (_g(r["cpu_per_sim_s"]) + (f"* over [0, {r['t_reached']:.4g} s]" if r["cut"] else "")
+                if r["cpu_per_sim_s"] else f"no step in {r['wall_s']:.0f} s of wall clock")
         lines.append(f"| {label(r)} | {_i(r['n'])} | {r['t_end']:g} | {rate} | {_g(r['cpu_s'])} | {_i(c['steps'])} "
                      f"| {_i(c['residual_evaluations'])} | {_i(c['jacobian_evaluations'])} "
                      f"| {_i(c['factorizations'])} | {_i(ev)} | {per('steps')} | {per('residual_evaluations')} "
