@@ -5,8 +5,8 @@ areas) on a Linear transformation whose vecxz is the member's local axis 3, a ri
 rigidDiaphragm to a master node at the floor's reference point that carries its ux, uy, rz
 (the floor's mass m, m and J_C on the master, or on a node at the mass centre tied to it when
 the reference is elsewhere: the same coupled mass matrix), flexible floors' and split points'
-masses on their own nodes, damping a0 M + a1 K by region (Rayleigh) or OpenSees' modal damping
-on the eigenvectors of the whole model (modal). The massless DOFs that martello condenses are
+masses on their own nodes, Rayleigh damping a0 M + a1 K by region (modal damping is refused:
+OpenSees cannot damp every mode of such a model, see check()). The massless DOFs that martello condenses are
 free DOFs of this model: static condensation is exact for them, so both model the same floor
 dynamics (docs/buildings.md "Condensation").
 
@@ -74,23 +74,15 @@ class BuildingWriter:
                       + (f" with nodes along the scene's axis ({', '.join(plain[:3])})" if plain else ""),
                       "UniformExcitation moves every mass of the model along one direction",
                       "give every building the same ground_angle (0 with other nodes)")
-        modal = [b for b in self.buildings if b["zeta"] > 0 and b["damping"] == "modal"]
-        if modal:
-            others = [b["prefix"] for b in self.buildings if b not in modal]
-            zetas = {b["zeta"] for b in modal}
-            stiff = [lk["name"] for lk in s.links if lk["type"] in ("spring", "bar", "bilinear")]
-            stiff += [c["name"] for c in s.contacts if float(c["gap"]) <= 0.0]
-            why = ("OpenSees' modalDamping damps the modes of the whole model (eigen on every mass "
-                   "DOF), martello each building's own modes")
-            if others or len(zetas) > 1:
-                b0.refuse("building.damping = \"modal\" on " + ", ".join(b["prefix"] for b in modal)
-                          + (f" beside {', '.join(others)}" if others else " with different zeta"),
-                          why + ": the same only when every building is damped modally with one zeta",
-                          "give every building damping = \"modal\" and one zeta, or use \"rayleigh\"")
-            if plain or stiff:
-                b0.refuse("building.damping = \"modal\" with " + ", ".join((plain + stiff)[:4]),
-                          why + ": nodes beside the buildings, springs between them or closed "
-                          "contacts would change those modes", "use damping = \"rayleigh\"")
+        for b in self.buildings:
+            if b["zeta"] > 0 and b["damping"] == "modal":
+                b0.refuse(f"building {b['prefix']}: damping = \"modal\"",
+                          "martello damps every mode of the building (C = M Φ diag(2ζω) Φᵀ M); "
+                          "OpenSees 3.7.1's modalDamping takes the modes of its last eigen, and on a "
+                          "model whose joints carry no mass ARPACK finds about half of the mass "
+                          "DOFs' modes and fullGenLapack leaves the eigenvectors unusable (measured: "
+                          "the first Newton step diverges)", "use damping = \"rayleigh\" (choose "
+                          "rayleigh_modes) for the export")
 
     # --- the model --------------------------------------------------------------------------
     def node(self, tag, x, y, z):
@@ -101,14 +93,6 @@ class BuildingWriter:
         """Every building's nodes, members, floors and damping; returns the last node tag."""
         for b in self.buildings:
             tag = self.building(b, tag)
-        modal = [b for b in self.buildings if b["zeta"] > 0 and b["damping"] == "modal"]
-        if modal:
-            n = sum(len(b["nodes"]) for b in self.buildings)
-            self.bld.add("eigen", n)
-            self.bld.add("modalDamping", float(modal[0]["zeta"]))
-            self.bld.map.append((f"modal damping zeta = {modal[0]['zeta']:g} (buildings "
-                                 f"{', '.join(b['prefix'] for b in modal)})",
-                                 f"eigen {n} (every mass DOF), modalDamping {modal[0]['zeta']:g}"))
         return tag
 
     def building(self, b, tag):
@@ -212,7 +196,7 @@ class BuildingWriter:
         return t
 
     def damping(self, b, eles, massed):
-        if not b["zeta"] > 0 or b["damping"] == "modal":
+        if not b["zeta"] > 0:
             return
         a0, a1 = b["rayleigh"]
         bld = self.bld
