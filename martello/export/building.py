@@ -180,7 +180,7 @@ class BuildingWriter:
         """One member: its local axis 3 (e.R[2]) as vecxz, so OpenSees' y, z are martello's
         axes 2, 3 and Iy = I2, Iz = I3 (martello.building3d: I3 resists displacement along 2)."""
         add, sec = self.bld.add, e.section
-        key = tuple(float(x) for x in e.R[2])
+        key = tuple(float(x) + 0.0 for x in e.R[2])      # + 0.0: no -0.0 in the script
         if key not in self.transf:
             self.transf[key] = len(self.transf) + 1
             add("geomTransf", "Linear", self.transf[key], *key)
