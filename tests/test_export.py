@@ -108,10 +108,15 @@ def test_p7_kelvin_script_builds_the_scene_and_samples_every_output_step(tmp_pat
     assert np.allclose(data[:, 10], 0.5 * 100 * u1 ** 2 + 0.5 * 400 * u2 ** 2, rtol=1e-13, atol=1e-300)
 
 
-def test_tcl_script_issues_the_same_commands(tmp_path):
+@pytest.mark.parametrize("which", ["two bodies", "two buildings"])
+def test_tcl_script_issues_the_same_commands(tmp_path, which):
     """model.tcl, run by tclsh with every OpenSees command a Tcl procedure that logs its
-    arguments, issues the same commands with the same numbers as model.py."""
-    scene = from_dict(two_bodies("hunt-crossley", restitution=0.5, exponent=1.5), source="tb")
+    arguments, issues the same commands with the same numbers as model.py (a building's too:
+    rigidDiaphragm, geomTransf with vecxz, oriented zeroLength elements, its rows' penetration)."""
+    if which == "two bodies":
+        scene = from_dict(two_bodies("hunt-crossley", restitution=0.5, exponent=1.5), source="tb")
+    else:
+        scene = from_dict(small_buildings(t_end=0.005), source="sb")
     export(scene, tmp_path / "x", tcl=True)
     fake, _ = run_fake(tmp_path / "x")
     names = sorted({n for n, _ in fake.calls})
@@ -132,7 +137,8 @@ def test_tcl_script_issues_the_same_commands(tmp_path):
                 assert x == y
             else:
                 assert float(x) == float(y), (g, w)
-    assert (tmp_path / "x" / "history.csv").read_text().startswith("t,u:m1,")
+    assert (tmp_path / "x" / "history.csv").read_text().startswith(
+        "t,u:m1," if which == "two bodies" else "t,u:A1.ux,")
 
 
 @pytest.mark.parametrize("law, e, a", [
