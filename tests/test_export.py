@@ -108,17 +108,26 @@ def test_p7_kelvin_script_builds_the_scene_and_samples_every_output_step(tmp_pat
     assert np.allclose(data[:, 10], 0.5 * 100 * u1 ** 2 + 0.5 * 400 * u2 ** 2, rtol=1e-13, atol=1e-300)
 
 
-def test_tcl_script_issues_the_same_commands(tmp_path):
+def scene_members(scene):
+    return [(f"{b['prefix']}.{e.name}", None) for b in scene.extras["buildings"] for e in b["building"].elements]
+
+
+@pytest.mark.parametrize("which", ["two bodies", "two buildings"])
+def test_tcl_script_issues_the_same_commands(tmp_path, which):
     """model.tcl, run by tclsh with every OpenSees command a Tcl procedure that logs its
-    arguments, issues the same commands with the same numbers as model.py."""
-    scene = from_dict(two_bodies("hunt-crossley", restitution=0.5, exponent=1.5), source="tb")
+    arguments, issues the same commands with the same numbers as model.py (a building's too:
+    rigidDiaphragm, geomTransf with vecxz, oriented zeroLength elements, its rows' penetration)."""
+    if which == "two bodies":
+        scene = from_dict(two_bodies("hunt-crossley", restitution=0.5, exponent=1.5), source="tb")
+    else:
+        scene = from_dict(small_buildings(t_end=0.005), source="sb")
     export(scene, tmp_path / "x", tcl=True)
     fake, _ = run_fake(tmp_path / "x")
     names = sorted({n for n, _ in fake.calls})
     stubs = "".join(f"proc {n} args {{ puts [concat CALL {n} $args] }}\n" for n in names)
     stubs += ("proc analyze args { return 0 }\nproc nodeDisp args { return 0.0 }\n"
               "proc nodeVel args { return 0.0 }\nproc nodeAccel args { return 0.0 }\n"
-              "proc eleResponse args { return {0.0} }\n")
+              "proc eleResponse args { return {0.0 1.0 2.0 3.0 4.0 5.0 6.0 7.0 8.0 9.0 10.0 11.0} }\n")
     (tmp_path / "run.tcl").write_text(stubs + "source model.tcl\n")
     r = subprocess.run(["tclsh", str(tmp_path / "run.tcl")], cwd=tmp_path / "x", capture_output=True, text=True)
     assert r.returncode == 0, r.stderr
@@ -132,7 +141,13 @@ def test_tcl_script_issues_the_same_commands(tmp_path):
                 assert x == y
             else:
                 assert float(x) == float(y), (g, w)
-    assert (tmp_path / "x" / "history.csv").read_text().startswith("t,u:m1,")
+    assert (tmp_path / "x" / "history.csv").read_text().startswith(
+        "t,u:m1," if which == "two bodies" else "t,u:A1.ux,")
+    if which == "two buildings":         # Tcl's members.csv: model.py's columns, localForce's 4, 5, 10, 11
+        rows = (tmp_path / "x" / "members.csv").read_text().splitlines()
+        assert rows[0] == ",".join(["t"] + [f"{q}_{e}:{n}" for n, _ in scene_members(scene) for e in "ij"
+                                            for q in ("M2", "M3")])
+        assert rows[-1].split(",")[1:5] == ["4", "5", "10", "11"]
 
 
 @pytest.mark.parametrize("law, e, a", [
