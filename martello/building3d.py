@@ -40,6 +40,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from .modes import modes
+
 # Local end-force components of a member; recovery rows 12e + 6·end + k.
 END_FORCES = ("N", "V2", "V3", "T", "M2", "M3")
 # A plan position matches a member's within this distance [m] (beams, splits, contacts).
@@ -522,28 +524,6 @@ def membrane_stiffness(lx, ly, t, E, nu):
 
 
 # --- modes ------------------------------------------------------------------------------------
-
-def modes(K, M):
-    """(ω ascending, Φ) of K φ = ω² M φ, Φᵀ M Φ = I; M dense or its diagonal; K and M
-    positive definite (the callers factor both first), so every ω² is positive in exact
-    arithmetic: one computed <= 0, inf or NaN (masses and stiffness too disparate for double
-    precision, e.g. a floor of 1e-12 kg among floors of 1e5 kg) raises LinAlgError rather
-    than being clipped to a zero frequency."""
-    M = np.asarray(M, float)
-    with np.errstate(all="ignore"):
-        if M.ndim == 1:
-            s = 1 / np.sqrt(M)
-            A, back = s[:, None] * K * s[None, :], lambda y: s[:, None] * y
-        else:
-            Li = np.linalg.inv(np.linalg.cholesky(M))
-            A, back = Li @ K @ Li.T, lambda y: Li.T @ y
-        if not np.all(np.isfinite(A)):
-            raise np.linalg.LinAlgError("K M^-1 leaves the doubles")
-        lam, y = np.linalg.eigh(A)
-    if not (np.all(np.isfinite(lam)) and lam[0] > 0):
-        raise np.linalg.LinAlgError(f"a computed squared frequency is {lam[0]!r}")
-    return np.sqrt(lam), back(y)
-
 
 def modal_table(building, K, M, count=None):
     """Per mode: period, effective-mass ratios along x and y (Chopra, Dynamics of Structures,

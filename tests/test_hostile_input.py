@@ -557,11 +557,11 @@ def test_a_building_past_the_doubles_is_one_line_on_the_command_line(tmp_path):
 
 
 def test_modes_refuse_a_frequency_that_is_not_positive():
-    """building3d.modes: K and M positive definite, so a computed ω² <= 0 or NaN is round-off
+    """martello.modes: K and M positive definite, so a computed ω² <= 0 or NaN is round-off
     past the problem's conditioning (the p11 case above): LinAlgError, where it was clipped
     to a zero frequency."""
     import numpy as np
-    from martello.building3d import modes
+    from martello.modes import modes
     K = np.array([[2.0, -1.0], [-1.0, 1.0]]) * 1e9
     w, phi = modes(K, np.array([1e5, 2e5]))
     assert np.all(w > 0) and np.allclose(phi.T @ np.diag([1e5, 2e5]) @ phi, np.eye(2))
