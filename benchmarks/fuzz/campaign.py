@@ -335,7 +335,9 @@ def main(argv=None):
     ap.add_argument("--root", default=str(ROOT),
                     help="checkout whose martello package is run (default: this one)")
     ap.add_argument("--lib", help="libmartello.so to load (default: ROOT/build/libmartello.so)")
-    ap.add_argument("--python", default=sys.executable, help="interpreter (default: this one)")
+    ap.add_argument("--python", help="interpreter (default: ROOT/.venv/bin/python if --root has "
+                    "one, else this one: an interpreter with another checkout installed editable "
+                    "imports that checkout's martello whatever PYTHONPATH says)")
     ap.add_argument("--memory", type=float, default=4.0,
                     help="address-space limit of each run in GiB (default 4)")
     ap.add_argument("--only", type=int, nargs="*", help="run only these case numbers")
@@ -360,6 +362,9 @@ def main(argv=None):
         return loader_campaign(args)
 
     root = Path(args.root).resolve()
+    if args.python is None:
+        venv = root / ".venv" / "bin" / "python"
+        args.python = str(venv) if venv.exists() else sys.executable
     env = dict(os.environ, PYTHONPATH=str(root), PYTHONDONTWRITEBYTECODE="1",
                OPENBLAS_NUM_THREADS="1", OMP_NUM_THREADS="1",
                MARTELLO_LIB=str(Path(args.lib).resolve() if args.lib
