@@ -615,3 +615,27 @@ def test_a_value_starting_with_a_dash_is_shown_how_to_write_it(capsys):
         err = capsys.readouterr().err
         assert e.value.code == 1 and err.count("\n") == 1 and "expected one argument" in err, err
         assert (hint in err) if hint else "written" not in err, err
+
+
+@pytest.mark.parametrize("name", ["a,b", "m\n", "", " m", 'm"'])
+def test_a_name_that_would_break_the_history_header_is_refused(tmp_path, name):
+    """A node named 'a,b' or 'm\\n' ran and wrote a history.csv whose header martello compare
+    could not read back ('duplicate column(s) b'; CLI fuzz of compare, session 5): names head
+    the history's columns, so the loader refuses them, naming the field."""
+    d = scene_dict("sdof/sdof_sine_newmark")
+    d["node"][0]["name"] = name
+    for lk in d["link"]:
+        lk["a"] = name
+    run_fails(tmp_path, d, "s.toml: node[0].name: invalid name", "no comma, quote or control character")
+
+
+def test_a_name_with_inner_spaces_or_a_colon_still_round_trips(tmp_path):
+    d = scene_dict("sdof/sdof_sine_newmark")
+    d["node"][0]["name"] = "top floor:1"
+    for lk in d["link"]:
+        lk["a"] = "top floor:1"
+    d["analysis"]["t_end"] = 0.05
+    f = write(tmp_path / "s.toml", d)
+    assert martello("run", f, "-o", tmp_path / "out", cwd=tmp_path).returncode == 0
+    r = martello("compare", tmp_path / "out" / "history.csv", "--against", f, cwd=tmp_path)
+    assert r.returncode == 0, r.stderr

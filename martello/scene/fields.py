@@ -50,6 +50,19 @@ def kind_ok(kind, v):
     return isinstance(v, {"str": str, "bool": bool, "list": list, "table": dict}[kind])
 
 
+# Names of items (and the prefixes of generated ones) head the columns of history.csv
+# (u:<node>, link_force:<link>; docs/results.md), which martello compare and plot read back:
+# a comma, a quote or a line break in one made a file martello could not read.
+NAME_KEYS = ("name", "prefix")
+NAME_RULE = ("a name is not empty, has no comma, quote or control character (line break, tab), "
+             "and no space at either end")
+
+
+def name_ok(v):
+    return (v != "" and v == v.strip() and not any(c in ',"' or ord(c) < 32 or ord(c) == 127
+                                                    for c in v))
+
+
 def check_fields(src, table, where, spec, extra_ok=()):
     """Validate one table against its spec; return a dict with defaults filled in."""
     if not isinstance(table, dict):
@@ -75,6 +88,8 @@ def check_fields(src, table, where, spec, extra_ok=()):
                              f"must be an integer of at most {INT_MAX} in magnitude")
         if kind == "float":
             v = float(v)
+        if key in NAME_KEYS and isinstance(v, str) and not name_ok(v):
+            raise SceneError(src, path, f"invalid name {v!r}", NAME_RULE)
         if check is not None and kind in ("float", "int"):
             ok, what = check
             if not ok(v):
