@@ -392,7 +392,8 @@ static int integrate(ida_problem *P, SUNContext sunctx, N_Vector yy, N_Vector yp
   double t_out = fmin((double)E->every * E->dt, E->t_end), t_last = 0.0;
   if ((st = observe(P, 0.0, N_VGetArrayPointer(yy), N_VGetArrayPointer(yp), 0)) != MARTELLO_OK) return st;
   oe_accepted(E, N_VGetArrayPointer(yy));
-  double t_stop = oe_next_stop(E, 0.0, t_out);
+  int kink = 0;
+  double t_stop = oe_next_stop(E, 0.0, t_out, &kink);
   if ((st = check(P, IDASetStopTime(mem, t_stop), "IDASetStopTime"))) return st;
   const size_t n_found = (size_t)(oe_nroots(E) + 1);
   int *found = calloc(n_found, sizeof(int));
@@ -450,7 +451,7 @@ static int integrate(ida_problem *P, SUNContext sunctx, N_Vector yy, N_Vector yp
       if (!restart) restart = root_stays_zero(P, N_VGetArrayPointer(yy), found);
     }
     /* a kink of the load (docs/ida.md, time events): IDA restarts across it */
-    if (!restart && flag == IDA_TSTOP_RETURN && tret == t_stop && t_stop < t_out) restart = 1;
+    if (!restart && flag == IDA_TSTOP_RETURN && tret == t_stop && kink && t_stop < t_out) restart = 1;
     if (!restart) {
       double h_last = 0.0;
       if (IDAGetLastStep(mem, &h_last) != IDA_SUCCESS) h_last = 0.0;
@@ -507,7 +508,7 @@ static int integrate(ida_problem *P, SUNContext sunctx, N_Vector yy, N_Vector yp
       memset(E->cnt_last, 0, sizeof E->cnt_last);   /* IDAReInit starts the counters again */
     }
     if (restart || at_output || tret >= t_stop) {
-      t_stop = oe_next_stop(E, t_r, t_out);
+      t_stop = oe_next_stop(E, t_r, t_out, &kink);
       if ((st = check(P, IDASetStopTime(mem, t_stop), "IDASetStopTime"))) break;
     }
   }

@@ -106,6 +106,8 @@ typedef struct {
   N_Vector yrow;
   /* settings */
   double rtol, atol, event_tol, t_end, h_max, out_dt, dt;
+  double h_hold;              /* the longest step while a rigid contact is held (0: no bound;
+                                 oe_max_step) */
   int restarts;               /* 1: the integrator restarts at order 1 after an event (BDF;
                                  the accumulation rule's resolution), 0: a one-step method */
   int every;                  /* output intervals dt per stop time out_dt */
@@ -226,8 +228,14 @@ int oe_hand_work(ode_events *E);
 int oe_stretch(ode_events *E, double t0, double t1, const double *y1, int at_event);
 /* After a stretch: its end's rates are the next one's start unless the integrator restarts. */
 void oe_keep_end_rates(ode_events *E, int unchanged);
-/* The next stop after t: t_to (an output time or t_end), or a kink of the load before it. */
-double oe_next_stop(ode_events *E, double t, double t_to);
+/* The longest step the integrator may take now (0: no limit): the setting h_max and, while a
+ * rigid contact is held, a fraction of the loads' shortest harmonic period (docs/sundials-ode.md,
+ * held contacts). The adapter sets it at the start and after every restart. */
+double oe_max_step(const ode_events *E);
+/* The next stop after t: t_to (an output time or t_end), or a kink of the load before it; a
+ * kink within 16 eps of t_to is t_to, one within 16 eps after t is skipped. *kink = 1 when the
+ * stop is (also) a kink: the integrator restarts there. */
+double oe_next_stop(ode_events *E, double t, double t_to, int *kink);
 /* The integrator's counters now (MARTELLO_COUNTER_* order; events and chatter ignored): their
  * increase since the last hand-over, and the events, to the run. */
 int oe_add_counts(ode_events *E, const long c[9]);
