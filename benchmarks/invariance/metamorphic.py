@@ -330,7 +330,8 @@ def check(path_or_data, relation, base_dir=None):
     to, measured as in the output invariance: what a 3 and 10 times looser tolerance (an
     adaptive run's rtol, atol and event_tol; a Newton method's tol_residual and
     tol_increment) moves it, and 100 times that relative tolerance; and the run's own
-    rounding, what scaling every mass by 1 + 4 eps moves it (relations.rounding_scene).
+    rounding, what scaling every mass by 1 + 4 eps moves it (relations.rounding_scene; the
+    Newmark family at six perturbations and within the ceiling relations.newmark_rounding).
     Raises Unsupported."""
     from benchmarks.invariance import relations as R
     if isinstance(path_or_data, (str, Path)):

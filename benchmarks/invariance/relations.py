@@ -323,24 +323,83 @@ def free_scene(data):
 # The perturbation of the rounding probe (rounding_scene): every mass times 1 + 4 eps, the
 # size of the rounding a reordered or rescaled sum leaves in a number.
 ROUNDING_PROBE = 4.0 * np.finfo(float).eps
+# The Newmark family (Newmark, HHT, generalized-α, Newmark–Lagrange) solves for u and takes
+# a = (u − u_n − h v_n)/(βh²) − …: the rounding of u, ε|u|, is an acceleration of up to
+# q = ε·max|u|/(βh²) (docs/invariance.md, "Rounding of the Newmark family"; P5 at h = 1e-7 s,
+# max|u| = 2 mm: q = 1.7e-4 m/s²; a free body's |a| measured up to 1.04 q), and a free body's
+# iterate stays on whichever value the rounding left (Newton cannot move u by less than an
+# ulp). A perturbation of the masses moves such a run to one of a few discrete outcomes, and
+# one probe may land on the same one (P5 Hertz-damp, generalized-α, masses × (1 + kε),
+# k = −16…16: m2's final speed at 0, 5.5e-8 or 1.1e-7 relative; k = 4 gave 2e-9, the renamed
+# scene 5.7e-8): these runs are probed at several k (their largest move), and their
+# accelerations, velocities and displacements are also allowed the ceiling of that rounding,
+# 4q, 2q·t_end and q·t_end² (newmark_rounding; P5 Hertz, generalized-α: 2.5e-6 relative on
+# m2's speed, 50 times its spread over k = −16…16, 5.1e-8, of which the 6 probes found 1.3e-8).
+ROUNDING_PROBES_NEWMARK = (4.0, -4.0, 1.0, -1.0, 2.0, -2.0)
+DISPLACEMENT_FORM = ("newmark", "hht", "generalized-alpha", "newmark-lagrange")
 
 
-def rounding_scene(data):
-    """The scene with every mass scaled by 1 + ROUNDING_PROBE (nodes and chains; None when it
-    has no mass given so): what that moves a number is what rounding moves it in this run. A
-    stiff contact met by a long sequence of short steps amplifies it far beyond ROUNDING
-    (measured: P5 Hertz on Newmark, 5e4 steps of 1e-7 s: |a| max moved 1.5e-8 relative by a
-    mass change of 1 ulp)."""
+def newmark_beta(an):
+    """β of a Newmark-family run (generalized_alpha_coefficients in fortran/generalized_alpha.f90;
+    Newmark–Lagrange: the average acceleration)."""
+    from martello.binding import native
+    defaults = native.settings_defaults()
+    integrator = an["integrator"]
+    if integrator == "hht":
+        return 0.25 * (1.0 - float(an.get("alpha", defaults["alpha"]))) ** 2
+    if integrator == "generalized-alpha":
+        rho = float(an.get("rho_inf", defaults["rho_inf"]))
+        am, af = (2.0 * rho - 1.0) / (rho + 1.0), rho / (rho + 1.0)
+        return 0.25 * (1.0 - am + af) ** 2
+    if integrator == "newmark":
+        return float(an.get("beta", defaults["beta"]))
+    return 0.25
+
+
+def newmark_rounding(data, base):
+    """The ceiling of the rounding of a Newmark-family run on each acceleration, velocity and
+    displacement of base (docs/invariance.md, "Rounding of the Newmark family"): q = ε·U/(βh²),
+    U the largest |u| of the run: 4q, 2q·t_end, q·t_end² (a difference of two nodes, each
+    within 2q, q·t_end, q·t_end²/2); {} for the other integrators."""
+    an = data["analysis"]
+    if an["integrator"] not in DISPLACEMENT_FORM:
+        return {}
+    U = max([abs(x) for p, x in base.items() if p.startswith("nodes.") and isinstance(x, float)
+             and p.rpartition(".")[2] in ("u_max", "u_min", "u_absmax") and math.isfinite(x)]
+            + [0.0])
+    h, T = float(an["dt"]), float(an["t_end"])
+    q = np.finfo(float).eps * U / (newmark_beta(an) * h * h)
+    # a node's acceleration error is up to ~q (measured up to 1.04 q: P5 bodies shifted 1 m,
+    # free flight), its velocity's up to q·t_end (measured up to 0.14 q·t_end); twice either
+    # for a difference of two nodes (a penetration, an approach speed, an elongation)
+    ceiling = {"A": 4.0 * q, "V": 2.0 * q * T, "L": q * T * T}
+    return {p: ceiling[_family(p)] for p in base if _family(p) in ceiling}
+
+
+def rounding_scene(data, k=4.0):
+    """The scene with every mass scaled by 1 + k eps (nodes and chains; None when it has no
+    mass given so): what that moves a number is what rounding moves it in this run. A stiff
+    contact met by a long sequence of short steps amplifies it far beyond ROUNDING (measured:
+    P5 Hertz on Newmark, 5e4 steps of 1e-7 s: |a| max moved 1.5e-8 relative by a mass change
+    of 1 ulp)."""
     d = base_scene(data)
     items = [n for n in d.get("node", []) if "mass" in n] + \
         [c for c in d.get("chain", []) if "mass" in c]
     if not items:
         return None
+    f = 1.0 + k * np.finfo(float).eps
     for item in items:
         m = item["mass"]
-        item["mass"] = [x * (1.0 + ROUNDING_PROBE) for x in m] if isinstance(m, list) \
-            else m * (1.0 + ROUNDING_PROBE)
+        item["mass"] = [x * f for x in m] if isinstance(m, list) else m * f
     return d
+
+
+def rounding_probes(data):
+    """The mass perturbations (in eps) that probe a run's rounding: several for the Newmark
+    family (DISPLACEMENT_FORM), one (ROUNDING_PROBE) for the others."""
+    if data["analysis"]["integrator"] in DISPLACEMENT_FORM:
+        return ROUNDING_PROBES_NEWMARK
+    return (ROUNDING_PROBE / np.finfo(float).eps,)
 
 
 def tolerance_error(data, base, base_dir, mapped=None, rounding=False):
@@ -367,10 +426,14 @@ def tolerance_error(data, base, base_dir, mapped=None, rounding=False):
                 error[p] = max(error.get(p, 0.0), e)
     if rounding:
         # a relation that reorders or rescales the arithmetic: the run's own rounding, probed
-        probe = rounding_scene(data)
-        if probe is not None:
+        for k in rounding_probes(data):
+            probe = rounding_scene(data, k)
+            if probe is None:
+                break
             for p, e in own_error(base, numbers(run(probe, base_dir)[0])).items():
                 error[p] = max(error.get(p, 0.0), e)
+        for p, e in newmark_rounding(data, base).items():
+            error[p] = max(error.get(p, 0.0), e)
     from martello.binding import native
     rtol = 0.0
     if an["integrator"] in ADAPTIVE:

@@ -10,33 +10,47 @@ rods or between a rod's end node and ground (a rigid wall), `summary["measures"]
 (martello.oracles.p4_rod_impact.rod_impact for the plateau force, the duration and the final
 velocities; martello.oracles.p4_wave_theory for the displacement field):
 
+No measure depends on how the run is recorded (docs/invariance.md). From what the run tracks
+at every step, whatever `output.every` (the summary's contact phases and maxima, the final
+state):
+
 * contact duration: first onset to the last separation of the first *episode* (phases
   whose open intervals are shorter than the shortest element transit time L_e/c, or one
-  output interval if that is longer, are one impact: a contact that only touches zero
-  between two steps has not separated);
-* the force pulse against the rectangle P0 = Z v0/2 (Z v0 on a wall) on
-  [t_on, t_on + 2 L_min/c): L1 error (the recorded force held constant over each output
-  interval, centred on its sample: the impulse a step of central difference applies),
-  peak error, total variation (the rectangle has 2 P0; the excess is spurious
-  oscillation) and impulse;
-* energy error: max |E_kin + E_recoverable − E0| / E0 over the history, and its final value;
+  step of a fixed-step method if that is longer, are one impact: a contact that only
+  touches zero between two steps has not separated);
 * penetration: the maximum, and the maximum over the interface displacement scale v_p τ;
+* impulse: the momentum the contact moved from one rod to the other (its error against the
+  rectangle's P0 T), from the rods' final momentum — the impulse the method applied, by
+  conservation of momentum, whatever the quadrature of its force;
 * final mean velocities of the rods (momentum / mass, consistent couplings included) at
-  the last recorded step, their errors over v0, and the share of energy left as vibration;
-* displacement error: max over samples and recorded rod nodes of |u − u_exact|, over v_p τ
+  the end of the run, their errors over v0, the share of energy left as vibration, and the
+  final energy error (E_kin + E_recoverable − E0) / E0.
+
+From the force, energy and displacement at every step of a fixed-step method — only where
+the history holds them, `every = 1` (an adaptive run's rows are its output times, not its
+steps; with every > 1, or adaptive, they are left out and a note says why, never computed
+on the recorded samples):
+
+* the force pulse against the rectangle P0 = Z v0/2 (Z v0 on a wall) on
+  [t_on, t_on + 2 L_min/c): L1 error (the force held constant over each step, centred on
+  its sample: the impulse a step of central difference applies), peak (the largest force
+  the method applies at its steps), total variation (the rectangle has 2 P0; the excess is
+  spurious oscillation) and the width of the held pulse;
+* energy error: max |E_kin + E_recoverable − E0| / E0 over the steps;
+* displacement error: max over the steps and the rod nodes of |u − u_exact|, over v_p τ
   (all nodes, and the two contact nodes alone).
 
 What the measures need from `[analysis.output]`: the contact in `contacts` (default) for
-the pulse, the energy and the duration's episode; every node of both rods in `nodes` for
-the final velocities and the displacement field (`[[bar]] output = "all"`, the default,
-puts them there); `every = 1` for the L1, peak and total-variation figures to mean what
-they say (with every > 1 they are computed on the recorded samples and a note says so).
-Errors are signed value − reference unless called relative. Quantities that cannot be
-formed are left out and `notes` says why; nothing here raises for a scene that does not fit.
+the pulse and the energy; every node of both rods in `nodes` for the impulse, the final
+velocities and the displacement field (`[[bar]] output = "all"`, the default, puts them
+there). Errors are signed value − reference unless called relative. Quantities that cannot
+be formed are left out and `notes` says why; nothing here raises for a scene that does not
+fit.
 """
 
 import numpy as np
 
+from ..binding import native
 from ..run import run_full
 
 REL_SAME = 1e-12     # two rods with c and Z equal to this relative tolerance are "the same bar"
@@ -174,9 +188,14 @@ def rod_impact_measures(scene, summary, history):
     P0, T = ref.force, ref.duration
     vp = P0 / ref.impedance
     an = scene.analysis
-    dt_out = an["dt"] * an["output"]["every"]
+    adaptive = an["integrator"] in native.adaptive_integrators()
+    # the method's steps are in the history: a fixed-step run recorded at every step
+    every_step = not adaptive and an["output"]["every"] == 1
     involved = [r for r in (rod_a, rod_b) if r is not None]
-    t_merge = max(min(r["transit_time"] for r in involved), dt_out) * (1.0 + 1e-9)
+    # one step of a fixed-step method (an adaptive run's phases are located, its dt is an
+    # output interval: not a length of the physics or the method)
+    h = 0.0 if adaptive else an["dt"]
+    t_merge = max(min(r["transit_time"] for r in involved), h) * (1.0 + 1e-9)
 
     m = {"applicable": True, "contact": c["name"],
          "rods": {"a": rod_a["name"] if rod_a else "ground", "b": rod_b["name"] if rod_b else "ground"},
@@ -207,21 +226,22 @@ def rod_impact_measures(scene, summary, history):
         m["notes"] = notes
         return m
     t = data[:, col["t"]]
-    if an["output"]["every"] > 1:
-        notes.append(f"output every {an['output']['every']} steps: L1, peak and total variation "
-                     "are computed on the recorded samples only")
+    if not every_step:
+        notes.append(("an adaptive run's history holds its output times, not its steps"
+                      if adaptive else f"output every {an['output']['every']} steps") +
+                     ": no pulse L1, peak, total variation or width, energy error over the run or "
+                     "displacement error (they need the force, energy and displacement at every "
+                     "step of the method)")
 
     fkey = f"force:{c['name']}"
-    if fkey in col:
+    if not every_step:
+        pass
+    elif fkey in col:
         p = data[:, col[fkey]]
         l1 = _hold_l1(t, p, t_on_ref, t_on_ref + T, P0)
         m["pulse_l1_error"] = l1 / (P0 * T)
         m["force_peak"] = float(np.max(p))
         m["peak_error"] = (float(np.max(p)) - P0) / P0
-        # impulse of the held samples (the rectangle's is P0 T)
-        lo, hi = _cells(t)
-        w = hi - lo
-        m["impulse_error"] = (float(np.dot(w, p)) - P0 * T) / (P0 * T)
         if t_on is not None:
             end = t_off if t_off is not None else t[-1]
             i0 = max(int(np.searchsorted(t, t_on, side="right")) - 1, 0)
@@ -245,7 +265,8 @@ def rod_impact_measures(scene, summary, history):
         e = data[:, col["energy:kinetic"]] + data[:, col["energy:recoverable"]]
         e0 = data[0, col["energy:initial"]]
         if e0 > 0:
-            m["energy_error"] = float(np.max(np.abs(e - e0)) / e0)
+            if every_step:
+                m["energy_error"] = float(np.max(np.abs(e - e0)) / e0)
             m["energy_final_error"] = float((e[-1] - e0) / e0)
 
     # final mean velocities and the displacement field need every node of the rods
@@ -255,17 +276,25 @@ def rod_impact_measures(scene, summary, history):
         notes.append("rod(s) " + ", ".join(missing) + " not fully in analysis.output.nodes "
                      "([[bar]] output = \"all\"): no final velocities or displacement field")
     else:
-        last = data[-1]
-        v_fin, v_err = {}, {}
-        for r in involved:
-            v = np.array([last[col[f"v:{nm}"]] for nm in r["nodes"]])
+        def momentum(row, r):
+            v = np.array([row[col[f"v:{nm}"]] for nm in r["nodes"]])
             mom = float(np.dot(r["node_mass"], v))
             pos = {nm: i for i, nm in enumerate(r["nodes"])}
             for na, nb, val in r["couplings"]:
                 mom += val * (v[pos[na]] + v[pos[nb]])
+            return mom
+
+        v_fin, v_err, impulse = {}, {}, None
+        for r in involved:
+            mom = momentum(data[-1], r)
             v_fin[r["name"]] = mom / r["mass_total"]
             v_err[r["name"]] = (v_fin[r["name"]] - v_ref[r["name"]]) / v_rel
+            if impulse is None:
+                # the contact pushes side a back and side b on (δ = u_a − u_b − gap); the
+                # first row is t = 0 (recorded at any every)
+                impulse = (mom - momentum(data[0], r)) * (-1.0 if r is rod_a else 1.0)
         m["v_final"], m["v_error"] = v_fin, v_err
+        m["impulse_error"] = (impulse - P0 * T) / (P0 * T)
         if t_off is None or t[-1] < t_off:
             notes.append("the run ends before the contact opens: final velocities are not post-impact")
         ma = rod_a["mass_total"] if rod_a else None
@@ -280,24 +309,25 @@ def rod_impact_measures(scene, summary, history):
         m["vibration_energy_fraction"] = frac
         m["vibration_energy_reference"] = frac_ref
 
-        # displacement field against d'Alembert (free rods of equal bars)
-        err_all, err_end = 0.0, 0.0
-        scale = vp * T
-        for side, r, end_node in (("a", rod_a, side_a and side_a[1]), ("b", rod_b, side_b and side_b[1])):
-            if r is None:
-                continue
-            face = r["x0"] + r["L"] if end_node == r["right"] else r["x0"]
-            other = (rod_b if side == "a" else rod_a)
-            L_other = other["L"] if other is not None else r["L"]
-            for nm, x in zip(r["nodes"], r["x"]):
-                s = min(max(abs(face - x), 0.0), r["L"])
-                u_ex = r["v0"] * t + rod_point_displacement(s, t - t_on_ref, ref.c, r["L"], L_other,
-                                                            v_rel, side, wall=wall)
-                e_node = float(np.max(np.abs(data[:, col[f"u:{nm}"]] - u_ex))) / scale
-                err_all = max(err_all, e_node)
-                if nm == end_node:
-                    err_end = max(err_end, e_node)
-        m["displacement_error"] = err_all
-        m["end_displacement_error"] = err_end
+        if every_step:
+            # displacement field against d'Alembert (free rods of equal bars)
+            err_all, err_end = 0.0, 0.0
+            scale = vp * T
+            for side, r, end_node in (("a", rod_a, side_a and side_a[1]), ("b", rod_b, side_b and side_b[1])):
+                if r is None:
+                    continue
+                face = r["x0"] + r["L"] if end_node == r["right"] else r["x0"]
+                other = (rod_b if side == "a" else rod_a)
+                L_other = other["L"] if other is not None else r["L"]
+                for nm, x in zip(r["nodes"], r["x"]):
+                    s = min(max(abs(face - x), 0.0), r["L"])
+                    u_ex = r["v0"] * t + rod_point_displacement(s, t - t_on_ref, ref.c, r["L"], L_other,
+                                                                v_rel, side, wall=wall)
+                    e_node = float(np.max(np.abs(data[:, col[f"u:{nm}"]] - u_ex))) / scale
+                    err_all = max(err_all, e_node)
+                    if nm == end_node:
+                        err_end = max(err_end, e_node)
+            m["displacement_error"] = err_all
+            m["end_displacement_error"] = err_end
     m["notes"] = notes
     return m
