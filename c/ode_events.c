@@ -824,9 +824,78 @@ int oe_prepare_restart(ode_events *E, double t, double *u, double *v) {
     return oe_fail(E, st, "%s: energy evaluation failed", E->name);
   E->e_impact += ke0 - ke1;
   for (int j = 0; j < E->nc; j++) E->act[j] = ACT_NONE;
+  E->held_ready = 0;
   if ((st = closed_set_roots(E)) != MARTELLO_OK)
     return oe_fail(E, MARTELLO_ERR_SINGULAR, "%s: redundant closed contacts at t = %.9e s (B^T M^-1 B singular)", E->name, t);
   return oe_hand_work(E);
+}
+
+/* The held set's multipliers plus their tension bars into lam and their rates into dlam at
+ * (t, u, v): lambda from the state (oe_closed_multipliers), lambda' the multiplier of the jerk,
+ * W_H lambda' = -B_H j (the constraints are linear and the mass constant; as c/event_driven.c). */
+static int held_values(ode_events *E, double t, const double *u, const double *v, double *lam,
+                       double *dlam) {
+  int st = oe_closed_multipliers(E, t, u, v);
+  if (st == MARTELLO_OK) st = martello_peak_rates(E->ev, t, u, v, E->ar, E->nc, E->nl, E->elc, E->jk);
+  if (st == MARTELLO_OK)
+    st = martello_impulse_project(E->n, E->mc, E->dlc, TOPOLOGY(E), E->Wc, NULL, E->jk, E->rhs);
+  if (st != MARTELLO_OK)
+    return oe_fail(E, st, "%s: the held contacts' forces failed at t = %.9e s", E->name, t);
+  for (int k = 0; k < E->mc; k++) {
+    lam[k] = E->lr[E->lc[k]] + E->lamtol[E->lc[k]];
+    dlam[k] = E->rhs[k];
+  }
+  return MARTELLO_OK;
+}
+
+/* held_values at t on the interpolant of the last step. */
+static int held_values_at(ode_events *E, double t, double *lam, double *dlam) {
+  int st = E->dky(E->ctx, t, 0, E->ytmp);
+  if (st != MARTELLO_OK) return st;
+  oe_gather(E, N_VGetArrayPointer(E->ytmp), E->uq, E->vq);
+  return held_values(E, t, E->uq, E->vq, lam, dlam);
+}
+
+int oe_held_release(ode_events *E, double t0, double t1, const double *y1, double *t_r) {
+  int st, kbest = -1;
+  double best = t1;
+  if (E->mc == 0 || !(t1 > t0)) return 0;
+  oe_gather(E, y1, E->uq, E->vq);
+  if ((st = held_values(E, t1, E->uq, E->vq, E->hl1, E->hd1)) != MARTELLO_OK) return st;
+  /* the start's values: kept from the last step's end, or (the first step after a restart)
+   * from the interpolant */
+  if (!E->held_ready && (st = held_values_at(E, t0, E->hl0, E->hd0)) != MARTELLO_OK) return st;
+  for (int k = 0; k < E->mc; k++) {
+    if (!(E->hl0[k] > 0.0 && E->hl1[k] > 0.0 && E->hd0[k] < 0.0 && E->hd1[k] > 0.0)) continue;
+    const double tol = fmax(E->event_tol, 4.0 * DBL_EPSILON * fabs(t1));
+    double lo = t0, hi = t1;
+    for (int it = 0; it < 200 && hi - lo > tol; it++) {
+      const double tm = 0.5 * (lo + hi);
+      if ((st = held_values_at(E, tm, E->hlm, E->hdm)) != MARTELLO_OK) return st;
+      if (E->hdm[k] < 0.0) lo = tm; else hi = tm;
+    }
+    if ((st = held_values_at(E, hi, E->hlm, E->hdm)) != MARTELLO_OK) return st;
+    if (!(E->hlm[k] < 0.0)) continue;       /* the minimum stays compressive */
+    lo = t0;
+    for (int it = 0; it < 200 && hi - lo > tol; it++) {
+      const double tm = 0.5 * (lo + hi);
+      if ((st = held_values_at(E, tm, E->hlm, E->hdm)) != MARTELLO_OK) return st;
+      if (E->hlm[k] > 0.0) lo = tm; else hi = tm;
+    }
+    if (kbest < 0 || hi < best) {
+      best = hi;
+      kbest = k;
+    }
+  }
+  if (kbest >= 0) {
+    E->act[E->rig_con[E->lc[kbest]]] = ACT_RELEASE;
+    *t_r = best;
+    return 1;
+  }
+  double *tmp = E->hl0; E->hl0 = E->hl1; E->hl1 = tmp;
+  tmp = E->hd0; E->hd0 = E->hd1; E->hd1 = tmp;
+  E->held_ready = 1;
+  return 0;
 }
 
 int oe_initial_contacts(ode_events *E, const double *u0, const double *v0) {
@@ -1038,7 +1107,7 @@ void oe_release(ode_events *E) {
                  E->sw_el, E->sw_al, E->sw_be, E->sw_ga, E->sw_hit, E->lc, E->dlc, E->Wc, E->ar,
                  E->lr, E->lamtol, E->v_last, E->el0, E->el1, E->elc, E->pv0, E->pa0, E->pj0,
                  E->pv1, E->pa1, E->pj1, E->ua, E->va, E->aa, E->jk, E->cont, E->d_last,
-                 E->r_last, E->vin, E->vin_j, E->tay_u, E->tay_v, E->ev_t, E->ev_j, E->ev_k};
+                 E->r_last, E->vin, E->vin_j, E->tay_u, E->tay_v, E->ev_t, E->ev_j, E->ev_k, E->hl0, E->hd0, E->hl1, E->hd1, E->hlm, E->hdm};
   for (size_t k = 0; k < sizeof all / sizeof all[0]; k++) free(all[k]);
   if (E->ev) martello_eval_free(&E->ev);
   martello_accumulation_free(&E->acc);
@@ -1113,7 +1182,8 @@ int oe_setup(ode_events *E, martello_model *model, martello_run *run, const char
                        &E->aset, &E->lc, &E->dlc};
   for (size_t k = 0; k < sizeof per_rigid / sizeof per_rigid[0]; k++)
     *per_rigid[k] = oe_take(nr, sizeof(int), &failed);
-  double **per_rigid_d[] = {&E->q, &E->w0, &E->lam, &E->rhs, &E->lr, &E->lamtol};
+  double **per_rigid_d[] = {&E->q, &E->w0, &E->lam, &E->rhs, &E->lr, &E->lamtol,
+                            &E->hl0, &E->hd0, &E->hl1, &E->hd1, &E->hlm, &E->hdm};
   for (size_t k = 0; k < sizeof per_rigid_d / sizeof per_rigid_d[0]; k++)
     *per_rigid_d[k] = oe_take(nr, sizeof(double), &failed);
   E->cols = oe_take(nr * un, sizeof(double), &failed);

@@ -575,6 +575,11 @@ static int integrate(ode_problem *P, SUNContext ctx, N_Vector yy, SUNMatrix *Jp,
         break;
       }
     }
+    /* a held contact's multiplier that turns tensile and back inside the step */
+    if (!again && (again = oe_held_release(E, t_last, tret, y, &t_r)) < 0) {
+      st = again;
+      break;
+    }
     if (again && t_r < tret && (st = interpolant(P, t_r, 0, yy)) != MARTELLO_OK) break;
     if ((st = oe_rows_inside(E, &t_last, t_r, &k_out, &t_out)) != MARTELLO_OK) break;
     if ((st = oe_inner_events(E, t_last, t_r, y)) != MARTELLO_OK) break;
