@@ -1107,7 +1107,8 @@ void oe_release(ode_events *E) {
                  E->sw_el, E->sw_al, E->sw_be, E->sw_ga, E->sw_hit, E->lc, E->dlc, E->Wc, E->ar,
                  E->lr, E->lamtol, E->v_last, E->el0, E->el1, E->elc, E->pv0, E->pa0, E->pj0,
                  E->pv1, E->pa1, E->pj1, E->ua, E->va, E->aa, E->jk, E->cont, E->d_last,
-                 E->r_last, E->vin, E->vin_j, E->tay_u, E->tay_v, E->ev_t, E->ev_j, E->ev_k, E->hl0, E->hd0, E->hl1, E->hd1, E->hlm, E->hdm};
+                 E->r_last, E->vin, E->vin_j, E->tay_u, E->tay_v, E->ev_t, E->ev_j, E->ev_k, E->hl0,
+                 E->hd0, E->hl1, E->hd1, E->hlm, E->hdm};
   for (size_t k = 0; k < sizeof all / sizeof all[0]; k++) free(all[k]);
   if (E->ev) martello_eval_free(&E->ev);
   martello_accumulation_free(&E->acc);
