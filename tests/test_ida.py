@@ -405,6 +405,7 @@ def test_an_atol_below_the_rounding_of_the_gap_is_a_warning_before_and_after_the
 # --- output rows on IDA's interpolant: no result depends on the output -----------------------------
 
 @pytest.mark.parametrize("path", ["benchmarks/p2/laws/p2_linear_ida.toml",
+                                  "benchmarks/p2/p2_ida_restitution.toml",
                                   "benchmarks/p7/laws/p7_two_kelvin_ida.toml"])
 def test_rows_on_the_interpolant_keep_output_invariance(path):
     # Identity of the method (no oracle). IDA stops only at the loads' kinks, its events and
@@ -418,7 +419,8 @@ def test_rows_on_the_interpolant_keep_output_invariance(path):
     # - an energy: the works' 3-point Gauss over stretches split at the rows, and the running
     #   balance sampled at the rows too: within the error the run reports on its works, its
     #   energy balance (as relations.mismatches).
-    # Measured (P2's linear plane stepped across, P7's Kelvin contact restarted): every number
+    # Measured (P2's linear plane stepped across, P2's bouncing mass with its held contact,
+    # P7's Kelvin contact restarted): every number
     # but the energies and located times to the bit; times within 3.4e-13 s, a peak force
     # 3.8e-14 relative, energies 1.1e-14 J of 0.76 J, P2's balance_max 2.9e-14 J of 4.2e-9 J.
     import sys
