@@ -72,8 +72,17 @@ class FakeOpenSees:
         assert master in self.nodes and slave in self.nodes
         self._rec("equalDOF", master, slave, *dofs)
 
-    def geomTransf(self, kind, tag):
-        self._rec("geomTransf", kind, tag)
+    def geomTransf(self, kind, tag, *vecxz):
+        assert kind == "Linear" and len(vecxz) == (3 if self.ndm == 3 else 0), (kind, tag, vecxz)
+        if vecxz:                          # a unit vector in the local x-z plane
+            assert abs(math.hypot(*vecxz) - 1.0) < 1e-12, vecxz
+        self._rec("geomTransf", kind, tag, *vecxz)
+
+    def rigidDiaphragm(self, perp, master, *slaves):
+        assert perp == 3 and self.ndm == 3 and slaves, (perp, master, slaves)
+        assert master in self.nodes and all(t in self.nodes for t in slaves), (master, slaves)
+        assert self.fixed.get(master, ())[2:5] == (1, 1, 1), "a master's uz, θx, θy are held"
+        self._rec("rigidDiaphragm", perp, master, *slaves)
 
     def region(self, tag, *args):
         self._rec("region", tag, *args)
@@ -98,8 +107,11 @@ class FakeOpenSees:
         if kind == "zeroLength":
             assert args[0] == "-mat" and args[2] == "-dir" and args[3] == 1, args
             assert args[1] in self.materials, f"element {tag}: material {args[1]} undefined"
-        else:
-            assert kind == "elasticBeamColumn" and len(args) == 4, args
+            assert len(args) == 4 or (args[4] == "-orient" and len(args) == 11), args
+        elif kind == "ElasticTimoshenkoBeam":     # E G A Jx Iy Iz Avy Avz transf (3D)
+            assert self.ndm == 3 and len(args) == 9, args
+        else:                                     # A E I transf (2D); A E G J Iy Iz transf (3D)
+            assert kind == "elasticBeamColumn" and len(args) == (7 if self.ndm == 3 else 4), args
         self.elements[tag] = (kind, i, j, args)
         self._rec("element", kind, tag, i, j, *args)
 
@@ -111,7 +123,8 @@ class FakeOpenSees:
     def pattern(self, kind, tag, *args):
         assert tag not in self.patterns
         if kind == "UniformExcitation":
-            assert args[0] == 1 and args[1] == "-accel" and args[2] in self.series, args
+            assert args[0] in ((1, 2) if self.ndm == 3 else (1,)) and args[1] == "-accel", args
+            assert args[2] in self.series and len(args) in (3, 5), args
         else:
             assert kind == "Plain" and args[0] in self.series, args
         self.patterns[tag] = (kind, args)
@@ -180,5 +193,15 @@ class FakeOpenSees:
         return -tag * 1e-3 * math.sin(self.time)
 
     def eleResponse(self, tag, what):
-        assert what == "basicForce" and tag in self.elements
+        assert tag in self.elements
+        if what == "localForce":                  # a beam-column's 12 end forces: tag + k + t
+            assert self.elements[tag][0] != "zeroLength"
+            return [tag + k + self.time for k in range(12)]
+        assert what == "basicForce"
         return [-(tag + self.time)]
+
+    def eigen(self, *args):
+        n = args[-1]
+        assert isinstance(n, int) and n > 0 and args[:-1] in ((), ("-fullGenLapack",)), args
+        self._rec("eigen", *args)
+        return [float((k + 1) ** 2) for k in range(n)]     # ω = 1, 2, ... rad/s

@@ -108,17 +108,26 @@ def test_p7_kelvin_script_builds_the_scene_and_samples_every_output_step(tmp_pat
     assert np.allclose(data[:, 10], 0.5 * 100 * u1 ** 2 + 0.5 * 400 * u2 ** 2, rtol=1e-13, atol=1e-300)
 
 
-def test_tcl_script_issues_the_same_commands(tmp_path):
+def scene_members(scene):
+    return [(f"{b['prefix']}.{e.name}", None) for b in scene.extras["buildings"] for e in b["building"].elements]
+
+
+@pytest.mark.parametrize("which", ["two bodies", "two buildings"])
+def test_tcl_script_issues_the_same_commands(tmp_path, which):
     """model.tcl, run by tclsh with every OpenSees command a Tcl procedure that logs its
-    arguments, issues the same commands with the same numbers as model.py."""
-    scene = from_dict(two_bodies("hunt-crossley", restitution=0.5, exponent=1.5), source="tb")
+    arguments, issues the same commands with the same numbers as model.py (a building's too:
+    rigidDiaphragm, geomTransf with vecxz, oriented zeroLength elements, its rows' penetration)."""
+    if which == "two bodies":
+        scene = from_dict(two_bodies("hunt-crossley", restitution=0.5, exponent=1.5), source="tb")
+    else:
+        scene = from_dict(small_buildings(t_end=0.005), source="sb")
     export(scene, tmp_path / "x", tcl=True)
     fake, _ = run_fake(tmp_path / "x")
     names = sorted({n for n, _ in fake.calls})
     stubs = "".join(f"proc {n} args {{ puts [concat CALL {n} $args] }}\n" for n in names)
     stubs += ("proc analyze args { return 0 }\nproc nodeDisp args { return 0.0 }\n"
               "proc nodeVel args { return 0.0 }\nproc nodeAccel args { return 0.0 }\n"
-              "proc eleResponse args { return {0.0} }\n")
+              "proc eleResponse args { return {0.0 1.0 2.0 3.0 4.0 5.0 6.0 7.0 8.0 9.0 10.0 11.0} }\n")
     (tmp_path / "run.tcl").write_text(stubs + "source model.tcl\n")
     r = subprocess.run(["tclsh", str(tmp_path / "run.tcl")], cwd=tmp_path / "x", capture_output=True, text=True)
     assert r.returncode == 0, r.stderr
@@ -132,7 +141,13 @@ def test_tcl_script_issues_the_same_commands(tmp_path):
                 assert x == y
             else:
                 assert float(x) == float(y), (g, w)
-    assert (tmp_path / "x" / "history.csv").read_text().startswith("t,u:m1,")
+    assert (tmp_path / "x" / "history.csv").read_text().startswith(
+        "t,u:m1," if which == "two bodies" else "t,u:A1.ux,")
+    if which == "two buildings":         # Tcl's members.csv: model.py's columns, localForce's 4, 5, 10, 11
+        rows = (tmp_path / "x" / "members.csv").read_text().splitlines()
+        assert rows[0] == ",".join(["t"] + [f"{q}_{e}:{n}" for n, _ in scene_members(scene) for e in "ij"
+                                            for q in ("M2", "M3")])
+        assert rows[-1].split(",")[1:5] == ["4", "5", "10", "11"]
 
 
 @pytest.mark.parametrize("law, e, a", [
@@ -226,15 +241,146 @@ def test_static_mass_coupling_and_central_difference_refusals():
         opensees_model(from_dict(d, source="tb"))
 
 
-def test_a_building_is_refused_naming_it_and_why():
-    """[[building]] (docs/buildings.md) is a 3D model condensed to its floors' DOFs: the
-    exporter writes none, and says so before the building's mass couplings could be blamed."""
-    b = {"prefix": "B", "storeys": 1, "storey_height": 3.0, "grid_x": [0.0, 6.0], "grid_y": [0.0, 4.0],
-         "column": {"E": 3e10, "b2": 0.3, "b3": 0.5}, "mass": 2.0e5}
-    d = {"building": [b], "analysis": {"type": "dynamic", "integrator": "newmark", "dt": 1e-3, "t_end": 0.1}}
-    with pytest.raises(ExportError, match=r"\[\[building\]\]: cannot be exported.*3D model.*rigidDiaphragm.*"
-                                          r"buildings B: a planar \[\[frame\]\]"):
-        opensees_model(from_dict(d, source="bd"))
+def small_buildings(t_end=0.3, reference=True, zeta=0.05):
+    """Two frame buildings side by side along x with a 1 mm joint (docs/buildings.md): A, one
+    storey, 2 x 2 columns with shear areas (Timoshenko members); B, two storeys, a stiff wall at
+    one end of its plan (its floors twist), its floors referred to a point off their mass
+    centre (mass couplings); a linear gap and a fluid damper between plan points of the shared
+    floor, off the centre line; a sine along x, Rayleigh 5 %, Newmark 1 ms."""
+    col = {"E": 3e10, "b2": 0.4, "b3": 0.4, "cracked": 0.5}
+    beam = {"E": 3e10, "b": 0.3, "h": 0.5, "cracked": 0.5}
+    a = {"prefix": "A", "storeys": 1, "storey_height": 3.0, "model": "frame", "grid_x": [0.0, 5.0],
+         "grid_y": [0.0, 6.0], "column": dict(col, As2=0.13, As3=0.12), "beam": beam, "mass": 1.0e5,
+         "zeta": zeta, "histories": True}
+    b = {"prefix": "B", "storeys": 2, "storey_height": 3.0, "model": "frame", "grid_x": [5.001, 10.001],
+         "grid_y": [0.0, 6.0], "column": col, "beam": beam, "mass": 1.2e5, "zeta": zeta,
+         "rayleigh_modes": [1, 3], "histories": True,
+         "member": [{"name": "W", "x": 7.5, "y": 6.0, "section": {"E": 3e10, "A": 0.5, "I2": 2e-3,
+                                                                    "I3": 0.6, "J": 5e-3}}]}
+    if reference:
+        b["reference"] = [6.0, 1.0]
+    return {"title": "two small buildings", "building": [a, b],
+            "contact": [{"name": "g", "a": {"floor": "A1", "x": 5.0, "y": 1.0},
+                         "b": {"floor": "B1", "x": 5.001, "y": 1.0}, "normal": [1.0, 0.0], "gap": 0.001,
+                         "scheme": "penalty", "law": "linear", "stiffness": 5e8}],
+            "link": [{"name": "d", "type": "fluid_damper", "a": {"floor": "A1", "x": 5.0, "y": 5.0},
+                      "b": {"floor": "B1", "x": 5.001, "y": 5.0}, "direction": [1.0, 0.0], "c": 2e5,
+                      "alpha": 1.0, "v_reg": 0.0}],
+            "loads": {"ground_acceleration": {"type": "sine", "amplitude": 6.0, "omega": 12.0}},
+            "analysis": {"type": "dynamic", "integrator": "newmark", "dt": 1e-3, "t_end": t_end}}
+
+
+def test_a_building_is_a_3d_frame_on_rigid_diaphragms(tmp_path):
+    """[[building]] (docs/opensees.md "Buildings"): 6-DOF nodes, one rigidDiaphragm per floor
+    to a master at the reference point, the floor's m, m, J on the master or on a node at the
+    mass centre tied to it, members with vecxz such that OpenSees' local y is martello's axis 2
+    (docs/buildings.md: a vertical member's axis 2 at `angle` from x, a beam's vertical; I3
+    resists displacement along axis 2, so OpenSees' Iz = I3), plan-point elements oriented
+    along their normal with both nodes on the row's line of action, the floors' DOFs sampled
+    on the masters and the member moments in members.csv."""
+    scene = from_dict(small_buildings(), source="sb")
+    m = export(scene, tmp_path / "x")
+    fake, rows = run_fake(tmp_path / "x")
+    assert (fake.ndm, fake.ndf) == (3, 6)
+    dia = calls(fake, "rigidDiaphragm")
+    assert len(dia) == 3 + 4                 # A1, B1, B2; a node of each side of the gap and the damper
+    floors = [d for d in dia if len(d) > 3]
+    assert len(floors) == 3
+    masses = {a[0]: a[1:] for a in calls(fake, "mass")}
+    # A1: the reference is the mass centre (2.5, 3): m, m and J = m (5² + 6²)/12 on the master
+    a1 = floors[0]
+    assert fake.nodes[a1[1]] == (2.5, 3.0, 3.0)
+    assert masses[a1[1]] == (1.0e5, 1.0e5, 0.0, 0.0, 0.0, 1.0e5 * (25 + 36) / 12)
+    assert sorted(fake.nodes[t] for t in a1[2:]) == [(0.0, 0.0, 3.0), (0.0, 6.0, 3.0), (5.0, 0.0, 3.0),
+                                                     (5.0, 6.0, 3.0)]
+    # B1: master at the reference (6, 1), the mass on a tied node at the centre (7.501, 3)
+    b1 = floors[1]
+    assert fake.nodes[b1[1]] == (6.0, 1.0, 3.0) and b1[1] not in masses
+    centre = [t for t in b1[2:] if t in masses]
+    assert len(centre) == 1 and fake.nodes[centre[0]] == pytest.approx((7.501, 3.0, 3.0), abs=1e-12)
+    # members: local y = vecxz × x is axis 2 (x for a column at angle 0, up for a beam)
+    transf = {a[1]: np.array(a[2:]) for a in calls(fake, "geomTransf")}
+    beams = calls(fake, "element", "elasticBeamColumn") + calls(fake, "element", "ElasticTimoshenkoBeam")
+    assert len(calls(fake, "element", "ElasticTimoshenkoBeam")) == 4        # A's columns: As2, As3
+    assert len(beams) == 4 + 4 + 2 * (4 + 1 + 4)                            # columns, beams, the wall
+    for e in beams:
+        i, j = np.array(fake.nodes[e[2]]), np.array(fake.nodes[e[3]])
+        x = (j - i) / np.linalg.norm(j - i)
+        y = np.cross(transf[e[-1]], x)
+        want = np.array([1.0, 0.0, 0.0]) if x[2] == 1.0 else np.array([0.0, 0.0, 1.0])
+        assert np.allclose(y, want, atol=1e-15), (e, y)
+    wall = [e for e in calls(fake, "element", "elasticBeamColumn") if e[4:10] == (0.5, 3e10, 1.25e10, 5e-3, 2e-3, 0.6)]
+    assert len(wall) == 2                                                   # A E G J Iy=I2 Iz=I3
+    # the gap and the damper: zeroLength along x between two nodes on y = 1 and y = 5
+    zl = calls(fake, "element", "zeroLength")
+    assert len(zl) == 2 and all(e[8:] == ("-orient", 1.0, 0.0, 0.0, 0.0, 1.0, 0.0) for e in zl)
+    for e, y in zip(zl, (5.0, 1.0)):                # links are written before contacts
+        assert fake.nodes[e[2]][1] == pytest.approx(y, abs=1e-12)
+        assert fake.nodes[e[3]][1] == pytest.approx(y, abs=1e-12)
+    assert [p[2] for p in calls(fake, "pattern", "UniformExcitation")] == [1]
+    assert len(calls(fake, "region")) == 4
+    # the floors' ux, uy, rz are the masters' DOFs 1, 2, 6
+    head, data = rows[0], np.array(rows[1:], float)
+    t = data[:, 0]
+    for nm, dof in (("A1.ux", 1), ("B2.rz", 6)):
+        master = floors[0][1] if nm == "A1.ux" else floors[2][1]
+        assert np.allclose(data[:, head.index(f"u:{nm}")], master * 1e-3 * np.sin(t), rtol=0, atol=1e-15)
+    mhead = open(tmp_path / "x" / "members.csv").readline().strip().split(",")
+    assert mhead[:5] == ["t", "M2_i:A.C1.0.0", "M3_i:A.C1.0.0", "M2_j:A.C1.0.0", "M3_j:A.C1.0.0"]
+    assert len(mhead) == 1 + 4 * len(beams)
+    assert any("rigidDiaphragm" in b for _, b in m.mapping)
+
+
+def test_a_building_reports_its_periods(tmp_path):
+    """model.py --periods: eigen on every mass DOF (fullGenLapack) -> periods.csv."""
+    export(from_dict(small_buildings(), source="sb"), tmp_path / "x")
+    saved = sys.argv
+    sys.argv = ["model.py", "--periods"]
+    try:
+        fake = FakeOpenSees()
+        mods = {"openseespy": type(sys)("openseespy"), "openseespy.opensees": fake.module()}
+        mods["openseespy"].opensees = mods["openseespy.opensees"]
+        old = {k: sys.modules.get(k) for k in mods}
+        sys.modules.update(mods)
+        runpy.run_path(str(tmp_path / "x" / "model.py"), run_name="__main__")
+    finally:
+        sys.argv = saved
+        for k, v in old.items():
+            if v is None:
+                sys.modules.pop(k, None)
+            else:
+                sys.modules[k] = v
+    assert calls(fake, "eigen") == [("-fullGenLapack", 9)]            # 3 rigid floors x 3
+    p = np.loadtxt(tmp_path / "x" / "periods.csv", delimiter=",", skiprows=1)
+    assert np.allclose(p[:, 1], 2 * np.pi / np.arange(1, 10))           # the fake's ω = 1, 2, ...
+    assert not (tmp_path / "x" / "history.csv").exists()
+
+
+@pytest.mark.parametrize("change, match", [
+    (lambda d: d["building"][1].update(damping="modal"),
+     r"building B: damping = \"modal\": cannot be exported.*modalDamping.*use damping = \"rayleigh\""),
+    (lambda d: d["building"][0]["column"].pop("As3"),
+     r"building A: member C1.0.0: one shear area.*give both As2 and As3"),
+    (lambda d: (d["building"][0].update(diaphragm=False, slab={"E": 3e10, "thickness": 0.2}),
+                d.update(link=[], contact=[])),
+     r"building A: slab: cannot be exported.*incompatible-mode.*remove slab"),
+    (lambda d: d["building"][1].update(ground_angle=30.0),
+     r"building.ground_angle = 0, 30: cannot be exported.*one direction.*same ground_angle"),
+    (lambda d: d["loads"].update(gravity=9.81), r"loads.gravity = 9.81 with \[\[building\]\].*remove gravity"),
+    (lambda d: d.update(frame=[{"prefix": "F", "storeys": 1, "bays": 1, "storey_height": 3.0, "bay_width": 5.0,
+                                "column": {"E": 3e10, "A": 0.16, "I": 2e-3}, "beam": {"E": 3e10, "A": 0.15,
+                                                                                     "I": 3e-3}, "mass": 1e5}]),
+     r"\[\[frame\]\] with \[\[building\]\]: cannot be exported.*two scenes"),
+    (lambda d: d["contact"][0].update(a=None, b=None, normal=None, terms=[{"node": "A1.ux", "coef": 2.0},
+                                                                         {"node": "B1.ux", "coef": -2.0}]),
+     r"contact\[0\] \(g\)\.terms: cannot be exported.*unit plan direction"),
+])
+def test_what_a_building_export_cannot_write_is_refused(change, match):
+    d = small_buildings()
+    change(d)
+    d["contact"] = [{k: v for k, v in c.items() if v is not None} for c in d["contact"]]
+    with pytest.raises(ExportError, match=match):
+        opensees_model(from_dict(d, source="sb"))
 
 
 def test_a_row_of_terms_is_refused_naming_the_contact():

@@ -206,3 +206,23 @@ def test_reference_for_scene_chooses_data_closed_form_or_nothing():
     assert reference_for_scene(from_dict(d)) is None     # no [check], no data
     with pytest.raises(ReferenceError, match="no closed-form history named"):
         closed_form_reference("nope", {}, 1.0)
+
+
+def test_a_plan_point_contact_is_scored_from_its_row():
+    """A contact between plan points (docs/buildings.md) has no nodes a, b: a history without
+    its penetration column is scored from the row Σ c·u of the floors' columns (martello
+    compare on another code's history of a building scene). Here martello's own history with
+    the contact's columns dropped: the penetration rebuilt from the row equals the recorded
+    one to rounding and the impacts are those of the run (identity of the method)."""
+    from martello.run import run_full
+    from tests.test_export import small_buildings
+    scene = from_dict(small_buildings(t_end=0.3), source="sb")
+    summary, (cols, data) = run_full(scene)
+    cols = list(cols)
+    keep = [k for k, c in enumerate(cols) if not c.endswith(":g")]
+    rebuilt = summary_from_history(scene, ([cols[k] for k in keep], data[:, keep]))["contacts"]["g"]
+    recorded = summary_from_history(scene, (cols, data))["contacts"]["g"]
+    assert rebuilt["impacts"] == recorded["impacts"] == summary["contacts"]["g"]["impacts"] == 2
+    assert rebuilt["impact_times"] == pytest.approx(recorded["impact_times"], abs=1e-3)   # one step
+    # δ = g·u − gap in two orders of summation: rounding of u (~0.07 m) only
+    assert rebuilt["max_penetration"] == pytest.approx(recorded["max_penetration"], abs=1e-15)

@@ -9,18 +9,31 @@ native wall time of the run (summary cost.wall_time_s) (the minimum of three run
 log-log slope of the error against rtol (or dt).
 
     .venv/bin/python benchmarks/events/accuracy.py [--integrators rk8pd,rkf45,msbdf,ida,newmark,...]
-        [--plot docs/studies/hysteretic_pounding_work_precision.png] [scene.toml ...]
+        [--plot docs/studies/hysteretic_pounding_work_precision.png] [-o DIR] [--docs] [scene.toml ...]
+    .venv/bin/python benchmarks/events/accuracy.py --docs --from DIR/accuracy.json
+    .venv/bin/python benchmarks/events/accuracy.py --check
+
+-o DIR keeps every run's figures as DIR/accuracy.json; --docs keeps them as
+docs/perf/events_accuracy.json and writes the adaptive integrators' table into
+docs/event-driven.md (benchmarks/perf/measured_docs.py); --from renders a finished run's
+JSON; --check finds the page's table the same as its record's (CI).
 """
 import argparse
 import copy
+import json
 import math
+import os
+import resource
 import sys
+import time
 from pathlib import Path
 
 import tomllib
 
 HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE))
+sys.path.insert(0, str(HERE.parent / "perf"))
+import measured_docs  # noqa: E402
 import reference  # noqa: E402
 
 import martello.api as api  # noqa: E402
@@ -32,6 +45,11 @@ FIXED_STEPS = [1e-3, 5e-4, 2.5e-4, 1.25e-4, 6.25e-5, 3.125e-5]
 ADAPTIVE = ("rkf45", "rk8pd", "msbdf", "ida")
 # the one parameter these schemes need (a common, mildly dissipative choice)
 FIXED_PARAMETERS = {"hht": {"alpha": -0.05}, "generalized-alpha": {"rho_inf": 0.9}}
+NAME = "events_accuracy"    # its record docs/perf/events_accuracy.json, its fence in docs/event-driven.md
+DOC = measured_docs.ROOT / "docs" / "event-driven.md"
+LABELS = {"pounding_bilinear": "two bilinear oscillators, elastic gap (`pounding_bilinear.toml`)",
+          "pounding_kelvin": "the same, clipped Kelvin e = 0.65 (`pounding_kelvin.toml`)",
+          "chain_bilinear_kelvin": "three bilinear buildings, Kelvin joints (`chain_bilinear_kelvin.toml`)"}
 
 
 def reference_quantities(path):
@@ -72,15 +90,21 @@ def measure(path, integrator, rtol, refq):
         if split:
             d["analysis"]["event_split"] = True
     scene = api.Scene.from_dict(d, base_dir=str(path.parent))
-    runs = [api.run(scene).summary for _ in range(REPEATS)]
+    runs, cpu = [], []
+    for _ in range(REPEATS):
+        r0 = resource.getrusage(resource.RUSAGE_SELF)
+        runs.append(api.run(scene).summary)
+        r1 = resource.getrusage(resource.RUSAGE_SELF)
+        cpu.append(r1.ru_utime - r0.ru_utime + r1.ru_stime - r0.ru_stime)
     s = runs[0]
     s["cost"]["wall_time_s"] = min(r["cost"]["wall_time_s"] for r in runs)
+    s["cost"]["cpu_s"] = min(cpu)    # the whole api.run (set-up and summary included)
     worst, which = 0.0, None
     for key, ref in refq.items():
         err = abs(lookup(s, key) - ref) / abs(ref)
         if err > worst:
             worst, which = err, key
-    return worst, which, s["cost"]["wall_time_s"], s["cost"]["steps"]
+    return worst, which, s["cost"]["wall_time_s"], s["cost"]["steps"], s["cost"]["cpu_s"]
 
 
 def slope(xs, ys):
@@ -90,38 +114,95 @@ def slope(xs, ys):
     return sum((a - mx) * (b - my) for a, b in zip(lx, ly)) / sum((a - mx) ** 2 for a in lx)
 
 
+def render(result):
+    """The adaptive integrators' table (rtol 1e-8, 1e-10, 1e-12, the slope, the native time at
+    1e-12) of a run's figures (accuracy.json)."""
+    lo, hi = result["load"]
+    lines = [f"{result['date_utc']} UTC, commit {result['commit']}, load {lo:.1f}–{hi:.1f} (nice "
+             f"{result['nice']}); worst relative error; CPU = the CPU time of the whole `api.run` "
+             f"(set-up and summary included), native = the library's wall clock of the run "
+             f"(`cost.wall_time_s`, which counts the waits of a loaded machine), each the minimum "
+             f"of {REPEATS} runs", "",
+             "| scene (8 s) | integrator | rtol 1e-8 | rtol 1e-10 | rtol 1e-12 | slope (1e-6…1e-12) | CPU at 1e-12 (native wall) |",
+             "|---|---|---|---|---|---|---|"]
+    last = None
+    for c in result["curves"]:
+        if c["integrator"] not in ADAPTIVE:
+            continue
+        at = {k: e for k, e in zip(c["knobs"], c["errors"])}
+        cell = lambda r: f"{at[r]:.1e}".replace("e-0", "e-") if r in at else "—"   # noqa: E731
+        k12 = c["knobs"].index(1e-12) if 1e-12 in c["knobs"] else None
+        ms = lambda x: f"{1e3 * x:.3g}" if x < 0.1 else f"{1e3 * x:.0f}"   # noqa: E731
+        wall = f"{ms(c['cpu_s'][k12])} ms ({ms(c['wall_s'][k12])} ms)" if k12 is not None else "—"
+        first = LABELS.get(c["scene"], c["scene"]) if c["scene"] != last else ""
+        last = c["scene"]
+        lines.append(f"| {first} | {c['integrator']} | {cell(1e-8)} | {cell(1e-10)} | {cell(1e-12)} "
+                     f"| {c['slope']:.2f} | {wall} |")
+    return "\n".join(lines)
+
+
 def main(argv=None):
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     p.add_argument("scenes", nargs="*")
     p.add_argument("--integrators", default="rk8pd")
     p.add_argument("--plot")
+    p.add_argument("-o", "--out", help="the folder accuracy.json is written into")
+    p.add_argument("--docs", action="store_true", help="keep the figures as docs/perf/events_accuracy.json "
+                   "and their table in docs/event-driven.md")
+    p.add_argument("--from", dest="source", help="a finished run's accuracy.json (no run)")
+    p.add_argument("--check", action="store_true", help="the page's table is its record's (CI)")
     a = p.parse_args(argv)
+    if a.check:
+        problem = measured_docs.check(NAME, render, DOC)
+        print(problem or f"docs/event-driven.md: the table of {NAME} is its record's")
+        return 1 if problem else 0
+    if a.source:
+        result = json.loads(Path(a.source).read_text())
+        print(render(result))
+        if a.docs:
+            measured_docs.record(NAME, result, render(result), DOC)
+        return 0
     paths = [Path(x) for x in a.scenes] or [HERE / s for s in SCENES if (HERE / s).exists()]
     curves = {}
+    result = {"date_utc": time.strftime("%Y-%m-%d %H:%M", time.gmtime()), "commit": measured_docs.commit(),
+              "nice": os.nice(0), "load": [os.getloadavg()[0]], "curves": []}
     for path in paths:
         refq = reference_quantities(path)
         print(f"{path.name}: reference {len(refq)} quantities (reference.py, DOP853 rtol 2.3e-14)")
         for integ in a.integrators.split(","):
-            errs, times = [], []
+            errs, times, cpus, whichs, steps_ = [], [], [], [], []
             knobs = RTOLS if integ in ADAPTIVE else FIXED_STEPS
             what = "rtol" if integ in ADAPTIVE else "dt"
             for rtol in knobs:
                 try:
-                    err, which, wall, steps = measure(path, integ, rtol, refq)
+                    err, which, wall, steps, cpu = measure(path, integ, rtol, refq)
                 except Exception as exc:   # an integrator that cannot run the scene
                     print(f"  {integ:6s} {what} {rtol:.3g}: {exc}")
                     break
                 errs.append(err)
                 times.append(wall)
+                cpus.append(cpu)
+                whichs.append(which)
+                steps_.append(steps)
                 print(f"  {integ:6s} {what} {rtol:.3g}: worst rel. error {err:.2e} ({which}), "
                       f"{steps} steps, native {1e3 * wall:.1f} ms")
             if len(errs) < 2:
                 continue
-            print(f"  {integ:6s} slope of log error against log {what}: "
-                  f"{slope(knobs[:len(errs)], errs):.2f}")
+            sl = slope(knobs[:len(errs)], errs)
+            print(f"  {integ:6s} slope of log error against log {what}: {sl:.2f}")
             curves[(path.stem, integ)] = (times, errs)
+            result["curves"].append({"scene": path.stem, "integrator": integ, "knob": what,
+                                     "knobs": knobs[:len(errs)], "errors": errs, "worst_quantity": whichs,
+                                     "wall_s": times, "cpu_s": cpus, "steps": steps_, "slope": sl})
+    result["load"] = [min(result["load"][0], os.getloadavg()[0]), max(result["load"][0], os.getloadavg()[0])]
+    if a.out:
+        Path(a.out).mkdir(parents=True, exist_ok=True)
+        (Path(a.out) / "accuracy.json").write_text(json.dumps(result, indent=1))
     if a.plot:
         write_plot(curves, a.plot)
+    if a.docs:
+        measured_docs.record(NAME, result, render(result), DOC)
+    return 0
 
 
 def write_plot(curves, path):
@@ -162,4 +243,4 @@ def write_plot(curves, path):
 
 
 if __name__ == "__main__":
-    main()
+    sys.exit(main())

@@ -16,12 +16,14 @@ size kept, Newton passes a step, and the error against all modes — max |u − 
 node and output time / max |u_all|, and the contacts' largest force, relative. The exponents
 are least-squares slopes of CPU per simulated second over n. Writes nothing unless --out DIR.
 
+Scene `closed` (--scene closed): benchmarks/perf/integrators_at_size.py's row with every contact
+closed (a contact between every pair of neighbours), dt 1e-4 s, every node recorded.
+
 Usage: benchmarks/perf/fna_ritz.py [--n 300 1000 3000 10000] [--m 10 20 40] [--modes-max 1000]
-       [--t-end 0.5] [--out DIR]"""
+       [--t-end 0.5] [--scene row|closed] [--out DIR]"""
 
 import argparse
 import json
-import math
 import os
 import sys
 from pathlib import Path
@@ -30,32 +32,25 @@ ROOT = Path(__file__).resolve().parents[2]
 sys.path.insert(0, str(ROOT))
 
 # the log-log slope, the timed run and the child process: defined there once
+from benchmarks.perf import integrators_at_size as at_size  # noqa: E402
 from benchmarks.perf.integrators_at_size import child, fit, timed_run  # noqa: E402
 
 
-def scene(n, m, t_end):
-    nodes = [{"name": f"b{i}", "mass": 1.0e5} for i in range(1, n + 1)]
-    links = []
-    for i in range(1, n + 1):
-        k = 2.0e7 if i % 2 else 5.0e7
-        links.append({"type": "spring", "a": f"b{i}", "b": "ground", "k": k})
-        links.append({"type": "dashpot", "a": f"b{i}", "b": "ground", "c": 2 * 0.05 * math.sqrt(k * 1.0e5)})
-        if i < n:
-            links.append({"type": "spring", "a": f"b{i}", "b": f"b{i + 1}", "k": 1.0e6})
-    contacts = [{"name": f"gap{j}", "a": f"b{j * n // 5}", "b": f"b{j * n // 5 + 1}", "gap": 2.0e-3,
-                 "scheme": "penalty", "law": "linear", "stiffness": 1.0e9} for j in range(1, 5)]
-    every = max(1, int(round(t_end / 1e-3 / 50)))
-    return {"title": f"row n={n} m={m}", "node": nodes, "link": links, "contact": contacts,
-            "loads": {"ground_acceleration": {"type": "sine", "amplitude": 3.0, "omega": 4 * math.pi}},
-            "analysis": {"type": "dynamic", "integrator": "fast-nonlinear", "dt": 1e-3, "t_end": t_end,
-                         "tol_residual": 1e-10, "max_newton": 100, "modal_vectors": m,
-                         "output": {"every": every, "nodes": [x["name"] for x in nodes],
-                                    "contacts": [c["name"] for c in contacts]}}}
+scene = at_size.row    # the row: defined there once
 
 
-def one(n, m, t_end, dump):
+def closed(n, m, t_end):
+    """integrators_at_size.py's scene `closed` (a contact between every pair, all closed) on
+    fast-nonlinear with m vectors, every node's u recorded ~50 times."""
+    sc = at_size.scene(n, f"fast-nonlinear:{m}" if m else "fast-nonlinear", "closed", t_end, 1.0e9)
+    sc["analysis"]["output"] = {"every": max(1, int(round(t_end / 1e-4 / 50))),
+                                "nodes": [f"b{i}" for i in range(1, n + 1)]}
+    return sc
+
+
+def one(n, m, t_end, dump, kind="row"):
     import numpy as np
-    summary, hist, cpu, _ = timed_run(scene(n, m, t_end))
+    summary, hist, cpu, _ = timed_run((closed if kind == "closed" else scene)(n, m, t_end))
     cols = [i for i, k in enumerate(hist[0]) if k.startswith("u:")]
     np.save(dump, np.asarray(hist[1])[:, cols])
     print(json.dumps({"n": n, "m": m, "status": summary["status"], "cpu_s": cpu,
@@ -70,17 +65,20 @@ def main():
     ap.add_argument("--m", type=int, nargs="*", default=[10, 20, 40])
     ap.add_argument("--modes-max", type=int, default=1000)
     ap.add_argument("--t-end", type=float, default=0.5)
+    ap.add_argument("--scene", choices=("row", "closed"), default="row",
+                    help="row (above) or integrators_at_size.py's closed row (dt 1e-4 s; a contact "
+                    "between every pair: the patterns need m ~ n vectors)")
     ap.add_argument("--out")
     ap.add_argument("--one", nargs=3, help=argparse.SUPPRESS)
     args = ap.parse_args()
     if args.one:
-        one(int(args.one[0]), int(args.one[1]), args.t_end, args.one[2])
+        one(int(args.one[0]), int(args.one[1]), args.t_end, args.one[2], args.scene)
         return
     import tempfile
     import numpy as np
     from martello.binding import native
-    print(f"martello {native.version()}; {os.cpu_count()} cores; scene row, fast-nonlinear, dt 1 ms, "
-          f"t_end {args.t_end} s")
+    print(f"martello {native.version()}; {os.cpu_count()} cores; scene {args.scene}, fast-nonlinear, "
+          f"dt {'1e-4 s' if args.scene == 'closed' else '1 ms'}, t_end {args.t_end} s")
     print(f"{'n':>6} {'m':>5} {'kept':>5} {'status':>12} {'CPU s':>8} {'CPU/sim s':>10} {'passes/step':>11} "
           f"{'u error':>9} {'force error':>11} {'load':>5}")
     rows = []
@@ -91,7 +89,7 @@ def main():
                 if m > n:
                     continue
                 dump = os.path.join(tmp, f"u_{n}_{m}.npy")
-                row, err = child([__file__, "--one", n, m, dump, "--t-end", args.t_end])
+                row, err = child([__file__, "--one", n, m, dump, "--t-end", args.t_end, "--scene", args.scene])
                 if row is None:
                     print(f"{n:>6} {m:>5} failed: {err}")
                     continue

@@ -31,36 +31,37 @@ def fence(name):
     return f"<!-- generated from docs/perf/{name}.json by its script's --docs -->"
 
 
-def _span(text, name):
+def _span(text, name, doc=DOC):
     start = text.find(fence(name))
     if start < 0:
-        raise SystemExit(f"{DOC.relative_to(ROOT)}: no fence for {name} ({fence(name)} ... {END})")
+        raise SystemExit(f"{doc.relative_to(ROOT)}: no fence for {name} ({fence(name)} ... {END})")
     i = start + len(fence(name))
     return i, text.index(END, i)
 
 
-def record(name, result, table):
-    """Keep result as docs/perf/<name>.json and put table into the page's fence for NAME."""
+def record(name, result, table, doc=DOC):
+    """Keep result as docs/perf/<name>.json and put table into the fence for NAME of the page
+    doc (docs/performance.md unless said)."""
     RECORDS.mkdir(exist_ok=True)
     (RECORDS / f"{name}.json").write_text(json.dumps(result, indent=1) + "\n")
-    text = DOC.read_text()
-    i, j = _span(text, name)
-    DOC.write_text(text[:i] + "\n" + table + "\n" + text[j:])
-    print(f"written: docs/perf/{name}.json, its table in {DOC.relative_to(ROOT)}")
+    text = doc.read_text()
+    i, j = _span(text, name, doc)
+    doc.write_text(text[:i] + "\n" + table + "\n" + text[j:])
+    print(f"written: docs/perf/{name}.json, its table in {doc.relative_to(ROOT)}")
 
 
-def check(name, render):
+def check(name, render, doc=DOC):
     """None if the page's table for NAME is what render makes of docs/perf/<name>.json, else
     what differs."""
     path = RECORDS / f"{name}.json"
     if not path.exists():
         return f"docs/perf/{name}.json missing (the script's --docs writes it)"
     want = render(json.loads(path.read_text())).strip()
-    text = DOC.read_text()
-    i, j = _span(text, name)
+    text = doc.read_text()
+    i, j = _span(text, name, doc)
     have = text[i:j].strip()
     if have != want:
-        return (f"{DOC.relative_to(ROOT)}: the table of {name} is not what docs/perf/{name}.json "
+        return (f"{doc.relative_to(ROOT)}: the table of {name} is not what docs/perf/{name}.json "
                 f"renders to (run the script with --docs --from the record, or measure again)\n"
                 f"--- page\n{have}\n--- record\n{want}")
     return None

@@ -18,6 +18,7 @@ import numpy as np
 from ..errors import ExportError
 from ..independent.laws import contact_law
 from ..independent.scene import effective_mass, time_function
+from ..scene.rows import element_terms
 
 NEWMARK_FAMILY = ("newmark", "hht", "generalized-alpha", "central-difference")
 DISP_SCALE = 0.1          # m: the displacement that tol_increment is relative to (NormDispIncr is absolute)
@@ -52,8 +53,9 @@ class Command:
 
 @dataclass
 class Column:
-    """One column of history.csv: `kind` u, v, a (node tag) or penetration (tags of a and b,
-    0 for ground, and the gap) or force (the contact element: P = −basicForce)."""
+    """One column of history.csv: `kind` u, v, a (node tag and DOF) or penetration (the
+    contact's row [(tag, dof, coef)] and its gap: δ = Σ coef·u − gap) or force (the contact
+    element: P = −basicForce)."""
     name: str
     kind: str
     args: tuple
@@ -76,6 +78,8 @@ class OpenSeesModel:
     contact_materials: list = field(default_factory=list)   # (contact, law, material)
     integrator: str = ""
     energy: dict = field(default_factory=dict)   # what energy:kinetic and energy:recoverable sum
+    members: list = field(default_factory=list)  # a building's members: (prefix.name, element tag)
+    modes: int = 0                               # a building's mass DOFs: the periods the script reports
 
 
 def _kelvin_e(xi):
@@ -114,6 +118,8 @@ class _Builder:
         self.n_series = 0
         self.mat = 0
         self.ele = 0
+        from .building import BuildingWriter
+        self.bw = BuildingWriter(self)
 
     # --- refusals -------------------------------------------------------------------------
     def refuse(self, what, why, fix=None):
@@ -134,22 +140,17 @@ class _Builder:
                         "(fast nonlinear) integrator",
                         "give --integrator newmark, hht, generalized-alpha or central-difference "
                         "and --dt")
-        buildings = s.extras.get("buildings", [])
-        if buildings:
-            self.refuse("[[building]]", "the exporter writes chains of nodes and planar frames; a "
-                        "building is a 3D model condensed to its floors' ux, uy, rz, which OpenSees "
-                        "would take as 6-DOF nodes with rigidDiaphragm floors (docs/buildings.md), a "
-                        "model the exporter does not write",
-                        "buildings " + ", ".join(b["prefix"] for b in buildings) + ": a planar "
-                        "[[frame]] per building exports where the plan is symmetric")
+        if s.extras.get("buildings"):
+            self.bw.check()
         for kind, items in (("contact", s.contacts), ("link", s.links)):
             for i, it in enumerate(items):
-                if it.get("terms") is not None:
+                if it.get("terms") is not None and not s.extras.get("buildings"):
                     self.refuse(f"{kind}[{i}] ({it['name']}).terms",
                                 "a row Σ c·u over several DOFs (plan points of rigid floors or "
                                 "written terms): OpenSees' zeroLength acts between two nodes along "
                                 "one direction", "give the element two nodes a and b")
-        if s.couplings:
+        in_building = {s.index[n] for b in s.extras.get("buildings", []) for n in b["nodes"]}
+        if any(not {c["a"], c["b"]} <= in_building for c in s.couplings):
             self.refuse("mass_coupling", "OpenSees nodal masses are diagonal and martello's "
                         "couplings are general off-diagonal terms",
                         "use lumped masses (bar mass = \"lumped\")")
@@ -200,9 +201,6 @@ class _Builder:
     def tag(self, i):
         return self.ground if i < 0 else self.node_tag[i]
 
-    def etag(self, i):
-        return 0 if i < 0 else self.node_tag[i]
-
     def add(self, name, *args):
         self.cmds.append(Command(name, tuple(args)))
 
@@ -211,19 +209,40 @@ class _Builder:
         self.add("uniaxialMaterial", kind, self.mat, *args)
         return self.mat
 
-    def zero_length(self, i, j, mat):
-        """A zeroLength element whose deformation is u_j − u_i (OpenSees' ZeroLength)."""
+    def zero_length(self, i, j, mat, n=None):
+        """A zeroLength element whose deformation is u_j − u_i (OpenSees' ZeroLength), along
+        the plan direction n = (nx, ny) where given (local x = n, local y = n turned by 90°)."""
         self.ele += 1
-        self.add("element", "zeroLength", self.ele, i, j, "-mat", mat, "-dir", 1)
+        orient = () if n is None else ("-orient", float(n[0]), float(n[1]), 0.0, float(-n[1]), float(n[0]), 0.0)
+        self.add("element", "zeroLength", self.ele, i, j, "-mat", mat, "-dir", 1, *orient)
         return self.ele
+
+    def ends(self, what, item, first, second):
+        """(i, j, n, terms) of a link or contact: the zeroLength's nodes, i the node of side
+        `first` ("a" or "b"), its plan direction (None: along x) and the element's row as
+        [(tag, dof, coef)] for the script's bookkeeping. A building's elements go through their
+        row (martello.export.building); a node pair is its two nodes."""
+        terms = element_terms(item)
+        if self.s.extras.get("buildings"):
+            i, j, n, _ = self.bw.row(what, terms)
+            if first == "b":
+                i, j = j, i
+            return i, j, n, [(*self.dof_of(k), c) for k, c in terms]
+        return (self.tag(item[first]), self.tag(item["b" if first == "a" else "a"]), None,
+                [(*self.dof_of(k), c) for k, c in terms])
+
+    def dof_of(self, i):
+        """(tag, dof) of scene node i."""
+        return self.bw.node_of.get(i, (self.node_tag[i], 1))
 
     # --- the model ------------------------------------------------------------------------
     def build(self):
         self.check_scene()
         s = self.s
         frames = s.extras.get("frames", [])
-        self.ndm, self.ndf = (2, 3) if frames else (1, 1)
-        self.energy = {"kinetic": [], "springs": [], "bilinear": [], "contacts": [], "blocks": []}
+        self.ndm, self.ndf = (3, 6) if s.extras.get("buildings") else (2, 3) if frames else (1, 1)
+        self.energy = {"kinetic": [], "couplings": [], "springs": [], "bilinear": [], "contacts": [],
+                       "blocks": []}
         self.add("wipe")
         self.add("model", "basic", "-ndm", self.ndm, "-ndf", self.ndf)
         self.nodes(frames)
@@ -235,17 +254,21 @@ class _Builder:
         return self.model()
 
     def node_cmd(self, tag, x=0.0, y=0.0):
-        self.add("node", tag, *((x,) if self.ndm == 1 else (x, y)))
+        self.add("node", tag, *((x,) if self.ndm == 1 else (x, y) if self.ndm == 2 else (x, y, 0.0)))
 
     def fix_cmd(self, tag, lateral=True):
-        flags = (1,) if self.ndm == 1 else ((1 if lateral else 0), 1, 1)
-        self.add("fix", tag, *flags)
+        self.add("fix", tag, (1 if lateral else 0), *(1,) * (self.ndf - 1))
+
+    def vector(self, dof, value):
+        """A nodal vector of ndf numbers with `value` at dof (1-based)."""
+        return tuple(value if d == dof else 0.0 for d in range(1, self.ndf + 1))
 
     def nodes(self, frames):
         s = self.s
         self.node_tag = [0] * len(s.nodes)
         self.frame_nodes = {}
         in_frame = {n for fr in frames for n in fr["nodes"]}
+        in_frame |= {n for b in s.extras.get("buildings", []) for n in b["nodes"]}
         tag = 0
         for i, n in enumerate(s.nodes):
             if n["name"] in in_frame:
@@ -255,10 +278,10 @@ class _Builder:
             self.node_cmd(tag)
             if n["fixed"]:
                 self.fix_cmd(tag)
-            elif self.ndm == 2:
-                self.add("fix", tag, 0, 1, 1)       # a line node: lateral DOF only
+            elif self.ndm > 1:
+                self.fix_cmd(tag, lateral=False)    # a line node: lateral DOF only
             if not n["fixed"]:
-                self.add("mass", tag, *((n["mass"],) if self.ndm == 1 else (n["mass"], 0.0, 0.0)))
+                self.add("mass", tag, *self.vector(1, n["mass"]))
         tag += 1
         self.ground = tag
         self.node_cmd(tag)
@@ -273,10 +296,12 @@ class _Builder:
         self.x0 = 0.0
         for i, n in enumerate(s.nodes):
             if not n["fixed"] and self.node_tag[i]:
-                self.energy["kinetic"].append((self.node_tag[i], n["mass"]))
+                self.energy["kinetic"].append((self.node_tag[i], 1, n["mass"]))
         for fr in frames:
             tag = self.frame(fr, tag)
             self.x0 += float(fr["frame"].x[-1])
+        tag = self.bw.write(tag)
+        self.tag_count = tag
 
     def frame(self, fr, tag):
         """A [[frame]]: every joint a 3-DOF node, members elasticBeamColumn on a Linear
@@ -315,10 +340,10 @@ class _Builder:
                 floor += 1
                 master = joint[(line, floor)]
             self.node_tag[i] = master
-            self.energy["kinetic"].append((master, float(masses[k])))
+            self.energy["kinetic"].append((master, 1, float(masses[k])))
             self.add("mass", master, float(masses[k]), 0.0, 0.0)
             self.map.append((f"frame node {name} (m = {masses[k]:g} kg)", f"node {master}"))
-        self.energy["blocks"].append(([self.node_tag[s.index[nm]] for nm in fr["nodes"]],
+        self.energy["blocks"].append(([(self.node_tag[s.index[nm]], 1) for nm in fr["nodes"]],
                                       [[float(x) for x in row] for row in fr["K"]]))
         a0, a1 = fr["rayleigh"]
         if fr["zeta"] > 0:
@@ -336,10 +361,10 @@ class _Builder:
 
     def links(self):
         s = self.s
-        for lk in s.links:
+        for li, lk in enumerate(s.links):
             kind, name = lk["type"], lk["name"]
             # element deformation u_j − u_i = u_a − u_b = martello's elongation du
-            i, j = self.tag(lk["b"]), self.tag(lk["a"])
+            i, j, n, terms = self.ends(f"link[{li}] ({name})", lk, "b", "a")
             if kind == "spring":
                 mat = self.material("Elastic", lk["k"])
                 what = f"Elastic E = {lk['k']:.17g}"
@@ -364,22 +389,28 @@ class _Builder:
                         "(kinematic hardening, no isotropic terms: martello's return map)")
             else:                                    # pragma: no cover - the loader's kinds
                 self.refuse(f"link {name}", f"link type {kind}")
-            ele = self.zero_length(i, j, mat)
-            self.map.append((f"link {name} ({kind})", f"zeroLength {ele}: {what}"))
-            ta, tb = self.etag(lk["a"]), self.etag(lk["b"])      # ground: 0 in the energies
+            ele = self.zero_length(i, j, mat, n)
+            self.map.append((f"link {name} ({kind})", f"zeroLength {ele}: {what}" + self.along(i, j, n)))
             if kind in ("spring", "bar"):
-                self.energy["springs"].append((ta, tb, lk["k"] if kind == "spring" else lk["EA"] / lk["L"]))
+                self.energy["springs"].append((terms, lk["k"] if kind == "spring" else lk["EA"] / lk["L"]))
             elif kind == "bilinear":
-                self.energy["bilinear"].append((ele, ta, tb, lk["k"], lk["hardening"]))
+                self.energy["bilinear"].append((ele, terms, lk["k"], lk["hardening"]))
+
+    def along(self, i, j, n):
+        """Where a building's element acts (its nodes and direction), for the mapping."""
+        if n is None:
+            return ""
+        pi, pj = (self.bw.position.get(t) for t in (i, j))
+        return (f" from node {i} ({pi[0]:g}, {pi[1]:g}, {pi[2]:g}) to node {j} ({pj[0]:g}, {pj[1]:g}, "
+                f"{pj[2]:g}) along ({n[0]:g}, {n[1]:g}) on the row's line of action")
 
     def contacts(self):
         s = self.s
-        self.contact_ele, self.contact_mat = [], []
+        self.contact_ele, self.contact_mat, self.contact_terms = [], [], []
         mass = [n["mass"] for n in s.nodes]
         fixed = [n["fixed"] for n in s.nodes]
         for ci, c in enumerate(s.contacts):
-            a, b = c["a"], c["b"]
-            mstar = effective_mass(mass, fixed, [(a, 1.0), (b, -1.0)])
+            mstar = effective_mass(mass, fixed, element_terms(c))
             law = _law(c, mstar)                     # the target e resolved by the published formula
             name, gap = c["name"], float(c["gap"])
             mat_kind = self.materials.get(law.law, DEFAULT_MATERIAL[law.law])
@@ -393,7 +424,7 @@ class _Builder:
                             f"{mat_kind} makes every gap a clearance (it flips the sign of a "
                             "positive one)", "give gap >= 0")
             # compression materials: element deformation u_j − u_i = u_b − u_a = −(δ + gap)
-            i, j = self.tag(a), self.tag(b)
+            i, j, n, terms = self.ends(f"contact[{ci}] ({name})", c, "a", "b")
             og = -gap if gap != 0 else 0.0
             if mat_kind == "ElasticPPGap":
                 # a linear spring past the gap in compression; Fy far beyond any force
@@ -426,12 +457,13 @@ class _Builder:
                     mat = self.material("JankowskiImpact", law.K, law.c, meff, og, law.n)
                     what = (f"JankowskiImpact Kh = {law.K:.17g}, xi = {law.c:.17g}, mEff = {meff:.17g}, "
                             f"n = {law.n:g}")
-            ele = self.zero_length(i, j, mat)
+            ele = self.zero_length(i, j, mat, n)
             self.contact_ele.append(ele)
+            self.contact_terms.append(terms)
             self.contact_mat.append((name, law.law, mat_kind))
-            self.energy["contacts"].append((self.etag(a), self.etag(b), gap, law.K, law.n))
+            self.energy["contacts"].append((terms, gap, law.K, law.n))
             self.map.append((f"contact {name} ({law.law}, K = {law.K:g}, n = {law.n:g}, damping = "
-                             f"{law.c:g}, gap = {gap:g})", f"zeroLength {ele}: {what}"))
+                             f"{law.c:g}, gap = {gap:g})", f"zeroLength {ele}: {what}" + self.along(i, j, n)))
 
     # --- loads ----------------------------------------------------------------------------
     def series(self, fn, label):
@@ -482,18 +514,31 @@ class _Builder:
         pattern = 0
         if s.ground is not None:
             tag = self.series(s.ground, "ground")
-            pattern += 1
-            # UniformExcitation loads −M·1·ü_g and its displacements are relative: martello's u
-            self.add("pattern", "UniformExcitation", pattern, 1, "-accel", tag)
-            self.map.append((f"ground acceleration ({s.ground['type']})",
-                             f"timeSeries {tag}, pattern UniformExcitation {pattern}"))
+            # UniformExcitation loads −M·ι·ü_g and its displacements are relative: martello's u;
+            # a building's ι is (cos α, sin α, 0) on ux, uy, rz (docs/buildings.md "Ground motion")
+            buildings = s.extras.get("buildings", [])
+            if buildings:
+                iota = buildings[0]["influence"]
+                names = [nm.rsplit(".", 1)[-1] for nm in buildings[0]["nodes"]]
+                dirs = [(1, float(iota[names.index("ux")])), (2, float(iota[names.index("uy")]))]
+            else:
+                dirs = [(1, 1.0)]
+            for dof, f in dirs:
+                if f == 0.0:
+                    continue
+                pattern += 1
+                self.add("pattern", "UniformExcitation", pattern, dof, "-accel", tag,
+                         *(() if f == 1.0 else ("-fact", f)))
+                self.map.append((f"ground acceleration ({s.ground['type']})" + (
+                    f" x {f:.17g} along {'xy'[dof - 1]}" if buildings else ""),
+                    f"timeSeries {tag}, pattern UniformExcitation {pattern} (direction {dof})"))
         loads = {}
         if s.gravity:
             for i, n in enumerate(s.nodes):
                 if not n["fixed"]:
-                    loads.setdefault(None, []).append((self.node_tag[i], n["mass"] * s.gravity))
+                    loads.setdefault(None, []).append((*self.dof_of(i), n["mass"] * s.gravity))
         for f in s.forces:
-            loads.setdefault(id(f), []).append((self.node_tag[f["node"]], 1.0, f["function"]))
+            loads.setdefault(id(f), []).append((*self.dof_of(f["node"]), 1.0, f["function"]))
         for key, items in loads.items():
             if key is None:
                 self.n_series += 1
@@ -501,12 +546,12 @@ class _Builder:
                 self.add("timeSeries", "Constant", tag)
                 what = f"gravity {s.gravity:g} m/s²: nodal loads m·g, Constant series {tag}"
             else:
-                tag = self.series(items[0][2], f"force{len(self.files)}")
-                what = f"nodal force ({items[0][2]['type']}), series {tag}"
+                tag = self.series(items[0][3], f"force{len(self.files)}")
+                what = f"nodal force ({items[0][3]['type']}), series {tag}"
             pattern += 1
             self.add("pattern", "Plain", pattern, tag)
-            for node, value, *_ in items:
-                self.add("load", node, *((value,) if self.ndm == 1 else (value, 0.0, 0.0)))
+            for node, dof, value, *_ in items:
+                self.add("load", node, *self.vector(dof, value))
             self.add("endPattern")
             self.map.append((what, f"pattern Plain {pattern}"))
 
@@ -521,17 +566,14 @@ class _Builder:
         v = np.array([0.0 if nd["fixed"] else nd["v0"] for nd in s.nodes], float)
         m = np.array([nd["mass"] for nd in s.nodes], float)
         f = np.zeros(n)
-        at = lambda i, x: u[i] if i >= 0 else 0.0     # noqa: E731
-        vt = lambda i, x: v[i] if i >= 0 else 0.0     # noqa: E731
+        row = lambda terms, x: sum(c * x[k] for k, c in terms)     # noqa: E731  (g·x; ground 0)
 
-        def apply(a, b, force):             # a tension force f: −f on a, +f on b
-            if a >= 0:
-                f[a] -= force
-            if b >= 0:
-                f[b] += force
+        def apply(terms, force):            # a tension force f on the row g: −g f (docs/buildings.md)
+            for k, c in terms:
+                f[k] -= c * force
         for lk in s.links:
-            a, b = lk["a"], lk["b"]
-            du, dv = at(a, 0) - at(b, 0), vt(a, 0) - vt(b, 0)
+            terms = element_terms(lk)
+            du, dv = row(terms, u), row(terms, v)
             kind = lk["type"]
             if kind == "spring":
                 force = lk["k"] * du
@@ -546,14 +588,14 @@ class _Builder:
                 vr = lk["v_reg"]
                 force = (lk["c"] * vr ** (lk["alpha"] - 1) * dv if abs(dv) < vr
                          else lk["c"] * math.copysign(abs(dv) ** lk["alpha"], dv))
-            apply(a, b, force)
+            apply(terms, force)
         mass_l, fixed = list(m), [nd["fixed"] for nd in s.nodes]
         for c in s.contacts:
-            a, b = c["a"], c["b"]
-            law = _law(c, effective_mass(mass_l, fixed, [(a, 1.0), (b, -1.0)]))
-            d = at(a, 0) - at(b, 0) - c["gap"]
+            terms = element_terms(c)
+            law = _law(c, effective_mass(mass_l, fixed, terms))
+            d = row(terms, u) - c["gap"]
             if d > 0:
-                rate = vt(a, 0) - vt(b, 0)
+                rate = row(terms, v)
                 if law.law in ("linear", "kelvin"):
                     force = law.K * d + law.c * rate
                 elif law.law == "jankowski":
@@ -561,29 +603,40 @@ class _Builder:
                                                 if rate > 0 else 0.0)
                 else:
                     force = law.K * d ** law.n * max(0.0, 1.0 + (law.c / rate if rate > 0 else 0.0) * rate)
-                apply(b, a, -force)         # compressive P: −P on a, +P on b
+                apply(terms, force)         # compressive P: −g P
         for blk in s.blocks:
             idx = list(blk["nodes"])
             f[idx] -= np.asarray(blk["k"]) @ u[idx] + np.asarray(blk["c"]) @ v[idx]
         f += m * s.gravity
+        # the mass matrix: diagonal, with a building's couplings (a floor referred off its centre)
+        Mc = np.zeros((n, n)) if len(s.couplings) else None
+        if Mc is not None:
+            Mc[np.arange(n), np.arange(n)] = m
+            for cp in s.couplings:
+                Mc[cp["a"], cp["b"]] = Mc[cp["b"], cp["a"]] = cp["value"]
         if s.ground is not None:
-            f -= m * self.value_at_zero(s.ground)
+            iota = np.ones(n) if s.influence is None else np.asarray(s.influence, float)
+            f -= (m * iota if Mc is None else Mc @ iota) * self.value_at_zero(s.ground)
         for fo in s.forces:
             f[fo["node"]] += self.value_at_zero(fo["function"])
+        free = [i for i, nd in enumerate(s.nodes) if not nd["fixed"]]
+        acc = np.zeros(n)
+        if Mc is None:
+            acc[free] = f[free] / m[free]
+        else:
+            acc[free] = np.linalg.solve(Mc[np.ix_(free, free)], f[free])
         self.accelerated = []               # free nodes with a_0 ≠ 0 (central difference's start)
-        for i, nd in enumerate(s.nodes):
-            if nd["fixed"]:
-                continue
-            tag = self.node_tag[i]
-            a0 = f[i] / m[i]
+        for i in free:
+            tag, dof = self.dof_of(i)
+            a0 = acc[i]
             if a0 != 0.0:
-                self.accelerated.append(nd["name"])
+                self.accelerated.append(s.nodes[i]["name"])
             if u[i] != 0.0:
-                self.add("setNodeDisp", tag, 1, float(u[i]), "-commit")
+                self.add("setNodeDisp", tag, dof, float(u[i]), "-commit")
             if v[i] != 0.0:
-                self.add("setNodeVel", tag, 1, float(v[i]), "-commit")
+                self.add("setNodeVel", tag, dof, float(v[i]), "-commit")
             if a0 != 0.0:
-                self.add("setNodeAccel", tag, 1, float(a0), "-commit")
+                self.add("setNodeAccel", tag, dof, float(a0), "-commit")
 
     def value_at_zero(self, fn):
         if fn["type"] in ("table", "record"):
@@ -676,14 +729,12 @@ class _Builder:
             if s.nodes[i]["fixed"]:
                 continue
             for k in ("u", "v", "a"):
-                cols.append(Column(f"{k}:{nm}", k, (self.node_tag[i],)))
+                cols.append(Column(f"{k}:{nm}", k, self.dof_of(i)))
         at = {c["name"]: ci for ci, c in enumerate(s.contacts)}
         for nm in want_contacts:
             ci = at[nm]
             c = s.contacts[ci]
-            ta = 0 if c["a"] < 0 else self.node_tag[c["a"]]
-            tb = 0 if c["b"] < 0 else self.node_tag[c["b"]]
-            cols.append(Column(f"penetration:{nm}", "penetration", (ta, tb, float(c["gap"]))))
+            cols.append(Column(f"penetration:{nm}", "penetration", (self.contact_terms[ci], float(c["gap"]))))
             cols.append(Column(f"force:{nm}", "force", (self.contact_ele[ci],)))
         cols += [Column("energy:kinetic", "energy", ("kinetic",)),
                  Column("energy:recoverable", "energy", ("recoverable",))]
@@ -691,7 +742,9 @@ class _Builder:
                              commands=self.cmds, columns=cols, dt=self.dt, steps=self.steps,
                              every=self.every, files=self.files, mapping=self.map,
                              differences=self.diff, contact_materials=self.contact_mat,
-                             integrator=self.an["integrator"], energy=self.energy)
+                             integrator=self.an["integrator"], energy=self.energy,
+                             members=[(f"{pre}.{name}", ele) for pre, name, ele in self.bw.members],
+                             modes=sum(len(b["nodes"]) for b in s.extras.get("buildings", [])))
 
 
 class _File(str):

@@ -7,6 +7,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..history import hermite, history_dict
+from ..scene.rows import element_terms
 
 
 def _crossings(t, d, rate, upward):
@@ -74,19 +75,22 @@ def summary_from_history(scene, history):
         name = c["name"]
         d = h.get(f"penetration:{name}")
 
-        def node_col(kind, i):
-            if i < 0:
-                return np.zeros_like(t)
-            return h.get(f"{kind}:{scene.nodes[i]['name']}")
-        ua, ub = node_col("u", c["a"]), node_col("u", c["b"])
-        if d is None and ua is not None and ub is not None:
-            d = ua - ub - c["gap"]
+        terms = element_terms(c)         # (a, +1), (b, −1) of a pair; a plan-point row's terms
+
+        def row_col(kind):
+            """Σ c·x over the contact's row (docs/buildings.md), None if a column is missing."""
+            cols = [h.get(f"{kind}:{scene.nodes[k]['name']}") for k, _ in terms]
+            if any(x is None for x in cols):
+                return None
+            return sum((cf * x for (_, cf), x in zip(terms, cols)), np.zeros_like(t))
+        u_row = row_col("u")
+        if d is None and u_row is not None:
+            d = u_row - c["gap"]
         if d is None:
             continue
-        va, vb = node_col("v", c["a"]), node_col("v", c["b"])
-        rate = va - vb if (va is not None and vb is not None) else np.gradient(d, t)
-        aa, ab = node_col("a", c["a"]), node_col("a", c["b"])
-        acc = aa - ab if (aa is not None and ab is not None) else None
+        rate = row_col("v")
+        rate = np.gradient(d, t) if rate is None else rate
+        acc = row_col("a")
 
         def free_side_rate(tc, k):
             """δ̇ at a crossing, extrapolated from sample k on the free side (the rate's
