@@ -29,7 +29,7 @@ depend on the load.
 Writes nothing unless told: --out DIR keeps the rows as DIR/integrators_at_size_<scene>.json;
 --docs keeps them (with --from, the rows of finished runs, .json or .jsonl, several files merged)
 in docs/perf/integrators_at_size.json, a new row replacing the record's row of the same scene,
-integrator and n, and writes their table into docs/performance.md
+integrator, n and window, and writes their table into docs/performance.md
 (benchmarks/perf/measured_docs.py); --check finds the page's table the same as its record's (CI).
 
 Usage: benchmarks/perf/integrators_at_size.py [--n 300 1000 3000 10000]
@@ -213,11 +213,11 @@ def window(row):
 
 
 def merged(rows):
-    """Rows keyed by (scene, integrator, n, t_end), a later row replacing an earlier one, in the
-    order the integrators first appear, then by window and n."""
+    """Rows keyed by (scene, integrator, n, window), a later row replacing an earlier one, in a
+    fixed order of scenes and integrators, then by window and n."""
     out = {}
     for r in rows:
-        out[r["scene"], r["integrator"], r["n"], r["t_end"]] = r
+        out[r["scene"], r["integrator"], r["n"], window(r)] = r
     scenes, integs = ["closing", "closed", "row"], ["ida", "cvode", "arkode", "newmark-general",
                                                     "newmark-fused", "moreau-jean", "fast-nonlinear"]
 
@@ -290,7 +290,7 @@ def read_rows(path):
 
 def keep(rows):
     """The record docs/perf/integrators_at_size.json merged with rows (a new row replaces the
-    record's row of the same scene, integrator and n) and its table in docs/performance.md."""
+    record's row of the same scene, integrator, n and window) and its table in docs/performance.md."""
     path = measured_docs.RECORDS / f"{NAME}.json"
     old = json.loads(path.read_text()) if path.exists() else []
     rows = merged(old + list(rows))

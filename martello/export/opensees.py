@@ -1,6 +1,7 @@
 """A scene as an OpenSees model (docs/opensees.md): the mapping from martello's nodes, links,
 contacts, loads and integrators onto OpenSees nodes, zeroLength elements of uniaxial
-materials, elasticBeamColumn frames, time series, load patterns and transient integrators.
+materials, elasticBeamColumn frames, 3D buildings on rigid diaphragms (martello.export.building),
+time series, load patterns and transient integrators.
 
 The result is a list of OpenSees commands (`Command`: a name and its arguments, the same in
 OpenSeesPy and Tcl) plus what the generated script records each output step (`Column`), so
