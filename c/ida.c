@@ -17,10 +17,15 @@
  * Events are roots of IDA (IDARootInit), those of every SUNDIALS integrator here (c/ode_events.c:
  * gaps and their rates, the state's multiplier of a closed rigid contact, the laws' switches);
  * at an event the state is made consistent there (penalty phases, impacts, closings by the
- * accumulation rule, releases) and IDA restarts (IDAReInit) instead of stepping across the
- * kink. Steps are taken in IDA_ONE_STEP mode so that path-dependent
- * links commit at every accepted step; output times are stop times (IDASetStopTime), so
- * every history row is an accepted, committed state. Every accepted state is a sample of
+ * accumulation rule, releases) and IDA restarts (IDAReInit). The penalty laws whose force is
+ * continuous at their switches are stepped across instead, their onsets and separations located
+ * inside the steps on IDA's interpolant (docs/ida.md, switching surfaces). Steps are taken in
+ * IDA_ONE_STEP mode so that path-dependent
+ * links commit at every accepted step. The kinks of the loads and t_end are stop times; so are
+ * the output times of a scene with rigid contacts (every history row an accepted, committed
+ * state); without them IDA steps past the output times and a row inside a step is its state on
+ * the step's interpolant, so the steps do not depend on the output (docs/ida.md, output).
+ * Every accepted state is a sample of
  * the run's observer, which measures it as it measures every integrator
  * (martello_observer_*, docs/run-layer.md). */
 #include <float.h>
@@ -50,6 +55,8 @@ typedef struct {
   sunindextype N;
   sunindextype *ip, *im;
   void *mem;             /* IDA's memory: its interpolant */
+  int rows_inside;       /* 1: output rows on the interpolant, no stop at output times */
+  N_Vector yprow;        /* y' of such a row */
   char ida_msg[240];
 } ida_problem;
 
@@ -168,6 +175,13 @@ static int observe(ida_problem *P, double t, const double *y, const double *yp, 
   return martello_observer_sample(E->obs, E->ev, t, E->u, E->v, E->a, E->force, k);
 }
 
+/* An output row on the interpolant (c/ode_events.c oe_rows_inside), its y' from it too. */
+static int sample(void *ctx, double t, const double *y, int k) {
+  ida_problem *P = ctx;
+  int st = interpolant(P, t, 1, P->yprow);
+  return st == MARTELLO_OK ? observe(P, t, y, N_VGetArrayPointer(P->yprow), k) : st;
+}
+
 /* Make the state at a restart consistent (c/ode_events.c), then y and y' for IDA: P the
  * multipliers of the closed set, mu = 0, v' the constrained accelerations. */
 static int prepare_restart(ida_problem *P, double t, double *u, double *v, N_Vector yy,
@@ -267,8 +281,14 @@ static int setup(ida_problem *P, martello_model *model, martello_run *run) {
   int st = oe_setup(E, model, run, "IDA");
   if (st != MARTELLO_OK) return st;
   E->restarts = 1;   /* IDAReInit: BDF from order 1 */
-  /* IDA restarts at every switch, also where CVODE steps across (docs/sundials-ode.md, events
-   * inside the steps: stepping across, P8's errors at 100 and 1e4 x rtol lose their order) */
+  E->sample = sample;
+  /* steps past the output times, as CVODE (docs/ida.md, output); not with rigid contacts: a
+   * closed one holds its nodes still, so nothing but the stops bounds the steps, while its
+   * load-driven multiplier may change sign twice inside one step unseen */
+  P->rows_inside = E->nr == 0;
+  /* IDA steps across the laws whose force is continuous at their switches, their events
+   * located inside the steps (docs/sundials-ode.md, events inside the steps) */
+  if ((st = oe_use_smooth(E)) != MARTELLO_OK) return st;
   P->ip = oe_take((size_t)E->nr, sizeof(sunindextype), &failed);
   P->im = oe_take((size_t)E->nr, sizeof(sunindextype), &failed);
   if (failed > 0.0) return oe_fail_memory(E, "an array of the IDA state", failed);
@@ -298,12 +318,15 @@ static int setup(ida_problem *P, martello_model *model, martello_run *run) {
  * at the start and at every restart: the first step h of order 1 errs by h^2 |y''|/2 per
  * component; y'' = (a, a') at the restart (a' by a
  * forward difference along the motion) and h0 = SAFETY min_i sqrt(2 w_i / |y''_i|), w_i =
- * rtol |y_i| + atol, capped at 1e-3 of the output interval, as on the GSL path. */
+ * rtol |y_i| + atol, capped at 1e-3 of t_end (of the output interval where it is a stop time,
+ * as on the GSL path). */
 #define SAFETY 0.1   /* IDA's first-order error estimate is crude: a margin below it */
 static int initial_step(ida_problem *P, double t, const double *u, const double *v, double *h0) {
   ode_events *E = &P->E;
   const int n = E->n;
-  const double cap = 1e-3 * fmin(E->out_dt, E->t_end), d = 1e-6 * cap;
+  /* a thousandth of the output interval, or of the run where the output is no stop (its steps
+   * do not depend on the output) */
+  const double cap = 1e-3 * (P->rows_inside ? E->t_end : fmin(E->out_dt, E->t_end)), d = 1e-6 * cap;
   int st = martello_eval_acceleration(E->ev, t, u, v, E->a);
   if (st != MARTELLO_OK) return fail(P, st, "IDA: acceleration failed at t = %.9e s", t);
   for (int i = 0; i < n; i++) {
@@ -389,10 +412,12 @@ static int integrate(ida_problem *P, SUNContext sunctx, N_Vector yy, N_Vector yp
   }
 
   int k_out = 1;
-  double t_out = fmin((double)E->every * E->dt, E->t_end), t_last = 0.0;
+  double t_out = oe_output_time(E, k_out), t_last = 0.0;
   if ((st = observe(P, 0.0, N_VGetArrayPointer(yy), N_VGetArrayPointer(yp), 0)) != MARTELLO_OK) return st;
   oe_accepted(E, N_VGetArrayPointer(yy));
-  double t_stop = oe_next_stop(E, 0.0, t_out);
+  /* where IDA must stop: the next output time, or only t_end */
+#define T_TO (P->rows_inside ? E->t_end : t_out)
+  double t_stop = oe_next_stop(E, 0.0, T_TO);
   if ((st = check(P, IDASetStopTime(mem, t_stop), "IDASetStopTime"))) return st;
   const size_t n_found = (size_t)(oe_nroots(E) + 1);
   int *found = calloc(n_found, sizeof(int));
@@ -401,7 +426,7 @@ static int integrate(ida_problem *P, SUNContext sunctx, N_Vector yy, N_Vector yp
   st = MARTELLO_OK;
   while (t_last < E->t_end) {
     double tret = t_last;
-    int flag = IDASolve(mem, t_out, &tret, yy, yp, IDA_ONE_STEP);
+    int flag = IDASolve(mem, T_TO, &tret, yy, yp, IDA_ONE_STEP);
     if (flag < 0) {
       double tcur = t_last;
       if (IDAGetCurrentTime(mem, &tcur) != IDA_SUCCESS) tcur = t_last;
@@ -450,7 +475,7 @@ static int integrate(ida_problem *P, SUNContext sunctx, N_Vector yy, N_Vector yp
       if (!restart) restart = root_stays_zero(P, N_VGetArrayPointer(yy), found);
     }
     /* a kink of the load (docs/ida.md, time events): IDA restarts across it */
-    if (!restart && flag == IDA_TSTOP_RETURN && tret == t_stop && t_stop < t_out) restart = 1;
+    if (!restart && flag == IDA_TSTOP_RETURN && tret == t_stop && t_stop < T_TO) restart = 1;
     if (!restart) {
       double h_last = 0.0;
       if (IDAGetLastStep(mem, &h_last) != IDA_SUCCESS) h_last = 0.0;
@@ -464,6 +489,7 @@ static int integrate(ida_problem *P, SUNContext sunctx, N_Vector yy, N_Vector yp
       int f0 = IDAGetDky(mem, t_r, 0, yy), f1 = IDAGetDky(mem, t_r, 1, yp);
       if ((st = check(P, f0 < 0 ? f0 : f1, "IDAGetDky"))) break;
     }
+    if (P->rows_inside && (st = oe_rows_inside(E, &t_last, t_r, &k_out, &t_out)) != MARTELLO_OK) break;
     if ((st = oe_inner_events(E, t_last, t_r, N_VGetArrayPointer(yy))) != MARTELLO_OK) break;
     if ((st = oe_stretch(E, t_last, t_r, N_VGetArrayPointer(yy), restart)) != MARTELLO_OK) break;
     oe_keep_end_rates(E, !restart);
@@ -494,9 +520,7 @@ static int integrate(ida_problem *P, SUNContext sunctx, N_Vector yy, N_Vector yp
         t_last = E->t_end;
         break;
       }
-      k_out++;
-      t_out = fmin((double)(k_out * E->every) * E->dt, E->t_end);   /* t = k dt, as on GSL */
-      if (E->t_end - t_out <= 1e-9 * E->out_dt) t_out = E->t_end;
+      t_out = oe_output_time(E, ++k_out);
     }
     if (restart) {
       double h0;
@@ -507,10 +531,11 @@ static int integrate(ida_problem *P, SUNContext sunctx, N_Vector yy, N_Vector yp
       memset(E->cnt_last, 0, sizeof E->cnt_last);   /* IDAReInit starts the counters again */
     }
     if (restart || at_output || tret >= t_stop) {
-      t_stop = oe_next_stop(E, t_r, t_out);
+      t_stop = oe_next_stop(E, t_r, T_TO);
       if ((st = check(P, IDASetStopTime(mem, t_stop), "IDASetStopTime"))) break;
     }
   }
+#undef T_TO
   free(found);
   int st2 = flush_counts(P, mem);
   if (st == MARTELLO_OK) st = st2;
@@ -539,7 +564,9 @@ int martello_ida_run(martello_model *model, martello_run *run) {
     id = N_VNew_Serial(P->N, sunctx);
     E->ytmp = N_VNew_Serial(P->N, sunctx);
     E->ytd = N_VNew_Serial(P->N, sunctx);
-    if (!yy || !yp || !id || !E->ytmp || !E->ytd)
+    E->yrow = N_VNew_Serial(P->N, sunctx);
+    P->yprow = N_VNew_Serial(P->N, sunctx);
+    if (!yy || !yp || !id || !E->ytmp || !E->ytd || !E->yrow || !P->yprow)
       st = oe_fail_memory(E, "the IDA state vectors", -1.0);
   }
   /* a failed run keeps what it computed (the observer closed its open phases) */
@@ -552,6 +579,8 @@ int martello_ida_run(martello_model *model, martello_run *run) {
   if (id) N_VDestroy(id);
   if (E->ytmp) N_VDestroy(E->ytmp);
   if (E->ytd) N_VDestroy(E->ytd);
+  if (E->yrow) N_VDestroy(E->yrow);
+  if (P->yprow) N_VDestroy(P->yprow);
   if (sunctx) SUNContext_Free(&sunctx);
   release(P);
   return st;

@@ -402,7 +402,9 @@ def main(argv=None):
     p = sub.add_parser("export", help="write a scene as a model for another code (OpenSees)",
                        description="Write a standalone OpenSeesPy script DIR/model.py (and with --tcl "
                        "DIR/model.tcl) that rebuilds the scene in OpenSees and, run inside DIR, writes "
-                       "DIR/history.csv in the format martello compare reads. What OpenSees cannot "
+                       "DIR/history.csv in the format martello compare reads (a [[building]] also "
+                       "DIR/members.csv, its members' M2, M3; `python model.py --periods` writes "
+                       "DIR/periods.csv instead). What OpenSees cannot "
                        "express is refused naming what and why; each mapping and its differences are "
                        "in the script's header and docs/opensees.md.")
     p.add_argument("scene", help="scene file (TOML), or a path in the catalogue")

@@ -270,6 +270,31 @@ def small_buildings(t_end=0.3, reference=True, zeta=0.05):
             "analysis": {"type": "dynamic", "integrator": "newmark", "dt": 1e-3, "t_end": t_end}}
 
 
+def shear_buildings(t_end=0.3):
+    """Two shear-type buildings (docs/buildings.md "Members"): A, 2 storeys on pinned feet, its
+    first floor flexible (joints with their tributary masses), heavier than B; B, columns turned
+    by 90°, storeys 3 and 3.5 m, a split point on a column of its second storey struck by A's
+    second floor between plan point and point, a node-pair gap from A's joint to B's floor; the
+    ground motion at 30° in plan, starting towards B (phase π), Rayleigh 5 %, Newmark 1 ms."""
+    col = {"E": 3e10, "b2": 0.4, "b3": 0.3, "cracked": 0.5}
+    a = {"prefix": "A", "storeys": 2, "storey_height": 3.0, "grid_x": [0.0, 5.0], "grid_y": [0.0, 6.0],
+         "column": col, "mass": [5.0e5, 4.0e5], "zeta": 0.05, "ground_angle": 30.0, "base": "pinned",
+         "diaphragm": [False, True], "histories": True}
+    b = {"prefix": "B", "storeys": 2, "storey_height": [3.0, 3.5], "grid_x": [5.002, 10.002],
+         "grid_y": [0.0, 6.0], "column": col, "mass": 1.2e5, "zeta": 0.05, "ground_angle": 30.0,
+         "column_angle": 90.0, "histories": True,
+         "split": [{"name": "S", "line": "0.0", "storey": 2, "height": 1.5, "mass": 500.0}]}
+    return {"title": "two shear buildings", "building": [a, b],
+            "contact": [{"name": "g", "a": {"floor": "A2", "x": 5.0, "y": 0.0}, "b": {"point": "B.S"},
+                         "normal": [1.0, 0.0], "gap": 0.0002, "scheme": "penalty", "law": "linear",
+                         "stiffness": 2e8},
+                        {"name": "j", "a": "A1.1.1.ux", "b": "B1.ux", "gap": 0.0005, "scheme": "penalty",
+                         "law": "linear", "stiffness": 2e8}],
+            "loads": {"ground_acceleration": {"type": "sine", "amplitude": 6.0, "omega": 15.0,
+                                              "phase": math.pi}},
+            "analysis": {"type": "dynamic", "integrator": "newmark", "dt": 1e-3, "t_end": t_end}}
+
+
 def test_a_building_is_a_3d_frame_on_rigid_diaphragms(tmp_path):
     """[[building]] (docs/opensees.md "Buildings"): 6-DOF nodes, one rigidDiaphragm per floor
     to a master at the reference point, the floor's m, m, J on the master or on a node at the

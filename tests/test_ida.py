@@ -1,5 +1,6 @@
-"""SUNDIALS IDA (docs/ida.md): penalty scenes as implicit ODEs restarted at every contact
-onset and separation, Lagrange/restitution scenes as a stabilised index-2 DAE (GGL) with
+"""SUNDIALS IDA (docs/ida.md): penalty scenes as implicit ODEs, restarted at every contact
+onset and separation of a law whose force jumps there and stepping across the others (their
+events located inside the steps), Lagrange/restitution scenes as a stabilised index-2 DAE (GGL) with
 IDA's root finding for impacts, closings and releases. Oracles: martello.oracles, coded
 independently of the solvers.
 
@@ -399,3 +400,60 @@ def test_an_atol_below_the_rounding_of_the_gap_is_a_warning_before_and_after_the
     d["analysis"]["integrator"] = "cvode"
     d["analysis"]["atol"] = 1e-17
     assert atol_note(from_dict(d)) is None          # IDA's error test only (measured: docs/ida.md)
+
+
+# --- output rows on IDA's interpolant: no result depends on the output -----------------------------
+
+@pytest.mark.parametrize("path", ["benchmarks/p2/laws/p2_linear_ida.toml",
+                                  "benchmarks/p7/laws/p7_two_kelvin_ida.toml"])
+def test_rows_on_the_interpolant_keep_output_invariance(path):
+    # Identity of the method (no oracle). IDA stops only at the loads' kinks, its events and
+    # t_end; an output row inside a step is the state on the step's interpolant (docs/ida.md,
+    # output rows), so the steps are those of every output variant (the output interval x 0.37
+    # and x 3, every x 7 and x 1000): step counts equal, and every number equal up to
+    # - a located time (an event, an extremum): bisected on the same polynomial in other
+    #   brackets, it stops anywhere within event_tol (1e-12 s) of the crossing;
+    # - a value: interpolated at other points, the rounding of its terms, ROUNDING (1e3 eps)
+    #   of its family's scale (relations.mismatches);
+    # - an energy: the works' 3-point Gauss over stretches split at the rows, and the running
+    #   balance sampled at the rows too: within the error the run reports on its works, its
+    #   energy balance (as relations.mismatches).
+    # Measured (P2's linear plane stepped across, P7's Kelvin contact restarted): every number
+    # but the energies and located times to the bit; times within 3.4e-13 s, a peak force
+    # 3.8e-14 relative, energies 1.1e-14 J of 0.76 J, P2's balance_max 2.9e-14 J of 4.2e-9 J.
+    import sys
+    from pathlib import Path
+    root = Path(__file__).resolve().parents[1]
+    sys.path.insert(0, str(root / "benchmarks" / "invariance"))
+    import relations
+    data, base_dir = relations.read(root / path)
+    s0 = relations.run(relations.base_scene(data), base_dir)[0]
+    base = relations.numbers(s0)
+    fams = {f: max([abs(v) for k, v in base.items() if relations._family(k) == f
+                    and isinstance(v, float) and math.isfinite(v)] + [0.0]) for f in ("L", "V", "A", "E")}
+    event_tol = 1e-12
+    balance = abs(s0["energy"]["balance_max"])
+    variants = [(n, v) for n, v in relations.output_variants(data, True) if n.startswith(("every", "output"))]
+    assert len(variants) == 4
+    for name, variant in variants:
+        s = relations.run(variant, base_dir)[0]
+        assert s["cost"]["steps"] == s0["cost"]["steps"], name
+        other = relations.numbers(s)
+        moved = []
+        for p, x in base.items():
+            y = other.get(p, x)
+            if relations._same(x, y) or p.startswith(("cost", "wall")):
+                continue
+            last = p.rsplit(".", 2)
+            if p == "energy.balance_relative":
+                ok = abs(x - y) <= balance / fams["E"]
+            elif p.startswith("energy."):
+                ok = abs(x - y) <= balance
+            elif any(w.startswith("t_") or w.endswith("_times") for w in last):
+                ok = abs(x - y) <= event_tol
+            else:
+                fam = relations._family(p)
+                ok = abs(x - y) <= relations.ROUNDING * max(abs(x), abs(y), fams.get(fam, 0.0))
+            if not ok:
+                moved.append((p, x, y))
+        assert not moved, (name, moved)

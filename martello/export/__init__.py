@@ -64,7 +64,8 @@ def main(args):
     files = [SCRIPT] + (["model.tcl"] if args.tcl else []) + sorted(model.files)
     print(f"{scene.title}: {len(model.commands)} OpenSees commands, {model.steps} steps -> "
           f"{', '.join(str(Path(args.output) / f) for f in files)} (run: cd {args.output} && "
-          f"python {SCRIPT})")
+          f"python {SCRIPT}" + (f"; it also writes members.csv, and `python {SCRIPT} --periods` "
+                                f"the periods of its {model.modes} modes" if model.members else "") + ")")
     return 0
 
 
