@@ -417,7 +417,8 @@ static int integrate(ida_problem *P, SUNContext sunctx, N_Vector yy, N_Vector yp
   oe_accepted(E, N_VGetArrayPointer(yy));
   /* where IDA must stop: the next output time, or only t_end */
 #define T_TO (P->rows_inside ? E->t_end : t_out)
-  double t_stop = oe_next_stop(E, 0.0, T_TO);
+  int kink = 0;
+  double t_stop = oe_next_stop(E, 0.0, T_TO, &kink);
   if ((st = check(P, IDASetStopTime(mem, t_stop), "IDASetStopTime"))) return st;
   const size_t n_found = (size_t)(oe_nroots(E) + 1);
   int *found = calloc(n_found, sizeof(int));
@@ -475,7 +476,7 @@ static int integrate(ida_problem *P, SUNContext sunctx, N_Vector yy, N_Vector yp
       if (!restart) restart = root_stays_zero(P, N_VGetArrayPointer(yy), found);
     }
     /* a kink of the load (docs/ida.md, time events): IDA restarts across it */
-    if (!restart && flag == IDA_TSTOP_RETURN && tret == t_stop && t_stop < T_TO) restart = 1;
+    if (!restart && flag == IDA_TSTOP_RETURN && tret == t_stop && kink && t_stop < T_TO) restart = 1;
     if (!restart) {
       double h_last = 0.0;
       if (IDAGetLastStep(mem, &h_last) != IDA_SUCCESS) h_last = 0.0;
@@ -531,7 +532,7 @@ static int integrate(ida_problem *P, SUNContext sunctx, N_Vector yy, N_Vector yp
       memset(E->cnt_last, 0, sizeof E->cnt_last);   /* IDAReInit starts the counters again */
     }
     if (restart || at_output || tret >= t_stop) {
-      t_stop = oe_next_stop(E, t_r, T_TO);
+      t_stop = oe_next_stop(E, t_r, T_TO, &kink);
       if ((st = check(P, IDASetStopTime(mem, t_stop), "IDASetStopTime"))) break;
     }
   }

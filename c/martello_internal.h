@@ -114,6 +114,9 @@ int martello_eval_switches(martello_eval *ev, int *el, double *alpha, double *be
 /* The first time after t where a load has a kink (a window's start or end, a table sample),
  * or DBL_MAX. */
 int martello_eval_next_breakpoint(martello_eval *ev, double t, double *tb);
+/* The shortest period of the loads' harmonic terms (a sine's 2 pi/omega, twice a half sine's
+ * window), or DBL_MAX: between their kinks the loads are otherwise linear in t. */
+int martello_eval_load_period(martello_eval *ev, double *period);
 /* power[5] at the last force evaluation: of the external and the internal forces on the free
  * nodes (f . v), and of the dampers, the other links and the penalty contacts (f (v_a - v_b)):
  * the integrands of martello_observer_work's works. */

@@ -26,6 +26,11 @@
  * a small multiple of their local tolerance rtol |u| + atol. */
 #define POSITION_TOL_FACTOR 10.0
 
+/* Steps per shortest harmonic period of the loads while a rigid contact is held
+ * (docs/sundials-ode.md, held contacts): a multiplier excursion longer than period/HOLD_STEPS
+ * contains a step end, where the root function's sign is seen. */
+#define HOLD_STEPS 16.0
+
 /* ---- failures --------------------------------------------------------------------------- */
 
 int oe_fail_memory(ode_events *E, const char *what, double bytes) {
@@ -422,6 +427,10 @@ static int node_extrema(ode_events *E, double t0, double t1, const double *y1) {
     const double v0 = E->v_last[i], v1 = y1[E->iv[i]];
     int is_max, st;
     if (E->fixed[i]) continue;
+    /* a turn inside the velocity's own tolerance is not resolved: its sign is the error's (as
+     * on c/event_driven.c: u ~ 1e-150 m ahead of a wave front turned back and forth with the
+     * steps; docs/results.md, u_peak) */
+    if (!(fmax(fabs(v0), fabs(v1)) > E->atol)) continue;
     if (v0 > 0.0 && v1 <= 0.0) is_max = 1;
     else if (v0 < 0.0 && v1 >= 0.0) is_max = 0;
     else continue;
@@ -524,10 +533,27 @@ void oe_keep_end_rates(ode_events *E, int unchanged) {
   tmp = E->pa0; E->pa0 = E->pa1; E->pa1 = tmp;
 }
 
-double oe_next_stop(ode_events *E, double t, double t_to) {
+/* Two stops closer than this many units of rounding of their time are one (oe_next_stop). */
+#define STOP_ROUNDING (16.0 * DBL_EPSILON)
+
+double oe_next_stop(ode_events *E, double t, double t_to, int *kink) {
   double tb = DBL_MAX;
   if (martello_eval_next_breakpoint(E->ev, t, &tb) != MARTELLO_OK) tb = DBL_MAX;
-  return fmin(tb, t_to);
+  /* a kink within rounding of t is the one just passed (two loads' kinks an ulp apart: a
+   * record's sample and a window's end), and one within rounding of t_to is t_to (a record
+   * sampled at 0.01 s, outputs every 0.015 s: the times differ by an ulp or two): one stop,
+   * never a step of an ulp (as c/event_driven.c) */
+  if (tb - t <= STOP_ROUNDING * fabs(t) && martello_eval_next_breakpoint(E->ev, tb, &tb) != MARTELLO_OK)
+    tb = DBL_MAX;
+  *kink = tb <= t_to + STOP_ROUNDING * fabs(t_to);
+  return tb < t_to - STOP_ROUNDING * fabs(t_to) ? tb : t_to;
+}
+
+double oe_max_step(const ode_events *E) {
+  if (E->h_hold > 0.0)
+    for (int r = 0; r < E->nr; r++)
+      if (E->closed[r]) return E->h_max > 0.0 ? fmin(E->h_max, E->h_hold) : E->h_hold;
+  return E->h_max;
 }
 
 double oe_output_time(const ode_events *E, int k) {
@@ -798,9 +824,78 @@ int oe_prepare_restart(ode_events *E, double t, double *u, double *v) {
     return oe_fail(E, st, "%s: energy evaluation failed", E->name);
   E->e_impact += ke0 - ke1;
   for (int j = 0; j < E->nc; j++) E->act[j] = ACT_NONE;
+  E->held_ready = 0;
   if ((st = closed_set_roots(E)) != MARTELLO_OK)
     return oe_fail(E, MARTELLO_ERR_SINGULAR, "%s: redundant closed contacts at t = %.9e s (B^T M^-1 B singular)", E->name, t);
   return oe_hand_work(E);
+}
+
+/* The held set's multipliers plus their tension bars into lam and their rates into dlam at
+ * (t, u, v): lambda from the state (oe_closed_multipliers), lambda' the multiplier of the jerk,
+ * W_H lambda' = -B_H j (the constraints are linear and the mass constant; as c/event_driven.c). */
+static int held_values(ode_events *E, double t, const double *u, const double *v, double *lam,
+                       double *dlam) {
+  int st = oe_closed_multipliers(E, t, u, v);
+  if (st == MARTELLO_OK) st = martello_peak_rates(E->ev, t, u, v, E->ar, E->nc, E->nl, E->elc, E->jk);
+  if (st == MARTELLO_OK)
+    st = martello_impulse_project(E->n, E->mc, E->dlc, TOPOLOGY(E), E->Wc, NULL, E->jk, E->rhs);
+  if (st != MARTELLO_OK)
+    return oe_fail(E, st, "%s: the held contacts' forces failed at t = %.9e s", E->name, t);
+  for (int k = 0; k < E->mc; k++) {
+    lam[k] = E->lr[E->lc[k]] + E->lamtol[E->lc[k]];
+    dlam[k] = E->rhs[k];
+  }
+  return MARTELLO_OK;
+}
+
+/* held_values at t on the interpolant of the last step. */
+static int held_values_at(ode_events *E, double t, double *lam, double *dlam) {
+  int st = E->dky(E->ctx, t, 0, E->ytmp);
+  if (st != MARTELLO_OK) return st;
+  oe_gather(E, N_VGetArrayPointer(E->ytmp), E->uq, E->vq);
+  return held_values(E, t, E->uq, E->vq, lam, dlam);
+}
+
+int oe_held_release(ode_events *E, double t0, double t1, const double *y1, double *t_r) {
+  int st, kbest = -1;
+  double best = t1;
+  if (E->mc == 0 || !(t1 > t0)) return 0;
+  oe_gather(E, y1, E->uq, E->vq);
+  if ((st = held_values(E, t1, E->uq, E->vq, E->hl1, E->hd1)) != MARTELLO_OK) return st;
+  /* the start's values: kept from the last step's end, or (the first step after a restart)
+   * from the interpolant */
+  if (!E->held_ready && (st = held_values_at(E, t0, E->hl0, E->hd0)) != MARTELLO_OK) return st;
+  for (int k = 0; k < E->mc; k++) {
+    if (!(E->hl0[k] > 0.0 && E->hl1[k] > 0.0 && E->hd0[k] < 0.0 && E->hd1[k] > 0.0)) continue;
+    const double tol = fmax(E->event_tol, 4.0 * DBL_EPSILON * fabs(t1));
+    double lo = t0, hi = t1;
+    for (int it = 0; it < 200 && hi - lo > tol; it++) {
+      const double tm = 0.5 * (lo + hi);
+      if ((st = held_values_at(E, tm, E->hlm, E->hdm)) != MARTELLO_OK) return st;
+      if (E->hdm[k] < 0.0) lo = tm; else hi = tm;
+    }
+    if ((st = held_values_at(E, hi, E->hlm, E->hdm)) != MARTELLO_OK) return st;
+    if (!(E->hlm[k] < 0.0)) continue;       /* the minimum stays compressive */
+    lo = t0;
+    for (int it = 0; it < 200 && hi - lo > tol; it++) {
+      const double tm = 0.5 * (lo + hi);
+      if ((st = held_values_at(E, tm, E->hlm, E->hdm)) != MARTELLO_OK) return st;
+      if (E->hlm[k] > 0.0) lo = tm; else hi = tm;
+    }
+    if (kbest < 0 || hi < best) {
+      best = hi;
+      kbest = k;
+    }
+  }
+  if (kbest >= 0) {
+    E->act[E->rig_con[E->lc[kbest]]] = ACT_RELEASE;
+    *t_r = best;
+    return 1;
+  }
+  double *tmp = E->hl0; E->hl0 = E->hl1; E->hl1 = tmp;
+  tmp = E->hd0; E->hd0 = E->hd1; E->hd1 = tmp;
+  E->held_ready = 1;
+  return 0;
 }
 
 int oe_initial_contacts(ode_events *E, const double *u0, const double *v0) {
@@ -1012,7 +1107,8 @@ void oe_release(ode_events *E) {
                  E->sw_el, E->sw_al, E->sw_be, E->sw_ga, E->sw_hit, E->lc, E->dlc, E->Wc, E->ar,
                  E->lr, E->lamtol, E->v_last, E->el0, E->el1, E->elc, E->pv0, E->pa0, E->pj0,
                  E->pv1, E->pa1, E->pj1, E->ua, E->va, E->aa, E->jk, E->cont, E->d_last,
-                 E->r_last, E->vin, E->vin_j, E->tay_u, E->tay_v, E->ev_t, E->ev_j, E->ev_k};
+                 E->r_last, E->vin, E->vin_j, E->tay_u, E->tay_v, E->ev_t, E->ev_j, E->ev_k, E->hl0,
+                 E->hd0, E->hl1, E->hd1, E->hlm, E->hdm};
   for (size_t k = 0; k < sizeof all / sizeof all[0]; k++) free(all[k]);
   if (E->ev) martello_eval_free(&E->ev);
   martello_accumulation_free(&E->acc);
@@ -1087,7 +1183,8 @@ int oe_setup(ode_events *E, martello_model *model, martello_run *run, const char
                        &E->aset, &E->lc, &E->dlc};
   for (size_t k = 0; k < sizeof per_rigid / sizeof per_rigid[0]; k++)
     *per_rigid[k] = oe_take(nr, sizeof(int), &failed);
-  double **per_rigid_d[] = {&E->q, &E->w0, &E->lam, &E->rhs, &E->lr, &E->lamtol};
+  double **per_rigid_d[] = {&E->q, &E->w0, &E->lam, &E->rhs, &E->lr, &E->lamtol,
+                            &E->hl0, &E->hd0, &E->hl1, &E->hd1, &E->hlm, &E->hdm};
   for (size_t k = 0; k < sizeof per_rigid_d / sizeof per_rigid_d[0]; k++)
     *per_rigid_d[k] = oe_take(nr, sizeof(double), &failed);
   E->cols = oe_take(nr * un, sizeof(double), &failed);
@@ -1118,6 +1215,12 @@ int oe_setup(ode_events *E, martello_model *model, martello_run *run, const char
   if (st != MARTELLO_OK) return oe_fail(E, st, "%s: could not create the force evaluator", name);
   if ((st = martello_eval_link_count(E->ev, &E->nl)) != MARTELLO_OK)
     return oe_fail(E, st, "%s: martello_eval_link_count failed", name);
+  if (E->nr > 0) {
+    double period = DBL_MAX;
+    if ((st = martello_eval_load_period(E->ev, &period)) != MARTELLO_OK)
+      return oe_fail(E, st, "%s: martello_eval_load_period failed", name);
+    E->h_hold = period < DBL_MAX ? period / HOLD_STEPS : 0.0;
+  }
   {
     const size_t ne = 4 * (ucn + (size_t)E->nl);
     double **el[] = {&E->el0, &E->el1, &E->elc};

@@ -106,6 +106,13 @@ typedef struct {
   N_Vector yrow;
   /* settings */
   double rtol, atol, event_tol, t_end, h_max, out_dt, dt;
+  double h_hold;              /* the longest step while a rigid contact is held (0: no bound;
+                                 oe_max_step) */
+  /* the held set's multipliers (plus their tension bars) and their rates at the end of the last
+   * step (hl0, hd0; valid while held_ready), of this one (hl1, hd1) and inside it (hlm, hdm):
+   * oe_held_release */
+  double *hl0, *hd0, *hl1, *hd1, *hlm, *hdm;
+  int held_ready;
   int restarts;               /* 1: the integrator restarts at order 1 after an event (BDF;
                                  the accumulation rule's resolution), 0: a one-step method */
   int every;                  /* output intervals dt per stop time out_dt */
@@ -176,6 +183,12 @@ int oe_root_stays_zero(ode_events *E, const double *y, const int *found);
  * step). 1 with E->act and *t_r if the integrator must restart, 0 if not, < 0 on failure. */
 int oe_boundary_events(ode_events *E, double t_last, double tret, const double *y,
                        double h_last, double *t_r);
+/* After a step without a root while rigid contacts are held: a multiplier that falls and rises
+ * again inside [t0, t1] (its rate, from the jerk, negative at t0 and positive at t1) with both
+ * ends compressive has its minimum located on the interpolant; if that is tensile, 1 with
+ * E->act (a release) and *t_r at its first zero. 0 if none, < 0 on failure
+ * (docs/sundials-ode.md, held contacts). */
+int oe_held_release(ode_events *E, double t0, double t1, const double *y1, double *t_r);
 /* The contacts at t = 0: penalty contacts at zero gap and closing get an onset; rigid contacts
  * at zero gap that approach or rest are resolved as impacts (one penetrated is refused). */
 int oe_initial_contacts(ode_events *E, const double *u0, const double *v0);
@@ -226,8 +239,14 @@ int oe_hand_work(ode_events *E);
 int oe_stretch(ode_events *E, double t0, double t1, const double *y1, int at_event);
 /* After a stretch: its end's rates are the next one's start unless the integrator restarts. */
 void oe_keep_end_rates(ode_events *E, int unchanged);
-/* The next stop after t: t_to (an output time or t_end), or a kink of the load before it. */
-double oe_next_stop(ode_events *E, double t, double t_to);
+/* The longest step the integrator may take now (0: no limit): the setting h_max and, while a
+ * rigid contact is held, a fraction of the loads' shortest harmonic period (docs/sundials-ode.md,
+ * held contacts). The adapter sets it at the start and after every restart. */
+double oe_max_step(const ode_events *E);
+/* The next stop after t: t_to (an output time or t_end), or a kink of the load before it; a
+ * kink within 16 eps of t_to is t_to, one within 16 eps after t is skipped. *kink = 1 when the
+ * stop is (also) a kink: the integrator restarts there. */
+double oe_next_stop(ode_events *E, double t, double t_to, int *kink);
 /* The integrator's counters now (MARTELLO_COUNTER_* order; events and chatter ignored): their
  * increase since the last hand-over, and the events, to the run. */
 int oe_add_counts(ode_events *E, const long c[9]);

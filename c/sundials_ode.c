@@ -24,12 +24,13 @@
  * once, the accumulation rule of c/accumulation.c. At an event the state is made consistent,
  * committed on the new branches, and the integrator restarts there (CVodeReInit; ARKStepReset,
  * which keeps the last step as the first: a one-step method has no history to rebuild).
- * The kinks of the loads and t_end are stop times (properties of the scene). CVODE steps past
- * the output times of a scene without rigid contacts: a history row inside a step is its state
- * on the step's interpolant (CVodeGetDky, of the method's order), so the steps, and every
- * result, do not depend on the output interval (docs/sundials-ode.md, output rows). Otherwise
- * (ARKODE, rigid contacts) the output times are stop times too, so its rows are accepted,
- * committed states. Steps are taken one at a time
+ * The kinks of the loads and t_end are the only stop times (properties of the scene): both step
+ * past the output times, a history row inside a step is its state on the step's interpolant
+ * (CVodeGetDky, ARKStepGetDky), so the steps, and every result, do not depend on the output
+ * interval (docs/sundials-ode.md, output rows). While a rigid contact is held, which may hold
+ * its nodes still, the steps are bounded by the loads' time scale so that its multiplier cannot
+ * change sign twice unseen inside one (oe_max_step; docs/sundials-ode.md, held contacts).
+ * Steps are taken one at a time
  * (CV_ONE_STEP, ARK_ONE_STEP); every accepted state is a sample of the run's observer, with the
  * works, the node extrema and the located peaks of the step on the interpolant (c/ode_events.c). */
 #include <float.h>
@@ -62,7 +63,6 @@ enum { KIND_BDF = 1, KIND_ADAMS = 2, KIND_ERK = 3, KIND_DIRK = 4, KIND_IMEX = 5 
 typedef struct {
   ode_events E;            /* contacts, events, the observer's hand-overs (c/ode_events.c) */
   int ark;                 /* 0: CVODE, 1: ARKODE */
-  int rows_inside;         /* 1: output rows on the interpolant, no stop at output times */
   int kind;                /* KIND_* */
   int erk_id, dirk_id;     /* ARKODE tables (ARKODE_*_NONE when absent) */
   const char *name;        /* "CVODE" or "ARKODE": what the messages say */
@@ -87,6 +87,14 @@ static const char *be_flag(ode_problem *P, int flag) {
 
 static int be_stop(ode_problem *P, double t) {
   return P->ark ? ARKStepSetStopTime(P->mem, t) : CVodeSetStopTime(P->mem, t);
+}
+
+/* The longest step now (oe_max_step; 0: no limit, SUNDIALS' own default). */
+static int be_max_step(ode_problem *P) {
+  const double h = oe_max_step(&P->E);
+  int flag = P->ark ? ARKStepSetMaxStep(P->mem, h) : CVodeSetMaxStep(P->mem, h);
+  if (flag < 0) return fail(P, MARTELLO_ERR_EXTERNAL, "%s: SetMaxStep failed: %s", P->name, be_flag(P, flag));
+  return MARTELLO_OK;
 }
 
 static double be_last_step(ode_problem *P) {
@@ -363,10 +371,8 @@ static int setup(ode_problem *P, martello_model *model, martello_run *run) {
    * nothing at a restart (the accumulation rule's resolution, docs/impulse.md §4) */
   E->restarts = !P->ark;
   E->degree = degree;
-  /* CVODE steps past the output times; not with rigid contacts: a closed one holds its nodes
-   * still, so nothing bounds the steps but the stops, while its multiplier, driven by the loads,
-   * may change sign twice inside one step unseen (docs/sundials-ode.md, output rows) */
-  P->rows_inside = !P->ark && E->nr == 0;
+  /* both step past the output times (docs/sundials-ode.md, output rows); while a rigid contact
+   * is held its steps are bounded by the loads' time scale instead (oe_max_step) */
   /* CVODE steps across the laws whose force is continuous at their switches, their events
    * located inside the steps; ARKODE restarts at them, which costs it less (docs/sundials-ode.md,
    * events inside the steps) */
@@ -414,7 +420,6 @@ static int create(ode_problem *P, SUNContext ctx, N_Vector y, SUNMatrix *Jp, SUN
      * highest degree ARKODE has (5) */
     if ((st = check(P, ARKStepSetInterpolantDegree(P->mem, ARK_INTERP_MAX_DEGREE),
                     "ARKStepSetInterpolantDegree"))) return st;
-    if (P->E.h_max > 0.0 && (st = check(P, ARKStepSetMaxStep(P->mem, P->E.h_max), "ARKStepSetMaxStep"))) return st;
     if (implicit && (st = check(P, ARKStepSetDeduceImplicitRhs(P->mem, SUNTRUE),
                                 "ARKStepSetDeduceImplicitRhs"))) return st;
     /* ARKODE's Newton test accepts an iterate when min(1, crate) |correction| <= the tolerance,
@@ -436,7 +441,6 @@ static int create(ode_problem *P, SUNContext ctx, N_Vector y, SUNMatrix *Jp, SUN
     if ((st = check(P, CVodeSetUserData(P->mem, P), "CVodeSetUserData"))) return st;
     if ((st = check(P, CVodeSetMaxNumSteps(P->mem, -1), "CVodeSetMaxNumSteps"))) return st;
     if ((st = check(P, CVodeSetMaxErrTestFails(P->mem, MAX_ERR_TEST_FAILS), "CVodeSetMaxErrTestFails"))) return st;
-    if (P->E.h_max > 0.0 && (st = check(P, CVodeSetMaxStep(P->mem, P->E.h_max), "CVodeSetMaxStep"))) return st;
   }
   if (implicit) {
     /* the analytic Jacobian with a lumped mass, banded where the band is narrower than half
@@ -458,6 +462,7 @@ static int create(ode_problem *P, SUNContext ctx, N_Vector y, SUNMatrix *Jp, SUN
       if (analytic && (st = check(P, CVodeSetJacFn(P->mem, jacobian), "CVodeSetJacFn"))) return st;
     }
   }
+  if ((st = be_max_step(P)) != MARTELLO_OK) return st;
   const int nroots = oe_nroots(&P->E);
   if (nroots > 0) {
     if (P->ark) {
@@ -476,14 +481,16 @@ static int create(ode_problem *P, SUNContext ctx, N_Vector y, SUNMatrix *Jp, SUN
 static int restart(ode_problem *P, double t, N_Vector y) {
   int st;
   if (P->ark) {
-    double h = be_last_step(P);
+    double h = be_last_step(P), h_max = oe_max_step(&P->E);
+    if (h_max > 0.0) h = fmin(h, h_max);
     if (h > 0.0 && (st = check(P, ARKStepSetInitStep(P->mem, h), "ARKStepSetInitStep"))) return st;
     if ((st = check(P, ARKStepReset(P->mem, t, y), "ARKStepReset"))) return st;
   } else if ((st = check(P, CVodeReInit(P->mem, t, y), "CVodeReInit"))) {
     return st;
   }
   rebase_counts(P);
-  return MARTELLO_OK;
+  /* the held set may have changed: its bound on the steps with it */
+  return be_max_step(P);
 }
 
 /* ---- the run ------------------------------------------------------------------------------------ */
@@ -510,9 +517,9 @@ static int integrate(ode_problem *P, SUNContext ctx, N_Vector yy, SUNMatrix *Jp,
   double t_out = oe_output_time(E, k_out), t_last = 0.0;
   if ((st = observe(P, 0.0, y, 0)) != MARTELLO_OK) return st;
   oe_accepted(E, y);
-  /* where the integrator must stop: the next output time, or only t_end */
-#define T_TO (P->rows_inside ? E->t_end : t_out)
-  double t_stop = oe_next_stop(E, 0.0, T_TO);
+  /* the stops: the loads' kinks and t_end (the output rows lie on the steps' interpolant) */
+  int kink = 0;
+  double t_stop = oe_next_stop(E, 0.0, E->t_end, &kink);
   if ((st = check(P, be_stop(P, t_stop), "SetStopTime"))) return st;
   const size_t n_found = (size_t)(oe_nroots(E) + 1);
   int *found = calloc(n_found, sizeof(int));
@@ -521,8 +528,8 @@ static int integrate(ode_problem *P, SUNContext ctx, N_Vector yy, SUNMatrix *Jp,
   st = MARTELLO_OK;
   while (t_last < E->t_end) {
     double tret = t_last;
-    int flag = P->ark ? ARKStepEvolve(P->mem, T_TO, yy, &tret, ARK_ONE_STEP)
-                      : CVode(P->mem, T_TO, yy, &tret, CV_ONE_STEP);
+    int flag = P->ark ? ARKStepEvolve(P->mem, E->t_end, yy, &tret, ARK_ONE_STEP)
+                      : CVode(P->mem, E->t_end, yy, &tret, CV_ONE_STEP);
     if (flag < 0) {
       double tcur = t_last;
       if ((P->ark ? ARKStepGetCurrentTime(P->mem, &tcur) : CVodeGetCurrentTime(P->mem, &tcur)) < 0)
@@ -559,7 +566,7 @@ static int integrate(ode_problem *P, SUNContext ctx, N_Vector yy, SUNMatrix *Jp,
     }
     /* a kink of the load: restart across it */
     if (!again && flag == (P->ark ? ARK_TSTOP_RETURN : CV_TSTOP_RETURN) && tret == t_stop &&
-        t_stop < T_TO)
+        kink && t_stop < E->t_end)
       again = 1;
     if (!again) {
       again = oe_boundary_events(E, t_last, tret, y, be_last_step(P), &t_r);
@@ -568,8 +575,13 @@ static int integrate(ode_problem *P, SUNContext ctx, N_Vector yy, SUNMatrix *Jp,
         break;
       }
     }
+    /* a held contact's multiplier that turns tensile and back inside the step */
+    if (!again && (again = oe_held_release(E, t_last, tret, y, &t_r)) < 0) {
+      st = again;
+      break;
+    }
     if (again && t_r < tret && (st = interpolant(P, t_r, 0, yy)) != MARTELLO_OK) break;
-    if (P->rows_inside && (st = oe_rows_inside(E, &t_last, t_r, &k_out, &t_out)) != MARTELLO_OK) break;
+    if ((st = oe_rows_inside(E, &t_last, t_r, &k_out, &t_out)) != MARTELLO_OK) break;
     if ((st = oe_inner_events(E, t_last, t_r, y)) != MARTELLO_OK) break;
     if ((st = oe_stretch(E, t_last, t_r, y, again)) != MARTELLO_OK) break;
     oe_keep_end_rates(E, !again);
@@ -597,21 +609,15 @@ static int integrate(ode_problem *P, SUNContext ctx, N_Vector yy, SUNMatrix *Jp,
       }
       t_out = oe_output_time(E, ++k_out);
     }
-    /* ARKODE 6.4.1 with an implicit table does not continue correctly from a stop time: on
-     * a free oscillator (docs/sundials-ode.md) 30 output stops left u off by 1e-7 .. 2e-5
-     * whatever rtol (kvaerno-5-3-4, sdirk-5-3-4, kvaerno-7-4-5), one stop 1e-13. A reset at
-     * every stop (a one-step method loses no history), with the implicit stages' f deduced
-     * from the Newton solution (ARKStepSetDeduceImplicitRhs), leaves 1e-12 .. 1e-15. */
-    const int arkode_stop = P->ark && P->kind != KIND_ERK && !again &&
-                            flag == ARK_TSTOP_RETURN && t_r < E->t_end;
-    if (arkode_stop && (st = flush_counts(P)) != MARTELLO_OK) break;
-    if ((again || arkode_stop) && (st = restart(P, t_r, yy)) != MARTELLO_OK) break;
+    /* ARKODE 6.4.1 with an implicit table did not continue correctly from a stop time (docs/
+     * sundials-ode.md, stops of the implicit tables); the only stops now are the loads' kinks,
+     * which restart it (again), and t_end */
+    if (again && (st = restart(P, t_r, yy)) != MARTELLO_OK) break;
     if (again || at_output || tret >= t_stop) {
-      t_stop = oe_next_stop(E, t_r, T_TO);
+      t_stop = oe_next_stop(E, t_r, E->t_end, &kink);
       if ((st = check(P, be_stop(P, t_stop), "SetStopTime"))) break;
     }
   }
-#undef T_TO
   free(found);
   int st2 = flush_counts(P);
   if (st == MARTELLO_OK) st = st2;

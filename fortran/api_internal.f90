@@ -296,6 +296,20 @@ contains
       c_eval_next_breakpoint = MARTELLO_OK
    end function c_eval_next_breakpoint
 
+   !> The shortest period of the loads' harmonic terms, or huge() (docs/sundials-ode.md, held
+   !> contacts).
+   integer(c_int) function c_eval_load_period(handle, period) bind(C, name='martello_eval_load_period')
+      type(c_ptr), value :: handle
+      real(c_double), intent(out) :: period
+      type(evaluator_t), pointer :: ep
+      ep => get_eval(handle)
+      period = huge(1.0_dp)
+      c_eval_load_period = MARTELLO_ERR_ARGUMENT
+      if (.not. associated(ep)) return
+      period = evaluator_load_period(ep)
+      c_eval_load_period = MARTELLO_OK
+   end function c_eval_load_period
+
    !> The number of links of the evaluator's scene.
    integer(c_int) function c_eval_link_count(handle, n_links) bind(C, name='martello_eval_link_count')
       type(c_ptr), value :: handle

@@ -12,12 +12,12 @@ module martello_assembly
       P_STIFF, P_DAMPING
    use martello_band_matrix, only: band_t, band_add
    use martello_element_rows, only: row_dot, row_add, row_stencil
-   use martello_time_functions, only: tf_value, tf_next_breakpoint, TF_NONE
+   use martello_time_functions, only: tf_value, tf_next_breakpoint, tf_period, TF_NONE
    implicit none
    private
    public :: mech_state_t, mech_init, internal_forces, external_forces, mech_commit, &
       element_power, recoverable_energy, mass_times, external_work, kinetic_energy, &
-      assemble_mass, uniform_acceleration, load_breakpoint, load_pattern, swap, ONSET_SPEED_FLOOR
+      assemble_mass, uniform_acceleration, load_breakpoint, load_period, load_pattern, swap, ONSET_SPEED_FLOOR
 
    !> Hunt–Crossley-type laws scale damping by 1/v_in; a contact first seen while δ̇ ≤ 0
    !> (grazing, or a step that lands inside) uses this floor [m/s] instead of a division by 0.
@@ -387,6 +387,18 @@ contains
          tb = min(tb, tf_next_breakpoint(m%force_fn(j), t))
       end do
    end function load_breakpoint
+
+   !> The shortest period of the loads' harmonic terms (tf_period), or huge().
+   pure function load_period(m) result(p)
+      type(model_t), intent(in) :: m
+      real(dp) :: p
+      integer :: j
+      p = huge(1.0_dp)
+      if (m%ground_accel%kind /= TF_NONE) p = tf_period(m%ground_accel)
+      do j = 1, m%nforce
+         p = min(p, tf_period(m%force_fn(j)))
+      end do
+   end function load_period
 
    !> Gravity on M·1, nodal forces, and −M·1·ü_g (relative coordinates), at time t.
    subroutine external_forces(m, mass_row_sum, t, fext)

@@ -16,7 +16,7 @@ module martello_evaluator
       evaluator_forces, evaluator_solve_mass, evaluator_commit, &
       evaluator_energy, evaluator_power, evaluator_use_branches, evaluator_switches, &
       evaluator_set_onset_speed, &
-      evaluator_next_breakpoint, evaluator_rates, evaluator_tangent
+      evaluator_next_breakpoint, evaluator_load_period, evaluator_rates, evaluator_tangent
 
    type :: evaluator_t
       type(model_t), pointer :: m => null()
@@ -159,6 +159,13 @@ contains
       real(dp) :: tb
       tb = load_breakpoint(ev%m, t)
    end function evaluator_next_breakpoint
+
+   !> The shortest period of the loads' harmonic terms (load_period), or huge().
+   pure function evaluator_load_period(ev) result(p)
+      type(evaluator_t), intent(in) :: ev
+      real(dp) :: p
+      p = load_period(ev%m)
+   end function evaluator_load_period
 
    !> The rates of the peak quantities at the state (t, u, v) with accelerations a (length
    !> n), on the laws' branches held (docs/run-layer.md, located peaks): per contact δ, δ̇,

@@ -5,7 +5,7 @@ module martello_time_functions
    use martello_kinds, only: dp
    implicit none
    private
-   public :: time_function_t, tf_value, tf_is_known, tf_next_breakpoint, NPAR_TF, &
+   public :: time_function_t, tf_value, tf_is_known, tf_next_breakpoint, tf_period, NPAR_TF, &
       TF_NONE, TF_CONSTANT, TF_TABLE, TF_SINE, TF_RECTANGULAR, TF_HALF_SINE
 
    integer, parameter :: TF_NONE = 0
@@ -90,6 +90,25 @@ contains
          tb = tf%t(hi)
       end select
    end function tf_next_breakpoint
+
+   !> The period of the function's harmonic term (a sine 2π/ω, a half sine twice its window), or
+   !> huge() for a function smooth between its breakpoints without one (a constant, a
+   !> rectangular pulse, a table: linear between its samples, which are breakpoints). An
+   !> integrator that holds a contact closed bounds its steps by it (docs/sundials-ode.md, held
+   !> contacts).
+   pure function tf_period(tf) result(p)
+      type(time_function_t), intent(in) :: tf
+      real(dp) :: p
+      real(dp), parameter :: pi = acos(-1.0_dp)
+      p = huge(1.0_dp)
+      select case (tf%kind)
+      case (TF_SINE)
+         if (tf%par(2) /= 0.0_dp .and. tf%par(1) /= 0.0_dp .and. tf%par(5) > tf%par(4)) &
+            p = 2.0_dp*pi/abs(tf%par(2))
+      case (TF_HALF_SINE)
+         if (tf%par(1) /= 0.0_dp .and. tf%par(5) > tf%par(4)) p = 2.0_dp*(tf%par(5) - tf%par(4))
+      end select
+   end function tf_period
 
    !> The samples around t by bisection, ts(lo) <= t < ts(hi) (hi = n at t = ts(n)), for
    !> ts(1) <= t <= ts(n): O(log n), no saved cursor (pure, thread-safe).

@@ -40,6 +40,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from .modes import modes
+
 # Local end-force components of a member; recovery rows 12e + 6·end + k.
 END_FORCES = ("N", "V2", "V3", "T", "M2", "M3")
 # A plan position matches a member's within this distance [m] (beams, splits, contacts).
@@ -522,19 +524,6 @@ def membrane_stiffness(lx, ly, t, E, nu):
 
 
 # --- modes ------------------------------------------------------------------------------------
-
-def modes(K, M):
-    """(ω ascending, Φ) of K φ = ω² M φ, Φᵀ M Φ = I; M dense or its diagonal."""
-    M = np.asarray(M, float)
-    if M.ndim == 1:
-        s = 1 / np.sqrt(M)
-        lam, y = np.linalg.eigh(s[:, None] * K * s[None, :])
-        return np.sqrt(np.maximum(lam, 0.0)), s[:, None] * y
-    L = np.linalg.cholesky(M)
-    Li = np.linalg.inv(L)
-    lam, y = np.linalg.eigh(Li @ K @ Li.T)
-    return np.sqrt(np.maximum(lam, 0.0)), Li.T @ y
-
 
 def modal_table(building, K, M, count=None):
     """Per mode: period, effective-mass ratios along x and y (Chopra, Dynamics of Structures,

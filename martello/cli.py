@@ -3,6 +3,7 @@
 import argparse
 import json
 import os
+import re
 import sys
 from pathlib import Path
 
@@ -190,7 +191,38 @@ def cmd_check(args):
 
 def cmd_export(args):
     from . import export
+    _check_export_flags(args)
     return export.main(args)
+
+
+# The [analysis] keys `martello export` overrides, each with the integrator whose own key it
+# is (None: every integrator's): checked against the scene spec's own domains (a scene with
+# that value would be refused the same way), and not given to another integrator.
+EXPORT_OVERRIDES = {"dt": None, "t_end": None, "beta": "newmark", "gamma": "newmark",
+                    "alpha": "hht", "rho_inf": "generalized-alpha"}
+
+
+def _check_export_flags(args):
+    """The overrides of `martello export` one by one: finite, in the range a scene's
+    [analysis] key has, for the integrator --integrator names; --tol > 0."""
+    import math
+    from .scene.spec import ANALYSIS_TYPES
+    dynamic = ANALYSIS_TYPES["dynamic"]
+    for key, owner in EXPORT_OVERRIDES.items():
+        value = getattr(args, key)
+        if value is None:
+            continue
+        flag = "--" + key.replace("_", "-")
+        check, text = dynamic[key][2]
+        if not (math.isfinite(value) and check(value)):
+            raise errors.ExportError(f"{flag}: invalid value {value!r} (must be {text}, as "
+                                     f"analysis.{key} of a scene)")
+        if owner and args.integrator is not None and args.integrator != owner:
+            raise errors.ExportError(f"{flag}: applies to --integrator {owner}, not "
+                                     f"{args.integrator} (remove it, or give --integrator {owner})")
+    if args.tol is not None and not (math.isfinite(args.tol) and args.tol > 0):
+        raise errors.ExportError(f"--tol: invalid value {args.tol!r} (must be a number > 0: "
+                                 "OpenSees' NormDispIncr tolerance in m)")
 
 
 def cmd_testset(args):
@@ -213,7 +245,25 @@ class _Parser(argparse.ArgumentParser):
     """Usage errors in one line, exit code 1, like every other error."""
 
     def error(self, message):
-        self.exit(1, f"{self.prog}: error: {_one_line(message)} (see {self.prog} --help)\n")
+        self.exit(1, f"{self.prog}: error: {_one_line(message)}{_dash_hint(message)} "
+                     f"(see {self.prog} --help)\n")
+
+
+_ARGV = []       # the command line main() parses, for _dash_hint
+
+
+def _dash_hint(message):
+    """`--columns -u:a` (a documented value: a leading - flips the sign) reads to argparse as
+    an option with no value: say how to write it."""
+    m = re.match(r"argument (\S+): expected one argument", message)
+    if not m:
+        return ""
+    names = m.group(1).split("/")
+    for flag, value in zip(_ARGV, _ARGV[1:]):
+        # a value, not another option (-o, --force): -u:a, -1e-3
+        if flag in names and re.match(r"-[^-]", value) and not re.fullmatch(r"-[A-Za-z]", value):
+            return f" (a value that starts with '-' is written {names[-1]}={value})"
+    return ""
 
 
 def _one_line(text):
@@ -444,6 +494,7 @@ def main(argv=None):
     for p in sub.choices.values():      # --debug after the command too
         p.add_argument("--debug", action="store_true", default=argparse.SUPPRESS,
                        help=argparse.SUPPRESS)
+    _ARGV[:] = sys.argv[1:] if argv is None else list(argv)
     args = parser.parse_args(argv)
     if args.version:
         args.command, args.func = "version", _print_version

@@ -21,6 +21,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from .modes import modes
+
 # Local end-force components of a member, in recovery rows 6e + k.
 END_FORCES = ("N_i", "V_i", "M_i", "N_j", "V_j", "M_j")
 
@@ -219,19 +221,16 @@ def modal_damping(K, M, zeta):
     given as its diagonal): the damping ratio zeta in every mode (Chopra, Dynamics of
     Structures, §11.5), symmetrised to round-off."""
     m = np.asarray(M, float)
-    s = 1 / np.sqrt(m)
-    lam, y = np.linalg.eigh(s[:, None] * K * s[None, :])
-    phi = s[:, None] * y                                   # Φᵀ M Φ = I
+    w, phi = modes(K, m)                                   # Φᵀ M Φ = I
     mp = m[:, None] * phi
-    C = mp @ np.diag(2 * zeta * np.sqrt(np.maximum(lam, 0.0))) @ mp.T
+    C = mp @ np.diag(2 * zeta * w) @ mp.T
     return 0.5 * (C + C.T)
 
 
 def natural_frequencies(K, M):
-    """ω (rad/s, ascending) of K φ = ω² M φ for a diagonal M (given as its diagonal)."""
-    s = 1 / np.sqrt(np.asarray(M, float))
-    lam = np.linalg.eigvalsh(s[:, None] * K * s[None, :])
-    return np.sqrt(np.maximum(lam, 0.0))
+    """ω (rad/s, ascending) of K φ = ω² M φ for a diagonal M (given as its diagonal); an ω²
+    computed <= 0 or not finite raises LinAlgError (martello.modes)."""
+    return modes(K, np.asarray(M, float))[0]
 
 
 # --- interface links across a joint (seed §4, after Muthukumar & DesRoches 2006) ----------

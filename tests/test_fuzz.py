@@ -137,7 +137,7 @@ def test_the_campaign_cases_are_reproducible():
     assert (a.argv, a.files) == (b.argv, b.files)
     kinds = {mutations.make_case(campaign.RandomChooser(f"seed:{i}")).label.split(":")[0]
              for i in range(300)}
-    assert kinds == {"run", "check", "compare", "study", "argv", "plot"}
+    assert kinds == {"run", "check", "compare", "study", "argv", "plot", "export"}
 
 
 def test_the_fast_targeted_cases_have_their_outcome(tmp_path):

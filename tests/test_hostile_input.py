@@ -498,3 +498,120 @@ def test_an_error_raised_while_a_ctrl_c_is_delivered_is_the_interrupt(monkeypatc
     monkeypatch.setattr(errors, "sigint_seen", True)
     assert cli.run_command(args) == 130
     assert capsys.readouterr().err == "martello: interrupted\n"
+
+
+def _edited(name, path, value):
+    d = scene_dict(name)
+    node = d
+    for p in path[:-1]:
+        node = node[p]
+    node[path[-1]] = value
+    return d
+
+
+@pytest.mark.parametrize("name, path, value, words", [
+    # the condensation's powers of a storey height leave the doubles (ZeroDivisionError at
+    # 1e-300 m, OverflowError at 1e300 m)
+    ("p11/p11_eccentric_storey", ("building", 0, "storey_height"), 1e-300,
+     "building[0]: the condensed stiffness is not finite"),
+    ("p11/p11_eccentric_storey", ("building", 0, "storey_height"), 1e300,
+     "building[0]: the condensed stiffness is not finite"),
+    # z = cumsum(heights) overflows (numpy's RuntimeWarning, then NaN)
+    ("p11/p11_shear_pounding", ("building", 0, "storey_height"), [1e308, 1e308],
+     "building[0].storey_height: the building's height leaves the doubles"),
+    # b2 b3³/12 of a 1e300 m side (OverflowError)
+    ("p11/p11_eccentric_storey", ("building", 0, "column", "b2"), 1e300,
+     "building[0].column: the rectangle's area, second moments or torsion constant"),
+    # m (lx² + ly²)/12 of a grid 1e300 m wide (OverflowError)
+    ("p11/p11_eccentric_storey", ("building", 0, "grid_x", 1), 1e300,
+     "building[0].inertia: the floors' polar inertia"),
+    # K M^-1 overflows (numpy's RuntimeWarning in the modal table)
+    ("p11/p11_eccentric_storey", ("building", 0, "mass"), 1e-300,
+     "building[0].mass: the frequencies of the building could not be computed"),
+    # masses 1e17 apart: a computed ω² <= 0 was clipped to a zero frequency, then 0/0 in the
+    # Rayleigh coefficients (NaN damping, numpy's RuntimeWarning)
+    ("p11/p11_shear_pounding", ("building", 0, "mass", 0), 1e-12,
+     "building[0].mass: the frequencies of the building could not be computed"),
+    ("p10/p10_bare", ("frame", 0, "mass", 1), 1e-12,
+     "frame[0].mass: the frequencies of the frame could not be computed"),
+    ("p10/p10_bare", ("frame", 1, "bay_width"), 1e308,
+     "frame[1].bay_width: the frame's height or width leaves the doubles"),
+])
+def test_buildings_and_frames_past_the_doubles_are_one_line_naming_the_field(name, path, value, words):
+    """Loader fuzz of every [[building]] and [[frame]] field (session 5): these raised
+    ZeroDivisionError / OverflowError, or loaded with numpy's RuntimeWarnings and NaN or
+    clipped frequencies. Now a SceneError naming the field, and no warning."""
+    import warnings
+    src = ROOT / "benchmarks" / f"{name}.toml"
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        with pytest.raises(SceneError) as e:
+            from_dict(_edited(name, path, value), source=str(src), base_dir=src.parent)
+    msg = str(e.value)
+    assert "\n" not in msg and words in msg, msg
+
+
+def test_a_building_past_the_doubles_is_one_line_on_the_command_line(tmp_path):
+    run_fails(tmp_path, _edited("p11/p11_eccentric_storey", ("building", 0, "storey_height"), 1e-300),
+              "s.toml: building[0]: the condensed stiffness is not finite")
+
+
+def test_modes_refuse_a_frequency_that_is_not_positive():
+    """martello.modes: K and M positive definite, so a computed ω² <= 0 or NaN is round-off
+    past the problem's conditioning (the p11 case above): LinAlgError, where it was clipped
+    to a zero frequency."""
+    import numpy as np
+    from martello.modes import modes
+    K = np.array([[2.0, -1.0], [-1.0, 1.0]]) * 1e9
+    w, phi = modes(K, np.array([1e5, 2e5]))
+    assert np.all(w > 0) and np.allclose(phi.T @ np.diag([1e5, 2e5]) @ phi, np.eye(2))
+    for bad_K, M in ((np.diag([1.0, -1.0]), np.ones(2)), (np.diag([1.0, 0.0]), np.eye(2)),
+                     (K, np.array([1e5, 1e-320]))):
+        with pytest.raises(np.linalg.LinAlgError):
+            modes(bad_K, M)
+
+
+@pytest.mark.parametrize("flags, words", [
+    (["--dt", "0"], "--dt: invalid value 0.0 (must be a number > 0"),          # ZeroDivisionError
+    (["--dt", "-1"], "--dt: invalid value -1.0"),                               # was written
+    (["--dt", "nan"], "--dt: invalid value nan"),                               # ValueError
+    (["--t-end", "inf"], "--t-end: invalid value inf"),                         # OverflowError
+    (["--integrator", "newmark", "--beta", "-1"], "--beta: invalid value -1.0"),  # was written
+    (["--integrator", "hht", "--alpha", "5"], "--alpha: invalid value 5.0 (must be a number in [-1/3, 0]"),
+    (["--integrator", "generalized-alpha", "--rho-inf", "2"], "--rho-inf: invalid value 2.0"),
+    (["--integrator", "hht", "--alpha", "-0.1", "--beta", "0.3"],
+     "--beta: applies to --integrator newmark, not hht"),                       # was ignored
+    (["--tol", "0"], "--tol: invalid value 0.0 (must be a number > 0"),         # was written
+    (["--tol", "1e400"], "--tol: invalid value inf"),                           # ValueError
+])
+def test_export_overrides_are_checked_as_the_scene_keys_they_replace(tmp_path, capsys, flags, words):
+    """`martello export`'s --dt, --t-end, --beta, --gamma, --alpha, --rho-inf and --tol
+    (CLI fuzz of export, session 5): an internal error, or a model.py written with the bad
+    value. Now one line naming the flag and the range of the scene key it replaces, nothing
+    written."""
+    out = tmp_path / "ex"
+    assert cli.main(["export", str(P5), "-o", str(out), *flags]) == 1
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and err.startswith("martello: error: ") and words in err, err
+    assert not out.exists()
+
+
+def test_export_overrides_in_range_still_export(tmp_path, capsys):
+    out = tmp_path / "ex"
+    assert cli.main(["export", str(P5), "-o", str(out), "--integrator", "hht", "--alpha", "-0.1",
+                     "--dt", "1e-5", "--tol", "1e-9"]) == 0
+    assert "HHT" in (out / "model.py").read_text()
+
+
+def test_a_value_starting_with_a_dash_is_shown_how_to_write_it(capsys):
+    """`--columns -u:s2` (a leading - flips the sign, as its help says) reads to argparse as an
+    option without its value: the usage error says to write --columns=-u:s2 (it said only
+    'expected one argument'); an option where the value should be gets no such hint."""
+    for argv, hint in ((["compare", "h.csv", "--against", "s.toml", "--columns", "-u:s2"],
+                        "(a value that starts with '-' is written --columns=-u:s2)"),
+                       (["run", "s.toml", "-o", "--force"], None)):
+        with pytest.raises(SystemExit) as e:
+            cli.main(argv)
+        err = capsys.readouterr().err
+        assert e.value.code == 1 and err.count("\n") == 1 and "expected one argument" in err, err
+        assert (hint in err) if hint else "written" not in err, err

@@ -129,7 +129,7 @@ def _limit_memory(gib):
 
 
 def run_case(i, args, env, work):
-    return run_one(i, mutations.make_case(RandomChooser(f"{args.seed}:{i}")), args, env, work)
+    return run_one(i, mutations.make_case(RandomChooser(f"{args.seed}:{i}"), args.kinds), args, env, work)
 
 
 def run_one(i, case, args, env, work):
@@ -340,6 +340,10 @@ def main(argv=None):
                     help="address-space limit of each run in GiB (default 4)")
     ap.add_argument("--only", type=int, nargs="*", help="run only these case numbers")
     ap.add_argument("--keep", action="store_true", help="keep each case's folder")
+    ap.add_argument("--kinds", type=lambda t: [k for k in t.split(",") if k],
+                    help="draw only these kinds of case (mutations.KINDS by name, comma-separated; "
+                    "e.g. later_scene_case,export_case,compare_columns_case: the features added "
+                    "since the first campaigns)")
     ap.add_argument("--out", default="out/fuzz", help="report folder (default out/fuzz)")
     ap.add_argument("--loader", type=int, metavar="N",
                     help="instead: N mutated scenes through the loader in this process "
@@ -348,6 +352,10 @@ def main(argv=None):
                     help="instead: the command lines of targeted.py, each with the outcome it "
                     "must have (the bad inputs reviews found, one by one)")
     args = ap.parse_args(argv)
+    unknown = set(args.kinds or ()) - {fn.__name__ for fn, _ in mutations.KINDS}
+    if unknown:
+        ap.error(f"--kinds: unknown {', '.join(sorted(unknown))} (valid: "
+                 f"{', '.join(fn.__name__ for fn, _ in mutations.KINDS)})")
     if args.loader:
         return loader_campaign(args)
 

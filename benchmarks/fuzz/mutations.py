@@ -35,7 +35,12 @@ QUICK = ["p1/p1_static_lagrange", "p1/p1_static_penalty", "p1/p1_static_augmente
          "p5/p5_ida_linear", "p5/p5_moreau_jean_e03", "p5/p5_newmark_lagrange_e03",
          "p5/p5_kelvin", "p6/p6_elastoplastic_rho005", "p7/p7_chain_10",
          "p4/p4_wall_cd_half_cell_courant1", "p4/p4_equal_rods_rk8pd_restitution_e0",
-         "p9/p9_davis_restitution", "sdof/sdof_sine_newmark"]
+         "p9/p9_davis_restitution", "sdof/sdof_sine_newmark",
+         # the features of later sessions: CVODE/ARKODE with events inside the steps, fast
+         # nonlinear analysis (modal_vectors), [[building]] (P11); each under 3 s
+         "p2/p2_cvode_restitution", "p2/p2_arkode_lagrange", "p7/laws/p7_two_kelvin_arkode",
+         "p7/laws/p7_two_linear_cvode", "sdof/sdof_sine_fast_nonlinear",
+         "p6/integrators/p6_rho005_fast_nonlinear", "p11/p11_shear_pounding"]
 
 
 def scene_dict(name):
@@ -181,6 +186,80 @@ def _analysis(d):
     return a if isinstance(a, dict) else d.setdefault("analysis", {})
 
 
+# --- the features added since the first campaigns: an integrator's own keys, buildings ---
+
+# the keys every dynamic integrator reads; switching integrator keeps only these, so that the
+# edit reaches the new integrator's own key instead of stopping at another's
+_COMMON = ("type", "dt", "t_end", "output", "max_steps", "max_wall")
+
+
+def _switch(d, integrator, **keys):
+    a = _analysis(d)
+    if a.get("integrator") != integrator:
+        for k in [k for k in a if k not in _COMMON]:
+            del a[k]
+        a.update(type="dynamic", integrator=integrator)
+        a.setdefault("dt", 1e-3)
+        a.setdefault("t_end", 0.01)
+    a.update(keys)
+
+
+def _method_names(integrator=None):
+    """The table methods of `integrator` (default: CVODE's and ARKODE's) by name (the
+    library's registry), read when a case needs them (not at import)."""
+    from martello.scene.spec import METHODS
+    return sorted(set(METHODS.get(integrator, ())) if integrator else
+                  set(METHODS.get("cvode", ())) | set(METHODS.get("arkode", ())))
+
+
+BAD_METHODS = ["", "BDF", "Adams", "dormand-prince", "kvaerno-5-3-4 ", "sdirk-2-1-2\u0000",
+               "x" * 300, 0, 1, -1, 2 ** 31, 1.5, True, ["bdf"], {"name": "bdf"}, "none", "default"]
+LENGTHS = [1e300, 1e-300, 1e308, 5e-324, 0.0, -1.0, float("nan"), float("inf"), 1e-12, 1e12]
+
+
+def _building_edit(d, ch):
+    """A [[building]] of P11 (its shear-type pair, or the one-storey eccentric storey) with
+    one field, or one field of a section, member or split, replaced by a hostile value."""
+    src = scene_dict(ch.choice(["p11/p11_shear_pounding", "p11/p11_eccentric_storey"]))
+    b = copy.deepcopy(src["building"][0])
+    spots = [p for p, _ in _leaves(b)[1:]]
+    path = ch.choice(spots)
+    value = ch.choice(LENGTHS + [[1e308, 1e308], [0.0], [], "x", Deep(20), {"E": 1.0}])
+    old = b
+    for k in path:
+        old = old[k]
+    if isinstance(old, float) and ch.coin(0.5):         # in range, far from the catalogue's
+        value = old * ch.choice([1e-6, 1e-3, 0.5, 2.0, 1e3, 1e6])
+    if ch.coin(0.2):
+        _delete(b, path)
+    else:
+        _set(b, path, copy.deepcopy(value))
+    extra = ch.choice([None, None, "diaphragm", "slab", "split", "point", "model", "damping"])
+    if extra == "diaphragm":
+        b["diaphragm"] = ch.choice([False, [False], [True, False, True], "no", 0])
+    elif extra == "slab":
+        b.update(diaphragm=False, slab=ch.choice([{"E": 3e10, "thickness": ch.choice(LENGTHS)},
+                                                   {"E": 3e10}, {}, 5]))
+    elif extra == "split":
+        b["split"] = [{"name": "s", "line": ch.choice(["0.0", "9.9", ""]), "storey": ch.choice(
+            [1, 0, 99, 2 ** 40]), "height": ch.choice(LENGTHS), "mass": ch.choice(LENGTHS)}]
+    elif extra == "point":
+        b["point"] = [{"name": "p", "floor": ch.choice([1, 0, 99]), "x": ch.choice(LENGTHS),
+                       "y": 0.0}]
+    elif extra == "model":
+        b.update(model=ch.choice(["frame", "shear", "x"]), beam=ch.choice(
+            [{"E": 3e10, "b": 0.3, "h": ch.choice(LENGTHS)}, None, False]))
+    elif extra == "damping":
+        b.update(damping=ch.choice(["modal", "rayleigh", "x"]), zeta=ch.choice([0.05, 0.0, 0.99, 1.0, -0.1]),
+                 rayleigh_modes=ch.choice([[1, 2], [1, 99], [0, 1], [2 ** 40, 1], [1]]))
+    d["building"] = [b] + (copy.deepcopy(src["building"][1:]) if ch.coin(0.5) else [])
+    for k in ("node", "link", "contact", "frame", "chain", "bar", "mass_coupling"):
+        if k in src:
+            d[k] = copy.deepcopy(src[k])
+        else:
+            d.pop(k, None)
+
+
 TARGETED = {
     "scalar loads": lambda d, ch: d.__setitem__("loads", ch.choice([5, "g", [1.0], True])),
     "nested output nodes": lambda d, ch: _analysis(d).setdefault("output", {}).__setitem__(
@@ -222,6 +301,16 @@ TARGETED = {
              "/proc/self/status", "\u0000x.csv", "x" * 5000, "record.AT2", "record.csv"]),
                                 **ch.choice([{}, {"format": "csv"}, {"format": "at2"},
                                              {"format": "wav"}, {"units": "furlongs"}])}),
+    # later features
+    "modal vectors": lambda d, ch: _switch(d, "fast-nonlinear", modal_vectors=ch.choice(
+        [-1, 0, 1, 2, 3, 7, 10 ** 6, 2 ** 31, 2 ** 63 - 1, HUGE_INT, 1.5, 2.0, "2", True,
+         float("nan"), [2]])),
+    "integrator method": lambda d, ch: _switch(d, (i := ch.choice(["cvode", "arkode"])), method=ch.choice(
+        _method_names(i) if ch.coin(0.6) else _method_names() + BAD_METHODS), **ch.choice([{}, {"rtol": ch.choice([1e-300, 1.0, 0.0, 1e-3])},
+                                                  {"atol": ch.choice([1e-300, 0.0, 1e300])},
+                                                  {"event_tol": ch.choice([1e-300, 1.0, 0.0])},
+                                                  {"h_max": ch.choice([1e-9, 0.0, 1e300])}])),
+    "building fields": _building_edit,
 }
 
 
@@ -294,8 +383,18 @@ def _record_files(ch):
     return {f"record{ext}": data, "record.AT2" if ext != ".AT2" else "record.csv": data}
 
 
-def scene_case(ch):
-    name = ch.choice(QUICK)
+# the targeted edits and quick scenes of the features added since the first campaigns
+LATER_TARGETS = ["modal vectors", "integrator method", "building fields"]
+LATER_QUICK = QUICK[QUICK.index("p2/p2_cvode_restitution"):]
+
+
+def later_scene_case(ch):
+    """scene_case on the later features only: their scenes mutated, or their targeted edits."""
+    return scene_case(ch, LATER_QUICK, LATER_TARGETS)
+
+
+def scene_case(ch, scenes=QUICK, targets=None):
+    name = ch.choice(scenes)
     d = scene_dict(name)
     files = {"fifo.csv": "fifo", "records": "dir", "etc/passwd":
              b"root:x:0:0:root:/root:/bin/bash\nsecret:x:1:1:the secret line:/home/s:/bin/sh\n"}
@@ -304,7 +403,7 @@ def scene_case(ch):
         d = mutate_dict(ch, d)
         label = "mutated scene"
     elif how <= 7:
-        label = ch.choice(sorted(TARGETED))
+        label = ch.choice(targets or sorted(TARGETED))
         try:
             TARGETED[label](d, ch)
         except (AttributeError, TypeError, IndexError, KeyError):
@@ -478,14 +577,111 @@ def scheduler_case(ch):
                 {"st.toml": study_text(extra=f"scheduler = {address}\n")}, None)
 
 
+# scenes the exporter writes (a chain of nodes, a planar frame on a record given by an
+# absolute path) and some it refuses (IDA, a building, a static scene)
+EXPORTABLE = ["p5/p5_linear", "p5/p5_hertz", "p5/p5_kelvin", "p2/p2_restitution_e08",
+              "p7/p7_chain_10", "p6/p6_elastoplastic_rho005", "sdof/sdof_sine_newmark",
+              "p7/laws/p7_two_kelvin_newmark", "p2/p2_ida_penalty_linear", "p11/p11_shear_pounding",
+              "p1/p1_static_lagrange"]
+EXPORT_FLAGS = {"--integrator": ["newmark", "hht", "generalized-alpha", "central-difference",
+                                 "cvode", "ida", "x", ""],
+                "--dt": ["0", "-1", "nan", "inf", "1e-320", "1e400", "1e-5", "1", "x", ""],
+                "--t-end": ["0", "-0", "nan", "1e300", "1e-9", "0.001", "x"],
+                "--beta": ["0", "-1", "0.25", "nan", "1e300"],
+                "--gamma": ["0.5", "0.4", "nan", "2"],
+                "--alpha": ["-0.1", "0", "0.1", "-1", "nan"],
+                "--rho-inf": ["0", "0.8", "1", "2", "-1", "nan"],
+                "--tol": ["0", "-1", "nan", "inf", "1e-12", "1e300"],
+                "--material": ["kelvin=JankowskiImpact", "linear=Elastic", "x", "=", "linear=",
+                               "=ENT", "hertz=ImpactMaterial", "linear=ENT,hertz=x"],
+                "--to": ["opensees", "abaqus", ""],
+                "--tcl": None}
+
+
+def export_case(ch):
+    """martello export of a (sometimes mutated) scene with hostile overrides and -o."""
+    name = ch.choice(EXPORTABLE)
+    files = {"afile": b"x"}
+    if ch.coin(0.3):
+        d = scene_dict(name)
+        d = mutate_dict(ch, d, 1) if ch.coin(0.5) else d
+        if ch.coin(0.3):
+            TARGETED[ch.choice(["modal vectors", "integrator method", "frame lengths past the doubles",
+                                "building fields", "chain damping overflow"])](d, ch)
+        files["s.toml"] = to_toml(d).encode("utf-8", "surrogatepass")
+        scene = "s.toml"
+    else:
+        scene = str(BENCHMARKS / f"{name}.toml")
+    argv = ["export", scene]
+    for _ in range(ch.integer(0, 3)):
+        flag = ch.choice(sorted(EXPORT_FLAGS))
+        argv += [flag] if EXPORT_FLAGS[flag] is None else [flag, ch.choice(EXPORT_FLAGS[flag])]
+    out = ch.choice(["ex", "ex", "ex", "afile", "afile/sub", "."])
+    argv += ["-o", out]
+    return Case("export: hostile overrides", argv, files, out if out == "ex" else None)
+
+
+# a history as martello writes it for a scene with links (sdof_sine_newmark: link0 the
+# spring, link1 the dashpot), and recorder files (whitespace, no header, time first)
+SDOF = "sdof/sdof_sine_newmark"
+
+
+def compare_columns_case(ch):
+    """compare's link columns (NaN throughout: not recorded; NaN among values: an error) and
+    OpenSees recorder files with hostile --columns."""
+    import math as _m
+    n = ch.choice([0, 1, 2, 50, 200])
+    cols = ch.choice([["u:m"], ["u:m", "link_force:link0"], ["u:m", "elongation:link1", "v:m"],
+                      ["link_force:link0"], ["u:m", "link_force:link9"], ["u:m", "link_force:"],
+                      ["u:m", "link_force:link0", "link_force:link0"], ["force:link0"]])
+    how = ch.choice(["nan", "nan", "finite", "some nan", "inf", "empty"])
+
+    def cell(c, i):
+        if c.startswith(("link_force", "elongation")):
+            if how == "nan" or (how == "some nan" and i % 2):
+                return "nan"
+            if how == "inf" and i == n // 2:
+                return "inf"
+            if how == "empty":
+                return ""
+        return f"{1e-3 * _m.sin(0.01 * i):.6g}"
+    files = {}
+    if ch.coin(0.5):
+        text = ",".join(["t"] + cols) + "\n" + "".join(
+            ",".join([f"{0.01 * i:.6g}"] + [cell(c, i) for c in cols]) + "\n" for i in range(n))
+        files["h.csv"] = text.encode()
+        argv = ["compare", "h.csv"]
+    else:
+        k = ch.integer(1, 3)
+        text = "".join(" ".join([f"{0.01 * i:.6g}"] + [cell("link_force" if j and how != "finite" else "u", i)
+                                                     for j in range(k)]) + "\n" for i in range(n))
+        files["r.out"] = text.encode()
+        argv = ["compare", "r.out"]
+        if ch.coin(0.3):
+            files["r2.out"] = text.encode()
+            argv.append("r2.out")
+        for _ in range(ch.choice([0, 1, 1, 2])):
+            argv.append("--columns=" + ch.choice(
+                ["u:m", "u:m,link_force:link0", "-u:m", "u:m,-link_force:link0,elongation:link1",
+                 ",", "", "u:nope", "u:m,u:m,u:m,u:m", "--", "v:m,a:m", "force:c", "t"]))
+    argv += ["--against", str(BENCHMARKS / f"{SDOF}.toml")]
+    if ch.coin(0.3):
+        argv += ["-o", ch.choice(["scores.json", "afile/x.json", "."])]
+        files["afile"] = b"x"
+    return Case("compare: link columns and recorder files", argv, files, None)
+
+
 KINDS = [(scene_case, 70), (path_case, 6), (check_case, 8), (compare_case, 9), (study_case, 3),
-         (argv_case, 4), (plot_case, 6), (reference_case, 3), (scheduler_case, 1)]
+         (argv_case, 4), (plot_case, 6), (reference_case, 3), (scheduler_case, 1),
+         (export_case, 8), (compare_columns_case, 5), (later_scene_case, 8)]
 
 
-def make_case(ch):
-    total = sum(w for _, w in KINDS)
+def make_case(ch, kinds=None):
+    """One case of a kind drawn by weight (of those named in `kinds`, if given)."""
+    pool = [(fn, w) for fn, w in KINDS if not kinds or fn.__name__ in kinds]
+    total = sum(w for _, w in pool)
     n = ch.integer(1, total)
-    for fn, w in KINDS:
+    for fn, w in pool:
         if n <= w:
             return fn(ch)
         n -= w

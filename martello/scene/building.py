@@ -5,6 +5,8 @@ joint of a flexible floor and of each split point) and one stiffness block betwe
 reference point is not its mass centre and the ground motion's influence on each node. The
 loader keeps what the results need (recovery operators, modes) in scene.extras["buildings"]."""
 
+import math
+
 import numpy as np
 
 from ..building3d import (Beam, Building, Floor, Line, Section, Slab, Split, column_section,
@@ -76,8 +78,14 @@ def section(src, where, tab, kind):
     rect = BEAM_RECT if kind == "beam" else COLUMN_RECT
     if any(k in tab for k in rect):
         s = check_fields(src, tab, where, SECTION_COMMON | rect | CRACKED)
-        sec = (beam_section(s["E"], s["b"], s["h"], s["G"], s["cracked"]) if kind == "beam"
-               else column_section(s["E"], s["b2"], s["b3"], s["G"], s["cracked"]))
+        try:
+            sec = (beam_section(s["E"], s["b"], s["h"], s["G"], s["cracked"]) if kind == "beam"
+                   else column_section(s["E"], s["b2"], s["b3"], s["G"], s["cracked"]))
+        except (OverflowError, ZeroDivisionError):     # b h³ of a side of 1e300 m
+            sec = None
+        if sec is None or not all(math.isfinite(x) and x > 0 for x in (sec.A, sec.I2, sec.I3, sec.J)):
+            raise SceneError(src, where, "the rectangle's area, second moments or torsion "
+                             "constant leave the doubles", "give the sides in m of a real section")
         return Section(sec.E, sec.G, sec.A, sec.I2, sec.I3, sec.J, s["As2"], s["As3"])
     s = check_fields(src, tab, where, SECTION_COMMON | SECTION_PROPS)
     G = s["G"] if s["G"] is not None else s["E"] / 2.4
@@ -107,6 +115,9 @@ def _grid(src, where, v):
     g = [float(x) for x in v]
     if any(b <= a for a, b in zip(g, g[1:])):
         raise SceneError(src, where, "must increase strictly", "grid lines in m, left to right")
+    if not math.isfinite(g[-1] - g[0]):
+        raise SceneError(src, where, f"spans {g[-1]!r} - ({g[0]!r}) m, past the doubles",
+                         "grid lines in m of a real building")
     return g
 
 
@@ -127,6 +138,9 @@ def parse_building(src, w, tab):
     choice(src, f"{w}.damping", f["damping"], DAMPING)
     gx, gy = _grid(src, f"{w}.grid_x", f["grid_x"]), _grid(src, f"{w}.grid_y", f["grid_y"])
     heights = per_item(src, f"{w}.storey_height", f["storey_height"], ns, POSITIVE)
+    if not math.isfinite(sum(heights)):
+        raise SceneError(src, f"{w}.storey_height", "the building's height leaves the doubles",
+                         "storey heights in m of a real building")
     masses = per_item(src, f"{w}.mass", f["mass"], ns, POSITIVE)
     rigid = f["diaphragm"] if isinstance(f["diaphragm"], list) else [f["diaphragm"]] * ns
     if len(rigid) != ns or not all(isinstance(x, bool) for x in rigid):
@@ -144,7 +158,11 @@ def parse_building(src, w, tab):
     else:
         centres = [_point(src, f"{w}.mass_centre", f["mass_centre"])] * ns
     if f["inertia"] is None:
-        inertia = [m * (lx**2 + ly**2) / 12 for m in masses]     # a uniform rectangular slab
+        inertia = [m * (lx * lx + ly * ly) / 12 for m in masses]     # a uniform rectangular slab
+        if not all(math.isfinite(j) for j in inertia):
+            raise SceneError(src, f"{w}.inertia", "the floors' polar inertia m (lx² + ly²)/12 of "
+                             "the grid's slab leaves the doubles (masses or plan dimensions too "
+                             "large)", "give masses in kg and the grid in m, or inertia")
     else:
         inertia = per_item(src, f"{w}.inertia", f["inertia"], ns, POSITIVE)
     floors = [Floor(m, c, j, r) for m, c, j, r in zip(masses, centres, inertia, rigid)]
@@ -318,15 +336,26 @@ def expand_buildings(src, data, made=0):
         except np.linalg.LinAlgError:
             raise SceneError(src, w, "the condensation is singular (a mechanism: a node or floor "
                              "that no member holds)", "check the members, beams and base") from None
-        M = b.mass_matrix()
+        except (OverflowError, ZeroDivisionError):
+            # lengths whose powers leave the doubles (a storey of 1e300 m or 1e-300 m):
+            # refused by _check just below, naming the building
+            K = G = np.array([[np.nan]])
+        with np.errstate(all="ignore"):
+            M = b.mass_matrix()
         _check(src, w, K, G, M)
+        table = _modes_or_refuse(src, w, b, K, M)
         C = np.zeros_like(K)
         a0 = a1 = 0.0
-        if f["zeta"] > 0 and f["damping"] == "modal":
-            C = modal_damping(K, M, f["zeta"])
-        elif f["zeta"] > 0:
-            a0, a1 = rayleigh_coefficients(K, M, f["zeta"], tuple(modes))
-            C = a0 * M + a1 * K
+        with np.errstate(all="ignore"):
+            if f["zeta"] > 0 and f["damping"] == "modal":
+                C = modal_damping(K, M, f["zeta"])
+            elif f["zeta"] > 0:
+                a0, a1 = rayleigh_coefficients(K, M, f["zeta"], tuple(modes))
+                C = a0 * M + a1 * K
+        if not np.all(np.isfinite(C)):
+            raise SceneError(src, f"{w}.zeta", "the damping matrix is not finite (masses and "
+                             "stiffness too disparate for double precision)",
+                             "give floor masses in kg and sections in SI units of a real building")
         names = b.kept_names(f["prefix"])
         nodes += [{"name": nm, "mass": float(M[i, i])} for i, nm in enumerate(names)]
         for i in range(n):
@@ -338,7 +367,7 @@ def expand_buildings(src, data, made=0):
                     "influence": b.influence(f["ground_angle"]), "ground_angle": f["ground_angle"],
                     "rayleigh": (a0, a1), "zeta": f["zeta"], "damping": f["damping"],
                     "recovery": R, "storey": b.storey_operator(R), "points": points,
-                    "modes": modal_table(b, K, M), "histories": f["histories"]})
+                    "modes": table, "histories": f["histories"]})
     data["node"] = nodes
     return data, out, couplings
 
@@ -356,6 +385,25 @@ def _check(src, where, K, G, M):
             raise SceneError(src, where, f"the condensed {what} is not positive definite (a "
                              "mechanism, or sections too disparate for double precision)",
                              "every floor needs members that hold it in x, y and torsion") from None
+
+
+def _modes_or_refuse(src, where, b, K, M):
+    """The building's modal table; refused when a frequency is not a finite positive number:
+    K and M passed their Cholesky factorization, so every ω² of K φ = ω² M φ is positive in
+    exact arithmetic, and one computed as <= 0, inf or NaN says the masses and stiffness are
+    too disparate for double precision (a floor of 1e-12 kg under a storey of 1e9 N/m) — the
+    frequencies, the Rayleigh damping and the periods reported would be wrong, not clipped."""
+    try:
+        with np.errstate(all="ignore"):
+            table = modal_table(b, K, M)
+    except np.linalg.LinAlgError:
+        table = None
+    if table is None or not all(0 < m["omega"] < math.inf and all(math.isfinite(m[k]) for k in
+                                ("mass_ratio_x", "mass_ratio_y", "torsional_share")) for m in table):
+        raise SceneError(src, f"{where}.mass", "the frequencies of the building could not be "
+                         "computed (masses and stiffness too disparate for double precision)",
+                         "give floor masses in kg and sections in SI units of a real building")
+    return table
 
 
 def building_blocks(buildings, index):

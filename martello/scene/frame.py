@@ -4,6 +4,8 @@ between them (the frame statically condensed, martello.frame2d). The loader keep
 results need (the recovery operator of the member end forces, drifts and shears) in
 scene.extras["frames"]."""
 
+import math
+
 import numpy as np
 
 from ..errors import SceneError
@@ -101,9 +103,15 @@ def expand_frames(src, data):
                                        for x in modes)):
             raise SceneError(src, f"{w}.rayleigh_modes", f"invalid value {modes!r}",
                              "two mode numbers >= 1, e.g. [1, 2]")
+        heights = per_item(src, f"{w}.storey_height", f["storey_height"], ns, POSITIVE)
+        widths = per_item(src, f"{w}.bay_width", f["bay_width"], nb, POSITIVE)
+        for key, lengths in (("storey_height", heights), ("bay_width", widths)):
+            if not math.isfinite(sum(lengths)):
+                raise SceneError(src, f"{w}.{key}", "the frame's height or width leaves the "
+                                 "doubles", "lengths in m of a real frame")
         frame = PlanarFrame(
-            heights=per_item(src, f"{w}.storey_height", f["storey_height"], ns, POSITIVE),
-            widths=per_item(src, f"{w}.bay_width", f["bay_width"], nb, POSITIVE),
+            heights=heights,
+            widths=widths,
             columns=_sections(src, f"{w}.column", f["column"], ns, nb + 1),
             beams=_sections(src, f"{w}.beam", f["beam"], ns, nb),
             masses=_masses(src, f"{w}.mass", f["mass"], ns, nb, f["mass_model"]),

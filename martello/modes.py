@@ -1,0 +1,27 @@
+"""The undamped modes of a structure: K φ = ω² M φ with K and M positive definite (Chopra,
+Dynamics of Structures, §10.2), solved on M^-1/2 K M^-1/2 (M diagonal) or L^-1 K L^-T
+(M = L Lᵀ dense). Shared by the planar frames (frame2d) and the buildings (building3d)."""
+
+import numpy as np
+
+
+def modes(K, M):
+    """(ω ascending, Φ) of K φ = ω² M φ, Φᵀ M Φ = I; M dense or its diagonal; K and M
+    positive definite (the callers factor both first), so every ω² is positive in exact
+    arithmetic: one computed <= 0, inf or NaN (masses and stiffness too disparate for double
+    precision, e.g. a floor of 1e-12 kg among floors of 1e5 kg) raises LinAlgError rather
+    than being clipped to a zero frequency."""
+    M = np.asarray(M, float)
+    with np.errstate(all="ignore"):
+        if M.ndim == 1:
+            s = 1 / np.sqrt(M)
+            A, back = s[:, None] * K * s[None, :], lambda y: s[:, None] * y
+        else:
+            Li = np.linalg.inv(np.linalg.cholesky(M))
+            A, back = Li @ K @ Li.T, lambda y: Li.T @ y
+        if not np.all(np.isfinite(A)):
+            raise np.linalg.LinAlgError("K M^-1 leaves the doubles")
+        lam, y = np.linalg.eigh(A)
+    if not (np.all(np.isfinite(lam)) and lam[0] > 0):
+        raise np.linalg.LinAlgError(f"a computed squared frequency is {lam[0]!r}")
+    return np.sqrt(lam), back(y)
