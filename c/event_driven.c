@@ -72,7 +72,7 @@ typedef struct {
   gsl_odeiv2_driver *rdrv;        /* msbdf: adaptive rk4imp from the step start */
   double *scale_abs;
   double *y, *y0, *yb, *ybest, *yc, *yerr, *fstart, *f, *f1, *fj, *yj, *fint, *fext;
-  double *jf0, *jf1;               /* ed_jacobian's own RHS values (msbdf, rk4imp) */
+  double *jf0, *jf1, *jf2;         /* ed_jacobian's own RHS values (msbdf, rk4imp) */
   double *jh;                      /* a jerk projected for the held forces' rates (rates) */
   /* contact kinematics at the step start (0), the step end (1) and the current state */
   double *pen0, *rate0, *acc0, *pen1, *rate1, *acc1, *pen, *rate, *force;
@@ -230,9 +230,10 @@ static int ed_rhs(double t, const double y[], double dydt[], void *params) {
   return GSL_SUCCESS;
 }
 
-/* Jacobian for msbdf and rk4imp: forward differences of the RHS, dense, row-major
- * dfdy[i*dim + j] (GSL's layout); 2n + 2 RHS evaluations; u' = v is set exactly. Its RHS
- * values have buffers of their own (jf0, jf1): rk4imp calls it while a step's end is held in
+/* Jacobian for msbdf and rk4imp: forward differences of the RHS (central ones where a
+ * component and its rate are both 0), dense, row-major dfdy[i*dim + j] (GSL's layout); 2n + 2
+ * RHS evaluations (one more per such component); u' = v is set exactly. Its RHS values have
+ * buffers of their own (jf0, jf1, jf2): rk4imp calls it while a step's end is held in
  * f1 (the event and peak location re-integrate), and a rate taken from a clobbered f1 missed
  * the |v| and |a| peaks of msbdf whenever an extremum of u was located in the same step. */
 static int ed_jacobian(double t, const double y[], double *dfdy, double dfdt[], void *params) {
@@ -253,9 +254,23 @@ static int ed_jacobian(double t, const double y[], double *dfdy, double dfdt[], 
     double step, hh;
     if (w->fixed[j % n]) continue;
     step = sq * fmax(fmax(fabs(y[j]), 1e-3 * (j < n ? umax : vmax)), w->atol);
-    /* away from zero along y_j (along its rate where y_j is 0: a mirrored scene's zeros are
-     * not negated): the mirrored state (y -> -y) differences the mirrored way, so that a
-     * mirrored scene runs the mirrored steps to the bit (docs/invariance.md) */
+    if (y[j] == 0.0 && w->jf0[j] == 0.0) {
+      /* no direction to step away from (a scene starting at rest: y_j and its rate are 0 in
+       * the scene and in its mirror image, whose zeros are not negated): the central
+       * difference, odd in the step, is the mirrored scene's column negated to the bit (a
+       * forward one is its backward difference there: P8 at rest moved 1e-10 – 1e-9 relative,
+       * docs/invariance.md) */
+      w->yj[j] = step;
+      if (ed_rhs(t, w->yj, w->jf1, w) != GSL_SUCCESS) return GSL_EBADFUNC;
+      w->yj[j] = -step;
+      if (ed_rhs(t, w->yj, w->jf2, w) != GSL_SUCCESS) return GSL_EBADFUNC;
+      w->yj[j] = y[j];
+      for (i = n; i < dim; i++) dfdy[i * dim + j] = (w->jf1[i] - w->jf2[i]) / (2.0 * step);
+      continue;
+    }
+    /* away from zero along y_j (along its rate where y_j is 0): the mirrored state (y -> -y)
+     * differences the mirrored way, so that a mirrored scene runs the mirrored steps to the
+     * bit (docs/invariance.md) */
     w->yj[j] = y[j] + copysign(step, y[j] != 0.0 ? y[j] : w->jf0[j]);
     hh = w->yj[j] - y[j];
     if (ed_rhs(t, w->yj, w->jf1, w) != GSL_SUCCESS) return GSL_EBADFUNC;
@@ -1001,7 +1016,7 @@ static int observe(ed_t *w, double t, int k) {
 static void ed_free(ed_t *w) {
   void *bufs[] = {w->mass, w->gap, w->e, w->fixed, w->el_first, w->el_node, w->el_coef, w->scheme, w->is_pen,
                   w->uni, w->inert, w->Cm, w->scale_abs, w->y, w->y0, w->yb, w->ybest, w->yc,
-                  w->yerr, w->fstart, w->f, w->f1, w->fj, w->jf0, w->jf1, w->jh, w->yj, w->fint, w->fext,
+                  w->yerr, w->fstart, w->f, w->f1, w->fj, w->jf0, w->jf1, w->jf2, w->jh, w->yj, w->fint, w->fext,
                   w->pen0, w->rate0, w->acc0, w->pen1, w->rate1, w->acc1, w->pen, w->rate,
                   w->force, w->lam, w->lam0, w->lam1, w->lamtol, w->hlist, w->held, w->Wh,
                   w->rh, w->ilist, w->hk, w->Wl, w->ql, w->pl, w->wl, w->sl, w->el, w->tg, 
@@ -1065,7 +1080,7 @@ static int ed_setup(ed_t *w) {
   if (!(ALLOC(w->Cm, (size_t)n * (size_t)w->nu) && ALLOC(w->scale_abs, dim) && ALLOC(w->y, dim) &&
         ALLOC(w->y0, dim) && ALLOC(w->yb, dim) && ALLOC(w->ybest, dim) && ALLOC(w->yc, dim) &&
         ALLOC(w->yerr, dim) && ALLOC(w->fstart, dim) && ALLOC(w->f, dim) && ALLOC(w->f1, dim) &&
-        ALLOC(w->fj, dim) && ALLOC(w->jf0, dim) && ALLOC(w->jf1, dim) && ALLOC(w->jh, n) && ALLOC(w->yj, dim) && ALLOC(w->fint, n) && ALLOC(w->fext, n) &&
+        ALLOC(w->fj, dim) && ALLOC(w->jf0, dim) && ALLOC(w->jf1, dim) && ALLOC(w->jf2, dim) && ALLOC(w->jh, n) && ALLOC(w->yj, dim) && ALLOC(w->fint, n) && ALLOC(w->fext, n) &&
         ALLOC(w->pen0, nc) && ALLOC(w->rate0, nc) && ALLOC(w->acc0, nc) &&
         ALLOC(w->pen1, nc) && ALLOC(w->rate1, nc) && ALLOC(w->acc1, nc) && ALLOC(w->pen, nc) &&
         ALLOC(w->rate, nc) && ALLOC(w->force, nc) && ALLOC(w->lam, nc) && ALLOC(w->lam0, nc) &&

@@ -21,11 +21,12 @@
  * continuous at their switches are stepped across instead, their onsets and separations located
  * inside the steps on IDA's interpolant (docs/ida.md, switching surfaces). Steps are taken in
  * IDA_ONE_STEP mode so that path-dependent
- * links commit at every accepted step. The kinks of the loads and t_end are stop times; so are
- * the output times of a scene with rigid contacts (every history row an accepted, committed
- * state); without them IDA steps past the output times and a row inside a step is its state on
- * the step's interpolant, so the steps do not depend on the output (docs/ida.md, output).
- * Every accepted state is a sample of
+ * links commit at every accepted step. The kinks of the loads and t_end are the only stop times:
+ * IDA steps past the output times and a row inside a step is its state on the step's
+ * interpolant, so the steps do not depend on the output (docs/ida.md, output). While a rigid
+ * contact is held, which may hold its nodes still, the steps are bounded by the loads' time
+ * scale and a multiplier that turns tensile and back inside a step is found on the interpolant
+ * (oe_max_step, oe_held_release). Every accepted state is a sample of
  * the run's observer, which measures it as it measures every integrator
  * (martello_observer_*, docs/run-layer.md). */
 #include <float.h>
@@ -55,7 +56,6 @@ typedef struct {
   sunindextype N;
   sunindextype *ip, *im;
   void *mem;             /* IDA's memory: its interpolant */
-  int rows_inside;       /* 1: output rows on the interpolant, no stop at output times */
   N_Vector yprow;        /* y' of such a row */
   char ida_msg[240];
 } ida_problem;
@@ -281,11 +281,9 @@ static int setup(ida_problem *P, martello_model *model, martello_run *run) {
   int st = oe_setup(E, model, run, "IDA");
   if (st != MARTELLO_OK) return st;
   E->restarts = 1;   /* IDAReInit: BDF from order 1 */
+  /* IDA steps past the output times, its rows on the interpolant (docs/ida.md, output); while a
+   * rigid contact is held its steps are bounded by the loads' time scale (oe_max_step) */
   E->sample = sample;
-  /* steps past the output times, as CVODE (docs/ida.md, output); not with rigid contacts: a
-   * closed one holds its nodes still, so nothing but the stops bounds the steps, while its
-   * load-driven multiplier may change sign twice inside one step unseen */
-  P->rows_inside = E->nr == 0;
   /* IDA steps across the laws whose force is continuous at their switches, their events
    * located inside the steps (docs/sundials-ode.md, events inside the steps) */
   if ((st = oe_use_smooth(E)) != MARTELLO_OK) return st;
@@ -318,15 +316,13 @@ static int setup(ida_problem *P, martello_model *model, martello_run *run) {
  * at the start and at every restart: the first step h of order 1 errs by h^2 |y''|/2 per
  * component; y'' = (a, a') at the restart (a' by a
  * forward difference along the motion) and h0 = SAFETY min_i sqrt(2 w_i / |y''_i|), w_i =
- * rtol |y_i| + atol, capped at 1e-3 of t_end (of the output interval where it is a stop time,
- * as on the GSL path). */
+ * rtol |y_i| + atol, capped at 1e-3 of t_end (not of the output interval: the steps do not
+ * depend on the output). */
 #define SAFETY 0.1   /* IDA's first-order error estimate is crude: a margin below it */
 static int initial_step(ida_problem *P, double t, const double *u, const double *v, double *h0) {
   ode_events *E = &P->E;
   const int n = E->n;
-  /* a thousandth of the output interval, or of the run where the output is no stop (its steps
-   * do not depend on the output) */
-  const double cap = 1e-3 * (P->rows_inside ? E->t_end : fmin(E->out_dt, E->t_end)), d = 1e-6 * cap;
+  const double cap = 1e-3 * E->t_end, d = 1e-6 * cap;
   int st = martello_eval_acceleration(E->ev, t, u, v, E->a);
   if (st != MARTELLO_OK) return fail(P, st, "IDA: acceleration failed at t = %.9e s", t);
   for (int i = 0; i < n; i++) {
@@ -397,7 +393,7 @@ static int integrate(ida_problem *P, SUNContext sunctx, N_Vector yy, N_Vector yp
   *LSp = banded ? SUNLinSol_Band(yy, *Jp, sunctx) : SUNLinSol_Dense(yy, *Jp, sunctx);
   if (!*LSp) return oe_fail_memory(E, "the IDA linear solver", -1.0);
   if ((st = check(P, IDASetLinearSolver(mem, *LSp, *Jp), "IDASetLinearSolver"))) return st;
-  if (E->h_max > 0.0 && (st = check(P, IDASetMaxStep(mem, E->h_max), "IDASetMaxStep"))) return st;
+  if ((st = check(P, IDASetMaxStep(mem, oe_max_step(E)), "IDASetMaxStep"))) return st;
   double h0;
   if ((st = initial_step(P, 0.0, u0, v0, &h0)) != MARTELLO_OK) return st;
   if ((st = check(P, IDASetInitStep(mem, h0), "IDASetInitStep"))) return st;
@@ -415,10 +411,9 @@ static int integrate(ida_problem *P, SUNContext sunctx, N_Vector yy, N_Vector yp
   double t_out = oe_output_time(E, k_out), t_last = 0.0;
   if ((st = observe(P, 0.0, N_VGetArrayPointer(yy), N_VGetArrayPointer(yp), 0)) != MARTELLO_OK) return st;
   oe_accepted(E, N_VGetArrayPointer(yy));
-  /* where IDA must stop: the next output time, or only t_end */
-#define T_TO (P->rows_inside ? E->t_end : t_out)
+  /* the stops: the loads' kinks and t_end (the output rows lie on the steps' interpolant) */
   int kink = 0;
-  double t_stop = oe_next_stop(E, 0.0, T_TO, &kink);
+  double t_stop = oe_next_stop(E, 0.0, E->t_end, &kink);
   if ((st = check(P, IDASetStopTime(mem, t_stop), "IDASetStopTime"))) return st;
   const size_t n_found = (size_t)(oe_nroots(E) + 1);
   int *found = calloc(n_found, sizeof(int));
@@ -427,7 +422,7 @@ static int integrate(ida_problem *P, SUNContext sunctx, N_Vector yy, N_Vector yp
   st = MARTELLO_OK;
   while (t_last < E->t_end) {
     double tret = t_last;
-    int flag = IDASolve(mem, T_TO, &tret, yy, yp, IDA_ONE_STEP);
+    int flag = IDASolve(mem, E->t_end, &tret, yy, yp, IDA_ONE_STEP);
     if (flag < 0) {
       double tcur = t_last;
       if (IDAGetCurrentTime(mem, &tcur) != IDA_SUCCESS) tcur = t_last;
@@ -476,7 +471,7 @@ static int integrate(ida_problem *P, SUNContext sunctx, N_Vector yy, N_Vector yp
       if (!restart) restart = root_stays_zero(P, N_VGetArrayPointer(yy), found);
     }
     /* a kink of the load (docs/ida.md, time events): IDA restarts across it */
-    if (!restart && flag == IDA_TSTOP_RETURN && tret == t_stop && kink && t_stop < T_TO) restart = 1;
+    if (!restart && flag == IDA_TSTOP_RETURN && tret == t_stop && kink && t_stop < E->t_end) restart = 1;
     if (!restart) {
       double h_last = 0.0;
       if (IDAGetLastStep(mem, &h_last) != IDA_SUCCESS) h_last = 0.0;
@@ -486,11 +481,16 @@ static int integrate(ida_problem *P, SUNContext sunctx, N_Vector yy, N_Vector yp
         break;
       }
     }
+    /* a held contact's multiplier that turns tensile and back inside the step */
+    if (!restart && (restart = oe_held_release(E, t_last, tret, N_VGetArrayPointer(yy), &t_r)) < 0) {
+      st = restart;
+      break;
+    }
     if (restart && t_r < tret) {
       int f0 = IDAGetDky(mem, t_r, 0, yy), f1 = IDAGetDky(mem, t_r, 1, yp);
       if ((st = check(P, f0 < 0 ? f0 : f1, "IDAGetDky"))) break;
     }
-    if (P->rows_inside && (st = oe_rows_inside(E, &t_last, t_r, &k_out, &t_out)) != MARTELLO_OK) break;
+    if ((st = oe_rows_inside(E, &t_last, t_r, &k_out, &t_out)) != MARTELLO_OK) break;
     if ((st = oe_inner_events(E, t_last, t_r, N_VGetArrayPointer(yy))) != MARTELLO_OK) break;
     if ((st = oe_stretch(E, t_last, t_r, N_VGetArrayPointer(yy), restart)) != MARTELLO_OK) break;
     oe_keep_end_rates(E, !restart);
@@ -529,14 +529,15 @@ static int integrate(ida_problem *P, SUNContext sunctx, N_Vector yy, N_Vector yp
       if ((st = initial_step(P, t_r, E->u, E->v, &h0)) != MARTELLO_OK) break;
       if ((st = check(P, IDASetInitStep(mem, h0), "IDASetInitStep"))) break;
       if ((st = check(P, IDAReInit(mem, t_r, yy, yp), "IDAReInit"))) break;
+      /* the held set may have changed: its bound on the steps with it (0: none) */
+      if ((st = check(P, IDASetMaxStep(mem, oe_max_step(E)), "IDASetMaxStep"))) break;
       memset(E->cnt_last, 0, sizeof E->cnt_last);   /* IDAReInit starts the counters again */
     }
     if (restart || at_output || tret >= t_stop) {
-      t_stop = oe_next_stop(E, t_r, T_TO, &kink);
+      t_stop = oe_next_stop(E, t_r, E->t_end, &kink);
       if ((st = check(P, IDASetStopTime(mem, t_stop), "IDASetStopTime"))) break;
     }
   }
-#undef T_TO
   free(found);
   int st2 = flush_counts(P, mem);
   if (st == MARTELLO_OK) st = st2;

@@ -445,7 +445,7 @@ def test_a_turn_of_v_inside_its_tolerance_is_no_extremum(integrator):
     assert peaks and min(abs(p) for p in peaks.values()) > 1e-12
 
 
-@pytest.mark.parametrize("integrator", ["cvode", "arkode"])
+@pytest.mark.parametrize("integrator", ["cvode", "arkode", "ida"])
 def test_a_release_shorter_than_a_held_step_is_found(integrator):
     # A free mass (1 kg) held on a rigid barrier (restitution, e = 0.5) from t = 0 by
     # f = c A + A sin(w t), c = 0.999, A = 1 N, w = 2 pi rad/s: the multiplier is f itself (the held

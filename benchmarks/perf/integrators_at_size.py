@@ -158,7 +158,7 @@ def variant(kind, active, spread):
 def one(n, integrator, kind, t_end, max_wall, active=None, spread=0.1):
     from martello.scene.spec import DEFAULT_METHODS
     # max_wall stops a slow one: its rate stands, marked as cut
-    load0 = os.getloadavg()[0]
+    load0, at = os.getloadavg()[0], measured_docs.commit()   # the commit whose library the run loads
     sc = scene(n, integrator, kind, t_end, max_wall, active, spread)
     r, _, cpu, wall = timed_run(sc)
     c = r["cost"]
@@ -173,7 +173,7 @@ def one(n, integrator, kind, t_end, max_wall, active=None, spread=0.1):
                                   if k in an and not (k == "dt" and "rtol" in an)},
                       "contact": sc["chain"][0]["contact"] if "chain" in sc else
                       {k: sc["contact"][0][k] for k in ("scheme", "law", "stiffness")}, "load": [load0, os.getloadavg()[0]],
-                      "nice": os.nice(0), "commit": measured_docs.commit(),
+                      "nice": os.nice(0), "commit": at,
                       "date_utc": time.strftime("%Y-%m-%d %H:%M", time.gmtime())}))
 
 

@@ -51,13 +51,15 @@ module martello_observer
    !> val(ptr(f):ptr(f+1)-1) on the nodes col(…) (1..n). Their signed extremes and times, over
    !> the samples and inside each stretch between two samples where the rate R·v changes
    !> sign (on the cubic Hermite of (q, R·v)); per pair of rows (pair(:, p)) the largest
-   !> resultant √(q_a² + q_b²) over the samples and its time. t0 < 0: no sample yet.
+   !> resultant √(q_a² + q_b²) over the samples and inside the stretches where its square
+   !> turns, and its time. q0, r0, a0: each row at the last sample; q1, r1, a1 at the one
+   !> being taken. t0 < 0: no sample yet.
    type :: functionals_t
       integer :: n = 0
       integer, allocatable :: ptr(:), col(:), pair(:, :)
       real(dp), allocatable :: val(:)
       real(dp), allocatable :: q_max(:), q_min(:), t_max(:), t_min(:), res_max(:), t_res(:)
-      real(dp), allocatable :: q0(:), r0(:), a0(:)
+      real(dp), allocatable :: q0(:), r0(:), a0(:), q1(:), r1(:), a1(:)
       real(dp) :: t0 = -1.0_dp
    end type functionals_t
 
