@@ -209,9 +209,10 @@ class BuildingWriter:
 
     # --- rows: contacts and links between plan points ----------------------------------------
     def row(self, what, terms):
-        """(i, j, n, position) of a row Σ c·u = n·(u(P_a) − u(P_b)): the element's nodes i (side
-        a) and j (side b, a new fixed node for the ground), the unit plan direction n, and
-        where the nodes are. Refused where the row is no such difference (a written row)."""
+        """(i, j, n) of a row Σ c·u = n·(u(P_a) − u(P_b)): the element's nodes i (side a) and j
+        (side b, a new fixed node for the ground) and the unit plan direction n. Refused where
+        the row is no such difference (a written row). A plain [[node]] is an x-only node at
+        the origin (martello.export.opensees nodes())."""
         masters = {m[0] for m in self.master.values()}
         bodies = {}                       # a floor's master ("floor", tag) or a node's tag -> [cx, cy, cr]
         for idx, c in terms:
@@ -243,7 +244,7 @@ class BuildingWriter:
             else:
                 if cr != 0.0:             # pragma: no cover - only rigid floors have rz
                     self.bld.refuse(f"{what}.terms", "a rotation term on a node without one")
-                x, y, z = self.position.get(key, (0.0, 0.0, 0.0))
+                x, y, z = self.position[key]
                 nodes.append(("node", key, np.array([x, y]), z))
         # both nodes on one line of action: the first side's point, the second projected on its line
         anchor = next((p for k, _, p, _ in nodes if k == "node"), nodes[0][2])
@@ -262,10 +263,10 @@ class BuildingWriter:
         if len(tags) == 1:
             self.bld.tag_count += 1
             g = self.bld.tag_count
-            x, y, z = self.position.get(tags[0], (0.0, 0.0, 0.0))
+            x, y, z = self.position[tags[0]]
             self.node(g, x, y, z)
             self.bld.add("fix", g, 1, 1, 1, 1, 1, 1)
             tags.append(g)
         # the first side's translation is n: it is side a of n·(u(P_a) − u(P_b))
         i, j = tags
-        return i, j, n, [self.position[t] for t in (i, j)]
+        return i, j, n

@@ -225,7 +225,7 @@ class _Builder:
         row (martello.export.building); a node pair is its two nodes."""
         terms = element_terms(item)
         if self.s.extras.get("buildings"):
-            i, j, n, _ = self.bw.row(what, terms)
+            i, j, n = self.bw.row(what, terms)
             if first == "b":
                 i, j = j, i
             return i, j, n, [(*self.dof_of(k), c) for k, c in terms]
@@ -256,6 +256,8 @@ class _Builder:
 
     def node_cmd(self, tag, x=0.0, y=0.0):
         self.add("node", tag, *((x,) if self.ndm == 1 else (x, y) if self.ndm == 2 else (x, y, 0.0)))
+        if self.ndm == 3:           # where a building's contact to a plain node acts (along())
+            self.bw.position[tag] = (float(x), float(y), 0.0)
 
     def fix_cmd(self, tag, lateral=True):
         self.add("fix", tag, (1 if lateral else 0), *(1,) * (self.ndf - 1))
