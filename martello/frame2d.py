@@ -21,7 +21,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .modes import modes
+from .modes import frequencies, modes
 
 # Local end-force components of a member, in recovery rows 6e + k.
 END_FORCES = ("N_i", "V_i", "M_i", "N_j", "V_j", "M_j")
@@ -230,7 +230,7 @@ def modal_damping(K, M, zeta):
 def natural_frequencies(K, M):
     """ω (rad/s, ascending) of K φ = ω² M φ for a diagonal M (given as its diagonal); an ω²
     computed <= 0 or not finite raises LinAlgError (martello.modes)."""
-    return modes(K, np.asarray(M, float))[0]
+    return frequencies(K, np.asarray(M, float))
 
 
 # --- interface links across a joint (seed §4, after Muthukumar & DesRoches 2006) ----------
