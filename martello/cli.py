@@ -474,6 +474,8 @@ def main(argv=None):
                    "kelvin=JankowskiImpact; a change of law is stated on stderr")
     p.add_argument("--tol", type=float, help="NormDispIncr tolerance in m (default: the scene's "
                    "tol_increment x 0.1 m)")
+    p.add_argument("--force", action="store_true", help="write a model of more steps than the "
+                   "budget of martello run (1e9 node-steps)")
     p.set_defaults(func=cmd_export)
 
     p = sub.add_parser("testset", help="write the pounding test set: a JSON file and a page per problem",

@@ -209,6 +209,43 @@ def test_overrides_replace_an_event_driven_integrator():
         opensees_model(from_dict(d, source="tb"), analysis={"integrator": "hht"})
 
 
+@pytest.mark.parametrize("over, match", [
+    # t_end/dt = inf: was an internal OverflowError (int(inf))
+    ({"dt": 1e-320}, r"^--dt: t_end/dt = 0.004/1e-320 = inf steps, more than 2\^53.*raise --dt"),
+    # ~1e303 steps were written without a budget
+    ({"t_end": 1e300}, r"^--t-end: .* = 1e305 steps, more than 2\^53.*shorten --t-end"),
+    # past `martello run`'s budget (1e9 node-steps): 2e9 steps of 2 nodes
+    ({"t_end": 2e4}, r"^--t-end: .*= 2e9 steps of 2 nodes, more than the 1e9 node-steps.*--force"),
+    ({"dt": 1e-14}, r"^--dt: .*more than the 1e9 node-steps.*raise --dt or shorten analysis.t_end"),
+    # an integrator's own key on a scene of another integrator without --integrator: was ignored
+    ({"alpha": -0.1}, "^--alpha: applies to integrator hht, not newmark .the scene's integrator.: "
+                      "it would be ignored .remove it, or give --integrator hht."),
+    ({"rho_inf": 0.5}, "^--rho-inf: applies to integrator generalized-alpha, not newmark"),
+])
+def test_overrides_the_model_would_not_honour_are_refused_naming_the_flag(over, match):
+    with pytest.raises(ExportError, match=match):
+        opensees_model(from_dict(two_bodies("kelvin"), source="tb"), analysis=over)
+    d = two_bodies("kelvin", integrator="hht")
+    with pytest.raises(ExportError, match="^--beta: applies to integrator newmark, not hht"):
+        opensees_model(from_dict(d, source="tb"), analysis={"beta": 0.3})
+
+
+def test_other_options_the_model_would_not_honour_are_refused(tmp_path):
+    """--tol on central-difference (no Newton test), --material for a law no contact has, and
+    --force past the budget writes the model (its step count as asked)."""
+    d = two_bodies("linear", integrator="central-difference")
+    d["node"][0]["v0"], d["node"][1]["u0"] = 0.0, -0.002
+    opensees_model(from_dict(d, source="tb"))
+    with pytest.raises(ExportError, match="^--tol: central-difference is explicit.*remove it"):
+        opensees_model(from_dict(d, source="tb"), tol=1e-9)
+    with pytest.raises(ExportError, match=r"^--material hertz=HertzLinear: no penalty contact of the "
+                                          r"scene has law hertz \(kelvin\)"):
+        opensees_model(from_dict(two_bodies("kelvin"), source="tb"), materials={"hertz": "HertzLinear"})
+    m = opensees_model(from_dict(two_bodies("kelvin"), source="tb"), analysis={"t_end": 2e4},
+                       force=True)
+    assert m.steps == 2_000_000_000
+
+
 @pytest.mark.parametrize("change, match", [
     ({"scheme": "restitution", "restitution": 0.5}, "scheme = restitution.*no Newton restitution"),
     ({"scheme": "lagrange"}, "scheme = lagrange.*Lagrange multipliers"),
