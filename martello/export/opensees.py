@@ -727,6 +727,7 @@ class _Builder:
                     "apart otherwise")
             self.map.append(("Newton test", f"NormDispIncr {tol:g} m (tol_increment {tol_inc:g} "
                              f"x {DISP_SCALE:g} m), at most {iters} iterations, Newton"))
+        self.bw.modal_damping()
         self.add("analysis", "Transient")
         self.map.append((f"integrator {name}, dt = {dt:g} s, t_end = {t_end:g} s",
                          f"{what}; {self.steps} steps of {dt:g} s"))
