@@ -568,3 +568,27 @@ def test_modal_damping_of_repeated_frequencies_is_refused():
         b["damping"], b["zeta"] = "modal", 0.05
     with pytest.raises(ExportError, match=r"two modes at 7.74596669 and 7.74596669 rad/s.*M-orthogonal"):
         opensees_model(from_dict(d, source="sh"))
+
+
+def test_a_plain_node_side_follows_martellos_row():
+    """martello's row of a contact between a floor point and a [[node]] is n·u(P) − u_node:
+    the node's term is −1 whatever the normal (martello.scene.rows side_terms). A fixed node
+    (a wall) is the ground here, so any normal exports (normal [−1, 0] was refused); a free
+    node moves along x in the 3D model, so a normal that is not +x from a to b is refused
+    naming the node and the fix (before: a bare "not a row" message)."""
+    for fixed, n in ((True, [-1.0, 0.0]), (True, [0.6, 0.8]), (False, [1.0, 0.0]), (False, [-1.0, 0.0])):
+        d = small_buildings(reference=False)
+        for b in d["building"]:
+            b["ground_angle"] = 0.0
+        d["node"] = [{"name": "w", "mass": 1e3, "fixed": fixed}]
+        d["contact"].append({"name": "fw", "a": {"floor": "A1", "x": 0.0, "y": 3.0}, "b": "w", "normal": n,
+                             "gap": 0.001, "scheme": "penalty", "law": "linear", "stiffness": 1e8})
+        if not fixed and n[0] < 0:
+            with pytest.raises(ExportError, match=r"contact\[1\] \(fw\): node w with normal \(-1, 0\).*along "
+                                                  r"the element's normal.*swap a and b"):
+                opensees_model(from_dict(d, source="fw"))
+            continue
+        m = opensees_model(from_dict(d, source="fw"))
+        (el,) = [c.args for c in m.commands if c.name == "element" and c.args[0] == "zeroLength"][-1:]
+        orient = el[el.index("-orient") + 1:el.index("-orient") + 3]
+        assert orient == pytest.approx(tuple(n))

@@ -50,6 +50,7 @@ class BuildingWriter:
         self.members = []                  # (prefix, member name, element tag)
         self.transf = {}
         self.n_master = 0                  # rigid floors written (their masters' tags)
+        self.kept = {n for b in self.buildings for n in b["nodes"]}    # the buildings' own DOFs
 
     # --- refusals ---------------------------------------------------------------------------
     def check(self):
@@ -278,6 +279,10 @@ class BuildingWriter:
         the origin (martello.export.opensees nodes())."""
         masters = {m[0] for m in self.master.values()}
         bodies = {}                       # a floor's master ("floor", tag) or a node's tag -> [cx, cy, cr]
+        # a plain [[node]] side is the term ±1 of its one DOF whatever the normal (martello.scene.rows
+        # side_terms: its u counted along n); a fixed one's u is 0, so it is the ground here
+        plain = [idx for idx, _ in terms if self.s.nodes[idx]["name"] not in self.kept]
+        terms = [(idx, c) for idx, c in terms if not self.s.nodes[idx]["fixed"]]
         for idx, c in terms:
             tag, dof = self.bld.dof_of(idx)
             key = ("floor", tag) if tag in masters else tag
@@ -289,6 +294,15 @@ class BuildingWriter:
         sides = list(bodies.items())
         t0 = np.array(sides[0][1][:2])
         scale = math.hypot(*t0)
+        if len(sides) == 2 and not np.array_equal(np.array(sides[1][1][:2]), -t0) and plain and \
+                abs(scale - 1.0) <= FREE_ROW:
+            name = next(self.s.nodes[i]["name"] for i in plain if not self.s.nodes[i]["fixed"])
+            self.bld.refuse(f"{what}: node {name} with normal ({t0[0]:g}, {t0[1]:g})",
+                            f"martello counts a [[node]]'s u along the element's normal (its term is ±1 "
+                            f"whatever the normal), while in the 3D model a plain node moves along x, the "
+                            "axis its ground motion and loads act on: the two agree only where the normal "
+                            "is +x from side a to side b", "write the contact with the node on the side "
+                            "that makes the normal [1, 0] (swap a and b and flip the normal), or fix the node")
         if len(sides) == 2 and not np.array_equal(np.array(sides[1][1][:2]), -t0) or \
                 not abs(scale - 1.0) <= FREE_ROW:
             self.bld.refuse(f"{what}.terms", "not a row n·(u(P_a) − u(P_b)) with a unit plan direction n "
