@@ -163,8 +163,9 @@ static int flush_counts(ida_problem *P, void *mem) {
 }
 
 /* An accepted (committed) state y, yp at t as a sample of the observer (the force of a
- * closed rigid contact is its multiplier P_r); k: the output grid point t = k dt, or -1. */
-static int observe(ida_problem *P, double t, const double *y, const double *yp, int k) {
+ * closed rigid contact is its multiplier P_r); k: the output grid point t = k dt, or -1;
+ * row: an output row on the interpolant inside a step (martello_observer_row). */
+static int observe(ida_problem *P, double t, const double *y, const double *yp, int k, int row) {
   ode_events *E = &P->E;
   oe_gather(E, y, E->u, E->v);
   for (int i = 0; i < E->n; i++) E->a[i] = yp[E->iv[i]];
@@ -172,14 +173,15 @@ static int observe(ida_problem *P, double t, const double *y, const double *yp, 
     int r = E->rig[j];
     E->force[j] = r >= 0 && E->closed[r] ? y[P->ip[r]] : 0.0;
   }
-  return martello_observer_sample(E->obs, E->ev, t, E->u, E->v, E->a, E->force, k);
+  return (row ? martello_observer_row : martello_observer_sample)(E->obs, E->ev, t, E->u, E->v, E->a,
+                                                                  E->force, k);
 }
 
 /* An output row on the interpolant (c/ode_events.c oe_rows_inside), its y' from it too. */
 static int sample(void *ctx, double t, const double *y, int k) {
   ida_problem *P = ctx;
   int st = interpolant(P, t, 1, P->yprow);
-  return st == MARTELLO_OK ? observe(P, t, y, N_VGetArrayPointer(P->yprow), k) : st;
+  return st == MARTELLO_OK ? observe(P, t, y, N_VGetArrayPointer(P->yprow), k, 1) : st;
 }
 
 /* Make the state at a restart consistent (c/ode_events.c), then y and y' for IDA: P the
@@ -409,7 +411,7 @@ static int integrate(ida_problem *P, SUNContext sunctx, N_Vector yy, N_Vector yp
 
   int k_out = 1;
   double t_out = oe_output_time(E, k_out), t_last = 0.0;
-  if ((st = observe(P, 0.0, N_VGetArrayPointer(yy), N_VGetArrayPointer(yp), 0)) != MARTELLO_OK) return st;
+  if ((st = observe(P, 0.0, N_VGetArrayPointer(yy), N_VGetArrayPointer(yp), 0, 0)) != MARTELLO_OK) return st;
   oe_accepted(E, N_VGetArrayPointer(yy));
   /* the stops: the loads' kinks and t_end (the output rows lie on the steps' interpolant) */
   int kink = 0;
@@ -513,7 +515,7 @@ static int integrate(ida_problem *P, SUNContext sunctx, N_Vector yy, N_Vector yp
      * k_out·every of the output interval dt (the observer records it) */
     int at_output = t_r == t_out || (restart && t_out - t_r <= 16.0 * DBL_EPSILON * t_out);
     if ((st = observe(P, t_r, N_VGetArrayPointer(yy), N_VGetArrayPointer(yp),
-                      at_output ? k_out * E->every : -1)) != MARTELLO_OK)
+                      at_output ? k_out * E->every : -1, 0)) != MARTELLO_OK)
       break;
     oe_accepted(E, N_VGetArrayPointer(yy));   /* after a restart's jumps */
     if (at_output) {

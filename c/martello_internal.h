@@ -162,6 +162,11 @@ int martello_observer_begin(martello_observer *obs, martello_eval *ev, const dou
  * Returns MARTELLO_ERR_DIVERGED (message set) when the run must stop. */
 int martello_observer_sample(martello_observer *obs, martello_eval *ev, double t, const double *u,
                              const double *v, const double *a, const double *force, int k);
+/* An output row on the method's interpolant inside a step, as martello_observer_sample but
+ * off the energy grid (no largest |balance|, no divergence test) and not a step of the budget:
+ * neither depends on the output (docs/run-layer.md, "the energy terms"). */
+int martello_observer_row(martello_observer *obs, martello_eval *ev, double t, const double *u,
+                          const double *v, const double *a, const double *force, int k);
 /* An extremum of node `node`'s displacement located inside an accepted step (the root of its
  * velocity), at t with value u; maximum = 1 for a maximum, 0 for a minimum. From the first
  * call on, u_peak holds located maxima only. */

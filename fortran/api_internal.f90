@@ -430,11 +430,31 @@ contains
       real(c_double), value :: t
       real(c_double), intent(in) :: u(*), v(*), a(*), force(*)
       integer(c_int), value :: k
+      c_observer_sample = sample_from_c(handle, ehandle, t, u, v, a, force, k, .false.)
+   end function c_observer_sample
+
+   !> An output row on the method's interpolant inside a step (martello_observer_row):
+   !> measured and recorded as a sample, off the energy grid and the step budget.
+   integer(c_int) function c_observer_row(handle, ehandle, t, u, v, a, force, k) &
+      bind(C, name='martello_observer_row')
+      type(c_ptr), value :: handle, ehandle
+      real(c_double), value :: t
+      real(c_double), intent(in) :: u(*), v(*), a(*), force(*)
+      integer(c_int), value :: k
+      c_observer_row = sample_from_c(handle, ehandle, t, u, v, a, force, k, .true.)
+   end function c_observer_row
+
+   integer(c_int) function sample_from_c(handle, ehandle, t, u, v, a, force, k, row) result(res)
+      type(c_ptr), value :: handle, ehandle
+      real(c_double), value :: t
+      real(c_double), intent(in) :: u(*), v(*), a(*), force(*)
+      integer(c_int), value :: k
+      logical, intent(in) :: row
       type(observer_t), pointer :: op
       type(evaluator_t), pointer :: ep
       integer :: n, j, stat
       op => get_observer(handle); ep => get_eval(ehandle)
-      c_observer_sample = MARTELLO_ERR_ARGUMENT
+      res = MARTELLO_ERR_ARGUMENT
       if (.not. (associated(op) .and. associated(ep))) return
       n = ep%m%n
       call evaluator_load(ep, u(1:n), v(1:n))
@@ -446,9 +466,9 @@ contains
          op%c_force(j) = merge(ep%ms%con_f(j), force(j), ep%ms%is_penalty(j))
       end do
       call observer_sample(op, ep%m, ep%ms, t, ep%u, ep%v, op%acc, op%c_pen, op%c_force, int(k), &
-                           stat, ep%ms%link_f, ep%ms%link_u)
-      c_observer_sample = stat
-   end function c_observer_sample
+                           stat, ep%ms%link_f, ep%ms%link_u, row=row)
+      res = stat
+   end function sample_from_c
 
    !> A located extremum of node `node` (0-based) at t, value u; maximum = 1 for a maximum.
    integer(c_int) function c_observer_extremum(handle, node, t, u, maximum) &

@@ -61,8 +61,9 @@ def cmd_run(args):
         print(f"warning: {w}", file=sys.stderr)
     out = Path(args.output) if args.output else Path("out") / Path(args.scene).stem
     check_output_folder(out, "summary.json", ResultError)   # refused before the run, not after it
-    show = sys.stderr.isatty() if args.progress is None else args.progress
-    line = ProgressLine(sys.stderr) if show else None
+    # default: on a terminal the line in place, in a log the sparse lines; --progress: a line
+    # every few seconds in a log too; --no-progress: none
+    line = None if args.progress is False else ProgressLine(sys.stderr, sparse=args.progress is None)
     pace = None if args.force or s.analysis["type"] != "dynamic" else PaceLimit(
         s, s.analysis["integrator"] in native.adaptive_integrators())
     reporters = [r for r in (pace, line) if r is not None]
@@ -122,19 +123,33 @@ class PaceLimit:
 
 
 class ProgressLine:
-    """The progress of a running dynamic run on a stream, once it has run for a second:
-    simulated time, share of t_end, steps, rate and ETA. On a terminal one line rewritten in
-    place (cleared when the run returns), else a line every few seconds."""
+    """The progress of a running dynamic run on a stream: simulated time, share of t_end,
+    steps, rate and ETA. On a terminal, once the run has taken a second, one line rewritten in
+    place (cleared when the run returns). Else (a log: nohup, a batch system) lines of their
+    own with the time spent: every EVERY_PLAIN seconds when asked for (--progress), or, by
+    default (sparse), at 30 s, 1, 2, 4 and 8 min, then every 5 min: a long run says it is alive
+    and when it should end without filling the log (15 lines in its first hour), a run under
+    30 s says nothing. It only reads the reports: the run is the same with or without it."""
 
     START, EVERY_PLAIN = 1.0, 5.0
+    SPARSE_FIRST, SPARSE_CAP = 30.0, 300.0
 
-    def __init__(self, stream):
-        self.stream, self.tty, self.last, self.shown = stream, stream.isatty(), -1e300, False
+    def __init__(self, stream, sparse=False):
+        self.stream, self.tty = stream, stream.isatty()
+        self.sparse = sparse and not self.tty
+        self.shown, self.last = False, -1.0
+        self.next = self.SPARSE_FIRST if self.sparse else self.START
 
     def __call__(self, t, t_end, steps, elapsed):
-        if elapsed < self.START or (not self.tty and elapsed - self.last < self.EVERY_PLAIN):
-            return
+        if elapsed < self.last:          # the next run of the same command (P4's measures)
+            self.next = self.SPARSE_FIRST if self.sparse else self.START
         self.last = elapsed
+        if elapsed < self.next:
+            return
+        if self.sparse:                  # the gap doubles, up to SPARSE_CAP
+            self.next = elapsed + min(elapsed, self.SPARSE_CAP)
+        elif not self.tty:
+            self.next = elapsed + self.EVERY_PLAIN
         share = min(max(t / t_end, 0.0), 1.0) if t_end > 0 else 0.0
         rate = steps / elapsed if elapsed > 0 else 0.0
         eta = elapsed * (1.0 - share) / share if share > 0 else float("inf")
@@ -144,7 +159,7 @@ class ProgressLine:
             self.stream.write("\r\033[K" + line)
             self.shown = True
         else:
-            self.stream.write(line + "\n")
+            self.stream.write(f"{line} ({_duration(elapsed)} so far)\n")
         self.stream.flush()
 
     def close(self):
@@ -372,8 +387,9 @@ def main(argv=None):
                    help="run even if it needs more than 1e9 node-steps, writes more than 1 GB, or "
                    "at its pace over its first 10 s would take more than an hour")
     p.add_argument("--progress", action=argparse.BooleanOptionalAction, default=None,
-                   help="a progress line on stderr for a run longer than a second (default: "
-                   "when stderr is a terminal)")
+                   help="a progress line on stderr for a run longer than a second, a line every 5 s "
+                   "when stderr is not a terminal (default: on a terminal; in a log, such as "
+                   "nohup's, a line at 30 s, 1, 2, 4, 8 min, then every 5 min)")
     p.set_defaults(func=cmd_run)
 
     p = sub.add_parser("check", help="verify scenes against their closed forms",
@@ -474,6 +490,8 @@ def main(argv=None):
                    "kelvin=JankowskiImpact; a change of law is stated on stderr")
     p.add_argument("--tol", type=float, help="NormDispIncr tolerance in m (default: the scene's "
                    "tol_increment x 0.1 m)")
+    p.add_argument("--force", action="store_true", help="write a model of more steps than the "
+                   "budget of martello run (1e9 node-steps)")
     p.set_defaults(func=cmd_export)
 
     p = sub.add_parser("testset", help="write the pounding test set: a JSON file and a page per problem",

@@ -26,6 +26,7 @@ from .history import history_dict, parse_csv
 from .paths import MiB, UnreadableFile, check_regular, read_input, write_text_atomic
 from .metrics.from_history import summary_from_history
 from .metrics.score import COST_KEYS, history_errors, score
+from .reference.base import CLOSED_FORM_DIGITS
 from .reference.selection import reference_for_scene
 from .scene.loader import load
 
@@ -286,13 +287,17 @@ def compare(history_path, scene_path, columns=None, compute=True, stream=None):
     # a closed form is exact anywhere: compare at their times; stored data at its samples
     times = t[t <= ref.t_end * (1 + 1e-12)] if ref.kind == "closed-form" else None
     summary = summary_from_history(sc, (columns, data))
-    u_cols = [c for c in cols if c.startswith("u:")] or cols[:1]
+    span_t = times if times is not None else ref.default_times()
+    span_t = span_t[(span_t >= t[0]) & (span_t <= min(t[-1], ref.t_end))]
+    rounding, bound = round_off_columns(ref, cols, span_t)
+    u_cols = [c for c in cols if c.startswith("u:") and c not in rounding] or \
+        [c for c in cols if c not in rounding][:1] or cols[:1]
     m = score(summary, (columns, data), ref, columns=u_cols, times=times)
     per_column = {}
     for c in cols:
         e = history_errors((columns, data), ref, [c], times)
         per_column[c] = {"max_abs_error": e.get(f"max_abs_error:{c}"), "max_rel_error": e["max_rel_error"],
-                         "scd": e["scd"], "mescd": e["mescd"]}
+                         "scd": e["scd"], "mescd": e["mescd"], "round_off": c in rounding}
     checks = []
     if sc.check:
         try:
@@ -318,11 +323,36 @@ def compare(history_path, scene_path, columns=None, compute=True, stream=None):
     return {"history": str(history_path), "scene": str(scene_path), "reference": ref.name,
             "reference_kind": ref.kind, "reference_digits": ref.trusted_digits(u_cols),
             "compared_columns": cols, "unrecorded_columns": unrecorded, "time_span": span, "rows": int(len(t)),
-            "score_scd": m.get("scd"), "metrics": {k: v for k, v in m.items() if k not in COST_KEYS},
+            "score_scd": m.get("scd"), "scored_columns": u_cols, "round_off_columns": rounding,
+            "round_off_bound": bound,
+            "metrics": {k: v for k, v in m.items() if k not in COST_KEYS},
             "per_column": per_column, "checks": checks, "computed_reference": computed,
             "derived_events": {k: {kk: v[kk] for kk in ("impact_times", "restitution",
                                                         "phase_max_penetration")}
                                for k, v in summary["contacts"].items()}}
+
+
+def round_off_columns(ref, cols, t):
+    """The columns whose reference is round-off: its largest |y_ref| over the compared times is
+    not above the reference's own absolute error on that kind of quantity (u, v, a, ...),
+    B_kind = max over the kind's columns of max |y_ref| · 10^−digits (the digits it is
+    trusted to: a closed form's 13, a computed reference's from its refinement, at most 15).
+    Such a column is not known to one digit (a symmetric plan's uy: |uy| ~ 1e-17 m beside
+    ux ~ 1e-2 m; a body at rest before an impact: exactly 0), so its relative error says
+    nothing: it is reported, not scored (docs/compare.md "Round-off columns"). Returns (the
+    columns, {kind: B})."""
+    if len(t) == 0:
+        return [], {}
+    y = ref.at(t, cols)
+    peak = {c: float(np.max(np.abs(y[c]))) for c in cols}
+    digits = getattr(ref, "digits", {}) or {}
+    bound = {}
+    for c in cols:
+        d = digits.get(c, CLOSED_FORM_DIGITS if ref.kind == "closed-form" else math.nan)
+        err = peak[c] * 10.0 ** -min(d, 15.0) if d == d else 0.0
+        kind = c.partition(":")[0]
+        bound[kind] = max(bound.get(kind, 0.0), err)
+    return [c for c in cols if peak[c] <= bound[c.partition(":")[0]]], bound
 
 
 DESCRIPTIONS = [
@@ -369,7 +399,8 @@ def print_report(rep, stream=sys.stdout):
     print(f"\n{'column':<26} {'max abs error':>14} {'max rel error':>14} {'scd':>6}", file=stream)
     for c, e in rep["per_column"].items():
         print(f"{c:<26} {_fmt(e['max_abs_error']):>14} {_fmt(e['max_rel_error']):>14} "
-              f"{_fmt(round(e['scd'], 2) if e['scd'] == e['scd'] else e['scd']):>6}", file=stream)
+              f"{_fmt(round(e['scd'], 2) if e['scd'] == e['scd'] else e['scd']):>6}"
+              + ("  round-off, not scored" if e.get("round_off") else ""), file=stream)
     if rep["checks"]:
         print("\nscene [check] quantities, from the history:", file=stream)
         for c in rep["checks"]:
@@ -378,6 +409,12 @@ def print_report(rep, stream=sys.stdout):
             else:
                 print(f"  {c['quantity']:<40} {c['value']:.10g} vs {c['reference']:.10g}: "
                       f"{c['digits']:.1f} digits", file=stream)
+    if rep.get("round_off_columns"):
+        print(f"\nround-off, not scored: {', '.join(rep['round_off_columns'])} (their reference's largest "
+              "value is not above the reference's own error on that kind of quantity, " + ", ".join(
+                  f"{k} {b:.2g}" for k, b in rep["round_off_bound"].items()
+                  if any(c.startswith(k + ":") for c in rep["round_off_columns"]))
+              + ": not known to one digit; the metrics above leave them out)", file=stream)
     d = rep["reference_digits"]
     if rep["score_scd"] is not None and d == d and rep["score_scd"] > d - 0.5:
         print(f"\nnote: the history agrees with the reference to about the reference's own accuracy "

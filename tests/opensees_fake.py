@@ -200,6 +200,12 @@ class FakeOpenSees:
         assert what == "basicForce"
         return [-(tag + self.time)]
 
+    def modalDamping(self, *factors):
+        assert any(n == "eigen" for n, _ in self.calls), "modalDamping takes the last eigen's modes"
+        assert not any(n == "analysis" for n, _ in self.calls) and factors
+        assert all(isinstance(f, float) and 0 <= f < 1 for f in factors), factors
+        self._rec("modalDamping", *factors)
+
     def eigen(self, *args):
         n = args[-1]
         assert isinstance(n, int) and n > 0 and args[:-1] in ((), ("-fullGenLapack",)), args

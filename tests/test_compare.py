@@ -201,3 +201,24 @@ def test_cli_error_exit_code(tmp_path):
     r = subprocess.run([sys.executable, "-m", "martello", "compare", p, "--against", KELVIN],
                        cwd=ROOT, capture_output=True, text=True, timeout=300)
     assert r.returncode == 1 and "missing column t" in r.stderr and "Traceback" not in r.stderr
+
+
+def test_round_off_columns_are_reported_not_scored(tmp_path):
+    """P5's two bodies before the impact (t ≤ 0.5 ms; it comes at 1 ms): m2's exact u is 0,
+    so a history with m2 at 1e-20 m (another code's round-off) had a relative error of inf
+    and a headline scd of −inf. A column whose reference is not above the reference's own
+    error on its kind (here the closed form's 1e-13 · 5e-4 m) is reported as round-off and
+    left out of the headline, which is m1's (exact here: inf)."""
+    scene = ROOT / "benchmarks" / "p5" / "p5_linear.toml"
+    t = np.linspace(0.0, 5e-4, 51)
+    cols = ["t", "u:m1", "u:m2"]
+    path = write_csv(tmp_path / "h.csv", cols, np.column_stack([t, 1.0 * t, 1e-20 * np.sin(t / 1e-4)]))
+    rep = compare.compare(path, scene)
+    assert rep["round_off_columns"] == ["u:m2"] and rep["scored_columns"] == ["u:m1"]
+    assert rep["per_column"]["u:m2"]["round_off"] and rep["per_column"]["u:m2"]["scd"] == -np.inf
+    assert rep["metrics"]["scd"] > 13
+    import io
+    buf = io.StringIO()
+    compare.print_report(rep, buf)
+    out = buf.getvalue()
+    assert "round-off, not scored: u:m2" in out and "u:m2" in out.split("round-off, not scored: ")[0]

@@ -209,6 +209,43 @@ def test_overrides_replace_an_event_driven_integrator():
         opensees_model(from_dict(d, source="tb"), analysis={"integrator": "hht"})
 
 
+@pytest.mark.parametrize("over, match", [
+    # t_end/dt = inf: was an internal OverflowError (int(inf))
+    ({"dt": 1e-320}, r"^--dt: t_end/dt = 0.004/1e-320 = inf steps, more than 2\^53.*raise --dt"),
+    # ~1e303 steps were written without a budget
+    ({"t_end": 1e300}, r"^--t-end: .* = 1e305 steps, more than 2\^53.*shorten --t-end"),
+    # past `martello run`'s budget (1e9 node-steps): 2e9 steps of 2 nodes
+    ({"t_end": 2e4}, r"^--t-end: .*= 2e9 steps of 2 nodes, more than the 1e9 node-steps.*--force"),
+    ({"dt": 1e-14}, r"^--dt: .*more than the 1e9 node-steps.*raise --dt or shorten analysis.t_end"),
+    # an integrator's own key on a scene of another integrator without --integrator: was ignored
+    ({"alpha": -0.1}, "^--alpha: applies to integrator hht, not newmark .the scene's integrator.: "
+                      "it would be ignored .remove it, or give --integrator hht."),
+    ({"rho_inf": 0.5}, "^--rho-inf: applies to integrator generalized-alpha, not newmark"),
+])
+def test_overrides_the_model_would_not_honour_are_refused_naming_the_flag(over, match):
+    with pytest.raises(ExportError, match=match):
+        opensees_model(from_dict(two_bodies("kelvin"), source="tb"), analysis=over)
+    d = two_bodies("kelvin", integrator="hht")
+    with pytest.raises(ExportError, match="^--beta: applies to integrator newmark, not hht"):
+        opensees_model(from_dict(d, source="tb"), analysis={"beta": 0.3})
+
+
+def test_other_options_the_model_would_not_honour_are_refused(tmp_path):
+    """--tol on central-difference (no Newton test), --material for a law no contact has, and
+    --force past the budget writes the model (its step count as asked)."""
+    d = two_bodies("linear", integrator="central-difference")
+    d["node"][0]["v0"], d["node"][1]["u0"] = 0.0, -0.002
+    opensees_model(from_dict(d, source="tb"))
+    with pytest.raises(ExportError, match="^--tol: central-difference is explicit.*remove it"):
+        opensees_model(from_dict(d, source="tb"), tol=1e-9)
+    with pytest.raises(ExportError, match=r"^--material hertz=HertzLinear: no penalty contact of the "
+                                          r"scene has law hertz \(kelvin\)"):
+        opensees_model(from_dict(two_bodies("kelvin"), source="tb"), materials={"hertz": "HertzLinear"})
+    m = opensees_model(from_dict(two_bodies("kelvin"), source="tb"), analysis={"t_end": 2e4},
+                       force=True)
+    assert m.steps == 2_000_000_000
+
+
 @pytest.mark.parametrize("change, match", [
     ({"scheme": "restitution", "restitution": 0.5}, "scheme = restitution.*no Newton restitution"),
     ({"scheme": "lagrange"}, "scheme = lagrange.*Lagrange multipliers"),
@@ -381,9 +418,34 @@ def test_a_building_reports_its_periods(tmp_path):
     assert not (tmp_path / "x" / "history.csv").exists()
 
 
+def test_modal_damping_is_eigen_then_modal_damping_with_the_masters_numbered_last():
+    """Modal damping (docs/opensees.md "Modal damping"): eigen -fullGenLapack on every mass DOF,
+    then modalDamping ζ, before the analysis; no Rayleigh region; every floor's master tagged
+    above every other node (OpenSees writes the equations' eigenvectors in node-tag order and a
+    slave's over its master's). Before, modal damping was refused."""
+    d = small_buildings(reference=False)
+    for b in d["building"]:
+        b["damping"] = "modal"
+    m = opensees_model(from_dict(d, source="sb"))
+    names = [c.name for c in m.commands]
+    assert [c.args for c in m.commands if c.name in ("eigen", "modalDamping")] == [("-fullGenLapack", 9), (0.05,)]
+    assert names.index("eigen") < names.index("modalDamping") < names.index("analysis")
+    assert "region" not in names
+    masters = {c.args[1] for c in m.commands if c.name == "rigidDiaphragm"}
+    others = {c.args[0] for c in m.commands if c.name == "node"} - masters
+    assert len(masters) == 3 and min(masters) > max(others)
+
+
 @pytest.mark.parametrize("change, match", [
     (lambda d: d["building"][1].update(damping="modal"),
-     r"building B: damping = \"modal\": cannot be exported.*modalDamping.*use damping = \"rayleigh\""),
+     r"building damping = A: rayleigh 0.05, B: modal 0.05: cannot be exported.*one list of factors.*"
+     r"the same zeta, or damping = \"rayleigh\""),
+    (lambda d: [b.update(damping="modal") for b in d["building"]],
+     r"building B: damping = \"modal\" with floor 1's reference point off its mass centre: cannot be "
+     r"exported.*does not M-normalise.*remove reference"),
+    (lambda d: ([b.update(damping="modal") for b in d["building"]], d["building"][1].pop("reference"),
+                d["link"].append({"name": "s", "type": "spring", "a": "A1.ux", "b": "B1.ux", "k": 1e6})),
+     r"building damping = \"modal\" with link s: cannot be exported.*couples the modes"),
     (lambda d: d["building"][0]["column"].pop("As3"),
      r"building A: member C1.0.0: one shear area.*give both As2 and As3"),
     (lambda d: (d["building"][0].update(diaphragm=False, slab={"E": 3e10, "thickness": 0.2}),
@@ -495,3 +557,38 @@ def test_scorecard_doc_deterministic_part_is_current():
     r = subprocess.run([sys.executable, "benchmarks/opensees/scorecard.py", "--check"],
                        capture_output=True, text=True)
     assert r.returncode == 0, r.stdout + r.stderr
+
+
+def test_modal_damping_of_repeated_frequencies_is_refused():
+    """shear_buildings has two modes at √60 rad/s: LAPACK's dggev returns any basis of that
+    eigenspace, not M-orthogonal (measured with OpenSeesPy 3.7.1.2: |ΦᵀMΦ − I| = 2.3e-3 and the
+    exported run 2e-5 off martello's), so modal damping is refused there."""
+    d = shear_buildings()
+    for b in d["building"]:
+        b["damping"], b["zeta"] = "modal", 0.05
+    with pytest.raises(ExportError, match=r"two modes at 7.74596669 and 7.74596669 rad/s.*M-orthogonal"):
+        opensees_model(from_dict(d, source="sh"))
+
+
+def test_a_plain_node_side_follows_martellos_row():
+    """martello's row of a contact between a floor point and a [[node]] is n·u(P) − u_node:
+    the node's term is −1 whatever the normal (martello.scene.rows side_terms). A fixed node
+    (a wall) is the ground here, so any normal exports (normal [−1, 0] was refused); a free
+    node moves along x in the 3D model, so a normal that is not +x from a to b is refused
+    naming the node and the fix (before: a bare "not a row" message)."""
+    for fixed, n in ((True, [-1.0, 0.0]), (True, [0.6, 0.8]), (False, [1.0, 0.0]), (False, [-1.0, 0.0])):
+        d = small_buildings(reference=False)
+        for b in d["building"]:
+            b["ground_angle"] = 0.0
+        d["node"] = [{"name": "w", "mass": 1e3, "fixed": fixed}]
+        d["contact"].append({"name": "fw", "a": {"floor": "A1", "x": 0.0, "y": 3.0}, "b": "w", "normal": n,
+                             "gap": 0.001, "scheme": "penalty", "law": "linear", "stiffness": 1e8})
+        if not fixed and n[0] < 0:
+            with pytest.raises(ExportError, match=r"contact\[1\] \(fw\): node w with normal \(-1, 0\).*along "
+                                                  r"the element's normal.*swap a and b"):
+                opensees_model(from_dict(d, source="fw"))
+            continue
+        m = opensees_model(from_dict(d, source="fw"))
+        (el,) = [c.args for c in m.commands if c.name == "element" and c.args[0] == "zeroLength"][-1:]
+        orient = el[el.index("-orient") + 1:el.index("-orient") + 3]
+        assert orient == pytest.approx(tuple(n))

@@ -11,6 +11,7 @@ records, histories, check tables, study files and command lines).
 Derandomized, so CI sees the same cases every time; bounded to about a minute. The campaign
 (scripts/fuzz) draws many more."""
 
+import json
 import os
 import subprocess
 import sys
@@ -129,6 +130,64 @@ def test_the_classifier_tells_a_traceback_and_a_write_from_a_clean_error(tmp_pat
     assert campaign.classify(case, P(-11), {}, {}, tmp_path) == ("crash", "signal SIGSEGV")
     assert campaign.classify(case, P(0), {}, {}, tmp_path)[0] == "suspicious ok"
     assert campaign.classify(case, P(1, clean * 2), {}, {}, tmp_path)[0] == "unclean error"
+
+
+def test_the_classifier_reads_what_an_exit_0_run_wrote_back(tmp_path):
+    """An exit-0 case is "ok" only if its output reads back (benchmarks/fuzz/roundtrip.py):
+    a history.csv whose header compare cannot read, a summary or scores with NaN, an exported
+    model with a convergence tolerance of 0 or unclosed Tcl, a runs.csv plot cannot read are
+    "round trip failed"; martello's own results of the same scene are "ok"."""
+    from martello.export import export
+    P0 = subprocess.CompletedProcess([], 0, "", "")
+    scene_text = (ROOT / "benchmarks" / "p5" / "p5_linear.toml").read_bytes()
+
+    def folder(name, files):
+        f = tmp_path / name
+        mutations.lay_out(mutations.Case(name, [], {"a/b/scene.toml": scene_text, **files}), f)
+        return f
+
+    def verdict(argv, f, output=None):
+        case = mutations.Case("x", argv, {}, output)
+        return campaign.classify(case, P0, {}, {}, f)
+
+    ok_summary = json.dumps({"status": "MARTELLO_OK"}).encode()
+    good = "t,u:m1,u:m2,penetration:impact\n0,0,0,-1e-3\n1e-5,1e-5,0,-9.9e-4\n"
+    run = ["run", "a/b/scene.toml", "-o", "out/run"]
+    f = folder("good", {"out/run/summary.json": ok_summary, "out/run/history.csv": good.encode()})
+    assert verdict(run, f, "out/run") == ("ok", "")
+    # the class of a node named 'a,b' (history.csv's header split in two): exit 0, unreadable
+    for n, bad in enumerate([good.replace("u:m2", "u:m2,b"), good.replace("u:m2", "u:m1"),
+                             good.replace("1e-5,", "0,", 1)]):
+        f = folder(f"badhist{n}", {"out/run/summary.json": ok_summary, "out/run/history.csv": bad.encode()})
+        cls, detail = verdict(run, f, "out/run")
+        assert cls == "round trip failed" and "history.csv" in detail, (bad, cls, detail)
+    f = folder("nan", {"out/run/summary.json": b'{"status": "MARTELLO_OK", "x": NaN}'})
+    assert verdict(run, f, "out/run")[0] == "round trip failed"
+
+    # export: martello's own model reads back; the same with tol = 0 (what `export --tol 0`
+    # wrote before the command line refused it) or with model.tcl cut does not
+    from martello.scene.loader import load
+    scene = load(ROOT / "benchmarks" / "p5" / "p5_linear.toml")
+    ex = ["export", str(ROOT / "benchmarks" / "p5" / "p5_linear.toml"), "-o", "ex", "--tcl"]
+    export(scene, tmp_path / "e1" / "ex", tcl=True)
+    assert verdict(ex, tmp_path / "e1") == ("ok", "")
+    export(scene, tmp_path / "e2" / "ex", tcl=True, tol=0.0)
+    cls, detail = verdict(ex, tmp_path / "e2")
+    assert cls == "round trip failed" and "ops.test" in detail, detail
+    tcl = tmp_path / "e1" / "ex" / "model.tcl"
+    text = tcl.read_text()
+    tcl.write_text(text[:text.rindex("}")])                   # a block left open
+    assert verdict(ex, tmp_path / "e1")[0] == "round trip failed"
+
+    # compare's scores and a study's runs.csv
+    cmp = ["compare", "h.csv", "--against", "a/b/scene.toml", "-o", "scores.json"]
+    assert verdict(cmp, folder("s1", {"scores.json": b'{"scd": 3.5}'}))[0] == "ok"
+    assert verdict(cmp, folder("s2", {"scores.json": b'{"scd": Infinity}'}))[0] == "round trip failed"
+    study = ["study", "st.toml", "-o", "out/study"]
+    runs = mutations.RUNS_CSV.encode()
+    assert verdict(study, folder("t1", {"out/study/runs.csv": runs}))[0] == "ok"
+    assert verdict(study, folder("t2", {"out/study/runs.csv": runs.replace(b"rtol,", b"", 1)}))[0] \
+        == "round trip failed"
 
 
 def test_the_campaign_cases_are_reproducible():

@@ -42,6 +42,9 @@ SCENES = {
     "p11/p11_eccentric_impact.toml": ("mirrored", "renamed"),
     "p7/p7_chain_10.toml": ("chains_as_lists",),
     "p7/p7_two_oscillators.toml": ("chains_as_lists",),
+    # IDA on a law stepped across: its rounding probe (masses x (1 + 4 eps)) failed the error
+    # test where a velocity crossed zero while atol was below its rounding (docs/ida.md, failures)
+    "p7/laws/p7_two_hertz_ida.toml": ("chains_as_lists",),
 }
 CASES = [(scene, rel) for scene, rels in SCENES.items() for rel in rels]
 

@@ -133,10 +133,83 @@ def test_ctrl_c_stops_the_native_loop_says_so_exits_130_and_writes_nothing(tmp_p
     assert not out.exists() and not any(tmp_path.glob(".o.*"))
 
 
-def test_no_progress_line_unless_asked_when_stderr_is_not_a_terminal(tmp_path):
+def test_a_short_run_prints_no_progress_line_in_a_log(tmp_path):
+    """stderr not a terminal, no --progress: a run under ProgressLine.SPARSE_FIRST (30 s)
+    writes no progress line (its log is what it was)."""
     d = p2(dt=1e-7, t_end=0.2, output={"every": 10 ** 6})   # 2e6 steps: over a second
     r = _cli("run", _write(tmp_path, d), "-o", tmp_path / "o")
     assert r.returncode == 0 and not [l for l in r.stderr.splitlines() if l.startswith("t = ")]
+
+
+class _Log(list):
+    """A stream that is not a terminal (a log file), keeping what was written."""
+
+    def write(self, text):
+        self.append(text)
+
+    def flush(self):
+        pass
+
+    def isatty(self):
+        return False
+
+
+def test_a_long_run_in_a_log_says_it_is_alive_without_flooding_it():
+    """The progress line in a log (nohup, a batch system; cli.ProgressLine, sparse): a run of
+    an hour reported four times a second, as the native loop does, writes 15 lines, at 30 s,
+    1, 2, 4, 8 min and then every 5 min, each with t, share, steps, rate, ETA and the time so
+    far; --progress in a log: every 5 s; the next run of the same command starts again."""
+    from martello.cli import ProgressLine
+    rate, t_end = 1e4, 3600.0
+
+    def feed(line, seconds, start=0.0):
+        for k in range(int(seconds * 4) + 1):
+            e = k / 4
+            line(t_end * (start + e) / 3600.0, t_end, int(rate * e), e)
+
+    log = _Log()
+    feed(ProgressLine(log, sparse=True), 3600.0)
+    assert len(log) == 15, log
+    shares = [float(re.search(r"\((\S+) %\)", x).group(1)) for x in log]
+    expected = [30, 60, 120, 240, 480] + [480 + 300 * k for k in range(1, 11)]
+    assert shares == pytest.approx([100 * e / 3600 for e in expected], abs=0.05)
+    for x in log:
+        assert re.fullmatch(r"t = \S+ of 3600 s \(\S+ %\), \S+ steps, 1e\+04 steps/s, "
+                            r"ETA \S+ (s|min|h) \(\S+ (s|min|h) so far\)\n", x), x
+    assert log[0].endswith("ETA 60 min (30 s so far)\n") and log[-1].endswith("(58 min so far)\n")
+    log = _Log()
+    line = ProgressLine(log, sparse=True)
+    feed(line, 29.75)
+    assert log == []                                  # a run under 30 s: nothing
+    feed(line, 40.0)                                  # the next run: its own 30 s
+    assert len(log) == 1 and "(30 s so far)" in log[0]
+    log = _Log()
+    feed(ProgressLine(log), 60.0)                     # --progress: every 5 s from 1 s
+    assert len(log) == 12 and "(1 s so far)" in log[0] and "(56 s so far)" in log[-1]
+
+
+def test_the_progress_lines_change_no_result(tmp_path, monkeypatch, capsys):
+    """The same run without and with its progress lines (in a log, every report printed):
+    history.csv byte for byte, summary.json but for its wall time and date."""
+    import json
+    from martello import cli
+    d = p2(dt=1e-7, t_end=0.2, output={"every": 10 ** 4})   # 2e6 steps: over a second
+    scene = _write(tmp_path, d)
+    assert cli.main(["run", str(scene), "-o", str(tmp_path / "quiet"), "--no-progress"]) == 0
+    monkeypatch.setattr(cli.ProgressLine, "SPARSE_FIRST", 0.0)
+    monkeypatch.setattr(cli.ProgressLine, "SPARSE_CAP", 0.0)
+    capsys.readouterr()
+    assert cli.main(["run", str(scene), "-o", str(tmp_path / "shown")]) == 0
+    err = capsys.readouterr().err
+    assert [x for x in err.splitlines() if x.startswith("t = ")], err
+
+    def summary(name):
+        s = json.loads((tmp_path / name / "summary.json").read_text())
+        del s["cost"]["wall_time_s"], s["provenance"]["date"]
+        return s
+    assert summary("quiet") == summary("shown")
+    assert (tmp_path / "quiet" / "history.csv").read_bytes() == \
+        (tmp_path / "shown" / "history.csv").read_bytes()
 
 
 def test_history_grows_past_its_first_allocation():

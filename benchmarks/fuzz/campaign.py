@@ -11,6 +11,9 @@ each `python -m martello ...` in a fresh folder of its own, classified as
     crash          killed by a signal, or an exit code other than 0, 1, 2
     hang           no end within --timeout seconds (the run is killed)
     suspicious ok  exit 0 without a complete result
+    round trip failed  exit 0, but what it wrote does not read back through martello's own
+                   readers (roundtrip.py: the run's history through compare's reader, the
+                   exported model parsed and its commands checked, the scores, runs.csv)
 
 Case i is drawn from random.Random(f"{seed}:{i}"), so a campaign is reproducible and any
 case can be rerun alone (--only i --keep shows its folder). The figures of the closing note
@@ -38,13 +41,16 @@ from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 
 if __package__:                           # imported as benchmarks.fuzz.campaign (the tests)
-    from . import mutations
+    from . import mutations, roundtrip
 else:                                     # run as a script
     sys.path.insert(0, str(Path(__file__).resolve().parent))
+    sys.path.insert(1, str(Path(__file__).resolve().parents[2]))   # martello, for roundtrip
     import mutations  # noqa: E402
+    import roundtrip  # noqa: E402
 
 ROOT = mutations.ROOT
-CLASSES = ("ok", "clean error", "unclean error", "traceback", "crash", "hang", "suspicious ok")
+CLASSES = ("ok", "clean error", "unclean error", "traceback", "crash", "hang", "suspicious ok",
+           "round trip failed")
 
 
 def progress(t0, done, total):
@@ -103,6 +109,9 @@ def classify(case, proc, before, after, folder):
                 assert summary.get("status", "").startswith("MARTELLO_")
             except Exception as exc:                     # noqa: BLE001
                 return "suspicious ok", f"exit 0 but {case.output}/summary.json: {exc!r}"[:200]
+        problem = roundtrip.check(case.argv, folder)
+        if problem:
+            return "round trip failed", problem
         return "ok", ""
     if case.argv[:1] == ["check"] and proc.returncode == 1 and "FAILED" in proc.stdout \
             and not err.strip():
@@ -411,7 +420,7 @@ def main(argv=None):
     for c in CLASSES[2:]:
         for r in examples[c][:5]:
             print(f"  {c}: case {r['case']} ({r['label']}): {r['detail']}")
-    bad = sum(counts[c] for c in ("unclean error", "traceback", "crash", "hang", "suspicious ok"))
+    bad = sum(counts[c] for c in CLASSES[2:])
     return 1 if bad else 0
 
 

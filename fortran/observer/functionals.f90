@@ -142,22 +142,10 @@ contains
       real(dp), intent(in) :: h, ea(6), eb(6)
       logical, intent(in) :: fixed_steps
       real(dp), intent(out) :: s, p
-      real(dp) :: ca(0:5), cb(0:5), lo, hi, x, qa, da, qb, db
-      integer :: it
+      real(dp) :: ca(0:5), cb(0:5), qa, da, qb, db
       call hermite_coefficients(h, ea, fixed_steps, ca)
       call hermite_coefficients(h, eb, fixed_steps, cb)
-      lo = 0.0_dp; hi = 1.0_dp
-      do it = 1, 60
-         x = 0.5_dp*(lo + hi)
-         call hermite_at(ca, x, qa, da)
-         call hermite_at(cb, x, qb, db)
-         if (qa*da + qb*db > 0.0_dp) then
-            lo = x
-         else
-            hi = x
-         end if
-      end do
-      s = 0.5_dp*(lo + hi)
+      s = rate_root(ca, .true., cb)
       call hermite_at(ca, s, qa, da)
       call hermite_at(cb, s, qb, db)
       p = hypot(qa, qb)
@@ -193,29 +181,42 @@ contains
    end subroutine hermite_at
 
    !> The extremum inside a step of h where the rate changes sign (r0·r1 < 0) on the quintic
-   !> Hermite of (q, q̇, q̈) at both ends: its abscissa s in (0, 1) (bisection on the rate,
-   !> which changes sign there) and value p.
+   !> Hermite of (q, q̇, q̈) at both ends (hermite_coefficients): its abscissa s in (0, 1)
+   !> (rate_root) and value p.
    pure subroutine quintic_extremum(h, q0, r0, a0, q1, r1, a1, s, p)
       real(dp), intent(in) :: h, q0, r0, a0, q1, r1, a1
       real(dp), intent(out) :: s, p
-      real(dp) :: d0, d1, e0, e1, c3, c4, c5, lo, hi, x, rate
+      real(dp) :: c(0:5), d
+      call hermite_coefficients(h, [q0, r0, a0, q1, r1, a1], .false., c)
+      s = rate_root(c, r0 > 0.0_dp)
+      call hermite_at(c, s, p, d)
+   end subroutine quintic_extremum
+
+   !> The root in (0, 1) of a rate that changes sign over a step, bisected 60 times (to the
+   !> last bit of x): the rate of the polynomial of power coefficients c (hermite_at), or, with
+   !> cb, that of half the square of the resultant of the two, q q' + q_b q_b'; rising: the
+   !> rate is positive at x = 0 (and negative at 1).
+   pure real(dp) function rate_root(c, rising, cb) result(s)
+      real(dp), intent(in) :: c(0:5)
+      logical, intent(in) :: rising
+      real(dp), intent(in), optional :: cb(0:5)
+      real(dp) :: lo, hi, x, q, d, qb, db, rate
       integer :: it
-      d0 = h*r0; d1 = h*r1; e0 = h*h*a0; e1 = h*h*a1
-      ! q(x) = q0 + d0 x + e0 x²/2 + c3 x³ + c4 x⁴ + c5 x⁵, matching q1, d1, e1 at x = 1
-      c3 = 10.0_dp*(q1 - q0) - 6.0_dp*d0 - 4.0_dp*d1 - 1.5_dp*e0 + 0.5_dp*e1
-      c4 = -15.0_dp*(q1 - q0) + 8.0_dp*d0 + 7.0_dp*d1 + 1.5_dp*e0 - e1
-      c5 = 6.0_dp*(q1 - q0) - 3.0_dp*(d0 + d1) - 0.5_dp*(e0 - e1)
       lo = 0.0_dp; hi = 1.0_dp
       do it = 1, 60
          x = 0.5_dp*(lo + hi)
-         rate = d0 + x*(e0 + x*(3.0_dp*c3 + x*(4.0_dp*c4 + x*5.0_dp*c5)))
-         if ((rate > 0.0_dp) .eqv. (r0 > 0.0_dp)) then
+         call hermite_at(c, x, q, d)
+         rate = d
+         if (present(cb)) then
+            call hermite_at(cb, x, qb, db)
+            rate = q*d + qb*db
+         end if
+         if ((rate > 0.0_dp) .eqv. rising) then
             lo = x
          else
             hi = x
          end if
       end do
       s = 0.5_dp*(lo + hi)
-      p = q0 + s*(d0 + s*(0.5_dp*e0 + s*(c3 + s*(c4 + s*c5))))
-   end subroutine quintic_extremum
+   end function rate_root
 end submodule functionals

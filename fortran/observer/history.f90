@@ -122,13 +122,19 @@ contains
    !> pen, force, link_f and link_du for the history row alone, where recorded).
    !> energies = [kinetic, links, contacts] at this state, from a method that keeps its own
    !> element states (no ms), where observer_energy_due.
+   !> row: the state is an output row on the method's interpolant inside a step, not a step:
+   !> measured and recorded, but not a sample of the energy grid (the largest |balance|, the
+   !> divergence test), nor a step of the budget, so that neither depends on the output
+   !> (docs/run-layer.md, "the energy terms").
    module procedure observer_sample_i8
       real(dp) :: e_mech
-      logical :: due, grid, measured
+      logical :: due, grid, measured, is_row
       stat = MARTELLO_OK
-      grid = energy_grid(o, k)
+      is_row = .false.
+      if (present(row)) is_row = row
+      grid = energy_grid(o, k) .and. .not. is_row
       due = grid .or. recorded(o, k)
-      o%nsamples = o%nsamples + 1
+      if (.not. is_row) o%nsamples = o%nsamples + 1
       measured = .false.
       if (present(folded)) measured = folded
       if (.not. measured) then
@@ -141,8 +147,8 @@ contains
       end if
       if (o%fq%n > 0) call functionals_track(o%fq, t, u(1:), v(1:), a(1:), o%fixed_steps)
       ! the next step's start
-      if (o%smooth_steps) o%chatter_prev = o%counters(C_CHATTER)
-      o%prev_t = t
+      if (o%smooth_steps .and. .not. is_row) o%chatter_prev = o%counters(C_CHATTER)
+      if (.not. is_row) o%prev_t = t
       if (due) call energy_at(o, m, ms, u, v, a, grid, energies, e_mech)
       if (recorded(o, k)) then
          call record(o, t, u(1:), v(1:), a(1:), pen, force, link_f, link_du, stat)
@@ -151,13 +157,13 @@ contains
          end if
       end if
       if (grid) call check_divergence(o, t, e_mech, u, v, stat)
-      if (stat == MARTELLO_OK) call observer_watch(o, t, stat)
+      if (stat == MARTELLO_OK .and. .not. is_row) call observer_watch(o, t, stat)
    end procedure observer_sample_i8
 
    !> observer_sample with the grid point k as a default integer (the C door, k ≤ 2^31).
    module procedure observer_sample_i4
       call observer_sample_i8(o, m, ms, t, u, v, a, pen, force, int(k, i8), stat, link_f, &
-                              link_du, u_prev, v_prev, a_prev, folded, energies)
+                              link_du, u_prev, v_prev, a_prev, folded, energies, row)
    end procedure observer_sample_i4
 
    !> The recording cadence: t = 0, every every-th output grid point, and the last one.

@@ -243,7 +243,7 @@ module martello_observer
          integer, intent(out) :: stat
       end subroutine observer_phase_lists
       module subroutine observer_sample_i8(o, m, ms, t, u, v, a, pen, force, k, stat, link_f, &
-                                           link_du, u_prev, v_prev, a_prev, folded, energies)
+                                           link_du, u_prev, v_prev, a_prev, folded, energies, row)
          type(observer_t), intent(inout) :: o
          type(model_t), intent(in) :: m
          type(mech_state_t), intent(in) :: ms
@@ -253,9 +253,10 @@ module martello_observer
          real(dp), intent(in), optional :: link_f(:), link_du(:), u_prev(:), v_prev(:), a_prev(:)
          logical, intent(in), optional :: folded
          real(dp), intent(in), optional :: energies(3)
+         logical, intent(in), optional :: row
       end subroutine observer_sample_i8
       module subroutine observer_sample_i4(o, m, ms, t, u, v, a, pen, force, k, stat, link_f, &
-                                           link_du, u_prev, v_prev, a_prev, folded, energies)
+                                           link_du, u_prev, v_prev, a_prev, folded, energies, row)
          type(observer_t), intent(inout) :: o
          type(model_t), intent(in) :: m
          type(mech_state_t), intent(in) :: ms
@@ -265,6 +266,7 @@ module martello_observer
          real(dp), intent(in), optional :: link_f(:), link_du(:), u_prev(:), v_prev(:), a_prev(:)
          logical, intent(in), optional :: folded
          real(dp), intent(in), optional :: energies(3)
+         logical, intent(in), optional :: row
       end subroutine observer_sample_i4
       pure module logical function recorded(o, k)
          type(observer_t), intent(in) :: o

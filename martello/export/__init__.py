@@ -17,14 +17,14 @@ SCRIPT = "model.py"
 
 
 def export(scene, out, to="opensees", analysis=None, materials=None, tcl=False, tol=None,
-           scene_path=None):
+           scene_path=None, force=False):
     """Write the scene for code `to` into the folder out (replaced whole; an earlier export
     is replaced): model.py, model.tcl with tcl, and the data files of its tables. Returns the
     OpenSeesModel (its .differences say what the other code does differently)."""
     if to not in TARGETS:
         raise ExportError(f"--to {to}: unknown code (valid: {', '.join(TARGETS)})")
     from ..binding import native
-    model = opensees_model(scene, analysis=analysis, materials=materials, tol=tol)
+    model = opensees_model(scene, analysis=analysis, materials=materials, tol=tol, force=force)
     shown = scene_path or scene.source
     version = native.version()
     with folder_replaced(Path(out), SCRIPT, ExportError) as tmp:
@@ -58,7 +58,7 @@ def main(args):
             "beta": args.beta, "gamma": args.gamma, "alpha": args.alpha, "rho_inf": args.rho_inf}
     model = export(scene, args.output, to=args.to, analysis=over,
                    materials=parse_materials(args.material), tcl=args.tcl, tol=args.tol,
-                   scene_path=str(path))
+                   scene_path=str(path), force=args.force)
     for d in model.differences:
         print(f"note: {d}", file=sys.stderr)
     files = [SCRIPT] + (["model.tcl"] if args.tcl else []) + sorted(model.files)

@@ -24,6 +24,15 @@ DOF = {"ux": 1, "uy": 2, "rz": 6}
 # a floor's master node and a diaphragm's extra nodes: uz, θx, θy held (they carry nothing)
 PLANAR = (0, 0, 1, 1, 1, 0)
 FREE_ROW = 4.0 * np.finfo(float).eps    # a plan point row's |n| is 1 up to the rounding of n/|n|
+# modal damping: frequencies closer than this (relative) make the eigenvectors' error ε/1e-6
+# ≈ 2e-10, above the cross-check's agreement (check_modal)
+MODE_SEPARATION = 1e-6
+# a rigid floor's master node: tagged above every other node. OpenSees' Transformation handler
+# makes the DOF groups in node-tag order, and its modal damping (IncrementalIntegrator::
+# setupModal) writes each group's eigenvector into the equations it holds, a slave's as Tᵀφ
+# (TransformationDOF_Group::getEigenvectors) over its master's: the master, iterated last,
+# writes φ itself (docs/opensees.md "Modal damping")
+MASTER_TAG0 = 1_000_000_000
 
 
 class BuildingWriter:
@@ -40,6 +49,8 @@ class BuildingWriter:
         self.master = {}                   # (prefix, floor) -> (master tag, reference (x, y), z)
         self.members = []                  # (prefix, member name, element tag)
         self.transf = {}
+        self.n_master = 0                  # rigid floors written (their masters' tags)
+        self.kept = {n for b in self.buildings for n in b["nodes"]}    # the buildings' own DOFs
 
     # --- refusals ---------------------------------------------------------------------------
     def check(self):
@@ -74,15 +85,53 @@ class BuildingWriter:
                       + (f" with nodes along the scene's axis ({', '.join(plain[:3])})" if plain else ""),
                       "UniformExcitation moves every mass of the model along one direction",
                       "give every building the same ground_angle (0 with other nodes)")
-        for b in self.buildings:
-            if b["zeta"] > 0 and b["damping"] == "modal":
-                b0.refuse(f"building {b['prefix']}: damping = \"modal\"",
-                          "martello damps every mode of the building (C = M Φ diag(2ζω) Φᵀ M); "
-                          "OpenSees 3.7.1's modalDamping takes the modes of its last eigen, and on a "
-                          "model whose joints carry no mass ARPACK finds about half of the mass "
-                          "DOFs' modes and fullGenLapack leaves the eigenvectors unusable (measured: "
-                          "the first Newton step diverges)", "use damping = \"rayleigh\" (choose "
-                          "rayleigh_modes) for the export")
+        self.check_modal()
+
+    def check_modal(self):
+        """Modal damping is written as OpenSees' eigen (fullGenLapack, every mass DOF) and
+        modalDamping ζ (docs/opensees.md "Modal damping"): the modes of the whole model must be
+        the buildings' own, each damped by one ζ, and each one M-orthonormal as OpenSees takes it."""
+        modal = [b for b in self.buildings if b["zeta"] > 0 and b["damping"] == "modal"]
+        if not modal:
+            return
+        b0, fix = self.bld, "use damping = \"rayleigh\" (choose rayleigh_modes) for the export"
+        zetas = {float(b["zeta"]) for b in self.buildings}
+        if len(modal) != len(self.buildings) or len(zetas) > 1:
+            b0.refuse("building damping = " + ", ".join(
+                f"{b['prefix']}: {b['damping'] if b['zeta'] > 0 else 'none'} {b['zeta']:g}" for b in self.buildings),
+                "OpenSees' modalDamping damps every mode of the model's last eigen by one list of "
+                "factors, not one building's modes by its own rule", "give every building damping = "
+                "\"modal\" with the same zeta, or " + fix[4:])
+        stiff = [lk["name"] for lk in self.s.links if lk["type"] not in ("dashpot", "fluid_damper")]
+        closed = [c["name"] for c in self.s.contacts if not float(c["gap"]) > 0]
+        if stiff or closed:
+            b0.refuse(f"building damping = \"modal\" with {'link' if stiff else 'contact'} "
+                      f"{(stiff or closed)[0]}", "a spring or a closed contact enters the eigen "
+                      "analysis at rest and couples the modes that martello damps building by building",
+                      "remove it, or " + fix)
+        for b in modal:
+            bd = b["building"]
+            for fs, fl in enumerate(bd.floors, start=1):
+                if fl.rigid and tuple(bd.reference_point(fs)) != tuple(fl.centre):
+                    # measured (OpenSees 3.7.1): a mass on a node tied to its floor's master comes
+                    # out of eigen -fullGenLapack with vectors not M-normalised (the master's
+                    # largest component exactly 1, dggev's own scaling), and modalDamping diverges
+                    b0.refuse(f"building {b['prefix']}: damping = \"modal\" with floor {fs}'s "
+                              "reference point off its mass centre", "the floor's mass sits on a node "
+                              "tied to the master, and OpenSees' eigen does not M-normalise the modes "
+                              "of such a model (docs/opensees.md \"Modal damping\")",
+                              "remove reference, or " + fix)
+        w = np.sort([m["omega"] for b in modal for m in b["modes"]])
+        # a (near-)repeated frequency: LAPACK's dggev returns any basis of its eigenspace, each
+        # vector M-normalised alone (FullGenEigenSolver::solve), not M-orthogonal to the others,
+        # while modalDamping sums 2ζω (Mφ)(Mφ)ᵀ as over an M-orthonormal set; the vectors of
+        # modes ω apart by δω carry an error of order ε/(δω/ω) (the eigenvector's condition)
+        rel = np.diff(w) / w[1:]
+        if rel.size and rel.min() < MODE_SEPARATION:
+            k = int(np.argmin(rel))
+            b0.refuse(f"building damping = \"modal\": two modes at {w[k]:.9g} and {w[k + 1]:.9g} rad/s",
+                      f"frequencies closer than {MODE_SEPARATION:g} relative, whose eigenvectors "
+                      "OpenSees' fullGenLapack does not make M-orthogonal", fix)
 
     # --- the model --------------------------------------------------------------------------
     def node(self, tag, x, y, z):
@@ -118,8 +167,8 @@ class BuildingWriter:
                 continue
             xo, yo = bd.reference_point(s)
             z = float(bd.z[s])
-            tag += 1
-            master = tag
+            self.n_master += 1
+            master = MASTER_TAG0 + self.n_master
             self.node(master, xo, yo, z)
             add("fix", master, *PLANAR)
             slaves = [node_tag[k] for k in bd.floor_nodes(s)]
@@ -196,7 +245,7 @@ class BuildingWriter:
         return t
 
     def damping(self, b, eles, massed):
-        if not b["zeta"] > 0:
+        if not b["zeta"] > 0 or b["damping"] == "modal":    # modal: modal_damping(), once
             return
         a0, a1 = b["rayleigh"]
         bld = self.bld
@@ -207,6 +256,21 @@ class BuildingWriter:
         bld.map.append((f"building {b['prefix']} Rayleigh damping (zeta = {b['zeta']:g})",
                         f"a1 = {a1:.17g} on its elements, a0 = {a0:.17g} on its masses (region)"))
 
+    def modal_damping(self):
+        """Every building's modal damping (check_modal): OpenSees' eigen on every mass DOF of
+        the model, then modalDamping ζ (its damping matrix enters the Newton tangent)."""
+        modal = [b for b in self.buildings if b["zeta"] > 0 and b["damping"] == "modal"]
+        if not modal:
+            return
+        n = sum(len(b["nodes"]) for b in self.buildings) + sum(
+            1 for nd in self.s.nodes if nd["name"] not in {x for b in self.buildings for x in b["nodes"]}
+            and not nd["fixed"])
+        zeta = float(modal[0]["zeta"])
+        self.bld.add("eigen", "-fullGenLapack", n)
+        self.bld.add("modalDamping", zeta)
+        self.bld.map.append((f"buildings' modal damping (zeta = {zeta:g})",
+                             f"eigen -fullGenLapack {n} (every mass DOF), modalDamping {zeta:g}"))
+
     # --- rows: contacts and links between plan points ----------------------------------------
     def row(self, what, terms):
         """(i, j, n) of a row Σ c·u = n·(u(P_a) − u(P_b)): the element's nodes i (side a) and j
@@ -215,6 +279,10 @@ class BuildingWriter:
         the origin (martello.export.opensees nodes())."""
         masters = {m[0] for m in self.master.values()}
         bodies = {}                       # a floor's master ("floor", tag) or a node's tag -> [cx, cy, cr]
+        # a plain [[node]] side is the term ±1 of its one DOF whatever the normal (martello.scene.rows
+        # side_terms: its u counted along n); a fixed one's u is 0, so it is the ground here
+        plain = [idx for idx, _ in terms if self.s.nodes[idx]["name"] not in self.kept]
+        terms = [(idx, c) for idx, c in terms if not self.s.nodes[idx]["fixed"]]
         for idx, c in terms:
             tag, dof = self.bld.dof_of(idx)
             key = ("floor", tag) if tag in masters else tag
@@ -226,6 +294,15 @@ class BuildingWriter:
         sides = list(bodies.items())
         t0 = np.array(sides[0][1][:2])
         scale = math.hypot(*t0)
+        if len(sides) == 2 and not np.array_equal(np.array(sides[1][1][:2]), -t0) and plain and \
+                abs(scale - 1.0) <= FREE_ROW:
+            name = next(self.s.nodes[i]["name"] for i in plain if not self.s.nodes[i]["fixed"])
+            self.bld.refuse(f"{what}: node {name} with normal ({t0[0]:g}, {t0[1]:g})",
+                            f"martello counts a [[node]]'s u along the element's normal (its term is ±1 "
+                            f"whatever the normal), while in the 3D model a plain node moves along x, the "
+                            "axis its ground motion and loads act on: the two agree only where the normal "
+                            "is +x from side a to side b", "write the contact with the node on the side "
+                            "that makes the normal [1, 0] (swap a and b and flip the normal), or fix the node")
         if len(sides) == 2 and not np.array_equal(np.array(sides[1][1][:2]), -t0) or \
                 not abs(scale - 1.0) <= FREE_ROW:
             self.bld.refuse(f"{what}.terms", "not a row n·(u(P_a) − u(P_b)) with a unit plan direction n "

@@ -109,13 +109,15 @@ def _law(c, mstar):
 
 
 class _Builder:
-    def __init__(self, scene, analysis=None, materials=None, tol=None):
+    def __init__(self, scene, analysis=None, materials=None, tol=None, force=False):
         self.s = scene
         self.src = scene.source
         self.cmds, self.cols, self.files, self.map, self.diff = [], [], {}, [], []
+        self.over = {k for k, v in (analysis or {}).items() if v is not None}
         self.an = _analysis(scene, dict(analysis or {}))
         self.materials = dict(materials or {})
         self.tol = tol
+        self.force = force
         self.n_series = 0
         self.mat = 0
         self.ele = 0
@@ -239,6 +241,7 @@ class _Builder:
     # --- the model ------------------------------------------------------------------------
     def build(self):
         self.check_scene()
+        self.check_options()
         s = self.s
         frames = s.extras.get("frames", [])
         self.ndm, self.ndf = (3, 6) if s.extras.get("buildings") else (2, 3) if frames else (1, 1)
@@ -253,6 +256,19 @@ class _Builder:
         self.initial_state()
         self.analysis()
         return self.model()
+
+    def check_options(self):
+        """An option the model would be written without is refused, as an integrator's own key
+        is (_analysis): --tol on an explicit integrator, --material for a law no contact has."""
+        if self.tol is not None and self.an["integrator"] == "central-difference":
+            raise ExportError("--tol: central-difference is explicit, OpenSees runs no Newton "
+                              "test: it would be ignored (remove it)")
+        laws = {_law(c, 1.0).law for c in self.s.contacts}      # the name does not depend on m*
+        for law, mat in self.materials.items():
+            if law not in laws:
+                raise ExportError(f"--material {law}={mat}: no penalty contact of the scene has law "
+                                  f"{law} ({', '.join(sorted(laws)) or 'it has none'}): it would be "
+                                  "ignored (remove it)")
 
     def node_cmd(self, tag, x=0.0, y=0.0):
         self.add("node", tag, *((x,) if self.ndm == 1 else (x, y) if self.ndm == 2 else (x, y, 0.0)))
@@ -656,6 +672,7 @@ class _Builder:
             self.refuse(f"dt = {dt:g}", f"longer than t_end = {t_end:g}")
         self.dt = dt
         # martello's grid: t_k = k·dt, k = 1 … ceil(t_end/dt (1 − 1e-12)), never a shortened step
+        self.budget(t_end / dt * (1.0 - 1e-12))
         self.steps = max(1, math.ceil(t_end / dt * (1.0 - 1e-12)))
         self.every = int(an.get("output", {}).get("every", 1))
         handler = "Transformation" if getattr(self, "equal_dof", False) else "Plain"
@@ -710,12 +727,32 @@ class _Builder:
                     "apart otherwise")
             self.map.append(("Newton test", f"NormDispIncr {tol:g} m (tol_increment {tol_inc:g} "
                              f"x {DISP_SCALE:g} m), at most {iters} iterations, Newton"))
+        self.bw.modal_damping()
         self.add("analysis", "Transient")
         self.map.append((f"integrator {name}, dt = {dt:g} s, t_end = {t_end:g} s",
                          f"{what}; {self.steps} steps of {dt:g} s"))
         if an.get("event_split"):
             self.diff.append("event_split = true: OpenSees has no event-split steps; the exported "
                              "run takes plain steps (first order across a Kelvin force jump)")
+
+    def budget(self, steps):
+        """The step budget of `martello run` (martello.run.check_budget: MAX_WORK node-steps),
+        unless force; never past 2^53 steps, where the grid t_k = k·dt is no longer exact in
+        doubles (and t_end/dt = inf for a subnormal dt)."""
+        from ..run import MAX_WORK, _g
+        nodes = max(1, len(self.s.nodes))
+        if steps <= 2.0 ** 53 and (self.force or steps * nodes <= MAX_WORK):
+            return
+        name = {k: (_flag(k) if k in self.over else f"analysis.{k}") for k in ("dt", "t_end")}
+        lead = name["t_end"] if "t_end" in self.over and "dt" not in self.over else name["dt"]
+        what = f"t_end/dt = {self.an['t_end']!r}/{self.an['dt']!r} = {_g(steps)} steps"
+        fix = f"raise {name['dt']} or shorten {name['t_end']}"
+        if steps > 2.0 ** 53:
+            raise ExportError(f"{lead}: {what}, more than 2^53: the step grid k·dt is not exact "
+                              f"in doubles past it ({fix})")
+        raise ExportError(f"{lead}: {what}" + (f" of {nodes} nodes" if nodes > 1 else "")
+                          + f", more than the {_g(MAX_WORK)} node-steps a run may take ({fix}; "
+                          "--force writes it anyway)")
 
     def model(self):
         s = self.s
@@ -761,13 +798,25 @@ COMMON_KEYS = ("type", "dt", "t_end", "output", "tol_residual", "tol_increment",
                "event_split")
 
 
+def _flag(key):
+    return "--" + key.replace("_", "-")
+
+
 def _analysis(scene, over):
     """The scene's [analysis] with `over` applied (integrator, dt, t_end, beta, gamma, alpha,
     rho_inf): another integrator drops the scene's integrator's own keys, Newmark's default
-    to average acceleration, HHT's alpha and generalized-α's rho_inf must be given."""
+    to average acceleration, HHT's alpha and generalized-α's rho_inf must be given. A key
+    that is another integrator's own (--alpha on a Newmark scene without --integrator hht)
+    is refused: the model would be written without it."""
     an = dict(scene.analysis)
     over = {k: v for k, v in over.items() if v is not None}
     name = over.get("integrator", an.get("integrator"))
+    for key in over:
+        owner = next((o for o, keys in OWN_KEYS.items() if key in keys), None)
+        if owner is not None and owner != name:
+            whose = "--integrator" if "integrator" in over else "the scene's integrator"
+            raise ExportError(f"{_flag(key)}: applies to integrator {owner}, not {name} ({whose}): "
+                              f"it would be ignored (remove it, or give --integrator {owner})")
     if name != an.get("integrator"):
         an = {k: v for k, v in an.items() if k in COMMON_KEYS}
         an["integrator"] = name
@@ -778,14 +827,15 @@ def _analysis(scene, over):
     for key in OWN_KEYS.get(name, ()):
         if an.get(key) is None:
             raise ExportError(f"{scene.source}: analysis.{key}: missing for integrator {name} "
-                              f"(give --{key.replace('_', '-')})")
+                              f"(give {_flag(key)})")
     return an
 
 
-def opensees_model(scene, analysis=None, materials=None, tol=None):
+def opensees_model(scene, analysis=None, materials=None, tol=None, force=False):
     """The scene as an OpenSeesModel. `analysis` overrides keys of the scene's [analysis]
     (integrator, dt, t_end, beta, gamma, alpha, rho_inf); `materials` maps a law to a material
     other than its default (docs/opensees.md "Contact laws"); `tol` is the NormDispIncr
-    tolerance in m (default tol_increment x 0.1 m). ExportError names what cannot be
+    tolerance in m (default tol_increment x 0.1 m); `force` writes a model past the step
+    budget of `martello run` (martello.run.MAX_WORK). ExportError names what cannot be
     exported and why."""
-    return _Builder(scene, analysis, materials, tol).build()
+    return _Builder(scene, analysis, materials, tol, force).build()
