@@ -136,8 +136,12 @@ static double switch_value(const ode_events *E, int s, const double *u, const do
  * 0 there, is not reported again, so the branch would change at the next commit, a whole step
  * late (docs/sundials-ode.md, events and restarts). Switch s, reported rising, is moved past its
  * surface beyond that rounding (16 eps of its terms, as c/event_driven.c's switch_rounding) by
- * the smallest shift of one free node of its element: its u where g depends on u, else its v. */
-static void past_switch(ode_events *E, int s, double *u, double *v) {
+ * the smallest shift of one free node of its element: its u where g depends on u, else its v.
+ * Reported falling (dir = -1: back towards the branch held), it is moved to the branch's side
+ * beyond the rounding: where the committed branch's surface passes through the state (a
+ * bilinear spring unloading at its yield point, g = 0 falling) the root would otherwise be met
+ * again at once after every restart. */
+static void past_switch(ode_events *E, int s, double *u, double *v, double dir) {
   const int e = E->sw_el[s];
   const double al = E->sw_al[s], be = E->sw_be[s];
   if (e < 0 || (al == 0.0 && be == 0.0)) return;
@@ -153,9 +157,9 @@ static void past_switch(ode_events *E, int s, double *u, double *v) {
     const double rounding = 16.0 * DBL_EPSILON *
                             (fabs(al) * martello_rows_abs(&E->elem, e, u) +
                              fabs(be) * martello_rows_abs(&E->elem, e, v) + fabs(E->sw_ga[s])) + DBL_MIN;
-    const double g = switch_value(E, s, u, v);
+    const double g = dir * switch_value(E, s, u, v);
     if (g > rounding) return;
-    x[node] += ldexp(rounding - g + rounding, k) / (a * c);
+    x[node] += dir * ldexp(rounding - g + rounding, k) / (a * c);
   }
 }
 
@@ -757,7 +761,7 @@ int oe_prepare_restart(ode_events *E, double t, double *u, double *v) {
   int st, any_rigid = 0;
   double ke0 = 0.0, ke1 = 0.0, dummy;
   for (int s = 0; s < E->nsw; s++) {
-    if (E->sw_hit[s] > 0) past_switch(E, s, u, v);
+    if (E->sw_hit[s] != 0) past_switch(E, s, u, v, E->sw_hit[s] > 0 ? 1.0 : -1.0);
     E->sw_hit[s] = 0;
   }
   if ((st = martello_eval_energy(E->ev, u, v, &ke0, &dummy)) != MARTELLO_OK)
