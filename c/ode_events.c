@@ -28,7 +28,9 @@
 
 /* Steps per shortest harmonic period of the loads while a rigid contact is held
  * (docs/sundials-ode.md, held contacts): a multiplier excursion longer than period/HOLD_STEPS
- * contains a step end, where the root function's sign is seen. */
+ * contains a step end, where the root function's sign is seen; with one harmonic frequency the
+ * multiplier's second derivative has at most one zero in such a step, so its rate at most one
+ * extremum, and a shorter excursion is found inside the step (oe_held_release). */
 #define HOLD_STEPS 16.0
 
 /* ---- failures --------------------------------------------------------------------------- */
@@ -856,6 +858,37 @@ static int held_values_at(ode_events *E, double t, double *lam, double *dlam) {
   return held_values(E, t, E->uq, E->vq, lam, dlam);
 }
 
+/* The extremum of held contact k's multiplier rate on [lo, hi] (the minimum for s = 1, the
+ * maximum for s = -1) by golden-section search on the interpolant, stopped as soon as the rate
+ * takes the sign -s (a bracket for the zero of the rate): its time in *t_x, and 1 if the rate
+ * there has the sign -s. Exact for a rate with at most one extremum inside the step (docs/
+ * sundials-ode.md, held contacts). */
+static int rate_extremum(ode_events *E, int k, double lo, double hi, double s, double tol, double *t_x,
+                         int *found) {
+  const double g = 0.5 * (3.0 - sqrt(5.0));
+  double a = lo, b = hi, c = a + g * (b - a), d = b - g * (b - a), fc, fd;
+  int st;
+  *found = 0;
+  if ((st = held_values_at(E, c, E->hlm, E->hdm)) != MARTELLO_OK) return st;
+  fc = s * E->hdm[k];
+  if ((st = held_values_at(E, d, E->hlm, E->hdm)) != MARTELLO_OK) return st;
+  fd = s * E->hdm[k];
+  for (int it = 0; it < 200 && fc >= 0.0 && fd >= 0.0 && b - a > tol; it++) {
+    if (fc <= fd) {
+      b = d, d = c, fd = fc, c = a + g * (b - a);
+      if ((st = held_values_at(E, c, E->hlm, E->hdm)) != MARTELLO_OK) return st;
+      fc = s * E->hdm[k];
+    } else {
+      a = c, c = d, fc = fd, d = b - g * (b - a);
+      if ((st = held_values_at(E, d, E->hlm, E->hdm)) != MARTELLO_OK) return st;
+      fd = s * E->hdm[k];
+    }
+  }
+  *t_x = fc <= fd ? c : d;
+  *found = fmin(fc, fd) < 0.0;
+  return MARTELLO_OK;
+}
+
 int oe_held_release(ode_events *E, double t0, double t1, const double *y1, double *t_r) {
   int st, kbest = -1;
   double best = t1;
@@ -865,10 +898,25 @@ int oe_held_release(ode_events *E, double t0, double t1, const double *y1, doubl
   /* the start's values: kept from the last step's end, or (the first step after a restart)
    * from the interpolant */
   if (!E->held_ready && (st = held_values_at(E, t0, E->hl0, E->hd0)) != MARTELLO_OK) return st;
+  const double tol = fmax(E->event_tol, 4.0 * DBL_EPSILON * fabs(t1));
   for (int k = 0; k < E->mc; k++) {
-    if (!(E->hl0[k] > 0.0 && E->hl1[k] > 0.0 && E->hd0[k] < 0.0 && E->hd1[k] > 0.0)) continue;
-    const double tol = fmax(E->event_tol, 4.0 * DBL_EPSILON * fabs(t1));
-    double lo = t0, hi = t1;
+    if (!(E->hl0[k] > 0.0 && E->hl1[k] > 0.0)) continue;
+    /* an interior minimum of the multiplier is a zero of its rate from - to +; with at most one
+     * extremum of the rate inside the step there is one at most, bracketed by [lo, hi]:
+     * - at t0, + at t1: the step; + at both ends: from the rate's minimum, if negative, to t1;
+     * - at both ends: from t0 to the rate's maximum, if positive; + then -: none */
+    double lo = t0, hi = t1, tx;
+    int found = 1;
+    if (E->hd0[k] >= 0.0 && E->hd1[k] > 0.0) {
+      if ((st = rate_extremum(E, k, t0, t1, 1.0, tol, &tx, &found)) != MARTELLO_OK) return st;
+      lo = tx;
+    } else if (E->hd0[k] < 0.0 && E->hd1[k] <= 0.0) {
+      if ((st = rate_extremum(E, k, t0, t1, -1.0, tol, &tx, &found)) != MARTELLO_OK) return st;
+      hi = tx;
+    } else if (!(E->hd0[k] < 0.0 && E->hd1[k] > 0.0)) {
+      continue;
+    }
+    if (!found) continue;
     for (int it = 0; it < 200 && hi - lo > tol; it++) {
       const double tm = 0.5 * (lo + hi);
       if ((st = held_values_at(E, tm, E->hlm, E->hdm)) != MARTELLO_OK) return st;

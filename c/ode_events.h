@@ -183,11 +183,13 @@ int oe_root_stays_zero(ode_events *E, const double *y, const int *found);
  * step). 1 with E->act and *t_r if the integrator must restart, 0 if not, < 0 on failure. */
 int oe_boundary_events(ode_events *E, double t_last, double tret, const double *y,
                        double h_last, double *t_r);
-/* After a step without a root while rigid contacts are held: a multiplier that falls and rises
- * again inside [t0, t1] (its rate, from the jerk, negative at t0 and positive at t1) with both
- * ends compressive has its minimum located on the interpolant; if that is tensile, 1 with
- * E->act (a release) and *t_r at its first zero. 0 if none, < 0 on failure
- * (docs/sundials-ode.md, held contacts). */
+/* After a step without a root while rigid contacts are held: a multiplier compressive at both
+ * ends of [t0, t1] whose rate (from the jerk) turns from negative to positive inside has that
+ * minimum located on the interpolant (bracketed by the rate's ends, or by the rate's extremum
+ * inside, found by golden section); if it is tensile, 1 with E->act (a release) and *t_r at its
+ * first zero. 0 if none, < 0 on failure. Every dip is found when the rate has at most one
+ * extremum in a held step: loads whose harmonic terms share one frequency (docs/sundials-ode.md,
+ * held contacts). */
 int oe_held_release(ode_events *E, double t0, double t1, const double *y1, double *t_r);
 /* The contacts at t = 0: penalty contacts at zero gap and closing get an onset; rigid contacts
  * at zero gap that approach or rest are resolved as impacts (one penetrated is refused). */

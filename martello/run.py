@@ -472,6 +472,8 @@ def _dynamic(scene, model, raise_on_failure=True):
         warnings.append(dense_note(an, len(scene.nodes)))
     if atol_note(scene):
         warnings.append(atol_note(scene))
+    if held_note(scene):
+        warnings.append(held_note(scene))
     if st >= 0 and energy["balance_relative"] > 1e-2:
         warnings.append(f"energy balance error {100 * energy['balance_relative']:.1f} % of the energy put in: "
                         "the step is too large for this scene (the result is inaccurate)")
@@ -886,6 +888,38 @@ def dense_note(an, nodes):
             '"cvode" (the same variable-order BDF, analytic band Jacobian, O(n))')
 
 
+# While a rigid contact is held, CVODE, ARKODE and IDA find every tensile dip of its multiplier
+# when the multiplier's second derivative is one harmonic between the stops: the loads' harmonic
+# terms share one frequency (docs/sundials-ode.md "Held contacts"); with two, a dip shorter than a
+# held step can be missed, and the run says so.
+def _frequency(f):
+    """The angular frequency of a load's time function dict, None for a non-harmonic one."""
+    if f is None:
+        return None
+    if f.get("type") == "sine":
+        return abs(float(f["omega"]))
+    if f.get("type") == "half_sine":
+        return np.pi / (float(f["t_end"]) - float(f.get("t_start", 0.0)))
+    return None
+
+
+def held_note(scene):
+    """The warning a scene gets when its integrator's held-contact release is not guaranteed:
+    cvode, arkode or ida, a rigid contact, loads with harmonic terms of two or more frequencies."""
+    an = scene.analysis
+    if an.get("type") != "dynamic" or an.get("integrator") not in ("cvode", "arkode", "ida"):
+        return None
+    funcs = [f["function"] for f in scene.forces] + [scene.ground]
+    omegas = sorted({w for w in map(_frequency, funcs) if w})
+    if len(omegas) < 2 or not any(c["scheme"] in ("restitution", "lagrange") for c in scene.contacts):
+        return None
+    return (f"the loads have harmonic terms of {len(omegas)} frequencies ({', '.join(_g(w) for w in omegas)} "
+            f"rad/s): while a rigid contact is held, {an['integrator']} finds every release whose "
+            "tension lasts longer than a held step (the shortest period / 16), but a shorter tensile "
+            "dip of its force may be missed (docs/sundials-ode.md \"Held contacts\"); a smaller "
+            "analysis.h_max shortens the held steps")
+
+
 def state_scale(scene):
     """The size of a scene's state before it moves: the largest |u0|, |v0| of its nodes and
     |gap| of its contacts (m, m/s)."""
@@ -933,6 +967,8 @@ def check_budget(scene, force=False):
         warnings.append(dense_note(an, nodes))
     if atol_note(scene):
         warnings.append(atol_note(scene))
+    if held_note(scene):
+        warnings.append(held_note(scene))
     if est["steps"] * nodes > MAX_WORK:
         adaptive = an["type"] == "dynamic" and an["integrator"] in native.adaptive_integrators()
         key = "h_max" if adaptive and an.get("h_max") else "dt"
