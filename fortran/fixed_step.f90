@@ -21,7 +21,8 @@ module martello_fixed_step
    implicit none
    private
    public :: run_fixed_step, stepper_t, stepper_start, stepper_rest_start, solve_free_mass, &
-      stepper_fail, newmark_kinematics, contact_state
+      stepper_fail, newmark_kinematics, newmark_predictor, newmark_increment, &
+      contact_state
 
    !> Samples between energy evaluations (kinetic and recoverable energy are two passes over
    !> the model, as dear as a cheap step): a NaN is caught at once through the works.
@@ -302,6 +303,47 @@ contains
          end do
       end associate
    end subroutine newmark_kinematics
+
+   !> The constant-acceleration predictor of a step: u = uₙ + h vₙ + ½h² aₙ with the (v, a)
+   !> the Newmark relations give it, v = vₙ + h aₙ and a = aₙ, written directly (any β, γ);
+   !> the fixed nodes at uₙ and at rest.
+   subroutine newmark_predictor(self)
+      class(stepper_t), intent(inout) :: self
+      integer :: n
+      real(dp) :: h
+      n = self%n; h = self%h
+      self%u(1:n) = self%un(1:n) + h*self%vn(1:n) + 0.5_dp*h*h*self%an(1:n)
+      self%v(1:n) = self%vn(1:n) + h*self%an(1:n)
+      self%a(1:n) = self%an(1:n)
+      call rest_fixed_nodes(self)
+   end subroutine newmark_predictor
+
+   !> A Newton increment du of u (0 on the fixed nodes) and the increments of a and v the
+   !> Newmark relations tie to it, Δa = du/(βh²), Δv = γ du/(βh) (bt, gm = β, γ). The state
+   !> moves by increments: a is never taken back from u − uₙ − h vₙ, whose rounding,
+   !> ε|u|, it would carry as ε|u|/(βh²) — on a sub-step τ ≪ h (event-split steps) an
+   !> acceleration the next stretch's trapezoid turns into a velocity error hε|u|/(2βτ²)
+   !> (docs/integrators.md, rounding of the Newmark family).
+   subroutine newmark_increment(self, du, bt, gm)
+      class(stepper_t), intent(inout) :: self
+      real(dp), intent(in) :: du(:), bt, gm
+      integer :: n
+      real(dp) :: h
+      n = self%n; h = self%h
+      self%u(1:n) = self%u(1:n) + du
+      self%v(1:n) = self%v(1:n) + (gm/(bt*h))*du
+      self%a(1:n) = self%a(1:n) + du/(bt*h*h)
+   end subroutine newmark_increment
+
+   !> The fixed nodes at uₙ and at rest.
+   subroutine rest_fixed_nodes(self)
+      class(stepper_t), intent(inout) :: self
+      integer :: i, k
+      do k = 1, size(self%fixed_nodes)
+         i = self%fixed_nodes(k)
+         self%u(i) = self%un(i); self%v(i) = 0.0_dp; self%a(i) = 0.0_dp
+      end do
+   end subroutine rest_fixed_nodes
 
    !> The method failed at t: what happened, and when.
    subroutine stepper_fail(o, code, t, what, stat)

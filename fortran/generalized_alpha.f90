@@ -19,7 +19,7 @@ module martello_generalized_alpha
    use martello_integrator_settings
    use martello_stability, only: omega_max
    use martello_fixed_step, only: stepper_t, stepper_rest_start, stepper_fail, newmark_kinematics, &
-      contact_state, solve_free_mass
+      newmark_predictor, newmark_increment, contact_state, solve_free_mass
    implicit none
    private
    public :: generalized_alpha_t, generalized_alpha_coefficients
@@ -178,13 +178,6 @@ contains
       integer :: n
       logical :: ok, converged
       character(len=256) :: msg
-      !> A switch within SPLIT_MIN·h of a stretch's end is not a sub-step's end: a sub-step τ
-      !> that short carries the rounding of u into its velocity as ~2ε|u|/τ (3.7e-7 m/s at
-      !> τ = 6e-11 s, |u| = 5 cm: the order-2 error it was to remove, and more). A contact's
-      !> switch there is put on that end (its jump acts up to SPLIT_MIN·h early or late: a
-      !> velocity error ≤ 1e-4·h·ΔF/m, below the O(h²) of the step); a link's kink there is
-      !> already on a boundary (an error second order in the distance).
-      real(dp), parameter :: SPLIT_MIN = 1.0e-4_dp
 
       stat = MARTELLO_OK
       n = self%n; h = self%h
@@ -215,13 +208,18 @@ contains
       !> reaches its yield line at the end to O(h³) under the return map, and is put on it),
       !> the contact force takes its new branch's value at the boundary (boundary_jump: the
       !> right limit), and the rest [t_a + τ, t] is solved and looked at again, up to
-      !> MAX_SPLITS switches a step. Each sub-step then integrates a smooth force. A contact's
-      !> switch within SPLIT_MIN·h of a stretch end is put on that end (the jump at the start,
-      !> or at the end after a sub-step over the whole stretch); a link's is already on a
-      !> boundary. False: no switch, the step stands as solved.
+      !> MAX_SPLITS switches a step. Each sub-step then integrates a smooth force, whatever its
+      !> length: the state moves by Newton increments (newmark_increment), so a sub-step τ ≪ h
+      !> carries no rounding of u into a. A contact's switch that the clock does not tell from
+      !> a stretch end (switch_time) is on that end (the jump at the start, or at the end after
+      !> a sub-step over the whole stretch); a link's is already on a boundary. False: no
+      !> switch, the step stands as solved.
       logical function split_step() result(split)
          integer, parameter :: MAX_SPLITS = 8
-         integer :: k, first, branch, kind
+         integer :: k, first, kind, j
+         integer :: waits(m%ncontact)      !< the switch each contact awaits from the start
+         integer :: branch(m%ncontact)     !< the branches as they were (the whole laws)
+         logical :: on_start(m%ncontact)   !< in contact at the sub-step's start
          real(dp) :: tau, h_full, h_left
          logical :: pending
          split = .false.
@@ -245,25 +243,43 @@ contains
                if (.not. converged) return
                cycle
             end if
-            ! the sub-step to the switch, a contact held on the start's branch up to its end
-            ! (whatever the sign of its switch there, 0 to the step's O(h³))
+            ! the sub-step to the switch: no law switches before it, so every contact is held
+            ! on its start's branch up to its end (the left limit), whatever the sign of its
+            ! switch there — the first's is 0 to the step's O(h³), and another's that falls at
+            ! the same instant (P7's symmetric chain: four contacts close at once) is the
+            ! first's to its own O(h³): left to the whole law, it switched inside the
+            ! sub-step or not as the rounding fell, its jump inside a step (an O(h) error)
             self%ms%forced_off = .false.
-            if (first > 0) then
-               branch = self%ms%con_branch(first)
-               self%ms%con_branch(first) = HELD(kind)
-            end if
+            branch = self%ms%con_branch; on_start = self%ms%con_on
+            do j = 1, m%ncontact
+               waits(j) = awaited_switch(j)
+               if (waits(j) /= 0) self%ms%con_branch(j) = HELD(waits(j))
+            end do
+            if (first > 0) self%ms%con_branch(first) = HELD(kind)
             h_left = h
             call set_step(tau)
             call external_forces(m, self%mrow, t_a + tau, self%fext)
             fext_mag = maxval(abs(self%fext))
             call newton_step(converged)
-            if (first > 0) self%ms%con_branch(first) = branch
+            self%ms%con_branch = branch
             if (.not. converged) return
             call commit_works()
             pending = .false.
             if (first > 0) then
                if (.not. boundary_jump(first, kind)) return
-            else if (kind /= 0) then
+            end if
+            ! the others held past their switch in the sub-step: their jumps at the boundary
+            ! too; those not past it are still on their branch (mech_commit's δ > 0 is the
+            ! rounding of a switch just taken at the sub-step's start)
+            do j = 1, m%ncontact
+               if (j == first .or. waits(j) == 0) cycle
+               if (past_switch(j, waits(j))) then
+                  if (.not. boundary_jump(j, waits(j))) return
+               else
+                  self%ms%con_on(j) = on_start(j)
+               end if
+            end do
+            if (first < 0 .and. kind /= 0) then
                ! a yield: the boundary is on the yield line (the sub-step's end is on it to
                ! O(h³), either side): the committed force is put on it, so the rest of the
                ! step starts on the line, not an O(h³) short of it
@@ -321,7 +337,7 @@ contains
       !> g + ġτ + ½g̈τ² (without the jerk where g holds a rate: unloading −du̇, the Kelvin
       !> force kδ + cδ̇), and a sign change of the solved end is a switch where the quadratic
       !> has none (chatter rule, or the return map past its surface). tau: from the stretch's
-      !> start (0 and h: a contact's switch within SPLIT_MIN·h of that end).
+      !> start (0 and h: a contact's switch on that end, switch_time).
       subroutine first_switch(first, tau, kind)
          integer, intent(out) :: first, kind
          real(dp), intent(out) :: tau
@@ -407,12 +423,15 @@ contains
       !> When g (≤ 0 at the stretch's start: a value past 0 there is a switch just taken, to
       !> the O(h³) of its location) first becomes > 0 in the stretch [0, h]: on the start's
       !> quadratic g0 + g1 τ + ½g2 τ², or at the crossing of the solved end g_end > 0 located
-      !> on the free side; huge if never. ends: a switch within SPLIT_MIN·h of an end is put
-      !> on that end (0 or h); otherwise it is no switch of the stretch (huge).
+      !> on the free side; huge if never. A switch whose time the clock does not tell from an
+      !> end — x + τ = x or x + (h − τ) = x in floating point, x = max(t_a, h), the time and
+      !> the stretch's length — is at that end: ends, put on it (0 or h); otherwise no switch
+      !> of the stretch (huge). No sub-step is thus shorter than half an ulp of h (its
+      !> 1/(βτ²) stays finite), and no switch is moved by more than the clock's rounding.
       real(dp) function switch_time(g0, g1, g2, g_end, ends) result(tau)
          real(dp), intent(in) :: g0, g1, g2, g_end
          logical, intent(in) :: ends
-         real(dp) :: g
+         real(dp) :: g, x
          g = min(g0, 0.0_dp)
          if (g == 0.0_dp .and. (g1 > 0.0_dp .or. (g1 == 0.0_dp .and. g2 > 0.0_dp))) then
             tau = 0.0_dp
@@ -424,9 +443,10 @@ contains
             end if
          end if
          if (tau > h) return
-         if (tau <= SPLIT_MIN*h) then
+         x = max(t_a, h)
+         if (.not. (x + tau > x)) then
             tau = merge(0.0_dp, huge(1.0_dp), ends)
-         else if (h - tau <= SPLIT_MIN*h) then
+         else if (.not. (x + (h - tau) > x)) then
             tau = merge(h, huge(1.0_dp), ends)
          end if
       end function switch_time
@@ -456,6 +476,54 @@ contains
          integer, intent(in) :: j
          clipped = m%con_law(j) == LAW_KELVIN .and. m%con_par(P_CLIP, j) > 0.5_dp
       end function clipped
+
+      !> The switch contact j awaits from the committed state (first_switch's kinds; its
+      !> branch up to it is HELD of it): SW_ONSET while open, SW_SEPARATION while in contact,
+      !> a clipped Kelvin's SW_CUT while it pushes and SW_REENGAGE while cut off; 0 for a
+      !> contact without a kink to hold (Jankowski, whose force is C¹ at δ = 0 and whose
+      !> turn is a kink of its damping alone; the smooth laws; the other schemes).
+      integer function awaited_switch(j) result(kj)
+         integer, intent(in) :: j
+         kj = 0
+         if (.not. self%ms%is_penalty(j) .or. .not. kinked_law(j)) return
+         if (.not. self%ms%con_on(j)) then
+            kj = SW_ONSET
+         else if (m%con_law(j) == LAW_JANKOWSKI) then
+            kj = 0
+         else if (.not. clipped(j)) then
+            kj = SW_SEPARATION
+         else
+            kj = merge(SW_CUT, SW_REENGAGE, self%ms%con_f(j) > 0.0_dp)
+         end if
+      end function awaited_switch
+
+      !> Contact j, held on its branch over the sub-step from (un, vn) to (u, v), crossed its
+      !> switch kj in it: its switch function g went from ≤ 0 at the start to > 0 at the end
+      !> (g = δ for an onset, −δ for a separation — in contact while δ > 0, as mech_commit
+      !> says —, ∓(δ + κδ̇), κ = c/k, for a clipped Kelvin's cut-off and re-engagement, this
+      !> one only while δ > 0). A g already > 0 at the start is a switch taken there, whose
+      !> location leaves it a rounding past 0, not one to take again.
+      logical function past_switch(j, kj) result(past)
+         integer, intent(in) :: j, kj
+         real(dp) :: d0, d1, kappa, k0, k1
+         d0 = row_dot(m%con, j, self%un) - m%con_gap(j)
+         d1 = row_dot(m%con, j, self%u) - m%con_gap(j)
+         select case (kj)
+         case (SW_ONSET)
+            past = .not. d0 > 0.0_dp .and. d1 > 0.0_dp
+         case (SW_SEPARATION)
+            past = d0 > 0.0_dp .and. .not. d1 > 0.0_dp
+         case default
+            kappa = m%con_par(P_DAMPING, j)/m%con_par(P_STIFF, j)
+            k0 = d0 + kappa*row_dot(m%con, j, self%vn)
+            k1 = d1 + kappa*row_dot(m%con, j, self%v)
+            if (kj == SW_CUT) then
+               past = .not. k0 < 0.0_dp .and. k1 < 0.0_dp
+            else
+               past = .not. k0 > 0.0_dp .and. k1 > 0.0_dp .and. d1 > 0.0_dp
+            end if
+         end select
+      end function past_switch
 
       !> Contact j takes its new branch at the current end state, a boundary of the smooth
       !> stretches (switch kind of first_switch): the force of that branch (an onset or a
@@ -548,7 +616,7 @@ contains
                call newton_iterations(converged, flips, was_on, 1)
             else
                ! predictor: constant acceleration
-               self%u(1:n) = self%un(1:n) + h*self%vn(1:n) + 0.5_dp*h*h*self%an(1:n)
+               call newmark_predictor(self)
                call newton_iterations(converged, flips, was_on, 0)
             end if
             self%tangent_valid = converged
@@ -586,7 +654,7 @@ contains
             du = -res(1:n)
             call solve_kept(du, ok)
             o%counters(C_NEWTON) = o%counters(C_NEWTON) + 1_i8
-            u(1:n) = un(1:n) + du
+            call newmark_increment(self, du, self%beta, self%gamma)
          end associate
       end subroutine linearised_first_iterate
 
@@ -600,7 +668,6 @@ contains
                     fint_n => self%fint_n, fext => self%fext, fext_n => self%fext_n, &
                     res => self%res, ma => self%ma, man => self%man, jac => self%jac, &
                     cjac => self%cjac, am => self%am, af => self%af, kd => self%kd)
-            call newmark_kinematics(self, self%beta, self%gamma)
             if (want_jac) then
                call internal_forces(m, self%ms, u, v, fint, link_tan=self%tan_link_trial, &
                                     con_tan=self%tan_con_trial)
@@ -709,7 +776,7 @@ contains
                if (it >= 2) then
                   call line_search(flips, was_on)
                else
-                  u(1:n) = u(1:n) + du
+                  call newmark_increment(self, du, self%beta, self%gamma)
                end if
             end do
          end associate
@@ -726,13 +793,16 @@ contains
       subroutine line_search(flips, was_on)
          integer, intent(inout) :: flips(:)
          logical, intent(in) :: was_on(:)
-         real(dp) :: lam, r0
+         real(dp) :: lam, r0, taken
          integer :: k, i
          r0 = rnorm
-         self%work(1:n) = self%u(1:n)
-         lam = 1.0_dp
+         lam = 1.0_dp; taken = 0.0_dp
          do k = 1, 12
-            self%u(1:n) = self%work(1:n) + lam*self%du
+            ! the trial lam·Δu from the iterate, by the increment from the last trial: u, v
+            ! and a move together (newmark_increment)
+            self%work(1:n) = (lam - taken)*self%du
+            call newmark_increment(self, self%work(1:n), self%beta, self%gamma)
+            taken = lam
             call evaluate(.false.)       ! the residual alone
             if (rnorm < r0) return
             if (k == 1) then
