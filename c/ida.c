@@ -349,16 +349,11 @@ static int setup(ida_problem *P, martello_model *model, martello_run *run) {
     }
   }
   P->N = pos;
-  /* the analytic Jacobian where the residual is a's alone (no rigid rows), M^-1 diagonal and
-   * no link held on a branch of a piecewise law: with bilinear storeys and fluid dampers, P8 A
-   * met a switch root again after every restart at 4.35 s (restarts 6e-14 s apart: the run
-   * stopped), though the Jacobian agreed with the residual's difference quotients to 3e-6 along
-   * the run; not diagnosed, so such scenes keep IDA's difference quotients */
-  int lumped = 0, branched = 0;
-  if ((st = martello_eval_bandwidth(E->ev, &P->kd, &lumped)) != MARTELLO_OK ||
-      (st = martello_eval_branched_links(E->ev, &branched)) != MARTELLO_OK)
+  /* the analytic Jacobian where the residual is a's alone (no rigid rows) and M^-1 diagonal */
+  int lumped = 0;
+  if ((st = martello_eval_bandwidth(E->ev, &P->kd, &lumped)) != MARTELLO_OK)
     return fail(P, st, "IDA: could not read the evaluator");
-  P->analytic = E->nr == 0 && lumped && branched == 0;
+  P->analytic = E->nr == 0 && lumped;
   if (P->analytic) {
     const size_t nb = (size_t)(3 * P->kd + 1) * (size_t)E->n;
     P->kb = oe_take(nb, sizeof(double), &failed);

@@ -131,8 +131,6 @@ int martello_eval_bandwidth(martello_eval *ev, int *kd, int *lumped);
  * nodes, |i - k| <= kd) at k_band[(2 kd + i - k) + k (3 kd + 1)], n columns. */
 int martello_eval_tangent(martello_eval *ev, const double *u, const double *v, double *k_band,
                           double *c_band);
-/* The number of links held on a branch of a piecewise law (bilinear springs, fluid dampers). */
-int martello_eval_branched_links(martello_eval *ev, int *n);
 /* The number of links of the scene. */
 int martello_eval_link_count(martello_eval *ev, int *n_links);
 /* The rates of the peak quantities at the state (t, u, v) with accelerations a, on the laws'

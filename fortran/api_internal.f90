@@ -9,7 +9,6 @@ module martello_api_internal
    use martello_evaluator
    use martello_switching, only: switch_count, force_continuous
    use martello_contact_laws, only: P_RESTITUTION
-   use martello_links, only: LINK_BILINEAR, LINK_FLUID_DAMPER
    use martello_element_rows, only: row_dot, rows_terms
    use martello_integrator_settings, only: integrator_settings_t
    use martello_observer
@@ -323,21 +322,6 @@ contains
       n_links = ep%m%nlink
       c_eval_link_count = MARTELLO_OK
    end function c_eval_link_count
-
-   !> The number of links held on a branch of a piecewise law (bilinear springs, fluid dampers):
-   !> IDA keeps its difference-quotient Jacobian where there are any (c/ida.c, jacobian).
-   integer(c_int) function c_eval_branched_links(handle, n) bind(C, name='martello_eval_branched_links')
-      type(c_ptr), value :: handle
-      integer(c_int), intent(out) :: n
-      type(evaluator_t), pointer :: ep
-      ep => get_eval(handle)
-      n = 0
-      c_eval_branched_links = MARTELLO_ERR_ARGUMENT
-      if (.not. associated(ep)) return
-      n = count(ep%m%link_kind(1:ep%m%nlink) == LINK_BILINEAR .or. &
-                ep%m%link_kind(1:ep%m%nlink) == LINK_FLUID_DAMPER)
-      c_eval_branched_links = MARTELLO_OK
-   end function c_eval_branched_links
 
    !> The rates of the peak quantities at (t, u, v) with accelerations a (evaluator_rates):
    !> per contact pen, pen_rate, force, force_rate; per link du, dv, lf, lf_rate; per node the
