@@ -275,8 +275,10 @@ static int degree(void *ctx) {
 
 /* An accepted, committed state at t as a sample (a from the right-hand side there, with the
  * forces of the closed rigid contacts, which are their multipliers); k: its output grid point
- * or -1. */
-static int observe(ode_problem *P, double t, const double *y, int k) {
+ * or -1; row: an output row on the interpolant inside a step (martello_observer_row: recorded,
+ * but neither a step nor a point of the energy balance's maximum, which must not move with the
+ * output). */
+static int observe(ode_problem *P, double t, const double *y, int k, int row) {
   ode_events *E = &P->E;
   oe_gather(E, y, E->u, E->v);
   int st = oe_closed_multipliers(E, t, E->u, E->v);
@@ -285,12 +287,13 @@ static int observe(ode_problem *P, double t, const double *y, int k) {
     int r = E->rig[j];
     E->force[j] = r >= 0 && E->closed[r] ? E->lr[r] : 0.0;
   }
-  return martello_observer_sample(E->obs, E->ev, t, E->u, E->v, E->ar, E->force, k);
+  return (row ? martello_observer_row : martello_observer_sample)(E->obs, E->ev, t, E->u, E->v,
+                                                                  E->ar, E->force, k);
 }
 
 /* An output row on the interpolant (c/ode_events.c oe_rows_inside). */
 static int sample(void *ctx, double t, const double *y, int k) {
-  return observe(ctx, t, y, k);
+  return observe(ctx, t, y, k, 1);
 }
 
 /* The state at a restart made consistent (c/ode_events.c), into y. */
@@ -516,7 +519,7 @@ static int integrate(ode_problem *P, SUNContext ctx, N_Vector yy, SUNMatrix *Jp,
 
   int k_out = 1;
   double t_out = oe_output_time(E, k_out), t_last = 0.0;
-  if ((st = observe(P, 0.0, y, 0)) != MARTELLO_OK) return st;
+  if ((st = observe(P, 0.0, y, 0, 0)) != MARTELLO_OK) return st;
   oe_accepted(E, y);
   /* the stops: the loads' kinks and t_end (the output rows lie on the steps' interpolant) */
   int kink = 0;
@@ -601,7 +604,7 @@ static int integrate(ode_problem *P, SUNContext ctx, N_Vector yy, SUNMatrix *Jp,
       if ((st = oe_hand_work(E)) != MARTELLO_OK) break;
     }
     int at_output = t_r == t_out || (again && t_out - t_r <= 16.0 * DBL_EPSILON * t_out);
-    if ((st = observe(P, t_r, y, at_output ? k_out * E->every : -1)) != MARTELLO_OK) break;
+    if ((st = observe(P, t_r, y, at_output ? k_out * E->every : -1, 0)) != MARTELLO_OK) break;
     oe_accepted(E, y);
     if (at_output) {
       if (t_out >= E->t_end) {
