@@ -1128,7 +1128,9 @@ void oe_accepted(ode_events *E, const double *y) {
   }
 }
 
-int oe_use_smooth(ode_events *E) {
+int oe_use_smooth(ode_events *E) { return oe_use_smooth_laws(E, MARTELLO_ACROSS_CONTINUOUS); }
+
+int oe_use_smooth_laws(ode_events *E, int laws) {
   double failed = 0.0;
   const size_t ucn = (size_t)E->nc;
   E->cont = oe_take(ucn, sizeof(int), &failed);
@@ -1140,7 +1142,7 @@ int oe_use_smooth(ode_events *E) {
   E->ev_j = oe_take(3 * ucn, sizeof(int), &failed);
   E->ev_k = oe_take(3 * ucn, sizeof(int), &failed);
   if (failed > 0.0) return oe_fail_memory(E, "the events inside the steps", failed);
-  int st = martello_eval_use_smooth_branches(E->ev, &E->nsw, E->cont);
+  int st = martello_eval_use_smooth_branches(E->ev, laws, &E->nsw, E->cont);
   if (st != MARTELLO_OK) return oe_fail(E, st, "%s: martello_eval_use_smooth_branches failed", E->name);
   E->smooth = 1;
   if (E->nsw > 0 &&

@@ -228,10 +228,11 @@ def test_lagrange_contact_released_when_its_multiplier_turns_tensile(integrator)
     assert c["phase_max_force"][1] == pytest.approx(M * G - K * H, rel=1e-12)
 
 
-# --- events inside the steps (docs/sundials-ode.md, events inside the steps): CVODE steps across
-# the laws whose force is continuous at onset and separation, their events located per contact
-# on the interpolant, without a root or a restart; IDA and ARKODE restart at them (the same
-# events, the same closed forms) ----------------------------------------------------------------
+# --- events inside the steps (docs/sundials-ode.md, events inside the steps): CVODE and IDA step
+# across the laws whose force is continuous at onset and separation, ARKODE across those whose
+# force's rate is bounded there too (here: linear), their events located per contact on the
+# interpolant, without a root or a restart; ARKODE restarts at the others (the same events, the
+# same closed forms) -------------------------------------------------------------------------------
 
 CONTINUOUS = [("linear", 1e6, None, None), ("hertz", 1e9, None, None),
               ("hunt-crossley", 1e9, 0.8, None), ("flores", 1e9, 0.5, None)]
