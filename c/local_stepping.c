@@ -74,7 +74,8 @@ typedef struct {
   int n, nc, nl_rows;
   cluster **cl;               /* by slot; NULL: free */
   int ncl;
-  int *heap, nheap;
+  int *heap, nheap;           /* slots by time; hkey[k] the time of heap[k] (contiguous: */
+  double *hkey;               /* the sifts read no cluster) */
   int *node_cl, *node_loc;    /* free node -> its cluster's slot and its index there */
   int *nd_first, *nd_con;     /* node -> its contacts */
   int *nl_first, *nl_link;    /* node -> its links */
@@ -92,14 +93,15 @@ typedef struct {
 
 static double t_of(const cluster *c) { return c->pend ? c->tp : c->t1; }
 
-static int heap_less(driver *D, int a, int b) {
-  return t_of(D->cl[D->heap[a]]) < t_of(D->cl[D->heap[b]]);
-}
+static int heap_less(driver *D, int a, int b) { return D->hkey[a] < D->hkey[b]; }
 
 static void heap_swap(driver *D, int a, int b) {
   int s = D->heap[a];
+  double t = D->hkey[a];
   D->heap[a] = D->heap[b];
+  D->hkey[a] = D->hkey[b];
   D->heap[b] = s;
+  D->hkey[b] = t;
   D->cl[D->heap[a]]->hpos = a;
   D->cl[D->heap[b]]->hpos = b;
 }
@@ -119,8 +121,15 @@ static void heap_fix(driver *D, int k) {
   }
 }
 
+/* Cluster c's time changed: its place. */
+static void heap_update(driver *D, cluster *c) {
+  D->hkey[c->hpos] = t_of(c);
+  heap_fix(D, c->hpos);
+}
+
 static void heap_push(driver *D, int slot) {
   D->heap[D->nheap] = slot;
+  D->hkey[D->nheap] = t_of(D->cl[slot]);
   D->cl[slot]->hpos = D->nheap++;
   heap_fix(D, D->nheap - 1);
 }
@@ -398,7 +407,7 @@ static int other_cluster(driver *D, int j, int s) {
 static void unfreeze(driver *D, int s) {
   cluster *c = D->cl[s];
   c->pend = PEND_NONE;
-  heap_fix(D, c->hpos);
+  heap_update(D, c);
   if (!c->queued) {
     c->queued = 1;
     D->todo[D->ntodo++] = s;
@@ -419,12 +428,12 @@ static int pend_event(driver *D, int kind, int a, int b, double t) {
   ca->pend = kind;
   ca->partner = b;
   ca->tp = t;
-  heap_fix(D, ca->hpos);
+  heap_update(D, ca);
   if (cb) {
     cb->pend = kind;
     cb->partner = a;
     cb->tp = t;
-    heap_fix(D, cb->hpos);
+    heap_update(D, cb);
   }
   return 1;
 }
@@ -630,7 +639,7 @@ static int step_cluster(driver *D, int s) {
   c->again = again;
   c->stepped = 1;
   c->tq = -1.0;
-  heap_fix(D, c->hpos);
+  heap_update(D, c);
   if ((st = check_release(D, s)) != MARTELLO_OK) return st;
   if ((st = check_cluster(D, s)) != MARTELLO_OK) return st;
   /* clusters unfrozen meanwhile: their time rose, their contacts are checked on */
@@ -746,6 +755,7 @@ static int integrate(driver *D) {
   D->ncl = n;
   D->cl = oe_take((size_t)n, sizeof(cluster *), &failed);
   D->heap = oe_take((size_t)n, sizeof(int), &failed);
+  D->hkey = oe_take((size_t)n, sizeof(double), &failed);
   D->node_cl = oe_take((size_t)n, sizeof(int), &failed);
   D->node_loc = oe_take((size_t)n, sizeof(int), &failed);
   D->checked = oe_take((size_t)D->nc, sizeof(double), &failed);
@@ -829,7 +839,7 @@ int martello_ode_local_run(martello_model *model, martello_run *run) {
   if (st == MARTELLO_OK) st = integrate(D);
   for (int k = 0; k < D->ncl && D->cl; k++) free_cluster(D, k);
   if (D->ctx) SUNContext_Free(&D->ctx);
-  void *arrays[] = {D->cl, D->heap, D->node_cl, D->node_loc, D->nd_first, D->nd_con, D->nl_first,
+  void *arrays[] = {D->cl, D->heap, D->hkey, D->node_cl, D->node_loc, D->nd_first, D->nd_con, D->nl_first,
                     D->nl_link, D->checked, D->u0, D->ys, D->mark, D->list, D->stack, D->todo, D->slots};
   for (size_t k = 0; k < sizeof arrays / sizeof arrays[0]; k++) free(arrays[k]);
   ode_problem_release(&D->S);
