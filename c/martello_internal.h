@@ -165,8 +165,8 @@ typedef struct martello_subset_map {
  * The nodal forces of its nodes, gravity, influence, ground motion, the contacts' effective
  * masses: the parent's. parent must hold no chains per node (martello_model_expand_chains). The
  * message of a refusal: martello_model_message(parent). O(n + the elements they touch): the
- * parent's node incidence is built on the first call and kept in it while it does not grow.
- * *sub: freed by martello_model_free; map: zeroed, then filled with malloc'ed arrays
+ * parent's node incidence is built on the first call and kept in it while it does not grow
+ * (with scratch marks: not reentrant on one parent). *sub: freed by martello_model_free; map: zeroed, then filled with malloc'ed arrays
  * (martello_subset_map_free, safe after a failure too). */
 int martello_model_subset(martello_model *parent, int n, const int *nodes, martello_model **sub,
                           martello_subset_map *map);
