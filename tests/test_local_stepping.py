@@ -170,3 +170,12 @@ def test_rigid_contacts_are_refused_with_the_fix():
     s, _ = run_full(from_dict(d), raise_on_failure=False)
     assert s["status"] != "MARTELLO_OK"
     assert "local_stepping" in s["message"] and "rigid" in s["message"]
+
+
+def test_every_cluster_step_counts_against_the_budget():
+    # max_steps bounds the steps of all clusters together (martello_observer_step)
+    d = closing(6)
+    d["analysis"]["max_steps"] = 100
+    s, _ = run_full(from_dict(d), raise_on_failure=False)
+    assert s["status"] == "MARTELLO_ERR_LIMIT" and "max_steps" in s["message"]
+    assert s["cost"]["steps"] <= 101
