@@ -174,6 +174,13 @@ void martello_subset_map_free(martello_subset_map *map);
 /* The model's chains (martello_model_add_chain) made into links and contacts one by one, in
  * place, numbered as the run numbers them. */
 int martello_model_expand_chains(martello_model *model);
+/* The clusters of the model's free nodes: nodes joined by links, mass couplings, stiffness
+ * blocks and the contacts with joined[j] != 0 (closed ones; joined NULL: none), each element
+ * joining the free nodes of its row (a fixed node or the ground joins nothing). label[i] (n
+ * values): node i's cluster, 0 .. *n_clusters - 1 numbered in the order of their first node; -1
+ * for a fixed node. O(n + terms) (union-find): on the parent once, on a sub-model for a split. */
+int martello_model_clusters(martello_model *model, const int *joined, int *label,
+                            int *n_clusters);
 /* Copy the state of map's elements -- committed and trial: link histories, forces and branches
  * held; contact penetrations, rates, forces, onset speeds, on/off and branches; stiffness
  * blocks' states -- and of the sub nodes' last loaded (u, v, f_int, f_ext), from the parent's

@@ -16,7 +16,7 @@ module martello_submodel
    use martello_assembly, only: mech_state_t
    implicit none
    private
-   public :: submodel_map_t, submodel_build, submodel_transfer
+   public :: submodel_map_t, submodel_build, submodel_transfer, model_clusters
 
    !> The parent's number (1-based) of each node, link, contact and stiffness block of a
    !> sub-model.
@@ -479,6 +479,72 @@ contains
          end if
       end subroutine move_l
    end subroutine submodel_transfer
+
+   !> The clusters of m: its free nodes joined by links, mass couplings, stiffness blocks and
+   !> the contacts j with joined(j) (closed ones), each element joining the free nodes of its
+   !> row (a fixed node or the ground joins nothing: it does not move). label(i): node i's
+   !> cluster, 1 … nclusters numbered in the order of their first node; 0 for a fixed node.
+   !> Union-find with path halving over the elements' terms: O(n + terms).
+   subroutine model_clusters(m, joined, label, nclusters)
+      type(model_t), intent(in) :: m
+      logical, intent(in) :: joined(:)
+      integer, intent(out) :: label(:), nclusters
+      integer :: j, first, i
+      ! label holds the union-find parents first, then the cluster numbers
+      label = [(i, i = 1, m%n)]
+      do j = 1, m%nlink
+         call join_row(m%lnk%node(m%lnk%first(j):m%lnk%first(j + 1) - 1))
+      end do
+      do j = 1, m%ncontact
+         if (joined(j)) call join_row(m%con%node(m%con%first(j):m%con%first(j + 1) - 1))
+      end do
+      do j = 1, m%ncoupling
+         call join_row([m%mc_a(j), m%mc_b(j)])
+      end do
+      do j = 1, m%nblock
+         call join_row(m%block(j)%node)
+      end do
+      ! the root of a cluster is its smallest node (join_row keeps the smaller root), so the
+      ! roots are met in node order before the other nodes of their clusters: numbered in one
+      ! pass, negated while the others still hold their roots
+      do i = 1, m%n
+         label(i) = root(i)
+      end do
+      nclusters = 0
+      do i = 1, m%n
+         if (m%fixed(i)) then
+            label(i) = 0
+         else if (label(i) == i) then
+            nclusters = nclusters + 1
+            label(i) = -nclusters
+         else
+            label(i) = label(label(i))
+         end if
+      end do
+      label = -label
+   contains
+      integer function root(i) result(r)
+         integer, intent(in) :: i
+         r = i
+         do while (label(r) /= r)
+            label(r) = label(label(r))        ! path halving
+            r = label(r)
+         end do
+      end function root
+      subroutine join_row(nd)
+         integer, intent(in) :: nd(:)
+         integer :: q, a, b
+         first = 0
+         do q = 1, size(nd)
+            if (m%fixed(nd(q))) cycle
+            if (first == 0) then
+               first = nd(q); cycle
+            end if
+            a = root(first); b = root(nd(q))
+            if (a /= b) label(max(a, b)) = min(a, b)   ! the smaller node is the root
+         end do
+      end subroutine join_row
+   end subroutine model_clusters
 
    !> a in ascending order (heapsort: O(k log k) whatever the order given)
    subroutine sort_ints(a)
