@@ -158,10 +158,10 @@ typedef struct martello_subset_map {
 } martello_subset_map;
 /* The sub-model of parent on its free nodes nodes[0..n-1] (any order; a node given twice, a
  * fixed node or one out of range: MARTELLO_ERR_ARGUMENT). Its nodes: those and the fixed nodes
- * their elements touch, in ascending parent number (kd_sub <= kd_parent). Its links and
- * contacts: every one whose free nodes all lie in nodes[], in the parent's order (one with a free
- * node outside is left out: the caller's open contact); its mass couplings and stiffness blocks
- * likewise, but one with a free node outside is refused (the mass or stiffness would be cut).
+ * their elements touch, in ascending parent number (kd_sub <= kd_parent). Its contacts: every
+ * one whose free nodes all lie in nodes[], in the parent's order (one with a free node outside
+ * is left out: the caller's open contact); its links, mass couplings and stiffness blocks
+ * likewise, but one with a free node outside is refused (it always joins its nodes' cluster).
  * The nodal forces of its nodes, gravity, influence, ground motion, the contacts' effective
  * masses: the parent's. parent must hold no chains per node (martello_model_expand_chains). The
  * message of a refusal: martello_model_message(parent). O(n + the elements they touch): the

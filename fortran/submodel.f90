@@ -118,10 +118,12 @@ contains
 
    !> The sub-model sub of p on the free nodes nodes(:) (1-based, any order): sub's nodes are
    !> those and the fixed nodes their elements touch, in p's order (so its half-bandwidth is at
-   !> most p's); its links and contacts every one of p's whose free nodes all lie in nodes(:),
-   !> in p's order, with p's parameters and effective masses; its mass couplings and stiffness
-   !> blocks likewise (one with a free node outside: refused — the mass or the stiffness would
-   !> be cut); the nodal forces of its nodes; p's gravity, influence and ground motion.
+   !> most p's); its contacts every one of p's whose free nodes all lie in nodes(:), in p's
+   !> order, with p's parameters and effective masses (one with a free node outside is left
+   !> out: an open contact between clusters); its links, mass couplings and stiffness blocks
+   !> likewise, but one with a free node outside is refused (it always joins its nodes' cluster:
+   !> the cluster would be cut); the nodal forces of its nodes; p's gravity, influence and
+   !> ground motion.
    !> map: p's number of each of sub's items. stat: MARTELLO_ERR_ARGUMENT (p%errmsg says
    !> which argument and the fix), MARTELLO_ERR_MEMORY. Cost O(size(nodes) + the items they
    !> touch) once p's incidence is built (O(p) once).
@@ -281,7 +283,8 @@ contains
       end subroutine element_nodes
 
       !> keep e if every free node of it is the cluster's (its fixed nodes then join); a
-      !> coupling or a block with a free node outside: why says so
+      !> contact with a free node outside is left out (an open contact between clusters, the
+      !> caller's); a link, a coupling or a block with one: why says so (it always joins)
       subroutine classify(e, kept)
          integer, intent(in) :: e
          logical, intent(out) :: kept
@@ -303,6 +306,10 @@ contains
                write (why, '(a,i0,a,i0,a,i0,a)') 'model_subset: the mass coupling ', q - 1, &
                   ' between nodes ', p%mc_a(q) - 1, ' and ', p%mc_b(q) - 1, &
                   ' crosses the cut: a consistent mass cannot be cut (give both nodes)'
+            else if (e <= p%nlink) then
+               write (why, '(a,i0,a,i0,a)') 'model_subset: link ', e - 1, ' has node ', &
+                  outside - 1, ' outside the cluster: a link always joins its nodes'' cluster'// &
+                  ' (give all its free nodes)'
             end if
             return
          end if

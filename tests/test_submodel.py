@@ -455,15 +455,16 @@ def test_chains_are_subset_on_the_expanded_model():
 
 def test_refusals_name_the_argument_and_the_fix():
     """Bad input gets a clear error: a node out of range, given twice or fixed, an empty
-    cluster, a mass coupling or a stiffness block cut by the cluster; a transfer with a map of
+    cluster, a link, a mass coupling or a stiffness block cut by the cluster; a transfer with a map of
     another sub-model or a NULL array. The parent is left usable (its marks cleared)."""
     ARG = K("MARTELLO_ERR_ARGUMENT")
-    with row_scene(couplings=[(2, 3, 50.0)], block=(6, 7, 8)) as m:
+    with row_scene(couplings=[(4, 5, 50.0)], block=(6, 7, 8)) as m:
         n = m.n_nodes
         cases = [([1, n], f"nodes[1] = {n} is not a node"), ([1, -1], "is not a node"),
                  ([1, 2, 1], "node 1 is given twice"), ([0, 1], "nodes[0] = 0 is a fixed node"),
-                 ([1, 2], "mass coupling 0 between nodes 2 and 3 crosses the cut"),
-                 ([5, 6, 7], "stiffness block 0 has node 8 outside the cluster")]
+                 ([4], "mass coupling 0 between nodes 4 and 5 crosses the cut"),
+                 ([1, 3], "link 20 has node 2 outside the cluster"),     # the fluid damper 2-3
+                 ([6, 7], "stiffness block 0 has node 8 outside the cluster")]
         for nodes, says in cases:
             st, sub, mp = subset(m.handle, nodes)
             assert st == ARG and says in message(m.handle), (nodes, message(m.handle))
