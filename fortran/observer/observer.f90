@@ -160,13 +160,14 @@ module martello_observer
       !> previous sample (observer_block computes them again from the previous state)
       real(dp), allocatable :: c_prev_f(:), c_prev_fr(:)
       !> the peak of |a| on fixed steps (observer_a_parabolas): a sample k that raised it
-      !> waits two samples for the parabola through k − 1, k, k + 1 and the smoothness test
-      !> with k + 2. Per node: a at k − 1, k, k + 1 and the sample k of its latest candidate
-      !> modulo 256 (a_gen; the lists name the candidates of the last three samples at most,
-      !> so no two stamps in use are equal); the candidates of the last two samples (pend1:
-      !> k = the last, pend2: the one before), with the time and the chatter count of their
-      !> sample k − 1
-      real(dp), allocatable :: a_m1(:), a_0(:), a_p1(:)
+      !> waits two samples for the parabola through k − 1, k, k + 1 and the tests of its
+      !> span with k − 2 and k + 2. Per node: a at k − 2, k − 1, k, k + 1 and the sample k of
+      !> its latest candidate modulo 256 (a_gen; the lists name the candidates of the last
+      !> three samples at most, so no two stamps in use are equal); the candidates of the
+      !> last two samples (pend1: k = the last, pend2: the one before), with the time and the
+      !> chatter count of their sample k − 1; a_back: every node's a at the sample before
+      !> the last (a candidate's k − 2)
+      real(dp), allocatable :: a_m2(:), a_m1(:), a_0(:), a_p1(:), a_back(:)
       integer(int8), allocatable :: a_gen(:)
       integer, allocatable :: pend1(:), pend2(:)
       integer :: npend1 = 0, npend2 = 0
