@@ -70,6 +70,8 @@ contains
          if (st == 0 .and. size(o%out_links) > 0) &
             call link_states(m, blk, o%out_links, u, v, bf, lf, ld, st)
       end if
+      ! the traced contact's force at every grid point (the step trace)
+      if (st == 0 .and. traced(o, k)) call traced_force(st)
       if (st /= 0) then
          call out_of_memory('the recorded contact and link states of a run', &
                             REAL_BYTES*2*(model_ncontacts(m) + real(model_nlinks(m), dp)), &
@@ -78,6 +80,16 @@ contains
       end if
       call observer_sample(o, m, none, t, u, v, a, pen, force, k, stat, lf, ld, folded=.true., &
                            energies=energies)
+   contains
+      !> o%trace_f ← the traced contact's force at the state (contact_states, as its
+      !> history column)
+      subroutine traced_force(st)
+         integer, intent(out) :: st
+         real(dp), allocatable :: p1(:), f1(:)
+         allocate (p1(0), f1(0))
+         call contact_states(m, blk, [o%trace_contact], u, v, br, xbr, p1, f1, st)
+         if (st == 0) o%trace_f = f1(o%trace_contact)
+      end subroutine traced_force
    end procedure observer_block
 
    !> observer_block's nodes and node pairs, one pass: a node's peaks (node_samples at the

@@ -138,7 +138,7 @@ contains
    !> grid (energy_grid) and where recorded, for the history row (a method that hands its
    !> energies to the sample computes them then).
    module procedure observer_energy_due
-      due = energy_grid(o, k) .or. recorded(o, k)
+      due = energy_grid(o, k) .or. recorded(o, k) .or. traced(o, k)
    end procedure observer_energy_due
 
    !> Whether the next sample, at grid point k (−1: off the grid), is on the energy grid,
