@@ -144,6 +144,47 @@ int martello_eval_rates(martello_eval *ev, double t, const double *u, const doub
                         double *force_rate, double *du, double *dv, double *lf, double *lf_rate,
                         double *jerk);
 
+/* ---- sub-models for local stepping (fortran/submodel.f90; docs/run-layer.md, "Sub-models for
+ * local stepping") ---------------------------------------------------------------------------
+ * A cluster's model: its free nodes, the fixed nodes its elements touch, its elements, their
+ * loads. Arrays 0-based, parent numbering. */
+typedef struct martello_subset_map {
+  int n_nodes, n_links, n_contacts; /* of the sub-model */
+  int *node;                        /* [n_nodes] parent node of sub node k */
+  int *link;                        /* [n_links] parent link of sub link k */
+  int *contact;                     /* [n_contacts] parent contact of sub contact k */
+  int n_blocks;                     /* stiffness blocks of the sub-model */
+  int *block;                       /* [n_blocks] parent block of sub block k */
+} martello_subset_map;
+/* The sub-model of parent on its free nodes nodes[0..n-1] (any order; a node given twice, a
+ * fixed node or one out of range: MARTELLO_ERR_ARGUMENT). Its nodes: those and the fixed nodes
+ * their elements touch, in ascending parent number (kd_sub <= kd_parent). Its links and
+ * contacts: every one whose free nodes all lie in nodes[], in the parent's order (one with a free
+ * node outside is left out: the caller's open contact); its mass couplings and stiffness blocks
+ * likewise, but one with a free node outside is refused (the mass or stiffness would be cut).
+ * The nodal forces of its nodes, gravity, influence, ground motion, the contacts' effective
+ * masses: the parent's. parent must hold no chains per node (martello_model_expand_chains). The
+ * message of a refusal: martello_model_message(parent). O(n + the elements they touch): the
+ * parent's node incidence is built on the first call and kept in it while it does not grow
+ * (with scratch marks: not reentrant on one parent). *sub: freed by martello_model_free; map: zeroed, then filled with malloc'ed arrays
+ * (martello_subset_map_free, safe after a failure too). */
+int martello_model_subset(martello_model *parent, int n, const int *nodes, martello_model **sub,
+                          martello_subset_map *map);
+void martello_subset_map_free(martello_subset_map *map);
+/* The model's chains (martello_model_add_chain) made into links and contacts one by one, in
+ * place, numbered as the run numbers them. */
+int martello_model_expand_chains(martello_model *model);
+/* Copy the state of map's elements -- committed and trial: link histories, forces and branches
+ * held; contact penetrations, rates, forces, onset speeds, on/off and branches; stiffness
+ * blocks' states -- and of the sub nodes' last loaded (u, v, f_int, f_ext), from the parent's
+ * evaluator into the sub-model's (to_sub = 1; also the branch mode of
+ * martello_eval_use_branches / use_smooth_branches) or back (to_sub = 0), bit for bit. Call
+ * martello_eval_use_smooth_branches(sub) before it, not after (that re-chooses the branches). A
+ * contact between two clusters stays in the parent while they advance: its committed state
+ * there is stale; commit a merged cluster at its start state after the transfer. */
+int martello_eval_state_transfer(martello_eval *parent, martello_eval *sub,
+                                 const martello_subset_map *map, int to_sub);
+
 /* The run being filled: its settings, as martello_run_set_settings validated them, and its
  * observer. */
 int martello_run_settings(const martello_run *run, martello_settings *settings);

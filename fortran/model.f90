@@ -16,6 +16,7 @@ module martello_model
       SCHEME_RESTITUTION, registry_name
    use martello_element_rows, only: rows_t, rows_init, rows_append, rows_append_pair, row_span, &
       row_pair, row_lo, row_hi, rows_move
+   use martello_node_incidence, only: node_incidence_t
    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
    implicit none
    private
@@ -26,7 +27,7 @@ module martello_model
       model_set_influence, model_influence, model_has_influence, &
       model_add_stiffness_block, stiffness_block_t, model_bandwidth, &
       SCHEME_PENALTY, SCHEME_LAGRANGE, SCHEME_AUGMENTED, &
-      SCHEME_RESTITUTION, scheme_name, chain_t, model_add_chain, model_expanded, &
+      SCHEME_RESTITUTION, scheme_name, chain_t, model_add_chain, model_expanded, model_expand_chains, &
       model_nlinks, model_ncontacts, model_link_index, model_contact_index, model_contact_at, &
       model_link_at, model_check_link, model_check_contact
 
@@ -101,6 +102,9 @@ module martello_model
       integer, allocatable :: force_node(:)
       type(time_function_t), allocatable :: force_fn(:)
       type(time_function_t) :: ground_accel
+      !> which items touch each node: built by the first sub-model taken of the model
+      !> (martello_submodel), kept while the model does not grow
+      type(node_incidence_t) :: incidence
       character(len=512) :: errmsg = ''
    end type model_t
 

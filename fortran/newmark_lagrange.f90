@@ -42,7 +42,8 @@ module martello_newmark_lagrange
       observer_close_phase, free_side_crossing
    use martello_run_quantities, only: C_REJECTED, C_NEWTON, C_RESIDUALS, C_FACTORIZATIONS, C_EVENTS
    use martello_integrator_settings, only: integrator_settings_t
-   use martello_fixed_step, only: stepper_t, stepper_start, newmark_kinematics, contact_state
+   use martello_fixed_step, only: stepper_t, stepper_start, newmark_predictor, newmark_increment, &
+      contact_state
    use martello_linalg, only: solve_symmetric_indefinite
    use martello_impulse, only: impulse_accumulation
    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
@@ -330,12 +331,18 @@ contains
 
       !> Newton on the constrained Newmark step: unknowns u_{n+1} and the multipliers λ of
       !> the active contacts; KKT matrix [J −Bᵀ; −B 0], J = M/(βh²) + γ/(βh) C + K.
+      !> From the constant-acceleration predictor, u, v, a and λ move together by each
+      !> increment (newmark_increment), and so does each active constraint's δ_{n+1}: from the
+      !> predictor's D₀ = δ_n + hδ̇_n + ½h²δ̈_n (δ_n = 0 for a contact held since the last
+      !> step, its constraint's; the stored gap otherwise) by B Δu. Neither a nor δ_{n+1} is
+      !> read back from u, whose rounding ε|u| would be an acceleration ε|u|/(βh²)
+      !> (docs/moreau-jean.md §2, "Rounding").
       subroutine newmark_solve(bt, gm, ok)
          real(dp), intent(in) :: bt, gm
          logical, intent(out) :: ok
          integer :: it, na, j, k, q, row, col, st, idx(nc)
          real(dp), allocatable :: kkt(:, :), rhs(:)
-         real(dp) :: rnorm, cnorm, fscale, uscale, rc
+         real(dp) :: rnorm, cnorm, fscale, uscale, rc, delta(nc), d_n
          associate (u => self%u, un => self%un, vn => self%vn, an => self%an, a => self%a, &
                     v => self%v, fint => self%fint, fext => self%fext, ma => self%ma, &
                     lam => self%lam, kd => self%kd, &
@@ -355,14 +362,21 @@ contains
                return
             end if
             lam = 0.0_dp
-            u(1:n) = un(1:n) + h*vn(1:n) + 0.5_dp*h*h*an(1:n)
+            call newmark_predictor(self)
+            do j = 1, na
+               k = idx(j)
+               d_n = 0.0_dp
+               if (.not. self%pers(k)) d_n = row_dot(m%con, k, un) - m%con_gap(k)
+               ! the expression of the impact's D₀ in step (the same number: the tuned ratio
+               ! γ/β then leaves δ̇_{n+1} = −e v_imp to the rounding of the arithmetic)
+               delta(j) = d_n + h*row_dot(m%con, k, vn) + 0.5_dp*h*h*row_dot(m%con, k, an)
+            end do
             uscale = tiny(1.0_dp)
             do k = 1, n
                uscale = max(uscale, abs(un(k)), h*abs(vn(k)), h*h*abs(an(k)))
             end do
             ok = .false.
             do it = 0, self%max_newton
-               call newmark_kinematics(self, bt, gm)
                kband%ab = 0.0_dp; cband%ab = 0.0_dp
                call internal_forces(m, self%ms, u, v, fint, kband%ab, 1.0_dp, 0.0_dp, cband%ab)
                o%counters(C_RESIDUALS) = o%counters(C_RESIDUALS) + 1_i8
@@ -374,7 +388,7 @@ contains
                   do q = row_lo(m%con, k), row_hi(m%con, k)
                      rhs(m%con%node(q)) = rhs(m%con%node(q)) + m%con%coef(q)*lam(k)
                   end do
-                  rhs(n + j) = row_dot(m%con, k, u) - m%con_gap(k)
+                  rhs(n + j) = delta(j)
                end do
                rhs(fixed_nodes) = 0.0_dp
                rnorm = maxval(abs(rhs(1:n)))
@@ -382,7 +396,8 @@ contains
                if (na > 0) cnorm = maxval(abs(rhs(n + 1:n + na)))
                fscale = max(maxval(abs(fext(1:n))), maxval(abs(fint(1:n))), maxval(abs(ma(1:n))), &
                             maxval(abs(lam)), tiny(1.0_dp))
-               ! the inertia term M u/(βh²) is evaluated with rounding ~ε·m|u|/(βh²)
+               ! not asked for: a residual below the inertia of an ulp of u, ε·m|u|/(βh²) (the
+               ! test in displacement units of the generalized-α family, docs/integrators.md)
                fscale = max(fscale, 64.0_dp*epsilon(1.0_dp)/self%tol_residual*maxval(m%mass)*uscale/(bt*h*h))
                if (it > 0 .and. rnorm <= self%tol_residual*fscale .and. &
                    cnorm <= max(self%tol_increment*max(uscale, maxval(abs(u))), &
@@ -414,9 +429,11 @@ contains
                   call observer_fail(o, st, t_prev, why, stat)
                   return
                end if
-               u(1:n) = u(1:n) + rhs(1:n)
+               call newmark_increment(self, rhs(1:n), bt, gm)
+               self%work(0) = 0.0_dp; self%work(1:n) = rhs(1:n)
                do j = 1, na
                   lam(idx(j)) = lam(idx(j)) + rhs(n + j)
+                  delta(j) = delta(j) + row_dot(m%con, idx(j), self%work)
                end do
             end do
             if (.not. ok) then
