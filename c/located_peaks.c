@@ -64,7 +64,8 @@ int martello_locate_peaks(martello_observer *obs, const martello_peak_ends *ends
       /* in the sense of the peak: +q for a maximum, -q for a minimum of a magnitude */
       sg = (by_magnitude(kind) && r0[j] < 0.0) ? -1.0 : 1.0;
       qend = fmax(sg * q0[j], sg * q1[j]);
-      st = martello_observer_peak_value(obs, kind, j, &cur);
+      const int g = ends->global[kind] ? ends->global[kind][j] : j;
+      st = martello_observer_peak_value(obs, kind, g, &cur);
       if (st != MARTELLO_OK) return st;
       if (sg * est + (sg * est - qend) < cur) continue;
       /* the extremum on the method's solution */
@@ -89,7 +90,7 @@ int martello_locate_peaks(martello_observer *obs, const martello_peak_ends *ends
         tm += dt;
         if (!(tm > ta && tm < tb)) tm = 0.5 * (ta + tb);
       }
-      st = martello_observer_peak(obs, kind, j, sg * best);
+      st = martello_observer_peak(obs, kind, g, sg * best);
       if (st != MARTELLO_OK) return st;
     }
   }
@@ -103,7 +104,8 @@ int martello_peak_fold_end(martello_observer *obs, const martello_peak_ends *end
     if (q1 == NULL) continue;
     for (j = 0; j < ends->count[kind]; j++) {
       if (ends->skip != NULL && ends->skip(ctx, kind, j)) continue;
-      if ((st = martello_observer_peak(obs, kind, j, q1[j])) != MARTELLO_OK) return st;
+      const int g = ends->global[kind] ? ends->global[kind][j] : j;
+      if ((st = martello_observer_peak(obs, kind, g, q1[j])) != MARTELLO_OK) return st;
     }
   }
   return MARTELLO_OK;

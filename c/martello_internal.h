@@ -208,6 +208,10 @@ int martello_observer_sample(martello_observer *obs, martello_eval *ev, double t
  * neither depends on the output (docs/run-layer.md, "the energy terms"). */
 int martello_observer_row(martello_observer *obs, martello_eval *ev, double t, const double *u,
                           const double *v, const double *a, const double *force, int k);
+/* A step at t of a method that samples the scene only where all of it stands at one time (local
+ * stepping): counted against the budget (max_steps, max_wall, the progress callback), no sample;
+ * MARTELLO_ERR_LIMIT or MARTELLO_ERR_INTERRUPTED (message set) when the run must stop. */
+int martello_observer_step(martello_observer *obs, double t);
 /* An extremum of node `node`'s displacement located inside an accepted step (the root of its
  * velocity), at t with value u; maximum = 1 for a maximum, 0 for a minimum. From the first
  * call on, u_peak holds located maxima only. */
@@ -232,6 +236,9 @@ typedef struct {
   const double *q0[MARTELLO_PEAK_LINK_DU + 1], *r0[MARTELLO_PEAK_LINK_DU + 1],
       *q1[MARTELLO_PEAK_LINK_DU + 1], *r1[MARTELLO_PEAK_LINK_DU + 1];
   int (*skip)(void *ctx, int kind, int index);
+  /* the observer's index of item j of kind: global[kind][j] (NULL: j), for a method that
+   * integrates part of the scene (docs/sundials-ode.md, local stepping) */
+  const int *global[MARTELLO_PEAK_LINK_DU + 1];
 } martello_peak_ends;
 typedef int (*martello_peak_probe)(void *ctx, double t, int kind, int index, double *q, double *r);
 /* Every extremum inside [t0, t1] that can raise a reported peak, located on the method's
@@ -357,4 +364,6 @@ int martello_accumulation_release(martello_accumulation *acc, martello_observer 
 int martello_event_driven_run(martello_model *model, martello_run *run);
 int martello_ida_run(martello_model *model, martello_run *run);
 int martello_ode_run(martello_model *model, martello_run *run);
+/* martello_ode_run with local_stepping: cluster by cluster (c/local_stepping.c). */
+int martello_ode_local_run(martello_model *model, martello_run *run);
 #endif

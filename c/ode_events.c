@@ -460,7 +460,7 @@ static int node_extrema(ode_events *E, double t0, double t1, const double *y1) {
         u = N_VGetArrayPointer(E->ytmp)[E->iu[i]];
       }
     }
-    st = martello_observer_extremum(E->obs, i, hi, u, is_max);
+    st = martello_observer_extremum(E->obs, oe_gnode(E, i), hi, u, is_max);
     if (st != MARTELLO_OK) return oe_fail(E, st, "%s: martello_observer_extremum failed", E->name);
   }
   return MARTELLO_OK;
@@ -494,7 +494,7 @@ static int peak_skip(void *ctx, int kind, int j) {
   ode_events *E = ctx;
   if (kind == MARTELLO_PEAK_V || kind == MARTELLO_PEAK_A) return E->fixed[j];
   if (kind == MARTELLO_PEAK_PEN || kind == MARTELLO_PEAK_FORCE)
-    return E->rig[j] >= 0 || !martello_observer_in_phase(E->obs, j);
+    return E->rig[j] >= 0 || !martello_observer_in_phase(E->obs, oe_gcon(E, j));
   return 0;
 }
 
@@ -518,6 +518,9 @@ static int located_peaks(ode_events *E, double t0, double t1, int at_event) {
   martello_peak_ends_set(&e, 0, E->n, E->nc, E->nl, E->pv0, E->pa0, E->pj0, E->el0);
   martello_peak_ends_set(&e, 1, E->n, E->nc, E->nl, E->pv1, E->pa1, E->pj1, E->el1);
   e.skip = peak_skip;
+  e.global[MARTELLO_PEAK_V] = e.global[MARTELLO_PEAK_A] = E->g_node;
+  e.global[MARTELLO_PEAK_PEN] = e.global[MARTELLO_PEAK_FORCE] = E->g_con;
+  e.global[MARTELLO_PEAK_LINK_FORCE] = e.global[MARTELLO_PEAK_LINK_DU] = E->g_link;
   if (at_event && (st = martello_peak_fold_end(E->obs, &e, E)) != MARTELLO_OK) return st;
   return martello_locate_peaks(E->obs, &e, t0, t1, E->rtol, E->event_tol, peak_probe, E);
 }
@@ -649,7 +652,7 @@ int oe_classify_roots(ode_events *E, double t_last, double tret, const double *y
     if (!found[2 * j + 1] || found[2 * j]) continue;
     if (r >= 0 && E->closed[r]) continue;
     double d = oe_pen(E, j, E->u);
-    int want = ACT_NONE, touching = martello_observer_in_phase(E->obs, j);
+    int want = ACT_NONE, touching = martello_observer_in_phase(E->obs, oe_gcon(E, j));
     if (r < 0) {
       /* touching with d > 0: the deepest point, sampled there as an accepted state */
       if (!touching && d > 0.0) want = ACT_ONSET;
@@ -674,7 +677,7 @@ int oe_classify_roots(ode_events *E, double t_last, double tret, const double *y
   }
   int any = 0;
   for (int j = 0; j < E->nc; j++) {
-    int r = E->rig[j], dir = found[2 * j], touching = martello_observer_in_phase(E->obs, j);
+    int r = E->rig[j], dir = found[2 * j], touching = martello_observer_in_phase(E->obs, oe_gcon(E, j));
     if (dir == 0) continue;
     if (r < 0) {
       if (dir > 0 && !touching) E->act[j] = ACT_ONSET;
@@ -723,7 +726,7 @@ int oe_boundary_events(ode_events *E, double t_last, double tret, const double *
   for (int i = 0; i < E->n; i++) vmax = fmax(vmax, fabs(E->v[i]));
   double wtol = 10.0 * (E->rtol * vmax + E->atol);
   for (int j = 0; j < E->nc; j++) {
-    int r = E->rig[j], want = ACT_NONE, touching = martello_observer_in_phase(E->obs, j);
+    int r = E->rig[j], want = ACT_NONE, touching = martello_observer_in_phase(E->obs, oe_gcon(E, j));
     if ((r >= 0 && E->closed[r]) || (E->smooth && E->cont[j])) continue;
     double d = oe_pen(E, j, E->u), w = oe_rate(E, j, E->v);
     /* on the surface within round-off of the gap, or of the time */
@@ -773,12 +776,12 @@ int oe_prepare_restart(ode_events *E, double t, double *u, double *v) {
     switch (E->act[j]) {
     case ACT_ONSET:
       oe_nudge(E, j, +1, u);
-      martello_observer_set_phase(E->obs, j, 1, t, w);
+      martello_observer_set_phase(E->obs, oe_gcon(E, j), 1, t, w);
       E->events++;
       break;
     case ACT_SEPARATION:
       oe_nudge(E, j, -1, u);
-      martello_observer_set_phase(E->obs, j, 0, t, w);
+      martello_observer_set_phase(E->obs, oe_gcon(E, j), 0, t, w);
       E->events++;
       break;
     case ACT_IMPACT:
@@ -1094,16 +1097,16 @@ int oe_inner_events(ode_events *E, double t0, double t1, const double *y1) {
     free(rows);
   }
   for (int k = 0; k < E->nev; k++) {
-    const int j = E->ev_j[k], touching = martello_observer_in_phase(E->obs, j);
+    const int j = E->ev_j[k], touching = martello_observer_in_phase(E->obs, oe_gcon(E, j));
     const double t = E->ev_t[k];
     if (E->ev_k[k] < 0) {
-      if (touching && (st = martello_observer_peak(E->obs, MARTELLO_PEAK_PEN, j, gap_at(E, j, t, 0))) != MARTELLO_OK)
+      if (touching && (st = martello_observer_peak(E->obs, MARTELLO_PEAK_PEN, oe_gcon(E, j), gap_at(E, j, t, 0))) != MARTELLO_OK)
         return oe_fail(E, st, "%s: martello_observer_peak failed", E->name);
       continue;
     }
     if (E->ev_k[k] == touching) continue;     /* the observer has it already */
     const double w = gap_at(E, j, t, 1);
-    if ((st = martello_observer_set_phase(E->obs, j, E->ev_k[k], t, w)) != MARTELLO_OK)
+    if ((st = martello_observer_set_phase(E->obs, oe_gcon(E, j), E->ev_k[k], t, w)) != MARTELLO_OK)
       return oe_fail(E, st, "%s: martello_observer_set_phase failed", E->name);
     if (E->vin[j] == 0.0) E->vin_j[E->nvin++] = j;     /* listed once until the commit */
     /* for the commit (Hunt-Crossley's v_in); -1: listed, no onset */

@@ -120,6 +120,9 @@ typedef struct {
    * than dampers and of the penalty contacts (quadrature), kinetic energy taken out at
    * restarts */
   double dw_ext, dw_int, dw_links, dw_contact, e_impact;
+  /* the observer's numbering of the nodes, contacts and links when the run is a cluster of a
+   * larger scene (c/local_stepping.c; NULL: the same numbering) */
+  const int *g_node, *g_con, *g_link;
   /* diagnostics */
   double t_now;               /* where the integration stands (the t_reached of a failure) */
   int nan_seen;
@@ -128,6 +131,11 @@ typedef struct {
   int same_time;              /* restarts in a row at one time */
   double t_prev_restart;
 } ode_events;
+
+/* The observer's index of node i and of contact j (the cluster's maps, docs/sundials-ode.md,
+ * local stepping). */
+static inline int oe_gnode(const ode_events *E, int i) { return E->g_node ? E->g_node[i] : i; }
+static inline int oe_gcon(const ode_events *E, int j) { return E->g_con ? E->g_con[j] : j; }
 
 /* ---- set-up and failures -------------------------------------------------------------------- */
 /* The settings, topology and arrays of a run, its evaluator on smooth branches with their

@@ -51,6 +51,7 @@
 #include "martello.h"
 #include "martello_internal.h"
 #include "ode_events.h"
+#include "sundials_ode.h"
 
 /* Kinds of the table "methods" (fortran/registry.f90 METHOD_*). */
 enum { KIND_BDF = 1, KIND_ADAMS = 2, KIND_ERK = 3, KIND_DIRK = 4, KIND_IMEX = 5 };
@@ -60,18 +61,6 @@ enum { KIND_BDF = 1, KIND_ADAMS = 2, KIND_ERK = 3, KIND_DIRK = 4, KIND_IMEX = 5 
 /* error-test failures of one step before the integrator gives up (SUNDIALS' default: 7) */
 #define MAX_ERR_TEST_FAILS 50
 
-typedef struct {
-  ode_events E;            /* contacts, events, the observer's hand-overs (c/ode_events.c) */
-  int ark;                 /* 0: CVODE, 1: ARKODE */
-  int kind;                /* KIND_* */
-  int erk_id, dirk_id;     /* ARKODE tables (ARKODE_*_NONE when absent) */
-  const char *name;        /* "CVODE" or "ARKODE": what the messages say */
-  int kd, lumped;
-  sunindextype N;
-  double *kb, *cb;         /* the tangents' bands (martello_eval_tangent) */
-  void *mem;
-  char msg[240];
-} ode_problem;
 
 #define fail(P, ...) oe_fail(&(P)->E, __VA_ARGS__)
 
@@ -630,6 +619,9 @@ static int integrate(ode_problem *P, SUNContext ctx, N_Vector yy, SUNMatrix *Jp,
 }
 
 int martello_ode_run(martello_model *model, martello_run *run) {
+  martello_settings s;
+  if (model && run && martello_run_settings(run, &s) == MARTELLO_OK && s.local_stepping)
+    return martello_ode_local_run(model, run);
   ode_problem prob;
   ode_problem *P = &prob;
   ode_events *E = &P->E;
@@ -667,3 +659,31 @@ int martello_ode_run(martello_model *model, martello_run *run) {
   release(P);
   return st;
 }
+
+/* ---- the pieces c/local_stepping.c drives per cluster (c/sundials_ode.h) ---------------------- */
+
+int ode_problem_setup(ode_problem *P, martello_model *model, martello_run *run) {
+  int st = martello_run_observer(run, &P->E.obs);
+  return st != MARTELLO_OK ? st : setup(P, model, run);
+}
+void ode_problem_release(ode_problem *P) {
+  if (P->mem) {
+    if (P->ark) ARKStepFree(&P->mem); else CVodeFree(&P->mem);
+  }
+  release(P);
+}
+int ode_problem_create(ode_problem *P, SUNContext ctx, N_Vector y, SUNMatrix *J, SUNLinearSolver *LS) {
+  return create(P, ctx, y, J, LS);
+}
+int ode_problem_restart(ode_problem *P, double t, N_Vector y) { return restart(P, t, y); }
+int ode_problem_prepare_restart(ode_problem *P, double t, double *y) { return prepare_restart(P, t, y); }
+int ode_problem_flush_counts(ode_problem *P) { return flush_counts(P); }
+int ode_problem_observe(ode_problem *P, double t, const double *y, int k, int row) {
+  return observe(P, t, y, k, row);
+}
+int ode_problem_check(ode_problem *P, int flag, const char *call) { return check(P, flag, call); }
+int ode_problem_root_stays_zero(ode_problem *P, const double *y, const int *found) {
+  return root_stays_zero(P, y, found);
+}
+int ode_problem_interpolant(ode_problem *P, double t, int k, N_Vector out) { return interpolant(P, t, k, out); }
+double ode_problem_last_step(ode_problem *P) { return be_last_step(P); }

@@ -433,6 +433,24 @@ contains
       c_observer_sample = sample_from_c(handle, ehandle, t, u, v, a, force, k, .false.)
    end function c_observer_sample
 
+   !> A step of a method that samples the scene only where all of it stands at one time (local
+   !> stepping, docs/sundials-ode.md): a step of the budget at t (max_steps, max_wall, the
+   !> progress callback), no sample. MARTELLO_ERR_LIMIT or MARTELLO_ERR_INTERRUPTED with the
+   !> message when the run must stop.
+   integer(c_int) function c_observer_step(handle, t) bind(C, name='martello_observer_step')
+      type(c_ptr), value :: handle
+      real(c_double), value :: t
+      type(observer_t), pointer :: op
+      integer :: stat
+      op => get_observer(handle)
+      c_observer_step = MARTELLO_ERR_ARGUMENT
+      if (.not. associated(op)) return
+      op%nsamples = op%nsamples + 1
+      stat = MARTELLO_OK
+      call observer_watch(op, t, stat)
+      c_observer_step = stat
+   end function c_observer_step
+
    !> An output row on the method's interpolant inside a step (martello_observer_row):
    !> measured and recorded as a sample, off the energy grid and the step budget.
    integer(c_int) function c_observer_row(handle, ehandle, t, u, v, a, force, k) &

@@ -12,7 +12,7 @@ module martello_integrator_settings
       INT_MSBDF, INT_IDA, INT_LAST, SETTINGS, INTEGRATORS, setting_t, NSETTINGS, S_DT, S_T_END, &
       S_BETA, S_GAMMA, S_ALPHA, S_RHO_INF, S_TOL_RESIDUAL, S_TOL_INCREMENT, S_MAX_NEWTON, &
       S_CHECK_STABILITY, S_EVERY, S_DIVERGENCE_FACTOR, S_RTOL, S_ATOL, S_THETA, S_EVENT_TOL, &
-      S_H_MAX, S_FUSED_CHAIN, S_MAX_STEPS, S_MAX_WALL, S_EVENT_SPLIT, S_METHOD, S_MODAL_VECTORS, T_INT, &
+      S_H_MAX, S_FUSED_CHAIN, S_MAX_STEPS, S_MAX_WALL, S_EVENT_SPLIT, S_METHOD, S_MODAL_VECTORS, S_LOCAL_STEPPING, T_INT, &
       METHODS, &
       INT_CVODE, INT_ARKODE
    implicit none
@@ -56,6 +56,8 @@ module martello_integrator_settings
       integer(c_int) :: method = nint(SETTINGS(S_METHOD)%default)
       !> fast-nonlinear: 0 all modes; m > 0 that many load-dependent Ritz vectors
       integer(c_int) :: modal_vectors = nint(SETTINGS(S_MODAL_VECTORS)%default)
+      !> cvode: integrate cluster by cluster (docs/sundials-ode.md, local stepping)
+      logical(c_bool) :: local_stepping = SETTINGS(S_LOCAL_STEPPING)%default /= 0.0_dp
    end type integrator_settings_t
 
 contains
@@ -168,6 +170,7 @@ contains
       case (S_EVENT_SPLIT); x = merge(1.0_dp, 0.0_dp, logical(s%event_split))
       case (S_METHOD); x = s%method
       case (S_MODAL_VECTORS); x = s%modal_vectors
+      case (S_LOCAL_STEPPING); x = merge(1.0_dp, 0.0_dp, logical(s%local_stepping))
       case default; x = 0.0_dp
       end select
    end function setting_value

@@ -34,7 +34,7 @@ module martello_registry
       INT_ARKODE, INT_LAST, NSETTINGS, S_DT, S_T_END, S_BETA, S_GAMMA, S_ALPHA, S_RHO_INF, S_TOL_RESIDUAL, &
       S_TOL_INCREMENT, S_MAX_NEWTON, S_CHECK_STABILITY, S_EVERY, S_DIVERGENCE_FACTOR, S_RTOL, &
       S_ATOL, S_THETA, S_EVENT_TOL, S_H_MAX, S_FUSED_CHAIN, S_MAX_STEPS, S_MAX_WALL, S_EVENT_SPLIT, S_METHOD, &
-      S_MODAL_VECTORS, SETTINGS, &
+      S_MODAL_VECTORS, S_LOCAL_STEPPING, SETTINGS, &
       INTEGRATORS, METHODS, method_t, METHOD_DEFAULT, METHOD_BDF, METHOD_ADAMS, METHOD_ERK, &
       METHOD_DIRK, METHOD_IMEX, setting_t, integrator_t, &
       registry_shape, registry_column, registry_row, registry_find, registry_name, &
@@ -70,7 +70,8 @@ module martello_registry
                          S_DIVERGENCE_FACTOR = 12, S_RTOL = 13, S_ATOL = 14, S_THETA = 15, &
                          S_EVENT_TOL = 16, S_H_MAX = 17, S_FUSED_CHAIN = 18, &
                          S_MAX_STEPS = 19, S_MAX_WALL = 20, S_EVENT_SPLIT = 21, &
-                         S_METHOD = 22, S_MODAL_VECTORS = 23, NSETTINGS = 23
+                         S_METHOD = 22, S_MODAL_VECTORS = 23, &
+                         S_LOCAL_STEPPING = 24, NSETTINGS = 24
    integer, parameter :: MAX_COLS = NSETTINGS   !< the widest table: reads, a column per setting
    ! C types of the settings (rows of the table "setting_types")
    integer, parameter :: T_DOUBLE = 1, T_INT = 2, T_BOOL = 3
@@ -305,7 +306,8 @@ module martello_registry
       setting_t('method', T_INT, 0.0_dp, 0.0_dp, 399.0_dp, .false., .false., &
                 'a row of the table methods for the integrator, or 0 (its default)'), &
       setting_t('modal_vectors', T_INT, 0.0_dp, 0.0_dp, BIG, .false., .false., &
-                'a whole number >= 0 (0: all modes; m: m load-dependent Ritz vectors)')]
+                'a whole number >= 0 (0: all modes; m: m load-dependent Ritz vectors)'), &
+      setting_t('local_stepping', T_BOOL, 0.0_dp, 0.0_dp, 1.0_dp, .false., .false., 'true or false')]
 
    ! Methods (values frozen; table "methods"): the kinds
    integer, parameter :: METHOD_DEFAULT = 0, METHOD_BDF = 1, METHOD_ADAMS = 2, METHOD_ERK = 3, &
@@ -381,7 +383,7 @@ module martello_registry
                    READS_BASE + READS_DIVERGENCE + 2**S_TOL_RESIDUAL + 2**S_MAX_NEWTON + 2**S_MODAL_VECTORS, &
                    RUNS_PENALTY, 'Wilson (2002) fast nonlinear analysis: exact modal steps, pseudo-forces'), &
       integrator_t('cvode', INT_CVODE, FAMILY_ODE, .true., &
-                   READS_BASE + READS_DIVERGENCE + READS_ADAPTIVE + 2**S_METHOD, &
+                   READS_BASE + READS_DIVERGENCE + READS_ADAPTIVE + 2**S_METHOD + 2**S_LOCAL_STEPPING, &
                    RUNS_PENALTY + RUNS_RIGID, &
                    'SUNDIALS CVODE, variable-order BDF or Adams, banded analytic Jacobian'), &
       integrator_t('arkode', INT_ARKODE, FAMILY_ODE, .true., &

@@ -17,6 +17,8 @@ def main():
     except KeyboardInterrupt:     # before the command runs (after, run_command has its own)
         print("martello: interrupted", file=sys.stderr)
         return 130
+    finally:                      # every interrupt was handled: the exit code is ours
+        errors.forget_handled_interrupts()
 
 
 if __name__ == "__main__":

@@ -94,8 +94,16 @@ def _processes(pool):
 
 def _end(pool):
     """End a pool now: its workers are killed, whatever they run (a sweep that was asked to
-    stop does not wait for runs of minutes to finish), and reaped."""
+    stop does not wait for runs of minutes to finish), and reaped.
+
+    A worker killed while it sends a result leaves half a message in the pool's result pipe;
+    the pool's thread reading it would wait for the rest for ever, and the interpreter joins
+    that thread at exit (a study that said "interrupted" and never ended). Once the workers
+    are gone, this process's copy of the pipe's writing end is closed: the reader then meets
+    the end of the pipe, the pool is broken, and its thread ends (private to
+    concurrent.futures: best effort, as _processes)."""
     procs = _processes(pool)
+    results = getattr(pool, "_result_queue", None)
     for p in procs:
         try:
             p.kill()
@@ -106,6 +114,12 @@ def _end(pool):
         try:
             p.join(2.0)
         except (OSError, ValueError, AssertionError):
+            pass
+    writer = getattr(results, "_writer", None)
+    if writer is not None and all(p.exitcode is not None for p in procs):
+        try:
+            writer.close()
+        except OSError:
             pass
 
 

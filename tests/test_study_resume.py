@@ -195,6 +195,52 @@ def test_a_stopped_sweep_yields_what_finished_and_ends_the_runs_in_flight():
     assert time.monotonic() - t0 < 20            # the 600 s runs were ended, not waited for
 
 
+# A sweep stopped while a worker is half way through sending its result (a long history
+# under load): the worker writes a message's header and 16 of its bytes, then runs on; the
+# sweep is stopped, its workers killed. The script must end: the pool's thread, left reading
+# a message that never completes, was joined at exit for ever.
+HALF_SENT = """
+import os, struct, sys, threading, time
+from martello.batch import run_specs
+marker = sys.argv[1]
+
+def half_sent(spec):
+    if spec["id"] == 1:
+        f = sys._getframe()
+        while f.f_code.co_name != "_process_worker":      # concurrent.futures' worker loop
+            f = f.f_back
+        os.write(f.f_locals["result_queue"]._writer.fileno(), struct.pack("!i", 1 << 20) + bytes(16))
+        open(marker, "w").close()
+        time.sleep(600)
+    return {"id": spec["id"], "status": "MARTELLO_OK", "message": ""}
+
+stop = threading.Event()
+
+def stop_once_half_sent():
+    while not os.path.exists(marker):
+        time.sleep(0.01)
+    stop.set()
+
+threading.Thread(target=stop_once_half_sent, daemon=True).start()
+print([r["id"] for r in run_specs([{"id": 0}, {"id": 1}], jobs=1, fn=half_sent, stop=stop)])
+"""
+
+
+def test_a_sweep_stopped_while_a_result_is_half_sent_ends(tmp_path):
+    p = subprocess.Popen([sys.executable, "-c", HALF_SENT, str(tmp_path / "half_sent")], cwd=ROOT,
+                         stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                         start_new_session=True)
+    try:
+        out, err = p.communicate(timeout=60)     # it ends within a second or two; else it hangs
+    except subprocess.TimeoutExpired:
+        os.killpg(p.pid, signal.SIGKILL)
+        p.communicate()
+        pytest.fail("the stopped sweep never ended (its pool's thread waits for the rest of a "
+                    "message from a killed worker)")
+    assert p.returncode == 0 and out.strip() == "[0]", (p.returncode, out, err)
+    assert not group_alive(p.pid)
+
+
 def test_a_temporary_folder_is_cleaned_only_once_its_writer_is_gone(tmp_path):
     out = tmp_path / "out"
     dead = tmp_path / ".out.abc.tmp"

@@ -44,7 +44,7 @@ module martello_observer
       observer_peak, observer_peak_value, peak_items
    ! the end of a run (budget)
    public :: observer_fail, observer_failed, observer_fail_nonfinite, observer_finish, &
-      observer_close
+      observer_close, observer_watch
 
    !> Linear functionals q = R·u of the state, tracked at every accepted sample whatever
    !> the history records (docs/results.md, "Frames and buildings": a frame's or building's

@@ -124,6 +124,7 @@ ANALYSIS_TYPES = {
                 "event_split": _setting("bool", "event_split"),
                 "method": ("str", False, None, None),
                 "modal_vectors": _setting("int", "modal_vectors"),
+                "local_stepping": _setting("bool", "local_stepping"),
                 "output": ("table", False, None, None)},
 }
 OUTPUT_KEYS = {"every": _setting("int", "every"), "nodes": ("list", False, None, None),
