@@ -160,10 +160,10 @@ typedef struct martello_subset_map {
 } martello_subset_map;
 /* The sub-model of parent on its free nodes nodes[0..n-1] (any order; a node given twice, a
  * fixed node or one out of range: MARTELLO_ERR_ARGUMENT). Its nodes: those and the fixed nodes
- * their elements touch, in ascending parent number (kd_sub <= kd_parent). Its links and
- * contacts: every one whose free nodes all lie in nodes[], in the parent's order (one with a free
- * node outside is left out: the caller's open contact); its mass couplings and stiffness blocks
- * likewise, but one with a free node outside is refused (the mass or stiffness would be cut).
+ * their elements touch, in ascending parent number (kd_sub <= kd_parent). Its contacts: every
+ * one whose free nodes all lie in nodes[], in the parent's order (one with a free node outside
+ * is left out: the caller's open contact); its links, mass couplings and stiffness blocks
+ * likewise, but one with a free node outside is refused (it always joins its nodes' cluster).
  * The nodal forces of its nodes, gravity, influence, ground motion, the contacts' effective
  * masses: the parent's. parent must hold no chains per node (martello_model_expand_chains). The
  * message of a refusal: martello_model_message(parent). O(n + the elements they touch): the
@@ -176,6 +176,13 @@ void martello_subset_map_free(martello_subset_map *map);
 /* The model's chains (martello_model_add_chain) made into links and contacts one by one, in
  * place, numbered as the run numbers them. */
 int martello_model_expand_chains(martello_model *model);
+/* The clusters of the model's free nodes: nodes joined by links, mass couplings, stiffness
+ * blocks and the contacts with joined[j] != 0 (closed ones; joined NULL: none), each element
+ * joining the free nodes of its row (a fixed node or the ground joins nothing). label[i] (n
+ * values): node i's cluster, 0 .. *n_clusters - 1 numbered in the order of their first node; -1
+ * for a fixed node. O(n + terms) (union-find): on the parent once, on a sub-model for a split. */
+int martello_model_clusters(martello_model *model, const int *joined, int *label,
+                            int *n_clusters);
 /* Copy the state of map's elements -- committed and trial: link histories, forces and branches
  * held; contact penetrations, rates, forces, onset speeds, on/off and branches; stiffness
  * blocks' states -- and of the sub nodes' last loaded (u, v, f_int, f_ext), from the parent's
