@@ -229,7 +229,7 @@ typedef struct martello_settings {
   bool event_split;         /* Newmark family: split a step at a penalty onset/separation */
   int method;               /* cvode, arkode: a value of the table "methods" (0: the default) */
   int modal_vectors;        /* fast-nonlinear: 0 all modes; m > 0: m load-dependent Ritz vectors */
-  bool local_stepping;      /* cvode: integrate cluster by cluster (docs/sundials-ode.md) */
+  bool local_stepping;      /* cvode, arkode: integrate cluster by cluster (docs/sundials-ode.md) */
 } martello_settings;
 
 /* Indices of martello_run_counters, martello_run_energy and the values of
