@@ -97,12 +97,14 @@ int martello_eval_commit(martello_eval *ev, const double *u, const double *v);
  * branch between located switches (fortran/switching.f90, docs/event-driven.md); branches
  * change at commits past their switches. *nsw: the number of switch slots. */
 int martello_eval_use_branches(martello_eval *ev, int *nsw);
-/* As martello_eval_use_branches, but only the laws whose force jumps at a switch are held:
- * penalty contacts whose force is continuous at onset and separation (linear, Hertz, the
- * Hunt-Crossley family) stay whole, their kinks inside the integrator's steps
- * (docs/sundials-ode.md, events inside the steps); continuous[j] = 1 for those contacts (n_contacts
- * values). */
-int martello_eval_use_smooth_branches(martello_eval *ev, int *nsw, int *continuous);
+/* As martello_eval_use_branches, but the penalty contacts of the class laws stay whole, their
+ * kinks inside the integrator's steps (docs/sundials-ode.md, events inside the steps):
+ * MARTELLO_ACROSS_CONTINUOUS those whose force is continuous at onset and separation (linear,
+ * Hertz, the Hunt-Crossley family), MARTELLO_ACROSS_RATE_BOUNDED those whose force's rate is
+ * bounded there too (linear, Hertz with a whole exponent: fortran/contact_laws.f90
+ * law_rate_bounded); continuous[j] = 1 for those contacts (n_contacts values). */
+enum { MARTELLO_ACROSS_CONTINUOUS = 1, MARTELLO_ACROSS_RATE_BOUNDED = 2 };
+int martello_eval_use_smooth_branches(martello_eval *ev, int laws, int *nsw, int *continuous);
 /* The approach speed v at the located onset of penalty contact j's phase (committed in contact):
  * the Hunt-Crossley family's v_in. */
 int martello_eval_set_onset_speed(martello_eval *ev, int j, double v);
@@ -158,10 +160,10 @@ typedef struct martello_subset_map {
 } martello_subset_map;
 /* The sub-model of parent on its free nodes nodes[0..n-1] (any order; a node given twice, a
  * fixed node or one out of range: MARTELLO_ERR_ARGUMENT). Its nodes: those and the fixed nodes
- * their elements touch, in ascending parent number (kd_sub <= kd_parent). Its links and
- * contacts: every one whose free nodes all lie in nodes[], in the parent's order (one with a free
- * node outside is left out: the caller's open contact); its mass couplings and stiffness blocks
- * likewise, but one with a free node outside is refused (the mass or stiffness would be cut).
+ * their elements touch, in ascending parent number (kd_sub <= kd_parent). Its contacts: every
+ * one whose free nodes all lie in nodes[], in the parent's order (one with a free node outside
+ * is left out: the caller's open contact); its links, mass couplings and stiffness blocks
+ * likewise, but one with a free node outside is refused (it always joins its nodes' cluster).
  * The nodal forces of its nodes, gravity, influence, ground motion, the contacts' effective
  * masses: the parent's. parent must hold no chains per node (martello_model_expand_chains). The
  * message of a refusal: martello_model_message(parent). O(n + the elements they touch): the
@@ -174,6 +176,13 @@ void martello_subset_map_free(martello_subset_map *map);
 /* The model's chains (martello_model_add_chain) made into links and contacts one by one, in
  * place, numbered as the run numbers them. */
 int martello_model_expand_chains(martello_model *model);
+/* The clusters of the model's free nodes: nodes joined by links, mass couplings, stiffness
+ * blocks and the contacts with joined[j] != 0 (closed ones; joined NULL: none), each element
+ * joining the free nodes of its row (a fixed node or the ground joins nothing). label[i] (n
+ * values): node i's cluster, 0 .. *n_clusters - 1 numbered in the order of their first node; -1
+ * for a fixed node. O(n + terms) (union-find): on the parent once, on a sub-model for a split. */
+int martello_model_clusters(martello_model *model, const int *joined, int *label,
+                            int *n_clusters);
 /* Copy the state of map's elements -- committed and trial: link histories, forces and branches
  * held; contact penetrations, rates, forces, onset speeds, on/off and branches; stiffness
  * blocks' states -- and of the sub nodes' last loaded (u, v, f_int, f_ext), from the parent's

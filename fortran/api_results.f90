@@ -197,4 +197,25 @@ contains
       end associate
       c_run_functionals = MARTELLO_OK
    end function c_run_functionals
+
+   !> The step trace (martello_run_set_trace, _set_trace_nodes): n, its grid points; with a
+   !> non-NULL buf also buf(4 + m, n) = t, the traced contact's force, the kinetic and the
+   !> recoverable energy, u of the m traced nodes.
+   integer(c_int) function c_run_trace(handle, n, buf) bind(C, name='martello_run_trace')
+      type(c_ptr), value :: handle
+      integer(c_int), intent(out) :: n
+      type(c_ptr), value :: buf
+      real(c_double), pointer :: b(:, :)
+      type(run_t), pointer :: rp
+      rp => get_run(handle)
+      c_run_trace = MARTELLO_ERR_ARGUMENT
+      n = 0
+      if (.not. associated(rp)) return
+      n = int(rp%results%ntrace, c_int)
+      if (c_associated(buf) .and. n > 0) then
+         call c_f_pointer(buf, b, [size(rp%results%trace, 1), int(n)])
+         b = rp%results%trace(:, 1:n)
+      end if
+      c_run_trace = MARTELLO_OK
+   end function c_run_trace
 end module martello_api_results

@@ -8,7 +8,7 @@ module martello_api_submodel
    use martello_status
    use martello_model, only: model_t, model_expand_chains
    use martello_evaluator, only: evaluator_t
-   use martello_submodel, only: submodel_map_t, submodel_build, submodel_transfer
+   use martello_submodel, only: submodel_map_t, submodel_build, submodel_transfer, model_clusters
    use martello_api_handles, only: get_model, get_eval
    implicit none
    private
@@ -120,6 +120,44 @@ contains
       if (stat /= MARTELLO_OK) mp%errmsg = message
       c_model_expand_chains = stat
    end function c_model_expand_chains
+
+   !> The clusters of the model's free nodes (model_clusters): joined[j] /= 0 for a contact that
+   !> joins its nodes (NULL: none does); label[i] the cluster of node i, 0 … *n_clusters − 1 in
+   !> the order of their first node, −1 for a fixed node.
+   integer(c_int) function c_model_clusters(handle, joined, label, n_clusters) &
+      bind(C, name='martello_model_clusters')
+      type(c_ptr), value :: handle, joined
+      integer(c_int), intent(out) :: label(*), n_clusters
+      type(model_t), pointer :: mp
+      integer(c_int), pointer :: pj(:)
+      logical, allocatable :: join(:)
+      integer, allocatable :: lab(:)
+      integer :: nc, st
+      n_clusters = 0
+      c_model_clusters = MARTELLO_ERR_ARGUMENT
+      mp => get_model(handle)
+      if (.not. associated(mp)) return
+      if (mp%nchain > 0) then
+         mp%errmsg = 'model_clusters: the model holds chains per node (model_add_chain);'// &
+                     ' call martello_model_expand_chains first'; return
+      end if
+      nc = mp%ncontact
+      allocate (join(nc), lab(mp%n), stat=st)
+      if (st /= 0) then
+         call out_of_memory('the clusters of a model', 4.0_dp*(nc + mp%n), FIX_SMALLER_SCENE, &
+                            st, mp%errmsg)
+         c_model_clusters = st; return
+      end if
+      join = .false.
+      if (c_associated(joined) .and. nc > 0) then
+         call c_f_pointer(joined, pj, [nc])
+         join = pj /= 0
+      end if
+      call model_clusters(mp, join, lab, st)
+      label(1:mp%n) = lab - 1
+      n_clusters = st
+      c_model_clusters = MARTELLO_OK
+   end function c_model_clusters
 
    !> The elements' and nodes' state of map between the parent's evaluator and the sub-model's
    !> (submodel_transfer): to_sub /= 0 parent → sub, 0 sub → parent.

@@ -57,6 +57,9 @@ module martello_generalized_alpha
       !> start state is kept in us, vs, as
       logical :: event_split = .false.
       real(dp), allocatable :: us(:), vs(:), as(:), jump(:)
+      !> the last step was split: its last stretch's a carries the lag of that stretch's
+      !> length, not of h (consistent_newton)
+      logical :: relag = .false.
    contains
       procedure :: init
       procedure :: step
@@ -185,7 +188,12 @@ contains
       call mass_times(m, self%an, self%man)
       call external_forces(m, self%mrow, t, self%fext)
       fext_mag = maxval(abs(self%fext))
-      call newton_step(converged)
+      if (self%relag) then
+         self%relag = .false.
+         call consistent_newton(converged)
+      else
+         call newton_step(converged)
+      end if
       if (.not. converged) return
       if (self%event_split) then
          if (split_step()) return
@@ -260,7 +268,7 @@ contains
             call set_step(tau)
             call external_forces(m, self%mrow, t_a + tau, self%fext)
             fext_mag = maxval(abs(self%fext))
-            call newton_step(converged)
+            call consistent_newton(converged)
             self%ms%con_branch = branch
             if (.not. converged) return
             call commit_works()
@@ -312,6 +320,7 @@ contains
          self%un = self%us; self%vn = self%vs; self%an = self%as
          call set_step(h_full)
          call contact_state(self, m)
+         self%relag = .true.
       end function split_step
 
       !> Solve the stretch [ta, t] of length hh from the state (un, vn, an) (uncommitted)
@@ -323,8 +332,38 @@ contains
          call external_forces(m, self%mrow, t, self%fext)
          fext_mag = maxval(abs(self%fext))
          self%ms%forced_off = .false.
-         call newton_step(converged)
+         call consistent_newton(converged)
       end subroutine solve_stretch
+
+      !> Newton on a stretch that does not continue one of its own length on its branch (an
+      !> event-split sub-step, the rest of a split step, the step after one). An α-method's a
+      !> is the acceleration at t + c·h, c = α_m − α_f, h the stretch's length (Erlicher et al.
+      !> 2002; docs/integrators.md, event-split steps): the start state carries the lag of
+      !> another length, or of the branch before a switch — an O(h) error of a, O(h²) of v at
+      !> every boundary, with a constant set by where the switch falls in the step. So the
+      !> stretch is solved once, its start's a set to ẍ_s + c(ẍ_e − ẍ_s), ẍ = M⁻¹(f_ext − f_int)
+      !> at its two ends on its branch (the right limit at the start), and solved again.
+      !> Newmark (c = 0): one solve, its a is ẍ already.
+      subroutine consistent_newton(converged)
+         logical, intent(out) :: converged
+         real(dp) :: c
+         c = self%am - self%af
+         call newton_step(converged)
+         if (c == 0.0_dp .or. .not. converged) return
+         self%work = self%fext - self%fint
+         call solve_free_mass(m, self%fixed_nodes, self%mband, self%work, ok)
+         self%jump = self%fext_n - self%fint_n
+         if (ok) call solve_free_mass(m, self%fixed_nodes, self%mband, self%jump, ok)
+         o%counters(C_FACTORIZATIONS) = o%counters(C_FACTORIZATIONS) + 2_i8
+         if (.not. ok) then
+            converged = .false.
+            call stepper_fail(o, MARTELLO_ERR_SINGULAR, t, 'singular mass at an event-split boundary', stat)
+            return
+         end if
+         self%an = self%jump + c*(self%work - self%jump)
+         call mass_times(m, self%an, self%man)
+         call newton_step(converged)
+      end subroutine consistent_newton
 
       !> The first switch of the stretch just solved, from its start (un, vn, an; the laws
       !> committed there) to its solved end (u, v), on the branches committed at the start:

@@ -16,7 +16,7 @@ module martello_submodel
    use martello_assembly, only: mech_state_t
    implicit none
    private
-   public :: submodel_map_t, submodel_build, submodel_transfer
+   public :: submodel_map_t, submodel_build, submodel_transfer, model_clusters
 
    !> The parent's number (1-based) of each node, link, contact and stiffness block of a
    !> sub-model.
@@ -118,10 +118,12 @@ contains
 
    !> The sub-model sub of p on the free nodes nodes(:) (1-based, any order): sub's nodes are
    !> those and the fixed nodes their elements touch, in p's order (so its half-bandwidth is at
-   !> most p's); its links and contacts every one of p's whose free nodes all lie in nodes(:),
-   !> in p's order, with p's parameters and effective masses; its mass couplings and stiffness
-   !> blocks likewise (one with a free node outside: refused — the mass or the stiffness would
-   !> be cut); the nodal forces of its nodes; p's gravity, influence and ground motion.
+   !> most p's); its contacts every one of p's whose free nodes all lie in nodes(:), in p's
+   !> order, with p's parameters and effective masses (one with a free node outside is left
+   !> out: an open contact between clusters); its links, mass couplings and stiffness blocks
+   !> likewise, but one with a free node outside is refused (it always joins its nodes' cluster:
+   !> the cluster would be cut); the nodal forces of its nodes; p's gravity, influence and
+   !> ground motion.
    !> map: p's number of each of sub's items. stat: MARTELLO_ERR_ARGUMENT (p%errmsg says
    !> which argument and the fix), MARTELLO_ERR_MEMORY. Cost O(size(nodes) + the items they
    !> touch) once p's incidence is built (O(p) once).
@@ -281,7 +283,8 @@ contains
       end subroutine element_nodes
 
       !> keep e if every free node of it is the cluster's (its fixed nodes then join); a
-      !> coupling or a block with a free node outside: why says so
+      !> contact with a free node outside is left out (an open contact between clusters, the
+      !> caller's); a link, a coupling or a block with one: why says so (it always joins)
       subroutine classify(e, kept)
          integer, intent(in) :: e
          logical, intent(out) :: kept
@@ -303,6 +306,10 @@ contains
                write (why, '(a,i0,a,i0,a,i0,a)') 'model_subset: the mass coupling ', q - 1, &
                   ' between nodes ', p%mc_a(q) - 1, ' and ', p%mc_b(q) - 1, &
                   ' crosses the cut: a consistent mass cannot be cut (give both nodes)'
+            else if (e <= p%nlink) then
+               write (why, '(a,i0,a,i0,a)') 'model_subset: link ', e - 1, ' has node ', &
+                  outside - 1, ' outside the cluster: a link always joins its nodes'' cluster'// &
+                  ' (give all its free nodes)'
             end if
             return
          end if
@@ -448,7 +455,7 @@ contains
       call move_r(se%u(1:), pe%u(1:), map%node); call move_r(se%v(1:), pe%v(1:), map%node)
       call move_r(se%f(1:), pe%f(1:), map%node); call move_r(se%fext(1:), pe%fext(1:), map%node)
       if (to_sub) then
-         se%branches = pe%branches; se%smooth = pe%smooth
+         se%branches = pe%branches; se%across = pe%across
       end if
    contains
       subroutine move_r(xs, xp, idx)
@@ -479,6 +486,72 @@ contains
          end if
       end subroutine move_l
    end subroutine submodel_transfer
+
+   !> The clusters of m: its free nodes joined by links, mass couplings, stiffness blocks and
+   !> the contacts j with joined(j) (closed ones), each element joining the free nodes of its
+   !> row (a fixed node or the ground joins nothing: it does not move). label(i): node i's
+   !> cluster, 1 … nclusters numbered in the order of their first node; 0 for a fixed node.
+   !> Union-find with path halving over the elements' terms: O(n + terms).
+   subroutine model_clusters(m, joined, label, nclusters)
+      type(model_t), intent(in) :: m
+      logical, intent(in) :: joined(:)
+      integer, intent(out) :: label(:), nclusters
+      integer :: j, first, i
+      ! label holds the union-find parents first, then the cluster numbers
+      label = [(i, i = 1, m%n)]
+      do j = 1, m%nlink
+         call join_row(m%lnk%node(m%lnk%first(j):m%lnk%first(j + 1) - 1))
+      end do
+      do j = 1, m%ncontact
+         if (joined(j)) call join_row(m%con%node(m%con%first(j):m%con%first(j + 1) - 1))
+      end do
+      do j = 1, m%ncoupling
+         call join_row([m%mc_a(j), m%mc_b(j)])
+      end do
+      do j = 1, m%nblock
+         call join_row(m%block(j)%node)
+      end do
+      ! the root of a cluster is its smallest node (join_row keeps the smaller root), so the
+      ! roots are met in node order before the other nodes of their clusters: numbered in one
+      ! pass, negated while the others still hold their roots
+      do i = 1, m%n
+         label(i) = root(i)
+      end do
+      nclusters = 0
+      do i = 1, m%n
+         if (m%fixed(i)) then
+            label(i) = 0
+         else if (label(i) == i) then
+            nclusters = nclusters + 1
+            label(i) = -nclusters
+         else
+            label(i) = label(label(i))
+         end if
+      end do
+      label = -label
+   contains
+      integer function root(i) result(r)
+         integer, intent(in) :: i
+         r = i
+         do while (label(r) /= r)
+            label(r) = label(label(r))        ! path halving
+            r = label(r)
+         end do
+      end function root
+      subroutine join_row(nd)
+         integer, intent(in) :: nd(:)
+         integer :: q, a, b
+         first = 0
+         do q = 1, size(nd)
+            if (m%fixed(nd(q))) cycle
+            if (first == 0) then
+               first = nd(q); cycle
+            end if
+            a = root(first); b = root(nd(q))
+            if (a /= b) label(max(a, b)) = min(a, b)   ! the smaller node is the root
+         end do
+      end subroutine join_row
+   end subroutine model_clusters
 
    !> a in ascending order (heapsort: O(k log k) whatever the order given)
    subroutine sort_ints(a)

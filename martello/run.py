@@ -324,7 +324,17 @@ def run_full(scene, raise_on_failure=True):
     with build_model(scene) as model:
         if scene.analysis["type"] == "static":
             return _static(scene, model), None
-        return _dynamic(scene, model, raise_on_failure)
+        return _dynamic(scene, model, raise_on_failure)[:2]
+
+
+def run_traced(scene, contact, nodes=()):
+    """(summary, history, trace) of a dynamic run whose step trace holds this contact and
+    these nodes (names): trace = {"t", "force", "kinetic", "recoverable": arrays over every grid
+    point of a fixed-step run, "u": {node: array}} (docs/results.md "Step trace"), whatever the
+    history records."""
+    with build_model(scene) as model:
+        return _dynamic(scene, model, True, trace=(names_of(scene.contacts).index(contact),
+                                                   [scene.index[n] for n in nodes], list(nodes)))
 
 
 def integrator_settings(an):
@@ -371,7 +381,7 @@ def _collector_paused():
 
 
 @_collector_paused()
-def _dynamic(scene, model, raise_on_failure=True):
+def _dynamic(scene, model, raise_on_failure=True, trace=None):
     an = scene.analysis
     out_nodes = [scene.index[n] for n in an["output"]["nodes"]]
     out_contacts = [names_of(scene.contacts).index(c) for c in an["output"]["contacts"]]
@@ -387,6 +397,8 @@ def _dynamic(scene, model, raise_on_failure=True):
         structures = _structure_functionals(scene)
         if structures.rows:
             r.set_functionals(structures.matrix(), structures.nodes, structures.pairs)
+        if trace is not None:
+            r.set_trace(*trace[:2])
         t0 = time.perf_counter()
         st = r.execute(model) if raise_on_failure else r.status_of(model)
         if st == native.constant("MARTELLO_ERR_INTERRUPTED"):
@@ -404,6 +416,7 @@ def _dynamic(scene, model, raise_on_failure=True):
         message = r.message()
         if structures.rows:
             structures.read(r)
+        steps = r.trace() if trace is not None else None
 
     columns = native.history_columns(an["output"]["nodes"], an["output"]["contacts"],
                                      an["output"]["links"])
@@ -508,7 +521,10 @@ def _dynamic(scene, model, raise_on_failure=True):
         "cost": counters | {"wall_time_s": wall},
         "provenance": provenance(scene),
     }
-    return summary, (columns, hist)
+    if steps is not None:
+        steps = dict(zip(("t", "force", "kinetic", "recoverable"), steps[:, :4].T),
+                     u=dict(zip(trace[2], steps[:, 4:].T)))
+    return summary, (columns, hist), steps
 
 
 # The library's per-node peaks that are a node's results, in the order summary.json lists

@@ -90,6 +90,30 @@ def test_a_turn_the_step_does_not_resolve_is_not_located(scene):
     assert not [(v, bad[:3], lost[:3]) for v, bad, lost, _ in found if bad or lost]
 
 
+@pytest.mark.parametrize("scene", ["p4_equal_rods_cd_half_cell_courant1.toml",
+                                   "p4_unequal_rods_cd_half_cell_courant1.toml"])
+def test_node_turns_the_steps_do_not_resolve_are_the_values_at_the_steps(scene):
+    # Central difference at Courant 1 on half-cell rods: the discrete solution is the exact
+    # wave at the steps (closed form, docs/p4-bars.md): every node's motion is made of
+    # jumps a step long, which no step resolves (docs/results.md "Peaks of a fixed-step
+    # method"): a wave front's |a| is 0, A, A, 0 at the steps (the parabola through them
+    # put its vertex 12.5 % above A, convex at its first sample), the struck ends' u turns
+    # from v0/4 to 0 in one step (its cubic is not concave: 3.7e-4 above). So every node's
+    # u_max, u_min, u_peak and a_absmax are the largest values at the steps, the history's at
+    # every = 1 exactly (fails before: a_absmax 2.84e5 for 2.52e5). (v is not asserted: a
+    # free end's v = 3v0/4 at two steps with a = ±A is a crest its cubic resolves, located
+    # at 7v0/8 — the method's own velocity over that step, (u1 − u0)/h, is v0.)
+    data = tomllib.loads((ROOT / "p4" / scene).read_text())
+    data.pop("check")
+    data["analysis"]["output"] = {"every": 1}
+    s, h = execute(data)
+    for nm, r in s["nodes"].items():
+        u, a = h[f"u:{nm}"], h[f"a:{nm}"]
+        assert (r["u_max"], r["u_min"], r["a_absmax"]) == (np.max(u), np.min(u), np.max(np.abs(a))), nm
+        if "u_peak" in r:
+            assert r["u_peak"] in u, nm
+
+
 @pytest.mark.parametrize("integrator, extra", [("newmark", {}), ("hht", {"alpha": -0.05}),
                                                ("generalized-alpha", {"rho_inf": 0.9})])
 def test_fixed_step_peaks_of_a_kelvin_impact_converge_at_order_2(integrator, extra):

@@ -47,7 +47,7 @@ def _lib():
         "martello_eval_power": (ctypes.c_int, [VP, DP]),
         "martello_eval_commit": (ctypes.c_int, [VP, DP, DP]),
         "martello_eval_use_branches": (ctypes.c_int, [VP, IP]),
-        "martello_eval_use_smooth_branches": (ctypes.c_int, [VP, IP, IP]),
+        "martello_eval_use_smooth_branches": (ctypes.c_int, [VP, ctypes.c_int, IP, IP]),
         "martello_eval_switches": (ctypes.c_int, [VP, IP, DP, DP, DP]),
         "martello_eval_bandwidth": (ctypes.c_int, [VP, IP, IP]),
         "martello_eval_tangent": (ctypes.c_int, [VP, DP, DP, DP, DP]),
@@ -128,7 +128,8 @@ class Eval:
         nsw = ctypes.c_int()
         if smooth:
             cont = np.zeros(max(self.nc, 1), dtype=np.int32)
-            assert L.martello_eval_use_smooth_branches(self.h, ctypes.byref(nsw),
+            # laws 1: MARTELLO_ACROSS_CONTINUOUS (c/martello_internal.h), CVODE's and IDA's class
+            assert L.martello_eval_use_smooth_branches(self.h, 1, ctypes.byref(nsw),
                                                        cont.ctypes.data_as(IP)) == 0
         else:
             assert L.martello_eval_use_branches(self.h, ctypes.byref(nsw)) == 0
@@ -226,16 +227,25 @@ def row_scene(n_free=10, couplings=(), block=None):
 
 
 def state(n, seed, closed=(), opened=()):
-    """A state (u, v): contacts i (between nodes i and i + 1) in `closed` penetrating, those in
-    `opened` open by 2 mm (gap 1 mm), the rest as random."""
+    """A state (u, v): contacts i (between nodes i and i + 1, gap 1 mm) in `closed` penetrating
+    by 2 mm, those in `opened` open by 1 mm, the rest as random (set left to right, so that
+    each contact is as asked)."""
     rng = np.random.default_rng(seed)
     u = np.cumsum(rng.uniform(-1e-3, 1e-3, n)) * 0.3
-    for i in opened:
-        u[i + 1] = u[i] + 2e-3
-    for i in closed:
-        u[i + 1] = u[i] - 3e-3
+    for i in range(n - 1):
+        if i in closed:
+            u[i + 1] = u[i] - 3e-3
+        elif i in opened:
+            u[i + 1] = u[i] + 2e-3
     v = rng.uniform(-0.2, 0.2, n)
     return u, v
+
+
+def assert_open(u, contacts):
+    """The contacts between neighbours i, i + 1 (gap 1 mm) are open at u: the premise of the
+    identities that leave them out."""
+    for i in contacts:
+        assert u[i] - u[i + 1] - 1e-3 < 0, f"contact {i} is not open"
 
 
 def assert_same(a, b, what):
@@ -295,6 +305,7 @@ def test_partition_with_open_cross_contacts_gives_the_parent_rows():
     with row_scene() as m:
         n = m.n_nodes
         u, v = state(n, 2, closed=(1, 7, 8), opened=(3, 5))
+        assert_open(u, (3, 5))
         pe = Eval(m.handle)
         pe.commit(u, v)            # energies are those of a committed state
         for smooth in (False, True):
@@ -332,6 +343,7 @@ def trajectory(n, steps=6):
         u[3] += 4e-3 * np.sin(k)          # node 3: bilinear spring, past its yield (1 mm)
         u[6] += 3e-3 * np.cos(1.3 * k)
         u[4] = u[3] + 2e-3; u[6] = max(u[6], u[5] + 2e-3)
+        assert_open(u, (3, 5))
         out.append((u, v))
     return out
 
@@ -369,7 +381,7 @@ def test_state_round_trip_through_sub_evaluators_equals_committing_on_the_parent
             L.martello_subset_map_free(ctypes.byref(mp))
             sub.free()
         u, v = state(n, 99, opened=(3, 5))
-        u[4] = u[3] + 2e-3
+        assert_open(u, (3, 5))
         assert_same(par.acceleration(0.1, u, v), ref.acceleration(0.1, u, v), "a")
         assert_same(par.power(), ref.power(), "power")
         assert_same(par.energy(*traj[-1]), ref.energy(*traj[-1]), "energy (the committed state)")
@@ -427,6 +439,7 @@ def test_chains_are_subset_on_the_expanded_model():
         assert L.martello_model_expand_chains(m.handle) == 0
         u, v = state(n + 1, 3, closed=(8, 9), opened=(7,))
         u[n] = 0.0
+        assert_open(u, (7,))
         pe = Eval(m.handle)
         a = pe.acceleration(0.05, u, v)
         st, sub, mp = subset(m.handle, [8, 9, 10, 11])
@@ -443,15 +456,16 @@ def test_chains_are_subset_on_the_expanded_model():
 
 def test_refusals_name_the_argument_and_the_fix():
     """Bad input gets a clear error: a node out of range, given twice or fixed, an empty
-    cluster, a mass coupling or a stiffness block cut by the cluster; a transfer with a map of
+    cluster, a link, a mass coupling or a stiffness block cut by the cluster; a transfer with a map of
     another sub-model or a NULL array. The parent is left usable (its marks cleared)."""
     ARG = K("MARTELLO_ERR_ARGUMENT")
-    with row_scene(couplings=[(2, 3, 50.0)], block=(6, 7, 8)) as m:
+    with row_scene(couplings=[(4, 5, 50.0)], block=(6, 7, 8)) as m:
         n = m.n_nodes
         cases = [([1, n], f"nodes[1] = {n} is not a node"), ([1, -1], "is not a node"),
                  ([1, 2, 1], "node 1 is given twice"), ([0, 1], "nodes[0] = 0 is a fixed node"),
-                 ([1, 2], "mass coupling 0 between nodes 2 and 3 crosses the cut"),
-                 ([5, 6, 7], "stiffness block 0 has node 8 outside the cluster")]
+                 ([4], "mass coupling 0 between nodes 4 and 5 crosses the cut"),
+                 ([1, 3], "link 20 has node 2 outside the cluster"),     # the fluid damper 2-3
+                 ([6, 7], "stiffness block 0 has node 8 outside the cluster")]
         for nodes, says in cases:
             st, sub, mp = subset(m.handle, nodes)
             assert st == ARG and says in message(m.handle), (nodes, message(m.handle))
@@ -477,3 +491,79 @@ def test_refusals_name_the_argument_and_the_fix():
         for s, p in ((sub, mp), (sub2, mp2)):
             L.martello_subset_map_free(ctypes.byref(p))
             s.free()
+
+
+L.martello_model_clusters.restype = ctypes.c_int
+L.martello_model_clusters.argtypes = [VP, IP, IP, IP]
+
+
+def clusters(model_h, n, joined):
+    label, k = np.zeros(n, dtype=np.int32), ctypes.c_int()
+    j = None if joined is None else np.ascontiguousarray(joined, dtype=np.int32)
+    st = L.martello_model_clusters(model_h, None if j is None else j.ctypes.data_as(IP),
+                                   label.ctypes.data_as(IP), ctypes.byref(k))
+    return st, label, k.value
+
+
+def components_by_search(n, fixed, rows):
+    """Connected components of the free nodes by breadth-first search over the rows (lists of
+    nodes) -- another algorithm than the library's union-find -- numbered in the order of their
+    first node, -1 for a fixed node."""
+    adj = [[] for _ in range(n)]
+    for row in rows:
+        free = [i for i in row if not fixed[i]]
+        for a, b in zip(free, free[1:]):
+            adj[a].append(b); adj[b].append(a)
+    label, k = [-1] * n, 0
+    for s in range(n):
+        if fixed[s] or label[s] >= 0:
+            continue
+        label[s], todo = k, [s]
+        while todo:
+            i = todo.pop()
+            for j in adj[i]:
+                if label[j] < 0:
+                    label[j] = k; todo.append(j)
+        k += 1
+    return label, k
+
+
+def test_clusters_are_the_components_of_links_couplings_blocks_and_closed_contacts():
+    """Identity of the method (union-find against a breadth-first search over the same rows):
+    the clusters are the free nodes joined by links (the fluid damper between nodes 2 and 3),
+    the mass coupling (4, 5), the stiffness block (7, 8, 9) and the contacts marked closed; the
+    walls (fixed) join nothing. Each cluster's sub-model at a state where exactly those contacts
+    are closed gives the parent's rows bit for bit: the driver's use of the two doors."""
+    with row_scene(couplings=[(4, 5, 30.0)], block=(7, 8, 9)) as m:
+        n = m.n_nodes
+        fixed = [i in (0, n - 1) for i in range(n)]
+        closed = (0, 5, 10)             # wall-1, 5-6, 10-wall
+        joined = np.isin(np.arange(n - 1), closed).astype(np.int32)
+        st, label, k = clusters(m.handle, n, joined)
+        assert st == 0, message(m.handle)
+        rows = [[2, 3], [4, 5], [7, 8, 9]] + [[i, i + 1] for i in closed]
+        want, kw = components_by_search(n, fixed, rows)
+        assert_same(label, want, "labels")
+        assert k == kw == 5
+        # by hand: {1}, {2, 3}, {4, 5, 6}, {7, 8, 9}, {10}
+        assert_same(label, [-1, 0, 1, 1, 2, 2, 2, 3, 3, 3, 4, -1], "labels by hand")
+        st, none, k0 = clusters(m.handle, n, None)
+        # no contact closed: {1}, {2, 3}, {4, 5}, {6}, {7, 8, 9}, {10}
+        assert st == 0 and k0 == 6
+        assert_same(none, [-1, 0, 1, 1, 2, 2, 3, 4, 4, 4, 5, -1], "labels, no contact closed")
+        cut = [i for i in range(n - 1) if i not in closed]
+        u, v = state(n, 4, closed=closed, opened=cut)
+        assert_open(u, cut)
+        pe = Eval(m.handle)
+        a = pe.acceleration(0.1, u, v)
+        for c in range(k):
+            st, sub, mp = subset(m.handle, np.flatnonzero(label == c))
+            assert st == 0, message(m.handle)
+            node = mp.arrays()[0]
+            se = Eval(sub.h)
+            free = label[node] == c
+            assert_same(se.acceleration(0.1, u[node], v[node])[free], a[node][free], "a")
+            se.free()
+            L.martello_subset_map_free(ctypes.byref(mp))
+            sub.free()
+        pe.free()

@@ -56,7 +56,7 @@ def one(n, steps, front_end=None, toml=False):
     model = run_module.build_model(scene)
     t2 = time.perf_counter()
     # the native run's own clock (cost.wall_time_s) splits _dynamic into run and summary
-    summary, history = run_module._dynamic(scene, model)
+    summary, history = run_module._dynamic(scene, model)[:2]
     t3 = time.perf_counter()
     model.free()
     write_s = None

@@ -41,11 +41,13 @@ contains
       if (loc .and. tracks(o, TRACK_NODE_PEAKS)) &
          call observer_a_parabolas(o, m, t, a(1:n), o%nsamples + 1)
       if (tracks(o, TRACK_NODE_PEAKS) .or. size(o%gu) + size(o%gv) + size(o%pu) + size(o%pv) > 0) &
-         call node_pass(n, t, o%prev_t, o%fixed_steps, loc, tracks(o, TRACK_NODE_PEAKS), &
+         call node_pass(n, t, o%prev_t, o%fixed_steps, loc, loc .and. o%nsamples + 1 >= 2, &
+                        o%smooth_steps, tracks(o, TRACK_NODE_PEAKS), &
                         size(o%gu) > 0, size(o%gv) > 0, size(o%pu) > 0, size(o%pv) > 0, &
                         stamp(o%nsamples + 1), un, vn, an, u, v, a, o%u_max, o%u_min, &
                         o%v_absmax, o%a_absmax, o%u_absmax, o%t_absmax, o%u_peak, o%t_peak, &
-                        o%gu, o%gv, o%pu, o%pv, o%a_m1, o%a_0, o%a_gen, o%pend1, o%npend1)
+                        o%gu, o%gv, o%pu, o%pv, o%a_back, o%a_m2, o%a_m1, o%a_0, o%a_gen, &
+                        o%pend1, o%npend1)
       if (blk%pairs) then
          p = 1
          do while (p < n)
@@ -68,6 +70,8 @@ contains
          if (st == 0 .and. size(o%out_links) > 0) &
             call link_states(m, blk, o%out_links, u, v, bf, lf, ld, st)
       end if
+      ! the traced contact's force at every grid point (the step trace)
+      if (st == 0 .and. traced(o, k)) call traced_force(st)
       if (st /= 0) then
          call out_of_memory('the recorded contact and link states of a run', &
                             REAL_BYTES*2*(model_ncontacts(m) + real(model_nlinks(m), dp)), &
@@ -76,25 +80,37 @@ contains
       end if
       call observer_sample(o, m, none, t, u, v, a, pen, force, k, stat, lf, ld, folded=.true., &
                            energies=energies)
+   contains
+      !> o%trace_f ← the traced contact's force at the state (contact_states, as its
+      !> history column)
+      subroutine traced_force(st)
+         integer, intent(out) :: st
+         real(dp), allocatable :: p1(:), f1(:)
+         allocate (p1(0), f1(0))
+         call contact_states(m, blk, [o%trace_contact], u, v, br, xbr, p1, f1, st)
+         if (st == 0) o%trace_f = f1(o%trace_contact)
+      end subroutine traced_force
    end procedure observer_block
 
    !> observer_block's nodes and node pairs, one pass: a node's peaks (node_samples at the
    !> state; node_step_extrema where node_turns: v or a changes sign in the step, which most
    !> nodes do in few steps; a node that raised its |a| listed in pend as a candidate of
-   !> observer_a_parabolas, stamped sgen), and the link maxima per node (gu, gv: |u|, |v|)
-   !> and per pair (pu, pv: |Δu|, |Δv|), inside the step too (step_absmax where the rate
-   !> changes sign). nodes, gu_on …: what is tracked; loc: the extrema inside the step
-   !> from t_prev.
-   subroutine node_pass(n, t, t_prev, fs, loc, nodes, gu_on, gv_on, pu_on, pv_on, sgen, un, vn, &
-                        an, u, v, a, umax, umin, vmax, amax, uabs, tabs, upk, tpk, gu, gv, pu, pv, &
-                        a_m1, a_0, a_gen, pend, npend)
+   !> observer_a_parabolas, stamped sgen, where cand: a located step two samples after
+   !> t = 0; a_back: every node's a of the sample before, where smooth), and the link
+   !> maxima per node (gu, gv: |u|, |v|) and per pair (pu, pv: |Δu|, |Δv|), inside the step
+   !> too (step_absmax where the rate changes sign). nodes, gu_on …: what is tracked; loc:
+   !> the extrema inside the step from t_prev.
+   subroutine node_pass(n, t, t_prev, fs, loc, cand, smooth, nodes, gu_on, gv_on, pu_on, pv_on, &
+                        sgen, un, vn, an, u, v, a, umax, umin, vmax, amax, uabs, tabs, upk, tpk, &
+                        gu, gv, pu, pv, a_back, a_m2, a_m1, a_0, a_gen, pend, npend)
       integer, intent(in), value :: n
       real(dp), intent(in), value :: t, t_prev
-      logical, intent(in), value :: fs, loc, nodes, gu_on, gv_on, pu_on, pv_on
+      logical, intent(in), value :: fs, loc, cand, smooth, nodes, gu_on, gv_on, pu_on, pv_on
       integer(int8), intent(in), value :: sgen
       real(dp), intent(in) :: un(0:n), vn(0:n), an(0:n), u(0:n), v(0:n), a(0:n)
       real(dp), intent(inout) :: umax(*), umin(*), vmax(*), amax(*), uabs(*), tabs(*), upk(*), &
-                                 tpk(*), gu(*), gv(*), pu(*), pv(*), a_m1(*), a_0(*)
+                                 tpk(*), gu(*), gv(*), pu(*), pv(*), a_back(*), a_m2(*), &
+                                 a_m1(*), a_0(*)
       integer(int8), intent(inout) :: a_gen(*)
       integer, intent(inout) :: pend(*), npend
       integer :: i, p
@@ -112,10 +128,11 @@ contains
             if (turns .and. fs) call node_step_extrema(t, t_prev, un(i), vn(i), an(i), u(i), v(i), &
                                                        a(i), umax(i), umin(i), vmax(i), uabs(i), &
                                                        tabs(i), upk(i), tpk(i))
-            if (raised .and. loc) then
+            if (raised .and. cand) then
                npend = npend + 1; pend(npend) = i
-               a_m1(i) = an(i); a_0(i) = a(i); a_gen(i) = sgen
+               a_m2(i) = a_back(i); a_m1(i) = an(i); a_0(i) = a(i); a_gen(i) = sgen
             end if
+            if (smooth) a_back(i) = an(i)
          end if
          ! the maxima stored only when they change (read, not rewritten, at every step)
          if (gu_on) then

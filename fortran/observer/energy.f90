@@ -91,10 +91,11 @@ contains
       st = 0
       if (.not. o%smooth_steps) return
       nn = merge(n, 0, tracks(o, TRACK_NODE_PEAKS))
-      allocate (o%node_change(0:nn), o%a_m1(nn), o%a_0(nn), o%a_p1(nn), o%a_gen(nn), &
-                o%pend1(nn), o%pend2(nn), stat=st)
+      allocate (o%node_change(0:nn), o%a_m2(nn), o%a_m1(nn), o%a_0(nn), o%a_p1(nn), o%a_gen(nn), &
+                o%pend1(nn), o%pend2(nn), o%a_back(nn), stat=st)
       if (st /= 0) return
       o%node_change = -huge(1.0_dp)
+      o%a_back = 0.0_dp
       if (folded .or. .not. (tracks(o, TRACK_CONTACT_PEAKS) .or. tracks(o, TRACK_PHASES))) return
       nc = size(o%ph_open)
       allocate (o%c_prev_f(nc), o%c_prev_fr(nc), source=0.0_dp, stat=st)
@@ -137,7 +138,7 @@ contains
    !> grid (energy_grid) and where recorded, for the history row (a method that hands its
    !> energies to the sample computes them then).
    module procedure observer_energy_due
-      due = energy_grid(o, k) .or. recorded(o, k)
+      due = energy_grid(o, k) .or. recorded(o, k) .or. traced(o, k)
    end procedure observer_energy_due
 
    !> Whether the next sample, at grid point k (−1: off the grid), is on the energy grid,

@@ -133,7 +133,7 @@ contains
       is_row = .false.
       if (present(row)) is_row = row
       grid = energy_grid(o, k) .and. .not. is_row
-      due = grid .or. recorded(o, k)
+      due = grid .or. recorded(o, k) .or. (traced(o, k) .and. .not. is_row)
       if (.not. is_row) o%nsamples = o%nsamples + 1
       measured = .false.
       if (present(folded)) measured = folded
@@ -150,6 +150,17 @@ contains
       if (o%smooth_steps .and. .not. is_row) o%chatter_prev = o%counters(C_CHATTER)
       if (.not. is_row) o%prev_t = t
       if (due) call energy_at(o, m, ms, u, v, a, grid, energies, e_mech)
+      if (traced(o, k) .and. .not. is_row) then
+         ! the traced contact's force: from the method that measured itself, or handed
+         if (measured) then
+            call trace_append(o, t, o%trace_f, u, stat)
+         else
+            call trace_append(o, t, force(o%trace_contact), u, stat)
+         end if
+         if (stat /= MARTELLO_OK) then
+            call observer_finish(o, t); return
+         end if
+      end if
       if (recorded(o, k)) then
          call record(o, t, u(1:), v(1:), a(1:), pen, force, link_f, link_du, stat)
          if (stat /= MARTELLO_OK) then
@@ -171,6 +182,12 @@ contains
       recorded = k == 0
       if (k > 0) recorded = mod(k, int(o%every, i8)) == 0 .or. k >= o%n_grid
    end procedure recorded
+
+   !> Whether the sample at grid point k (−1: off the grid) enters the step trace: every
+   !> grid point, where a contact is traced (martello_run_set_trace).
+   module procedure traced
+      traced = o%trace_contact > 0 .and. k >= 0
+   end procedure traced
 
    !> Append one history row (grows by doubling when a variable-step integrator needs it).
    !> link_f, link_du absent: NaN columns. stat = MARTELLO_ERR_MEMORY (message set) if the

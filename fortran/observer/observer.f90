@@ -15,7 +15,8 @@
 !>   block   — the bulk entry of a method that measures itself;
 !>   energy  — the start of the run, works and energy terms, divergence;
 !>   budget  — max_steps, max_wall, the progress callback, failure and finish;
-!>   functionals — linear functionals R·u of the state (a frame's or building's forces).
+!>   functionals — linear functionals R·u of the state (a frame's or building's forces);
+!>   trace   — one contact's force and the energies at every step, whatever is recorded.
 module martello_observer
    use, intrinsic :: iso_fortran_env, only: int8
    use martello_kinds, only: dp, i8
@@ -97,6 +98,15 @@ module martello_observer
       !> per link: max |force| and max |elongation| (storey shear and drift of a frame)
       real(dp), allocatable :: link_force_absmax(:), link_du_absmax(:)
       integer, allocatable :: impacts(:)
+      !> the step trace (trace; martello_run_set_trace): contact trace_contact's force, the
+      !> kinetic and recoverable energies and u of the nodes trace_nodes at every grid point
+      !> of the run (t = k·dt), whatever the history records: trace(:, j) = [t, force,
+      !> kinetic, recoverable, u(trace_nodes)], j ≤ ntrace; trace_f: that force at the
+      !> sample, from a method that measures itself
+      integer :: trace_contact = 0, ntrace = 0
+      integer, allocatable :: trace_nodes(:)
+      real(dp), allocatable :: trace(:, :)
+      real(dp) :: trace_f = 0.0_dp
       real(dp) :: energy(NENERGY) = 0.0_dp
       real(dp) :: energy_balance_max = 0.0_dp   !< max |balance| over the run
       integer(i8) :: counters(NCOUNTERS) = 0_i8
@@ -160,13 +170,14 @@ module martello_observer
       !> previous sample (observer_block computes them again from the previous state)
       real(dp), allocatable :: c_prev_f(:), c_prev_fr(:)
       !> the peak of |a| on fixed steps (observer_a_parabolas): a sample k that raised it
-      !> waits two samples for the parabola through k − 1, k, k + 1 and the smoothness test
-      !> with k + 2. Per node: a at k − 1, k, k + 1 and the sample k of its latest candidate
-      !> modulo 256 (a_gen; the lists name the candidates of the last three samples at most,
-      !> so no two stamps in use are equal); the candidates of the last two samples (pend1:
-      !> k = the last, pend2: the one before), with the time and the chatter count of their
-      !> sample k − 1
-      real(dp), allocatable :: a_m1(:), a_0(:), a_p1(:)
+      !> waits two samples for the parabola through k − 1, k, k + 1 and the tests of its
+      !> span with k − 2 and k + 2. Per node: a at k − 2, k − 1, k, k + 1 and the sample k of
+      !> its latest candidate modulo 256 (a_gen; the lists name the candidates of the last
+      !> three samples at most, so no two stamps in use are equal); the candidates of the
+      !> last two samples (pend1: k = the last, pend2: the one before), with the time and the
+      !> chatter count of their sample k − 1; a_back: every node's a at the sample before
+      !> the last (a candidate's k − 2)
+      real(dp), allocatable :: a_m2(:), a_m1(:), a_0(:), a_p1(:), a_back(:)
       integer(int8), allocatable :: a_gen(:)
       integer, allocatable :: pend1(:), pend2(:)
       integer :: npend1 = 0, npend2 = 0
@@ -272,6 +283,10 @@ module martello_observer
          type(observer_t), intent(in) :: o
          integer(i8), intent(in) :: k
       end function recorded
+      pure module logical function traced(o, k)
+         type(observer_t), intent(in) :: o
+         integer(i8), intent(in) :: k
+      end function traced
       module subroutine record(r, t, u, v, a, pen, force, link_f, link_du, stat)
          class(results_t), intent(inout) :: r
          real(dp), intent(in) :: t, u(:), v(:), a(:), pen(:), force(:)
@@ -464,6 +479,14 @@ module martello_observer
          type(observer_t), intent(inout) :: o
          real(dp), intent(in), optional :: external, damping, links, contact, impact, internal
       end subroutine observer_work
+      !> Append the grid point at t (force f of the traced contact, the energies of the
+      !> sample, u of the traced nodes) to the step trace; stat = MARTELLO_ERR_MEMORY
+      !> (message set) if it cannot grow.
+      module subroutine trace_append(o, t, f, u, stat)
+         type(observer_t), intent(inout) :: o
+         real(dp), intent(in) :: t, f, u(0:)
+         integer, intent(out) :: stat
+      end subroutine trace_append
       module logical function observer_energy_due(o, k) result(due)
          type(observer_t), intent(in) :: o
          integer(i8), intent(in) :: k

@@ -35,8 +35,11 @@ contains
             call node_peaks(t, o%prev_t, o%fixed_steps, u_prev(i), v_prev(i), a_prev(i), u(i), &
                             v(i), a(i), o%u_max(i), o%u_min(i), o%v_absmax(i), o%a_absmax(i), &
                             o%u_absmax(i), o%t_absmax(i), o%u_peak(i), o%t_peak(i), raised)
-            if (raised .and. stepped) call a_candidate(o, i, a_prev(i), a(i), o%nsamples)
+            ! a candidate needs the sample two back (k − 2 ≥ 0, t = 0 being sample 0)
+            if (raised .and. stepped .and. o%nsamples >= 2) &
+               call a_candidate(o, i, a_prev(i), a(i), o%nsamples)
          end do
+         if (o%smooth_steps) o%a_back(1:size(u)) = a_prev
       else
          ! no previous state (an adaptive method, which locates its own): the samples alone
          do i = 1, size(u)
@@ -59,7 +62,7 @@ contains
    !> at the last sample's time t_prev (< 0: none): extremes of u, |v|, |a| (umax … amax) and
    !> the largest |u| and its time (uabs, tabs) at the state; for a fixed-step method also
    !> the extrema of u and v located on the step's cubic Hermite (into the same and into the
-   !> largest local maximum of u, upk at tpk: hermite_extremum, step_absmax). raised: the
+   !> largest local maximum of u, upk at tpk: hermite_extremum, step_max). raised: the
    !> state raised amax (a candidate of observer_a_parabolas on a smooth method). The maxima
    !> are stored only when they change: a peak array is then read, not rewritten, at every
    !> step. observer_block takes its three parts in line.
@@ -95,15 +98,16 @@ contains
 
    !> node_peaks inside a fixed step from the state (un, vn, an) at t_prev to (u, v, a) at t
    !> where node_turns (t_prev < 0: no step yet): the extrema of u and v on the step's cubic
-   !> Hermite (hermite_extremum, step_absmax), and a maximum of u on the step's end.
+   !> Hermite where the step resolves them (hermite_extremum, step_max), and a maximum of u
+   !> on the step's end.
    module procedure node_step_extrema
       real(dp) :: h
       h = t - t_prev
       if (.not. (t_prev >= 0.0_dp .and. h > 0.0_dp)) return
       call hermite_extremum(t_prev, h, un, vn, an, u, v, a, umax, umin, uabs, tabs, upk, tpk)
-      ! |v| at the extremum of v, on the cubic Hermite of (v, a) where a changes sign
-      ! (O(h⁴) in v; docs/results.md)
-      vmax = max(vmax, step_absmax(h, vn, an, v, a))
+      ! |v| at a maximum of v (and, of −v, at a minimum) on the cubic Hermite of (v, a), where
+      ! the step resolves it (O(h⁴) in v; docs/results.md "Peaks of a fixed-step method")
+      vmax = max(vmax, step_max(h, vn, an, v, a), step_max(h, -vn, -an, -v, -a))
       ! a maximum on the step's end
       if (vn > 0.0_dp .and. v == 0.0_dp .and. u > upk) then
          upk = u; tpk = t
@@ -230,8 +234,12 @@ contains
    !> sample (t, a on nodes 1..n; before the sample's candidates, a_candidate): a sample k
    !> that raised it (a candidate) is the middle of the parabola through k − 1, k, k + 1,
    !> whose vertex (equal steps; inside the middle step when the middle sample is the
-   !> largest) is O(h³) in a, below the O(h²) of the steps, if a is smooth there: no jump of
-   !> the forces (a phase change of a contact at the node, a chatter resolution, a kink of a
+   !> largest) is O(h³) in a, below the O(h²) of the steps, if the samples resolve the
+   !> turn: concave at each sample of the parabola's span (second differences of the
+   !> crest's sign at k − 1, k and k + 1: the samples' p'' over the span, as the cubic's over
+   !> a step, docs/results.md "Peaks of a fixed-step method"; a pulse of a few steps, as a
+   !> wave front's 0, A, A, 0 at Courant 1, is convex at k − 1) and smooth: no jump of the
+   !> forces (a phase change of a contact at the node, a chatter resolution, a kink of a
    !> load) from k − 1 to k + 2, and no kink — the second differences at k and k + 1 agree to
    !> half their size (a slope kink at the peak, as a bilinear spring's yield onto a flat
    !> line, makes them differ by O(h); its vertex would overshoot by O(h)). Candidates of
@@ -239,7 +247,7 @@ contains
    module procedure observer_a_parabolas
       integer :: k, j
       integer(int8) :: s2, s1
-      real(dp) :: ym, y0, yp, yq, d2, sg
+      real(dp) :: ym2, ym, y0, yp, yq, d2, sg
       logical :: smooth
       s2 = stamp(sample - 2); s1 = stamp(sample - 1)
       if (o%npend2 > 0) then
@@ -248,9 +256,11 @@ contains
             j = o%pend2(k)
             if (.not. smooth .or. o%a_gen(j) /= s2 .or. o%node_change(j) > o%pend2_t0) cycle
             sg = sign(1.0_dp, o%a_0(j))
-            ym = sg*o%a_m1(j); y0 = sg*o%a_0(j); yp = sg*o%a_p1(j); yq = sg*a(j)
+            ym2 = sg*o%a_m2(j); ym = sg*o%a_m1(j); y0 = sg*o%a_0(j); yp = sg*o%a_p1(j)
+            yq = sg*a(j)
             d2 = ym - 2.0_dp*y0 + yp
             if (.not. (y0 >= ym .and. y0 >= yp .and. d2 < 0.0_dp)) cycle
+            if (.not. (ym2 - 2.0_dp*ym + y0 <= 0.0_dp)) cycle
             if (abs((y0 - 2.0_dp*yp + yq) - d2) > 0.5_dp*abs(d2)) cycle
             o%a_absmax(j) = max(o%a_absmax(j), y0 - (yp - ym)**2/(8.0_dp*d2))
          end do
@@ -265,16 +275,16 @@ contains
       o%npend1 = 0; o%pend1_t0 = o%prev_t; o%pend1_stamp = o%chatter_prev
    end procedure observer_a_parabolas
 
-   !> Node j raised its sampled peak of |a| at sample number sample of a smooth fixed-step
-   !> method (node_peaks' raised), from a_prev at the sample before to a_now: a candidate of
-   !> observer_a_parabolas.
+   !> Node j raised its sampled peak of |a| at sample number sample (≥ 2) of a smooth
+   !> fixed-step method (node_peaks' raised), from a_prev at the sample before to a_now (the
+   !> one before that: a_back): a candidate of observer_a_parabolas.
    subroutine a_candidate(o, j, a_prev, a_now, sample)
       type(observer_t), intent(inout) :: o
       integer, intent(in) :: j
       real(dp), intent(in) :: a_prev, a_now
       integer(i8), intent(in) :: sample
       o%npend1 = o%npend1 + 1; o%pend1(o%npend1) = j
-      o%a_m1(j) = a_prev; o%a_0(j) = a_now; o%a_gen(j) = stamp(sample)
+      o%a_m2(j) = o%a_back(j); o%a_m1(j) = a_prev; o%a_0(j) = a_now; o%a_gen(j) = stamp(sample)
    end subroutine a_candidate
 
    !> A sample number modulo 256, as a_gen keeps it
@@ -284,8 +294,11 @@ contains
 
    !> The extremum of u inside a fixed step [t0, t0 + h], located on the cubic Hermite
    !> interpolant of (u, v) at both ends, p(s) = u0 H00 + h v0 H10 + u1 H01 + h v1 H11
-   !> (s = τ/h): the root of p'(s), a quadratic, where v changes sign inside the step; into
-   !> umax, umin, uabs (tabs) and, a maximum, upk (tpk).
+   !> (s = τ/h): the root of p'(s), a quadratic, where v changes sign inside the step and the
+   !> step resolves the turn: the cubic is concave over the step at a maximum, convex at a
+   !> minimum (resolved_turn; docs/results.md "Peaks of a fixed-step method"); into umax,
+   !> umin, uabs (tabs) and, a maximum, upk (tpk) — a maximum the step does not resolve is
+   !> the larger value at its ends.
    !> Interpolation error O(h⁴) in u (O(h³) in the time of the extremum), below the
    !> O(h²) of the structural steps themselves (docs/results.md). A turn the step's
    !> accelerations do not support (v reversed by an impulse: no a of the turn's sign at
@@ -299,6 +312,14 @@ contains
       if (.not. (v0*v1 < 0.0_dp)) return
       if (v0 > 0.0_dp .and. min(a0, a1) >= 0.0_dp) return
       if (v0 < 0.0_dp .and. max(a0, a1) <= 0.0_dp) return
+      if (v0 > 0.0_dp .and. .not. resolved_turn(h, u0, v0, u1, v1)) then
+         ! a maximum the step does not resolve: the larger value at its ends
+         if (max(u0, u1) > upk) then
+            upk = max(u0, u1); tpk = merge(t0, t0 + h, u0 > u1)
+         end if
+         return
+      end if
+      if (v0 < 0.0_dp .and. .not. resolved_turn(h, -u0, -v0, -u1, -v1)) return
       call cubic_hermite_extrema(h, u0, v0, u1, v1, s, p)
       do k = 1, 2
          if (.not. (s(k) > 0.0_dp .and. s(k) < 1.0_dp)) cycle

@@ -113,6 +113,9 @@ def lib():
         "martello_run_abs_peaks": (c_int, [_VOID_P] * 3),
         "martello_run_set_functionals": (c_int, [_VOID_P, c_int, _INT_P, _INT_P, _DOUBLE_P, c_int, _INT_P]),
         "martello_run_functionals": (c_int, [_VOID_P] * 7),
+        "martello_run_set_trace": (c_int, [_VOID_P, c_int]),
+        "martello_run_trace": (c_int, [_VOID_P, ctypes.POINTER(c_int), _VOID_P]),
+        "martello_run_set_trace_nodes": (c_int, [_VOID_P, c_int, _INT_P]),
         "martello_memory_message": (None, [c_char_p, c_double, c_char_p, c_char_p, c_int]),
         "martello_write_csv": (c_int, [c_char_p, c_char_p, _DOUBLE_P, ctypes.c_int64, c_int]),
     }
@@ -590,6 +593,24 @@ class Run(_Handle):
         out = [np.zeros(max(n, 1)) for _ in range(4)] + [np.zeros(max(n_pairs, 1)) for _ in range(2)]
         self._check(lib().martello_run_functionals(self._h, *(o.ctypes.data for o in out)), "functionals")
         return [o[:n] for o in out[:4]] + [o[:n_pairs] for o in out[4:]]
+
+    def set_trace(self, contact, nodes=()):
+        """Keep the step trace of this 0-based contact and the displacement of these 0-based
+        nodes (c/martello.h, martello_run_set_trace, _set_trace_nodes)."""
+        self._check(lib().martello_run_set_trace(self._h, int(contact)), "trace")
+        nd = np.ascontiguousarray(nodes, dtype=np.int32)
+        self._check(lib().martello_run_set_trace_nodes(self._h, nd.size, nd if nd.size else np.zeros(1, np.int32)),
+                    "trace nodes")
+        self._trace_width = 4 + nd.size
+
+    def trace(self):
+        """The step trace: an array of rows [t, force, kinetic, recoverable, u of the traced
+        nodes], one per grid point of the run."""
+        n = ctypes.c_int()
+        self._check(lib().martello_run_trace(self._h, ctypes.byref(n), None), "trace")
+        buf = np.zeros((max(n.value, 1), self._trace_width))
+        self._check(lib().martello_run_trace(self._h, ctypes.byref(n), buf.ctypes.data), "trace")
+        return buf[:n.value]
 
     def link_peaks(self, n_links):
         f, du = np.zeros(max(n_links, 1)), np.zeros(max(n_links, 1))

@@ -30,10 +30,12 @@ state):
   the end of the run, their errors over v0, the share of energy left as vibration, and the
   final energy error (E_kin + E_recoverable − E0) / E0.
 
-From the force, energy and displacement at every step of a fixed-step method — only where
-the history holds them, `every = 1` (an adaptive run's rows are its output times, not its
-steps; with every > 1, or adaptive, they are left out and a note says why, never computed
-on the recorded samples):
+From the force, energy and displacement at every step of a fixed-step method — its step
+trace (docs/results.md "Step trace": the contact's force, the energies and the rods' nodes'
+displacement at every step, whatever `output.every`; the samples of the history at
+every = 1), or the history where it holds every step (`every = 1`) when the measures are
+attached without the trace (an adaptive run's rows are its output times, not its steps:
+there they are left out and a note says why, never computed on the recorded samples):
 
 * the force pulse against the rectangle P0 = Z v0/2 (Z v0 on a wall) on
   [t_on, t_on + 2 L_min/c): L1 error (the force held constant over each step, centred on
@@ -54,7 +56,7 @@ fit.
 import numpy as np
 
 from ..binding import native
-from ..run import run_full
+from ..run import run_full, run_traced
 
 REL_SAME = 1e-12     # two rods with c and Z equal to this relative tolerance are "the same bar"
 # A held force below this share of P0 is no pulse: rounding-level forces while two faces
@@ -64,18 +66,43 @@ PULSE_THRESHOLD = 1e-6
 
 def run_measured(scene):
     """(summary, history) of run_full(scene) with the problem's measures attached: what
-    `martello run` writes and `martello check` verifies."""
-    summary, history = run_full(scene)
-    attach(scene, summary, history)
+    `martello run` writes and `martello check` verifies. A rod impact on a fixed-step method
+    keeps its contact's step trace (force and energies at every step, whatever the history
+    records: martello.run.run_traced) for the measures that need every step."""
+    traced = _traced(scene)
+    if traced is None:
+        summary, history = run_full(scene)
+        steps = None
+    else:
+        summary, history, steps = run_traced(scene, *traced)
+    attach(scene, summary, history, steps)
     return summary, history
 
 
-def attach(scene, summary, history):
+def _traced(scene):
+    """(contact, nodes): the names of the contact and of the rods' nodes whose step trace
+    the rod-impact measures read, or None (not a rod impact, or not a dynamic fixed-step
+    run)."""
+    rods = scene.extras.get("bars") if scene.extras else None
+    an = scene.analysis
+    if not (rods and scene.contacts and an["type"] == "dynamic") or \
+            an["integrator"] in native.adaptive_integrators():
+        return None
+    got = _applicability(scene, rods)
+    if isinstance(got, str):
+        return None
+    c, side_a, side_b = got
+    return c["name"], [nm for side in (side_a, side_b) if side for nm in side[0]["nodes"]]
+
+
+def attach(scene, summary, history, steps=None):
     """Add measures that the scene's generators ask for (scene.extras) to the summary of a
-    dynamic run (a static run, whose history is None, has none)."""
+    dynamic run (a static run, whose history is None, has none); steps: the rod impact's
+    step trace (run_measured), without which the measures that need every step are made
+    from the history where it holds every step (output.every = 1)."""
     rods = scene.extras.get("bars") if scene.extras else None
     if rods and scene.contacts and history is not None:
-        m = rod_impact_measures(scene, summary, history)
+        m = rod_impact_measures(scene, summary, history, steps)
         summary.setdefault("measures", {})["rod_impact"] = m
     return summary
 
@@ -160,7 +187,7 @@ def _hold_l1(t, p, t0, t1, level):
     return float(np.sum(np.abs(p - level) * overlap + np.abs(p) * (hi - lo - overlap)))
 
 
-def rod_impact_measures(scene, summary, history):
+def rod_impact_measures(scene, summary, history, steps=None):
     # the wave-theory oracles: only for a scene of rods (a plain run does not load them)
     from ..oracles.p4_rod_impact import rod_impact
     from ..oracles.p4_wave_theory import rod_point_displacement, vibration_energy_fraction
@@ -192,8 +219,10 @@ def rod_impact_measures(scene, summary, history):
     vp = P0 / ref.impedance
     an = scene.analysis
     adaptive = an["integrator"] in native.adaptive_integrators()
-    # the method's steps are in the history: a fixed-step run recorded at every step
-    every_step = not adaptive and an["output"]["every"] == 1
+    # the method's steps: its step trace (the contact's force and the energies at every
+    # step, whatever is recorded), else the history of a fixed-step run recorded at every step
+    rows_every_step = not adaptive and an["output"]["every"] == 1
+    every_step = not adaptive and (steps is not None or rows_every_step)
     involved = [r for r in (rod_a, rod_b) if r is not None]
     # one step of a fixed-step method (an adaptive run's phases are located, its dt is an
     # output interval: not a length of the physics or the method)
@@ -238,29 +267,35 @@ def rod_impact_measures(scene, summary, history):
         m["notes"] = notes
         return m
     t = data[:, col["t"]]
+    why = ("an adaptive run's history holds its output times, not its steps" if adaptive
+           else f"output every {an['output']['every']} steps")
     if not every_step:
-        notes.append(("an adaptive run's history holds its output times, not its steps"
-                      if adaptive else f"output every {an['output']['every']} steps") +
-                     ": no pulse L1, total variation or width, energy error over the run or "
+        notes.append(why + ": no pulse L1, total variation or width, energy error over the run or "
                      "displacement error (they need the force, energy and displacement at every "
                      "step of the method)")
 
     fkey = f"force:{c['name']}"
+    # the force and the energies at every step: the step trace, else the rows (every = 1)
+    ts, p, e_steps = None, None, None
+    if steps is not None:
+        ts, p = steps["t"], steps["force"]
+        e_steps = steps["kinetic"] + steps["recoverable"]
+    elif every_step and fkey in col:
+        ts, p = t, data[:, col[fkey]]
     if not every_step:
         pass
-    elif fkey in col:
-        p = data[:, col[fkey]]
-        l1 = _hold_l1(t, p, t_on_ref, t_on_ref + T, P0)
+    elif p is not None:
+        l1 = _hold_l1(ts, p, t_on_ref, t_on_ref + T, P0)
         m["pulse_l1_error"] = l1 / (P0 * T)
         if t_on is not None:
-            end = t_off if t_off is not None else t[-1]
-            i0 = max(int(np.searchsorted(t, t_on, side="right")) - 1, 0)
-            i1 = min(int(np.searchsorted(t, end, side="left")), len(t) - 1)
+            end = t_off if t_off is not None else ts[-1]
+            i0 = max(int(np.searchsorted(ts, t_on, side="right")) - 1, 0)
+            i1 = min(int(np.searchsorted(ts, end, side="left")), len(ts) - 1)
             tv = float(np.sum(np.abs(np.diff(p[i0:i1 + 1])))) if i1 > i0 else 0.0
             m["force_total_variation"] = tv / P0
             m["spurious_variation"] = tv / P0 - 2.0
             # width of the held pulse: cells with P > PULSE_THRESHOLD·P0 in the episode
-            lo, hi = _cells(t)
+            lo, hi = _cells(ts)
             inside = (hi > t_on) & (lo < end + t_merge) & (p > PULSE_THRESHOLD * P0)
             if np.any(inside):
                 k = np.nonzero(inside)[0]
@@ -274,9 +309,11 @@ def rod_impact_measures(scene, summary, history):
     if all(k in col for k in ekeys):
         e = data[:, col["energy:kinetic"]] + data[:, col["energy:recoverable"]]
         e0 = data[0, col["energy:initial"]]
+        if e_steps is None and rows_every_step:
+            e_steps = e
         if e0 > 0:
-            if every_step:
-                m["energy_error"] = float(np.max(np.abs(e - e0)) / e0)
+            if e_steps is not None:
+                m["energy_error"] = float(np.max(np.abs(e_steps - e0)) / e0)
             m["energy_final_error"] = float((e[-1] - e0) / e0)
 
     # final mean velocities and the displacement field need every node of the rods
@@ -320,7 +357,10 @@ def rod_impact_measures(scene, summary, history):
         m["vibration_energy_reference"] = frac_ref
 
         if every_step:
-            # displacement field against d'Alembert (free rods of equal bars)
+            # displacement field against d'Alembert (free rods of equal bars), at every step:
+            # the step trace's, else the rows' (every = 1)
+            tu = steps["t"] if steps is not None else t
+            u_of = (lambda nm: steps["u"][nm]) if steps is not None else (lambda nm: data[:, col[f"u:{nm}"]])
             err_all, err_end = 0.0, 0.0
             scale = vp * T
             for side, r, end_node in (("a", rod_a, side_a and side_a[1]), ("b", rod_b, side_b and side_b[1])):
@@ -331,9 +371,9 @@ def rod_impact_measures(scene, summary, history):
                 L_other = other["L"] if other is not None else r["L"]
                 for nm, x in zip(r["nodes"], r["x"]):
                     s = min(max(abs(face - x), 0.0), r["L"])
-                    u_ex = r["v0"] * t + rod_point_displacement(s, t - t_on_ref, ref.c, r["L"], L_other,
-                                                                v_rel, side, wall=wall)
-                    e_node = float(np.max(np.abs(data[:, col[f"u:{nm}"]] - u_ex))) / scale
+                    u_ex = r["v0"] * tu + rod_point_displacement(s, tu - t_on_ref, ref.c, r["L"], L_other,
+                                                                 v_rel, side, wall=wall)
+                    e_node = float(np.max(np.abs(u_of(nm) - u_ex))) / scale
                     err_all = max(err_all, e_node)
                     if nm == end_node:
                         err_end = max(err_end, e_node)
