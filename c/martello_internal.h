@@ -97,12 +97,14 @@ int martello_eval_commit(martello_eval *ev, const double *u, const double *v);
  * branch between located switches (fortran/switching.f90, docs/event-driven.md); branches
  * change at commits past their switches. *nsw: the number of switch slots. */
 int martello_eval_use_branches(martello_eval *ev, int *nsw);
-/* As martello_eval_use_branches, but only the laws whose force jumps at a switch are held:
- * penalty contacts whose force is continuous at onset and separation (linear, Hertz, the
- * Hunt-Crossley family) stay whole, their kinks inside the integrator's steps
- * (docs/sundials-ode.md, events inside the steps); continuous[j] = 1 for those contacts (n_contacts
- * values). */
-int martello_eval_use_smooth_branches(martello_eval *ev, int *nsw, int *continuous);
+/* As martello_eval_use_branches, but the penalty contacts of the class laws stay whole, their
+ * kinks inside the integrator's steps (docs/sundials-ode.md, events inside the steps):
+ * MARTELLO_ACROSS_CONTINUOUS those whose force is continuous at onset and separation (linear,
+ * Hertz, the Hunt-Crossley family), MARTELLO_ACROSS_RATE_BOUNDED those whose force's rate is
+ * bounded there too (linear, Hertz with a whole exponent: fortran/contact_laws.f90
+ * law_rate_bounded); continuous[j] = 1 for those contacts (n_contacts values). */
+enum { MARTELLO_ACROSS_CONTINUOUS = 1, MARTELLO_ACROSS_RATE_BOUNDED = 2 };
+int martello_eval_use_smooth_branches(martello_eval *ev, int laws, int *nsw, int *continuous);
 /* The approach speed v at the located onset of penalty contact j's phase (committed in contact):
  * the Hunt-Crossley family's v_in. */
 int martello_eval_set_onset_speed(martello_eval *ev, int j, double v);

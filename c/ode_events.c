@@ -1032,10 +1032,12 @@ static double gap_at(const ode_events *E, int j, double t, int what) {
   return what == 0 ? x - E->gap[j] : x;
 }
 
-/* The time in [lo, hi] where contact j's gap (what = 0) or rate (1) changes sign, positive at
- * the side `positive_hi` says, by bisection to event_tol: the first time on the far side. */
-static double crossing(const ode_events *E, int j, int what, double lo, double hi) {
-  const int lo_positive = gap_at(E, j, lo, what) > 0.0;
+/* The time in [lo, hi] where contact j's gap (what = 0) or rate (1) leaves the side it has at lo
+ * (lo_positive: > 0 there, as the state at lo says), by bisection to event_tol: the first time on
+ * the far side. The side at lo is the state's, not the polynomial's: the two differ by rounding
+ * where the gap is 0 at lo (an output row at the touch), and the polynomial's would bracket
+ * nothing and return hi, a whole step late. */
+static double crossing(const ode_events *E, int j, int what, int lo_positive, double lo, double hi) {
   for (int it = 0; it < 200 && hi - lo > fmax(E->event_tol, 4.0 * DBL_EPSILON * fabs(hi)); it++) {
     const double tm = 0.5 * (lo + hi);
     if ((gap_at(E, j, tm, what) > 0.0) == lo_positive) lo = tm; else hi = tm;
@@ -1070,14 +1072,14 @@ int oe_inner_events(ode_events *E, double t0, double t1, const double *y1) {
     if (in0 == in1 && !turn) continue;
     if ((st = taylor(E)) != MARTELLO_OK) return st;
     if (in0 != in1) {
-      add_event(E, crossing(E, j, 0, t0, t1), j, in1);
+      add_event(E, crossing(E, j, 0, in0, t0, t1), j, in1);
       continue;
     }
-    const double tx = crossing(E, j, 1, t0, t1), dx = gap_at(E, j, tx, 0);
+    const double tx = crossing(E, j, 1, r0 > 0.0, t0, t1), dx = gap_at(E, j, tx, 0);
     if ((dx > 0.0) == in0) continue;          /* the extremum stays on its side */
-    add_event(E, crossing(E, j, 0, t0, tx), j, !in0);
+    add_event(E, crossing(E, j, 0, in0, t0, tx), j, !in0);
     if (!in0) add_event(E, tx, j, -1);        /* the peak penetration of the touch */
-    add_event(E, crossing(E, j, 0, tx, t1), j, in0);
+    add_event(E, crossing(E, j, 0, !in0, tx, t1), j, in0);
   }
   /* in time order (an event's three fields sort together) */
   if (E->nev > 1) {
@@ -1131,7 +1133,9 @@ void oe_accepted(ode_events *E, const double *y) {
   }
 }
 
-int oe_use_smooth(ode_events *E) {
+int oe_use_smooth(ode_events *E) { return oe_use_smooth_laws(E, MARTELLO_ACROSS_CONTINUOUS); }
+
+int oe_use_smooth_laws(ode_events *E, int laws) {
   double failed = 0.0;
   const size_t ucn = (size_t)E->nc;
   E->cont = oe_take(ucn, sizeof(int), &failed);
@@ -1143,7 +1147,7 @@ int oe_use_smooth(ode_events *E) {
   E->ev_j = oe_take(3 * ucn, sizeof(int), &failed);
   E->ev_k = oe_take(3 * ucn, sizeof(int), &failed);
   if (failed > 0.0) return oe_fail_memory(E, "the events inside the steps", failed);
-  int st = martello_eval_use_smooth_branches(E->ev, &E->nsw, E->cont);
+  int st = martello_eval_use_smooth_branches(E->ev, laws, &E->nsw, E->cont);
   if (st != MARTELLO_OK) return oe_fail(E, st, "%s: martello_eval_use_smooth_branches failed", E->name);
   E->smooth = 1;
   if (E->nsw > 0 &&

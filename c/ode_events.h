@@ -211,9 +211,12 @@ int oe_prepare_restart(ode_events *E, double t, double *u, double *v);
 int oe_restart_progress(ode_events *E, double t);
 
 /* ---- events inside the steps ---------------------------------------------------------------- */
-/* Hold on branches only the laws whose force jumps (martello_eval_use_smooth_branches): the
- * continuous contacts lose their roots, their events are located by oe_inner_events. Call after
- * oe_setup, before the first restart; the adapter sets E->degree. */
+/* Leave the penalty contacts of the class laws (MARTELLO_ACROSS_*) whole and hold the other laws
+ * on branches (martello_eval_use_smooth_branches): those contacts lose their roots, their events
+ * are located by oe_inner_events. Call after oe_setup, before the first restart; the adapter
+ * sets E->degree. */
+int oe_use_smooth_laws(ode_events *E, int laws);
+/* oe_use_smooth_laws with every law whose force is continuous at its switches (CVODE, IDA). */
 int oe_use_smooth(ode_events *E);
 /* The onsets and separations of the continuous contacts inside [t0, t1] (y1: the state at t1),
  * each located on the interpolant of the last step by a scalar search on its own gap (its

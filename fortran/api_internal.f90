@@ -7,7 +7,8 @@ module martello_api_internal
    use martello_status
    use martello_model
    use martello_evaluator
-   use martello_switching, only: switch_count, force_continuous
+   use martello_switching, only: switch_count, stepped_across, ACROSS_CONTINUOUS, &
+      ACROSS_RATE_BOUNDED
    use martello_contact_laws, only: P_RESTITUTION
    use martello_element_rows, only: row_dot, rows_terms
    use martello_integrator_settings, only: integrator_settings_t
@@ -232,12 +233,14 @@ contains
    end function c_eval_use_branches
 
    !> Adaptive integrators that step across continuous kinks (docs/sundials-ode.md, events
-   !> inside the steps): only the laws whose force jumps at a switch are held on branches; continuous(j) = 1
-   !> for each penalty contact left whole (its onsets and separations are the caller's to
-   !> locate), 0 for the others.
-   integer(c_int) function c_eval_use_smooth_branches(handle, nsw, continuous) &
+   !> inside the steps): the penalty contacts of the class laws (ACROSS_CONTINUOUS: the force
+   !> continuous at its switches; ACROSS_RATE_BOUNDED: its rate bounded too) are left whole,
+   !> the other laws held on branches; continuous(j) = 1 for each penalty contact left whole
+   !> (its onsets and separations are the caller's to locate), 0 for the others.
+   integer(c_int) function c_eval_use_smooth_branches(handle, laws, nsw, continuous) &
       bind(C, name='martello_eval_use_smooth_branches')
       type(c_ptr), value :: handle
+      integer(c_int), value :: laws
       integer(c_int), intent(out) :: nsw
       integer(c_int), intent(out) :: continuous(*)
       type(evaluator_t), pointer :: ep
@@ -246,10 +249,11 @@ contains
       nsw = 0
       c_eval_use_smooth_branches = MARTELLO_ERR_ARGUMENT
       if (.not. associated(ep)) return
-      call evaluator_use_branches(ep, smooth=.true.)
+      if (laws /= ACROSS_CONTINUOUS .and. laws /= ACROSS_RATE_BOUNDED) return
+      call evaluator_use_branches(ep, across=int(laws))
       nsw = switch_count(ep%m)
       do j = 1, ep%m%ncontact
-         continuous(j) = merge(1, 0, ep%ms%is_penalty(j) .and. force_continuous(ep%m, j))
+         continuous(j) = merge(1, 0, ep%ms%is_penalty(j) .and. stepped_across(ep%m, j, int(laws)))
       end do
       c_eval_use_smooth_branches = MARTELLO_OK
    end function c_eval_use_smooth_branches

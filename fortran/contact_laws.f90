@@ -18,7 +18,7 @@ module martello_contact_laws
              LAW_FLORES, LAW_GONTHIER, LAW_HERTZDAMP, LAW_JANKOWSKI
    public :: NPAR_CONTACT, P_STIFF, P_EXPONENT, P_DAMPING, P_RESTITUTION, P_CLIP, HERTZ_EXPONENT
    public :: contact_force, contact_elastic_energy, damping_from_restitution, exact_hc_factor
-   public :: law_is_known, law_exponent
+   public :: law_is_known, law_exponent, law_rate_bounded
    public :: BRANCH_OFF, BRANCH_ON, BRANCH_CLIPPED, AFFINE_LINEAR, AFFINE_KELVIN, &
              AFFINE_KELVIN_CLIPPED
 
@@ -273,6 +273,25 @@ contains
          n = par(P_EXPONENT)
       end select
    end function law_exponent
+
+   !> Whether the law's force on the contact side is K delta^n with a whole n >= 1 and
+   !> coefficients the law's own (linear; Hertz with a whole exponent): a polynomial in delta,
+   !> so along a motion through the onset every derivative of the force is bounded on each side,
+   !> the force is continuous and its rate jumps by a finite amount (k times the approach speed
+   !> for n = 1, 0 above). Not so: a fractional exponent (K delta^(3/2): the second derivative
+   !> K (3/4) delta^(-1/2) delta'^2 is unbounded at the onset), the Hunt-Crossley family (its
+   !> damping chi = a/v_in takes the approach speed at the onset, known only once the onset is
+   !> located), Kelvin (the force jumps by c delta') and Jankowski (damping ~ delta^(1/4)).
+   !> docs/sundials-ode.md, events inside the steps.
+   pure logical function law_rate_bounded(law, par)
+      integer, intent(in) :: law
+      real(dp), intent(in) :: par(NPAR_CONTACT)
+      real(dp) :: n
+      law_rate_bounded = .false.
+      if (law /= LAW_LINEAR .and. law /= LAW_HERTZ) return
+      n = law_exponent(law, par)
+      law_rate_bounded = n >= 1.0_dp .and. n == aint(n)
+   end function law_rate_bounded
 
    ! ---------------------------------------------------------------- private helpers
 

@@ -8,7 +8,7 @@ module martello_evaluator
    use martello_model, only: model_t, model_bandwidth, model_initial_state, model_u0
    use martello_assembly
    use martello_band_matrix
-   use martello_switching, only: switch_count, switching_choose, switching_functions
+   use martello_switching, only: switch_count, switching_choose, switching_functions, ACROSS_NONE
    use martello_element_rows, only: row_dot, row_add
    implicit none
    private
@@ -26,8 +26,8 @@ module martello_evaluator
       integer, allocatable :: fixed_nodes(:)
       !> laws held on smooth branches between located switches (martello_switching)
       logical :: branches = .false.
-      !> ... except those whose force is continuous at their switches (switching_choose)
-      logical :: smooth = .false.
+      !> ... except the penalty contacts stepped across (switching_choose: ACROSS_*)
+      integer :: across = ACROSS_NONE
    end type evaluator_t
 
 contains
@@ -119,18 +119,18 @@ contains
       call evaluator_load(ev, u, v)
       call internal_forces(ev%m, ev%ms, ev%u, ev%v, ev%f)
       call mech_commit(ev%m, ev%ms, ev%u)
-      if (ev%branches) call switching_choose(ev%m, ev%ms, ev%u, ev%v, ev%smooth)
+      if (ev%branches) call switching_choose(ev%m, ev%ms, ev%u, ev%v, ev%across)
    end subroutine evaluator_commit
 
    !> From now on the laws are held on smooth branches, chosen at the committed state and
    !> changed at commits past their switches (docs/event-driven.md, switching surfaces).
-   !> smooth: only the laws whose force jumps at a switch are held (switching_choose).
-   subroutine evaluator_use_branches(ev, smooth)
+   !> across (ACROSS_*): the penalty contacts left whole, stepped across (switching_choose).
+   subroutine evaluator_use_branches(ev, across)
       type(evaluator_t), intent(inout) :: ev
-      logical, intent(in), optional :: smooth
+      integer, intent(in), optional :: across
       ev%branches = .true.
-      if (present(smooth)) ev%smooth = smooth
-      call switching_choose(ev%m, ev%ms, ev%u, ev%v, ev%smooth)
+      if (present(across)) ev%across = across
+      call switching_choose(ev%m, ev%ms, ev%u, ev%v, ev%across)
    end subroutine evaluator_use_branches
 
    !> The approach speed at the located onset of penalty contact j's phase (the Hunt-Crossley

@@ -455,7 +455,7 @@ contains
       call move_r(se%u(1:), pe%u(1:), map%node); call move_r(se%v(1:), pe%v(1:), map%node)
       call move_r(se%f(1:), pe%f(1:), map%node); call move_r(se%fext(1:), pe%fext(1:), map%node)
       if (to_sub) then
-         se%branches = pe%branches; se%smooth = pe%smooth
+         se%branches = pe%branches; se%across = pe%across
       end if
    contains
       subroutine move_r(xs, xp, idx)

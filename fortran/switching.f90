@@ -19,10 +19,19 @@ module martello_switching
       L_HARDENING, L_ALPHA, L_VREG, BRANCH_FREE, BRANCH_ELASTIC, BRANCH_UPPER, BRANCH_LOWER, &
       BRANCH_LINEAR, BRANCH_POWER_POS, BRANCH_POWER_NEG
    use martello_contact_laws, only: LAW_KELVIN, LAW_LINEAR, LAW_HERTZ, LAW_HUNT_CROSSLEY, &
-      LAW_LANKARANI_NIKRAVESH, LAW_FLORES, LAW_GONTHIER, LAW_HERTZDAMP, P_STIFF, P_DAMPING, P_CLIP
+      LAW_LANKARANI_NIKRAVESH, LAW_FLORES, LAW_GONTHIER, LAW_HERTZDAMP, P_STIFF, P_DAMPING, P_CLIP, &
+      law_rate_bounded
    implicit none
    private
-   public :: switch_count, switching_choose, switching_functions, force_continuous
+   public :: switch_count, switching_choose, switching_functions, force_continuous, stepped_across
+   public :: ACROSS_NONE, ACROSS_CONTINUOUS, ACROSS_RATE_BOUNDED
+
+   !> The penalty contacts an integrator steps across (left whole, not held on branches):
+   !> none; those whose force is continuous at their switches (force_continuous: CVODE, IDA);
+   !> only those whose force's rate is bounded there too (law_rate_bounded: ARKODE, whose
+   !> embedded error estimate does not bound a step across an unbounded second derivative;
+   !> docs/sundials-ode.md, events inside the steps). Values shared with the C door.
+   integer, parameter :: ACROSS_NONE = 0, ACROSS_CONTINUOUS = 1, ACROSS_RATE_BOUNDED = 2
 
 contains
 
@@ -35,22 +44,21 @@ contains
    !> After a commit at the state (u, v) (0:n, 0 = ground): every branch whose switch is past
    !> (g > 0) moves to the next branch (a bilinear one only while loading outward);
    !> CONTACT_FREE and BRANCH_FREE are chosen from the state. A bilinear force left outside its band by the located crossing (by at most
-   !> k |dv| event_tol) is put back on the band's edge. smooth: the laws whose force is
-   !> continuous at their switches (force_continuous contacts) are not held:
-   !> they stay the whole law, whose kinks the integrator's error control takes
-   !> (docs/sundials-ode.md, events inside the steps).
-   subroutine switching_choose(m, s, u, v, smooth)
+   !> k |dv| event_tol) is put back on the band's edge. across (ACROSS_*, default none): the
+   !> contacts stepped across (stepped_across) are not held: they stay the whole law, whose
+   !> kinks the integrator's error control takes (docs/sundials-ode.md, events inside the steps).
+   subroutine switching_choose(m, s, u, v, across)
       type(model_t), intent(in) :: m
       type(mech_state_t), intent(inout) :: s
       real(dp), intent(in) :: u(0:), v(0:)
-      logical, intent(in), optional :: smooth
-      logical :: free_continuous
+      integer, intent(in), optional :: across
+      integer :: laws
       integer :: j
       real(dp) :: du, dv, k, rho, r, back, fp, pen, g(2)
       integer :: el(2)
       real(dp) :: al(2), be(2), ga(2)
-      free_continuous = .false.
-      if (present(smooth)) free_continuous = smooth
+      laws = ACROSS_NONE
+      if (present(across)) laws = across
       do j = 1, m%nlink
          du = row_dot(m%lnk, j, u); dv = row_dot(m%lnk, j, v)
          select case (m%link_kind(j))
@@ -93,7 +101,7 @@ contains
       end do
       do j = 1, m%ncontact
          if (.not. s%is_penalty(j)) cycle
-         if (free_continuous .and. force_continuous(m, j)) then
+         if (stepped_across(m, j, laws)) then
             s%con_branch(j) = CONTACT_FREE
             cycle
          end if
@@ -191,6 +199,20 @@ contains
          force_continuous = .false.
       end select
    end function force_continuous
+
+   !> Whether penalty contact j is stepped across under the class laws (ACROSS_*).
+   pure logical function stepped_across(m, j, laws)
+      type(model_t), intent(in) :: m
+      integer, intent(in) :: j, laws
+      select case (laws)
+      case (ACROSS_CONTINUOUS)
+         stepped_across = force_continuous(m, j)
+      case (ACROSS_RATE_BOUNDED)
+         stepped_across = force_continuous(m, j) .and. law_rate_bounded(m%con_law(j), m%con_par(:, j))
+      case default
+         stepped_across = .false.
+      end select
+   end function stepped_across
 
    pure logical function kelvin_clipped(m, j)
       type(model_t), intent(in) :: m

@@ -47,7 +47,7 @@ def _lib():
         "martello_eval_power": (ctypes.c_int, [VP, DP]),
         "martello_eval_commit": (ctypes.c_int, [VP, DP, DP]),
         "martello_eval_use_branches": (ctypes.c_int, [VP, IP]),
-        "martello_eval_use_smooth_branches": (ctypes.c_int, [VP, IP, IP]),
+        "martello_eval_use_smooth_branches": (ctypes.c_int, [VP, ctypes.c_int, IP, IP]),
         "martello_eval_switches": (ctypes.c_int, [VP, IP, DP, DP, DP]),
         "martello_eval_bandwidth": (ctypes.c_int, [VP, IP, IP]),
         "martello_eval_tangent": (ctypes.c_int, [VP, DP, DP, DP, DP]),
@@ -128,7 +128,8 @@ class Eval:
         nsw = ctypes.c_int()
         if smooth:
             cont = np.zeros(max(self.nc, 1), dtype=np.int32)
-            assert L.martello_eval_use_smooth_branches(self.h, ctypes.byref(nsw),
+            # laws 1: MARTELLO_ACROSS_CONTINUOUS (c/martello_internal.h), CVODE's and IDA's class
+            assert L.martello_eval_use_smooth_branches(self.h, 1, ctypes.byref(nsw),
                                                        cont.ctypes.data_as(IP)) == 0
         else:
             assert L.martello_eval_use_branches(self.h, ctypes.byref(nsw)) == 0

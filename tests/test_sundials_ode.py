@@ -228,10 +228,11 @@ def test_lagrange_contact_released_when_its_multiplier_turns_tensile(integrator)
     assert c["phase_max_force"][1] == pytest.approx(M * G - K * H, rel=1e-12)
 
 
-# --- events inside the steps (docs/sundials-ode.md, events inside the steps): CVODE steps across
-# the laws whose force is continuous at onset and separation, their events located per contact
-# on the interpolant, without a root or a restart; IDA and ARKODE restart at them (the same
-# events, the same closed forms) ----------------------------------------------------------------
+# --- events inside the steps (docs/sundials-ode.md, events inside the steps): CVODE and IDA step
+# across the laws whose force is continuous at onset and separation, ARKODE across those whose
+# force's rate is bounded there too (here: linear), their events located per contact on the
+# interpolant, without a root or a restart; ARKODE restarts at the others (the same events, the
+# same closed forms) -------------------------------------------------------------------------------
 
 CONTINUOUS = [("linear", 1e6, None, None), ("hertz", 1e9, None, None),
               ("hunt-crossley", 1e9, 0.8, None), ("flores", 1e9, 0.5, None)]
@@ -257,6 +258,32 @@ def test_continuous_law_events_located_inside_the_steps(integrator, method, law,
     if "contact_time" in exact:
         assert c["contact_time"] == pytest.approx(exact["contact_time"], rel=1e-7)
     assert c["max_penetration"] == pytest.approx(exact["max_penetration"], rel=1e-7)
+
+
+@pytest.mark.parametrize("n,t_end", [(2.0, 0.005), (3.0, 0.02)])
+def test_arkode_steps_across_hertz_with_a_whole_exponent(n, t_end):
+    # Verification against closed forms: P5's two bodies (m* = 2/3 kg, v0 = 1 m/s, gap 1 mm) on
+    # K delta^n with n whole, which ARKODE steps across (its force a polynomial on each side of the
+    # onset: docs/sundials-ode.md, events inside the steps). Energy conservation gives
+    # delta_max = ((n+1) m* v0^2 / (2K))^(1/(n+1)) and the contact time
+    # 2 (delta_max/v0) sqrt(pi) Gamma(1 + 1/(n+1)) / Gamma(1/2 + 1/(n+1)); e = 1; the onset is
+    # at gap/v0 = 1e-3 s exactly (free flight), which is also an output time (dt = 1e-4 s): the
+    # gap is 0 there to rounding, and the onset was located a step late (3.8e-8 s for n = 2) when
+    # the bisection took the side at the row from the polynomial rather than the state. Bounds:
+    # 1e-7 relative as for the laws above (measured <= 2e-10 at rtol 1e-10); the onset within
+    # 2 event_tol (the bisection's resolution, event_tol = 1e-12 s; measured 5.9e-13 s).
+    k, m1, m2, v0, gap = 1e9, 1.0, 2.0, 1.0, 1e-3
+    ms = m1 * m2 / (m1 + m2)
+    d_max = ((n + 1) * ms * v0 ** 2 / (2 * k)) ** (1 / (n + 1))
+    t_c = 2 * d_max / v0 * math.sqrt(math.pi) * math.gamma(1 + 1 / (n + 1)) / math.gamma(0.5 + 1 / (n + 1))
+    an = dynamic("arkode", dt=1e-4, t_end=t_end, rtol=1e-10, atol=1e-15)
+    s = run(from_dict(two_bodies("hertz", k, m1=m1, m2=m2, v0=v0, gap=gap, analysis=an, exponent=n)))
+    c = s["contacts"]["impact"]
+    assert s["cost"]["events"] == 2
+    assert c["impact_times"][0] == pytest.approx(gap / v0, abs=2e-12)
+    assert c["restitution"][0] == pytest.approx(1.0, rel=1e-7)
+    assert c["contact_time"] == pytest.approx(t_c, rel=1e-7)
+    assert c["max_penetration"] == pytest.approx(d_max, rel=1e-7)
 
 
 @pytest.mark.parametrize("integrator", ["ida", "cvode"])
