@@ -331,7 +331,7 @@ def check(path_or_data, relation, base_dir=None, tied=None):
     adaptive run's rtol, atol and event_tol; a Newton method's tol_residual and
     tol_increment) moves it, and 100 times that relative tolerance; and the run's own
     rounding, what scaling every mass by 1 + 4 eps moves it (relations.rounding_scene; the
-    Newmark family at six perturbations and within the ceiling relations.newmark_rounding).
+    Newmark family also within the ceiling relations.newmark_rounding).
     The time of an extreme attained more than once within that allowance is not compared
     (relations.tied_times' rule, docs/invariance.md, ties); such mismatches go to the list
     `tied` when one is given. Raises Unsupported."""
