@@ -331,7 +331,7 @@ def check(path_or_data, relation, base_dir=None):
     adaptive run's rtol, atol and event_tol; a Newton method's tol_residual and
     tol_increment) moves it, and 100 times that relative tolerance; and the run's own
     rounding, what scaling every mass by 1 + 4 eps moves it (relations.rounding_scene; the
-    Newmark family at six perturbations and within the ceiling relations.newmark_rounding).
+    Newmark family also within the ceiling relations.newmark_rounding).
     Raises Unsupported."""
     from benchmarks.invariance import relations as R
     if isinstance(path_or_data, (str, Path)):
