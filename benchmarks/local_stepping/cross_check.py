@@ -48,8 +48,10 @@ from martello.scene.loader import load  # noqa: E402
 
 
 def is_cvode(path):
+    """A dynamic scene on cvode run globally (the catalogue's local-stepping scenes are the
+    local versions of such scenes: benchmarks/p7/local_stepping/)."""
     an = load(path).analysis
-    return an["type"] == "dynamic" and an.get("integrator") == "cvode"
+    return an["type"] == "dynamic" and an.get("integrator") == "cvode" and not an.get("local_stepping")
 
 
 def local(data):
