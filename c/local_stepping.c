@@ -1,18 +1,19 @@
 /* Local stepping (docs/sundials-ode.md, local stepping): the scene integrated cluster by cluster.
  *
  * Bodies joined by links or closed contacts form a cluster; clusters interact only through open
- * penalty contacts (gap < 0: no force). Each cluster is integrated by its own CVODE instance on its
- * sub-model (martello_model_subset), so that a step, an event and a restart cost O(cluster), not
- * O(n). Inside a cluster everything is as on the whole scene (c/sundials_ode.c, c/ode_events.c):
- * roots, events inside the steps, the observer's hand-overs (with the cluster's maps to the
- * scene's numbering).
+ * penalty contacts (gap < 0: no force). Each cluster is integrated by its own CVODE or ARKODE
+ * instance on its sub-model (martello_model_subset), so that a step, an event and a restart cost
+ * O(cluster), not O(n). Inside a cluster everything is as on the whole scene (c/sundials_ode.c,
+ * c/ode_events.c): roots, events inside the steps, the observer's hand-overs (with the cluster's
+ * maps to the scene's numbering).
  *
- * The scheduler always advances the cluster of least time by one step (CV_ONE_STEP; a binary heap
- * on the times). A cluster's last step is TENTATIVE: its hand-overs to the observer and its commit
- * are made only when it steps again, when an event cuts it, or at t_end. When a cluster steps, it
- * has the least time, so every other cluster's last step began at or before its own: every check
- * and every output row needs only each cluster's last step, on its interpolant (CVodeGetDky), and a
- * cut at t* inside a tentative step undoes nothing (no rollback beyond one step).
+ * The scheduler always advances the cluster of least time by one step (CV_ONE_STEP, ARK_ONE_STEP;
+ * a binary heap on the times). A cluster's last step is TENTATIVE: its hand-overs to the observer
+ * and its commit are made only when it steps again, when an event cuts it, or at t_end. When a
+ * cluster steps, it has the least time, so every other cluster's last step began at or before its
+ * own: every check and every output row needs only each cluster's last step, on its interpolant
+ * (CVodeGetDky, ARKStepGetDky), and a cut at t* inside a tentative step undoes nothing (no
+ * rollback beyond one step).
  *
  * Gaps between clusters: each open contact joining two clusters X, Y is checked through a time
  * (checked[j]); after X or Y moves, its gap delta and rate are tested on [checked, min(t_X, t_Y)]
@@ -36,7 +37,6 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include <cvode/cvode.h>
 #include <nvector/nvector_serial.h>
 
 #include "martello.h"
@@ -83,7 +83,9 @@ typedef struct {
   double *u0, *ys;            /* the scene's initial u; its state (interleaved) */
   int *mark, *list, *stack;   /* graph work */
   int *todo, ntodo;
-  int *slots, nslots;         /* the free slots */           /* clusters whose time rose (unfrozen): their contacts to check */
+  int *slots, nslots;         /* the free slots */
+  int *ev_n;                  /* per free node: events in a row of its cluster at one time, */
+  double *ev_t;               /* the last at ev_t */           /* clusters whose time rose (unfrozen): their contacts to check */
   double t_end;
 } driver;
 
@@ -199,11 +201,6 @@ static int scene_state(driver *D, double t) {
 
 /* ---- clusters: start, cut, stop ------------------------------------------------------------- */
 
-static int check_flag(driver *D, cluster *c, int flag, const char *call) {
-  (void)D;
-  return ode_problem_check(&c->P, flag, call);
-}
-
 /* A cluster of the free nodes nodes[0..m) at t, its state from D->ys, its element states from the
  * scene's evaluator (the store); its stop time, and its place in the heap (its slot into *at). */
 static int start_cluster(driver *D, const int *nodes, int m, double t, int *at) {
@@ -264,7 +261,7 @@ static int start_cluster(driver *D, const int *nodes, int m, double t, int *at) 
   c->t0 = c->t1 = c->tret = t;
   c->tq = -1.0;
   c->t_stop = oe_next_stop(E, t, D->t_end, &c->kink);
-  if ((st = check_flag(D, c, CVodeSetStopTime(c->P.mem, c->t_stop), "CVodeSetStopTime"))) return st;
+  if ((st = ode_problem_stop(&c->P, c->t_stop)) != MARTELLO_OK) return st;
   heap_push(D, slot);
   return MARTELLO_OK;
 }
@@ -323,7 +320,7 @@ static int finalize(driver *D, cluster *c, double tf, int cut) {
   if (own && !cut && (st = ode_problem_restart(&c->P, tf, c->y)) != MARTELLO_OK) return st;
   if (!cut && (own || c->tret >= c->t_stop)) {
     c->t_stop = oe_next_stop(E, tf, D->t_end, &c->kink);
-    if ((st = check_flag(D, c, CVodeSetStopTime(c->P.mem, c->t_stop), "CVodeSetStopTime"))) return st;
+    if ((st = ode_problem_stop(&c->P, c->t_stop)) != MARTELLO_OK) return st;
   }
   c->again = 0;
   return MARTELLO_OK;
@@ -461,12 +458,9 @@ static int check_contact(driver *D, int j, int s, int o) {
   int st;
   const double lo = D->checked[j], hi = fmin(t_of(D->cl[s]), t_of(D->cl[o]));
   if (!(hi > lo)) return MARTELLO_OK;
-  const double g0 = gap_at(D, j, lo, 0, &st);
-  if (st != MARTELLO_OK) return st;
-  if (g0 >= 0.0) {   /* closed at the start: the merge is there */
-    if (pend_event(D, PEND_MERGE, s, o, lo)) D->checked[j] = lo;
-    return MARTELLO_OK;
-  }
+  /* open at lo by construction (checked through it, or a cut's open side): its gap there on a
+   * new interpolant may differ by rounding, and is not tested again (a merge and a split at one
+   * time would follow each other) */
   const double r0 = gap_at(D, j, lo, 1, &st);
   if (st != MARTELLO_OK) return st;
   const double r1 = gap_at(D, j, hi, 1, &st);
@@ -552,17 +546,23 @@ static int check_release(driver *D, int s) {
       if (st != MARTELLO_OK) return st;
       if (g >= 0.0) a = m; else b = m;
     }
-    if (!(b < t_split)) continue;
+    /* the cut: its first open time, or the step's end when the step ends with an event of its
+     * own (the contact's separation where it is a root: a cut before would drop it) */
+    const double tc = c->again ? c->t1 : b;
+    if (!(tc < t_split)) continue;
+    /* separating there (delta' < 0): a grazing contact that closes again at once stays inside
+     * (a split and a merge at one time would follow each other without end) */
+    const double rc = gap_at(D, j, tc, 1, &st);
+    if (st != MARTELLO_OK) return st;
+    if (!(rc < 0.0)) continue;
     /* does its opening split the cluster? its graph at b, contact j open */
     if ((st = cluster_state(D, c, b)) != MARTELLO_OK) return st;
     for (int q = 0; q < c->nfree; q++) D->mark[free_node(c, q)] = 0;
     const int m = component(D, free_node(c, 0), 0, -1);
     for (int q = 0; q < c->nfree; q++) D->mark[free_node(c, q)] = -1;
-    if (m < c->nfree) t_split = b;
+    if (m < c->nfree) t_split = tc;
   }
-  /* a step that ends with an event of its own (the contact's separation where it is a root)
-   * splits after it: a cut before would drop it */
-  if (t_split < HUGE_VAL) pend_event(D, PEND_SPLIT, s, -1, c->again ? c->t1 : t_split);
+  if (t_split < HUGE_VAL) pend_event(D, PEND_SPLIT, s, -1, t_split);
   return MARTELLO_OK;
 }
 
@@ -573,6 +573,17 @@ static int run_event(driver *D, int s) {
   const double tp = c->tp;
   const int kind = c->pend, o = c->partner;
   int st, m = 0;
+  /* merges and splits of the same nodes that recur without progress in time (within a few
+   * ulps; other clusters may meet at one time by symmetry): the run fails rather than loop */
+  for (int q = 0; q < c->nfree; q++) {
+    const int i = free_node(c, q);
+    D->ev_n[i] = tp - D->ev_t[i] <= 16.0 * DBL_EPSILON * fabs(tp) ? D->ev_n[i] + 1 : 0;
+    D->ev_t[i] = tp;
+    if (D->ev_n[i] > 64)
+      return fail(D, MARTELLO_ERR_NOT_CONVERGED, "local stepping: the cluster of node %d merges and "
+                  "splits at t = %.9e s without progress (a grazing contact?); set "
+                  "analysis.local_stepping = false", i, tp);
+  }
   int *nodes = D->stack + D->n;   /* the second half of the work stack */
   for (int q = 0; q < c->nfree; q++) nodes[m++] = free_node(c, q);
   if (kind == PEND_MERGE)
@@ -604,16 +615,15 @@ static int step_cluster(driver *D, int s) {
   int st;
   if ((st = finalize(D, c, c->t1, 0)) != MARTELLO_OK) return st;
   double tret = c->t1, *y = N_VGetArrayPointer(c->y);
-  int flag = CVode(c->P.mem, D->t_end, c->y, &tret, CV_ONE_STEP);
+  int flag = ode_problem_step(&c->P, D->t_end, c->y, &tret);
   if (flag < 0) {
-    double tcur = c->t1;
-    if (CVodeGetCurrentTime(c->P.mem, &tcur) < 0) tcur = c->t1;
+    const double tcur = ode_problem_current_time(&c->P, c->t1);
     E->t_now = D->S.E.t_now = tcur;
     for (sunindextype k = 0; k < c->P.N; k++)
       if (!isfinite(y[k])) E->nan_seen = 1;
     if (E->nan_seen || !isfinite(tcur)) return martello_observer_fail(D->S.E.obs, MARTELLO_ERR_DIVERGED, tcur, NULL);
-    return fail(D, MARTELLO_ERR_EXTERNAL, "CVODE failed at t = %.9e s in a cluster of %d nodes: %s (%s)",
-                tcur, c->nfree, CVodeGetReturnFlagName(flag), c->P.msg);
+    return fail(D, MARTELLO_ERR_EXTERNAL, "%s failed at t = %.9e s in a cluster of %d nodes: %s (%s)",
+                c->P.name, tcur, c->nfree, ode_problem_flag(&c->P, flag), c->P.msg);
   }
   E->nan_seen = 0;
   oe_new_step(E, tret);
@@ -621,13 +631,13 @@ static int step_cluster(driver *D, int s) {
   if ((st = martello_observer_step(D->S.E.obs, D->S.E.t_now = c->t1)) != MARTELLO_OK) return st;
   int again = 0;
   double t_r = tret;
-  if (flag == CV_ROOT_RETURN) {
-    if ((st = check_flag(D, c, CVodeGetRootInfo(c->P.mem, c->found), "CVodeGetRootInfo"))) return st;
+  if (flag == ODE_STEP_ROOT) {
+    if ((st = ode_problem_root_info(&c->P, c->found)) != MARTELLO_OK) return st;
     again = oe_classify_roots(E, c->t1, tret, y, c->found, &t_r);
     if (again < 0) return again;
     if (!again) again = ode_problem_root_stays_zero(&c->P, y, c->found);
   }
-  if (!again && flag == CV_TSTOP_RETURN && tret == c->t_stop && c->kink && c->t_stop < D->t_end) again = 1;
+  if (!again && flag == ODE_STEP_TSTOP && tret == c->t_stop && c->kink && c->t_stop < D->t_end) again = 1;
   if (!again) {
     again = oe_boundary_events(E, c->t1, tret, y, ode_problem_last_step(&c->P), &t_r);
     if (again < 0) return again;
@@ -700,9 +710,6 @@ static int scene_sample(driver *D, double t, int k, int row) {
 /* What local stepping cannot run, refused by name with the fix. */
 static int refuse(driver *D) {
   ode_events *S = &D->S.E;
-  if (D->S.ark)
-    return fail(D, MARTELLO_ERR_UNSUPPORTED, "analysis.local_stepping: only integrator = \"cvode\" steps "
-                "locally; set local_stepping = false or integrator = \"cvode\"");
   if (S->nr > 0)
     return fail(D, MARTELLO_ERR_UNSUPPORTED, "analysis.local_stepping: contact %d is rigid (lagrange or "
                 "restitution); local stepping needs penalty contacts: set local_stepping = false",
@@ -766,6 +773,8 @@ static int integrate(driver *D) {
   D->stack = oe_take(2 * (size_t)n, sizeof(int), &failed);
   D->todo = oe_take((size_t)n, sizeof(int), &failed);
   D->slots = oe_take((size_t)n, sizeof(int), &failed);
+  D->ev_n = oe_take((size_t)n, sizeof(int), &failed);
+  D->ev_t = oe_take((size_t)n, sizeof(double), &failed);
   if (failed > 0.0) return oe_fail_memory(S, "the clusters of the local stepping", failed);
   if ((st = incidence(D)) != MARTELLO_OK) return st;
   for (int s = n - 1; s >= 0; s--) D->slots[D->nslots++] = s;
@@ -840,8 +849,9 @@ int martello_ode_local_run(martello_model *model, martello_run *run) {
   for (int k = 0; k < D->ncl && D->cl; k++) free_cluster(D, k);
   if (D->ctx) SUNContext_Free(&D->ctx);
   void *arrays[] = {D->cl, D->heap, D->hkey, D->node_cl, D->node_loc, D->nd_first, D->nd_con, D->nl_first,
-                    D->nl_link, D->checked, D->u0, D->ys, D->mark, D->list, D->stack, D->todo, D->slots};
+                    D->nl_link, D->checked, D->u0, D->ys, D->mark, D->list, D->stack, D->todo, D->slots, D->ev_n, D->ev_t};
   for (size_t k = 0; k < sizeof arrays / sizeof arrays[0]; k++) free(arrays[k]);
   ode_problem_release(&D->S);
   return st;
 }
+

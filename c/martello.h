@@ -229,7 +229,7 @@ typedef struct martello_settings {
   bool event_split;         /* Newmark family: split a step at a penalty onset/separation */
   int method;               /* cvode, arkode: a value of the table "methods" (0: the default) */
   int modal_vectors;        /* fast-nonlinear: 0 all modes; m > 0: m load-dependent Ritz vectors */
-  bool local_stepping;      /* cvode: integrate cluster by cluster (docs/sundials-ode.md) */
+  bool local_stepping;      /* cvode, arkode: integrate cluster by cluster (docs/sundials-ode.md) */
 } martello_settings;
 
 /* Indices of martello_run_counters, martello_run_energy and the values of
@@ -277,9 +277,12 @@ int martello_run_set_tracking(martello_run *run, int what);
 int martello_run_set_functionals(martello_run *run, int n, const int *ptr, const int *col,
                                  const double *val, int np, const int *pairs);
 /* The step trace (docs/results.md "Step trace"): contact (0-based; < 0: none, the default)
- * whose force the run keeps, with the kinetic and recoverable energies, at every grid point
- * t = k dt of a fixed-step method, whatever the history records: martello_run_trace. */
+ * whose force the run keeps, with the kinetic and recoverable energies (and the traced nodes'
+ * u), at every grid point t = k dt of a fixed-step method, whatever the history records:
+ * martello_run_trace. */
 int martello_run_set_trace(martello_run *run, int contact);
+/* The n nodes (0-based; default none) whose displacement u the step trace holds too. */
+int martello_run_set_trace_nodes(martello_run *run, int n, const int *nodes);
 /* ---- closed forms of catalogue problems (docs/c-api.md "Closed forms") ------------------
  * The closed form `name` at the n_par parameters par: out (4 values) receives its *n_out
  * values. MARTELLO_ERR_ARGUMENT for an unknown name, a wrong parameter count or parameters
@@ -331,7 +334,8 @@ int martello_run_link_peaks(const martello_run *run, double *force_absmax, doubl
 int martello_run_functionals(const martello_run *run, double *q_max, double *t_max, double *q_min,
                              double *t_min, double *res_max, double *t_res);
 /* The step trace (martello_run_set_trace): n grid points on return; with a non-NULL buf also
- * buf[n][4] = {t, the contact's force, kinetic energy, recoverable energy}. */
+ * buf[n][4 + m] = {t, the contact's force, kinetic energy, recoverable energy, u of the m
+ * traced nodes (martello_run_set_trace_nodes)}. */
 int martello_run_trace(const martello_run *run, int *n, double *buf);
 
 #ifdef __cplusplus

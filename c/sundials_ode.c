@@ -821,3 +821,19 @@ int ode_problem_root_stays_zero(ode_problem *P, const double *y, const int *foun
 }
 int ode_problem_interpolant(ode_problem *P, double t, int k, N_Vector out) { return interpolant(P, t, k, out); }
 double ode_problem_last_step(ode_problem *P) { return be_last_step(P); }
+int ode_problem_step(ode_problem *P, double tout, N_Vector y, double *tret) {
+  int flag = P->ark ? ARKStepEvolve(P->mem, tout, y, tret, ARK_ONE_STEP) : CVode(P->mem, tout, y, tret, CV_ONE_STEP);
+  if (flag < 0) return flag;
+  if (flag == (P->ark ? ARK_ROOT_RETURN : CV_ROOT_RETURN)) return ODE_STEP_ROOT;
+  return flag == (P->ark ? ARK_TSTOP_RETURN : CV_TSTOP_RETURN) ? ODE_STEP_TSTOP : ODE_STEP_DONE;
+}
+int ode_problem_root_info(ode_problem *P, int *found) {
+  return check(P, P->ark ? ARKStepGetRootInfo(P->mem, found) : CVodeGetRootInfo(P->mem, found), "GetRootInfo");
+}
+int ode_problem_stop(ode_problem *P, double t) { return check(P, be_stop(P, t), "SetStopTime"); }
+double ode_problem_current_time(ode_problem *P, double t_last) {
+  double t = t_last;
+  if ((P->ark ? ARKStepGetCurrentTime(P->mem, &t) : CVodeGetCurrentTime(P->mem, &t)) < 0) t = t_last;
+  return t;
+}
+const char *ode_problem_flag(ode_problem *P, int flag) { return be_flag(P, flag); }

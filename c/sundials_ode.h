@@ -58,5 +58,14 @@ int ode_problem_root_stays_zero(ode_problem *P, const double *y, const int *foun
 /* The k-th derivative of the last step's interpolant at t. */
 int ode_problem_interpolant(ode_problem *P, double t, int k, N_Vector out);
 double ode_problem_last_step(ode_problem *P);
+/* One step towards tout (CV_ONE_STEP, ARK_ONE_STEP): the integrator's flag if < 0, else one of */
+enum { ODE_STEP_DONE, ODE_STEP_ROOT, ODE_STEP_TSTOP };
+int ode_problem_step(ode_problem *P, double tout, N_Vector y, double *tret);
+/* The roots found at the last return; the stop time; the time the integrator reached (t_last if
+ * it cannot say); a flag's name. */
+int ode_problem_root_info(ode_problem *P, int *found);
+int ode_problem_stop(ode_problem *P, double t);
+double ode_problem_current_time(ode_problem *P, double t_last);
+const char *ode_problem_flag(ode_problem *P, int flag);
 #pragma GCC visibility pop
 #endif

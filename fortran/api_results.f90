@@ -198,8 +198,9 @@ contains
       c_run_functionals = MARTELLO_OK
    end function c_run_functionals
 
-   !> The step trace (martello_run_set_trace): n, its grid points; with a non-NULL buf also
-   !> buf(4, n) = t, the traced contact's force, the kinetic and the recoverable energy.
+   !> The step trace (martello_run_set_trace, _set_trace_nodes): n, its grid points; with a
+   !> non-NULL buf also buf(4 + m, n) = t, the traced contact's force, the kinetic and the
+   !> recoverable energy, u of the m traced nodes.
    integer(c_int) function c_run_trace(handle, n, buf) bind(C, name='martello_run_trace')
       type(c_ptr), value :: handle
       integer(c_int), intent(out) :: n
@@ -212,7 +213,7 @@ contains
       if (.not. associated(rp)) return
       n = int(rp%results%ntrace, c_int)
       if (c_associated(buf) .and. n > 0) then
-         call c_f_pointer(buf, b, [4, int(n)])
+         call c_f_pointer(buf, b, [size(rp%results%trace, 1), int(n)])
          b = rp%results%trace(:, 1:n)
       end if
       c_run_trace = MARTELLO_OK

@@ -147,6 +147,21 @@ contains
       c_run_set_trace = MARTELLO_OK
    end function c_run_set_trace
 
+   !> The nodes (0-based, n of them; default none) whose displacement the step trace holds
+   !> after the contact's force and the energies (martello_run_trace).
+   integer(c_int) function c_run_set_trace_nodes(handle, n, nodes) &
+      bind(C, name='martello_run_set_trace_nodes')
+      type(c_ptr), value :: handle
+      integer(c_int), value :: n
+      integer(c_int), intent(in) :: nodes(*)
+      type(run_t), pointer :: rp
+      rp => get_run(handle)
+      c_run_set_trace_nodes = MARTELLO_ERR_ARGUMENT
+      if (.not. associated(rp) .or. n < 0) return
+      rp%trace_nodes = nodes(1:n) + 1
+      c_run_set_trace_nodes = MARTELLO_OK
+   end function c_run_set_trace_nodes
+
    !> What the run tracks: an OR of MARTELLO_TRACK_* (default MARTELLO_TRACK_ALL).
    integer(c_int) function c_run_set_tracking(handle, what) bind(C, name='martello_run_set_tracking')
       type(c_ptr), value :: handle

@@ -56,7 +56,7 @@ module martello_integrator_settings
       integer(c_int) :: method = nint(SETTINGS(S_METHOD)%default)
       !> fast-nonlinear: 0 all modes; m > 0 that many load-dependent Ritz vectors
       integer(c_int) :: modal_vectors = nint(SETTINGS(S_MODAL_VECTORS)%default)
-      !> cvode: integrate cluster by cluster (docs/sundials-ode.md, local stepping)
+      !> cvode, arkode: integrate cluster by cluster (docs/sundials-ode.md, local stepping)
       logical(c_bool) :: local_stepping = SETTINGS(S_LOCAL_STEPPING)%default /= 0.0_dp
    end type integrator_settings_t
 

@@ -387,7 +387,7 @@ module martello_registry
                    RUNS_PENALTY + RUNS_RIGID, &
                    'SUNDIALS CVODE, variable-order BDF or Adams, banded analytic Jacobian'), &
       integrator_t('arkode', INT_ARKODE, FAMILY_ODE, .true., &
-                   READS_BASE + READS_DIVERGENCE + READS_ADAPTIVE + 2**S_METHOD, &
+                   READS_BASE + READS_DIVERGENCE + READS_ADAPTIVE + 2**S_METHOD + 2**S_LOCAL_STEPPING, &
                    RUNS_PENALTY + RUNS_RIGID, &
                    'SUNDIALS ARKODE, explicit, diagonally implicit or ImEx Runge-Kutta tables')]
 

@@ -55,8 +55,10 @@ module martello_run
       integer :: tracking = TRACK_ALL
       !> the linear functionals of the state the run tracks (martello_run_set_functionals)
       type(functionals_t) :: fq
-      !> the contact whose force the step trace holds (0: no trace; martello_run_set_trace)
+      !> the contact whose force the step trace holds (0: no trace) and the nodes whose
+      !> displacement it holds (martello_run_set_trace)
       integer :: trace_contact = 0
+      integer, allocatable :: trace_nodes(:)
       logical :: configured = .false., done = .false.
       !> the caller's progress callback and its argument (martello_run_set_progress)
       type(c_funptr) :: progress = c_null_funptr
@@ -104,7 +106,14 @@ contains
          rp%results%message = 'dynamic_run: the traced contact is out of range'
          stat = MARTELLO_ERR_ARGUMENT
       end if
+      if (stat == MARTELLO_OK .and. allocated(rp%trace_nodes)) then
+         if (any(rp%trace_nodes < 1 .or. rp%trace_nodes > mp%n)) then
+            rp%results%message = 'dynamic_run: a traced node is out of range'
+            stat = MARTELLO_ERR_ARGUMENT
+         end if
+      end if
       rp%results%trace_contact = rp%trace_contact
+      if (allocated(rp%trace_nodes)) rp%results%trace_nodes = rp%trace_nodes
       if (stat == MARTELLO_OK .and. rp%fq%n > 0) then
          if (any(rp%fq%col < 1 .or. rp%fq%col > mp%n)) then
             rp%results%message = 'dynamic_run: a functional''s node is out of range'

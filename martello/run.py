@@ -327,12 +327,14 @@ def run_full(scene, raise_on_failure=True):
         return _dynamic(scene, model, raise_on_failure)[:2]
 
 
-def run_traced(scene, contact):
-    """(summary, history, trace) of a dynamic run whose step trace holds this contact (its
-    name): trace = {"t", "force", "kinetic", "recoverable"}, arrays over every grid point of a
-    fixed-step run (docs/results.md "Step trace"), whatever the history records."""
+def run_traced(scene, contact, nodes=()):
+    """(summary, history, trace) of a dynamic run whose step trace holds this contact and
+    these nodes (names): trace = {"t", "force", "kinetic", "recoverable": arrays over every grid
+    point of a fixed-step run, "u": {node: array}} (docs/results.md "Step trace"), whatever the
+    history records."""
     with build_model(scene) as model:
-        return _dynamic(scene, model, True, trace=names_of(scene.contacts).index(contact))
+        return _dynamic(scene, model, True, trace=(names_of(scene.contacts).index(contact),
+                                                   [scene.index[n] for n in nodes], list(nodes)))
 
 
 def integrator_settings(an):
@@ -396,7 +398,7 @@ def _dynamic(scene, model, raise_on_failure=True, trace=None):
         if structures.rows:
             r.set_functionals(structures.matrix(), structures.nodes, structures.pairs)
         if trace is not None:
-            r.set_trace(trace)
+            r.set_trace(*trace[:2])
         t0 = time.perf_counter()
         st = r.execute(model) if raise_on_failure else r.status_of(model)
         if st == native.constant("MARTELLO_ERR_INTERRUPTED"):
@@ -520,7 +522,8 @@ def _dynamic(scene, model, raise_on_failure=True, trace=None):
         "provenance": provenance(scene),
     }
     if steps is not None:
-        steps = dict(zip(("t", "force", "kinetic", "recoverable"), steps.T))
+        steps = dict(zip(("t", "force", "kinetic", "recoverable"), steps[:, :4].T),
+                     u=dict(zip(trace[2], steps[:, 4:].T)))
     return summary, (columns, hist), steps
 
 

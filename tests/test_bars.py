@@ -335,19 +335,21 @@ def test_measures_say_what_is_missing_from_the_output():
     m = measures(N=10, output="ends")
     assert "v_final" not in m and "duration" in m
     assert any("output.nodes" in n for n in m["notes"])
-    m = measures(N=10, every=3)
-    assert any("every 3 steps" in n for n in m["notes"])
+    m = measures(N=10, every=3)        # the every-step measures from the step trace
+    assert "pulse_l1_error" in m and "displacement_error" in m
+    m = measures(N=10, integrator="rk8pd")
+    assert "pulse_l1_error" not in m and any("output times" in n for n in m["notes"])
 
 
 def test_no_measure_depends_on_output_every():
     # A measure is taken from what the run tracks at every step (the contact phases and
-    # maxima, the final state, and the step trace: the contact's force and the energies at
-    # every step, whatever is recorded; docs/results.md "Step trace"), or, needing every
-    # node's displacement at every step, only where the history holds them (every = 1):
-    # never from recorded samples. The unequal rods on Newmark had 1 phase at every = 1 and
-    # 7 at every = 16 (the episode merged gaps shorter than an output interval), force_peak
-    # 1984.376 vs 1984.347 N; the pulse's L1, total variation and width and the energy error
-    # existed at every = 1 alone. Every = 1, 7, 16 and 1000 give the same numbers, bit for bit,
+    # maxima, the final state, and the step trace: the contact's force, the energies and the
+    # rods' displacements at every step, whatever is recorded; docs/results.md "Step
+    # trace"): never from recorded samples. The unequal rods on Newmark had 1 phase at
+    # every = 1 and 7 at every = 16 (the episode merged gaps shorter than an output
+    # interval), force_peak 1984.376 vs 1984.347 N; the pulse's L1, total variation and width,
+    # the energy error and the displacement error existed at every = 1 alone. Every = 1, 7,
+    # 16 and 1000 give the same numbers, bit for bit,
     # and the same as the rows at every = 1 (attach without the trace): the trace holds the
     # samples of those rows. An identity of the method, no oracle.
     import tomllib
@@ -368,8 +370,7 @@ def test_no_measure_depends_on_output_every():
         for key in ("onset_time", "duration", "phases", "later_phases", "max_penetration",
                     "force_peak", "peak_error", "impulse_error", "v_final", "energy_final_error",
                     "vibration_energy_fraction", "pulse_l1_error", "force_total_variation",
-                    "spurious_variation", "pulse_duration", "energy_error"):
+                    "spurious_variation", "pulse_duration", "energy_error", "displacement_error",
+                    "end_displacement_error"):
             assert got[every][key] == one[key] == rows[key], (every, key)
-        assert "displacement_error" in one and "displacement_error" not in got[every]
-    sixteen = got[16]
-    assert any("every 16 steps" in n and "displacement error" in n for n in sixteen["notes"])
+        assert not any("every" in n for n in got[every]["notes"]), got[every]["notes"]

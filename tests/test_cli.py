@@ -246,7 +246,8 @@ def test_ctrl_c_at_any_moment_of_a_command_is_one_line_and_exit_130(tmp_path):
     (tmp_path / "seam" / "sitecustomize.py").write_text(SIGINT_SEAM)
 
     def run(at, how, out):
-        env = dict(os.environ, PYTHONPATH=str(tmp_path / "seam"), SEAM_AT=str(at), SEAM_HOW=how,
+        path = os.pathsep.join(p for p in (str(tmp_path / "seam"), os.environ.get("PYTHONPATH")) if p)
+        env = dict(os.environ, PYTHONPATH=path, SEAM_AT=str(at), SEAM_HOW=how,
                    SEAM_COUNT=str(tmp_path / "count"))
         return subprocess.run([sys.executable, "-m", "martello", "run", str(P1), "-o", str(out)],
                               cwd=ROOT, env=env, capture_output=True, text=True, timeout=120)

@@ -31,7 +31,7 @@ from pathlib import Path
 
 import pytest
 
-from martello.report import check_catalogue, coverage_counts, readme_counts
+from martello.report import cell_integrator, check_catalogue, coverage_counts, readme_counts
 from martello.scene import catalogue
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -88,8 +88,7 @@ def _cell_of(path):
     contacts = list(d.get("contact", [])) + [ch["contact"] for ch in d.get("chain", []) if "contact" in ch]
     laws = ",".join(sorted({c["scheme"] if c["scheme"] != "penalty" else c.get("law", "linear")
                             for c in contacts})) or "-"
-    an = d.get("analysis", {})
-    return d.get("problem", ""), laws, an.get("integrator") or "static"
+    return d.get("problem", ""), laws, cell_integrator(d.get("analysis", {}))
 
 
 def test_a_sample_of_cells_is_current(tmp_path):

@@ -63,9 +63,11 @@ def one_metamorphic(path):
     for name in metamorphic.RELATIONS:
         t0 = time.perf_counter()
         try:
-            bad = metamorphic.check(path, name)
+            tied = []
+            bad = metamorphic.check(path, name, tied=tied)
             out["relations"][name] = {"held": not bad, "seconds": time.perf_counter() - t0,
-                                      "mismatches": [[p, repr(x), repr(y), a] for p, x, y, a in bad[:8]]}
+                                      "mismatches": [[p, repr(x), repr(y), a] for p, x, y, a in bad[:8]],
+                                      "tied": sorted({p for p, *_ in tied})}
         except metamorphic.Unsupported as exc:
             out["relations"][name] = {"unsupported": str(exc)}
         except Exception as exc:

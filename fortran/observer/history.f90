@@ -153,9 +153,9 @@ contains
       if (traced(o, k) .and. .not. is_row) then
          ! the traced contact's force: from the method that measured itself, or handed
          if (measured) then
-            call trace_append(o, t, o%trace_f, stat)
+            call trace_append(o, t, o%trace_f, u, stat)
          else
-            call trace_append(o, t, force(o%trace_contact), stat)
+            call trace_append(o, t, force(o%trace_contact), u, stat)
          end if
          if (stat /= MARTELLO_OK) then
             call observer_finish(o, t); return

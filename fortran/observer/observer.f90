@@ -98,11 +98,13 @@ module martello_observer
       !> per link: max |force| and max |elongation| (storey shear and drift of a frame)
       real(dp), allocatable :: link_force_absmax(:), link_du_absmax(:)
       integer, allocatable :: impacts(:)
-      !> the step trace (trace; martello_run_set_trace): contact trace_contact's force and
-      !> the kinetic and recoverable energies at every grid point of the run (t = k·dt),
-      !> whatever the history records: trace(:, j) = [t, force, kinetic, recoverable], j ≤
-      !> ntrace; trace_f: that force at the sample, from a method that measures itself
+      !> the step trace (trace; martello_run_set_trace): contact trace_contact's force, the
+      !> kinetic and recoverable energies and u of the nodes trace_nodes at every grid point
+      !> of the run (t = k·dt), whatever the history records: trace(:, j) = [t, force,
+      !> kinetic, recoverable, u(trace_nodes)], j ≤ ntrace; trace_f: that force at the
+      !> sample, from a method that measures itself
       integer :: trace_contact = 0, ntrace = 0
+      integer, allocatable :: trace_nodes(:)
       real(dp), allocatable :: trace(:, :)
       real(dp) :: trace_f = 0.0_dp
       real(dp) :: energy(NENERGY) = 0.0_dp
@@ -478,10 +480,11 @@ module martello_observer
          real(dp), intent(in), optional :: external, damping, links, contact, impact, internal
       end subroutine observer_work
       !> Append the grid point at t (force f of the traced contact, the energies of the
-      !> sample) to the step trace; stat = MARTELLO_ERR_MEMORY (message set) if it cannot grow.
-      module subroutine trace_append(o, t, f, stat)
+      !> sample, u of the traced nodes) to the step trace; stat = MARTELLO_ERR_MEMORY
+      !> (message set) if it cannot grow.
+      module subroutine trace_append(o, t, f, u, stat)
          type(observer_t), intent(inout) :: o
-         real(dp), intent(in) :: t, f
+         real(dp), intent(in) :: t, f, u(0:)
          integer, intent(out) :: stat
       end subroutine trace_append
       module logical function observer_energy_due(o, k) result(due)

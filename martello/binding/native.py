@@ -115,6 +115,7 @@ def lib():
         "martello_run_functionals": (c_int, [_VOID_P] * 7),
         "martello_run_set_trace": (c_int, [_VOID_P, c_int]),
         "martello_run_trace": (c_int, [_VOID_P, ctypes.POINTER(c_int), _VOID_P]),
+        "martello_run_set_trace_nodes": (c_int, [_VOID_P, c_int, _INT_P]),
         "martello_memory_message": (None, [c_char_p, c_double, c_char_p, c_char_p, c_int]),
         "martello_write_csv": (c_int, [c_char_p, c_char_p, _DOUBLE_P, ctypes.c_int64, c_int]),
     }
@@ -593,16 +594,21 @@ class Run(_Handle):
         self._check(lib().martello_run_functionals(self._h, *(o.ctypes.data for o in out)), "functionals")
         return [o[:n] for o in out[:4]] + [o[:n_pairs] for o in out[4:]]
 
-    def set_trace(self, contact):
-        """Keep the step trace of this 0-based contact (c/martello.h, martello_run_set_trace)."""
+    def set_trace(self, contact, nodes=()):
+        """Keep the step trace of this 0-based contact and the displacement of these 0-based
+        nodes (c/martello.h, martello_run_set_trace, _set_trace_nodes)."""
         self._check(lib().martello_run_set_trace(self._h, int(contact)), "trace")
+        nd = np.ascontiguousarray(nodes, dtype=np.int32)
+        self._check(lib().martello_run_set_trace_nodes(self._h, nd.size, nd if nd.size else np.zeros(1, np.int32)),
+                    "trace nodes")
+        self._trace_width = 4 + nd.size
 
     def trace(self):
-        """The step trace: an array of rows [t, force, kinetic, recoverable], one per grid
-        point of the run."""
+        """The step trace: an array of rows [t, force, kinetic, recoverable, u of the traced
+        nodes], one per grid point of the run."""
         n = ctypes.c_int()
         self._check(lib().martello_run_trace(self._h, ctypes.byref(n), None), "trace")
-        buf = np.zeros((max(n.value, 1), 4))
+        buf = np.zeros((max(n.value, 1), self._trace_width))
         self._check(lib().martello_run_trace(self._h, ctypes.byref(n), buf.ctypes.data), "trace")
         return buf[:n.value]
 

@@ -30,12 +30,12 @@ state):
   the end of the run, their errors over v0, the share of energy left as vibration, and the
   final energy error (E_kin + E_recoverable − E0) / E0.
 
-From the force and the energy at every step of a fixed-step method — its step trace
-(docs/results.md "Step trace": the contact's force and the energies at every step, whatever
-`output.every`; the samples of the history at every = 1), and from the displacement at every
-step only where the history holds it, `every = 1` (an adaptive run's rows are its output
-times, not its steps; where a measure cannot be made it is left out and a note says why,
-never computed on the recorded samples):
+From the force, energy and displacement at every step of a fixed-step method — its step
+trace (docs/results.md "Step trace": the contact's force, the energies and the rods' nodes'
+displacement at every step, whatever `output.every`; the samples of the history at
+every = 1), or the history where it holds every step (`every = 1`) when the measures are
+attached without the trace (an adaptive run's rows are its output times, not its steps:
+there they are left out and a note says why, never computed on the recorded samples):
 
 * the force pulse against the rectangle P0 = Z v0/2 (Z v0 on a wall) on
   [t_on, t_on + 2 L_min/c): L1 error (the force held constant over each step, centred on
@@ -69,26 +69,30 @@ def run_measured(scene):
     `martello run` writes and `martello check` verifies. A rod impact on a fixed-step method
     keeps its contact's step trace (force and energies at every step, whatever the history
     records: martello.run.run_traced) for the measures that need every step."""
-    contact = _traced_contact(scene)
-    if contact is None:
+    traced = _traced(scene)
+    if traced is None:
         summary, history = run_full(scene)
         steps = None
     else:
-        summary, history, steps = run_traced(scene, contact)
+        summary, history, steps = run_traced(scene, *traced)
     attach(scene, summary, history, steps)
     return summary, history
 
 
-def _traced_contact(scene):
-    """The name of the contact whose step trace the rod-impact measures read, or None (not
-    a rod impact, or not a dynamic fixed-step run)."""
+def _traced(scene):
+    """(contact, nodes): the names of the contact and of the rods' nodes whose step trace
+    the rod-impact measures read, or None (not a rod impact, or not a dynamic fixed-step
+    run)."""
     rods = scene.extras.get("bars") if scene.extras else None
     an = scene.analysis
     if not (rods and scene.contacts and an["type"] == "dynamic") or \
             an["integrator"] in native.adaptive_integrators():
         return None
     got = _applicability(scene, rods)
-    return None if isinstance(got, str) else got[0]["name"]
+    if isinstance(got, str):
+        return None
+    c, side_a, side_b = got
+    return c["name"], [nm for side in (side_a, side_b) if side for nm in side[0]["nodes"]]
 
 
 def attach(scene, summary, history, steps=None):
@@ -269,9 +273,6 @@ def rod_impact_measures(scene, summary, history, steps=None):
         notes.append(why + ": no pulse L1, total variation or width, energy error over the run or "
                      "displacement error (they need the force, energy and displacement at every "
                      "step of the method)")
-    elif not rows_every_step:
-        notes.append(why + ": no displacement error (it needs every node's displacement at every "
-                     "step of the method)")
 
     fkey = f"force:{c['name']}"
     # the force and the energies at every step: the step trace, else the rows (every = 1)
@@ -355,8 +356,11 @@ def rod_impact_measures(scene, summary, history, steps=None):
         m["vibration_energy_fraction"] = frac
         m["vibration_energy_reference"] = frac_ref
 
-        if rows_every_step:
-            # displacement field against d'Alembert (free rods of equal bars)
+        if every_step:
+            # displacement field against d'Alembert (free rods of equal bars), at every step:
+            # the step trace's, else the rows' (every = 1)
+            tu = steps["t"] if steps is not None else t
+            u_of = (lambda nm: steps["u"][nm]) if steps is not None else (lambda nm: data[:, col[f"u:{nm}"]])
             err_all, err_end = 0.0, 0.0
             scale = vp * T
             for side, r, end_node in (("a", rod_a, side_a and side_a[1]), ("b", rod_b, side_b and side_b[1])):
@@ -367,9 +371,9 @@ def rod_impact_measures(scene, summary, history, steps=None):
                 L_other = other["L"] if other is not None else r["L"]
                 for nm, x in zip(r["nodes"], r["x"]):
                     s = min(max(abs(face - x), 0.0), r["L"])
-                    u_ex = r["v0"] * t + rod_point_displacement(s, t - t_on_ref, ref.c, r["L"], L_other,
-                                                                v_rel, side, wall=wall)
-                    e_node = float(np.max(np.abs(data[:, col[f"u:{nm}"]] - u_ex))) / scale
+                    u_ex = r["v0"] * tu + rod_point_displacement(s, tu - t_on_ref, ref.c, r["L"], L_other,
+                                                                 v_rel, side, wall=wall)
+                    e_node = float(np.max(np.abs(u_of(nm) - u_ex))) / scale
                     err_all = max(err_all, e_node)
                     if nm == end_node:
                         err_end = max(err_end, e_node)
