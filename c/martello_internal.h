@@ -93,6 +93,11 @@ int martello_eval_forces(martello_eval *ev, double t, const double *u, const dou
 int martello_eval_solve_mass(martello_eval *ev, double *x);
 /* Accept (u, v) at the end of a step: path-dependent links (hysteresis) commit. */
 int martello_eval_commit(martello_eval *ev, const double *u, const double *v);
+/* Keep every element state (committed and trial) / bring back the kept ones: an output row inside
+ * a step is committed for its own values, then the step's states are restored, so that no later
+ * step depends on where the rows fall. */
+int martello_eval_save(martello_eval *ev);
+int martello_eval_restore(martello_eval *ev);
 /* Event-driven integrators: from now on every piecewise-smooth law is held on one smooth
  * branch between located switches (fortran/switching.f90, docs/event-driven.md); branches
  * change at commits past their switches. *nsw: the number of switch slots. */

@@ -179,6 +179,27 @@ contains
       c_eval_commit = MARTELLO_OK
    end function c_eval_commit
 
+   !> martello_eval_save / martello_eval_restore (evaluator_save, evaluator_restore).
+   integer(c_int) function c_eval_save(handle) bind(C, name='martello_eval_save')
+      type(c_ptr), value :: handle
+      type(evaluator_t), pointer :: ep
+      ep => get_eval(handle)
+      c_eval_save = MARTELLO_ERR_ARGUMENT
+      if (.not. associated(ep)) return
+      call evaluator_save(ep)
+      c_eval_save = MARTELLO_OK
+   end function c_eval_save
+
+   integer(c_int) function c_eval_restore(handle) bind(C, name='martello_eval_restore')
+      type(c_ptr), value :: handle
+      type(evaluator_t), pointer :: ep
+      ep => get_eval(handle)
+      c_eval_restore = MARTELLO_ERR_ARGUMENT
+      if (.not. associated(ep)) return
+      call evaluator_restore(ep)
+      c_eval_restore = MARTELLO_OK
+   end function c_eval_restore
+
    !> The half-bandwidth kd of the model's node couplings (model_bandwidth) and whether its
    !> mass is lumped (no couplings: M⁻¹ diagonal).
    integer(c_int) function c_eval_bandwidth(handle, kd, lumped) bind(C, name='martello_eval_bandwidth')

@@ -16,11 +16,13 @@ module martello_evaluator
       evaluator_forces, evaluator_solve_mass, evaluator_commit, &
       evaluator_energy, evaluator_power, evaluator_use_branches, evaluator_switches, &
       evaluator_set_onset_speed, &
-      evaluator_next_breakpoint, evaluator_load_period, evaluator_rates, evaluator_tangent
+      evaluator_next_breakpoint, evaluator_load_period, evaluator_rates, evaluator_tangent, evaluator_save, evaluator_restore
 
    type :: evaluator_t
       type(model_t), pointer :: m => null()
       type(mech_state_t) :: ms
+      !> the element states of evaluator_save, for evaluator_restore
+      type(mech_state_t) :: saved
       type(band_t) :: mband
       real(dp), allocatable :: mrow(:), u(:), v(:), f(:), fext(:), work(:)
       integer, allocatable :: fixed_nodes(:)
@@ -113,6 +115,20 @@ contains
    end subroutine evaluator_solve_mass
 
    !> Accept (u, v) as the state at the end of a step: path-dependent links commit.
+   !> Keep every element state (committed and trial, branches, onset speeds): an output row
+   !> inside a step is committed for its own values and the step's states are then restored,
+   !> so that no later step depends on where the rows fall (docs/sundials-ode.md, output rows).
+   subroutine evaluator_save(ev)
+      type(evaluator_t), intent(inout) :: ev
+      ev%saved = ev%ms
+   end subroutine evaluator_save
+
+   !> The element states of the last evaluator_save.
+   subroutine evaluator_restore(ev)
+      type(evaluator_t), intent(inout) :: ev
+      ev%ms = ev%saved
+   end subroutine evaluator_restore
+
    subroutine evaluator_commit(ev, u, v)
       type(evaluator_t), intent(inout) :: ev
       real(dp), intent(in) :: u(:), v(:)
