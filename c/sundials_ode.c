@@ -104,6 +104,7 @@ static int be_counts(ode_problem *P, long c[9]) {
     st |= ARKStepGetNumGEvals(P->mem, &c[MARTELLO_COUNTER_ROOT_EVALUATIONS]);
     /* ImEx: a step evaluates both parts at a stage; count the stage evaluations once */
     if (P->kind == KIND_DIRK) c[MARTELLO_COUNTER_RESIDUAL_EVALUATIONS] = nfi;
+    c[MARTELLO_COUNTER_RESIDUAL_EVALUATIONS] += P->row_rhs;
     if (P->kind != KIND_ERK) {
       st |= ARKStepGetNumNonlinSolvConvFails(P->mem, &cf);
       st |= ARKStepGetNumNonlinSolvIters(P->mem, &c[MARTELLO_COUNTER_NEWTON_ITERATIONS]);
@@ -280,9 +281,19 @@ static int observe(ode_problem *P, double t, const double *y, int k, int row) {
                                                                   E->ar, E->force, k);
 }
 
-/* An output row on the interpolant (c/ode_events.c oe_rows_inside). */
+static int row_by_step(ode_problem *P, double t, N_Vector out);
+static int rows_setup(ode_problem *P, N_Vector y);
+
+/* An output row inside a step (c/ode_events.c oe_rows_inside): y, the state on the interpolant,
+ * or where the table's order exceeds the interpolant's degree, its own step (row_by_step). */
 static int sample(void *ctx, double t, const double *y, int k) {
-  return observe(ctx, t, y, k, 1);
+  ode_problem *P = ctx;
+  if (P->rows_by_step) {
+    int st = row_by_step(P, t, P->y_row);
+    if (st != MARTELLO_OK) return st;
+    y = N_VGetArrayPointer(P->y_row);
+  }
+  return observe(P, t, y, k, 1);
 }
 
 /* The state at a restart made consistent (c/ode_events.c), into y. */
@@ -391,42 +402,81 @@ static int check(ode_problem *P, int flag, const char *call) {
   return fail(P, MARTELLO_ERR_EXTERNAL, "%s failed: %s", call, be_flag(P, flag));
 }
 
+/* ARKODE at (t0, y) with the run's table, tolerances and Newton test, into *memp (P->mem, or the
+ * memory of the rows' own steps); on failure *memp is freed. */
+static int ark_create(ode_problem *P, SUNContext ctx, double t0, N_Vector y, void **memp) {
+  ARKRhsFn fe = P->kind == KIND_ERK ? rhs_full : P->kind == KIND_IMEX ? rhs_loads : NULL;
+  ARKRhsFn fi = P->kind == KIND_DIRK ? rhs_full : P->kind == KIND_IMEX ? rhs_internal : NULL;
+  const int implicit = P->kind != KIND_ERK;
+  void *mem = *memp = ARKStepCreate(fe, fi, t0, y, ctx);
+  if (!mem) return oe_fail_memory(&P->E, "the ARKODE solver memory (ARKStepCreate)", -1.0);
+  int st;
+  if ((st = check(P, ARKStepSetErrHandlerFn(mem, error_handler, P), "ARKStepSetErrHandlerFn")) ||
+      (st = check(P, ARKStepSetTableNum(mem, P->dirk_id, P->erk_id), "ARKStepSetTableNum")) ||
+      (st = check(P, ARKStepSStolerances(mem, P->E.rtol, P->E.atol), "ARKStepSStolerances")) ||
+      (st = check(P, ARKStepSetUserData(mem, P), "ARKStepSetUserData")) ||
+      (st = check(P, ARKStepSetMaxNumSteps(mem, -1), "ARKStepSetMaxNumSteps")) ||
+      /* a law whose force has an unbounded derivative at first touch (Jankowski's damping goes
+       * as delta^(1/4)) fails the error test of the first steps in contact many times over before
+       * the step is small enough: ARKODE's default of 7 failures stopped P2, P5 and P7's
+       * Jankowski scenes at onset (h ~ 1e-8 s) */
+      (st = check(P, ARKStepSetMaxErrTestFails(mem, MAX_ERR_TEST_FAILS), "ARKStepSetMaxErrTestFails")) ||
+      /* the interpolant of the steps, for the roots, the works and the located peaks: the
+       * highest degree ARKODE has (5) */
+      (st = check(P, ARKStepSetInterpolantDegree(mem, ARK_INTERP_MAX_DEGREE), "ARKStepSetInterpolantDegree")))
+    goto out;
+  if (implicit &&
+      ((st = check(P, ARKStepSetDeduceImplicitRhs(mem, SUNTRUE), "ARKStepSetDeduceImplicitRhs")) ||
+       /* ARKODE's Newton test accepts an iterate when min(1, crate) |correction| <= the
+        * tolerance, and keeps the rate estimate crate from stage to stage until the next
+        * linear-solver setup, shrinking it by crdown (0.3) at least every iteration
+        * (arkStep_NlsConvTest; its own comment says crate = 1 at the first iteration). A law
+        * linear between events converges in one iteration, so crate soon allows first
+        * corrections many times the tolerance; after a change of step the matrix's gamma is up to
+        * 20 % old, the accepted first iterate is off by up to 20 % of its correction, and the
+        * embedded error estimate, built from the same stages, cannot see it (docs/sundials-ode.md,
+        * the implicit tables). crdown = 1 keeps crate >= 1: an iterate is accepted only when its
+        * correction is within the tolerance. */
+       (st = check(P, ARKStepSetNonlinCRDown(mem, 1.0), "ARKStepSetNonlinCRDown"))))
+    goto out;
+  return MARTELLO_OK;
+out:
+  ARKStepFree(memp);
+  return st;
+}
+
+/* The linear solver of the Newton systems of mem (CVODE's or ARKODE's): the analytic Jacobian
+ * with a lumped mass, banded where the band is narrower than half the state (c/ida.c's rule);
+ * SUNDIALS' dense difference quotients where a mass coupling makes M^-1 full, and its
+ * difference quotients where rigid contacts may close (the projection of their forces is in
+ * the right-hand side). */
+static int linear_solver(ode_problem *P, void *mem, SUNContext ctx, N_Vector y, SUNMatrix *Jp,
+                         SUNLinearSolver *LSp) {
+  int st;
+  const sunindextype bw = 2 * (sunindextype)P->kd + 1;
+  const int band = P->lumped && 2 * bw + 1 < P->N / 2;
+  const int analytic = P->lumped && P->E.nr == 0;
+  *Jp = band ? SUNBandMatrix(P->N, bw, bw, ctx) : SUNDenseMatrix(P->N, P->N, ctx);
+  if (!*Jp) return oe_fail_memory(&P->E, "the Jacobian matrix", -1.0);
+  *LSp = band ? SUNLinSol_Band(y, *Jp, ctx) : SUNLinSol_Dense(y, *Jp, ctx);
+  if (!*LSp) return oe_fail_memory(&P->E, "the linear solver", -1.0);
+  if (P->ark) {
+    if ((st = check(P, ARKStepSetLinearSolver(mem, *LSp, *Jp), "ARKStepSetLinearSolver"))) return st;
+    if (analytic && (st = check(P, ARKStepSetJacFn(mem, jacobian), "ARKStepSetJacFn"))) return st;
+  } else {
+    if ((st = check(P, CVodeSetLinearSolver(mem, *LSp, *Jp), "CVodeSetLinearSolver"))) return st;
+    if (analytic && (st = check(P, CVodeSetJacFn(mem, jacobian), "CVodeSetJacFn"))) return st;
+  }
+  return MARTELLO_OK;
+}
+
 /* Create the integrator at (0, y): method, tolerances, the linear solver of its Newton
  * systems (none for an explicit table), roots. */
 static int create(ode_problem *P, SUNContext ctx, N_Vector y, SUNMatrix *Jp, SUNLinearSolver *LSp) {
   int st;
   const int implicit = P->kind != KIND_ERK;
   if (P->ark) {
-    ARKRhsFn fe = P->kind == KIND_ERK ? rhs_full : P->kind == KIND_IMEX ? rhs_loads : NULL;
-    ARKRhsFn fi = P->kind == KIND_DIRK ? rhs_full : P->kind == KIND_IMEX ? rhs_internal : NULL;
-    P->mem = ARKStepCreate(fe, fi, 0.0, y, ctx);
-    if (!P->mem) return oe_fail_memory(&P->E, "the ARKODE solver memory (ARKStepCreate)", -1.0);
-    if ((st = check(P, ARKStepSetErrHandlerFn(P->mem, error_handler, P), "ARKStepSetErrHandlerFn"))) return st;
-    if ((st = check(P, ARKStepSetTableNum(P->mem, P->dirk_id, P->erk_id), "ARKStepSetTableNum"))) return st;
-    if ((st = check(P, ARKStepSStolerances(P->mem, P->E.rtol, P->E.atol), "ARKStepSStolerances"))) return st;
-    if ((st = check(P, ARKStepSetUserData(P->mem, P), "ARKStepSetUserData"))) return st;
-    if ((st = check(P, ARKStepSetMaxNumSteps(P->mem, -1), "ARKStepSetMaxNumSteps"))) return st;
-    /* a law whose force has an unbounded derivative at first touch (Jankowski's damping goes
-     * as delta^(1/4)) fails the error test of the first steps in contact many times over before
-     * the step is small enough: ARKODE's default of 7 failures stopped P2, P5 and P7's
-     * Jankowski scenes at onset (h ~ 1e-8 s) */
-    if ((st = check(P, ARKStepSetMaxErrTestFails(P->mem, MAX_ERR_TEST_FAILS), "ARKStepSetMaxErrTestFails"))) return st;
-    /* the interpolant of the steps, for the roots, the works and the located peaks: the
-     * highest degree ARKODE has (5) */
-    if ((st = check(P, ARKStepSetInterpolantDegree(P->mem, ARK_INTERP_MAX_DEGREE),
-                    "ARKStepSetInterpolantDegree"))) return st;
-    if (implicit && (st = check(P, ARKStepSetDeduceImplicitRhs(P->mem, SUNTRUE),
-                                "ARKStepSetDeduceImplicitRhs"))) return st;
-    /* ARKODE's Newton test accepts an iterate when min(1, crate) |correction| <= the tolerance,
-     * and keeps the rate estimate crate from stage to stage until the next linear-solver setup,
-     * shrinking it by crdown (0.3) at least every iteration (arkStep_NlsConvTest; its own comment
-     * says crate = 1 at the first iteration). A law linear between events converges in one
-     * iteration, so crate soon allows first corrections many times the tolerance; after a change
-     * of step the matrix's gamma is up to 20 % old, the accepted first iterate is off by up to
-     * 20 % of its correction, and the embedded error estimate, built from the same stages, cannot
-     * see it (docs/sundials-ode.md, the implicit tables). crdown = 1 keeps crate >= 1: an
-     * iterate is accepted only when its correction is within the tolerance. */
-    if (implicit && (st = check(P, ARKStepSetNonlinCRDown(P->mem, 1.0), "ARKStepSetNonlinCRDown"))) return st;
+    if ((st = ark_create(P, ctx, 0.0, y, &P->mem))) return st;
   } else {
     P->mem = CVodeCreate(P->kind == KIND_ADAMS ? CV_ADAMS : CV_BDF, ctx);
     if (!P->mem) return oe_fail_memory(&P->E, "the CVODE solver memory (CVodeCreate)", -1.0);
@@ -437,26 +487,7 @@ static int create(ode_problem *P, SUNContext ctx, N_Vector y, SUNMatrix *Jp, SUN
     if ((st = check(P, CVodeSetMaxNumSteps(P->mem, -1), "CVodeSetMaxNumSteps"))) return st;
     if ((st = check(P, CVodeSetMaxErrTestFails(P->mem, MAX_ERR_TEST_FAILS), "CVodeSetMaxErrTestFails"))) return st;
   }
-  if (implicit) {
-    /* the analytic Jacobian with a lumped mass, banded where the band is narrower than half
-     * the state (c/ida.c's rule); SUNDIALS' dense difference quotients where a mass coupling
-     * makes M^-1 full, and its difference quotients where rigid contacts may close (the
-     * projection of their forces is in the right-hand side) */
-    const sunindextype bw = 2 * (sunindextype)P->kd + 1;
-    const int band = P->lumped && 2 * bw + 1 < P->N / 2;
-    const int analytic = P->lumped && P->E.nr == 0;
-    *Jp = band ? SUNBandMatrix(P->N, bw, bw, ctx) : SUNDenseMatrix(P->N, P->N, ctx);
-    if (!*Jp) return oe_fail_memory(&P->E, "the Jacobian matrix", -1.0);
-    *LSp = band ? SUNLinSol_Band(y, *Jp, ctx) : SUNLinSol_Dense(y, *Jp, ctx);
-    if (!*LSp) return oe_fail_memory(&P->E, "the linear solver", -1.0);
-    if (P->ark) {
-      if ((st = check(P, ARKStepSetLinearSolver(P->mem, *LSp, *Jp), "ARKStepSetLinearSolver"))) return st;
-      if (analytic && (st = check(P, ARKStepSetJacFn(P->mem, jacobian), "ARKStepSetJacFn"))) return st;
-    } else {
-      if ((st = check(P, CVodeSetLinearSolver(P->mem, *LSp, *Jp), "CVodeSetLinearSolver"))) return st;
-      if (analytic && (st = check(P, CVodeSetJacFn(P->mem, jacobian), "CVodeSetJacFn"))) return st;
-    }
-  }
+  if (implicit && (st = linear_solver(P, P->mem, ctx, y, Jp, LSp))) return st;
   if ((st = be_max_step(P)) != MARTELLO_OK) return st;
   const int nroots = oe_nroots(&P->E);
   if (nroots > 0) {
@@ -488,6 +519,101 @@ static int restart(ode_problem *P, double t, N_Vector y) {
   return be_max_step(P);
 }
 
+/* ---- ARKODE's rows by a step of their own (docs/sundials-ode.md, output rows) ---------------------
+ * ARKODE's interpolant is a Hermite polynomial of degree 5 at most: inside a step of a table of
+ * order q > 5 (Verner 6(5), Fehlberg 8(7)) it errs by O(h^6), more than the step's O(h^(q+1)). A
+ * row at t_k inside the step [t_n-1, t_n] is then the state of one step of the same table from
+ * (t_n-1, y_n-1) to t_k, on a second memory: off the trajectory, so the run's steps, events and
+ * located values are what they are whatever the rows, and a row's error is the table's. */
+
+/* Whether the table's order exceeds the interpolant's degree; the vectors the rows need. */
+static int rows_setup(ode_problem *P, N_Vector y) {
+  ARKodeButcherTable Bi = NULL, Be = NULL;
+  if (ARKStepGetCurrentButcherTables(P->mem, &Bi, &Be) < 0)
+    return fail(P, MARTELLO_ERR_EXTERNAL, "ARKODE: could not read its tables");
+  const int q = Be ? Be->q : Bi ? Bi->q : 0;
+  P->rows_by_step = q > ARK_INTERP_MAX_DEGREE;
+  if (!P->rows_by_step) return MARTELLO_OK;
+  P->y_start = N_VClone(y);
+  P->y_int = N_VClone(y);
+  P->y_row = N_VClone(y);
+  if (!P->y_start || !P->y_int || !P->y_row) return oe_fail_memory(&P->E, "the rows' state vectors", -1.0);
+  return MARTELLO_OK;
+}
+
+/* The main memory restarted (or started) at (t, y): the next step starts there. */
+static void rows_restart(ode_problem *P, double t, N_Vector y) {
+  if (!P->rows_by_step) return;
+  P->t_int = t;
+  N_VScale(1.0, y, P->y_int);
+  if (ARKStepGetNumSteps(P->mem, &P->nst_seen) < 0) P->nst_seen = -1;
+}
+
+/* After ARKStepEvolve returned at tret with y: if it took a step, that step started where the
+ * last one ended (t_int), and ends at ARKODE's current time (past tret at a root). */
+static int rows_track(ode_problem *P, double tret, N_Vector y) {
+  long nst = 0;
+  if (!P->rows_by_step) return MARTELLO_OK;
+  if (ARKStepGetNumSteps(P->mem, &nst) < 0) return fail(P, MARTELLO_ERR_EXTERNAL, "ARKODE: could not read its steps");
+  if (nst == P->nst_seen) return MARTELLO_OK;
+  P->nst_seen = nst;
+  P->t_start = P->t_int;
+  N_VScale(1.0, P->y_int, P->y_start);
+  if (ARKStepGetCurrentTime(P->mem, &P->t_int) < 0) return fail(P, MARTELLO_ERR_EXTERNAL, "ARKODE: could not read its time");
+  if (P->t_int == tret) {
+    N_VScale(1.0, y, P->y_int);
+    return MARTELLO_OK;
+  }
+  return interpolant(P, P->t_int, 0, P->y_int);
+}
+
+/* The state at t inside the last step by one step of the run's table from the step's start. */
+static int row_by_step(ode_problem *P, double t, N_Vector out) {
+  int st;
+  const double h = t - P->t_start;
+  /* ARKODE refuses a step within 100 ulps of t ("tout too close to t0"): such a row is the
+   * start's state, off by its rate times those ulps */
+  if (!(h > 1e3 * DBL_EPSILON * fabs(t))) {
+    N_VScale(1.0, P->y_start, out);
+    return MARTELLO_OK;
+  }
+  if (!P->row_mem) {
+    if ((st = ark_create(P, P->ctx, P->t_start, P->y_start, &P->row_mem))) return st;
+    if (P->kind != KIND_ERK &&
+        (st = linear_solver(P, P->row_mem, P->ctx, P->y_start, &P->row_J, &P->row_LS)))
+      return st;
+  }
+  long fe0 = 0, fi0 = 0, fe1 = 0, fi1 = 0, nls0 = 0, nls1 = 0;
+  double tret = t;
+  if ((st = check(P, ARKStepReset(P->row_mem, P->t_start, P->y_start), "ARKStepReset")) ||
+      (st = check(P, ARKStepSetFixedStep(P->row_mem, h), "ARKStepSetFixedStep")))
+    return st;
+  ARKStepGetNumRhsEvals(P->row_mem, &fe0, &fi0);
+  if (P->kind != KIND_ERK) ARKStepGetNumLinRhsEvals(P->row_mem, &nls0);
+  int flag = ARKStepEvolve(P->row_mem, t, out, &tret, ARK_ONE_STEP);
+  if (flag < 0)
+    return fail(P, MARTELLO_ERR_EXTERNAL, "ARKODE: the step of the output row at t = %.9e s failed: %s (%s)", t,
+                ARKStepGetReturnFlagName(flag), P->msg);
+  ARKStepGetNumRhsEvals(P->row_mem, &fe1, &fi1);
+  if (P->kind != KIND_ERK) ARKStepGetNumLinRhsEvals(P->row_mem, &nls1);
+  /* counted as the main memory's are (be_counts) */
+  P->row_rhs += (P->kind == KIND_DIRK ? fi1 - fi0 : fe1 - fe0) + (nls1 - nls0);
+  return MARTELLO_OK;
+}
+
+/* The rows' memory and vectors (before their context is freed). */
+static void rows_free(ode_problem *P) {
+  if (P->row_mem) ARKStepFree(&P->row_mem);
+  if (P->row_LS) SUNLinSolFree(P->row_LS);
+  if (P->row_J) SUNMatDestroy(P->row_J);
+  N_Vector rows[] = {P->y_start, P->y_int, P->y_row};
+  for (size_t k = 0; k < sizeof rows / sizeof rows[0]; k++)
+    if (rows[k]) N_VDestroy(rows[k]);
+  P->row_LS = NULL;
+  P->row_J = NULL;
+  P->y_start = P->y_int = P->y_row = NULL;
+}
+
 /* ---- the run ------------------------------------------------------------------------------------ */
 
 static int integrate(ode_problem *P, SUNContext ctx, N_Vector yy, SUNMatrix *Jp,
@@ -506,7 +632,10 @@ static int integrate(ode_problem *P, SUNContext ctx, N_Vector yy, SUNMatrix *Jp,
   if ((st = martello_observer_begin(E->obs, E->ev, E->u, E->v, "tighten rtol and atol")) != MARTELLO_OK)
     return st == MARTELLO_ERR_MEMORY ? st : fail(P, st, "%s: martello_observer_begin failed", P->name);
   if ((st = prepare_restart(P, 0.0, y)) != MARTELLO_OK) return st;
+  P->ctx = ctx;
   if ((st = create(P, ctx, yy, Jp, LSp)) != MARTELLO_OK) return st;
+  if (P->ark && (st = rows_setup(P, yy)) != MARTELLO_OK) return st;
+  rows_restart(P, 0.0, yy);
 
   int k_out = 1;
   double t_out = oe_output_time(E, k_out), t_last = 0.0;
@@ -542,6 +671,7 @@ static int integrate(ode_problem *P, SUNContext ctx, N_Vector yy, SUNMatrix *Jp,
     }
     E->nan_seen = 0;
     oe_new_step(E, tret);
+    if ((st = rows_track(P, tret, yy)) != MARTELLO_OK) break;
     if (++steps > MAX_STEPS) {
       st = fail(P, MARTELLO_ERR_NOT_CONVERGED, "%s: more than %ld steps before t = %.9e s", P->name, MAX_STEPS, tret);
       break;
@@ -608,6 +738,7 @@ static int integrate(ode_problem *P, SUNContext ctx, N_Vector yy, SUNMatrix *Jp,
      * sundials-ode.md, stops of the implicit tables); the only stops now are the loads' kinks,
      * which restart it (again), and t_end */
     if (again && (st = restart(P, t_r, yy)) != MARTELLO_OK) break;
+    if (again) rows_restart(P, t_r, yy);
     if (again || at_output || tret >= t_stop) {
       t_stop = oe_next_stop(E, t_r, E->t_end, &kink);
       if ((st = check(P, be_stop(P, t_stop), "SetStopTime"))) break;
@@ -651,6 +782,7 @@ int martello_ode_run(martello_model *model, martello_run *run) {
   if (P->mem) {
     if (P->ark) ARKStepFree(&P->mem); else CVodeFree(&P->mem);
   }
+  rows_free(P);
   if (LS) SUNLinSolFree(LS);
   if (J) SUNMatDestroy(J);
   if (yy) N_VDestroy(yy);

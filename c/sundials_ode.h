@@ -22,6 +22,19 @@ typedef struct {
   double *kb, *cb;         /* the tangents' bands (martello_eval_tangent) */
   void *mem;
   char msg[240];
+  /* ARKODE's rows by a step of their own (c/sundials_ode.c row_by_step): where the table's order
+   * exceeds the interpolant's degree, a row inside a step is one step of the same table from the
+   * step's start, on a second ARKODE memory (created at the first such row) */
+  int rows_by_step;
+  SUNContext ctx;
+  void *row_mem;
+  SUNMatrix row_J;
+  SUNLinearSolver row_LS;
+  N_Vector y_start, y_int;  /* the state at the start of the last step; at its end */
+  N_Vector y_row;           /* a row's state */
+  double t_start, t_int;
+  long nst_seen;            /* the main memory's steps when t_int was read */
+  long row_rhs;             /* right-hand sides of the row steps (in the run's counts) */
 } ode_problem;
 
 /* The problem of model with the settings and observer of run (P zeroed); its arrays freed and
