@@ -1,6 +1,6 @@
 /* Local stepping (docs/sundials-ode.md, local stepping): the scene integrated cluster by cluster.
  *
- * Bodies joined by links or closed contacts form a cluster; clusters interact only through open
+ * Bodies joined by links, stiffness blocks, mass couplings or closed contacts form a cluster; clusters interact only through open
  * penalty contacts (gap < 0: no force). Each cluster is integrated by its own CVODE or ARKODE
  * instance on its sub-model (martello_model_subset), so that a step, an event and a restart cost
  * O(cluster), not O(n). Inside a cluster everything is as on the whole scene (c/sundials_ode.c,
@@ -71,14 +71,15 @@ typedef struct {
   martello_model *model;
   martello_run *run;
   SUNContext ctx;
-  int n, nc, nl_rows;
+  int n, nc;
   cluster **cl;               /* by slot; NULL: free */
   int ncl;
   int *heap, nheap;           /* slots by time; hkey[k] the time of heap[k] (contiguous: */
   double *hkey;               /* the sifts read no cluster) */
   int *node_cl, *node_loc;    /* free node -> its cluster's slot and its index there */
   int *nd_first, *nd_con;     /* node -> its contacts */
-  int *nl_first, *nl_link;    /* node -> its links */
+  int *grp, *gr_first, *gr_node; /* free node -> its group (nodes joined for good: links, blocks,
+                                 * couplings; martello_model_clusters), group -> its nodes */
   double *checked;            /* per contact joining two clusters: checked through */
   double *u0, *ys;            /* the scene's initial u; its state (interleaved) */
   int *mark, *list, *stack;   /* graph work */
@@ -347,7 +348,7 @@ static int stop_cluster(driver *D, int slot, double tf) {
   return MARTELLO_OK;
 }
 
-/* ---- the graph: bonds (links, closed contacts) and components -------------------------------- */
+/* ---- the graph: bonds (groups, closed contacts) and components -------------------------------- */
 
 /* Whether contact j is closed (a bond) in the state D->ys. */
 static int closed_in(driver *D, int j) {
@@ -360,29 +361,29 @@ static int closed_in(driver *D, int j) {
   return s - D->S.E.gap[j] >= 0.0;
 }
 
+/* Marks group g's nodes (all of mark want: a group never splits) want + 1, onto the stack. */
+static int push_group(driver *D, int g, int want, int top) {
+  for (int p = D->gr_first[g]; p < D->gr_first[g + 1]; p++) {
+    D->mark[D->gr_node[p]] = want + 1;
+    D->stack[top++] = D->gr_node[p];
+  }
+  return top;
+}
+
 /* The component of free node i0 among the nodes with mark[i] == want, bonds of the state D->ys
- * (skip: a contact not counted as a bond, or -1): marked want + 1, listed in D->list. */
+ * (the groups, and the closed contacts but skip, a contact not counted as a bond, or -1): marked
+ * want + 1, listed in D->list. */
 static int component(driver *D, int i0, int want, int skip) {
-  int top = 0, m = 0;
-  const martello_rows *el = &D->S.E.elem;
-  D->stack[top++] = i0;
-  D->mark[i0] = want + 1;
+  int top = push_group(D, D->grp[i0], want, 0), m = 0;
   while (top > 0) {
     const int i = D->stack[--top];
     D->list[m++] = i;
-    for (int p = D->nl_first[i]; p < D->nl_first[i + 1]; p++) {
-      const int l = D->nl_link[p];
-      for (int k = el->first[l]; k < el->first[l + 1]; k++) {
-        const int b = el->node[k];
-        if (!D->S.E.fixed[b] && D->mark[b] == want) { D->mark[b] = want + 1; D->stack[top++] = b; }
-      }
-    }
     for (int p = D->nd_first[i]; p < D->nd_first[i + 1]; p++) {
       const int j = D->nd_con[p];
       if (j == skip || !closed_in(D, j)) continue;
       for (int k = D->S.E.con.first[j]; k < D->S.E.con.first[j + 1]; k++) {
         const int b = D->S.E.con.node[k];
-        if (!D->S.E.fixed[b] && D->mark[b] == want) { D->mark[b] = want + 1; D->stack[top++] = b; }
+        if (!D->S.E.fixed[b] && D->mark[b] == want) top = push_group(D, D->grp[b], want, top);
       }
     }
   }
@@ -721,32 +722,41 @@ static int refuse(driver *D) {
   return MARTELLO_OK;
 }
 
+/* Node -> its contacts; the groups: nodes a link, a stiffness block or a mass coupling joins
+ * whatever the state (docs/sundials-ode.md, local stepping). */
 static int incidence(driver *D) {
   ode_events *S = &D->S.E;
   const int n = D->n;
   double failed = 0.0;
+  int ng = 0, st;
   D->nd_first = oe_take((size_t)n + 1, sizeof(int), &failed);
-  D->nl_first = oe_take((size_t)n + 1, sizeof(int), &failed);
+  D->grp = oe_take((size_t)n, sizeof(int), &failed);
+  D->gr_node = oe_take((size_t)n, sizeof(int), &failed);
   if (failed > 0.0) return oe_fail_memory(S, "the node incidence of the local stepping", failed);
-  const martello_rows *rc = &S->con, *rl = &S->elem;
+  if ((st = martello_model_clusters(D->model, NULL, D->grp, &ng)) != MARTELLO_OK) {
+    char msg[256];
+    martello_model_message(D->model, msg, (int)sizeof msg);
+    return fail(D, st, "local stepping: the groups of the model: %s", msg);
+  }
+  D->gr_first = oe_take((size_t)ng + 1, sizeof(int), &failed);
+  if (failed > 0.0) return oe_fail_memory(S, "the node incidence of the local stepping", failed);
+  const martello_rows *rc = &S->con;
   for (int j = 0; j < D->nc; j++)
     for (int k = rc->first[j]; k < rc->first[j + 1]; k++) D->nd_first[rc->node[k] + 1]++;
-  for (int l = 0; l < D->nl_rows; l++)
-    for (int k = rl->first[l]; k < rl->first[l + 1]; k++) D->nl_first[rl->node[k] + 1]++;
   for (int i = 0; i < n; i++) {
     D->nd_first[i + 1] += D->nd_first[i];
-    D->nl_first[i + 1] += D->nl_first[i];
+    if (D->grp[i] >= 0) D->gr_first[D->grp[i] + 1]++;
   }
+  for (int g = 0; g < ng; g++) D->gr_first[g + 1] += D->gr_first[g];
   D->nd_con = oe_take((size_t)D->nd_first[n], sizeof(int), &failed);
-  D->nl_link = oe_take((size_t)D->nl_first[n], sizeof(int), &failed);
-  int *at = oe_take((size_t)n, sizeof(int), &failed);
+  int *at = oe_take((size_t)(n > ng ? n : ng), sizeof(int), &failed);
   if (failed > 0.0) { free(at); return oe_fail_memory(S, "the node incidence of the local stepping", failed); }
   for (int i = 0; i < n; i++) at[i] = D->nd_first[i];
   for (int j = 0; j < D->nc; j++)
     for (int k = rc->first[j]; k < rc->first[j + 1]; k++) D->nd_con[at[rc->node[k]]++] = j;
-  for (int i = 0; i < n; i++) at[i] = D->nl_first[i];
-  for (int l = 0; l < D->nl_rows; l++)
-    for (int k = rl->first[l]; k < rl->first[l + 1]; k++) D->nl_link[at[rl->node[k]]++] = l;
+  for (int g = 0; g < ng; g++) at[g] = D->gr_first[g];
+  for (int i = 0; i < n; i++)
+    if (D->grp[i] >= 0) D->gr_node[at[D->grp[i]]++] = i;
   free(at);
   return MARTELLO_OK;
 }
@@ -756,9 +766,6 @@ static int integrate(driver *D) {
   int st, n = D->n;
   double failed = 0.0;
   if ((st = refuse(D)) != MARTELLO_OK) return st;
-  int nterms;
-  if ((st = martello_model_elements(D->model, &D->nl_rows, &nterms, NULL, NULL, NULL)) != MARTELLO_OK)
-    return fail(D, st, "local stepping: could not read the model");
   D->ncl = n;
   D->cl = oe_take((size_t)n, sizeof(cluster *), &failed);
   D->heap = oe_take((size_t)n, sizeof(int), &failed);
@@ -792,7 +799,7 @@ static int integrate(driver *D) {
     return st == MARTELLO_ERR_MEMORY ? st : fail(D, st, "local stepping: martello_observer_begin failed");
   if ((st = oe_commit(S, S->u, S->v)) != MARTELLO_OK) return fail(D, st, "local stepping: commit failed");
   if ((st = ode_problem_observe(&D->S, 0.0, D->ys, 0, 0)) != MARTELLO_OK) return st;
-  /* the clusters at t = 0: the components of links and closed contacts */
+  /* the clusters at t = 0: the components of the groups and closed contacts */
   for (int i = 0; i < n; i++) {
     if (D->mark[i] != 0) continue;
     const int m = component(D, i, 0, -1);
@@ -848,8 +855,8 @@ int martello_ode_local_run(martello_model *model, martello_run *run) {
   if (st == MARTELLO_OK) st = integrate(D);
   for (int k = 0; k < D->ncl && D->cl; k++) free_cluster(D, k);
   if (D->ctx) SUNContext_Free(&D->ctx);
-  void *arrays[] = {D->cl, D->heap, D->hkey, D->node_cl, D->node_loc, D->nd_first, D->nd_con, D->nl_first,
-                    D->nl_link, D->checked, D->u0, D->ys, D->mark, D->list, D->stack, D->todo, D->slots, D->ev_n, D->ev_t};
+  void *arrays[] = {D->cl, D->heap, D->hkey, D->node_cl, D->node_loc, D->nd_first, D->nd_con, D->grp,
+                    D->gr_first, D->gr_node, D->checked, D->u0, D->ys, D->mark, D->list, D->stack, D->todo, D->slots, D->ev_n, D->ev_t};
   for (size_t k = 0; k < sizeof arrays / sizeof arrays[0]; k++) free(arrays[k]);
   ode_problem_release(&D->S);
   return st;

@@ -101,7 +101,10 @@ static int be_counts(ode_problem *P, long c[9]) {
     st |= ARKStepGetNumSteps(P->mem, &c[MARTELLO_COUNTER_STEPS]);
     st |= ARKStepGetNumErrTestFails(P->mem, &c[MARTELLO_COUNTER_REJECTED_STEPS]);
     st |= ARKStepGetNumRhsEvals(P->mem, &c[MARTELLO_COUNTER_RESIDUAL_EVALUATIONS], &nfi);
-    st |= ARKStepGetNumGEvals(P->mem, &c[MARTELLO_COUNTER_ROOT_EVALUATIONS]);
+    /* without root functions ARKODE keeps no root memory and refuses the query (ARK_MEM_NULL,
+     * unlike CVODE): no roots, no root evaluations -- e.g. a cluster of local stepping whose
+     * contacts all lie between clusters (docs/sundials-ode.md, local stepping) */
+    if (oe_nroots(&P->E) > 0) st |= ARKStepGetNumGEvals(P->mem, &c[MARTELLO_COUNTER_ROOT_EVALUATIONS]);
     /* ImEx: a step evaluates both parts at a stage; count the stage evaluations once */
     if (P->kind == KIND_DIRK) c[MARTELLO_COUNTER_RESIDUAL_EVALUATIONS] = nfi;
     c[MARTELLO_COUNTER_RESIDUAL_EVALUATIONS] += P->row_rhs;

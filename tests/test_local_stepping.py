@@ -1,4 +1,5 @@
-"""Local stepping (analysis.local_stepping = true on cvode; docs/sundials-ode.md, local stepping).
+"""Local stepping (analysis.local_stepping = true on cvode and arkode; docs/sundials-ode.md, local
+stepping).
 
 Verification: catalogue rows of P7 (penalty contacts between oscillators, each its own cluster
 until they touch) against the independent engine (martello.independent, stored in
@@ -6,6 +7,9 @@ reference/independent/), with the catalogue's own bounds (martello.checks.indepe
 Cross-check: `closing` (n oscillators, linear contacts closing and opening) against the global
 CVODE run. Identities of the method (no oracle): clusters that never meet equal separate runs;
 results do not depend on the output interval; a scene that is one cluster equals the global run.
+Cross-check and verification of two catalogue scenes the catalogue sweep once stopped on (P10's
+frame of stiffness blocks on cvode, P5's two bodies on arkode): as global, and their closed-form
+rows kept.
 """
 
 import copy
@@ -180,3 +184,33 @@ def test_every_cluster_step_counts_against_the_budget():
     s, _ = run_full(from_dict(d), raise_on_failure=False)
     assert s["status"] == "MARTELLO_ERR_LIMIT" and "max_steps" in s["message"]
     assert s["cost"]["steps"] <= 101
+
+
+# --- scenes the cross-check over the catalogue stopped on (benchmarks/local_stepping/cross_check.py)
+
+def _cross_check(scene):
+    # the cross-check of every summary number and history column against the global run within
+    # both runs' own errors (same kernels: not verification), and `martello check`'s rows of the
+    # scene with local stepping (closed form: verification), none lost against the global run
+    from benchmarks.local_stepping import cross_check
+    r = cross_check.one(ROOT / "benchmarks" / scene)
+    assert "refused" not in r and "failed" not in r, r
+    assert r["n_summary_mismatches"] == 0 and not r["missing"], r["summary_mismatches"]
+    assert r["n_history_mismatches"] == 0, r["history_mismatches"]
+    assert r["numbers"] > 10                               # it compared something
+    g, loc = r["check"]["global"], r["check"]["local"]
+    assert loc["verification"] > 0 and not loc["failed"], loc
+    assert loc["verification_passed"] >= g["verification_passed"], r["check"]
+
+
+def test_a_stiffness_block_joins_its_nodes_into_one_cluster():
+    # P10's frame: its beams and columns are stiffness blocks over the joints; a block acts
+    # whatever the state, so its nodes are one cluster (as a link's). The driver once split the
+    # frame into clusters of one node (the sub-model then refused the cut block).
+    _cross_check("p10/integrators/p10_linear_cvode.toml")
+
+
+def test_arkode_clusters_without_root_functions_run():
+    # P5's two free bodies: each its own cluster, their one contact between the clusters, so a
+    # cluster's ARKODE instance has no root functions (its counters were once read as a failure).
+    _cross_check("p5/laws/p5_linear_arkode.toml")

@@ -1,7 +1,7 @@
 """Local stepping against the global run over the catalogue (docs/sundials-ode.md, "Local
-stepping"): every dynamic catalogue scene on cvode, run as written (the global run: one CVODE
-instance on the whole scene) and again with analysis.local_stepping = true (one CVODE instance
-per cluster). Two kinds of evidence, said apart:
+stepping"): every dynamic catalogue scene on cvode or arkode, run as written (the global run:
+one integrator instance on the whole scene) and again with analysis.local_stepping = true (one
+instance per cluster). Two kinds of evidence, said apart:
 
 * CROSS-CHECK (the same kernels, not verification): every summary number and every history
   column of the local run against the global one, within the two runs' own errors: each run's
@@ -15,7 +15,9 @@ per cluster). Two kinds of evidence, said apart:
   engine, or stored reference data, whose kind martello.checks.kinds says) for both runs:
   rows, rows passed, verification rows passed; none may be lost with local stepping.
 
-A scene the option refuses (a rigid contact, a mass coupling) is counted by its reason.
+A scene the option refuses (MARTELLO_ERR_UNSUPPORTED naming analysis.local_stepping: a rigid
+contact, a mass coupling) is counted by its reason; any other stop of the local run is a
+failure.
 
     .venv/bin/python benchmarks/local_stepping/cross_check.py -o /tmp/ls [--only p7/] [-j 2]
 
@@ -47,11 +49,15 @@ from martello.scene import catalogue  # noqa: E402
 from martello.scene.loader import load  # noqa: E402
 
 
-def is_cvode(path):
-    """A dynamic scene on cvode run globally (the catalogue's local-stepping scenes are the
-    local versions of such scenes: benchmarks/p7/local_stepping/)."""
+# the integrators that take analysis.local_stepping
+LOCAL = ("cvode", "arkode")
+
+
+def runs_locally(path):
+    """A dynamic scene on an integrator of LOCAL run globally (the catalogue's local-stepping
+    scenes are the local versions of such scenes: benchmarks/p7/local_stepping/)."""
     an = load(path).analysis
-    return an["type"] == "dynamic" and an.get("integrator") == "cvode" and not an.get("local_stepping")
+    return an["type"] == "dynamic" and an.get("integrator") in LOCAL and not an.get("local_stepping")
 
 
 def local(data):
@@ -119,12 +125,14 @@ def one(path, with_check=True):
     base_data = relations.base_scene(data)
     try:
         s_loc, c_loc, r_loc = relations.run(local(base_data), base_dir)
+        why = None if s_loc["status"] == "MARTELLO_OK" else f"{s_loc['status']}: {s_loc.get('message', '')}"
     except MartelloError as exc:
-        out.update(refused=f"{type(exc).__name__}: {exc}", seconds=time.perf_counter() - t0)
-        return out
-    if s_loc["status"] != "MARTELLO_OK":
-        out.update(refused=f"{s_loc['status']}: {s_loc.get('message', '')}",
-                   seconds=time.perf_counter() - t0)
+        why = f"{type(exc).__name__}: {exc}"
+    if why is not None:
+        # refused: what the option documents it does not take (MARTELLO_ERR_UNSUPPORTED,
+        # naming analysis.local_stepping); any other stop is a failure of the local run
+        refused = "UNSUPPORTED" in why and "local_stepping" in why
+        out.update({"refused" if refused else "failed": why, "seconds": time.perf_counter() - t0})
         return out
     s_glob, c_glob, r_glob = relations.run(base_data, base_dir)
     base, other = relations.numbers(s_glob), relations.numbers(s_loc)
@@ -162,10 +170,14 @@ def one(path, with_check=True):
 
 
 def report(results):
-    refused = Counter()
+    refused, failed = Counter(), Counter()
     agree = disagree = 0
     rows = Counter()
     for r in results:
+        if "failed" in r:
+            failed[r["failed"].split(": ", 1)[-1][:90]] += 1
+            print(f"FAILED {r['scene']}: {r['failed'][:200]}")
+            continue
         if "refused" in r:
             # the reason without the scene's own names and numbers
             reason = r["refused"].split(": ", 1)[-1]
@@ -187,16 +199,18 @@ def report(results):
             r["check"]["global"]["verification_passed"]
         if lost:
             print(f"LOST ROWS {r['scene']}: {r['check']}")
-    print(f"\n{len(results)} cvode scenes: {agree} agree with the global run (cross-check), "
-          f"{disagree} differ, {sum(refused.values())} refused")
+    print(f"\n{len(results)} scenes: {agree} agree with the global run (cross-check), "
+          f"{disagree} differ, {sum(refused.values())} refused, {sum(failed.values())} failed")
     for why, n in refused.most_common():
         print(f"  refused ({n}): {why}")
+    for why, n in failed.most_common():
+        print(f"  failed ({n}): {why}")
     if rows:
         print(f"\n{'martello check rows':22s} {'rows':>6s} {'passed':>7s} {'verif.':>7s} {'verif. passed':>14s}")
         for name in ("global", "local"):
             print(f"{name:22s} {rows[name, 'rows']:6d} {rows[name, 'passed']:7d} "
                   f"{rows[name, 'verification']:7d} {rows[name, 'verification_passed']:14d}")
-    return disagree
+    return disagree + sum(failed.values())
 
 
 def main(argv=None):
@@ -209,12 +223,12 @@ def main(argv=None):
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
     scenes = [p for p in catalogue.scene_files()
-              if (not args.only or any(s in str(p) for s in args.only)) and is_cvode(p)]
+              if (not args.only or any(s in str(p) for s in args.only)) and runs_locally(p)]
     t0 = time.perf_counter()
     with ProcessPoolExecutor(args.jobs) as pool:
         results = list(pool.map(one, scenes, [not args.no_check] * len(scenes)))
     for r in results:
-        state = "refused" if "refused" in r else \
+        state = "failed" if "failed" in r else "refused" if "refused" in r else \
             ("differs" if r["n_summary_mismatches"] or r["missing"] or r["n_history_mismatches"]
              else "agrees")
         print(f"{r['scene']:60s} {state:8s} {r['seconds']:6.1f} s")
