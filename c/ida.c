@@ -46,11 +46,14 @@
 #include "martello.h"
 #include "martello_internal.h"
 #include "ode_events.h"
+#include "sundials_ode.h"
 
 #define MAX_STEPS 100000000L
 
 typedef struct {
-  ode_events E;          /* contacts, events, the observer's hand-overs (c/ode_events.c) */
+  ode_events *E;         /* contacts, events, the observer's hand-overs (c/ode_events.c): own,
+                          * or a cluster's in the local stepping (c/sundials_ode.h) */
+  ode_events own;
   martello_run *run;
   /* layout of y beyond the nodes' u and v (E.iu, E.iv): the rigid contacts' P and mu */
   sunindextype N;
@@ -62,13 +65,13 @@ typedef struct {
   char ida_msg[240];
 } ida_problem;
 
-#define fail(P, ...) oe_fail(&(P)->E, __VA_ARGS__)
+#define fail(P, ...) oe_fail((P)->E, __VA_ARGS__)
 
 /* ---- IDA callbacks ------------------------------------------------------------------ */
 
 static int residual(realtype t, N_Vector yy, N_Vector yp, N_Vector rr, void *data) {
   ida_problem *P = data;
-  ode_events *E = &P->E;
+  ode_events *E = P->E;
   const double *y = N_VGetArrayPointer(yy), *d = N_VGetArrayPointer(yp);
   double *res = N_VGetArrayPointer(rr);
   oe_gather(E, y, E->u, E->v);
@@ -118,7 +121,7 @@ static int residual(realtype t, N_Vector yy, N_Vector yp, N_Vector rr, void *dat
 static int jacobian(realtype t, realtype cj, N_Vector yy, N_Vector yp, N_Vector rr, SUNMatrix J,
                     void *data, N_Vector t1, N_Vector t2, N_Vector t3) {
   ida_problem *P = data;
-  ode_events *E = &P->E;
+  ode_events *E = P->E;
   const int kd = P->kd, ld = 3 * kd + 1;
   (void)t; (void)yp; (void)rr; (void)t1; (void)t2; (void)t3;
   oe_gather(E, N_VGetArrayPointer(yy), E->u, E->v);
@@ -148,7 +151,7 @@ static int jacobian(realtype t, realtype cj, N_Vector yy, N_Vector yp, N_Vector 
 /* The roots of c/ode_events.c on the state y. */
 static int roots(realtype t, N_Vector yy, N_Vector yp, realtype *g, void *data) {
   ida_problem *P = data;
-  ode_events *E = &P->E;
+  ode_events *E = P->E;
   (void)yp;
   oe_gather(E, N_VGetArrayPointer(yy), E->uq, E->vq);
   return oe_roots(E, t, E->uq, E->vq, g);
@@ -197,14 +200,14 @@ static int flush_counts(ida_problem *P, void *mem) {
   if (st != IDA_SUCCESS) return fail(P, MARTELLO_ERR_EXTERNAL, "IDA: could not read the counters");
   c[MARTELLO_COUNTER_REJECTED_STEPS] += cf;
   c[MARTELLO_COUNTER_RESIDUAL_EVALUATIONS] += nre_ls;
-  return oe_add_counts(&P->E, c);
+  return oe_add_counts(P->E, c);
 }
 
 /* An accepted (committed) state y, yp at t as a sample of the observer (the force of a
  * closed rigid contact is its multiplier P_r); k: the output grid point t = k dt, or -1;
  * row: an output row on the interpolant inside a step (martello_observer_row). */
 static int observe(ida_problem *P, double t, const double *y, const double *yp, int k, int row) {
-  ode_events *E = &P->E;
+  ode_events *E = P->E;
   oe_gather(E, y, E->u, E->v);
   for (int i = 0; i < E->n; i++) E->a[i] = yp[E->iv[i]];
   for (int j = 0; j < E->nc; j++) {
@@ -224,12 +227,10 @@ static int sample(void *ctx, double t, const double *y, int k) {
 
 /* Make the state at a restart consistent (c/ode_events.c), then y and y' for IDA: P the
  * multipliers of the closed set, mu = 0, v' the constrained accelerations. */
-static int prepare_restart(ida_problem *P, double t, double *u, double *v, N_Vector yy,
-                           N_Vector yp) {
-  ode_events *E = &P->E;
+static int prepare_restart(ida_problem *P, double t, double *u, double *v, double *y, double *d) {
+  ode_events *E = P->E;
   int st = oe_prepare_restart(E, t, u, v);
   if (st != MARTELLO_OK) return st;
-  double *y = N_VGetArrayPointer(yy), *d = N_VGetArrayPointer(yp);
   oe_apply_B(E, E->lam, E->x);
   if (E->nr > 0 && (st = martello_eval_solve_mass(E->ev, E->x)) != MARTELLO_OK) return fail(P, st, "IDA: singular mass");
   for (int i = 0; i < E->n; i++) {
@@ -250,7 +251,7 @@ static int prepare_restart(ida_problem *P, double t, double *u, double *v, N_Vec
 /* A reported root exactly 0 at the return (c/ode_events.c), here also the multiplier P of a
  * closed rigid contact. */
 static int root_stays_zero(ida_problem *P, const double *y, const int *found) {
-  ode_events *E = &P->E;
+  ode_events *E = P->E;
   for (int r = 0; r < E->nr; r++)
     if (E->closed[r] && found[2 * E->rig_con[r]] && y[P->ip[r]] == 0.0) return 1;
   return oe_root_stays_zero(E, y, found);
@@ -263,14 +264,14 @@ static void release(ida_problem *P) {
   free(P->cb);
   free(P->ip);
   free(P->im);
-  oe_release(&P->E);
+  oe_release(P->E);
 }
 
 /* Half-bandwidth of the Jacobian in the interleaved layout: the node couplings are probed
  * (which accelerations change when one node's u or v does, at the initial state) and
  * completed with the contacts of the topology (penalty contacts are open at t = 0). */
 static int bandwidth(ida_problem *P, const double *u0, const double *v0, sunindextype *bw) {
-  ode_events *E = &P->E;
+  ode_events *E = P->E;
   int n = E->n, st, dnode = 0;
   double *base = E->a, *pert = E->fint, *up = E->uq, *vp = E->vq;
   if ((st = martello_eval_acceleration(E->ev, 0.0, u0, v0, base)) != MARTELLO_OK) return st;
@@ -314,7 +315,7 @@ static int bandwidth(ida_problem *P, const double *u0, const double *v0, suninde
 }
 
 static int setup(ida_problem *P, martello_model *model, martello_run *run) {
-  ode_events *E = &P->E;
+  ode_events *E = P->E;
   double failed = 0.0;
   P->run = run;
   E->dky = interpolant;
@@ -373,7 +374,7 @@ static int setup(ida_problem *P, martello_model *model, martello_run *run) {
  * depend on the output). */
 #define SAFETY 0.1   /* IDA's first-order error estimate is crude: a margin below it */
 static int initial_step(ida_problem *P, double t, const double *u, const double *v, double *h0) {
-  ode_events *E = &P->E;
+  ode_events *E = P->E;
   const int n = E->n;
   const double cap = 1e-3 * E->t_end, d = 1e-6 * cap;
   int st = martello_eval_acceleration(E->ev, t, u, v, E->a);
@@ -401,7 +402,7 @@ static int check(ida_problem *P, int flag, const char *call) {
 
 static int integrate(ida_problem *P, SUNContext sunctx, N_Vector yy, N_Vector yp, N_Vector id,
                      SUNMatrix *Jp, SUNLinearSolver *LSp) {
-  ode_events *E = &P->E;
+  ode_events *E = P->E;
   int st, n = E->n;
   double *u0 = E->u, *v0 = E->v;
   if ((st = martello_model_initial_state(E->model, u0, v0)) != MARTELLO_OK)
@@ -426,7 +427,7 @@ static int integrate(ida_problem *P, SUNContext sunctx, N_Vector yy, N_Vector yp
   if ((st = martello_observer_begin(E->obs, E->ev, u0, v0, "tighten rtol and atol")) != MARTELLO_OK)
     /* out of memory: the observer failed the run with its line */
     return st == MARTELLO_ERR_MEMORY ? st : fail(P, st, "IDA: martello_observer_begin failed");
-  if ((st = prepare_restart(P, 0.0, u0, v0, yy, yp)) != MARTELLO_OK) return st;
+  if ((st = prepare_restart(P, 0.0, u0, v0, N_VGetArrayPointer(yy), N_VGetArrayPointer(yp))) != MARTELLO_OK) return st;
 
   /* IDA: create, init, options (SUNDIALS lifecycle) */
   void *mem = IDACreate(sunctx);
@@ -558,7 +559,7 @@ static int integrate(ida_problem *P, SUNContext sunctx, N_Vector yy, N_Vector yp
     if (restart) {
       if ((st = oe_restart_progress(E, t_r)) != MARTELLO_OK) break;
       if ((st = flush_counts(P, mem)) != MARTELLO_OK) break;
-      if ((st = prepare_restart(P, t_r, E->u, E->v, yy, yp)) != MARTELLO_OK) break;
+      if ((st = prepare_restart(P, t_r, E->u, E->v, N_VGetArrayPointer(yy), N_VGetArrayPointer(yp))) != MARTELLO_OK) break;
     } else {
       if ((st = oe_commit(E, E->u, E->v)) != MARTELLO_OK) {
         st = fail(P, st, "IDA: commit failed");
@@ -603,10 +604,13 @@ static int integrate(ida_problem *P, SUNContext sunctx, N_Vector yy, N_Vector yp
 }
 
 int martello_ida_run(martello_model *model, martello_run *run) {
+  martello_settings s;
+  if (model && run && martello_run_settings(run, &s) == MARTELLO_OK && s.local_stepping)
+    return martello_ode_local_run(model, run);
   ida_problem prob;
   ida_problem *P = &prob;
-  ode_events *E = &P->E;
   memset(P, 0, sizeof *P);
+  ode_events *E = P->E = &P->own;
   if (!model || !run) return MARTELLO_ERR_ARGUMENT;
   int st = martello_run_observer(run, &E->obs);
   if (st != MARTELLO_OK) return st;
@@ -644,3 +648,150 @@ int martello_ida_run(martello_model *model, martello_run *run) {
   release(P);
   return st;
 }
+
+/* ---- the pieces c/local_stepping.c drives per cluster (c/sundials_ode.h) ----------------------
+ * IDA on a cluster's sub-model, its events those of the cluster's ode_problem (P->E): the same
+ * residual, Jacobian, roots, first step and restarts as the global run above (docs/ida.md). The
+ * local stepping has no rigid contacts, so y = [u_i, v_i] node by node as in CVODE's layout. */
+
+typedef struct {
+  ida_problem I;
+  void *ctx;
+  N_Vector yp, id;
+  double *yp0;    /* y' made consistent by a restart before IDA has its vectors (create) */
+} ida_seam;
+
+static ida_seam *seam(ode_problem *P) { return P->ida; }
+
+int ida_seam_setup(ode_problem *P, martello_model *model, martello_run *run) {
+  ida_seam *S = calloc(1, sizeof *S);
+  if (!S) return oe_fail_memory(&P->E, "the IDA problem of a cluster", (double)sizeof *S);
+  P->ida = S;
+  S->I.E = &P->E;
+  P->name = "IDA";
+  P->E.name = P->name;
+  int st = setup(&S->I, model, run);
+  if (st != MARTELLO_OK) return st;
+  P->N = S->I.N;
+  P->kd = S->I.kd;
+  S->yp0 = calloc((size_t)P->N, sizeof(double));
+  return S->yp0 ? MARTELLO_OK : oe_fail_memory(&P->E, "the IDA state of a cluster", (double)P->N * sizeof(double));
+}
+
+void ida_seam_release(ode_problem *P) {
+  ida_seam *S = seam(P);
+  if (!S) return;
+  if (S->I.mem) IDAFree(&S->I.mem);
+  if (S->yp) N_VDestroy(S->yp);
+  if (S->id) N_VDestroy(S->id);
+  if (S->I.yprow) N_VDestroy(S->I.yprow);
+  free(S->I.kb);
+  free(S->I.cb);
+  free(S->I.ip);
+  free(S->I.im);
+  free(S->yp0);
+  free(S);
+  P->ida = NULL;
+}
+
+/* The state y at a restart at t made consistent, y' with it (prepare_restart). */
+int ida_seam_prepare_restart(ode_problem *P, double t, double *y) {
+  ida_seam *S = seam(P);
+  ode_events *E = &P->E;
+  oe_gather(E, y, E->u, E->v);
+  double *d = S->yp ? N_VGetArrayPointer(S->yp) : S->yp0;
+  return prepare_restart(&S->I, t, E->u, E->v, y, d);
+}
+
+static int seam_first_step(ida_seam *S, double t, N_Vector y) {
+  ode_events *E = S->I.E;
+  double h0;
+  oe_gather(E, N_VGetArrayPointer(y), E->u, E->v);
+  int st = initial_step(&S->I, t, E->u, E->v, &h0);
+  return st != MARTELLO_OK ? st : check(&S->I, IDASetInitStep(S->I.mem, h0), "IDASetInitStep");
+}
+
+/* IDA at (0, y, y') with the global run's options (integrate above). */
+int ida_seam_create(ode_problem *P, SUNContext ctx, N_Vector y, SUNMatrix *Jp, SUNLinearSolver *LSp) {
+  ida_seam *S = seam(P);
+  ida_problem *I = &S->I;
+  ode_events *E = &P->E;
+  int st;
+  S->yp = N_VNew_Serial(I->N, ctx);
+  S->id = N_VNew_Serial(I->N, ctx);
+  I->yprow = N_VNew_Serial(I->N, ctx);
+  if (!S->yp || !S->id || !I->yprow) return oe_fail_memory(E, "the IDA state vectors of a cluster", -1.0);
+  memcpy(N_VGetArrayPointer(S->yp), S->yp0, sizeof(double) * (size_t)I->N);
+  oe_gather(E, N_VGetArrayPointer(y), E->u, E->v);
+  sunindextype bw = I->N;
+  if (E->ncoupling == 0 && I->N > 8 && (st = bandwidth(I, E->u, E->v, &bw)) != MARTELLO_OK)
+    return fail(I, st, "IDA: force evaluation failed while probing the bandwidth");
+  if (I->analytic && bw < 2 * (sunindextype)I->kd + 1) bw = 2 * (sunindextype)I->kd + 1;
+  const int banded = 2 * bw + 1 < I->N / 2;
+  void *mem = IDACreate(ctx);
+  if (!mem) return oe_fail_memory(E, "the IDA solver memory (IDACreate)", -1.0);
+  I->mem = mem;
+  if ((st = check(I, IDASetErrHandlerFn(mem, error_handler, I), "IDASetErrHandlerFn"))) return st;
+  if ((st = check(I, IDAInit(mem, residual, 0.0, y, S->yp), "IDAInit"))) return st;
+  N_VConst(E->atol, S->id);
+  if ((st = check(I, IDASVtolerances(mem, E->rtol, S->id), "IDASVtolerances"))) return st;
+  if ((st = check(I, IDASetUserData(mem, I), "IDASetUserData"))) return st;
+  *Jp = banded ? SUNBandMatrix(I->N, bw, bw, ctx) : SUNDenseMatrix(I->N, I->N, ctx);
+  if (!*Jp) return oe_fail_memory(E, "the IDA Jacobian matrix", -1.0);
+  *LSp = banded ? SUNLinSol_Band(y, *Jp, ctx) : SUNLinSol_Dense(y, *Jp, ctx);
+  if (!*LSp) return oe_fail_memory(E, "the IDA linear solver", -1.0);
+  if ((st = check(I, IDASetLinearSolver(mem, *LSp, *Jp), "IDASetLinearSolver"))) return st;
+  if (I->analytic && (st = check(I, IDASetJacFn(mem, jacobian), "IDASetJacFn"))) return st;
+  if ((st = check(I, IDASetMaxStep(mem, oe_max_step(E)), "IDASetMaxStep"))) return st;
+  if ((st = seam_first_step(S, 0.0, y)) != MARTELLO_OK) return st;
+  N_VConst(1.0, S->id);
+  if ((st = check(I, IDASetId(mem, S->id), "IDASetId"))) return st;
+  if (oe_nroots(E) > 0) {
+    if ((st = check(I, IDARootInit(mem, oe_nroots(E), roots), "IDARootInit"))) return st;
+    if ((st = check(I, IDASetNoInactiveRootWarn(mem), "IDASetNoInactiveRootWarn"))) return st;
+  }
+  return MARTELLO_OK;
+}
+
+/* A restart at (t, y) with the y' of ida_seam_prepare_restart, its first step as the global
+ * run's (initial_step). */
+int ida_seam_restart(ode_problem *P, double t, N_Vector y) {
+  ida_seam *S = seam(P);
+  int st;
+  if ((st = seam_first_step(S, t, y)) != MARTELLO_OK) return st;
+  if ((st = check(&S->I, IDAReInit(S->I.mem, t, y, S->yp), "IDAReInit"))) return st;
+  memset(P->E.cnt_last, 0, sizeof P->E.cnt_last);   /* IDAReInit starts the counters again */
+  return check(&S->I, IDASetMaxStep(S->I.mem, oe_max_step(&P->E)), "IDASetMaxStep");
+}
+
+int ida_seam_flush_counts(ode_problem *P) { return flush_counts(&seam(P)->I, seam(P)->I.mem); }
+int ida_seam_check(ode_problem *P, int flag, const char *call) { return check(&seam(P)->I, flag, call); }
+int ida_seam_root_stays_zero(ode_problem *P, const double *y, const int *found) {
+  return root_stays_zero(&seam(P)->I, y, found);
+}
+int ida_seam_interpolant(ode_problem *P, double t, int k, N_Vector out) {
+  return interpolant(&seam(P)->I, t, k, out);
+}
+double ida_seam_last_step(ode_problem *P) {
+  double h = 0.0;
+  if (IDAGetLastStep(seam(P)->I.mem, &h) != IDA_SUCCESS) h = 0.0;
+  return h;
+}
+int ida_seam_step(ode_problem *P, double tout, N_Vector y, double *tret) {
+  int flag = IDASolve(seam(P)->I.mem, tout, tret, y, seam(P)->yp, IDA_ONE_STEP);
+  if (flag < 0) return flag;
+  if (flag == IDA_ROOT_RETURN) return ODE_STEP_ROOT;
+  return flag == IDA_TSTOP_RETURN ? ODE_STEP_TSTOP : ODE_STEP_DONE;
+}
+int ida_seam_root_info(ode_problem *P, int *found) {
+  return check(&seam(P)->I, IDAGetRootInfo(seam(P)->I.mem, found), "IDAGetRootInfo");
+}
+int ida_seam_stop(ode_problem *P, double t) {
+  return check(&seam(P)->I, IDASetStopTime(seam(P)->I.mem, t), "IDASetStopTime");
+}
+double ida_seam_current_time(ode_problem *P, double t_last) {
+  double t = t_last;
+  if (IDAGetCurrentTime(seam(P)->I.mem, &t) != IDA_SUCCESS) t = t_last;
+  return t;
+}
+const char *ida_seam_flag(ode_problem *P, int flag) { (void)P; return IDAGetReturnFlagName(flag); }

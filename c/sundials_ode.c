@@ -800,43 +800,62 @@ int martello_ode_run(martello_model *model, martello_run *run) {
 /* ---- the pieces c/local_stepping.c drives per cluster (c/sundials_ode.h) ---------------------- */
 
 int ode_problem_setup(ode_problem *P, martello_model *model, martello_run *run) {
+  martello_settings s;
   int st = martello_run_observer(run, &P->E.obs);
-  return st != MARTELLO_OK ? st : setup(P, model, run);
+  if (st == MARTELLO_OK) st = martello_run_settings(run, &s);
+  if (st != MARTELLO_OK) return st;
+  return s.kind == MARTELLO_INT_IDA ? ida_seam_setup(P, model, run) : setup(P, model, run);
 }
 void ode_problem_release(ode_problem *P) {
+  ida_seam_release(P);
   if (P->mem) {
     if (P->ark) ARKStepFree(&P->mem); else CVodeFree(&P->mem);
   }
   release(P);
 }
 int ode_problem_create(ode_problem *P, SUNContext ctx, N_Vector y, SUNMatrix *J, SUNLinearSolver *LS) {
-  return create(P, ctx, y, J, LS);
+  return P->ida ? ida_seam_create(P, ctx, y, J, LS) : create(P, ctx, y, J, LS);
 }
-int ode_problem_restart(ode_problem *P, double t, N_Vector y) { return restart(P, t, y); }
-int ode_problem_prepare_restart(ode_problem *P, double t, double *y) { return prepare_restart(P, t, y); }
-int ode_problem_flush_counts(ode_problem *P) { return flush_counts(P); }
+int ode_problem_restart(ode_problem *P, double t, N_Vector y) {
+  return P->ida ? ida_seam_restart(P, t, y) : restart(P, t, y);
+}
+int ode_problem_prepare_restart(ode_problem *P, double t, double *y) {
+  return P->ida ? ida_seam_prepare_restart(P, t, y) : prepare_restart(P, t, y);
+}
+int ode_problem_flush_counts(ode_problem *P) {
+  return P->ida ? ida_seam_flush_counts(P) : flush_counts(P);
+}
 int ode_problem_observe(ode_problem *P, double t, const double *y, int k, int row) {
   return observe(P, t, y, k, row);
 }
-int ode_problem_check(ode_problem *P, int flag, const char *call) { return check(P, flag, call); }
-int ode_problem_root_stays_zero(ode_problem *P, const double *y, const int *found) {
-  return root_stays_zero(P, y, found);
+int ode_problem_check(ode_problem *P, int flag, const char *call) {
+  return P->ida ? ida_seam_check(P, flag, call) : check(P, flag, call);
 }
-int ode_problem_interpolant(ode_problem *P, double t, int k, N_Vector out) { return interpolant(P, t, k, out); }
-double ode_problem_last_step(ode_problem *P) { return be_last_step(P); }
+int ode_problem_root_stays_zero(ode_problem *P, const double *y, const int *found) {
+  return P->ida ? ida_seam_root_stays_zero(P, y, found) : root_stays_zero(P, y, found);
+}
+int ode_problem_interpolant(ode_problem *P, double t, int k, N_Vector out) {
+  return P->ida ? ida_seam_interpolant(P, t, k, out) : interpolant(P, t, k, out);
+}
+double ode_problem_last_step(ode_problem *P) { return P->ida ? ida_seam_last_step(P) : be_last_step(P); }
 int ode_problem_step(ode_problem *P, double tout, N_Vector y, double *tret) {
+  if (P->ida) return ida_seam_step(P, tout, y, tret);
   int flag = P->ark ? ARKStepEvolve(P->mem, tout, y, tret, ARK_ONE_STEP) : CVode(P->mem, tout, y, tret, CV_ONE_STEP);
   if (flag < 0) return flag;
   if (flag == (P->ark ? ARK_ROOT_RETURN : CV_ROOT_RETURN)) return ODE_STEP_ROOT;
   return flag == (P->ark ? ARK_TSTOP_RETURN : CV_TSTOP_RETURN) ? ODE_STEP_TSTOP : ODE_STEP_DONE;
 }
 int ode_problem_root_info(ode_problem *P, int *found) {
+  if (P->ida) return ida_seam_root_info(P, found);
   return check(P, P->ark ? ARKStepGetRootInfo(P->mem, found) : CVodeGetRootInfo(P->mem, found), "GetRootInfo");
 }
-int ode_problem_stop(ode_problem *P, double t) { return check(P, be_stop(P, t), "SetStopTime"); }
+int ode_problem_stop(ode_problem *P, double t) {
+  return P->ida ? ida_seam_stop(P, t) : check(P, be_stop(P, t), "SetStopTime");
+}
 double ode_problem_current_time(ode_problem *P, double t_last) {
+  if (P->ida) return ida_seam_current_time(P, t_last);
   double t = t_last;
   if ((P->ark ? ARKStepGetCurrentTime(P->mem, &t) : CVodeGetCurrentTime(P->mem, &t)) < 0) t = t_last;
   return t;
 }
-const char *ode_problem_flag(ode_problem *P, int flag) { return be_flag(P, flag); }
+const char *ode_problem_flag(ode_problem *P, int flag) { return P->ida ? ida_seam_flag(P, flag) : be_flag(P, flag); }

@@ -14,6 +14,7 @@
 typedef struct {
   ode_events E;            /* contacts, events, the observer's hand-overs (c/ode_events.c) */
   int ark;                 /* 0: CVODE, 1: ARKODE */
+  void *ida;               /* IDA on this problem's events when the integrator is IDA (c/ida.c) */
   int kind;                /* KIND_* */
   int erk_id, dirk_id;     /* ARKODE tables (ARKODE_*_NONE when absent) */
   const char *name;        /* "CVODE" or "ARKODE": what the messages say */
@@ -67,5 +68,22 @@ int ode_problem_root_info(ode_problem *P, int *found);
 int ode_problem_stop(ode_problem *P, double t);
 double ode_problem_current_time(ode_problem *P, double t_last);
 const char *ode_problem_flag(ode_problem *P, int flag);
+
+/* The same pieces on IDA (c/ida.c; docs/ida.md): the wrappers above choose them when P->ida. */
+int ida_seam_setup(ode_problem *P, martello_model *model, martello_run *run);
+void ida_seam_release(ode_problem *P);
+int ida_seam_create(ode_problem *P, SUNContext ctx, N_Vector y, SUNMatrix *J, SUNLinearSolver *LS);
+int ida_seam_restart(ode_problem *P, double t, N_Vector y);
+int ida_seam_prepare_restart(ode_problem *P, double t, double *y);
+int ida_seam_flush_counts(ode_problem *P);
+int ida_seam_check(ode_problem *P, int flag, const char *call);
+int ida_seam_root_stays_zero(ode_problem *P, const double *y, const int *found);
+int ida_seam_interpolant(ode_problem *P, double t, int k, N_Vector out);
+double ida_seam_last_step(ode_problem *P);
+int ida_seam_step(ode_problem *P, double tout, N_Vector y, double *tret);
+int ida_seam_root_info(ode_problem *P, int *found);
+int ida_seam_stop(ode_problem *P, double t);
+double ida_seam_current_time(ode_problem *P, double t_last);
+const char *ida_seam_flag(ode_problem *P, int flag);
 #pragma GCC visibility pop
 #endif

@@ -377,7 +377,7 @@ module martello_registry
       integrator_t('msbdf', INT_MSBDF, FAMILY_EVENT_DRIVEN, .true., READS_BASE + READS_ADAPTIVE, &
                    RUNS_PENALTY + RUNS_RIGID, 'multistep BDF (stiff), GSL'), &
       integrator_t('ida', INT_IDA, FAMILY_DAE, .true., &
-                   READS_BASE + READS_DIVERGENCE + READS_ADAPTIVE, RUNS_PENALTY + RUNS_RIGID, &
+                   READS_BASE + READS_DIVERGENCE + READS_ADAPTIVE + 2**S_LOCAL_STEPPING, RUNS_PENALTY + RUNS_RIGID, &
                    'SUNDIALS IDA, variable-order BDF on the contact DAE'), &
       integrator_t('fast-nonlinear', INT_FAST_NONLINEAR, FAMILY_MODAL, .false., &
                    READS_BASE + READS_DIVERGENCE + 2**S_TOL_RESIDUAL + 2**S_MAX_NEWTON + 2**S_MODAL_VECTORS, &

@@ -1,5 +1,5 @@
 """Local stepping against the global run over the catalogue (docs/sundials-ode.md, "Local
-stepping"): every dynamic catalogue scene on cvode or arkode, run as written (the global run:
+stepping"): every dynamic catalogue scene on cvode, arkode or ida, run as written (the global run:
 one integrator instance on the whole scene) and again with analysis.local_stepping = true (one
 instance per cluster). Two kinds of evidence, said apart:
 
@@ -50,7 +50,7 @@ from martello.scene.loader import load  # noqa: E402
 
 
 # the integrators that take analysis.local_stepping
-LOCAL = ("cvode", "arkode")
+LOCAL = ("cvode", "arkode", "ida")
 
 
 def runs_locally(path):

@@ -14,8 +14,8 @@ Scenes (one process per run, so that its CPU time is its own):
   row      fast-nonlinear only: benchmarks/perf/fna_ritz.py's row (4 contacts among n
            oscillators, weak neighbour springs, a 2 Hz ground sine; dt 1 ms), where a few Ritz
            vectors are accurate (that script measures their error against all modes).
-Integrators: ida, cvode, arkode (their default methods: BDF, Dormand–Prince 5(4)), cvode-local and
-arkode-local (with analysis.local_stepping = true: cluster by cluster), msbdf, rk8pd,
+Integrators: ida, cvode, arkode (their default methods: BDF, Dormand–Prince 5(4)), cvode-local,
+arkode-local and ida-local (with analysis.local_stepping = true: cluster by cluster), msbdf, rk8pd,
 rkf45, newmark-general (fused_chain = false), newmark-fused, moreau-jean, fast-nonlinear (all
 modes) and fast-nonlinear:M (M load-dependent Ritz vectors, analysis.modal_vectors = M).
 Each run is cut at max_wall (default 60 s): the cost per simulated second is then its CPU
@@ -56,7 +56,7 @@ import measured_docs  # noqa: E402
 
 NAME = "integrators_at_size"  # its record docs/perf/integrators_at_size.json, its fence in docs/performance.md
 
-ADAPTIVE = {"ida", "cvode", "arkode", "rk8pd", "rkf45", "msbdf", "cvode-local", "arkode-local"}
+ADAPTIVE = {"ida", "cvode", "arkode", "rk8pd", "rkf45", "msbdf", "cvode-local", "arkode-local", "ida-local"}
 
 
 def row(n, m, t_end, record_all=True):
@@ -115,7 +115,7 @@ def scene(n, integrator, kind, t_end, max_wall, active=None, spread=0.1):
     integrator, _, m = integrator.partition(":")
     if m:
         an["modal_vectors"] = int(m)
-    if integrator in ("cvode-local", "arkode-local"):
+    if integrator in ("cvode-local", "arkode-local", "ida-local"):
         # cluster by cluster (docs/sundials-ode.md, local stepping)
         an.update(integrator=integrator.split("-")[0], dt=t_end, rtol=1e-8, atol=1e-12, local_stepping=True)
     elif integrator in ADAPTIVE:
@@ -190,7 +190,7 @@ def fit(ns, ys):
 
 
 LABEL = {"ida": "IDA (BDF)", "cvode": "CVODE BDF", "cvode-local": "CVODE BDF, local stepping",
-         "arkode-local": "ARKODE Dormand–Prince 5(4), local stepping", "arkode": "ARKODE Dormand–Prince 5(4)",
+         "arkode-local": "ARKODE Dormand–Prince 5(4), local stepping", "ida-local": "IDA (BDF), local stepping", "arkode": "ARKODE Dormand–Prince 5(4)",
          "newmark-general": "Newmark general path", "newmark-fused": "Newmark fused chain step",
          "moreau-jean": "Moreau–Jean", "fast-nonlinear": "fast nonlinear, all modes",
          "msbdf": "GSL msbdf", "rk8pd": "GSL rk8pd", "rkf45": "GSL rkf45"}
@@ -223,7 +223,7 @@ def merged(rows):
     out = {}
     for r in rows:
         out[r["scene"], r["integrator"], r["n"], window(r)] = r
-    scenes, integs = ["closing", "closed", "row"], ["ida", "cvode", "cvode-local", "arkode", "arkode-local", "newmark-general",
+    scenes, integs = ["closing", "closed", "row"], ["ida", "ida-local", "cvode", "cvode-local", "arkode", "arkode-local", "newmark-general",
                                                     "newmark-fused", "moreau-jean", "fast-nonlinear"]
 
     def key(r):
