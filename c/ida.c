@@ -400,16 +400,10 @@ static int check(ida_problem *P, int flag, const char *call) {
   return fail(P, MARTELLO_ERR_EXTERNAL, "%s failed: %s", call, IDAGetReturnFlagName(flag));
 }
 
-static int integrate(ida_problem *P, SUNContext sunctx, N_Vector yy, N_Vector yp, N_Vector id,
-                     SUNMatrix *Jp, SUNLinearSolver *LSp) {
+/* The Jacobian's half-bandwidth bw at the state (u, v) and whether a band solver pays. */
+static int band(ida_problem *P, const double *u0, const double *v0, sunindextype *bwp, int *banded) {
   ode_events *E = P->E;
-  int st, n = E->n;
-  double *u0 = E->u, *v0 = E->v;
-  if ((st = martello_model_initial_state(E->model, u0, v0)) != MARTELLO_OK)
-    return fail(P, st, "IDA: could not read the initial state");
-  for (int i = 0; i < n; i++)
-    if (E->fixed[i]) v0[i] = 0.0;
-
+  int st;
   /* linear solver: band in the interleaved layout when it pays (chains), dense otherwise or
    * with consistent-mass couplings (M^-1 is full) */
   sunindextype bw = P->N;
@@ -418,17 +412,17 @@ static int integrate(ida_problem *P, SUNContext sunctx, N_Vector yy, N_Vector yp
   /* the analytic Jacobian's couplings: u_k and v_k of |i - k| <= kd in v_i's row (2 kd + 1
    * places away in the interleaved layout) */
   if (P->analytic && bw < 2 * (sunindextype)P->kd + 1) bw = 2 * (sunindextype)P->kd + 1;
-  int banded = 2 * bw + 1 < P->N / 2;
+  *bwp = bw;
+  *banded = 2 * bw + 1 < P->N / 2;
+  return MARTELLO_OK;
+}
 
-  /* initial contact states: penalty contacts already penetrated are in a phase from t = 0
-   * (the observer opens it); rigid contacts at zero gap that approach or rest are resolved as
-   * impacts at t = 0 */
-  if ((st = oe_initial_contacts(E, u0, v0)) != MARTELLO_OK) return st;
-  if ((st = martello_observer_begin(E->obs, E->ev, u0, v0, "tighten rtol and atol")) != MARTELLO_OK)
-    /* out of memory: the observer failed the run with its line */
-    return st == MARTELLO_ERR_MEMORY ? st : fail(P, st, "IDA: martello_observer_begin failed");
-  if ((st = prepare_restart(P, 0.0, u0, v0, N_VGetArrayPointer(yy), N_VGetArrayPointer(yp))) != MARTELLO_OK) return st;
-
+/* IDA at (0, yy, yp) with its tolerances, linear solver (band of half-width bw or dense), first
+ * step from (u0, v0), algebraic rows and roots. */
+static int create(ida_problem *P, SUNContext sunctx, N_Vector yy, N_Vector yp, N_Vector id, sunindextype bw,
+                  int banded, const double *u0, const double *v0, SUNMatrix *Jp, SUNLinearSolver *LSp) {
+  ode_events *E = P->E;
+  int st;
   /* IDA: create, init, options (SUNDIALS lifecycle) */
   void *mem = IDACreate(sunctx);
   if (!mem) return oe_fail_memory(E, "the IDA solver memory (IDACreate)", -1.0);
@@ -464,6 +458,35 @@ static int integrate(ida_problem *P, SUNContext sunctx, N_Vector yy, N_Vector yp
     if ((st = check(P, IDARootInit(mem, oe_nroots(E), roots), "IDARootInit"))) return st;
     if ((st = check(P, IDASetNoInactiveRootWarn(mem), "IDASetNoInactiveRootWarn"))) return st;
   }
+  return MARTELLO_OK;
+}
+
+static int integrate(ida_problem *P, SUNContext sunctx, N_Vector yy, N_Vector yp, N_Vector id,
+                     SUNMatrix *Jp, SUNLinearSolver *LSp) {
+  ode_events *E = P->E;
+  int st, n = E->n;
+  double *u0 = E->u, *v0 = E->v;
+  if ((st = martello_model_initial_state(E->model, u0, v0)) != MARTELLO_OK)
+    return fail(P, st, "IDA: could not read the initial state");
+  for (int i = 0; i < n; i++)
+    if (E->fixed[i]) v0[i] = 0.0;
+
+  /* linear solver: band in the interleaved layout when it pays (chains), dense otherwise */
+  sunindextype bw;
+  int banded;
+  if ((st = band(P, u0, v0, &bw, &banded)) != MARTELLO_OK) return st;
+
+  /* initial contact states: penalty contacts already penetrated are in a phase from t = 0
+   * (the observer opens it); rigid contacts at zero gap that approach or rest are resolved as
+   * impacts at t = 0 */
+  if ((st = oe_initial_contacts(E, u0, v0)) != MARTELLO_OK) return st;
+  if ((st = martello_observer_begin(E->obs, E->ev, u0, v0, "tighten rtol and atol")) != MARTELLO_OK)
+    /* out of memory: the observer failed the run with its line */
+    return st == MARTELLO_ERR_MEMORY ? st : fail(P, st, "IDA: martello_observer_begin failed");
+  if ((st = prepare_restart(P, 0.0, u0, v0, N_VGetArrayPointer(yy), N_VGetArrayPointer(yp))) != MARTELLO_OK) return st;
+
+  if ((st = create(P, sunctx, yy, yp, id, bw, banded, u0, v0, Jp, LSp)) != MARTELLO_OK) return st;
+  void *mem = P->mem;
 
   int k_out = 1;
   double t_out = oe_output_time(E, k_out), t_last = 0.0;
@@ -716,41 +739,16 @@ int ida_seam_create(ode_problem *P, SUNContext ctx, N_Vector y, SUNMatrix *Jp, S
   ida_seam *S = seam(P);
   ida_problem *I = &S->I;
   ode_events *E = &P->E;
-  int st;
+  int st, banded;
+  sunindextype bw;
   S->yp = N_VNew_Serial(I->N, ctx);
   S->id = N_VNew_Serial(I->N, ctx);
   I->yprow = N_VNew_Serial(I->N, ctx);
   if (!S->yp || !S->id || !I->yprow) return oe_fail_memory(E, "the IDA state vectors of a cluster", -1.0);
   memcpy(N_VGetArrayPointer(S->yp), S->yp0, sizeof(double) * (size_t)I->N);
   oe_gather(E, N_VGetArrayPointer(y), E->u, E->v);
-  sunindextype bw = I->N;
-  if (E->ncoupling == 0 && I->N > 8 && (st = bandwidth(I, E->u, E->v, &bw)) != MARTELLO_OK)
-    return fail(I, st, "IDA: force evaluation failed while probing the bandwidth");
-  if (I->analytic && bw < 2 * (sunindextype)I->kd + 1) bw = 2 * (sunindextype)I->kd + 1;
-  const int banded = 2 * bw + 1 < I->N / 2;
-  void *mem = IDACreate(ctx);
-  if (!mem) return oe_fail_memory(E, "the IDA solver memory (IDACreate)", -1.0);
-  I->mem = mem;
-  if ((st = check(I, IDASetErrHandlerFn(mem, error_handler, I), "IDASetErrHandlerFn"))) return st;
-  if ((st = check(I, IDAInit(mem, residual, 0.0, y, S->yp), "IDAInit"))) return st;
-  N_VConst(E->atol, S->id);
-  if ((st = check(I, IDASVtolerances(mem, E->rtol, S->id), "IDASVtolerances"))) return st;
-  if ((st = check(I, IDASetUserData(mem, I), "IDASetUserData"))) return st;
-  *Jp = banded ? SUNBandMatrix(I->N, bw, bw, ctx) : SUNDenseMatrix(I->N, I->N, ctx);
-  if (!*Jp) return oe_fail_memory(E, "the IDA Jacobian matrix", -1.0);
-  *LSp = banded ? SUNLinSol_Band(y, *Jp, ctx) : SUNLinSol_Dense(y, *Jp, ctx);
-  if (!*LSp) return oe_fail_memory(E, "the IDA linear solver", -1.0);
-  if ((st = check(I, IDASetLinearSolver(mem, *LSp, *Jp), "IDASetLinearSolver"))) return st;
-  if (I->analytic && (st = check(I, IDASetJacFn(mem, jacobian), "IDASetJacFn"))) return st;
-  if ((st = check(I, IDASetMaxStep(mem, oe_max_step(E)), "IDASetMaxStep"))) return st;
-  if ((st = seam_first_step(S, 0.0, y)) != MARTELLO_OK) return st;
-  N_VConst(1.0, S->id);
-  if ((st = check(I, IDASetId(mem, S->id), "IDASetId"))) return st;
-  if (oe_nroots(E) > 0) {
-    if ((st = check(I, IDARootInit(mem, oe_nroots(E), roots), "IDARootInit"))) return st;
-    if ((st = check(I, IDASetNoInactiveRootWarn(mem), "IDASetNoInactiveRootWarn"))) return st;
-  }
-  return MARTELLO_OK;
+  if ((st = band(I, E->u, E->v, &bw, &banded)) != MARTELLO_OK) return st;
+  return create(I, ctx, y, S->yp, S->id, bw, banded, E->u, E->v, Jp, LSp);
 }
 
 /* A restart at (t, y) with the y' of ida_seam_prepare_restart, its first step as the global
